@@ -1,0 +1,35 @@
+//! Our own metadata sections in 6502 ELF files, beside llvm-mos's numbering.
+//!
+//! ELF has no place for three things our tools pass along, so they travel in
+//! non-allocated `SHT_PROGBITS` sections that other tools ignore:
+//!
+//! | section | written by | read by | holds |
+//! |---|---|---|---|
+//! | [`SRCMAP_SECTION`] | assembler | linker | where each instruction, data item and symbol came from (file:line:col) |
+//! | [`ASSERT_SECTION`] | assembler | linker | `.assert`s that depend on addresses, as expression bytecode |
+//! | [`HOOKS_SECTION`] | linker | uploader, `scorpion sim` | which ROM hooks an image takes over, and where its fallthrough lives |
+//!
+//! Every section starts with a four-byte magic and a version byte; all
+//! integers are little-endian. Decoders return [`FormatError`] for any
+//! malformed input and never panic: the linker reads other producers'
+//! objects too.
+
+mod assert;
+mod codec;
+mod hooks;
+mod srcmap;
+
+pub use assert::{AssertAction, Assertion, BinaryOp, EvalError, Expr, ExprOp, UnaryOp};
+pub use codec::FormatError;
+pub use hooks::{
+    CHAIN_LOOP_SYMBOL, CHAIN_UNKNOWN_SYMBOL, HOOK_LOOP_SYMBOL, HOOK_UNKNOWN_SYMBOL, HookKind,
+    HookRecord, Hooks,
+};
+pub use srcmap::{SourceLoc, SrcMap, SrcMapEntry, SymbolLoc};
+
+/// Source locations of section bytes and symbols (assembler to linker).
+pub const SRCMAP_SECTION: &str = ".scorpion.srcmap";
+/// Deferred assertions (assembler to linker).
+pub const ASSERT_SECTION: &str = ".scorpion.assert";
+/// Hook records of a linked image (linker to uploader and simulator).
+pub const HOOKS_SECTION: &str = ".scorpion.hooks";

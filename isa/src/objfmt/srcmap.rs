@@ -1,0 +1,248 @@
+//! `.scorpion.srcmap`: where each piece of a section came from.
+//!
+//! Layout (version 1): magic `SCSM`, version, then
+//! - files: count, then each path as a length-prefixed UTF-8 string;
+//! - entries: count, then `section: u32, offset: u32, file: u32, line: u32,
+//!   column: u32`, sorted by (section, offset). An entry covers the bytes from
+//!   its offset up to the next entry's offset in the same section;
+//! - symbols: count, then `symbol: u32, file: u32, line: u32, column: u32`
+//!   (symbol = index in `.symtab`).
+//!
+//! `section` is an ELF section header index. Lines and columns count from 1.
+
+use super::SRCMAP_SECTION;
+use super::codec::{FormatError, Reader, Writer};
+
+const MAGIC: &[u8; 4] = b"SCSM";
+const VERSION: u8 = 1;
+
+/// A place in a source file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SourceLoc {
+    /// Index into [`SrcMap::files`].
+    pub file: u32,
+    /// Line, from 1.
+    pub line: u32,
+    /// Column (in characters), from 1.
+    pub column: u32,
+}
+
+/// The source of the bytes of a section from `offset` on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SrcMapEntry {
+    /// ELF section header index.
+    pub section: u32,
+    /// Byte offset in the section.
+    pub offset: u32,
+    /// Where those bytes were written.
+    pub loc: SourceLoc,
+}
+
+/// Where a symbol was defined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SymbolLoc {
+    /// Index in `.symtab`.
+    pub symbol: u32,
+    /// Where it was defined.
+    pub loc: SourceLoc,
+}
+
+/// The decoded `.scorpion.srcmap` section.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SrcMap {
+    /// Source file paths, as given to the assembler.
+    pub files: Vec<String>,
+    /// Byte ranges of sections, sorted by (section, offset).
+    pub entries: Vec<SrcMapEntry>,
+    /// Symbol definitions.
+    pub symbols: Vec<SymbolLoc>,
+}
+
+impl SrcMap {
+    /// Serialises the map (entries are sorted first).
+    #[must_use]
+    pub fn encode(&self) -> Vec<u8> {
+        let mut entries = self.entries.clone();
+        entries.sort_unstable();
+        let mut out = Writer::header(MAGIC, VERSION);
+        out.len32(self.files.len());
+        for file in &self.files {
+            out.string(file);
+        }
+        out.len32(entries.len());
+        for entry in &entries {
+            out.u32(entry.section);
+            out.u32(entry.offset);
+            write_loc(&mut out, entry.loc);
+        }
+        out.len32(self.symbols.len());
+        for symbol in &self.symbols {
+            out.u32(symbol.symbol);
+            write_loc(&mut out, symbol.loc);
+        }
+        out.bytes
+    }
+
+    /// Parses a section's contents.
+    ///
+    /// # Errors
+    /// [`FormatError`] if the bytes are not a version-1 source map, or an
+    /// entry names a file that is not in the table.
+    pub fn decode(bytes: &[u8]) -> Result<SrcMap, FormatError> {
+        let mut input = Reader::new(SRCMAP_SECTION, bytes);
+        input.header(MAGIC, VERSION)?;
+        let file_count = input.count(4)?;
+        let mut files = Vec::with_capacity(file_count);
+        for _ in 0..file_count {
+            files.push(input.string()?);
+        }
+        let entry_count = input.count(20)?;
+        let mut entries = Vec::with_capacity(entry_count);
+        for _ in 0..entry_count {
+            let section = input.u32()?;
+            let offset = input.u32()?;
+            let loc = read_loc(&mut input, files.len())?;
+            entries.push(SrcMapEntry {
+                section,
+                offset,
+                loc,
+            });
+        }
+        // Lookups binary-search; a foreign producer may not have sorted.
+        entries.sort_unstable();
+        let symbol_count = input.count(16)?;
+        let mut symbols = Vec::with_capacity(symbol_count);
+        for _ in 0..symbol_count {
+            let symbol = input.u32()?;
+            let loc = read_loc(&mut input, files.len())?;
+            symbols.push(SymbolLoc { symbol, loc });
+        }
+        if !input.is_empty() {
+            return Err(input.error("trailing bytes after the symbol table"));
+        }
+        Ok(SrcMap {
+            files,
+            entries,
+            symbols,
+        })
+    }
+
+    /// The source of the byte at `offset` in section `section`: the entry
+    /// with the greatest offset not above it.
+    #[must_use]
+    pub fn lookup(&self, section: u32, offset: u32) -> Option<SourceLoc> {
+        let index = self
+            .entries
+            .partition_point(|entry| (entry.section, entry.offset) <= (section, offset));
+        let entry = self.entries.get(index.checked_sub(1)?)?;
+        (entry.section == section).then_some(entry.loc)
+    }
+
+    /// Where symbol `symbol` (a `.symtab` index) was defined.
+    #[must_use]
+    pub fn symbol(&self, symbol: u32) -> Option<SourceLoc> {
+        self.symbols
+            .iter()
+            .find(|entry| entry.symbol == symbol)
+            .map(|entry| entry.loc)
+    }
+
+    /// The path of a location's file.
+    #[must_use]
+    pub fn file_name(&self, loc: SourceLoc) -> Option<&str> {
+        self.files.get(loc.file as usize).map(String::as_str)
+    }
+}
+
+fn write_loc(out: &mut Writer, loc: SourceLoc) {
+    out.u32(loc.file);
+    out.u32(loc.line);
+    out.u32(loc.column);
+}
+
+fn read_loc(input: &mut Reader<'_>, file_count: usize) -> Result<SourceLoc, FormatError> {
+    let file = input.u32()?;
+    if file as usize >= file_count {
+        return Err(input.error(format!(
+            "file index {file} is outside the table of {file_count} files"
+        )));
+    }
+    Ok(SourceLoc {
+        file,
+        line: input.u32()?,
+        column: input.u32()?,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> SrcMap {
+        let loc = |line| SourceLoc {
+            file: 0,
+            line,
+            column: 5,
+        };
+        SrcMap {
+            files: vec!["main.s".into()],
+            entries: vec![
+                SrcMapEntry {
+                    section: 2,
+                    offset: 3,
+                    loc: loc(11),
+                },
+                SrcMapEntry {
+                    section: 2,
+                    offset: 0,
+                    loc: loc(10),
+                },
+                SrcMapEntry {
+                    section: 4,
+                    offset: 0,
+                    loc: loc(20),
+                },
+            ],
+            symbols: vec![SymbolLoc {
+                symbol: 7,
+                loc: loc(9),
+            }],
+        }
+    }
+
+    #[test]
+    fn round_trips_and_looks_up() {
+        let map = SrcMap::decode(&sample().encode()).unwrap();
+        assert_eq!(map.lookup(2, 0).unwrap().line, 10);
+        assert_eq!(map.lookup(2, 2).unwrap().line, 10);
+        assert_eq!(map.lookup(2, 3).unwrap().line, 11);
+        assert_eq!(map.lookup(2, 900).unwrap().line, 11);
+        assert_eq!(map.lookup(3, 0), None);
+        assert_eq!(map.lookup(4, 1).unwrap().line, 20);
+        assert_eq!(map.symbol(7).unwrap().line, 9);
+        assert_eq!(map.symbol(8), None);
+    }
+
+    #[test]
+    fn every_truncation_is_an_error() {
+        let bytes = sample().encode();
+        for len in 0..bytes.len() {
+            assert!(SrcMap::decode(&bytes[..len]).is_err(), "length {len}");
+        }
+    }
+
+    #[test]
+    fn huge_counts_are_refused_without_allocating() {
+        let mut bytes = b"SCSM\x01".to_vec();
+        bytes.extend_from_slice(&u32::MAX.to_le_bytes());
+        let error = SrcMap::decode(&bytes).unwrap_err();
+        assert!(error.reason.contains("does not fit"), "{error}");
+    }
+
+    #[test]
+    fn bad_file_index_is_an_error() {
+        let mut map = sample();
+        map.entries[0].loc.file = 3;
+        assert!(SrcMap::decode(&map.encode()).is_err());
+    }
+}

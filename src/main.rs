@@ -1,0 +1,46 @@
+//! `scorpion`: the command-line front end of the Scorpion toolchain.
+//!
+//! Each subcommand lives in its own module under `cmd/`; this file only
+//! parses arguments and reports errors. The CLI is the one place that prints
+//! or exits: the libraries return typed errors and report progress through
+//! callbacks.
+
+mod args;
+mod cmd;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// The Scorpion robot cross-toolchain: assemble, link, emulate and upload
+/// 6502 extensions for the Scorpion's ROM.
+#[derive(Debug, Parser)]
+#[command(name = "scorpion", version, about, long_about = None, max_term_width = 100)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Disassemble a raw binary file.
+    Disasm(cmd::disasm::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Disasm(args) => cmd::disasm::run(&args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(report) => {
+            // The only place errors reach the user: render them with miette.
+            #[allow(clippy::print_stderr, reason = "the CLI reports errors")]
+            {
+                eprintln!("{report:?}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Cross-crate and snapshot tests of the Scorpion toolchain live in `tests/`.
