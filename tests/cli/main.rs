@@ -1,0 +1,28 @@
+//! The `scorpion` binary run as a process: arguments in, output and exit
+//! status out, snapshotted with insta. One module per subcommand.
+
+mod disasm;
+
+use std::process::{Command, Output};
+
+/// Runs `scorpion` with `args` in `dir` and returns its output.
+pub(crate) fn scorpion(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("RUST_BACKTRACE")
+        .env("NO_COLOR", "1")
+        .env("COLUMNS", "100")
+        .output()
+        .expect("the scorpion binary runs")
+}
+
+/// Exit code, stdout and stderr as one text, for snapshots.
+pub(crate) fn transcript(output: &Output) -> String {
+    format!(
+        "exit: {}\n--- stdout\n{}--- stderr\n{}",
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}

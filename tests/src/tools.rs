@@ -1,0 +1,59 @@
+//! Outside tools that differential tests compare against.
+//!
+//! The rule (DEVELOPERS.md): a test that needs an outside tool fails when
+//! the tool is missing and `CI=true`; locally it skips, saying so on stderr.
+//! `.ci/install-test-tools` installs every tool named here.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|value| value == "true" || value == "1")
+}
+
+fn missing(what: &str, test: &str) {
+    assert!(
+        !in_ci(),
+        "{what} is required in CI but missing; run .ci/install-test-tools"
+    );
+    #[allow(clippy::print_stderr, reason = "the skip must be visible")]
+    {
+        eprintln!("SKIPPED {test}: {what} is not installed (run .ci/install-test-tools)");
+    }
+}
+
+fn find_on_path(program: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(program))
+        .find(|candidate| candidate.is_file())
+}
+
+/// The path of `program` (`"ca65"`, `"64tass"`, `"srec_cat"`...), or `None`
+/// after printing why `test` is skipped. Panics when the tool is missing
+/// under `CI=true`.
+#[must_use]
+pub fn require(program: &str, test: &str) -> Option<PathBuf> {
+    let found = find_on_path(program);
+    if found.is_none() {
+        missing(&format!("`{program}`"), test);
+    }
+    found
+}
+
+/// The Python interpreter, if it can `import module` (`"py65"`), or `None`
+/// after printing why `test` is skipped. Panics when missing under `CI=true`.
+#[must_use]
+pub fn require_python_module(module: &str, test: &str) -> Option<PathBuf> {
+    let python = find_on_path("python3").or_else(|| find_on_path("python"));
+    let usable = python.filter(|python| {
+        Command::new(python)
+            .args(["-c", &format!("import {module}")])
+            .output()
+            .is_ok_and(|output| output.status.success())
+    });
+    if usable.is_none() {
+        missing(&format!("the Python module `{module}`"), test);
+    }
+    usable
+}
