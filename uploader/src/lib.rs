@@ -1,3 +1,34 @@
 //! Verified uploads of extensions into a Scorpion over RS-232.
 //!
-//! Not landed yet (issue 6): this crate has no API.
+//! Layers, bottom up:
+//! - [`transport`]: the [`Transport`] trait (bytes with deadlines on the
+//!   transport's own clock) and its implementations: a serial port, a
+//!   fault-injecting wrapper for tests.
+//! - [`Client`]: the command protocol over a transport, through
+//!   [`romlib::protocol`]: probe (`/1X`), questions with timeouts from the
+//!   baud rate, pipelined `/7R` reads.
+//! - [`upload()`]: writes an [`UploadImage`] with `/9W`/`/7W`, verifies every
+//!   byte with overlapping `/7R` reads, rewrites what differs, and installs
+//!   hooks only after the body verified.
+//!
+//! Nothing here prints: progress goes through [`Progress`], failures are
+//! [`Error`]s.
+
+mod client;
+mod error;
+mod image;
+mod progress;
+pub mod transport;
+mod upload;
+
+#[cfg(test)]
+mod model;
+#[cfg(test)]
+mod tests;
+
+pub use client::{Client, ClientConfig, ClientStats};
+pub use error::{Error, Result};
+pub use image::{Area, RomProfile, UploadImage};
+pub use progress::{Event, NoProgress, Phase, Progress};
+pub use transport::Transport;
+pub use upload::{InstalledHook, UploadOptions, UploadReport, client, upload};

@@ -1,0 +1,525 @@
+//! The protocol client: questions with timeouts derived from the baud rate,
+//! and a pipeline that keeps several `/7R` questions in flight while
+//! writes go out, matching each answer to its question.
+//!
+//! Answers carry no tag, and line noise can lose one, so the pipeline never
+//! has two questions of the same byte count in flight: an answer's length
+//! says which question it answers, and every earlier question still waiting
+//! is known lost. Each question also has a deadline computed from the
+//! characters ahead of it on both wires.
+
+use std::collections::VecDeque;
+use std::time::Duration;
+
+use romlib::protocol::{Answer, BusyByte, Command, EOL, MAX_READ, ProtocolError, ReadSpan};
+
+use crate::transport::{Transport, char_time};
+use crate::{Error, Result};
+
+/// How the client paces itself.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ClientConfig {
+    /// The most characters sent after a question whose answer has not fully
+    /// arrived. While the ROM sends an answer it may not read its input,
+    /// so this must fit its receive buffer; 0 is stop-and-wait.
+    pub window: usize,
+    /// The most questions in flight at once (at most 4: byte counts 8
+    /// apart tell their answers apart).
+    pub max_questions: usize,
+    /// Slack added to every computed deadline (USB adapters add up to
+    /// 16 ms a turn; ROM work adds more).
+    pub margin: Duration,
+    /// How long the line may stay silent with answers due before the work
+    /// is abandoned.
+    pub stall_limit: Duration,
+    /// Attempts at a single question before giving up.
+    pub question_attempts: u32,
+}
+
+impl Default for ClientConfig {
+    fn default() -> Self {
+        ClientConfig {
+            window: 48,
+            max_questions: 4,
+            margin: Duration::from_millis(150),
+            stall_limit: Duration::from_secs(3),
+            question_attempts: 5,
+        }
+    }
+}
+
+/// A question in flight.
+#[derive(Debug, Clone, Copy)]
+struct InFlight {
+    span: ReadSpan,
+    tag: u64,
+    /// Host characters sent when this question's last character was sent.
+    sent_mark: usize,
+    deadline: Duration,
+}
+
+/// What the pipeline learned.
+#[derive(Debug)]
+pub(crate) enum Outcome {
+    /// A question was answered.
+    Answered {
+        span: ReadSpan,
+        tag: u64,
+        data: Vec<u8>,
+    },
+    /// A question's answer was lost, late or garbled.
+    Lost { span: ReadSpan, tag: u64 },
+    /// A frame that answers nothing (noise, an extension's answer).
+    Stray(Option<ProtocolError>),
+}
+
+/// Talks to one robot over a transport.
+#[derive(Debug)]
+pub struct Client<T> {
+    transport: T,
+    config: ClientConfig,
+    rx: Vec<u8>,
+    in_flight: VecDeque<InFlight>,
+    next_tag: u64,
+    /// Host characters sent so far.
+    sent: usize,
+    /// Host characters sent when the last fully answered question was sent.
+    /// When the host-to-robot wire is expected to be free again, and the
+    /// robot-to-host wire.
+    host_free: Duration,
+    robot_free: Duration,
+    last_rx: Duration,
+    stats: ClientStats,
+}
+
+/// Counters of one client's traffic.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ClientStats {
+    /// Characters sent.
+    pub sent: usize,
+    /// Characters received.
+    pub received: usize,
+    /// Questions whose answer was lost, late or garbled.
+    pub lost: usize,
+    /// Frames that answered no question.
+    pub stray: usize,
+}
+
+impl<T: Transport> Client<T> {
+    /// A client over `transport`.
+    pub fn new(transport: T, config: ClientConfig) -> Self {
+        let now = transport.now();
+        Client {
+            transport,
+            config,
+            rx: Vec::new(),
+            in_flight: VecDeque::new(),
+            next_tag: 0,
+            sent: 0,
+            host_free: now,
+            robot_free: now,
+            last_rx: now,
+            stats: ClientStats::default(),
+        }
+    }
+
+    /// The transport.
+    pub fn transport(&mut self) -> &mut T {
+        &mut self.transport
+    }
+
+    /// Unwraps the transport.
+    pub fn into_transport(self) -> T {
+        self.transport
+    }
+
+    /// The pacing in use.
+    #[must_use]
+    pub fn config(&self) -> &ClientConfig {
+        &self.config
+    }
+
+    /// Traffic so far.
+    #[must_use]
+    pub fn stats(&self) -> ClientStats {
+        self.stats
+    }
+
+    fn chars(&self, count: usize) -> Duration {
+        char_time(count, self.transport.baud())
+    }
+
+    /// Sends raw bytes, tracking when they will have left.
+    pub(crate) fn send_raw(&mut self, bytes: &[u8]) -> Result<()> {
+        let now = self.transport.now();
+        self.host_free = self.host_free.max(now) + self.chars(bytes.len());
+        self.sent += bytes.len();
+        self.stats.sent += bytes.len();
+        self.transport.send(bytes)
+    }
+
+    /// Sends an instruction (no answer expected).
+    ///
+    /// # Errors
+    /// An I/O error on the line.
+    pub fn send(&mut self, command: &Command) -> Result<()> {
+        self.send_raw(&command.encode())
+    }
+
+    /// Reads from the line, waiting up to `timeout`; records the time of
+    /// the last byte.
+    fn fill(&mut self, timeout: Duration) -> Result<usize> {
+        let count = self.transport.receive(&mut self.rx, timeout)?;
+        if count > 0 {
+            self.last_rx = self.transport.now();
+            self.stats.received += count;
+        }
+        Ok(count)
+    }
+
+    /// Takes the next complete frame (through its carriage return).
+    fn take_frame(&mut self) -> Option<Vec<u8>> {
+        let end = self.rx.iter().position(|&b| b == EOL)?;
+        Some(self.rx.drain(..=end).collect())
+    }
+
+    /// How many characters may go out now without overrunning a robot that
+    /// is busy answering.
+    pub(crate) fn room(&self) -> usize {
+        match self.in_flight.front() {
+            None => usize::MAX,
+            Some(oldest) => (oldest.sent_mark + self.config.window).saturating_sub(self.sent),
+        }
+    }
+
+    /// Whether a question of `count` bytes can be sent now.
+    pub(crate) fn can_ask(&self, count: u8) -> bool {
+        self.in_flight.len() < self.config.max_questions.clamp(1, 4)
+            && !self
+                .in_flight
+                .iter()
+                .any(|q| q.span.count().abs_diff(count) < COUNT_SPACING)
+            && self.room() >= 9
+    }
+
+    /// Questions in flight.
+    pub(crate) fn in_flight(&self) -> usize {
+        self.in_flight.len()
+    }
+
+    /// Sends a `/7R` question into the pipeline; its answer comes back
+    /// through [`Client::poll`].
+    pub(crate) fn ask_read(&mut self, span: ReadSpan) -> Result<u64> {
+        let command = Command::ReadMemory(span);
+        let bytes = command.encode();
+        self.send_raw(&bytes)?;
+        let answer_len = command.answer_len().unwrap_or(2);
+        let arrival = self.host_free;
+        self.robot_free = self.robot_free.max(arrival) + self.chars(answer_len);
+        let expected = self.robot_free.saturating_sub(self.transport.now());
+        let deadline = self.robot_free + self.config.margin + expected / 4;
+        let tag = self.next_tag;
+        self.next_tag += 1;
+        self.in_flight.push_back(InFlight {
+            span,
+            tag,
+            sent_mark: self.sent,
+            deadline,
+        });
+        Ok(tag)
+    }
+
+    /// Waits up to `timeout` for answers and returns what happened: answers
+    /// matched to their questions, questions known lost (overtaken or past
+    /// their deadline), stray frames.
+    pub(crate) fn poll(&mut self, timeout: Duration) -> Result<Vec<Outcome>> {
+        let now = self.transport.now();
+        let wait = match self.in_flight.front() {
+            Some(oldest) => timeout.min(oldest.deadline.saturating_sub(now)),
+            None => timeout,
+        };
+        if self.take_frame_available() {
+            self.fill(Duration::ZERO)?;
+        } else {
+            self.fill(wait)?;
+        }
+        let mut outcomes = Vec::new();
+        let due = self.in_flight.len();
+        while let Some(frame) = self.take_frame() {
+            self.match_frame(&frame, &mut outcomes);
+        }
+        let now = self.transport.now();
+        while let Some(oldest) = self.in_flight.front().copied() {
+            if now < oldest.deadline {
+                break;
+            }
+            self.in_flight.pop_front();
+            self.stats.lost += 1;
+            outcomes.push(Outcome::Lost {
+                span: oldest.span,
+                tag: oldest.tag,
+            });
+            // Its answer may still be on its way: resynchronise the
+            // robot-to-host estimate so later deadlines are not shortened.
+            self.robot_free = self.robot_free.max(now);
+        }
+        if due > 0 && now.saturating_sub(self.last_rx) > self.config.stall_limit {
+            return Err(Error::Stalled {
+                port: self.transport.name(),
+                waited: now.saturating_sub(self.last_rx),
+                outstanding: due,
+            });
+        }
+        Ok(outcomes)
+    }
+
+    fn take_frame_available(&self) -> bool {
+        self.rx.contains(&EOL)
+    }
+
+    fn match_frame(&mut self, frame: &[u8], outcomes: &mut Vec<Outcome>) {
+        let data = match Answer::parse(frame) {
+            Ok(Answer::Memory(data)) => data,
+            Ok(_) => {
+                self.stats.stray += 1;
+                outcomes.push(Outcome::Stray(None));
+                return;
+            }
+            Err(error) => {
+                self.stats.stray += 1;
+                outcomes.push(Outcome::Stray(Some(error)));
+                return;
+            }
+        };
+        let Some(index) = self
+            .in_flight
+            .iter()
+            .position(|q| usize::from(q.span.count()) == data.len())
+        else {
+            self.stats.stray += 1;
+            outcomes.push(Outcome::Stray(None));
+            return;
+        };
+        // Answers come in order: every question before this one is lost.
+        for lost in self.in_flight.drain(..index) {
+            self.stats.lost += 1;
+            outcomes.push(Outcome::Lost {
+                span: lost.span,
+                tag: lost.tag,
+            });
+        }
+        if let Some(question) = self.in_flight.pop_front() {
+            outcomes.push(Outcome::Answered {
+                span: question.span,
+                tag: question.tag,
+                data,
+            });
+        }
+    }
+
+    /// Drops every question in flight and any partial input, waiting until
+    /// their answers are due so none arrives later.
+    pub(crate) fn drain(&mut self) -> Result<()> {
+        let until = self.in_flight.back().map(|q| q.deadline);
+        if let Some(until) = until {
+            loop {
+                let now = self.transport.now();
+                if now >= until {
+                    break;
+                }
+                self.fill(until - now)?;
+            }
+        }
+        self.in_flight.clear();
+        self.rx.clear();
+        Ok(())
+    }
+
+    /// Asks one question and waits for its answer (stop-and-wait), with a
+    /// timeout from the baud rate and the configured retries.
+    ///
+    /// # Errors
+    /// [`Error::NoAnswer`] when nothing at all came back,
+    /// [`Error::WrongBaud`] when only garbage did, or the last
+    /// [`ProtocolError`] when answers kept being malformed.
+    pub fn ask(&mut self, command: &Command) -> Result<Answer> {
+        let bytes = command.encode();
+        // `/1S` and extensions: allow the longest answer there is.
+        let answer_len = command.answer_len().unwrap_or(2 * 199 + 3);
+        let timeout = self.chars(bytes.len() + answer_len) + self.config.margin * 2;
+        let mut heard = Vec::new();
+        let mut last_error = None;
+        for _ in 0..self.config.question_attempts.max(1) {
+            self.drain()?;
+            self.transport.clear_input()?;
+            self.send_raw(&bytes)?;
+            let start = self.transport.now();
+            let deadline = start + timeout;
+            loop {
+                if let Some(frame) = self.take_frame() {
+                    match command.parse_answer(&frame) {
+                        Ok(answer) => return Ok(answer),
+                        Err(error) => {
+                            heard.extend_from_slice(&frame);
+                            last_error = Some(error);
+                            continue;
+                        }
+                    }
+                }
+                let now = self.transport.now();
+                if now >= deadline {
+                    heard.append(&mut self.rx);
+                    break;
+                }
+                self.fill(deadline - now)?;
+            }
+        }
+        if heard.is_empty() {
+            return Err(Error::NoAnswer {
+                port: self.transport.name(),
+                baud: self.transport.baud(),
+                question: command.to_string(),
+                waited: timeout * self.config.question_attempts.max(1),
+            });
+        }
+        if heard
+            .iter()
+            .any(|&b| !(0x20..0x7F).contains(&b) && b != EOL)
+            || last_error.is_none()
+        {
+            heard.truncate(40);
+            return Err(Error::WrongBaud {
+                port: self.transport.name(),
+                baud: self.transport.baud(),
+                sample: heard.escape_ascii().to_string(),
+            });
+        }
+        Err(last_error.map_or_else(
+            || Error::NoAnswer {
+                port: self.transport.name(),
+                baud: self.transport.baud(),
+                question: command.to_string(),
+                waited: timeout,
+            },
+            Error::Protocol,
+        ))
+    }
+
+    /// Probes the robot with `/1X`: is something there, at this baud rate,
+    /// speaking the protocol?
+    ///
+    /// # Errors
+    /// As [`Client::ask`].
+    pub fn probe(&mut self) -> Result<BusyByte> {
+        match self.ask(&Command::Busy)? {
+            Answer::Busy(busy) => Ok(busy),
+            // `parse_answer` only accepts `X` answers to `/1X`.
+            other => Err(Error::Protocol(ProtocolError::UnexpectedAnswer {
+                question: "/1X".into(),
+                text: format!("{other:?}"),
+                expected: "`Xhh`".into(),
+            })),
+        }
+    }
+
+    /// Reads `len` bytes from `address` with pipelined `/7R` questions (up
+    /// to 99 bytes each). Each span is read until two answers agree, since
+    /// an answer that lost one character and gained another elsewhere
+    /// parses as well as a true one.
+    ///
+    /// # Errors
+    /// [`Error::BadImage`] if the range runs past `$FFFF`,
+    /// [`Error::Unreadable`] when a span keeps failing, [`Error::Stalled`].
+    pub fn read_memory(&mut self, address: u16, len: usize) -> Result<Vec<u8>> {
+        if u32::from(address) + len as u32 > 0x1_0000 {
+            return Err(Error::BadImage {
+                reason: format!("reading {len} bytes at ${address:04X} runs past $FFFF"),
+            });
+        }
+        let mut out = vec![0u8; len];
+        let mut todo: VecDeque<ReadSpan> = spans(address, len).collect();
+        let mut remaining = len;
+        let mut size = MAX_READ;
+        let mut candidates: std::collections::HashMap<u16, Vec<u8>> =
+            std::collections::HashMap::new();
+        let mut failures = 0u32;
+        let mut last_error = None;
+        while remaining > 0 {
+            while let Some(&span) = todo.front() {
+                if !self.can_ask(span.count()) {
+                    break;
+                }
+                todo.pop_front();
+                self.ask_read(span)?;
+            }
+            for outcome in self.poll(self.config.stall_limit)? {
+                match outcome {
+                    Outcome::Answered { span, data, .. } => {
+                        if candidates.get(&span.address()) == Some(&data) {
+                            failures = 0;
+                            size = size.saturating_add(4).min(MAX_READ);
+                            remaining -= data.len();
+                            let offset = usize::from(span.address() - address);
+                            out[offset..offset + data.len()].copy_from_slice(&data);
+                        } else {
+                            if candidates.insert(span.address(), data).is_some() {
+                                failures += 1;
+                            }
+                            todo.push_back(span);
+                        }
+                    }
+                    Outcome::Lost { span, .. } => {
+                        failures += 1;
+                        size = (size / 2).max(4);
+                        let parts: Vec<ReadSpan> =
+                            pieces(span.address(), usize::from(span.count()), size).collect();
+                        for part in parts.into_iter().rev() {
+                            todo.push_front(part);
+                        }
+                    }
+                    Outcome::Stray(error) => last_error = error.or(last_error),
+                }
+                if failures > 40 * self.config.question_attempts {
+                    return Err(Error::Unreadable {
+                        address,
+                        attempts: failures,
+                        last: last_error,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The least difference between the byte counts of two questions in
+/// flight: an answer must lose or gain 16 characters to pass for another.
+pub(crate) const COUNT_SPACING: u8 = 8;
+
+/// Splits a range into `/7R` spans of at most 99 bytes whose counts step
+/// down 99, 91, 83, 75 and repeat, so that questions in flight differ in
+/// length by [`COUNT_SPACING`].
+pub(crate) fn spans(address: u16, len: usize) -> impl Iterator<Item = ReadSpan> {
+    pieces(address, len, MAX_READ)
+}
+
+/// Like [`spans`], with at most `size` bytes a question: noisy lines
+/// garble long answers, so the pipeline shrinks its questions when answers
+/// are lost.
+pub(crate) fn pieces(address: u16, len: usize, size: u8) -> impl Iterator<Item = ReadSpan> {
+    let size = size.clamp(1, MAX_READ);
+    let steps = (size - 1) / COUNT_SPACING + 1;
+    let mut at = u32::from(address);
+    let end = at + len as u32;
+    let mut turn = 0u8;
+    std::iter::from_fn(move || {
+        if at >= end {
+            return None;
+        }
+        let size = u32::from(size - (turn % steps.min(4)) * COUNT_SPACING).min(end - at);
+        turn = turn.wrapping_add(1);
+        let span = ReadSpan::new(at as u16, size as u8).ok()?;
+        at += size;
+        Some(span)
+    })
+}

@@ -1,0 +1,257 @@
+//! The uploader's one error type.
+
+use std::time::Duration;
+
+use isa::objfmt::HookKind;
+use romlib::protocol::ProtocolError;
+
+/// Everything that can stop a probe, a read or an upload.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[non_exhaustive]
+pub enum Error {
+    /// The serial port is held by another program.
+    #[error("serial port {port} is busy")]
+    #[diagnostic(
+        code(uploader::port_busy),
+        help(
+            "another program (a terminal, `scorpion sim`, a second upload) has it open; close it and retry"
+        )
+    )]
+    PortBusy {
+        /// The port's path.
+        port: String,
+    },
+
+    /// The serial port does not exist.
+    #[error("serial port {port} does not exist")]
+    #[diagnostic(
+        code(uploader::port_not_found),
+        help("`scorpion ports` lists the serial ports of this machine")
+    )]
+    PortNotFound {
+        /// The port's path.
+        port: String,
+    },
+
+    /// The serial port could not be opened or configured.
+    #[error("cannot open serial port {port}: {message}")]
+    #[diagnostic(code(uploader::port))]
+    Port {
+        /// The port's path.
+        port: String,
+        /// What the operating system said.
+        message: String,
+    },
+
+    /// Reading or writing the line failed (an unplugged adapter, a closed pty).
+    #[error("I/O error on {port}")]
+    #[diagnostic(code(uploader::io), help("check that the adapter is still plugged in"))]
+    Io {
+        /// The transport's name.
+        port: String,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// Nothing came back at all.
+    #[error("no answer from the robot on {port} at {baud} baud (`{question}` waited {waited:?})")]
+    #[diagnostic(
+        code(uploader::no_answer),
+        help(
+            "check that the robot is on, the cable is a null-modem cable, and the ROM is running (not an operating system that took HOOK_LOOP)"
+        )
+    )]
+    NoAnswer {
+        /// The transport's name.
+        port: String,
+        /// The baud rate used.
+        baud: u32,
+        /// The question that got no answer.
+        question: String,
+        /// How long it waited.
+        waited: Duration,
+    },
+
+    /// Bytes came back, but never a well-formed answer: the usual sign of a
+    /// baud-rate mismatch.
+    #[error("the robot on {port} answers garbage at {baud} baud: `{sample}`")]
+    #[diagnostic(
+        code(uploader::wrong_baud),
+        help(
+            "the robot is probably set to another baud rate; try --baud 9600 (the ROM's default)"
+        )
+    )]
+    WrongBaud {
+        /// The transport's name.
+        port: String,
+        /// The baud rate used.
+        baud: u32,
+        /// What arrived, escaped.
+        sample: String,
+    },
+
+    /// The line went quiet in the middle of the work.
+    #[error(
+        "the line to {port} stalled: nothing received for {waited:?} with {outstanding} answers due"
+    )]
+    #[diagnostic(
+        code(uploader::stalled),
+        help(
+            "the robot stopped answering mid-upload (power, cable, or a crash); nothing that did not verify was hooked, so it is safe to retry"
+        )
+    )]
+    Stalled {
+        /// The transport's name.
+        port: String,
+        /// How long nothing arrived.
+        waited: Duration,
+        /// Questions still unanswered.
+        outstanding: usize,
+    },
+
+    /// A byte never read back as written.
+    #[error(
+        "verification failed at ${address:04X}: expected ${expected:02X}, found ${found:02X} after {attempts} writes"
+    )]
+    #[diagnostic(
+        code(uploader::verify_failed),
+        help(
+            "that address does not keep what is written: no RAM there (check the image's layout) or a faulty line; no hook was installed"
+        )
+    )]
+    VerifyFailed {
+        /// The address.
+        address: u16,
+        /// The image's byte.
+        expected: u8,
+        /// The robot's byte.
+        found: u8,
+        /// How many times it was written.
+        attempts: u32,
+    },
+
+    /// The answers kept being malformed or lost.
+    #[error("gave up reading ${address:04X} after {attempts} garbled or lost answers")]
+    #[diagnostic(
+        code(uploader::unreadable),
+        help("the line is too noisy; try a lower baud rate or a shorter cable")
+    )]
+    Unreadable {
+        /// The first address of the read.
+        address: u16,
+        /// Attempts made.
+        attempts: u32,
+        /// The last malformed answer, if one was parsed.
+        #[source]
+        last: Option<ProtocolError>,
+    },
+
+    /// The robot reset (or something else rewrote its hooks) while the
+    /// upload was installing hooks, more often than the retries allow.
+    #[error("the robot reset during the upload: {hook} changed from ${before:04X} to ${after:04X}")]
+    #[diagnostic(
+        code(uploader::robot_reset),
+        help(
+            "the robot reset or another program wrote to it; the body is in RAM but not hooked; upload again"
+        )
+    )]
+    RobotReset {
+        /// The hook that changed.
+        hook: &'static str,
+        /// Its target when the upload began.
+        before: u16,
+        /// Its target now.
+        after: u16,
+    },
+
+    /// A hook's RAM does not hold a `JMP`: not a ROM this uploader knows.
+    #[error("{hook} at ${address:04X} holds ${found:02X}, not a JMP ($4C)")]
+    #[diagnostic(
+        code(uploader::not_a_hook),
+        help("the robot's ROM is not the one the image was linked against; pass its ROM profile")
+    )]
+    NotAHook {
+        /// The hook's name.
+        hook: &'static str,
+        /// Its address.
+        address: u16,
+        /// The byte found where the `JMP` should be.
+        found: u8,
+    },
+
+    /// A hook currently points into memory the upload is about to
+    /// overwrite, and no ROM default is known to disarm it with.
+    #[error("{hook} points at ${target:04X}, inside the memory being uploaded")]
+    #[diagnostic(
+        code(uploader::hook_in_use),
+        help(
+            "an earlier upload is hooked there; send /1R to the robot (it restores the hooks), then upload again"
+        )
+    )]
+    HookInUse {
+        /// The hook's name.
+        hook: &'static str,
+        /// Where it points.
+        target: u16,
+    },
+
+    /// The image is not something that can be uploaded safely.
+    #[error("the image cannot be uploaded: {reason}")]
+    #[diagnostic(
+        code(uploader::bad_image),
+        help("link extensions with --target scorpion-ext (or scorpion-os)")
+    )]
+    BadImage {
+        /// Why.
+        reason: String,
+    },
+
+    /// A chain slot or handler of a hook record lies outside the image.
+    #[error("{kind:?} hook record names ${address:04X}, which the image does not load")]
+    #[diagnostic(code(uploader::bad_hook_record))]
+    BadHookRecord {
+        /// Which hook.
+        kind: HookKind,
+        /// The address.
+        address: u16,
+    },
+
+    /// A protocol error outside the retried paths (a probe's answer, say).
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Protocol(#[from] ProtocolError),
+
+    /// The expectation file's commands did not get the answers it requires.
+    #[error("rehearsal failed: `{command}` answered `{found}`, expected `{expected}`")]
+    #[diagnostic(
+        code(uploader::rehearsal_failed),
+        help(
+            "the image does not behave on the virtual Scorpion as the expectations say; nothing was sent to the robot"
+        )
+    )]
+    RehearsalFailed {
+        /// The command.
+        command: String,
+        /// The required answer.
+        expected: String,
+        /// The actual answer (or `no answer`).
+        found: String,
+    },
+
+    /// The expectation file does not parse.
+    #[error("expectations line {line}: {reason}")]
+    #[diagnostic(
+        code(uploader::bad_expectations),
+        help("each line is `COMMAND` or `COMMAND => ANSWER`; `#` starts a comment")
+    )]
+    BadExpectations {
+        /// 1-based line.
+        line: usize,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// The uploader's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
