@@ -4,11 +4,25 @@
 //!   devices (exact bus cycles, lazy device catch-up, interrupt polling), the
 //!   [`Line`] helper for devices' interrupt outputs, and [`Ram`], the plain
 //!   64 KiB machine memory.
+//! - [`cpu`]: the [`Cpu`]: every opcode of the NMOS part, documented or not,
+//!   exact in result, flags, cycles and bus accesses; the run loop and the
+//!   interrupt sequences.
+//! - [`hooks`]: what a run does besides executing ([`Hooks`]): tracing,
+//!   breakpoints, stopping at traps. Off means absent from the compiled loop.
+//! - [`machine`]: a [`Cpu`] with its [`Bus`]; [`RamMachine`] is the plain
+//!   64 KiB machine test programs run on.
+//!
 //!
 //! The emulator knows nothing of ELF: callers load bytes into it.
 
 pub mod bus;
+pub mod cpu;
 mod error;
+pub mod hooks;
+pub mod machine;
 
 pub use bus::{Bus, Interrupts, Line, Ram};
+pub use cpu::{Cpu, Interrupt, Step, Stop};
 pub use error::Error;
+pub use hooks::{Breakpoints, Control, Hooks, NoHooks, StopAtTrap, Tracer};
+pub use machine::{Machine, RamMachine};

@@ -1,0 +1,430 @@
+//! The NMOS 6502 core: registers, the run loop, interrupt polling and the
+//! BRK/IRQ/NMI/RESET sequences. The opcode dispatch is in `execute`, the
+//! addressing modes and bus accesses in `access`, the arithmetic in `alu`.
+//!
+//! # Timing model
+//!
+//! Every bus cycle is one [`Bus`] call made with the exact cycle number
+//! (see [`crate::bus`]); the cycle counter advances by one per call, so an
+//! instruction's cycle count *is* the number of accesses it makes, dummy
+//! accesses included. A test checks every opcode's count against
+//! [`isa::OPCODES`] (base cycles plus page-cross and branch penalties).
+//!
+//! Interrupts follow the datasheet: the inputs are polled once per
+//! instruction at its second-to-last cycle (one earlier for a taken branch
+//! that stays in its page), with the I flag as it was at that point, so CLI,
+//! SEI and PLP act one instruction late while RTI acts at once. The
+//! interrupt sequences do not poll at their end: at least one instruction of
+//! a handler runs before the next interrupt. BRK and IRQ sequences check for
+//! an NMI on their fourth cycle and take the NMI vector if one arrived
+//! ("NMI hijacking"); the pushed B flag still tells BRK from IRQ.
+
+mod access;
+mod alu;
+mod execute;
+
+use crate::bus::Bus;
+use crate::hooks::{Control, Hooks, NoHooks};
+
+/// Bits of the processor status register P.
+pub mod flag {
+    /// Carry.
+    pub const C: u8 = 0x01;
+    /// Zero.
+    pub const Z: u8 = 0x02;
+    /// Interrupt disable.
+    pub const I: u8 = 0x04;
+    /// Decimal mode.
+    pub const D: u8 = 0x08;
+    /// Break: not a register bit; set in the copy of P that BRK and PHP push,
+    /// clear in the copy IRQ and NMI push.
+    pub const B: u8 = 0x10;
+    /// Unused: always reads as 1.
+    pub const U: u8 = 0x20;
+    /// Overflow.
+    pub const V: u8 = 0x40;
+    /// Negative.
+    pub const N: u8 = 0x80;
+}
+
+/// The NMI vector's address.
+pub const NMI_VECTOR: u16 = 0xFFFA;
+/// The reset vector's address.
+pub const RESET_VECTOR: u16 = 0xFFFC;
+/// The IRQ/BRK vector's address.
+pub const IRQ_VECTOR: u16 = 0xFFFE;
+
+/// An interrupt sequence the CPU went through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Interrupt {
+    /// A maskable interrupt request (vector `$FFFE`).
+    Irq,
+    /// A non-maskable interrupt (vector `$FFFA`), including one that hijacked
+    /// an IRQ sequence.
+    Nmi,
+}
+
+/// Why [`Cpu::run`] returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Stop {
+    /// The cycle counter reached the limit given to the run.
+    Limit,
+    /// The instruction at `pc` jumped or branched to itself (`JMP *`,
+    /// `BNE *`), and the hooks asked to stop at traps.
+    Trap {
+        /// The trap's address, which is also the PC.
+        pc: u16,
+    },
+    /// A JAM (KIL) opcode halted the processor. The PC stays on it and no
+    /// cycle is counted for it; running again reports the same JAM.
+    Jam {
+        /// The address of the JAM opcode.
+        pc: u16,
+        /// The opcode byte.
+        opcode: u8,
+    },
+    /// A hook (a breakpoint) asked to stop before the instruction at `pc`.
+    Hook {
+        /// The address of the instruction not yet executed.
+        pc: u16,
+    },
+}
+
+/// What one [`Cpu::step`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Step {
+    /// Executed one instruction.
+    Instruction,
+    /// Executed one instruction that jumped or branched to itself.
+    Trap,
+    /// Went through an interrupt sequence instead of an instruction.
+    Interrupt(Interrupt),
+    /// Hit a JAM opcode: nothing executed, the PC stays on it.
+    Jam {
+        /// The opcode byte.
+        opcode: u8,
+    },
+}
+
+// What an instruction tells the step about its interrupt poll and outcome.
+/// Poll one cycle earlier (a taken branch that stays in its page).
+const LATE_POLL: u8 = 1;
+/// Poll with the I flag as it was before the instruction (CLI, SEI, PLP).
+const OLD_I: u8 = 2;
+/// The instruction jumped or branched to its own address.
+const TRAP: u8 = 4;
+/// A JAM opcode: nothing executed.
+const JAM: u8 = 8;
+/// No poll at the end (BRK: the interrupt sequence has its own).
+const NO_POLL: u8 = 16;
+
+/// An NMOS 6502. Registers are public fields; the status register is read
+/// and written through [`Cpu::p`] and [`Cpu::set_p`] because the CPU keeps
+/// its flags unpacked.
+#[derive(Clone, PartialEq, Eq)]
+pub struct Cpu {
+    /// Accumulator.
+    pub a: u8,
+    /// Index register X.
+    pub x: u8,
+    /// Index register Y.
+    pub y: u8,
+    /// Stack pointer (the stack is page one, `$0100 + s`).
+    pub s: u8,
+    /// Program counter.
+    pub pc: u16,
+    // N is bit 7 of `n`; Z is set when `z` is 0 (the last result is kept
+    // instead of computing the flags on every instruction).
+    n: u8,
+    z: u8,
+    c: bool,
+    v: bool,
+    d: bool,
+    i: bool,
+    cycles: u64,
+    instructions: u64,
+    // The NMI level seen at the previous poll (edge detection).
+    nmi_line: bool,
+    nmi_pending: bool,
+    // An IRQ was asserted with I clear at the last poll.
+    irq_pending: bool,
+}
+
+impl Default for Cpu {
+    fn default() -> Cpu {
+        Cpu::new()
+    }
+}
+
+impl core::fmt::Debug for Cpu {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "PC=${:04X} A=${:02X} X=${:02X} Y=${:02X} S=${:02X} P=${:02X} ({}) cycles={} instructions={}",
+            self.pc,
+            self.a,
+            self.x,
+            self.y,
+            self.s,
+            self.p(),
+            flags_text(self.p()),
+            self.cycles,
+            self.instructions
+        )
+    }
+}
+
+/// The status register as `NV-BDIZC` letters, upper case when set
+/// (`nv-bdIzc`).
+#[must_use]
+pub fn flags_text(p: u8) -> String {
+    "NV-BDIZC"
+        .chars()
+        .enumerate()
+        .map(|(index, letter)| {
+            if letter == '-' {
+                '-'
+            } else if p & (0x80 >> index) != 0 {
+                letter
+            } else {
+                letter.to_ascii_lowercase()
+            }
+        })
+        .collect()
+}
+
+impl Cpu {
+    /// The power-on state: A, X, Y, S and PC zero, only I (and the unused
+    /// bit) set in P, no interrupt pending, cycle 0. Call [`Cpu::reset`]
+    /// before running, as the hardware's reset line does.
+    #[must_use]
+    pub const fn new() -> Cpu {
+        Cpu {
+            a: 0,
+            x: 0,
+            y: 0,
+            s: 0,
+            pc: 0,
+            n: 0,
+            z: 1,
+            c: false,
+            v: false,
+            d: false,
+            i: true,
+            cycles: 0,
+            instructions: 0,
+            nmi_line: false,
+            nmi_pending: false,
+            irq_pending: false,
+        }
+    }
+
+    /// The status register as PHP would push it without the B bit (bit 5
+    /// always set, bit 4 clear).
+    #[inline]
+    #[must_use]
+    pub fn p(&self) -> u8 {
+        (self.n & flag::N)
+            | if self.v { flag::V } else { 0 }
+            | flag::U
+            | if self.d { flag::D } else { 0 }
+            | if self.i { flag::I } else { 0 }
+            | if self.z == 0 { flag::Z } else { 0 }
+            | u8::from(self.c)
+    }
+
+    /// Sets the status register (bits 4 and 5 do not exist in the register
+    /// and are ignored).
+    #[inline]
+    pub fn set_p(&mut self, p: u8) {
+        self.n = p;
+        self.v = p & flag::V != 0;
+        self.d = p & flag::D != 0;
+        self.i = p & flag::I != 0;
+        self.z = u8::from(p & flag::Z == 0);
+        self.c = p & flag::C != 0;
+    }
+
+    /// Bus cycles since the CPU was created (every access is one cycle).
+    #[inline]
+    #[must_use]
+    pub const fn cycles(&self) -> u64 {
+        self.cycles
+    }
+
+    /// Instructions completed since the CPU was created (interrupt and reset
+    /// sequences are not instructions).
+    #[inline]
+    #[must_use]
+    pub const fn instructions(&self) -> u64 {
+        self.instructions
+    }
+
+    /// True if an interrupt sequence will run before the next instruction.
+    #[must_use]
+    pub const fn interrupt_pending(&self) -> bool {
+        self.nmi_pending || self.irq_pending
+    }
+
+    /// The RESET sequence (7 cycles): two reads at the PC, three stack reads
+    /// while S decreases by 3 (the suppressed pushes of an interrupt), then
+    /// the vector at `$FFFC`. Sets I; D is left alone, as on the NMOS part.
+    /// Pending interrupts are forgotten.
+    pub fn reset<B: Bus>(&mut self, bus: &mut B) {
+        self.read(bus, self.pc);
+        self.read(bus, self.pc);
+        for _ in 0..3 {
+            self.read(bus, 0x0100 | u16::from(self.s));
+            self.s = self.s.wrapping_sub(1);
+        }
+        self.i = true;
+        self.nmi_pending = false;
+        self.irq_pending = false;
+        let lo = self.read(bus, RESET_VECTOR);
+        let hi = self.read(bus, RESET_VECTOR + 1);
+        self.pc = u16::from_le_bytes([lo, hi]);
+    }
+
+    /// Runs an IRQ or NMI sequence now (7 cycles), as if the input had just
+    /// been polled asserted; an IRQ runs even with I set. For tests and
+    /// hosts that inject interrupts directly; devices use [`Bus::poll`].
+    pub fn interrupt<B: Bus>(&mut self, bus: &mut B, kind: Interrupt) -> Interrupt {
+        match kind {
+            Interrupt::Irq => self.irq_pending = true,
+            Interrupt::Nmi => self.nmi_pending = true,
+        }
+        self.interrupt_sequence(bus)
+    }
+
+    /// Executes one instruction, or the pending interrupt sequence.
+    pub fn step<B: Bus>(&mut self, bus: &mut B) -> Step {
+        if self.nmi_pending || self.irq_pending {
+            return Step::Interrupt(self.interrupt_sequence(bus));
+        }
+        let flow = self.instruction(bus);
+        if flow & JAM != 0 {
+            Step::Jam {
+                opcode: bus.peek(self.pc),
+            }
+        } else if flow & TRAP != 0 {
+            Step::Trap
+        } else {
+            Step::Instruction
+        }
+    }
+
+    /// Runs until the cycle counter reaches `until` (checked between
+    /// instructions, so the run may end a few cycles past it), a JAM, or a
+    /// stop asked by `hooks`. With [`NoHooks`] the loop has no hook code at
+    /// all: tracing and breakpoints cost nothing when off.
+    #[inline]
+    pub fn run<B: Bus, H: Hooks>(&mut self, bus: &mut B, until: u64, hooks: &mut H) -> Stop {
+        // The loop runs on a local copy whose address never escapes, so the
+        // compiler can keep the registers in machine registers.
+        let mut cpu = self.clone();
+        let stop = cpu.run_local(bus, until, hooks);
+        *self = cpu;
+        stop
+    }
+
+    #[inline(always)]
+    fn run_local<B: Bus, H: Hooks>(&mut self, bus: &mut B, until: u64, hooks: &mut H) -> Stop {
+        while self.cycles < until {
+            if self.nmi_pending || self.irq_pending {
+                let kind = self.interrupt_sequence(bus);
+                hooks.interrupt(self, &*bus, kind);
+                continue;
+            }
+            if let Control::Stop = hooks.before_instruction(self, &*bus) {
+                return Stop::Hook { pc: self.pc };
+            }
+            let flow = self.instruction(bus);
+            if flow & (TRAP | JAM) != 0 {
+                if flow & JAM != 0 {
+                    return Stop::Jam {
+                        pc: self.pc,
+                        opcode: bus.peek(self.pc),
+                    };
+                }
+                if let Control::Stop = hooks.trap(self, &*bus) {
+                    return Stop::Trap { pc: self.pc };
+                }
+            }
+        }
+        Stop::Limit
+    }
+
+    /// [`Cpu::run`] without hooks.
+    #[inline]
+    pub fn run_plain<B: Bus>(&mut self, bus: &mut B, until: u64) -> Stop {
+        self.run(bus, until, &mut NoHooks)
+    }
+
+    /// One instruction and its interrupt poll. Returns the flow bits.
+    #[inline(always)]
+    fn instruction<B: Bus>(&mut self, bus: &mut B) -> u8 {
+        let pc = self.pc;
+        let i_before = self.i;
+        let opcode = self.fetch(bus);
+        let flow = self.execute(bus, opcode, pc);
+        if flow & (JAM | NO_POLL) != 0 {
+            if flow & JAM != 0 {
+                // The processor locks up on the opcode: leave it there,
+                // uncounted, so the fault is reported where it happened.
+                self.pc = pc;
+                self.cycles -= 1;
+                return flow;
+            }
+            self.instructions += 1;
+            return flow;
+        }
+        self.instructions += 1;
+        let poll_at = self.cycles - 2 - u64::from(flow & LATE_POLL);
+        let i = if flow & OLD_I != 0 { i_before } else { self.i };
+        self.poll(bus, poll_at, i);
+        flow
+    }
+
+    /// Samples the interrupt inputs for bus cycle `cycle`, with I as it was
+    /// then.
+    #[inline(always)]
+    fn poll<B: Bus>(&mut self, bus: &mut B, cycle: u64, i: bool) {
+        let lines = bus.poll(cycle);
+        self.nmi_pending |= lines.nmi & !self.nmi_line;
+        self.nmi_line = lines.nmi;
+        self.irq_pending = lines.irq & !i;
+    }
+
+    /// IRQ/NMI: two reads at the PC (the opcode fetch, suppressed), then the
+    /// common tail with B clear.
+    #[inline(always)]
+    fn interrupt_sequence<B: Bus>(&mut self, bus: &mut B) -> Interrupt {
+        self.read(bus, self.pc);
+        self.read(bus, self.pc);
+        self.interrupt_tail(bus, 0)
+    }
+
+    /// Cycles 3 to 7 of BRK, IRQ and NMI: push PC and P (with `b` as the B
+    /// bit), set I, fetch the vector. An NMI seen by cycle 4 takes the NMI
+    /// vector, whatever started the sequence.
+    #[inline(always)]
+    fn interrupt_tail<B: Bus>(&mut self, bus: &mut B, b: u8) -> Interrupt {
+        let [pcl, pch] = self.pc.to_le_bytes();
+        self.push(bus, pch);
+        self.push(bus, pcl);
+        let lines = bus.poll(self.cycles - 1);
+        self.nmi_pending |= lines.nmi & !self.nmi_line;
+        self.nmi_line = lines.nmi;
+        let nmi = self.nmi_pending;
+        self.nmi_pending = false;
+        let p = self.p() | b;
+        self.push(bus, p);
+        self.i = true;
+        self.irq_pending = false;
+        let vector = if nmi { NMI_VECTOR } else { IRQ_VECTOR };
+        let lo = self.read(bus, vector);
+        let hi = self.read(bus, vector + 1);
+        self.pc = u16::from_le_bytes([lo, hi]);
+        if nmi { Interrupt::Nmi } else { Interrupt::Irq }
+    }
+}
