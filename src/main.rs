@@ -25,12 +25,15 @@ struct Cli {
 enum Command {
     /// Disassemble a raw binary file.
     Disasm(cmd::disasm::Args),
+    /// Link 6502 ELF objects into a Scorpion image.
+    Link(cmd::link::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Disasm(args) => cmd::disasm::run(&args),
+        Command::Link(args) => cmd::link::run(&args),
     };
     match result {
         Ok(code) => code,

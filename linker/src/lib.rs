@@ -1,3 +1,37 @@
 //! The linker: 6502 ELF objects to Scorpion images, maps and symbol files.
 //!
-//! Not landed yet (issue 4): this crate has no API.
+//! - [`link`] reads relocatable objects (`goblin`), places their sections
+//!   by a [`layout`], resolves symbols (with `--just-symbols` images as a
+//!   fallback), applies `R_MOS_*` relocations with lld's semantics and range
+//!   checks, checks deferred `.assert`s and records ROM hooks. Problems are
+//!   collected: one [`Error::Failed`] carries them all, each naming its
+//!   source line through the objects' `.scorpion.srcmap`.
+//! - [`image`]: the linked image model and its one reader, used by the
+//!   emulator CLI, the virtual Scorpion and the uploader.
+//! - [`output`]: the ELF executable, raw binary, Intel HEX, S-record and
+//!   KIM-1 tape writers; [`Linked::map`] and [`Linked::vice_labels`].
+//! - [`objbuild`]: writes relocatable objects from a description (tests,
+//!   and a model of other producers' objects).
+//!
+//! The library never prints; sources for diagnostics come through
+//! [`SourceProvider`].
+
+mod error;
+pub mod image;
+mod input;
+pub mod layout;
+mod link;
+mod map;
+pub mod objbuild;
+pub mod output;
+mod place;
+mod relocate;
+mod source;
+
+pub use error::Error;
+pub use image::{Image, ImageSection, ImageSymbol, LoadArea};
+pub use input::Input;
+pub use layout::{Layout, Target};
+pub use link::{LinkOptions, Linked, SymbolFile, link};
+pub use output::Format;
+pub use source::{MemorySources, NoSources, SourceProvider};

@@ -1,0 +1,218 @@
+//! The built-in targets. The Scorpion ones read their bounds from the ROM's
+//! symbols; see the table in [`crate::layout`].
+
+use std::collections::HashMap;
+
+use super::{Area, Layout, Segment, SegmentKind};
+use crate::error::Error;
+
+/// Names `--target` accepts besides a `.toml` file.
+pub const BUILTIN_TARGETS: [&str; 4] = ["flat", "scorpion-ext", "scorpion-os", "scorpion-rom"];
+
+/// KIM-bus expansion space (docs/ARCHITECTURE.md, the memory map): a board
+/// property, not a ROM one.
+const KIM_START: u64 = 0x1000;
+const KIM_END: u64 = 0xBFFF;
+/// The ROM (PLATFORM.md section 3).
+const ROM_START: u64 = 0xF000;
+const ROM_SIZE: u64 = 0x1000;
+/// The ROM's own RAM starts after the stack page (ARCHITECTURE.md).
+const ROM_RAM_START: u64 = 0x0200;
+/// Where the optional service jump table and the vectors go.
+const JUMPTABLE_START: u64 = 0xFF00;
+const VECTORS_START: u64 = 0xFFFA;
+/// An erased EPROM reads $FF.
+const ROM_FILL: u8 = 0xFF;
+
+/// Absolute symbols the Scorpion layouts read their bounds from: the ROM's
+/// exports (from `--just-symbols`) or, when linking the ROM itself, its own.
+#[derive(Debug, Clone, Default)]
+pub struct RomSymbols {
+    values: HashMap<String, i64>,
+}
+
+impl RomSymbols {
+    /// Adds a symbol; the first definition of a name wins.
+    pub fn insert(&mut self, name: &str, value: i64) {
+        self.values.entry(name.to_owned()).or_insert(value);
+    }
+
+    /// A symbol's value.
+    #[must_use]
+    pub fn get(&self, name: &str) -> Option<i64> {
+        self.values.get(name).copied()
+    }
+
+    fn require<const N: usize>(&self, target: &str, names: [&str; N]) -> Result<[u64; N], Error> {
+        let missing: Vec<&str> = names
+            .iter()
+            .copied()
+            .filter(|name| self.get(name).is_none())
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::MissingRomSymbols {
+                target: target.to_owned(),
+                missing: missing.join(", "),
+            });
+        }
+        let mut values = [0u64; N];
+        for (value, name) in values.iter_mut().zip(names) {
+            let raw = self.get(name).unwrap_or_default();
+            *value = u64::try_from(raw)
+                .ok()
+                .filter(|value| *value <= 0xFFFF)
+                .ok_or_else(|| Error::LayoutInvalid {
+                    path: target.to_owned(),
+                    reason: format!("the ROM's {name} = {raw} is not an address"),
+                })?;
+        }
+        Ok(values)
+    }
+}
+
+fn area(name: &str, start: u64, end_inclusive: u64, output: bool) -> Area {
+    Area {
+        name: name.to_owned(),
+        start,
+        size: end_inclusive + 1 - start,
+        fill: false,
+        fill_value: 0,
+        output,
+        define: false,
+    }
+}
+
+fn inclusive(target: &str, what: &str, start: u64, end: u64) -> Result<(), Error> {
+    if end < start {
+        return Err(Error::LayoutInvalid {
+            path: target.to_owned(),
+            reason: format!("the ROM's {what} range ${start:04X}-${end:04X} is empty"),
+        });
+    }
+    Ok(())
+}
+
+/// `flat`: see the module docs for the equivalent ld65 config.
+pub(crate) fn flat(start: u64) -> Layout {
+    Layout {
+        name: "flat".into(),
+        areas: vec![
+            area("ZP", 0, 0xFF, false),
+            area("MAIN", start, 0xFFFF, true),
+        ],
+        segments: vec![
+            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            Segment::new("CODE", "MAIN", SegmentKind::ReadOnly),
+            Segment::new("RODATA", "MAIN", SegmentKind::ReadOnly),
+            Segment::new("DATA", "MAIN", SegmentKind::ReadWrite),
+            Segment::new("BSS", "MAIN", SegmentKind::Bss),
+        ],
+        ld65_alignment: true,
+    }
+}
+
+/// `scorpion-ext`: everything in the user's zero page and RAM.
+pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
+    let target = "scorpion-ext";
+    let [zp_start, zp_end, ram_start, ram_end] = rom.require(
+        target,
+        [
+            "USER_ZP_START",
+            "USER_ZP_END",
+            "USER_RAM_START",
+            "USER_RAM_END",
+        ],
+    )?;
+    inclusive(target, "user zero page", zp_start, zp_end)?;
+    inclusive(target, "user RAM", ram_start, ram_end)?;
+    Ok(Layout {
+        name: target.into(),
+        areas: vec![
+            area("ZP", zp_start, zp_end, false),
+            area("RAM", ram_start, ram_end, true),
+        ],
+        segments: vec![
+            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            Segment::new("CODE", "RAM", SegmentKind::ReadOnly),
+            Segment::new("RODATA", "RAM", SegmentKind::ReadOnly),
+            Segment::new("DATA", "RAM", SegmentKind::ReadWrite),
+            Segment::new("BSS", "RAM", SegmentKind::Bss),
+        ],
+        ld65_alignment: false,
+    })
+}
+
+/// `scorpion-os`: code and data in KIM-bus RAM, BSS in user RAM.
+pub(crate) fn scorpion_os(rom: &RomSymbols) -> Result<Layout, Error> {
+    let target = "scorpion-os";
+    let [zp_start, zp_end, ram_start, ram_end] = rom.require(
+        target,
+        [
+            "USER_ZP_START",
+            "USER_ZP_END",
+            "USER_RAM_START",
+            "USER_RAM_END",
+        ],
+    )?;
+    inclusive(target, "user zero page", zp_start, zp_end)?;
+    inclusive(target, "user RAM", ram_start, ram_end)?;
+    Ok(Layout {
+        name: target.into(),
+        areas: vec![
+            area("ZP", zp_start, zp_end, false),
+            area("KIM", KIM_START, KIM_END, true),
+            area("URAM", ram_start, ram_end, false),
+        ],
+        segments: vec![
+            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            Segment::new("CODE", "KIM", SegmentKind::ReadOnly),
+            Segment::new("RODATA", "KIM", SegmentKind::ReadOnly),
+            Segment::new("DATA", "KIM", SegmentKind::ReadWrite),
+            Segment::new("BSS", "URAM", SegmentKind::Bss),
+        ],
+        ld65_alignment: false,
+    })
+}
+
+/// `scorpion-rom`: the ROM image, its zero page and RAM below the user's.
+pub(crate) fn scorpion_rom(rom: &RomSymbols) -> Result<Layout, Error> {
+    let target = "scorpion-rom";
+    let [zp_user, ram_user] = rom.require(target, ["USER_ZP_START", "USER_RAM_START"])?;
+    if zp_user == 0 || ram_user <= ROM_RAM_START {
+        return Err(Error::LayoutInvalid {
+            path: target.into(),
+            reason: format!(
+                "USER_ZP_START = ${zp_user:02X} and USER_RAM_START = ${ram_user:04X} leave the ROM no zero page or RAM (its RAM starts at ${ROM_RAM_START:04X})"
+            ),
+        });
+    }
+    let mut rom_area = area("ROM", ROM_START, ROM_START + ROM_SIZE - 1, true);
+    rom_area.fill = true;
+    rom_area.fill_value = ROM_FILL;
+    let mut data = Segment::new("DATA", "ROM", SegmentKind::ReadWrite);
+    data.run = Some("RAM".into());
+    data.define = true;
+    let mut jumptable = Segment::new("JUMPTABLE", "ROM", SegmentKind::ReadOnly);
+    jumptable.start = Some(JUMPTABLE_START);
+    let mut vectors = Segment::new("VECTORS", "ROM", SegmentKind::ReadOnly);
+    vectors.start = Some(VECTORS_START);
+    vectors.optional = false;
+    Ok(Layout {
+        name: target.into(),
+        areas: vec![
+            area("ZP", 0, zp_user - 1, false),
+            area("RAM", ROM_RAM_START, ram_user - 1, false),
+            rom_area,
+        ],
+        segments: vec![
+            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            Segment::new("CODE", "ROM", SegmentKind::ReadOnly),
+            Segment::new("RODATA", "ROM", SegmentKind::ReadOnly),
+            data,
+            Segment::new("BSS", "RAM", SegmentKind::Bss),
+            jumptable,
+            vectors,
+        ],
+        ld65_alignment: false,
+    })
+}

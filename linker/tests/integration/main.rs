@@ -1,0 +1,11 @@
+//! Linker integration tests: objects built with `linker::objbuild`, linked,
+//! written and read back. One test binary, one module per concern.
+
+mod support;
+
+mod diagnostics;
+mod formats;
+mod layouts;
+mod ld65;
+mod relocations;
+mod round_trip;

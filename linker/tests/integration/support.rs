@@ -1,0 +1,64 @@
+//! Helpers shared by the linker's integration tests.
+
+use linker::{Error, Image, Input, LinkOptions, Linked, MemorySources, SymbolFile, Target};
+
+/// Links named objects with `target`, no symbol files, sources from `sources`.
+pub(crate) fn link_with(
+    objects: &[(&str, Vec<u8>)],
+    target: &Target,
+    just_symbols: &[SymbolFile<'_>],
+    sources: &MemorySources,
+) -> Result<Linked, Error> {
+    let inputs: Vec<Input<'_>> = objects
+        .iter()
+        .map(|(name, bytes)| Input { name, bytes })
+        .collect();
+    linker::link(
+        &inputs,
+        &LinkOptions {
+            target,
+            just_symbols,
+            sources,
+        },
+    )
+}
+
+/// Links with the flat target at `start`.
+pub(crate) fn link_flat(objects: &[(&str, Vec<u8>)], start: u64) -> Result<Linked, Error> {
+    let target = Target::builtin("flat", Some(start)).expect("flat is a target");
+    link_with(objects, &target, &[], &MemorySources::default())
+}
+
+/// Renders a diagnostic as the CLI shows it, without colour, for snapshots.
+pub(crate) fn render(error: &dyn miette::Diagnostic) -> String {
+    let mut out = String::new();
+    miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
+        .with_width(100)
+        .render_report(&mut out, error)
+        .expect("rendering to a string cannot fail");
+    out
+}
+
+/// A ROM image exporting the user-area bounds, as issue 5's ROM will.
+pub(crate) fn fake_rom(extra: &[(&str, u32)]) -> Image {
+    let mut symbols = vec![
+        ("USER_ZP_START", 0x80),
+        ("USER_ZP_END", 0xFF),
+        ("USER_RAM_START", 0x0400),
+        ("USER_RAM_END", 0x0FFF),
+    ];
+    symbols.extend_from_slice(extra);
+    Image {
+        symbols: symbols
+            .into_iter()
+            .map(|(name, value)| linker::ImageSymbol {
+                name: name.to_owned(),
+                value,
+                size: 0,
+                global: true,
+                section: None,
+            })
+            .collect(),
+        ..Image::default()
+    }
+}

@@ -1,0 +1,180 @@
+//! `scorpion link`: link 6502 ELF objects into a Scorpion image.
+//!
+//! [`LinkArgs`] are shared with `scorpion build`, which links the objects it
+//! assembles without writing them to disk.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use linker::{Format, Image, Input, LinkOptions, Linked, SourceProvider, SymbolFile, Target};
+use miette::{Context, IntoDiagnostic};
+
+use crate::args;
+
+/// Where the image goes and what the linker needs besides the objects.
+#[derive(Debug, clap::Args)]
+pub(crate) struct LinkArgs {
+    /// The image to write.
+    #[arg(short, long, value_name = "OUT")]
+    pub(crate) output: PathBuf,
+    /// Where things go: flat, scorpion-ext, scorpion-os, scorpion-rom, or a
+    /// layout file (FILE.toml).
+    #[arg(long, value_name = "NAME|FILE.toml", default_value = "scorpion-ext")]
+    pub(crate) target: String,
+    /// First address of the flat target's area.
+    #[arg(long, value_name = "ADDR", value_parser = args::address)]
+    pub(crate) start: Option<u16>,
+    /// Output format.
+    #[arg(long, value_name = "FORMAT", default_value = "elf", value_parser = parse_format)]
+    pub(crate) format: Format,
+    /// Also write a map file (areas, segments, modules, symbols).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) map: Option<PathBuf>,
+    /// Also write a VICE label file.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) labels: Option<PathBuf>,
+    /// Take absolute symbols from a linked ELF image (the ROM, for an
+    /// extension); also gives the Scorpion targets their RAM bounds.
+    #[arg(long = "just-symbols", value_name = "FILE")]
+    pub(crate) just_symbols: Vec<PathBuf>,
+}
+
+fn parse_format(text: &str) -> Result<Format, String> {
+    text.parse()
+}
+
+/// Link 6502 ELF objects into a Scorpion image.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// The objects, in link order.
+    #[arg(required = true, value_name = "OBJ")]
+    objects: Vec<PathBuf>,
+    #[command(flatten)]
+    link: LinkArgs,
+}
+
+/// Source files for diagnostics, read from the disk when asked for.
+pub(crate) struct DiskSources;
+
+impl SourceProvider for DiskSources {
+    fn source(&self, path: &str) -> Option<String> {
+        std::fs::read_to_string(path).ok()
+    }
+}
+
+fn read(path: &Path) -> miette::Result<Vec<u8>> {
+    std::fs::read(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read {}", path.display()))
+}
+
+/// The target `--target` and `--start` name.
+fn target(args: &LinkArgs) -> miette::Result<Target> {
+    let start = args.start.map(u64::from);
+    let name = &args.target;
+    if name.ends_with(".toml") {
+        if start.is_some() {
+            miette::bail!(
+                help = "a layout file gives its areas' addresses itself",
+                "--start applies to the flat target, not a layout file"
+            );
+        }
+        let text = std::fs::read_to_string(name)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot read layout {name}"))?;
+        return Ok(Target::Custom(linker::Layout::from_toml(name, &text)?));
+    }
+    Ok(Target::builtin(name, start)?)
+}
+
+/// Links named objects with `args` and writes everything asked for.
+pub(crate) fn link_and_write(
+    objects: &[(String, Vec<u8>)],
+    args: &LinkArgs,
+    sources: &dyn SourceProvider,
+) -> miette::Result<ExitCode> {
+    let target = target(args)?;
+    let mut symbol_images = Vec::with_capacity(args.just_symbols.len());
+    for path in &args.just_symbols {
+        let name = path.display().to_string();
+        let image = Image::parse(&name, &read(path)?)?;
+        symbol_images.push((name, image));
+    }
+    let symbol_files: Vec<SymbolFile<'_>> = symbol_images
+        .iter()
+        .map(|(name, image)| SymbolFile { name, image })
+        .collect();
+    let inputs: Vec<Input<'_>> = objects
+        .iter()
+        .map(|(name, bytes)| Input { name, bytes })
+        .collect();
+    let mut linked = linker::link(
+        &inputs,
+        &LinkOptions {
+            target: &target,
+            just_symbols: &symbol_files,
+            sources,
+        },
+    )?;
+    report_warnings(&mut linked);
+    let bytes = args.format.write(&linked.image)?;
+    write(&args.output, &bytes)?;
+    if let Some(path) = &args.map {
+        write(path, linked.map().as_bytes())?;
+    }
+    if let Some(path) = &args.labels {
+        write(path, linked.vice_labels().as_bytes())?;
+    }
+    summary(&linked, args);
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write(path: &Path, bytes: &[u8]) -> miette::Result<()> {
+    std::fs::write(path, bytes)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot write {}", path.display()))
+}
+
+fn report_warnings(linked: &mut Linked) {
+    for warning in std::mem::take(&mut linked.warnings) {
+        #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
+        {
+            eprintln!("{:?}", miette::Report::new(warning));
+        }
+    }
+}
+
+fn summary(linked: &Linked, args: &LinkArgs) {
+    let image = &linked.image;
+    let ranges: Vec<String> = image
+        .areas
+        .iter()
+        .map(|area| format!("${:04X}-${:04X}", area.load, area.end().saturating_sub(1)))
+        .collect();
+    let bytes: usize = image.areas.iter().map(|area| area.bytes.len()).sum();
+    #[allow(clippy::print_stdout, reason = "the CLI reports what it wrote")]
+    {
+        println!(
+            "{} ({}, target {}): {} byte{} at {}, entry ${:04X}",
+            args.output.display(),
+            args.format,
+            linked.layout.name,
+            bytes,
+            if bytes == 1 { "" } else { "s" },
+            if ranges.is_empty() {
+                "no address".to_owned()
+            } else {
+                ranges.join(", ")
+            },
+            image.entry
+        );
+    }
+}
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let mut objects = Vec::with_capacity(args.objects.len());
+    for path in &args.objects {
+        objects.push((path.display().to_string(), read(path)?));
+    }
+    link_and_write(&objects, &args.link, &DiskSources)
+}
