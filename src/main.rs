@@ -25,15 +25,18 @@ struct Cli {
 enum Command {
     /// Disassemble a raw binary file.
     Disasm(cmd::disasm::Args),
-    /// Link 6502 ELF objects into a Scorpion image.
-    Link(cmd::link::Args),
+    /// List the serial ports a robot could be on.
+    Ports(cmd::ports::Args),
+    /// Dump robot memory with `/7R` questions.
+    Read(cmd::read::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Disasm(args) => cmd::disasm::run(&args),
-        Command::Link(args) => cmd::link::run(&args),
+        Command::Ports(args) => cmd::ports::run(&args),
+        Command::Read(args) => cmd::read::run(&args),
     };
     match result {
         Ok(code) => code,

@@ -1,4 +1,5 @@
 //! One module per subcommand.
 
 pub(crate) mod disasm;
-pub(crate) mod link;
+pub(crate) mod ports;
+pub(crate) mod read;

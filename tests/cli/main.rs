@@ -2,6 +2,7 @@
 //! status out, snapshotted with insta. One module per subcommand.
 
 mod disasm;
+mod read;
 
 use std::process::{Command, Output};
 

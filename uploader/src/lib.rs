@@ -11,11 +11,15 @@
 //!   byte with overlapping `/7R` reads, rewrites what differs, and installs
 //!   hooks only after the body verified.
 //!
+//! - [`Expectations`]: commands and the answers they must produce, checked
+//!   on the virtual Scorpion before a real robot is touched.
+//!
 //! Nothing here prints: progress goes through [`Progress`], failures are
 //! [`Error`]s.
 
 mod client;
 mod error;
+mod expect;
 mod image;
 mod progress;
 pub mod transport;
@@ -28,6 +32,7 @@ mod tests;
 
 pub use client::{Client, ClientConfig, ClientStats};
 pub use error::{Error, Result};
+pub use expect::{Expectation, Expectations, Required};
 pub use image::{Area, RomProfile, UploadImage};
 pub use progress::{Event, NoProgress, Phase, Progress};
 pub use transport::Transport;

@@ -412,3 +412,40 @@ fn probe_tells_no_answer_from_wrong_baud() {
         romlib::protocol::BusyByte(0)
     );
 }
+
+#[test]
+fn expectations_parse_and_check() {
+    let text =
+        "# rehearsal\n/1X => X00\n/7R040003 => R4C23F1  # the chain slot\n/2E3\n/1X\n/1X => *\n";
+    let expectations = Expectations::parse(text).expect("parses");
+    assert_eq!(expectations.lines.len(), 5);
+    assert_eq!(expectations.lines[2].required, Required::Nothing);
+    assert_eq!(expectations.lines[3].required, Required::Any);
+    let mut robot = ModelRobot::new(BAUD);
+    robot.memory[0x0400..0x0403].copy_from_slice(&[0x4C, 0x23, 0xF1]);
+    let mut client = Client::new(robot, ClientConfig::default());
+    let transcript = expectations.check(&mut client).expect("all answered");
+    assert_eq!(transcript.len(), 5);
+    assert_eq!(
+        transcript[1].1,
+        Some(romlib::protocol::Answer::Memory(vec![0x4C, 0x23, 0xF1]))
+    );
+
+    let wrong = Expectations::parse("/7R040001 => R00").expect("parses");
+    let error = wrong.check(&mut client).expect_err("differs");
+    assert!(
+        matches!(&error, Error::RehearsalFailed { expected, found, .. } if expected == "R00" && found == "R4C"),
+        "{error:?}"
+    );
+    for (bad, why) in [
+        ("/1X => B00", "cannot answer"),
+        ("/7R0400 => R", "command"),
+        ("/1X =>", "nothing after"),
+    ] {
+        let error = Expectations::parse(bad).expect_err(bad);
+        assert!(
+            matches!(&error, Error::BadExpectations { line: 1, reason } if reason.contains(why)),
+            "{bad}: {error:?}"
+        );
+    }
+}
