@@ -1,0 +1,475 @@
+//! Diagnostics: spans, the collector the assembler reports into, and the
+//! public [`Diagnostic`] that miette renders.
+//!
+//! The assembler never stops at the first problem. Every stage pushes cheap
+//! raw records (a span, a message, the expansion context) into a [`Reporter`];
+//! only at the end are they turned into [`Diagnostic`]s with their source
+//! text, line and column, and a backtrace of macro expansions and includes
+//! as related notes.
+
+use std::fmt;
+use std::sync::Arc;
+
+use miette::{LabeledSpan, NamedSource, SourceCode};
+
+/// A byte range in one source file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub(crate) struct Span {
+    /// Index in [`Files`].
+    pub(crate) file: u32,
+    /// First byte.
+    pub(crate) start: u32,
+    /// One past the last byte.
+    pub(crate) end: u32,
+}
+
+impl Span {
+    /// The smallest span covering both (same file assumed; else `self`).
+    pub(crate) fn to(self, other: Span) -> Span {
+        if self.file != other.file {
+            return self;
+        }
+        Span {
+            file: self.file,
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
+    }
+}
+
+/// One source file the assembler read.
+#[derive(Debug)]
+pub(crate) struct SourceFile {
+    /// The name shown to users (the path as given or as resolved).
+    pub(crate) name: String,
+    /// The bytes.
+    pub(crate) text: Arc<[u8]>,
+}
+
+/// Every file read during one assembly, indexed by [`Span::file`].
+#[derive(Debug, Default)]
+pub(crate) struct Files {
+    pub(crate) files: Vec<SourceFile>,
+}
+
+impl Files {
+    pub(crate) fn add(&mut self, name: String, text: Arc<[u8]>) -> u32 {
+        self.files.push(SourceFile { name, text });
+        (self.files.len() - 1) as u32
+    }
+
+    pub(crate) fn text(&self, file: u32) -> &[u8] {
+        self.files.get(file as usize).map_or(&[], |f| &f.text)
+    }
+
+    pub(crate) fn name(&self, file: u32) -> &str {
+        self.files
+            .get(file as usize)
+            .map_or("<unknown>", |f| f.name.as_str())
+    }
+
+    /// The text of a span, lossily decoded.
+    pub(crate) fn snippet(&self, span: Span) -> String {
+        let text = self.text(span.file);
+        let start = (span.start as usize).min(text.len());
+        let end = (span.end as usize).clamp(start, text.len());
+        String::from_utf8_lossy(&text[start..end]).into_owned()
+    }
+
+    /// Line and column (both from 1, the column in characters) of a byte offset.
+    pub(crate) fn line_col(&self, file: u32, offset: u32) -> (u32, u32) {
+        let text = self.text(file);
+        let offset = (offset as usize).min(text.len());
+        let before = &text[..offset];
+        let line = before.iter().filter(|b| **b == b'\n').count() as u32 + 1;
+        let line_start = before
+            .iter()
+            .rposition(|b| *b == b'\n')
+            .map_or(0, |p| p + 1);
+        let column = count_chars(&text[line_start..offset]) + 1;
+        (line, column)
+    }
+}
+
+/// Characters in a UTF-8 byte string (continuation bytes are not counted).
+pub(crate) fn count_chars(bytes: &[u8]) -> u32 {
+    bytes.iter().filter(|b| (**b & 0xC0) != 0x80).count() as u32
+}
+
+/// Index in the expansion-context tree; 0 is the main file.
+pub(crate) type CtxId = u32;
+
+/// Why the assembler is reading a line: the chain of includes and
+/// expansions, kept as a tree so that a deferred diagnostic can name it.
+#[derive(Debug, Clone)]
+pub(crate) enum CtxKind {
+    /// The main source file.
+    Root,
+    /// A file included at `span`.
+    Include,
+    /// Macro `name` expanded at `span`.
+    Macro(String),
+    /// A `.repeat` block started at `span`.
+    Repeat,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct CtxNode {
+    pub(crate) parent: CtxId,
+    pub(crate) kind: CtxKind,
+    pub(crate) span: Span,
+}
+
+/// How serious a diagnostic is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Severity {
+    /// The object is not written.
+    Error,
+    /// Likely a mistake; the object is still written.
+    Warning,
+}
+
+/// A diagnostic as recorded during assembly, before rendering.
+#[derive(Debug, Clone)]
+pub(crate) struct RawDiag {
+    pub(crate) severity: Severity,
+    pub(crate) code: &'static str,
+    pub(crate) message: String,
+    pub(crate) span: Span,
+    pub(crate) label: Option<String>,
+    pub(crate) secondary: Vec<(Span, String)>,
+    pub(crate) help: Option<String>,
+    pub(crate) ctx: CtxId,
+}
+
+impl RawDiag {
+    pub(crate) fn label(mut self, label: impl Into<String>) -> RawDiag {
+        self.label = Some(label.into());
+        self
+    }
+
+    pub(crate) fn help(mut self, help: impl Into<String>) -> RawDiag {
+        self.help = Some(help.into());
+        self
+    }
+
+    pub(crate) fn also(mut self, span: Span, label: impl Into<String>) -> RawDiag {
+        self.secondary.push((span, label.into()));
+        self
+    }
+}
+
+/// Collects diagnostics; stores at most `max_errors` errors but counts all.
+#[derive(Debug)]
+pub(crate) struct Reporter {
+    pub(crate) diags: Vec<RawDiag>,
+    pub(crate) errors: usize,
+    pub(crate) max_errors: usize,
+    pub(crate) dropped: usize,
+    warnings_kept: usize,
+}
+
+impl Reporter {
+    pub(crate) fn new(max_errors: usize) -> Reporter {
+        Reporter {
+            diags: Vec::new(),
+            errors: 0,
+            max_errors: max_errors.max(1),
+            dropped: 0,
+            warnings_kept: 0,
+        }
+    }
+
+    pub(crate) fn push(&mut self, diag: RawDiag) {
+        match diag.severity {
+            Severity::Error => {
+                self.errors += 1;
+                if self.errors > self.max_errors {
+                    self.dropped += 1;
+                    return;
+                }
+            }
+            Severity::Warning => {
+                // Warnings share the cap so a noisy file cannot flood output.
+                if self.warnings_kept >= self.max_errors {
+                    self.dropped += 1;
+                    return;
+                }
+                self.warnings_kept += 1;
+            }
+        }
+        self.diags.push(diag);
+    }
+
+    pub(crate) fn has_errors(&self) -> bool {
+        self.errors > 0
+    }
+}
+
+/// Builds a raw error.
+pub(crate) fn error(code: &'static str, span: Span, message: impl Into<String>) -> RawDiag {
+    RawDiag {
+        severity: Severity::Error,
+        code,
+        message: message.into(),
+        span,
+        label: None,
+        secondary: Vec::new(),
+        help: None,
+        ctx: 0,
+    }
+}
+
+/// Builds a raw warning.
+pub(crate) fn warning(code: &'static str, span: Span, message: impl Into<String>) -> RawDiag {
+    RawDiag {
+        severity: Severity::Warning,
+        ..error(code, span, message)
+    }
+}
+
+/// Where a diagnostic points: file, line and column (from 1).
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Location {
+    /// The file's name as the assembler knows it.
+    pub file: String,
+    /// Line, from 1.
+    pub line: u32,
+    /// Column in characters, from 1.
+    pub column: u32,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file, self.line, self.column)
+    }
+}
+
+/// One rendered assembler diagnostic (error, warning or backtrace note),
+/// with its source snippet for miette.
+#[derive(Debug, Clone)]
+pub struct Diagnostic {
+    severity: Severity,
+    code: &'static str,
+    message: String,
+    location: Option<Location>,
+    source: Option<NamedSource<Arc<[u8]>>>,
+    labels: Vec<LabeledSpan>,
+    help: Option<String>,
+    related: Vec<Diagnostic>,
+    advice: bool,
+}
+
+impl Diagnostic {
+    /// Error or warning.
+    #[must_use]
+    pub fn severity(&self) -> Severity {
+        self.severity
+    }
+
+    /// The stable code (`asm::range`, `asm::undefined`...).
+    #[must_use]
+    pub fn code(&self) -> &'static str {
+        self.code
+    }
+
+    /// The message, without location.
+    #[must_use]
+    pub fn message(&self) -> &str {
+        &self.message
+    }
+
+    /// Where the diagnostic points, if it points into a source file.
+    #[must_use]
+    pub fn location(&self) -> Option<&Location> {
+        self.location.as_ref()
+    }
+
+    /// Suggested fix, if any.
+    #[must_use]
+    pub fn help_text(&self) -> Option<&str> {
+        self.help.as_deref()
+    }
+
+    /// The backtrace and secondary notes (macro expansions, includes,
+    /// "defined here").
+    #[must_use]
+    pub fn notes(&self) -> &[Diagnostic] {
+        &self.related
+    }
+
+    /// A one-line summary: `file:line:col: error: message`.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let kind = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
+        match &self.location {
+            Some(location) => format!("{location}: {kind}: {}", self.message),
+            None => format!("{kind}: {}", self.message),
+        }
+    }
+
+    /// A diagnostic with no source position (used for whole-file problems).
+    pub(crate) fn plain(severity: Severity, code: &'static str, message: String) -> Diagnostic {
+        Diagnostic {
+            severity,
+            code,
+            message,
+            location: None,
+            source: None,
+            labels: Vec::new(),
+            help: None,
+            related: Vec::new(),
+            advice: false,
+        }
+    }
+
+    fn at(
+        files: &Files,
+        severity: Severity,
+        code: &'static str,
+        message: String,
+        span: Span,
+        label: Option<String>,
+    ) -> Diagnostic {
+        let file = files.files.get(span.file as usize);
+        let Some(file) = file else {
+            return Diagnostic::plain(severity, code, message);
+        };
+        let (line, column) = files.line_col(span.file, span.start);
+        let len = file.text.len();
+        let start = (span.start as usize).min(len);
+        let end = (span.end as usize).clamp(start, len);
+        Diagnostic {
+            severity,
+            code,
+            message,
+            location: Some(Location {
+                file: file.name.clone(),
+                line,
+                column,
+            }),
+            source: Some(NamedSource::new(file.name.clone(), Arc::clone(&file.text))),
+            labels: vec![LabeledSpan::new_primary_with_span(
+                label,
+                (start, end - start),
+            )],
+            help: None,
+            related: Vec::new(),
+            advice: false,
+        }
+    }
+
+    /// Renders a raw diagnostic with its context chain.
+    pub(crate) fn render(files: &Files, ctx: &[CtxNode], raw: &RawDiag) -> Diagnostic {
+        let mut diagnostic = Diagnostic::at(
+            files,
+            raw.severity,
+            raw.code,
+            raw.message.clone(),
+            raw.span,
+            raw.label.clone(),
+        );
+        diagnostic.help = raw.help.clone();
+        for (span, label) in &raw.secondary {
+            if span.file == raw.span.file {
+                let len = files.text(span.file).len();
+                let start = (span.start as usize).min(len);
+                let end = (span.end as usize).clamp(start, len);
+                diagnostic.labels.push(LabeledSpan::new_with_span(
+                    Some(label.clone()),
+                    (start, end - start),
+                ));
+            } else {
+                let mut note =
+                    Diagnostic::at(files, raw.severity, "asm::note", label.clone(), *span, None);
+                note.advice = true;
+                diagnostic.related.push(note);
+            }
+        }
+        let mut id = raw.ctx;
+        let mut guard = 0;
+        while id != 0 && guard < 64 {
+            guard += 1;
+            let Some(node) = ctx.get(id as usize) else {
+                break;
+            };
+            let message = match &node.kind {
+                CtxKind::Root => break,
+                CtxKind::Include => "in the file included from here".to_string(),
+                CtxKind::Macro(name) => format!("in the expansion of macro `{name}`"),
+                CtxKind::Repeat => "in this `.repeat` block".to_string(),
+            };
+            let mut note = Diagnostic::at(
+                files,
+                raw.severity,
+                "asm::backtrace",
+                message,
+                node.span,
+                Some("from here".to_string()),
+            );
+            note.advice = true;
+            diagnostic.related.push(note);
+            id = node.parent;
+        }
+        diagnostic
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Diagnostic {}
+
+impl miette::Diagnostic for Diagnostic {
+    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        if self.advice {
+            return None;
+        }
+        Some(Box::new(self.code))
+    }
+
+    fn severity(&self) -> Option<miette::Severity> {
+        Some(if self.advice {
+            miette::Severity::Advice
+        } else {
+            match self.severity {
+                Severity::Error => miette::Severity::Error,
+                Severity::Warning => miette::Severity::Warning,
+            }
+        })
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        self.help
+            .as_ref()
+            .map(|help| Box::new(help) as Box<dyn fmt::Display>)
+    }
+
+    fn source_code(&self) -> Option<&dyn SourceCode> {
+        self.source.as_ref().map(|source| source as &dyn SourceCode)
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
+        if self.labels.is_empty() {
+            return None;
+        }
+        Some(Box::new(self.labels.iter().cloned()))
+    }
+
+    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
+        if self.related.is_empty() {
+            return None;
+        }
+        Some(Box::new(
+            self.related
+                .iter()
+                .map(|diagnostic| diagnostic as &dyn miette::Diagnostic),
+        ))
+    }
+}

@@ -1,0 +1,507 @@
+//! Instructions: operand syntax, addressing-mode choice, encoding.
+//!
+//! Opcodes come only from `isa::encode`. Where an operand could be
+//! zero-page or absolute and its value is not known yet (a symbol defined
+//! later), the instruction becomes a variable-size item that the layout
+//! passes settle; everything else is encoded at once.
+
+use isa::objfmt::{BinaryOp, UnaryOp};
+use isa::{AddressingMode as Mode, Mnemonic};
+
+use crate::asm::{Asm, PResult};
+use crate::diag::{self, Span};
+use crate::expr::{Base, EvalErr, Value};
+use crate::intern::Keyword;
+use crate::lexer::{Tok, Token};
+use crate::model::{AssertRec, FixKind, Fixup, Node, NodeId, VarItem, VarKind};
+
+/// An address-size override (`z:`, `a:`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Size {
+    Auto,
+    Zp,
+    Abs,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Index {
+    None,
+    X,
+    Y,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Operand {
+    None,
+    Acc,
+    Imm(NodeId),
+    Direct(NodeId, Index, Size),
+    Ind(NodeId),
+    IndX(NodeId),
+    IndY(NodeId),
+}
+
+/// Where an address-like value lands: zero page, absolute, or not known yet.
+enum Fit {
+    Zp,
+    Abs,
+    Unknown,
+}
+
+impl Asm<'_> {
+    fn reg(&self, tok: Option<&Token>) -> Option<Keyword> {
+        let tok = tok?;
+        if tok.kind != Tok::Ident {
+            return None;
+        }
+        match self.names.keyword(tok.name()) {
+            k @ (Keyword::RegA | Keyword::RegX | Keyword::RegY) => Some(k),
+            _ => None,
+        }
+    }
+
+    fn operand(&mut self, mnemonic: Mnemonic, t: &[Token], mut p: usize) -> PResult<Operand> {
+        let n = t.len();
+        if p == n {
+            return Ok(Operand::None);
+        }
+        if p + 1 == n
+            && self.reg(t.get(p)) == Some(Keyword::RegA)
+            && isa::has_mode(mnemonic, Mode::Accumulator)
+        {
+            return Ok(Operand::Acc);
+        }
+        if t[p].kind == Tok::Hash {
+            p += 1;
+            let expr = self.expression(t, &mut p)?;
+            self.expect_end(t, p)?;
+            return Ok(Operand::Imm(expr));
+        }
+        let mut size = Size::Auto;
+        if t[p].kind == Tok::Ident && t.get(p + 1).map(|t| t.kind) == Some(Tok::Colon) {
+            size = match self.names.keyword(t[p].name()) {
+                Keyword::SizeZ => Size::Zp,
+                Keyword::RegA => Size::Abs,
+                Keyword::SizeF => {
+                    return Err(self.err(
+                        "asm::mode",
+                        t[p].span,
+                        "`f:` (far, 24-bit) addressing does not exist on the 6502",
+                    ));
+                }
+                _ => {
+                    return Err(self.err(
+                        "asm::syntax",
+                        t[p].span.to(t[p + 1].span),
+                        "an address-size prefix is `z:` (zero page) or `a:` (absolute)",
+                    ));
+                }
+            };
+            p += 2;
+        }
+        if t.get(p).map(|t| t.kind) == Some(Tok::LParen) {
+            let save = p;
+            p += 1;
+            let inner = self.expression(t, &mut p)?;
+            if t.get(p).map(|t| t.kind) == Some(Tok::Comma)
+                && self.reg(t.get(p + 1)) == Some(Keyword::RegX)
+                && t.get(p + 2).map(|t| t.kind) == Some(Tok::RParen)
+            {
+                self.expect_end(t, p + 3)?;
+                return Ok(Operand::IndX(inner));
+            }
+            if t.get(p).map(|t| t.kind) == Some(Tok::RParen) {
+                if p + 1 == n {
+                    return Ok(Operand::Ind(inner));
+                }
+                if t[p + 1].kind == Tok::Comma && self.reg(t.get(p + 2)) == Some(Keyword::RegY) {
+                    self.expect_end(t, p + 3)?;
+                    return Ok(Operand::IndY(inner));
+                }
+            }
+            // `(a+b)*2`: a parenthesised expression, not indirection.
+            p = save;
+        }
+        let expr = self.expression(t, &mut p)?;
+        let mut index = Index::None;
+        if t.get(p).map(|t| t.kind) == Some(Tok::Comma) {
+            index = match self.reg(t.get(p + 1)) {
+                Some(Keyword::RegX) => Index::X,
+                Some(Keyword::RegY) => Index::Y,
+                _ => {
+                    let span = self.span_at(t, p + 1);
+                    return Err(self.err(
+                        "asm::syntax",
+                        span,
+                        "expected `x` or `y` after the comma",
+                    ));
+                }
+            };
+            p += 2;
+        }
+        self.expect_end(t, p)?;
+        Ok(Operand::Direct(expr, index, size))
+    }
+
+    /// Encodes one instruction.
+    pub(crate) fn instruction(&mut self, mnemonic: Mnemonic, t: &[Token], p: usize) -> PResult<()> {
+        let head = t[p];
+        let operand = self.operand(mnemonic, t, p + 1)?;
+        let operand_span = if p + 1 < t.len() {
+            t[p + 1].span.to(t[t.len() - 1].span)
+        } else {
+            head.span
+        };
+        let whole = head.span.to(t[t.len() - 1].span);
+        match operand {
+            Operand::None => {
+                let mode = if isa::has_mode(mnemonic, Mode::Implied) {
+                    Mode::Implied
+                } else if isa::has_mode(mnemonic, Mode::Accumulator) {
+                    Mode::Accumulator
+                } else {
+                    let help = self.mode_help(mnemonic);
+                    let diag = diag::error(
+                        "asm::mode",
+                        head.span,
+                        format!(
+                            "`{}` needs an operand",
+                            mnemonic.name().to_ascii_lowercase()
+                        ),
+                    )
+                    .help(help);
+                    return Err(self.report(diag));
+                };
+                let code = self.opcode(mnemonic, mode, head.span, whole)?;
+                self.item(head.span, 1);
+                self.emit(&[code]);
+                Ok(())
+            }
+            Operand::Acc => {
+                let code = self.opcode(mnemonic, Mode::Accumulator, head.span, whole)?;
+                self.item(head.span, 1);
+                self.emit(&[code]);
+                Ok(())
+            }
+            Operand::Imm(expr) => {
+                let code = self.opcode(mnemonic, Mode::Immediate, head.span, whole)?;
+                self.item(head.span, 2);
+                self.emit(&[code]);
+                self.operand_bytes(expr, FixKind::Imm8, operand_span)
+            }
+            Operand::Ind(expr) => {
+                let code = self.opcode(mnemonic, Mode::Indirect, head.span, whole)?;
+                self.item(head.span, 3);
+                self.emit(&[code]);
+                self.page_wrap_check(expr, whole);
+                self.operand_bytes(expr, FixKind::Abs, operand_span)
+            }
+            Operand::IndX(expr) | Operand::IndY(expr) => {
+                let mode = if matches!(operand, Operand::IndX(_)) {
+                    Mode::IndirectX
+                } else {
+                    Mode::IndirectY
+                };
+                let code = self.opcode(mnemonic, mode, head.span, whole)?;
+                self.item(head.span, 2);
+                self.emit(&[code]);
+                self.operand_bytes(expr, FixKind::Zp, operand_span)
+            }
+            Operand::Direct(expr, index, size) => {
+                if mnemonic.is_branch() {
+                    if index != Index::None || size != Size::Auto {
+                        return Err(self.err(
+                            "asm::mode",
+                            operand_span,
+                            "a branch takes a plain target address",
+                        ));
+                    }
+                    let code = self.opcode(mnemonic, Mode::Relative, head.span, whole)?;
+                    return self.branch(code, expr, head.span, operand_span);
+                }
+                let (zp_mode, abs_mode) = match index {
+                    Index::None => (Mode::ZeroPage, Mode::Absolute),
+                    Index::X => (Mode::ZeroPageX, Mode::AbsoluteX),
+                    Index::Y => (Mode::ZeroPageY, Mode::AbsoluteY),
+                };
+                let narrow = isa::encode(mnemonic, zp_mode);
+                let wide = isa::encode(mnemonic, abs_mode);
+                let choice = match (narrow, wide, size) {
+                    (None, None, _) => {
+                        let mode = abs_mode;
+                        return Err(self.no_mode(mnemonic, mode, whole));
+                    }
+                    (Some(_), _, Size::Zp) | (Some(_), None, Size::Auto) => Fit::Zp,
+                    (_, Some(_), Size::Abs) | (None, Some(_), Size::Auto) => Fit::Abs,
+                    (None, Some(_), Size::Zp) => return Err(self.no_mode(mnemonic, zp_mode, whole)),
+                    (Some(_), None, Size::Abs) => {
+                        return Err(self.no_mode(mnemonic, abs_mode, whole));
+                    }
+                    (Some(_), Some(_), Size::Auto) => self.fit(expr, operand_span)?,
+                };
+                match choice {
+                    Fit::Zp => {
+                        let code = self.opcode(mnemonic, zp_mode, head.span, whole)?;
+                        self.item(head.span, 2);
+                        self.emit(&[code]);
+                        self.operand_bytes(expr, FixKind::Zp, operand_span)
+                    }
+                    Fit::Abs => {
+                        let code = self.opcode(mnemonic, abs_mode, head.span, whole)?;
+                        self.item(head.span, 3);
+                        self.emit(&[code]);
+                        self.operand_bytes(expr, FixKind::Abs, operand_span)
+                    }
+                    Fit::Unknown => {
+                        let narrow = self.opcode(mnemonic, zp_mode, head.span, whole)?;
+                        let wide = self.opcode(mnemonic, abs_mode, head.span, whole)?;
+                        self.item(head.span, 2);
+                        self.pending(narrow, wide, expr, operand_span);
+                        Ok(())
+                    }
+                }
+            }
+        }
+    }
+
+    /// The opcode, refusing undocumented ones unless enabled.
+    fn opcode(&mut self, mnemonic: Mnemonic, mode: Mode, span: Span, whole: Span) -> PResult<u8> {
+        let Some(code) = isa::encode(mnemonic, mode) else {
+            return Err(self.no_mode(mnemonic, mode, whole));
+        };
+        if !isa::opcode(code).is_documented() {
+            if !self.cpu_x {
+                let diag = diag::error(
+                    "asm::undocumented",
+                    span,
+                    format!(
+                        "`{} {}` (opcode ${code:02X}) is an undocumented NMOS opcode",
+                        mnemonic.name().to_ascii_lowercase(),
+                        mode
+                    ),
+                )
+                .help("enable the undocumented opcodes with `.setcpu \"6502X\"`");
+                return Err(self.report(diag));
+            }
+            self.used_undoc = true;
+        }
+        Ok(code)
+    }
+
+    fn mode_help(&self, mnemonic: Mnemonic) -> String {
+        let modes: Vec<String> = isa::AddressingMode::ALL
+            .iter()
+            .filter(|mode| {
+                isa::encode(mnemonic, **mode)
+                    .is_some_and(|code| self.cpu_x || isa::opcode(code).is_documented())
+            })
+            .map(ToString::to_string)
+            .collect();
+        format!(
+            "`{}` has: {}",
+            mnemonic.name().to_ascii_lowercase(),
+            modes.join(", ")
+        )
+    }
+
+    fn no_mode(&mut self, mnemonic: Mnemonic, mode: Mode, span: Span) -> crate::asm::Reported {
+        let help = self.mode_help(mnemonic);
+        let diag = diag::error(
+            "asm::mode",
+            span,
+            format!(
+                "`{}` has no {mode} addressing mode",
+                mnemonic.name().to_ascii_lowercase()
+            ),
+        )
+        .help(help);
+        self.report(diag)
+    }
+
+    /// Whether an operand is zero-page, absolute or not known yet.
+    fn fit(&mut self, expr: NodeId, span: Span) -> PResult<Fit> {
+        match self.prog.eval(expr) {
+            Ok(value) => Ok(match self.value_fit(value) {
+                Some(true) => Fit::Zp,
+                Some(false) => Fit::Abs,
+                None => Fit::Unknown,
+            }),
+            Err(EvalErr::NotYet(_)) => Ok(Fit::Unknown),
+            Err(error) => Err(self.eval_error(error, span)),
+        }
+    }
+
+    /// `Some(true)` if the value is a zero-page address, `None` if unknown.
+    pub(crate) fn value_fit(&self, value: Value) -> Option<bool> {
+        Some(match value {
+            Value::Const(v) => (0..=0xFF).contains(&v),
+            Value::Addr { base, .. } => self.base_is_zp(base),
+            Value::Byte { .. } => true,
+            Value::Chunk { chunk, .. } => {
+                let c = &self.prog.chunks[chunk as usize];
+                if c.org {
+                    return None;
+                }
+                self.prog.segs[c.seg as usize].zp
+            }
+        })
+    }
+
+    pub(crate) fn base_is_zp(&self, base: Base) -> bool {
+        match base {
+            Base::Sec(seg) => self.prog.segs[seg as usize].zp,
+            Base::Ext(sym) => matches!(
+                self.prog.syms[sym as usize].def,
+                crate::model::SymDef::Import { zp: true }
+            ),
+        }
+    }
+
+    /// Writes an operand or data value: bytes now if constant, else a
+    /// placeholder and a fixup resolved after layout.
+    pub(crate) fn operand_bytes(&mut self, expr: NodeId, kind: FixKind, span: Span) -> PResult<()> {
+        match self.prog.eval(expr) {
+            Ok(Value::Const(value)) => {
+                let bytes = crate::layout::const_bytes(kind, value).map_err(|(what, range)| {
+                    self.report(crate::layout::range_diag(span, what, value, range))
+                });
+                match bytes {
+                    Ok(bytes) => {
+                        self.emit(&bytes[..kind.len() as usize]);
+                        Ok(())
+                    }
+                    Err(reported) => {
+                        self.emit(&[0; 4][..kind.len() as usize]);
+                        Err(reported)
+                    }
+                }
+            }
+            Ok(_) | Err(EvalErr::NotYet(_)) => {
+                let (chunk, off) = self.here();
+                let loc = self.loc(span);
+                self.prog.fixups.push(Fixup {
+                    chunk,
+                    off,
+                    kind,
+                    expr,
+                    loc,
+                });
+                self.keep_nodes = true;
+                self.emit(&[0; 4][..kind.len() as usize]);
+                Ok(())
+            }
+            Err(error) => {
+                self.emit(&[0; 4][..kind.len() as usize]);
+                Err(self.eval_error(error, span))
+            }
+        }
+    }
+
+    /// An instruction whose size the layout passes decide.
+    fn pending(&mut self, narrow: u8, wide: u8, expr: NodeId, span: Span) {
+        let loc = self.loc(span);
+        let id = self.prog.vars.len() as u32;
+        self.prog.vars.push(VarItem {
+            kind: VarKind::Instr {
+                narrow,
+                wide,
+                expr,
+                is_wide: false,
+            },
+            loc,
+            size: 2,
+        });
+        self.keep_nodes = true;
+        let seg = self.seg as usize;
+        let cur = self.prog.segs[seg].cur as usize;
+        self.prog.chunks[cur].var = Some(id);
+        self.prog.segs[seg].has_data = true;
+        self.prog.segs[seg].used = true;
+        self.total_bytes += 3;
+        let org = self.prog.chunks[cur].org;
+        self.new_chunk(org, None);
+    }
+
+    fn branch(&mut self, code: u8, expr: NodeId, head: Span, span: Span) -> PResult<()> {
+        self.item(head, 2);
+        let (chunk, off) = self.here();
+        self.emit(&[code]);
+        let loc = self.loc(span);
+        self.prog.branches.push((chunk, off + 1, loc));
+        let target = self.prog.eval(expr);
+        let next = self.prog.position(chunk, i64::from(off) + 2);
+        let distance = match target {
+            Ok(target) => self.prog.binary(BinaryOp::Sub, target, next),
+            Err(error) => Err(error),
+        };
+        match distance {
+            Ok(Value::Const(distance)) => {
+                if !(-128..=127).contains(&distance) {
+                    self.emit(&[0]);
+                    return Err(self.report(crate::layout::branch_diag(span, distance)));
+                }
+                self.emit(&[distance as u8]);
+                Ok(())
+            }
+            Err(error @ (EvalErr::DivZero | EvalErr::Circular(_) | EvalErr::TooComplex)) => {
+                self.emit(&[0]);
+                Err(self.eval_error(error, span))
+            }
+            _ => {
+                let (chunk, off) = self.here();
+                self.prog.fixups.push(Fixup {
+                    chunk,
+                    off,
+                    kind: FixKind::Branch,
+                    expr,
+                    loc,
+                });
+                self.keep_nodes = true;
+                self.emit(&[0]);
+                Ok(())
+            }
+        }
+    }
+
+    /// `jmp ($xxFF)` reads its target across the page wrap on the NMOS
+    /// part: warn now if the pointer is known, else leave the check to the
+    /// linker as a deferred warning.
+    fn page_wrap_check(&mut self, expr: NodeId, span: Span) {
+        let message = "`jmp (pointer)` with the pointer at $xxFF reads its high byte from $xx00 on the NMOS 6502";
+        match self.prog.eval(expr) {
+            Ok(Value::Const(value)) => {
+                if value & 0xFF == 0xFF {
+                    let diag = diag::warning(
+                        "asm::jmp-page-wrap",
+                        span,
+                        format!(
+                            "`jmp (${value:04X})` reads its target from ${value:04X} and ${:04X}, not ${:04X}",
+                            value & 0xFF00,
+                            (value + 1) & 0xFFFF
+                        ),
+                    )
+                    .help("move the pointer so that it does not start at the last byte of a page");
+                    self.report(diag);
+                }
+            }
+            Ok(_) | Err(EvalErr::NotYet(_)) => {
+                let low = self.prog.node(Node::Unary(UnaryOp::LoByte, expr));
+                let ff = self.prog.node(Node::Const(0xFF));
+                let check = self.prog.node(Node::Binary(BinaryOp::Ne, low, ff));
+                let loc = self.loc(span);
+                let column = self.column_of(span);
+                self.keep_nodes = true;
+                self.prog.asserts.push(AssertRec {
+                    expr: check,
+                    error: false,
+                    link_only: false,
+                    message: message.to_string(),
+                    loc,
+                    line: self.line.line,
+                    column,
+                });
+            }
+            Err(_) => {}
+        }
+    }
+}

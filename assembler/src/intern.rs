@@ -1,0 +1,241 @@
+//! The name interner: every identifier and directive becomes a [`NameId`]
+//! once, so the hot paths compare integers, and each name carries what it
+//! means to the assembler (mnemonic, directive, register) from the moment
+//! it is first seen.
+
+use std::rc::Rc;
+
+use isa::Mnemonic;
+use rustc_hash::FxHashMap;
+
+/// An interned name.
+pub(crate) type NameId = u32;
+
+macro_rules! directives {
+    ($( $variant:ident = $($name:literal)|+ ;)*) => {
+        /// A directive or pseudo-function (`.byte`, `.lobyte`...).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub(crate) enum Dir { $( $variant, )* }
+
+        fn directive(lower: &str) -> Option<Dir> {
+            match lower {
+                $( $($name)|+ => Some(Dir::$variant), )*
+                _ => None,
+            }
+        }
+    };
+}
+
+directives! {
+    Addr = "addr";
+    Align = "align";
+    And = "and";
+    Asciiz = "asciiz";
+    Assert = "assert";
+    Bankbyte = "bankbyte";
+    Bankbytes = "bankbytes";
+    Bitand = "bitand";
+    Bitnot = "bitnot";
+    Bitor = "bitor";
+    Bitxor = "bitxor";
+    Blank = "blank";
+    Bss = "bss";
+    Byte = "byte" | "byt";
+    Charmap = "charmap";
+    Code = "code";
+    Const = "const";
+    Data = "data";
+    Dbyt = "dbyt";
+    Define = "define";
+    Defined = "defined" | "def";
+    Dword = "dword";
+    Else = "else";
+    Elseif = "elseif";
+    Endenum = "endenum";
+    Endif = "endif";
+    Endmacro = "endmacro" | "endmac";
+    Endproc = "endproc";
+    Endrepeat = "endrepeat" | "endrep";
+    Endscope = "endscope";
+    Endstruct = "endstruct";
+    Endunion = "endunion";
+    Enum = "enum";
+    Error = "error";
+    Exitmacro = "exitmacro" | "exitmac";
+    Export = "export";
+    Exportzp = "exportzp";
+    Fatal = "fatal";
+    Feature = "feature";
+    Global = "global";
+    Globalzp = "globalzp";
+    Hibyte = "hibyte";
+    Hibytes = "hibytes";
+    Hiword = "hiword";
+    If = "if";
+    Ifblank = "ifblank";
+    Ifconst = "ifconst";
+    Ifdef = "ifdef";
+    Ifnblank = "ifnblank";
+    Ifndef = "ifndef";
+    Ifnref = "ifnref";
+    Ifp02 = "ifp02";
+    Ifp816 = "ifp816";
+    Ifpc02 = "ifpc02";
+    Ifref = "ifref";
+    Import = "import";
+    Importzp = "importzp";
+    Incbin = "incbin";
+    Include = "include";
+    List = "list";
+    Local = "local";
+    Lobyte = "lobyte";
+    Lobytes = "lobytes";
+    Loword = "loword";
+    Macro = "macro" | "mac";
+    Mod = "mod";
+    Not = "not";
+    Or = "or";
+    Org = "org";
+    Out = "out";
+    P02 = "p02";
+    Paramcount = "paramcount";
+    Proc = "proc";
+    Referenced = "referenced" | "ref";
+    Reloc = "reloc";
+    Repeat = "repeat";
+    Res = "res";
+    Rodata = "rodata";
+    Scope = "scope";
+    Segment = "segment";
+    Set = "set";
+    Setcpu = "setcpu";
+    Shl = "shl";
+    Shr = "shr";
+    Sizeof = "sizeof";
+    Strlen = "strlen";
+    Struct = "struct";
+    Tag = "tag";
+    Undefine = "undefine" | "undef";
+    Union = "union";
+    Warning = "warning";
+    Word = "word";
+    Xor = "xor";
+    Zeropage = "zeropage";
+}
+
+/// What a name means before any symbol is looked up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Keyword {
+    /// An ordinary identifier.
+    None,
+    /// An instruction mnemonic (any case).
+    Mnemonic(Mnemonic),
+    /// A directive (the name starts with `.`).
+    Directive(Dir),
+    /// `a` / `A`: the accumulator, or the `a:` address-size prefix.
+    RegA,
+    /// `x` / `X`.
+    RegX,
+    /// `y` / `Y`.
+    RegY,
+    /// `z:` zero-page address-size prefix.
+    SizeZ,
+    /// `f:` far (24-bit) address-size prefix, refused on the 6502.
+    SizeF,
+}
+
+/// Per-name data the front end needs on every line.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NameInfo {
+    /// The fixed meaning.
+    pub(crate) keyword: Keyword,
+    /// The macro of that name, if one is defined.
+    pub(crate) macro_id: Option<u32>,
+    /// The `.define` of that name, if one is active.
+    pub(crate) define_id: Option<u32>,
+}
+
+/// The interner.
+#[derive(Debug, Default)]
+pub(crate) struct Interner {
+    map: FxHashMap<Rc<str>, NameId>,
+    names: Vec<Rc<str>>,
+    pub(crate) info: Vec<NameInfo>,
+}
+
+impl Interner {
+    pub(crate) fn new() -> Interner {
+        Interner::default()
+    }
+
+    /// The id of `name`, interning it on first sight.
+    pub(crate) fn intern(&mut self, name: &str) -> NameId {
+        if let Some(id) = self.map.get(name) {
+            return *id;
+        }
+        let id = self.names.len() as NameId;
+        let rc: Rc<str> = Rc::from(name);
+        self.map.insert(Rc::clone(&rc), id);
+        self.names.push(rc);
+        self.info.push(NameInfo {
+            keyword: keyword_of(name),
+            macro_id: None,
+            define_id: None,
+        });
+        id
+    }
+
+    pub(crate) fn name(&self, id: NameId) -> &str {
+        self.names.get(id as usize).map_or("", |n| n)
+    }
+
+    pub(crate) fn keyword(&self, id: NameId) -> Keyword {
+        self.info
+            .get(id as usize)
+            .map_or(Keyword::None, |info| info.keyword)
+    }
+
+    pub(crate) fn info_mut(&mut self, id: NameId) -> Option<&mut NameInfo> {
+        self.info.get_mut(id as usize)
+    }
+}
+
+fn keyword_of(name: &str) -> Keyword {
+    if name.len() > 16 {
+        return Keyword::None;
+    }
+    let lower = name.to_ascii_lowercase();
+    if let Some(rest) = lower.strip_prefix('.') {
+        return directive(rest).map_or(Keyword::None, Keyword::Directive);
+    }
+    match lower.as_str() {
+        "a" => return Keyword::RegA,
+        "x" => return Keyword::RegX,
+        "y" => return Keyword::RegY,
+        "z" => return Keyword::SizeZ,
+        "f" => return Keyword::SizeF,
+        _ => {}
+    }
+    Mnemonic::from_name(&lower).map_or(Keyword::None, Keyword::Mnemonic)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keywords_ignore_case_but_names_do_not() {
+        let mut names = Interner::new();
+        let lower = names.intern("lda");
+        let upper = names.intern("LDA");
+        assert_ne!(lower, upper);
+        assert_eq!(names.keyword(lower), Keyword::Mnemonic(Mnemonic::Lda));
+        assert_eq!(names.keyword(upper), Keyword::Mnemonic(Mnemonic::Lda));
+        let byte = names.intern(".BYT");
+        assert_eq!(names.keyword(byte), Keyword::Directive(Dir::Byte));
+        let label = names.intern("label");
+        assert_eq!(names.keyword(label), Keyword::None);
+        assert_eq!(names.intern("lda"), lower);
+        assert_eq!(names.name(upper), "LDA");
+    }
+}

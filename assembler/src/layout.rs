@@ -1,0 +1,906 @@
+//! After the front end: end-of-input checks, the layout fixpoint that
+//! settles zero-page versus absolute operands, and final resolution of
+//! every fixup into bytes or relocations.
+//!
+//! The fixpoint starts every undecided operand at zero page and only ever
+//! widens: a pass places the chunks, re-evaluates the undecided operands
+//! with the placed addresses, widens those that no longer fit, and stops
+//! when a pass widens nothing. Each operand widens at most once, so the
+//! loop ends.
+
+use isa::elf::{
+    R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_ADDR16_HI, R_MOS_ADDR16_LO, R_MOS_ADDR24_BANK, R_MOS_IMM8,
+    R_MOS_PCREL_8,
+};
+use isa::objfmt::{BinaryOp, ExprOp, UnaryOp};
+
+use crate::asm::Asm;
+use crate::diag::{self, RawDiag, Span};
+use crate::expr::{Base, EvalErr, Sel, Value};
+use crate::model::{
+    ChunkId, FixKind, GLOBAL_SCOPE, LocId, Node, NodeId, ScopeKind, SegId, SymDef, SymId, SymKind,
+    VarKind,
+};
+
+/// What a relocation or a deferred assertion refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Target {
+    /// The section symbol of an output section (index in [`Output::sections`]).
+    Section(usize),
+    /// An output symbol (index in [`Output::symbols`]).
+    Symbol(usize),
+    /// No symbol (`S = 0`).
+    Absolute,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct OutReloc {
+    pub(crate) offset: u32,
+    pub(crate) r_type: u32,
+    pub(crate) target: Target,
+    pub(crate) addend: i64,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct OutSection {
+    pub(crate) name: String,
+    pub(crate) zp: bool,
+    pub(crate) nobits: bool,
+    pub(crate) data: Vec<u8>,
+    pub(crate) size: u32,
+    pub(crate) align: u32,
+    pub(crate) relocs: Vec<OutReloc>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum OutSymKind {
+    Abs(i64),
+    Sec(usize, u32),
+    Undef { zp: bool },
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct OutSym {
+    pub(crate) name: String,
+    pub(crate) kind: OutSymKind,
+    pub(crate) global: bool,
+    /// (file, line, column) of the definition.
+    pub(crate) place: Option<(u32, u32, u32)>,
+}
+
+/// One bytecode step of a deferred assertion, before symbol numbering.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum AssertOp {
+    Const(i64),
+    Target(Target),
+    Unary(UnaryOp),
+    Binary(BinaryOp),
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct OutAssert {
+    pub(crate) error: bool,
+    pub(crate) file: u32,
+    pub(crate) line: u32,
+    pub(crate) column: u32,
+    pub(crate) message: String,
+    pub(crate) ops: Vec<AssertOp>,
+}
+
+/// Everything the object writer needs.
+#[derive(Debug, Default)]
+pub(crate) struct Output {
+    pub(crate) sections: Vec<OutSection>,
+    pub(crate) symbols: Vec<OutSym>,
+    /// (section, offset, file, line, column) of every item.
+    pub(crate) items: Vec<(usize, u32, u32, u32, u32)>,
+    pub(crate) asserts: Vec<OutAssert>,
+    /// Output section of each segment (`None` when the segment is empty).
+    pub(crate) seg_section: Vec<Option<usize>>,
+}
+
+/// The bytes of a constant stored as `kind`, or what and which range.
+pub(crate) fn const_bytes(
+    kind: FixKind,
+    value: i64,
+) -> Result<[u8; 4], (&'static str, (i64, i64))> {
+    let (what, range) = match kind {
+        FixKind::Imm8 => ("immediate value", (0, 0xFF)),
+        FixKind::Byte => ("byte value", (0, 0xFF)),
+        FixKind::Zp => ("zero-page address", (0, 0xFF)),
+        FixKind::Abs => ("address", (0, 0xFFFF)),
+        FixKind::Word => ("word value", (0, 0xFFFF)),
+        FixKind::Dbyt => ("word value", (0, 0xFFFF)),
+        FixKind::Dword => ("dword value", (i64::from(i32::MIN), i64::from(u32::MAX))),
+        FixKind::Branch => ("branch distance", (-128, 127)),
+    };
+    if value < range.0 || value > range.1 {
+        return Err((what, range));
+    }
+    let v = value as u32;
+    Ok(match kind {
+        FixKind::Dbyt => [(v >> 8) as u8, v as u8, 0, 0],
+        _ => v.to_le_bytes(),
+    })
+}
+
+fn show(value: i64) -> String {
+    if (0..10).contains(&value) {
+        value.to_string()
+    } else if value < 0 {
+        format!("{value}")
+    } else {
+        format!("{value} (${value:X})")
+    }
+}
+
+/// A range error naming the value and the allowed range.
+pub(crate) fn range_diag(span: Span, what: &str, value: i64, range: (i64, i64)) -> RawDiag {
+    let bounds = if range.0 >= 0 && range.1 >= 16 {
+        format!("{} to {} (${:X})", range.0, range.1, range.1)
+    } else {
+        format!("{} to {}", range.0, range.1)
+    };
+    diag::error(
+        "asm::range",
+        span,
+        format!("{what} {} is out of range", show(value)),
+    )
+    .label(format!("this is {}", show(value)))
+    .help(format!("a {what} must be {bounds}"))
+}
+
+/// A branch that does not reach.
+pub(crate) fn branch_diag(span: Span, distance: i64) -> RawDiag {
+    diag::error(
+        "asm::branch-range",
+        span,
+        format!("branch target is {distance:+} bytes away; a branch reaches -128 to +127"),
+    )
+    .label(format!("{distance:+} bytes from the next instruction"))
+    .help("branch the other way over a `jmp` to the target")
+}
+
+impl Asm<'_> {
+    fn report_at(&mut self, loc: LocId, mut diag: RawDiag) {
+        if let Some(l) = self.prog.locs.get(loc as usize) {
+            diag.ctx = l.ctx;
+        }
+        self.rep.push(diag);
+    }
+
+    fn loc_span(&self, loc: LocId) -> Span {
+        self.prog
+            .locs
+            .get(loc as usize)
+            .map(|l| l.span)
+            .unwrap_or_default()
+    }
+
+    /// End-of-input checks: open scopes, outer-scope binding of names
+    /// used inside scopes, `.global`, undefined names.
+    pub(crate) fn finish_front(&mut self) {
+        while let Some((scope, loc)) = self.scope_stack.pop() {
+            let kind = self.prog.scopes[scope as usize].kind;
+            let what = if kind == ScopeKind::Proc {
+                "`.proc` has no `.endproc`"
+            } else {
+                "`.scope` has no `.endscope`"
+            };
+            let span = self.loc_span(loc);
+            self.report_at(loc, diag::error("asm::unclosed", span, what));
+        }
+        for sym in 0..self.prog.syms.len() {
+            let s = &self.prog.syms[sym];
+            if s.def != SymDef::Undefined || s.kind != SymKind::Normal || s.scope == GLOBAL_SCOPE {
+                continue;
+            }
+            let (name, mut scope) = (s.name, s.scope);
+            while scope != GLOBAL_SCOPE {
+                scope = self.prog.scopes[scope as usize].parent;
+                if let Some(outer) = self.find_sym(scope, name)
+                    && self.prog.syms[outer as usize].is_defined()
+                {
+                    self.prog.syms[sym].def = SymDef::Alias(outer);
+                    break;
+                }
+            }
+        }
+        for sym in 0..self.prog.syms.len() {
+            let s = &self.prog.syms[sym];
+            if s.def == SymDef::Undefined && s.global {
+                let zp = s.export.unwrap_or(false);
+                let s = &mut self.prog.syms[sym];
+                s.def = SymDef::Import { zp };
+                s.export = None;
+                s.def_loc = s.export_loc;
+            }
+        }
+        for sym in 0..self.prog.syms.len() {
+            let s = &self.prog.syms[sym];
+            if s.def != SymDef::Undefined {
+                continue;
+            }
+            let Some(loc) = s.ref_loc.or(s.export_loc) else {
+                continue;
+            };
+            let name = self.sym_name(sym as SymId);
+            let span = self.loc_span(loc);
+            let diag = match s.kind {
+                SymKind::Unnamed => diag::error(
+                    "asm::undefined",
+                    span,
+                    "there is no unnamed label `:` after this",
+                ),
+                SymKind::Cheap => diag::error(
+                    "asm::undefined",
+                    span,
+                    format!("cheap local `{name}` is not defined before the next normal label"),
+                ),
+                SymKind::Normal => {
+                    let exported = s.ref_loc.is_none();
+                    let message = if exported {
+                        format!("`{name}` is exported but never defined")
+                    } else {
+                        format!("`{name}` is not defined")
+                    };
+                    diag::error("asm::undefined", span, message).help(format!(
+                        "define it, or import it with `.import {}` if another file defines it",
+                        self.names.name(s.name)
+                    ))
+                }
+            };
+            self.report_at(loc, diag);
+        }
+    }
+
+    /// Places every chunk with the current sizes.
+    fn place(&mut self) {
+        let prog = &mut self.prog;
+        for seg in &mut prog.segs {
+            let mut offset: u32 = 0;
+            let mut abs: i64 = 0;
+            for &c in &seg.chunks {
+                let chunk = &mut prog.chunks[c as usize];
+                chunk.start = offset;
+                if chunk.org {
+                    chunk.abs = chunk.org_base.unwrap_or(abs);
+                }
+                let end = offset.saturating_add(chunk.len);
+                let var_size = match chunk.var.and_then(|v| prog.vars.get_mut(v as usize)) {
+                    None => 0,
+                    Some(var) => {
+                        let size = match var.kind {
+                            VarKind::Instr { is_wide, .. } => 2 + u32::from(is_wide),
+                            VarKind::Align { align, .. } => {
+                                let position = if chunk.org {
+                                    chunk.abs + i64::from(chunk.len)
+                                } else {
+                                    i64::from(end)
+                                };
+                                let align = i64::from(align);
+                                ((align - position.rem_euclid(align)) % align) as u32
+                            }
+                        };
+                        var.size = size;
+                        size
+                    }
+                };
+                offset = end.saturating_add(var_size);
+                abs = chunk.abs + i64::from(chunk.len) + i64::from(var_size);
+            }
+            seg.size = offset;
+        }
+    }
+
+    /// Iterates layout passes until no undecided operand widens.
+    pub(crate) fn layout(&mut self) {
+        self.prog.placed = true;
+        loop {
+            self.place();
+            self.prog.stamp += 1;
+            let mut changed = false;
+            for v in 0..self.prog.vars.len() {
+                let VarKind::Instr {
+                    expr,
+                    is_wide: false,
+                    ..
+                } = self.prog.vars[v].kind
+                else {
+                    continue;
+                };
+                let fits = match self.prog.eval(expr) {
+                    Ok(value) => self.value_fit(value).unwrap_or(false),
+                    // Errors are reported in the final pass; stay narrow.
+                    Err(_) => true,
+                };
+                if !fits && let VarKind::Instr { is_wide, .. } = &mut self.prog.vars[v].kind {
+                    *is_wide = true;
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        self.prog.stamp += 1;
+    }
+
+    fn chunk_pos(&self, chunk: ChunkId, off: u32) -> (SegId, u32) {
+        let c = &self.prog.chunks[chunk as usize];
+        (c.seg, c.start + off)
+    }
+
+    /// Builds the output: section bytes, relocations, symbols, asserts.
+    pub(crate) fn resolve(&mut self) -> Output {
+        let mut out = Output::default();
+        // Sections for used segments.
+        let mut seg_section = vec![None; self.prog.segs.len()];
+        let mut datas: Vec<Vec<u8>> = Vec::with_capacity(self.prog.segs.len());
+        let mut var_fixups: Vec<(ChunkId, u32, FixKind, NodeId, LocId)> = Vec::new();
+        for (index, seg) in self.prog.segs.iter_mut().enumerate() {
+            let has_var = seg
+                .chunks
+                .iter()
+                .any(|c| self.prog.chunks[*c as usize].var.is_some());
+            let data = if has_var {
+                let mut data = Vec::with_capacity(seg.size as usize);
+                for &c in &seg.chunks {
+                    let chunk = &self.prog.chunks[c as usize];
+                    let start = chunk.data_start as usize;
+                    data.extend_from_slice(&seg.data[start..start + chunk.len as usize]);
+                    let Some(var) = chunk.var.and_then(|v| self.prog.vars.get(v as usize)) else {
+                        continue;
+                    };
+                    match var.kind {
+                        VarKind::Instr {
+                            narrow,
+                            wide,
+                            expr,
+                            is_wide,
+                        } => {
+                            data.push(if is_wide { wide } else { narrow });
+                            let kind = if is_wide { FixKind::Abs } else { FixKind::Zp };
+                            var_fixups.push((c, chunk.len + 1, kind, expr, var.loc));
+                            data.extend_from_slice(&[0; 2][..kind.len() as usize]);
+                        }
+                        VarKind::Align { fill, .. } => {
+                            data.resize(data.len() + var.size as usize, fill);
+                        }
+                    }
+                }
+                data
+            } else {
+                std::mem::take(&mut seg.data)
+            };
+            if seg.used || !data.is_empty() {
+                seg_section[index] = Some(out.sections.len());
+                out.sections.push(OutSection {
+                    name: seg.name.clone(),
+                    zp: seg.zp,
+                    nobits: !seg.has_data,
+                    data: Vec::new(),
+                    size: seg.size,
+                    align: seg.align,
+                    relocs: Vec::new(),
+                });
+            }
+            datas.push(data);
+        }
+        out.seg_section = seg_section;
+        // Symbols first: relocations against imports need their indices.
+        let sym_index = self.collect_symbols(&mut out);
+        let fixups = std::mem::take(&mut self.prog.fixups);
+        for fixup in &fixups {
+            self.resolve_field(
+                &mut out,
+                &mut datas,
+                &sym_index,
+                fixup.chunk,
+                fixup.off,
+                fixup.kind,
+                fixup.expr,
+                fixup.loc,
+            );
+        }
+        self.prog.fixups = fixups;
+        for (chunk, off, kind, expr, loc) in var_fixups {
+            self.resolve_field(
+                &mut out, &mut datas, &sym_index, chunk, off, kind, expr, loc,
+            );
+        }
+        self.check_branches(&out, &datas);
+        for (seg, data) in datas.into_iter().enumerate() {
+            if let Some(section) = out.seg_section[seg] {
+                let s = &mut out.sections[section];
+                s.relocs.sort_by_key(|r| r.offset);
+                if !s.nobits {
+                    s.data = data;
+                }
+            }
+        }
+        // Source map items.
+        out.items.reserve(self.prog.items.len());
+        for item in &self.prog.items {
+            let (seg, offset) = self.chunk_pos(item.chunk, item.off);
+            if let Some(section) = out.seg_section[seg as usize] {
+                out.items
+                    .push((section, offset, item.file, item.line, item.column));
+            }
+        }
+        self.check_asserts(&mut out, &sym_index);
+        out
+    }
+
+    /// The output symbols; returns, per symbol id, its output index.
+    fn collect_symbols(&mut self, out: &mut Output) -> Vec<Option<usize>> {
+        let mut index = vec![None; self.prog.syms.len()];
+        for (sym, slot) in index.iter_mut().enumerate() {
+            let s = &self.prog.syms[sym];
+            if s.kind != SymKind::Normal {
+                if s.export.is_some()
+                    && let Some(loc) = s.export_loc
+                {
+                    let span = self.loc_span(loc);
+                    self.report_at(
+                        loc,
+                        diag::error(
+                            "asm::export",
+                            span,
+                            "cheap locals and unnamed labels cannot be exported",
+                        ),
+                    );
+                }
+                continue;
+            }
+            let exported = s.export.is_some();
+            let place = Some(s.place());
+            let export_loc = s.export_loc;
+            let kind = match s.def {
+                SymDef::Undefined | SymDef::Alias(_) | SymDef::Var(_) => continue,
+                SymDef::Import { zp } => {
+                    if s.ref_loc.is_none() && !s.global {
+                        continue;
+                    }
+                    OutSymKind::Undef { zp }
+                }
+                SymDef::Const(value) => OutSymKind::Abs(value),
+                SymDef::Label { .. } | SymDef::Expr(_) => match self.prog.eval_sym(sym as SymId) {
+                    Ok(Value::Const(value)) => OutSymKind::Abs(value),
+                    Ok(Value::Addr {
+                        base: Base::Sec(seg),
+                        off,
+                    }) => match out.seg_section[seg as usize] {
+                        Some(section) => OutSymKind::Sec(section, off as u32),
+                        None => continue,
+                    },
+                    other => {
+                        if exported
+                            && let Some(loc) = export_loc
+                            && !matches!(other, Err(EvalErr::Undefined(_)))
+                        {
+                            let name = self.sym_name(sym as SymId);
+                            let span = self.loc_span(loc);
+                            self.report_at(
+                                loc,
+                                diag::error(
+                                    "asm::export",
+                                    span,
+                                    format!("`{name}` cannot be exported: its value is neither a constant nor an address in this file"),
+                                ),
+                            );
+                        }
+                        continue;
+                    }
+                },
+            };
+            let global = exported || matches!(kind, OutSymKind::Undef { .. });
+            *slot = Some(out.symbols.len());
+            out.symbols.push(OutSym {
+                name: self.sym_name(sym as SymId),
+                kind,
+                global,
+                place: if matches!(kind, OutSymKind::Undef { .. }) {
+                    None
+                } else {
+                    place
+                },
+            });
+        }
+        index
+    }
+
+    fn base_target(&self, base: Base, out: &Output, sym_index: &[Option<usize>]) -> Option<Target> {
+        match base {
+            Base::Sec(seg) => out.seg_section[seg as usize].map(Target::Section),
+            Base::Ext(sym) => sym_index
+                .get(sym as usize)
+                .copied()
+                .flatten()
+                .map(Target::Symbol),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn resolve_field(
+        &mut self,
+        out: &mut Output,
+        datas: &mut [Vec<u8>],
+        sym_index: &[Option<usize>],
+        chunk: ChunkId,
+        off: u32,
+        kind: FixKind,
+        expr: NodeId,
+        loc: LocId,
+    ) {
+        let (seg, pos) = self.chunk_pos(chunk, off);
+        let span = self.loc_span(loc);
+        let value = if kind == FixKind::Branch {
+            let next = self.prog.position(chunk, i64::from(off) + 1);
+            match self.prog.eval(expr) {
+                Ok(target @ Value::Addr { base, off: addend }) => {
+                    match self.prog.binary(BinaryOp::Sub, target, next) {
+                        Ok(distance) => Ok(distance),
+                        Err(_) if !self.prog.chunks[chunk as usize].org => {
+                            // Different section or an import: the linker's job.
+                            if let Some(target) = self.base_target(base, out, sym_index)
+                                && let Some(section) = out.seg_section[seg as usize]
+                            {
+                                out.sections[section].relocs.push(OutReloc {
+                                    offset: pos,
+                                    r_type: R_MOS_PCREL_8,
+                                    target,
+                                    addend,
+                                });
+                            }
+                            return;
+                        }
+                        Err(_) => {
+                            self.report_at(
+                                loc,
+                                diag::error(
+                                    "asm::not-relocatable",
+                                    span,
+                                    "a branch in `.org` code cannot reach a label the linker places",
+                                )
+                                .help("use `jmp`, or put the branch in relocatable code"),
+                            );
+                            return;
+                        }
+                    }
+                }
+                Ok(target @ Value::Const(address)) => {
+                    match self.prog.binary(BinaryOp::Sub, target, next) {
+                        Ok(distance) => Ok(distance),
+                        Err(_) => {
+                            // Relocatable code branching to a fixed address.
+                            if let Some(section) = out.seg_section[seg as usize] {
+                                out.sections[section].relocs.push(OutReloc {
+                                    offset: pos,
+                                    r_type: R_MOS_PCREL_8,
+                                    target: Target::Absolute,
+                                    addend: address,
+                                });
+                            }
+                            return;
+                        }
+                    }
+                }
+                Ok(_) => Err(EvalErr::NotRelocatable),
+                Err(error) => Err(error),
+            }
+        } else {
+            self.prog.eval(expr)
+        };
+        let data = &mut datas[seg as usize];
+        let pos_usize = pos as usize;
+        let value = match value {
+            Ok(value) => value,
+            Err(error) => {
+                let saved = self.line_ctx;
+                self.line_ctx = self.prog.locs.get(loc as usize).map_or(0, |l| l.ctx);
+                self.eval_error(error, span);
+                self.line_ctx = saved;
+                return;
+            }
+        };
+        let (base, addend, r_type) = match value {
+            Value::Const(v) => {
+                if kind == FixKind::Branch {
+                    if !(-128..=127).contains(&v) {
+                        self.report_at(loc, branch_diag(span, v));
+                        return;
+                    }
+                    if let Some(slot) = data.get_mut(pos_usize) {
+                        *slot = v as u8;
+                    }
+                    return;
+                }
+                match const_bytes(kind, v) {
+                    Ok(bytes) => {
+                        let len = kind.len() as usize;
+                        if let Some(slots) = data.get_mut(pos_usize..pos_usize + len) {
+                            slots.copy_from_slice(&bytes[..len]);
+                        }
+                    }
+                    Err((what, range)) => self.report_at(loc, range_diag(span, what, v, range)),
+                }
+                return;
+            }
+            Value::Addr { base, off } => {
+                let r_type = match kind {
+                    FixKind::Imm8 | FixKind::Byte => R_MOS_IMM8,
+                    FixKind::Zp => R_MOS_ADDR8,
+                    FixKind::Abs | FixKind::Word | FixKind::Dword => R_MOS_ADDR16,
+                    FixKind::Dbyt => {
+                        // Big-endian: the high byte first, then the low byte.
+                        if let (Some(target), Some(section)) = (
+                            self.base_target(base, out, sym_index),
+                            out.seg_section[seg as usize],
+                        ) {
+                            let relocs = &mut out.sections[section].relocs;
+                            relocs.push(OutReloc {
+                                offset: pos,
+                                r_type: R_MOS_ADDR16_HI,
+                                target,
+                                addend: off,
+                            });
+                            relocs.push(OutReloc {
+                                offset: pos + 1,
+                                r_type: R_MOS_ADDR16_LO,
+                                target,
+                                addend: off,
+                            });
+                        }
+                        return;
+                    }
+                    FixKind::Branch => R_MOS_PCREL_8,
+                };
+                (base, off, r_type)
+            }
+            Value::Byte { sel, base, off } => {
+                let r_type = match sel {
+                    Sel::Lo => R_MOS_ADDR16_LO,
+                    Sel::Hi => R_MOS_ADDR16_HI,
+                    Sel::Bank => R_MOS_ADDR24_BANK,
+                };
+                // `.dbyt <x`: the byte goes in the low (second) position.
+                let pos = if kind == FixKind::Dbyt { pos + 1 } else { pos };
+                if let (Some(target), Some(section)) = (
+                    self.base_target(base, out, sym_index),
+                    out.seg_section[seg as usize],
+                ) {
+                    out.sections[section].relocs.push(OutReloc {
+                        offset: pos,
+                        r_type,
+                        target,
+                        addend: off,
+                    });
+                }
+                return;
+            }
+            Value::Chunk { .. } => return,
+        };
+        if let (Some(target), Some(section)) = (
+            self.base_target(base, out, sym_index),
+            out.seg_section[seg as usize],
+        ) {
+            out.sections[section].relocs.push(OutReloc {
+                offset: pos,
+                r_type,
+                target,
+                addend,
+            });
+        }
+    }
+
+    /// Warns about branches that land inside an instruction (typically
+    /// `*+n` off by one, into the next instruction's operand).
+    fn check_branches(&mut self, out: &Output, datas: &[Vec<u8>]) {
+        if self.prog.branches.is_empty() {
+            return;
+        }
+        // Instruction starts per segment, in order.
+        let mut starts: Vec<Vec<(u32, u8, ChunkId)>> = vec![Vec::new(); self.prog.segs.len()];
+        for item in &self.prog.items {
+            if item.instr_len > 1 {
+                let (seg, offset) = self.chunk_pos(item.chunk, item.off);
+                starts[seg as usize].push((offset, item.instr_len, item.chunk));
+            }
+        }
+        let mut relocated: Vec<Vec<u32>> = vec![Vec::new(); self.prog.segs.len()];
+        for (seg, section) in out.seg_section.iter().enumerate() {
+            if let Some(section) = section {
+                relocated[seg] = out.sections[*section]
+                    .relocs
+                    .iter()
+                    .map(|r| r.offset)
+                    .collect();
+                relocated[seg].sort_unstable();
+            }
+        }
+        let branches = std::mem::take(&mut self.prog.branches);
+        for &(chunk, off, loc) in &branches {
+            let (seg, pos) = self.chunk_pos(chunk, off);
+            if relocated[seg as usize].binary_search(&pos).is_ok() {
+                continue;
+            }
+            let Some(&byte) = datas[seg as usize].get(pos as usize) else {
+                continue;
+            };
+            let target = i64::from(pos) + 1 + i64::from(byte as i8);
+            let list = &starts[seg as usize];
+            let index = list.partition_point(|(start, _, _)| i64::from(*start) <= target);
+            let Some(&(start, len, target_chunk)) = index.checked_sub(1).and_then(|i| list.get(i))
+            else {
+                continue;
+            };
+            let inside = target > i64::from(start) && target < i64::from(start) + i64::from(len);
+            // Only when both ends are in one contiguous address run.
+            let same_run = {
+                let a = self
+                    .prog
+                    .position(chunk, i64::from(off) + 1 + i64::from(byte as i8));
+                let c = &self.prog.chunks[target_chunk as usize];
+                let b = self
+                    .prog
+                    .position(target_chunk, target - i64::from(c.start));
+                a == b
+            };
+            if inside && same_run {
+                let span = self.loc_span(loc);
+                let into = target - i64::from(start);
+                self.report_at(
+                    loc,
+                    diag::warning(
+                        "asm::branch-into-instruction",
+                        span,
+                        format!("this branch lands on byte {into} of a {len}-byte instruction, not on its opcode"),
+                    )
+                    .help("check the target: `*+n` counts bytes from this branch's own first byte"),
+                );
+            }
+        }
+        self.prog.branches = branches;
+    }
+
+    fn check_asserts(&mut self, out: &mut Output, sym_index: &[Option<usize>]) {
+        let asserts = std::mem::take(&mut self.prog.asserts);
+        for a in &asserts {
+            let span = self.loc_span(a.loc);
+            let value = self.prog.eval(a.expr);
+            match value {
+                // `lderror`/`ldwarning`: the linker's to check, always.
+                Ok(Value::Const(v)) if !a.link_only => {
+                    if v == 0 {
+                        let diag = if a.error {
+                            diag::error("asm::assert", span, a.message.clone())
+                        } else {
+                            diag::warning("asm::assert", span, a.message.clone())
+                        };
+                        let diag = if a.message.starts_with("`jmp (pointer)`") {
+                            RawDiag { code: "asm::jmp-page-wrap", ..diag }
+                                .help("move the pointer so that it does not start at the last byte of a page")
+                        } else {
+                            diag
+                        };
+                        self.report_at(a.loc, diag);
+                    }
+                }
+                Err(EvalErr::Undefined(_)) => {}
+                Ok(_) | Err(EvalErr::NotRelocatable) => {
+                    let mut ops = Vec::new();
+                    if self.compile(a.expr, out, sym_index, &mut ops, 0).is_some() {
+                        out.asserts.push(OutAssert {
+                            error: a.error,
+                            file: self.prog.locs[a.loc as usize].span.file,
+                            line: a.line,
+                            column: a.column,
+                            message: a.message.clone(),
+                            ops,
+                        });
+                    } else {
+                        let saved = self.line_ctx;
+                        self.line_ctx = self.prog.locs[a.loc as usize].ctx;
+                        self.eval_error(EvalErr::NotRelocatable, span);
+                        self.line_ctx = saved;
+                    }
+                }
+                Err(error) => {
+                    let saved = self.line_ctx;
+                    self.line_ctx = self.prog.locs[a.loc as usize].ctx;
+                    self.eval_error(error, span);
+                    self.line_ctx = saved;
+                }
+            }
+        }
+        self.prog.asserts = asserts;
+    }
+
+    fn push_value(
+        &self,
+        value: Value,
+        out: &Output,
+        sym_index: &[Option<usize>],
+        ops: &mut Vec<AssertOp>,
+    ) -> Option<()> {
+        match value {
+            Value::Const(v) => ops.push(AssertOp::Const(v)),
+            Value::Addr { base, off } => {
+                ops.push(AssertOp::Target(self.base_target(base, out, sym_index)?));
+                ops.push(AssertOp::Const(off));
+                ops.push(AssertOp::Binary(BinaryOp::Add));
+            }
+            Value::Byte { sel, base, off } => {
+                ops.push(AssertOp::Target(self.base_target(base, out, sym_index)?));
+                ops.push(AssertOp::Const(off));
+                ops.push(AssertOp::Binary(BinaryOp::Add));
+                ops.push(AssertOp::Unary(match sel {
+                    Sel::Lo => UnaryOp::LoByte,
+                    Sel::Hi => UnaryOp::HiByte,
+                    Sel::Bank => UnaryOp::BankByte,
+                }));
+            }
+            Value::Chunk { .. } => return None,
+        }
+        Some(())
+    }
+
+    /// Compiles an expression to assertion bytecode.
+    fn compile(
+        &mut self,
+        node: NodeId,
+        out: &Output,
+        sym_index: &[Option<usize>],
+        ops: &mut Vec<AssertOp>,
+        depth: u32,
+    ) -> Option<()> {
+        if depth > 200 {
+            return None;
+        }
+        if let Ok(value) = self.prog.eval(node) {
+            return self.push_value(value, out, sym_index, ops);
+        }
+        match *self.prog.nodes.get(node as usize)? {
+            Node::Unary(op, inner) => {
+                self.compile(inner, out, sym_index, ops, depth + 1)?;
+                ops.push(AssertOp::Unary(op));
+            }
+            Node::Binary(op, left, right) => {
+                self.compile(left, out, sym_index, ops, depth + 1)?;
+                self.compile(right, out, sym_index, ops, depth + 1)?;
+                ops.push(AssertOp::Binary(op));
+            }
+            Node::Sym(sym) => match self.prog.syms.get(sym as usize)?.def {
+                SymDef::Expr(inner) | SymDef::Var(inner) => {
+                    self.compile(inner, out, sym_index, ops, depth + 1)?
+                }
+                SymDef::Alias(other) => {
+                    let node = self.prog.node(Node::Sym(other));
+                    self.compile(node, out, sym_index, ops, depth + 1)?;
+                }
+                _ => return None,
+            },
+            _ => return None,
+        }
+        Some(())
+    }
+}
+
+/// Converts assertion ops into `isa::objfmt` bytecode, given symbol indices.
+pub(crate) fn assert_ops(
+    ops: &[AssertOp],
+    target_index: impl Fn(Target) -> Option<u32>,
+) -> Option<Vec<ExprOp>> {
+    ops.iter()
+        .map(|op| {
+            Some(match *op {
+                AssertOp::Const(v) => ExprOp::Const(v),
+                AssertOp::Target(Target::Absolute) => ExprOp::Const(0),
+                AssertOp::Target(target) => ExprOp::Symbol(target_index(target)?),
+                AssertOp::Unary(op) => ExprOp::Unary(op),
+                AssertOp::Binary(op) => ExprOp::Binary(op),
+            })
+        })
+        .collect()
+}

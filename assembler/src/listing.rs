@@ -1,0 +1,228 @@
+//! The listing (`-l`): for each source line, its address, the bytes it
+//! produced and the line itself, macro and `.repeat` expansions included.
+//!
+//! Format (stable, for snapshot tests), after ca65's:
+//!
+//! ```text
+//! 001000  1  A9 05        lda #5
+//! 000003r 2  8D rr rr     sta ptr
+//! ```
+//!
+//! Six hex digits of address, `r` when it is an offset in a relocatable
+//! segment, the input depth (1 = main file, more in includes and
+//! expansions), up to four bytes per row (`rr` where the linker patches
+//! the byte), then the source. Lines from expansions show the body line
+//! with the macro's arguments in place.
+
+use std::fmt::Write as _;
+
+use crate::asm::Frame;
+use crate::diag::Files;
+use crate::layout::Output;
+use crate::lexer::{LineInfo, Token};
+use crate::model::{ChunkId, Program, SegId};
+
+/// Bytes shown for one line at most; the rest is summarised.
+const MAX_BYTES: usize = 16;
+
+#[derive(Debug, Clone)]
+enum Text {
+    Source { file: u32, start: u32, end: u32 },
+    Expanded(String),
+}
+
+#[derive(Debug, Clone)]
+struct Line {
+    depth: u8,
+    text: Text,
+    seg: SegId,
+    chunk: ChunkId,
+    off: u32,
+    end: Option<(SegId, ChunkId, u32)>,
+}
+
+/// Collects lines during assembly; renders after layout.
+#[derive(Debug, Default)]
+pub(crate) struct ListingBuilder {
+    /// `.list off` turns this off.
+    pub(crate) enabled: bool,
+    lines: Vec<Line>,
+    /// The expanded text of the next line, when it comes from an expansion.
+    pub(crate) expanded: Option<String>,
+}
+
+fn depth(frames: &[Frame]) -> u8 {
+    frames.len().clamp(1, 9) as u8
+}
+
+impl ListingBuilder {
+    pub(crate) fn new() -> ListingBuilder {
+        ListingBuilder {
+            enabled: true,
+            lines: Vec::new(),
+            expanded: None,
+        }
+    }
+
+    fn text(&mut self, info: LineInfo) -> Text {
+        match self.expanded.take() {
+            Some(text) => Text::Expanded(text),
+            None => Text::Source {
+                file: info.file,
+                start: info.start,
+                end: info.end,
+            },
+        }
+    }
+
+    /// A line that produces nothing (a macro or `.repeat` body being read).
+    pub(crate) fn text_line(&mut self, frames: &[Frame], info: LineInfo, _toks: &[Token]) {
+        let text = self.text(info);
+        if !self.enabled {
+            return;
+        }
+        self.lines.push(Line {
+            depth: depth(frames),
+            text,
+            seg: 0,
+            chunk: 0,
+            off: 0,
+            end: None,
+        });
+    }
+
+    pub(crate) fn begin_line(
+        &mut self,
+        frames: &[Frame],
+        info: LineInfo,
+        _toks: &[Token],
+        prog: &Program,
+        seg: SegId,
+    ) {
+        let text = self.text(info);
+        if !self.enabled {
+            return;
+        }
+        let chunk = prog.segs[seg as usize].cur;
+        self.lines.push(Line {
+            depth: depth(frames),
+            text,
+            seg,
+            chunk,
+            off: prog.chunks[chunk as usize].len,
+            end: Some((seg, chunk, prog.chunks[chunk as usize].len)),
+        });
+    }
+
+    pub(crate) fn end_line(&mut self, prog: &Program, seg: SegId) {
+        let Some(line) = self.lines.last_mut() else {
+            return;
+        };
+        if line.end.is_none() {
+            return;
+        }
+        let chunk = prog.segs[seg as usize].cur;
+        line.end = Some((seg, chunk, prog.chunks[chunk as usize].len));
+    }
+
+    /// Renders the listing after layout.
+    pub(crate) fn render(
+        &self,
+        title: &str,
+        files: &Files,
+        prog: &Program,
+        out: &Output,
+    ) -> String {
+        let mut text = String::with_capacity(self.lines.len() * 40);
+        let _ = writeln!(text, "; scorpion asm listing of {title}");
+        let _ = writeln!(text);
+        // Relocated byte offsets per output section.
+        let relocated: Vec<Vec<u32>> = out
+            .sections
+            .iter()
+            .map(|s| {
+                let mut offsets: Vec<u32> = Vec::new();
+                for r in &s.relocs {
+                    let width = match r.r_type {
+                        isa::elf::R_MOS_ADDR16 => 2,
+                        _ => 1,
+                    };
+                    offsets.extend(r.offset..r.offset + width);
+                }
+                offsets.sort_unstable();
+                offsets
+            })
+            .collect();
+        for line in &self.lines {
+            let source = match &line.text {
+                Text::Source { file, start, end } => {
+                    let bytes = files.text(*file);
+                    let start = (*start as usize).min(bytes.len());
+                    let end = (*end as usize).clamp(start, bytes.len());
+                    String::from_utf8_lossy(&bytes[start..end]).into_owned()
+                }
+                Text::Expanded(text) => text.clone(),
+            };
+            let source = source.replace('\t', "        ");
+            let Some((end_seg, end_chunk, end_off)) = line.end else {
+                let _ = writeln!(
+                    text,
+                    "{:7} {}  {:12} {}",
+                    "",
+                    line.depth,
+                    "",
+                    source.trim_end()
+                );
+                continue;
+            };
+            let chunk = &prog.chunks[line.chunk as usize];
+            let section = out.seg_section.get(line.seg as usize).copied().flatten();
+            let start = chunk.start + line.off;
+            let end = if end_seg == line.seg {
+                prog.chunks[end_chunk as usize].start + end_off
+            } else {
+                start
+            };
+            let address = if chunk.org {
+                format!("{:06X} ", chunk.abs + i64::from(line.off))
+            } else {
+                format!("{start:06X}r")
+            };
+            let mut cells: Vec<String> = Vec::new();
+            if let Some(section) = section {
+                let s = &out.sections[section];
+                for offset in start..end.max(start) {
+                    if cells.len() == MAX_BYTES {
+                        break;
+                    }
+                    let cell = if relocated[section].binary_search(&offset).is_ok() {
+                        "rr".to_string()
+                    } else if s.nobits {
+                        "xx".to_string()
+                    } else {
+                        s.data
+                            .get(offset as usize)
+                            .map_or_else(|| "??".to_string(), |b| format!("{b:02X}"))
+                    };
+                    cells.push(cell);
+                }
+            }
+            let total = end.saturating_sub(start) as usize;
+            let mut rows = cells.chunks(4);
+            let first = rows.next().map(|r| r.join(" ")).unwrap_or_default();
+            let _ = writeln!(
+                text,
+                "{address} {}  {first:12} {}",
+                line.depth,
+                source.trim_end()
+            );
+            for row in rows {
+                let _ = writeln!(text, "{:7} {}  {:12}", "", line.depth, row.join(" "));
+            }
+            if total > MAX_BYTES {
+                let _ = writeln!(text, "{:7} {}  ({} bytes in all)", "", line.depth, total);
+            }
+        }
+        text
+    }
+}

@@ -1,0 +1,655 @@
+//! Expressions with ca65's operators and precedence (not C's):
+//!
+//! | level | operators |
+//! |---|---|
+//! | 1 (tightest) | unary `+ - ~ < > ^ !`, `.bitnot`, pseudo-functions |
+//! | 2 | `* / .mod & ^ << >>` `.bitand .bitxor .shl .shr` |
+//! | 3 | `+ - \|` `.bitor` |
+//! | 4 | `= <> < > <= >=` |
+//! | 5 | `&& .and .xor` |
+//! | 6 | `\|\| .or` |
+//! | 7 (loosest) | `! .not` |
+//!
+//! So `a+b&c` is `a+(b&c)` and `!a=b` is `!(a=b)`. Nodes go into the
+//! program's arena; names resolve to symbols as they are read, in the
+//! current scope.
+
+use isa::objfmt::{BinaryOp, UnaryOp};
+
+use crate::asm::{Asm, Frame, PResult, Reported};
+use crate::diag::{self, Span};
+use crate::expr::{EvalErr, Value};
+use crate::intern::{Dir, Keyword};
+use crate::lexer::{Tok, Token};
+use crate::model::{GLOBAL_SCOPE, Node, NodeId, ScopeId, SymDef, SymId};
+
+const MAX_NESTING: u32 = 256;
+
+impl Asm<'_> {
+    /// A zero-width span just after token `p - 1` (where something is missing).
+    pub(crate) fn span_at(&self, t: &[Token], p: usize) -> Span {
+        if let Some(tok) = t.get(p) {
+            return tok.span;
+        }
+        match t.last() {
+            Some(last) => Span {
+                file: last.span.file,
+                start: last.span.end,
+                end: last.span.end,
+            },
+            None => Span {
+                file: self.line.file,
+                start: self.line.end,
+                end: self.line.end,
+            },
+        }
+    }
+
+    fn directive_of(&self, tok: &Token) -> Option<Dir> {
+        if tok.kind != Tok::Directive {
+            return None;
+        }
+        match self.names.keyword(tok.name()) {
+            Keyword::Directive(dir) => Some(dir),
+            _ => None,
+        }
+    }
+
+    /// Parses an expression starting at `*p`.
+    pub(crate) fn expression(&mut self, t: &[Token], p: &mut usize) -> PResult<NodeId> {
+        self.level7(t, p, 0)
+    }
+
+    fn level7(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
+        if depth > MAX_NESTING {
+            let span = self.span_at(t, *p);
+            return Err(self.err("asm::too-deep", span, "expression nested too deeply"));
+        }
+        if let Some(tok) = t.get(*p)
+            && (tok.kind == Tok::Bang || self.directive_of(tok) == Some(Dir::Not))
+        {
+            *p += 1;
+            let inner = self.level7(t, p, depth + 1)?;
+            return Ok(self.prog.node(Node::Unary(UnaryOp::LogNot, inner)));
+        }
+        self.binary_level(t, p, 6, depth)
+    }
+
+    fn binary_op(&self, tok: &Token, level: u8) -> Option<BinaryOp> {
+        let dir = self.directive_of(tok);
+        Some(match (level, tok.kind, dir) {
+            (2, Tok::Star, _) => BinaryOp::Mul,
+            (2, Tok::Slash, _) => BinaryOp::Div,
+            (2, Tok::Amp, _) | (2, _, Some(Dir::Bitand)) => BinaryOp::BitAnd,
+            (2, Tok::Caret, _) | (2, _, Some(Dir::Bitxor)) => BinaryOp::BitXor,
+            (2, Tok::Shl, _) | (2, _, Some(Dir::Shl)) => BinaryOp::Shl,
+            (2, Tok::Shr, _) | (2, _, Some(Dir::Shr)) => BinaryOp::Shr,
+            (2, _, Some(Dir::Mod)) => BinaryOp::Mod,
+            (3, Tok::Plus, _) => BinaryOp::Add,
+            (3, Tok::Minus, _) => BinaryOp::Sub,
+            (3, Tok::Pipe, _) | (3, _, Some(Dir::Bitor)) => BinaryOp::BitOr,
+            (4, Tok::Eq, _) => BinaryOp::Eq,
+            (4, Tok::Ne, _) => BinaryOp::Ne,
+            (4, Tok::Lt, _) => BinaryOp::Lt,
+            (4, Tok::Gt, _) => BinaryOp::Gt,
+            (4, Tok::Le, _) => BinaryOp::Le,
+            (4, Tok::Ge, _) => BinaryOp::Ge,
+            (5, Tok::AndAnd, _) | (5, _, Some(Dir::And)) => BinaryOp::LogAnd,
+            (5, _, Some(Dir::Xor)) => BinaryOp::LogXor,
+            (6, Tok::OrOr, _) | (6, _, Some(Dir::Or)) => BinaryOp::LogOr,
+            _ => return None,
+        })
+    }
+
+    fn binary_level(
+        &mut self,
+        t: &[Token],
+        p: &mut usize,
+        level: u8,
+        depth: u32,
+    ) -> PResult<NodeId> {
+        let mut left = if level == 2 {
+            self.unary(t, p, depth + 1)?
+        } else {
+            self.binary_level(t, p, level - 1, depth + 1)?
+        };
+        while let Some(tok) = t.get(*p) {
+            let Some(op) = self.binary_op(tok, level) else {
+                break;
+            };
+            *p += 1;
+            let right = if level == 2 {
+                self.unary(t, p, depth + 1)?
+            } else {
+                self.binary_level(t, p, level - 1, depth + 1)?
+            };
+            left = self.fold(op, left, right);
+        }
+        Ok(left)
+    }
+
+    /// Builds a binary node, folding two constants on the spot.
+    fn fold(&mut self, op: BinaryOp, left: NodeId, right: NodeId) -> NodeId {
+        if let (Some(Node::Const(a)), Some(Node::Const(b))) = (
+            self.prog.nodes.get(left as usize).copied(),
+            self.prog.nodes.get(right as usize).copied(),
+        ) && let Ok(value) = op.apply(a, b)
+        {
+            return self.prog.node(Node::Const(value));
+        }
+        self.prog.node(Node::Binary(op, left, right))
+    }
+
+    fn unary_node(&mut self, op: UnaryOp, inner: NodeId) -> NodeId {
+        if let Some(Node::Const(value)) = self.prog.nodes.get(inner as usize).copied() {
+            return self.prog.node(Node::Const(op.apply(value)));
+        }
+        self.prog.node(Node::Unary(op, inner))
+    }
+
+    fn unary(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
+        if depth > MAX_NESTING {
+            let span = self.span_at(t, *p);
+            return Err(self.err("asm::too-deep", span, "expression nested too deeply"));
+        }
+        let Some(tok) = t.get(*p).copied() else {
+            let span = self.span_at(t, *p);
+            return Err(self.err("asm::syntax", span, "expected an expression here"));
+        };
+        let op = match tok.kind {
+            Tok::Plus => {
+                *p += 1;
+                return self.unary(t, p, depth + 1);
+            }
+            Tok::Minus => Some(UnaryOp::Neg),
+            Tok::Tilde => Some(UnaryOp::BitNot),
+            Tok::Lt => Some(UnaryOp::LoByte),
+            Tok::Gt => Some(UnaryOp::HiByte),
+            Tok::Caret => Some(UnaryOp::BankByte),
+            Tok::Bang => Some(UnaryOp::LogNot),
+            Tok::Directive if self.directive_of(&tok) == Some(Dir::Bitnot) => Some(UnaryOp::BitNot),
+            Tok::Directive if self.directive_of(&tok) == Some(Dir::Not) => Some(UnaryOp::LogNot),
+            _ => None,
+        };
+        if let Some(op) = op {
+            *p += 1;
+            let inner = self.unary(t, p, depth + 1)?;
+            return Ok(self.unary_node(op, inner));
+        }
+        self.primary(t, p, depth)
+    }
+
+    fn primary(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
+        let tok = t[*p];
+        match tok.kind {
+            Tok::Number => {
+                *p += 1;
+                Ok(self.prog.node(Node::Const(tok.value as i64)))
+            }
+            Tok::Char => {
+                *p += 1;
+                match usize::try_from(tok.value)
+                    .ok()
+                    .and_then(|v| self.charmap.get(v))
+                {
+                    Some(&byte) => Ok(self.prog.node(Node::Const(i64::from(byte)))),
+                    None => Err(self.err(
+                        "asm::range",
+                        tok.span,
+                        format!("character U+{:04X} does not fit in a byte", tok.value),
+                    )),
+                }
+            }
+            Tok::Str => {
+                *p += 1;
+                let text = self.string_bytes(&tok);
+                if text.len() == 1 {
+                    let byte = self.charmap[usize::from(text[0])];
+                    return Ok(self.prog.node(Node::Const(i64::from(byte))));
+                }
+                Err(self.err(
+                    "asm::syntax",
+                    tok.span,
+                    "a string is not a number (only a one-character string is)",
+                ))
+            }
+            Tok::Star => {
+                *p += 1;
+                let (chunk, off) = self.here();
+                Ok(self.prog.node(Node::Pos { chunk, off }))
+            }
+            Tok::LParen => {
+                *p += 1;
+                let inner = self.level7(t, p, depth + 1)?;
+                if t.get(*p).map(|t| t.kind) != Some(Tok::RParen) {
+                    let span = self.span_at(t, *p);
+                    let diag = diag::error("asm::syntax", span, "expected `)`")
+                        .also(tok.span, "to close this `(`");
+                    return Err(self.report(diag));
+                }
+                *p += 1;
+                Ok(inner)
+            }
+            Tok::Unnamed => {
+                *p += 1;
+                let sym = self.unnamed_ref(&tok)?;
+                Ok(self.prog.node(Node::Sym(sym)))
+            }
+            Tok::Local => {
+                *p += 1;
+                let sym = self.cheap_sym(tok.name());
+                self.note_ref(sym, tok.span);
+                Ok(self.sym_node(sym))
+            }
+            Tok::Ident | Tok::ColonColon => {
+                let sym = self.symbol_ref(t, p)?;
+                Ok(self.sym_node(sym))
+            }
+            Tok::Directive => self.pseudo_function(t, p, depth),
+            _ => Err(self.err("asm::syntax", tok.span, "expected an expression here")),
+        }
+    }
+
+    /// A node for a symbol: `.set` variables give their current value.
+    fn sym_node(&mut self, sym: SymId) -> NodeId {
+        match self.prog.syms[sym as usize].def {
+            SymDef::Var(node) => node,
+            SymDef::Const(value) => self.prog.node(Node::Const(value)),
+            _ => self.prog.node(Node::Sym(sym)),
+        }
+    }
+
+    fn unnamed_ref(&mut self, tok: &Token) -> PResult<SymId> {
+        let count = tok.value as i64;
+        let index = if count < 0 {
+            let back = count.unsigned_abs() as usize;
+            if back > self.unnamed_count {
+                return Err(self.err(
+                    "asm::undefined",
+                    tok.span,
+                    format!(
+                        "there {} only {} unnamed label{} before this",
+                        if self.unnamed_count == 1 { "is" } else { "are" },
+                        self.unnamed_count,
+                        if self.unnamed_count == 1 { "" } else { "s" }
+                    ),
+                ));
+            }
+            self.unnamed_count - back
+        } else {
+            self.unnamed_count + count as usize - 1
+        };
+        if index > self.unnamed_count + 1_000_000 {
+            return Err(self.err(
+                "asm::undefined",
+                tok.span,
+                "unnamed label reference too far ahead",
+            ));
+        }
+        let sym = self.unnamed_sym(index);
+        self.note_ref(sym, tok.span);
+        Ok(sym)
+    }
+
+    /// `name`, `scope::name`, `::name`: a reference, creating the symbol
+    /// when it does not exist yet.
+    pub(crate) fn symbol_ref(&mut self, t: &[Token], p: &mut usize) -> PResult<SymId> {
+        let start = t[*p].span;
+        let mut scope: Option<ScopeId> = None;
+        if t[*p].kind == Tok::ColonColon {
+            scope = Some(GLOBAL_SCOPE);
+            *p += 1;
+        }
+        let Some(first) = t.get(*p).filter(|t| t.kind == Tok::Ident).copied() else {
+            let span = self.span_at(t, *p);
+            return Err(self.err("asm::syntax", span, "expected a name after `::`"));
+        };
+        *p += 1;
+        let mut name = first;
+        while t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon)
+            && t.get(*p + 1).map(|t| t.kind) == Some(Tok::Ident)
+        {
+            let outer = name.name();
+            let next = match scope {
+                None => match self.lookup_scope(outer) {
+                    Some(found) => found,
+                    None => {
+                        self.child_scope_or_new(self.scope, outer, crate::model::ScopeKind::Scope)
+                    }
+                },
+                Some(s) => self.child_scope_or_new(s, outer, crate::model::ScopeKind::Scope),
+            };
+            scope = Some(next);
+            name = t[*p + 1];
+            *p += 2;
+        }
+        let span = start.to(name.span);
+        match scope {
+            None => Ok(self.ref_sym(name.name(), span)),
+            Some(s) => {
+                let sym = self.sym_in(s, name.name());
+                self.note_ref(sym, span);
+                Ok(sym)
+            }
+        }
+    }
+
+    /// A symbol name for `.defined`, `.ifdef`...: found, never created.
+    pub(crate) fn parse_symbol_name(
+        &mut self,
+        t: &[Token],
+        p: &mut usize,
+        _create: bool,
+    ) -> PResult<Option<SymId>> {
+        let Some(tok) = t.get(*p).copied() else {
+            let span = self.span_at(t, *p);
+            return Err(self.err("asm::syntax", span, "expected a symbol name"));
+        };
+        if tok.kind == Tok::Local {
+            *p += 1;
+            let sym = self.cheap_sym(tok.name());
+            return Ok(Some(sym));
+        }
+        let mut scope: Option<ScopeId> = None;
+        if tok.kind == Tok::ColonColon {
+            scope = Some(GLOBAL_SCOPE);
+            *p += 1;
+        }
+        let Some(first) = t.get(*p).filter(|t| t.kind == Tok::Ident).copied() else {
+            let span = self.span_at(t, *p);
+            return Err(self.err("asm::syntax", span, "expected a symbol name"));
+        };
+        *p += 1;
+        let mut name = first.name();
+        let mut missing_scope = false;
+        while t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon)
+            && t.get(*p + 1).map(|t| t.kind) == Some(Tok::Ident)
+        {
+            let next = match scope {
+                None => self.lookup_scope(name),
+                Some(s) => self.child_scope(s, name),
+            };
+            match next {
+                Some(s) => scope = Some(s),
+                None => missing_scope = true,
+            }
+            name = t[*p + 1].name();
+            *p += 2;
+        }
+        if missing_scope {
+            return Ok(None);
+        }
+        Ok(match scope {
+            Some(s) => self.find_sym(s, name),
+            None => {
+                let mut s = self.scope;
+                loop {
+                    if let Some(sym) = self.find_sym(s, name) {
+                        break Some(sym);
+                    }
+                    if s == GLOBAL_SCOPE {
+                        break None;
+                    }
+                    s = self.prog.scopes[s as usize].parent;
+                }
+            }
+        })
+    }
+
+    fn expect(&mut self, t: &[Token], p: &mut usize, kind: Tok, what: &str) -> PResult<()> {
+        if t.get(*p).map(|t| t.kind) == Some(kind) {
+            *p += 1;
+            return Ok(());
+        }
+        let span = self.span_at(t, *p);
+        Err(self.err("asm::syntax", span, format!("expected {what}")))
+    }
+
+    fn pseudo_function(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
+        let head = t[*p];
+        let Some(dir) = self.directive_of(&head) else {
+            let name = self.names.name(head.name()).to_string();
+            return Err(self.err(
+                "asm::unknown-directive",
+                head.span,
+                format!("`{name}` is not a directive this assembler knows"),
+            ));
+        };
+        *p += 1;
+        let bool_node = |asm: &mut Self, value: bool| asm.prog.node(Node::Const(i64::from(value)));
+        match dir {
+            Dir::Lobyte | Dir::Hibyte | Dir::Bankbyte | Dir::Loword | Dir::Hiword | Dir::Const => {
+                self.expect(t, p, Tok::LParen, "`(`")?;
+                let inner = self.level7(t, p, depth + 1)?;
+                self.expect(t, p, Tok::RParen, "`)`")?;
+                Ok(match dir {
+                    Dir::Lobyte => self.unary_node(UnaryOp::LoByte, inner),
+                    Dir::Hibyte => self.unary_node(UnaryOp::HiByte, inner),
+                    Dir::Bankbyte => self.unary_node(UnaryOp::BankByte, inner),
+                    Dir::Loword => {
+                        let mask = self.prog.node(Node::Const(0xFFFF));
+                        self.fold(BinaryOp::BitAnd, inner, mask)
+                    }
+                    Dir::Hiword => {
+                        let sixteen = self.prog.node(Node::Const(16));
+                        let shifted = self.fold(BinaryOp::Shr, inner, sixteen);
+                        let mask = self.prog.node(Node::Const(0xFFFF));
+                        self.fold(BinaryOp::BitAnd, shifted, mask)
+                    }
+                    _ => {
+                        let constant = matches!(self.prog.eval(inner), Ok(Value::Const(_)));
+                        bool_node(self, constant)
+                    }
+                })
+            }
+            Dir::Defined | Dir::Referenced => {
+                self.expect(t, p, Tok::LParen, "`(`")?;
+                let sym = self.parse_symbol_name(t, p, false)?;
+                self.expect(t, p, Tok::RParen, "`)`")?;
+                let answer = sym.is_some_and(|s| {
+                    let sym = &self.prog.syms[s as usize];
+                    if dir == Dir::Defined {
+                        sym.is_defined()
+                    } else {
+                        sym.ref_loc.is_some()
+                    }
+                });
+                Ok(bool_node(self, answer))
+            }
+            Dir::Blank => {
+                self.expect(t, p, Tok::LParen, "`(`")?;
+                let mut nesting = 0usize;
+                let mut count = 0usize;
+                while let Some(tok) = t.get(*p) {
+                    match tok.kind {
+                        Tok::LParen => nesting += 1,
+                        Tok::RParen if nesting == 0 => break,
+                        Tok::RParen => nesting -= 1,
+                        Tok::LBrace | Tok::RBrace => {
+                            *p += 1;
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    count += 1;
+                    *p += 1;
+                }
+                self.expect(t, p, Tok::RParen, "`)`")?;
+                Ok(bool_node(self, count == 0))
+            }
+            Dir::Paramcount => {
+                let count = self.frames.iter().rev().find_map(|frame| match frame {
+                    Frame::Macro { args, .. } => Some(args.len()),
+                    _ => None,
+                });
+                match count {
+                    Some(count) => Ok(self.prog.node(Node::Const(count as i64))),
+                    None => Err(self.err(
+                        "asm::syntax",
+                        head.span,
+                        "`.paramcount` is only meaningful inside a macro",
+                    )),
+                }
+            }
+            Dir::Strlen => {
+                self.expect(t, p, Tok::LParen, "`(`")?;
+                let Some(tok) = t.get(*p).filter(|t| t.kind == Tok::Str).copied() else {
+                    let span = self.span_at(t, *p);
+                    return Err(self.err("asm::syntax", span, "expected a string"));
+                };
+                *p += 1;
+                self.expect(t, p, Tok::RParen, "`)`")?;
+                let len = self.string_bytes(&tok).len();
+                Ok(self.prog.node(Node::Const(len as i64)))
+            }
+            Dir::Sizeof => {
+                self.expect(t, p, Tok::LParen, "`(`")?;
+                let node = self.sizeof(t, p)?;
+                self.expect(t, p, Tok::RParen, "`)`")?;
+                Ok(node)
+            }
+            _ => {
+                let name = self.names.name(head.name()).to_string();
+                Err(self.err(
+                    "asm::syntax",
+                    head.span,
+                    format!("`{name}` cannot be used in an expression"),
+                ))
+            }
+        }
+    }
+
+    /// `.sizeof(name)`: the size of a struct, union, enum or scope.
+    fn sizeof(&mut self, t: &[Token], p: &mut usize) -> PResult<NodeId> {
+        let start = self.span_at(t, *p);
+        let mut scope: Option<ScopeId> = None;
+        let mut absolute = false;
+        if t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon) {
+            absolute = true;
+            *p += 1;
+        }
+        loop {
+            let Some(tok) = t.get(*p).filter(|t| t.kind == Tok::Ident).copied() else {
+                let span = self.span_at(t, *p);
+                return Err(self.err("asm::syntax", span, "expected a struct or scope name"));
+            };
+            *p += 1;
+            let found = match (scope, absolute) {
+                (None, false) => self.lookup_scope(tok.name()),
+                (None, true) => self.child_scope(GLOBAL_SCOPE, tok.name()),
+                (Some(s), _) => self.child_scope(s, tok.name()),
+            };
+            let Some(found) = found else {
+                let name = self.names.name(tok.name()).to_string();
+                return Err(self.err(
+                    "asm::undefined",
+                    start.to(tok.span),
+                    format!("`.sizeof` needs a struct, union, enum or scope; `{name}` is none of these (yet)"),
+                ));
+            };
+            scope = Some(found);
+            if t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon) {
+                *p += 1;
+                continue;
+            }
+            break;
+        }
+        let scope = scope.unwrap_or(GLOBAL_SCOPE);
+        let info = &self.prog.scopes[scope as usize];
+        if let Some(size) = info.size {
+            return Ok(self.prog.node(Node::Const(size)));
+        }
+        Ok(self.prog.node(Node::ScopeSize(scope)))
+    }
+
+    /// The bytes between a string token's quotes.
+    pub(crate) fn string_bytes(&self, tok: &Token) -> Vec<u8> {
+        let text = self.files.text(tok.span.file);
+        let start = (tok.span.start as usize + 1).min(text.len());
+        let end = (tok.span.end as usize)
+            .saturating_sub(1)
+            .clamp(start, text.len());
+        text[start..end].to_vec()
+    }
+
+    /// An expression that must be a constant now (`.if`, `.res`, `.org`...).
+    pub(crate) fn const_expr(&mut self, t: &[Token], p: &mut usize, what: &str) -> PResult<i64> {
+        let start = *p;
+        let node = self.expression(t, p)?;
+        let span = self
+            .span_at(t, start)
+            .to(self.span_at(t, p.saturating_sub(1)));
+        match self.prog.eval(node) {
+            Ok(Value::Const(value)) => Ok(value),
+            Ok(_) => {
+                let diag = diag::error(
+                    "asm::not-constant",
+                    span,
+                    format!("{what} needs a constant, but this is an address the linker decides"),
+                )
+                .help("labels are constants only after `.org`; compute this from constants or label differences");
+                Err(self.report(diag))
+            }
+            Err(EvalErr::NotYet(Some(sym))) => {
+                let name = self.sym_name(sym);
+                Err(self.err(
+                    "asm::not-constant",
+                    span,
+                    format!("{what} needs a value known here, but `{name}` is not defined yet"),
+                ))
+            }
+            Err(EvalErr::NotYet(None)) => Err(self.err(
+                "asm::not-constant",
+                span,
+                format!(
+                    "{what} needs a value known here, but it depends on addresses not fixed yet"
+                ),
+            )),
+            Err(error) => Err(self.eval_error(error, span)),
+        }
+    }
+
+    /// Reports an evaluation failure at `span`.
+    pub(crate) fn eval_error(&mut self, error: EvalErr, span: Span) -> Reported {
+        let (code, message, help) = match error {
+            EvalErr::Undefined(_) => return Reported,
+            EvalErr::NotYet(Some(sym)) => (
+                "asm::not-constant",
+                format!("`{}` is not defined yet", self.sym_name(sym)),
+                None,
+            ),
+            EvalErr::NotYet(None) => (
+                "asm::not-constant",
+                "this value depends on addresses not fixed yet".to_string(),
+                None,
+            ),
+            EvalErr::DivZero => ("asm::div-zero", "division by zero".to_string(), None),
+            EvalErr::NotRelocatable => (
+                "asm::not-relocatable",
+                format!(
+                    "`{}` uses an address in a way no relocation can express",
+                    self.files.snippet(span)
+                ),
+                Some(
+                    "the linker can add a constant to an address, or take its `<` / `>` / `^` byte; other arithmetic needs constants (use `.org`, or label differences in one segment)"
+                        .to_string(),
+                ),
+            ),
+            EvalErr::Circular(sym) => (
+                "asm::circular",
+                format!("`{}` is defined in terms of itself", self.sym_name(sym)),
+                None,
+            ),
+            EvalErr::TooComplex => (
+                "asm::too-deep",
+                "this expression is too deeply nested to evaluate".to_string(),
+                None,
+            ),
+        };
+        let mut diag = diag::error(code, span, message);
+        if let Some(help) = help {
+            diag = diag.help(help);
+        }
+        self.report(diag)
+    }
+}
