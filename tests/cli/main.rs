@@ -3,6 +3,7 @@
 
 mod disasm;
 mod read;
+mod upload;
 
 use std::process::{Command, Output};
 

@@ -3,8 +3,8 @@
 //! missing or busy.
 
 use std::io::{Read, Write};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -14,9 +14,11 @@ use serialport::{SerialPort, TTYPort};
 use crate::{scorpion, transcript};
 
 /// A robot double on the master side of a pty: it answers `/1X` and
-/// `/7R` from its memory, with the ROM's resync rule (a `/` restarts).
-struct PtyRobot {
-    path: String,
+/// `/7R` from its memory and obeys `/7W` and `/9W`, with the ROM's resync
+/// rule (a `/` restarts).
+pub(crate) struct PtyRobot {
+    pub(crate) path: String,
+    pub(crate) memory: Arc<Mutex<Vec<u8>>>,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
     // The slave stays open so the master never sees a hang-up between
@@ -25,7 +27,9 @@ struct PtyRobot {
 }
 
 impl PtyRobot {
-    fn spawn(memory: Vec<u8>) -> PtyRobot {
+    pub(crate) fn spawn(memory: Vec<u8>) -> PtyRobot {
+        let memory = Arc::new(Mutex::new(memory));
+        let shared = Arc::clone(&memory);
         let (mut master, slave) = TTYPort::pair().expect("a pseudo-terminal pair");
         let path = slave.name().expect("the slave's path");
         master
@@ -53,6 +57,7 @@ impl PtyRobot {
                     if text.len() < 2 || text.len() != usize::from(text[1].wrapping_sub(b'0')) + 2 {
                         continue;
                     }
+                    let mut memory = shared.lock().expect("the robot's memory");
                     let answer = match Command::parse(text) {
                         Ok(Command::Busy) => Some(Answer::Busy(BusyByte(0))),
                         Ok(Command::ReadMemory(span)) => {
@@ -60,8 +65,18 @@ impl PtyRobot {
                             let end = start + usize::from(span.count());
                             Some(Answer::Memory(memory[start..end].to_vec()))
                         }
+                        Ok(Command::WriteByte { address, value }) => {
+                            memory[usize::from(address)] = value;
+                            None
+                        }
+                        Ok(Command::WriteWord(write)) => {
+                            let at = usize::from(write.address());
+                            memory[at..at + 2].copy_from_slice(&write.bytes());
+                            None
+                        }
                         _ => None,
                     };
+                    drop(memory);
                     command = None;
                     if let Some(answer) = answer {
                         master.write_all(&answer.encode()).expect("answer");
@@ -71,6 +86,7 @@ impl PtyRobot {
         });
         PtyRobot {
             path,
+            memory,
             stop,
             thread: Some(thread),
             _slave: slave,
@@ -87,7 +103,7 @@ impl Drop for PtyRobot {
     }
 }
 
-fn memory() -> Vec<u8> {
+pub(crate) fn memory() -> Vec<u8> {
     let mut memory = vec![0u8; 0x1_0000];
     memory[0x0200..0x0206].copy_from_slice(&[0x4C, 0x23, 0xF1, 0x4C, 0x45, 0xF0]);
     memory[0x0400..0x0410].copy_from_slice(b"HELLO, SCORPION!");

@@ -135,6 +135,26 @@ impl UploadImage {
     }
 }
 
+impl TryFrom<&linker::Image> for UploadImage {
+    type Error = Error;
+
+    /// Takes the load addresses of a linked image's areas (what an upload
+    /// writes) and its hook records.
+    fn try_from(image: &linker::Image) -> Result<Self> {
+        let mut areas = Vec::new();
+        for area in &image.areas {
+            let address = u16::try_from(area.load).map_err(|_| Error::BadImage {
+                reason: format!("an area loads at ${:X}, past $FFFF", area.load),
+            })?;
+            areas.push(Area {
+                address,
+                bytes: area.bytes.clone(),
+            });
+        }
+        UploadImage::new(areas, image.hooks.records.clone())
+    }
+}
+
 /// Where a ROM keeps its hooks and which memory an upload may write: the
 /// reference ROM's values by default (PLATFORM.md section 4,
 /// docs/ARCHITECTURE.md's memory map).
