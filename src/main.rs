@@ -23,23 +23,26 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Assemble a ca65-syntax source file into an ELF object.
+    Asm(cmd::asm::Args),
     /// Disassemble a raw binary file.
     Disasm(cmd::disasm::Args),
+    /// Upload a linked image into a robot, verified, hooks last.
+    Upload(cmd::upload::Args),
     /// List the serial ports a robot could be on.
     Ports(cmd::ports::Args),
     /// Dump robot memory with `/7R` questions.
     Read(cmd::read::Args),
-    /// Upload a linked image into a robot, verified, hooks last.
-    Upload(cmd::upload::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Asm(args) => cmd::asm::run(&args),
         Command::Disasm(args) => cmd::disasm::run(&args),
+        Command::Upload(args) => cmd::upload::run(&args),
         Command::Ports(args) => cmd::ports::run(&args),
         Command::Read(args) => cmd::read::run(&args),
-        Command::Upload(args) => cmd::upload::run(&args),
     };
     match result {
         Ok(code) => code,

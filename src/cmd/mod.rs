@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub(crate) mod asm;
 pub(crate) mod disasm;
 pub(crate) mod ports;
 pub(crate) mod read;
