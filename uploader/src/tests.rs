@@ -132,6 +132,11 @@ fn clean_upload_verifies_and_hooks_last() {
     // The ROM-only bound: 11 characters per 2 bytes written.
     let bound = char_time(2048 / 2 * 11, BAUD);
     let ratio = report.device_time.as_secs_f64() / bound.as_secs_f64();
+    eprintln!(
+        "model robot, 2048 bytes at {BAUD} baud: {:.3} s device time, ROM-only bound {:.3} s, {ratio:.3}x",
+        report.device_time.as_secs_f64(),
+        bound.as_secs_f64()
+    );
     assert!(
         ratio < 1.1,
         "{:?} is {ratio:.3}x the ROM-only bound {bound:?}",
