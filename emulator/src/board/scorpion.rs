@@ -209,6 +209,13 @@ impl Board {
         Ok(())
     }
 
+    /// Whether `address` is RAM a loader may write: the card's RAM or
+    /// KIM-bus RAM not taken by a mapped device.
+    #[must_use]
+    pub fn is_ram(&self, address: u16) -> bool {
+        self.is_plain_ram(address)
+    }
+
     fn is_plain_ram(&self, address: u16) -> bool {
         match self.pages[usize::from(address >> 8)] {
             Page::Ram => true,

@@ -1,0 +1,85 @@
+//! The errors of romlib outside the typed protocol (which has its own
+//! [`ProtocolError`], wrapped here).
+
+use crate::protocol::ProtocolError;
+
+/// What the ROM profile, the simulator set-up or a conversation with the
+/// virtual Scorpion can refuse.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[non_exhaustive]
+pub enum Error {
+    /// A command or an answer that the protocol rejects.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Protocol(#[from] ProtocolError),
+
+    /// The emulated board refused something (an image outside RAM, a ROM
+    /// of the wrong size).
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Emulator(#[from] emulator::Error),
+
+    /// A ROM profile that cannot run on the virtual Scorpion.
+    #[error("the ROM profile `{name}` cannot be used: {reason}")]
+    #[diagnostic(
+        code(romlib::rom_profile),
+        help(
+            "a ROM profile is the ROM's linked ELF: bytes for all of $F000-$FFFF and its exported symbols"
+        )
+    )]
+    RomProfile {
+        /// The profile's name.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
+
+    /// A hook that does not hold a `JMP` where the ROM's symbols say.
+    #[error(
+        "{hook} at ${address:04X} holds ${found:02X}, not a JMP ($4C): the hook cannot be installed"
+    )]
+    #[diagnostic(
+        code(romlib::hook_not_jmp),
+        help("reset the robot (/1R) so the ROM rebuilds its hooks, or check the ROM profile")
+    )]
+    HookNotJmp {
+        /// The hook's name.
+        hook: &'static str,
+        /// Its address.
+        address: u16,
+        /// The byte found there.
+        found: u8,
+    },
+
+    /// The robot did not finish its answer in time.
+    #[error(
+        "no complete answer to `{command}` within {timeout_ms} ms of robot time (got `{received}`)"
+    )]
+    #[diagnostic(
+        code(romlib::no_answer),
+        help(
+            "an extension command that answers must end its answer with PUTEOL; check that its hook is installed"
+        )
+    )]
+    NoAnswer {
+        /// The command sent.
+        command: String,
+        /// What arrived, escaped.
+        received: String,
+        /// How long the host waited, in milliseconds of emulated time.
+        timeout_ms: u64,
+    },
+
+    /// The emulated CPU hit a JAM opcode.
+    #[error("the robot's CPU jammed at ${pc:04X} (opcode ${opcode:02X})")]
+    #[diagnostic(
+        code(romlib::jam),
+        help("an extension jumped into data or a bad address; check its listing")
+    )]
+    Jam {
+        /// Where.
+        pc: u16,
+        /// The JAM opcode.
+        opcode: u8,
+    },
+}

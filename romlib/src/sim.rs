@@ -1,0 +1,341 @@
+//! The virtual Scorpion with a ROM in it, set up the way a robot is after
+//! an upload, and a host that talks to it through the typed protocol.
+//!
+//! [`VirtualScorpion`] owns an [`emulator::board::Scorpion`] running the
+//! reference ROM (or a ROM profile), powered up and past its reset code.
+//! [`VirtualScorpion::load_image`] leaves an image as the uploader would:
+//! every loaded area written into RAM, then each hook the image takes over
+//! installed last, with the hook's previous target written into the image's
+//! chain slot first, so images loaded one after the other chain.
+//! [`VirtualScorpion::exchange`] sends a [`Command`] through the emulated
+//! 6551 at the line's baud rate and parses the answer.
+
+use emulator::Stop;
+use emulator::board::{CPU_HZ, Scorpion};
+use isa::objfmt::HookKind;
+use linker::Image;
+
+use crate::error::Error;
+use crate::protocol::{Answer, Command};
+use crate::symbols;
+
+/// Robot time the host waits for an answer by default: one second.
+pub const ANSWER_TIMEOUT: u64 = CPU_HZ;
+
+/// Robot time the ROM needs to act on an instruction once its last byte
+/// arrived, with margin (the command loop, the dispatch, a handler).
+pub const INSTRUCTION_TIME: u64 = 5_000;
+
+/// Robot time from power-up until the reference ROM waits for commands.
+const BOOT_TIME: u64 = 20_000;
+
+/// A hook [`VirtualScorpion::load_image`] installed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InstalledHook {
+    /// Which hook.
+    pub kind: HookKind,
+    /// Where it jumps now.
+    pub handler: u16,
+    /// Where it jumped before (now in the chain slot, if the image has one).
+    pub previous: u16,
+    /// The image's chain slot.
+    pub chain: Option<u16>,
+}
+
+/// The two RAM hooks of the ROM in use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Hooks {
+    unknown: u16,
+    main_loop: u16,
+}
+
+impl Hooks {
+    fn address(self, kind: HookKind) -> u16 {
+        match kind {
+            HookKind::Unknown => self.unknown,
+            HookKind::Loop => self.main_loop,
+        }
+    }
+}
+
+/// The virtual Scorpion and its host.
+#[derive(Debug)]
+pub struct VirtualScorpion {
+    robot: Scorpion,
+    hooks: Hooks,
+}
+
+impl Default for VirtualScorpion {
+    fn default() -> VirtualScorpion {
+        VirtualScorpion::new()
+    }
+}
+
+impl VirtualScorpion {
+    /// The reference ROM, powered up, waiting for commands at 9600 baud.
+    #[must_use]
+    pub fn new() -> VirtualScorpion {
+        let robot = Scorpion::scorpion(crate::ROM)
+            .unwrap_or_else(|_| unreachable!("the built ROM is 4 KiB, as build.rs checks"));
+        let mut scorpion = VirtualScorpion {
+            robot,
+            hooks: Hooks {
+                unknown: symbols::HOOK_UNKNOWN,
+                main_loop: symbols::HOOK_LOOP,
+            },
+        };
+        scorpion.boot();
+        scorpion
+    }
+
+    /// A ROM profile: the linked ELF of a ROM for `$F000-$FFFF` that exports
+    /// `HOOK_UNKNOWN` and `HOOK_LOOP`.
+    ///
+    /// # Errors
+    /// [`Error::RomProfile`] if the image does not fill the ROM or lacks
+    /// the hook symbols.
+    pub fn with_rom(name: &str, rom: &Image) -> Result<VirtualScorpion, Error> {
+        let bad = |reason: String| Error::RomProfile {
+            name: name.to_owned(),
+            reason,
+        };
+        let mut bytes = Vec::with_capacity(0x1000);
+        for address in 0xF000..=0xFFFF_u32 {
+            let byte = rom
+                .byte_at(address)
+                .ok_or_else(|| bad(format!("it has no byte for ${address:04X}")))?;
+            bytes.push(byte);
+        }
+        let symbol = |name: &str| {
+            rom.symbol(name)
+                .and_then(|value| u16::try_from(value).ok())
+                .ok_or_else(|| bad(format!("it does not export {name}")))
+        };
+        let hooks = Hooks {
+            unknown: symbol("HOOK_UNKNOWN")?,
+            main_loop: symbol("HOOK_LOOP")?,
+        };
+        let mut scorpion = VirtualScorpion {
+            robot: Scorpion::scorpion(&bytes)?,
+            hooks,
+        };
+        scorpion.boot();
+        Ok(scorpion)
+    }
+
+    fn boot(&mut self) {
+        let until = self.robot.now() + BOOT_TIME;
+        self.robot.run(until);
+    }
+
+    /// The emulated robot: the CPU, the board and the host's end of the
+    /// line.
+    #[must_use]
+    pub fn robot(&self) -> &Scorpion {
+        &self.robot
+    }
+
+    /// The emulated robot, mutable (press bumpers, set sensors, map KIM-bus
+    /// devices).
+    pub fn robot_mut(&mut self) -> &mut Scorpion {
+        &mut self.robot
+    }
+
+    /// Robot time since power-up, in cycles of the 1 MHz CPU.
+    #[must_use]
+    pub fn cycles(&self) -> u64 {
+        self.robot.now()
+    }
+
+    /// Sets the line to `bits_per_second` on both ends: the host's UART and
+    /// the robot's DIP switches, then presses reset so the ROM programs the
+    /// new rate. Returns `false` (and changes nothing) if the 6551 has no
+    /// such rate.
+    pub fn set_baud(&mut self, bits_per_second: u32) -> bool {
+        if self.robot.set_switch_baud(bits_per_second).is_none() {
+            return false;
+        }
+        self.robot.set_baud(bits_per_second);
+        self.robot.power_on();
+        self.boot();
+        true
+    }
+
+    /// Loads `image` as an upload leaves it: every loaded area written into
+    /// RAM, then each hook it takes over installed (chain slot first, then
+    /// the hook's operand). Returns the hooks installed.
+    ///
+    /// # Errors
+    /// [`Error::Emulator`] if an area does not fit in RAM, [`Error::HookNotJmp`]
+    /// if a hook does not hold a `JMP`. Nothing is written when an area does
+    /// not fit.
+    pub fn load_image(&mut self, image: &Image) -> Result<Vec<InstalledHook>, Error> {
+        for area in &image.areas {
+            self.check_ram(area.load, area.bytes.len())?;
+        }
+        for area in &image.areas {
+            let start = u16::try_from(area.load).unwrap_or_else(|_| unreachable!("checked"));
+            self.robot.board_mut().load(start, &area.bytes)?;
+        }
+        let mut installed = Vec::new();
+        for record in &image.hooks.records {
+            installed.push(self.install_hook(record.kind, record.handler, record.chain)?);
+        }
+        Ok(installed)
+    }
+
+    /// Whether `len` bytes from `load` are all RAM the board lets a loader
+    /// write (no ROM, I/O page or mapped KIM-bus device, nothing past `$FFFF`).
+    fn check_ram(&self, load: u32, len: usize) -> Result<(), Error> {
+        let board = self.robot.board();
+        for offset in 0..len {
+            let at = u64::from(load) + offset as u64;
+            let address = u16::try_from(at).ok().filter(|&a| board.is_ram(a));
+            if address.is_none() {
+                return Err(emulator::Error::NotRam {
+                    address: u16::try_from(at).unwrap_or(0xFFFF),
+                    len,
+                }
+                .into());
+            }
+        }
+        Ok(())
+    }
+
+    /// Points a hook at `handler`, first writing its previous target into
+    /// `chain` (two bytes, little-endian) when given.
+    ///
+    /// # Errors
+    /// [`Error::HookNotJmp`] if the hook does not hold a `JMP`.
+    pub fn install_hook(
+        &mut self,
+        kind: HookKind,
+        handler: u16,
+        chain: Option<u16>,
+    ) -> Result<InstalledHook, Error> {
+        let hook = self.hooks.address(kind);
+        let memory = self.robot.board().memory();
+        let opcode = memory[usize::from(hook)];
+        if opcode != 0x4C {
+            return Err(Error::HookNotJmp {
+                hook: kind.rom_symbol(),
+                address: hook,
+                found: opcode,
+            });
+        }
+        let previous = u16::from_le_bytes([
+            memory[usize::from(hook.wrapping_add(1))],
+            memory[usize::from(hook.wrapping_add(2))],
+        ]);
+        if let Some(slot) = chain {
+            self.robot.board_mut().load(slot, &previous.to_le_bytes())?;
+        }
+        self.robot
+            .board_mut()
+            .load(hook.wrapping_add(1), &handler.to_le_bytes())?;
+        Ok(InstalledHook {
+            kind,
+            handler,
+            previous,
+            chain,
+        })
+    }
+
+    /// Sends raw bytes, back to back from now, without running the robot.
+    pub fn send(&mut self, bytes: &[u8]) {
+        self.robot.send(bytes);
+    }
+
+    /// What the robot sent that the host has not read yet.
+    pub fn receive(&mut self) -> Vec<u8> {
+        self.robot.receive()
+    }
+
+    /// Runs the robot for `cycles`.
+    ///
+    /// # Errors
+    /// [`Error::Jam`] if the CPU jams.
+    pub fn run_for(&mut self, cycles: u64) -> Result<(), Error> {
+        let until = self.robot.now().saturating_add(cycles);
+        check(self.robot.run(until))
+    }
+
+    /// Runs the robot until everything sent has arrived and the ROM had
+    /// [`INSTRUCTION_TIME`] to act on it.
+    ///
+    /// # Errors
+    /// [`Error::Jam`] if the CPU jams.
+    pub fn settle(&mut self) -> Result<(), Error> {
+        check(self.robot.settle(INSTRUCTION_TIME))
+    }
+
+    /// Sends `bytes` and waits up to `timeout` cycles for an answer (up to
+    /// and including its carriage return). Bytes received before the
+    /// command are discarded first.
+    ///
+    /// # Errors
+    /// [`Error::NoAnswer`] on timeout, [`Error::Jam`] if the CPU jams.
+    pub fn transact(&mut self, bytes: &[u8], timeout: u64) -> Result<Vec<u8>, Error> {
+        self.robot.receive();
+        self.robot.send(bytes);
+        match self.robot.read_answer(timeout) {
+            Ok(answer) => Ok(answer),
+            Err(failure) => {
+                if let Some(Stop::Jam { pc, opcode }) = failure.stop {
+                    return Err(Error::Jam { pc, opcode });
+                }
+                Err(Error::NoAnswer {
+                    command: escape(bytes),
+                    received: escape(&failure.received),
+                    timeout_ms: timeout * 1000 / CPU_HZ,
+                })
+            }
+        }
+    }
+
+    /// Sends a command; for a question, waits for its answer and parses
+    /// it, for an instruction lets the robot act on it. Extension commands
+    /// are treated as instructions: use [`VirtualScorpion::ask_extension`]
+    /// for one that answers.
+    ///
+    /// # Errors
+    /// [`Error::NoAnswer`], a [`Error::Protocol`] error for an answer that
+    /// is malformed or not the one asked for, [`Error::Jam`].
+    pub fn exchange(&mut self, command: &Command) -> Result<Option<Answer>, Error> {
+        if command.is_question() {
+            let raw = self.transact(&command.encode(), ANSWER_TIMEOUT)?;
+            Ok(Some(command.parse_answer(&raw)?))
+        } else {
+            self.robot.receive();
+            self.robot.send(&command.encode());
+            self.settle()?;
+            Ok(None)
+        }
+    }
+
+    /// Sends an extension command that answers, and returns its answer.
+    ///
+    /// # Errors
+    /// As [`VirtualScorpion::exchange`].
+    pub fn ask_extension(&mut self, command: &Command) -> Result<Answer, Error> {
+        let raw = self.transact(&command.encode(), ANSWER_TIMEOUT)?;
+        Ok(command.parse_answer(&raw)?)
+    }
+}
+
+fn check(stop: Stop) -> Result<(), Error> {
+    match stop {
+        Stop::Jam { pc, opcode } => Err(Error::Jam { pc, opcode }),
+        _ => Ok(()),
+    }
+}
+
+/// Bytes as text with control characters escaped (`\r`).
+#[must_use]
+pub fn escape(bytes: &[u8]) -> String {
+    bytes
+        .iter()
+        .flat_map(|&byte| std::ascii::escape_default(byte))
+        .map(char::from)
+        .collect()
+}

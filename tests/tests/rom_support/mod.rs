@@ -1,0 +1,163 @@
+//! What the ROM, conformance and example tests share: a host session with
+//! the virtual Scorpion that keeps a transcript for insta snapshots, and a
+//! way to build extensions with our own assembler and linker.
+#![allow(dead_code, reason = "each test file uses a part")]
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use emulator::board::{CPU_HZ, Motor};
+use romlib::VirtualScorpion;
+use romlib::protocol::{Answer, Command};
+
+/// A host talking to the virtual Scorpion at 9600 baud, writing down what
+/// crosses the line.
+pub struct Session {
+    /// The robot.
+    pub robot: VirtualScorpion,
+    /// `> command`, `< answer` and `# note` lines.
+    pub transcript: String,
+}
+
+impl Session {
+    /// A fresh robot with the reference ROM.
+    pub fn new() -> Session {
+        Session {
+            robot: VirtualScorpion::new(),
+            transcript: String::new(),
+        }
+    }
+
+    /// Sends a command written as text; returns the parsed answer of a
+    /// question, `None` for an instruction.
+    pub fn send(&mut self, text: &str) -> Option<Answer> {
+        let command = Command::parse(text.as_bytes())
+            .unwrap_or_else(|error| panic!("`{text}` is a valid command: {error}"));
+        writeln!(self.transcript, "> {text}").expect("writing to a String");
+        let answer = self
+            .robot
+            .exchange(&command)
+            .unwrap_or_else(|error| panic!("`{text}`: {error}\n{}", self.transcript));
+        if let Some(answer) = &answer {
+            let raw = answer.encode();
+            writeln!(self.transcript, "< {}", text_of(&raw)).expect("writing to a String");
+        }
+        answer
+    }
+
+    /// Sends a question and returns the raw answer text, carriage return
+    /// included.
+    pub fn ask(&mut self, text: &str) -> String {
+        writeln!(self.transcript, "> {text}").expect("writing to a String");
+        let raw = self
+            .robot
+            .transact(text.as_bytes(), romlib::sim::ANSWER_TIMEOUT)
+            .unwrap_or_else(|error| panic!("`{text}`: {error}\n{}", self.transcript));
+        let answer = String::from_utf8(raw).expect("answers are ASCII");
+        writeln!(self.transcript, "< {}", answer.escape_default()).expect("writing to a String");
+        answer
+    }
+
+    /// Sends raw bytes that must not be answered, and lets the robot act.
+    pub fn tell_raw(&mut self, bytes: &[u8]) {
+        writeln!(self.transcript, "> {}", text_of(bytes)).expect("writing to a String");
+        self.robot.receive();
+        self.robot.send(bytes);
+        self.robot.settle().expect("the CPU runs");
+        let answer = self.robot.receive();
+        assert!(
+            answer.is_empty(),
+            "`{}` got an answer: `{}`",
+            text_of(bytes),
+            text_of(&answer)
+        );
+    }
+
+    /// Lets `ms` milliseconds of robot time pass.
+    pub fn wait_ms(&mut self, ms: u64) {
+        writeln!(self.transcript, "# {ms} ms pass").expect("writing to a String");
+        self.robot
+            .run_for(ms * CPU_HZ / 1000)
+            .expect("the CPU does not jam");
+    }
+
+    /// Writes a note into the transcript.
+    pub fn note(&mut self, text: &str) {
+        writeln!(self.transcript, "# {text}").expect("writing to a String");
+    }
+
+    /// A motor's position in steps.
+    pub fn position(&self, motor: Motor) -> i64 {
+        self.robot.robot().board().motor(motor).position()
+    }
+
+    /// Closes the bumpers set in `mask` (opens the others).
+    pub fn bumpers(&mut self, mask: u8) {
+        writeln!(self.transcript, "# bumpers {mask:08b}").expect("writing to a String");
+        self.robot.robot_mut().set_bumpers(mask);
+    }
+}
+
+/// Bytes as printable text (`\r` escaped).
+pub fn text_of(bytes: &[u8]) -> String {
+    romlib::sim::escape(bytes)
+}
+
+/// The repository's `examples/` directory.
+pub fn examples_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ is inside the workspace")
+        .join("examples")
+}
+
+/// Assembles `sources` (path, in the order given) with our assembler,
+/// `scorpion.inc` built in, and links them with `target` against the ROM's
+/// symbols. Returns the linked image.
+pub fn build(sources: &[PathBuf], target: &str) -> linker::Image {
+    let mut includes = BTreeMap::new();
+    includes.insert(
+        "scorpion.inc".to_owned(),
+        romlib::SCORPION_INC.as_bytes().to_vec(),
+    );
+    let options = assembler::Options {
+        builtin_includes: includes,
+        ..assembler::Options::default()
+    };
+    let objects: Vec<(String, Vec<u8>)> = sources
+        .iter()
+        .map(|path| {
+            let assembly = assembler::assemble(&assembler::FsSource, path, &options)
+                .unwrap_or_else(|error| {
+                    panic!(
+                        "{} does not assemble: {error}\n{:?}",
+                        path.display(),
+                        error.diagnostics()
+                    )
+                });
+            (path.display().to_string(), assembly.object)
+        })
+        .collect();
+    let inputs: Vec<linker::Input<'_>> = objects
+        .iter()
+        .map(|(name, bytes)| linker::Input { name, bytes })
+        .collect();
+    let rom =
+        linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("romlib's ROM ELF parses");
+    let target = linker::Target::builtin(target, None).expect("a built-in target");
+    let just_symbols = [linker::SymbolFile {
+        name: "scorpion-rom.elf",
+        image: &rom,
+    }];
+    let linked = linker::link(
+        &inputs,
+        &linker::LinkOptions {
+            target: &target,
+            just_symbols: &just_symbols,
+            sources: &linker::NoSources,
+        },
+    )
+    .unwrap_or_else(|error| panic!("the example does not link: {error:?}"));
+    linked.image
+}
