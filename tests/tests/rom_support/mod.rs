@@ -13,16 +13,16 @@ use romlib::protocol::{Answer, Command};
 
 /// A host talking to the virtual Scorpion at 9600 baud, writing down what
 /// crosses the line.
-pub struct Session {
+pub(crate) struct Session {
     /// The robot.
-    pub robot: VirtualScorpion,
+    pub(crate) robot: VirtualScorpion,
     /// `> command`, `< answer` and `# note` lines.
-    pub transcript: String,
+    pub(crate) transcript: String,
 }
 
 impl Session {
     /// A fresh robot with the reference ROM.
-    pub fn new() -> Session {
+    pub(crate) fn new() -> Session {
         Session {
             robot: VirtualScorpion::new(),
             transcript: String::new(),
@@ -31,7 +31,7 @@ impl Session {
 
     /// Sends a command written as text; returns the parsed answer of a
     /// question, `None` for an instruction.
-    pub fn send(&mut self, text: &str) -> Option<Answer> {
+    pub(crate) fn send(&mut self, text: &str) -> Option<Answer> {
         let command = Command::parse(text.as_bytes())
             .unwrap_or_else(|error| panic!("`{text}` is a valid command: {error}"));
         writeln!(self.transcript, "> {text}").expect("writing to a String");
@@ -48,7 +48,7 @@ impl Session {
 
     /// Sends a question and returns the raw answer text, carriage return
     /// included.
-    pub fn ask(&mut self, text: &str) -> String {
+    pub(crate) fn ask(&mut self, text: &str) -> String {
         writeln!(self.transcript, "> {text}").expect("writing to a String");
         let raw = self
             .robot
@@ -60,7 +60,7 @@ impl Session {
     }
 
     /// Sends raw bytes that must not be answered, and lets the robot act.
-    pub fn tell_raw(&mut self, bytes: &[u8]) {
+    pub(crate) fn tell_raw(&mut self, bytes: &[u8]) {
         writeln!(self.transcript, "> {}", text_of(bytes)).expect("writing to a String");
         self.robot.receive();
         self.robot.send(bytes);
@@ -75,7 +75,7 @@ impl Session {
     }
 
     /// Lets `ms` milliseconds of robot time pass.
-    pub fn wait_ms(&mut self, ms: u64) {
+    pub(crate) fn wait_ms(&mut self, ms: u64) {
         writeln!(self.transcript, "# {ms} ms pass").expect("writing to a String");
         self.robot
             .run_for(ms * CPU_HZ / 1000)
@@ -83,29 +83,29 @@ impl Session {
     }
 
     /// Writes a note into the transcript.
-    pub fn note(&mut self, text: &str) {
+    pub(crate) fn note(&mut self, text: &str) {
         writeln!(self.transcript, "# {text}").expect("writing to a String");
     }
 
     /// A motor's position in steps.
-    pub fn position(&self, motor: Motor) -> i64 {
+    pub(crate) fn position(&self, motor: Motor) -> i64 {
         self.robot.robot().board().motor(motor).position()
     }
 
     /// Closes the bumpers set in `mask` (opens the others).
-    pub fn bumpers(&mut self, mask: u8) {
+    pub(crate) fn bumpers(&mut self, mask: u8) {
         writeln!(self.transcript, "# bumpers {mask:08b}").expect("writing to a String");
         self.robot.robot_mut().set_bumpers(mask);
     }
 }
 
 /// Bytes as printable text (`\r` escaped).
-pub fn text_of(bytes: &[u8]) -> String {
+pub(crate) fn text_of(bytes: &[u8]) -> String {
     romlib::sim::escape(bytes)
 }
 
 /// The repository's `examples/` directory.
-pub fn examples_dir() -> PathBuf {
+pub(crate) fn examples_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .expect("tests/ is inside the workspace")
@@ -115,7 +115,7 @@ pub fn examples_dir() -> PathBuf {
 /// Assembles `sources` (path, in the order given) with our assembler,
 /// `scorpion.inc` built in, and links them with `target` against the ROM's
 /// symbols. Returns the linked image.
-pub fn build(sources: &[PathBuf], target: &str) -> linker::Image {
+pub(crate) fn build(sources: &[PathBuf], target: &str) -> linker::Image {
     let mut includes = BTreeMap::new();
     includes.insert(
         "scorpion.inc".to_owned(),
