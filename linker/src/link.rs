@@ -646,6 +646,7 @@ fn map_data(
                         let (segment, offset) = placement.sections[object_index][section_index]?;
                         Some(MapPart {
                             segment: placement.segments[segment].rule.name.clone(),
+                            section: section.name.clone(),
                             offset,
                             size: u64::from(section.size),
                             align: u64::from(section.align),

@@ -31,6 +31,7 @@ pub(crate) struct MapSegment {
 #[derive(Debug, Clone)]
 pub(crate) struct MapPart {
     pub(crate) segment: String,
+    pub(crate) section: String,
     pub(crate) offset: u64,
     pub(crate) size: u64,
     pub(crate) align: u64,
@@ -126,9 +127,14 @@ impl Linked {
         for module in &map.modules {
             let _ = writeln!(out, "{}", module.name);
             for part in &module.parts {
+                let from = if part.section == part.segment {
+                    String::new()
+                } else {
+                    format!("  (section {})", part.section)
+                };
                 let _ = writeln!(
                     out,
-                    "    {:<12} offset ${:04X}  size {:>6}  align {}",
+                    "    {:<12} offset ${:04X}  size {:>6}  align {}{from}",
                     part.segment, part.offset, part.size, part.align
                 );
             }
@@ -155,15 +161,20 @@ impl Linked {
     }
 
     /// A VICE monitor label file (`al ADDRESS .name`, ld65's `-Ln` form):
-    /// every symbol that names an address in a placed segment, sorted by
-    /// address then name.
+    /// every symbol in a placed segment and every exported constant (ROM
+    /// entry points are constants here) except the layout's `__NAME_SIZE__`
+    /// sizes, sorted by address then name.
     #[must_use]
     pub fn vice_labels(&self) -> String {
         let mut labels: Vec<(u32, &str)> = self
             .image
             .symbols
             .iter()
-            .filter(|symbol| symbol.section.is_some() || symbol.global)
+            .filter(|symbol| {
+                symbol.section.is_some()
+                    || (symbol.global
+                        && !(symbol.name.starts_with("__") && symbol.name.ends_with("_SIZE__")))
+            })
             .map(|symbol| (symbol.value, symbol.name.as_str()))
             .collect();
         labels.sort_unstable();

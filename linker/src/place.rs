@@ -247,15 +247,16 @@ pub(crate) fn place(
                 end: segment.run + segment.size - 1,
             });
         }
-        if segment.has_bytes() {
-            let fill = layout
-                .areas
-                .iter()
-                .find(|area| area.name == segment.rule.load)
-                .map_or(0, |area| area.fill_value);
-            // Overflowing segments are still built, so relocation errors
-            // inside them are reported too; cap the buffer at 4 GiB.
-            let size = usize::try_from(segment.size.min(1 << 32)).unwrap_or(0);
+        let load_area = layout
+            .areas
+            .iter()
+            .find(|area| area.name == segment.rule.load);
+        // A segment that does not fit its area (already an error) gets no
+        // buffer: a corrupt size must not make the linker allocate it.
+        let fits = load_area.is_some_and(|area| segment.load + segment.size <= area.end());
+        if segment.has_bytes() && fits {
+            let fill = load_area.map_or(0, |area| area.fill_value);
+            let size = usize::try_from(segment.size).unwrap_or(0);
             let mut bytes = vec![fill; size];
             for fragment in &segment.fragments {
                 let data = &objects[fragment.object].sections[fragment.section].data;
@@ -265,7 +266,7 @@ pub(crate) fn place(
                 }
             }
             segment.bytes = bytes;
-        } else {
+        } else if !segment.has_bytes() {
             for fragment in &segment.fragments {
                 let section = &objects[fragment.object].sections[fragment.section];
                 if !section.nobits && section.data.iter().any(|byte| *byte != 0) {

@@ -2,6 +2,7 @@
 //! status out, snapshotted with insta. One module per subcommand.
 
 mod disasm;
+mod link;
 mod read;
 mod upload;
 

@@ -8,4 +8,5 @@ mod formats;
 mod layouts;
 mod ld65;
 mod relocations;
-mod round_trip;
+mod robustness;
+pub(crate) mod round_trip;
