@@ -74,9 +74,19 @@ anything_moves:
 
 ; One tick: the drives and the active scanner step when their time comes.
 tick:
-        lda #<TICK_LOAD         ; re-arm timer 2 (clears its flag)
+        ; Re-arm timer 2 so that the next time-out comes exactly one period
+        ; after this one, however late the handler got here. Past zero the
+        ; counter keeps counting down: its low byte is $100 - d, d cycles
+        ; after the zero. The write below comes 16 cycles after the read,
+        ; and a count M written at cycle w reaches zero at w + 1 + M, so
+        ; M = PERIOD - 17 - d = A + TICK_REARM. (Reading T2C-L also clears
+        ; the flag.)
+        lda VIA_T2CL
+        clc
+        adc #<TICK_REARM
         sta VIA_T2CL
-        lda #>TICK_LOAD
+        lda #>TICK_REARM
+        adc #0
         sta VIA_T2CH
         lda #0
         sta ISTEP
