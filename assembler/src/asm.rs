@@ -468,6 +468,13 @@ impl<'a> Asm<'a> {
         }
         let loc = self.loc(span);
         let column = self.column_of(span);
+        // As in ca65, defining any normal symbol (label, constant, struct
+        // member...) starts a new region for cheap locals.
+        if self.prog.syms[sym as usize].kind == SymKind::Normal
+            && !matches!(def, SymDef::Import { .. })
+        {
+            self.cheap_epoch += 1;
+        }
         let s = &mut self.prog.syms[sym as usize];
         s.def = def;
         s.def_loc = Some(loc);
@@ -492,10 +499,7 @@ impl<'a> Asm<'a> {
                 self.unnamed_count += 1;
                 self.unnamed_sym(index)
             }
-            _ => {
-                self.cheap_epoch += 1;
-                self.sym_in(self.scope, tok.name())
-            }
+            _ => self.sym_in(self.scope, tok.name()),
         };
         self.define(sym, def, tok.span)?;
         Ok(sym)
@@ -1062,18 +1066,13 @@ impl<'a> Asm<'a> {
     }
 
     /// `name = expr` and `name := expr`.
-    fn assignment(&mut self, t: &[Token], label_like: bool) -> PResult<()> {
+    fn assignment(&mut self, t: &[Token], _label_like: bool) -> PResult<()> {
         let mut p = 2;
         let expr = self.expression(t, &mut p)?;
         self.expect_end(t, p)?;
         let sym = match t[0].kind {
             Tok::Local => self.cheap_sym(t[0].name()),
-            _ => {
-                if label_like {
-                    self.cheap_epoch += 1;
-                }
-                self.sym_in(self.scope, t[0].name())
-            }
+            _ => self.sym_in(self.scope, t[0].name()),
         };
         let def = match self.prog.eval(expr) {
             Ok(crate::expr::Value::Const(value)) => SymDef::Const(value),
@@ -1099,6 +1098,7 @@ impl<'a> Asm<'a> {
             Err(error) => return Err(self.eval_error(error, t[2].span.to(t[p - 1].span))),
         };
         self.keep_nodes = true;
+        self.cheap_epoch += 1;
         let s = &mut self.prog.syms[sym as usize];
         match s.def {
             SymDef::Undefined | SymDef::Var(_) => {

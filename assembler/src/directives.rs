@@ -562,7 +562,7 @@ impl Asm<'_> {
     fn export(&mut self, t: &[Token], p: usize, zp: bool, global: bool) -> PResult<()> {
         for (tok, assignment) in self.name_list(t, p)? {
             let sym = self.sym_in(self.scope, tok.name());
-            if let Some((label_like, start)) = assignment {
+            if let Some((_, start)) = assignment {
                 let mut i = start;
                 let expr = self.expression(t, &mut i)?;
                 let def = match self.prog.eval(expr) {
@@ -572,10 +572,6 @@ impl Asm<'_> {
                         SymDef::Expr(expr)
                     }
                 };
-                if label_like {
-                    // A `:=` label ends the cheap-local region like a label.
-                    self.cheap_epoch += 1;
-                }
                 self.define(sym, def, tok.span)?;
             }
             let loc = self.loc(tok.span);

@@ -111,7 +111,7 @@ pub(crate) fn const_bytes(
         FixKind::Abs => ("address", (0, 0xFFFF)),
         FixKind::Word => ("word value", (0, 0xFFFF)),
         FixKind::Dbyt => ("word value", (0, 0xFFFF)),
-        FixKind::Dword => ("dword value", (i64::from(i32::MIN), i64::from(u32::MAX))),
+        FixKind::Dword => ("dword value", (0, i64::from(u32::MAX))),
         FixKind::Branch => ("branch distance", (-128, 127)),
     };
     if value < range.0 || value > range.1 {
