@@ -27,6 +27,10 @@ enum Command {
     Asm(cmd::asm::Args),
     /// Disassemble a raw binary file.
     Disasm(cmd::disasm::Args),
+    /// Link 6502 ELF objects into a Scorpion image.
+    Link(cmd::link::Args),
+    /// Assemble ca65-syntax sources and link them into a Scorpion image.
+    Build(cmd::build::Args),
     /// Upload a linked image into a robot, verified, hooks last.
     Upload(cmd::upload::Args),
     /// List the serial ports a robot could be on.
@@ -40,6 +44,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Asm(args) => cmd::asm::run(&args),
         Command::Disasm(args) => cmd::disasm::run(&args),
+        Command::Link(args) => cmd::link::run(&args),
+        Command::Build(args) => cmd::build::run(&args),
         Command::Upload(args) => cmd::upload::run(&args),
         Command::Ports(args) => cmd::ports::run(&args),
         Command::Read(args) => cmd::read::run(&args),

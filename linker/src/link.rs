@@ -258,7 +258,15 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         places.sort();
         places.dedup();
         let (src, span) = places[0].snippet(options.sources);
-        let help = if name
+        let similar = globals
+            .keys()
+            .map(String::as_str)
+            .chain(file_symbols.keys().copied())
+            .filter(|candidate| edit_distance(candidate, &name) <= 2.min(name.len() / 2))
+            .min_by_key(|candidate| (edit_distance(candidate, &name), *candidate));
+        let help = if let Some(similar) = similar {
+            format!("did you mean `{similar}`?")
+        } else if name
             .chars()
             .all(|c| c.is_ascii_uppercase() || c == '_' || c.is_ascii_digit())
             && options.just_symbols.is_empty()
@@ -672,4 +680,31 @@ fn map_data(
 /// The `R_MOS_*` name of a relocation type, for messages.
 pub(crate) fn relocation_name(r_type: u32) -> &'static str {
     mos::relocation_name(r_type).unwrap_or("R_MOS_?")
+}
+
+/// Levenshtein distance, for "did you mean" suggestions.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut previous = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let substitute = previous + usize::from(ca != *cb);
+            previous = row[j + 1];
+            row[j + 1] = substitute.min(row[j] + 1).min(previous + 1);
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn edit_distance() {
+        assert_eq!(super::edit_distance("prnt", "print"), 1);
+        assert_eq!(super::edit_distance("PUTCH", "PUTHEX"), 3);
+        assert_eq!(super::edit_distance("", "abc"), 3);
+        assert_eq!(super::edit_distance("same", "same"), 0);
+    }
 }

@@ -1,7 +1,9 @@
 //! One module per subcommand.
 
 pub(crate) mod asm;
+pub(crate) mod build;
 pub(crate) mod disasm;
+pub(crate) mod link;
 pub(crate) mod ports;
 pub(crate) mod read;
 pub(crate) mod upload;

@@ -1,6 +1,7 @@
 //! The `scorpion` binary run as a process: arguments in, output and exit
 //! status out, snapshotted with insta. One module per subcommand.
 
+mod build;
 mod disasm;
 mod link;
 mod read;

@@ -1,0 +1,143 @@
+//! `scorpion build`: sources to images in one step.
+
+use std::path::Path;
+
+use linker::Image;
+
+use crate::{scorpion, transcript};
+
+const MAIN_S: &str = "\
+; The entry point: prints the library's greeting.
+.import print, greeting
+.importzp text
+.export start
+
+.macro point_at pointer, address
+        lda #<address
+        sta pointer
+        lda #>address
+        sta pointer+1
+.endmacro
+
+.code
+start:  point_at text, greeting
+        jsr print
+done:   jmp done
+";
+
+const LIB_S: &str = "\
+; Sends the zero-terminated string at (text) to $C000.
+.exportzp text
+.export print, greeting
+
+.zeropage
+text:   .res 2
+
+.code
+print:  ldy #0
+@next:  lda (text),y
+        beq @end
+        sta $C000
+        iny
+        bne @next
+@end:   rts
+
+.rodata
+greeting: .byte \"HELLO\", 0
+";
+
+fn write_sources(dir: &Path) {
+    std::fs::write(dir.join("main.s"), MAIN_S).expect("write main.s");
+    std::fs::write(dir.join("lib.s"), LIB_S).expect("write lib.s");
+}
+
+#[test]
+fn builds_a_multi_file_program_into_every_format() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_sources(dir.path());
+    let mut all = String::new();
+    for format in ["elf", "bin", "ihex", "srec", "kim"] {
+        let out = format!("hello.{format}");
+        let output = scorpion(
+            dir.path(),
+            &[
+                "build",
+                "main.s",
+                "lib.s",
+                "-o",
+                &out,
+                "--target",
+                "flat",
+                "--start",
+                "$0800",
+                "--format",
+                format,
+                "--map",
+                "hello.map",
+                "--labels",
+                "hello.lbl",
+            ],
+        );
+        assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+        all.push_str(&transcript(&output));
+    }
+    insta::assert_snapshot!("build_every_format", all);
+    let bin = std::fs::read(dir.path().join("hello.bin")).expect("bin written");
+    let image = Image::parse(
+        "hello.elf",
+        &std::fs::read(dir.path().join("hello.elf")).expect("elf written"),
+    )
+    .expect("reads back");
+    assert_eq!(linker::output::write_bin(&image), bin);
+    assert_eq!(image.symbol("text"), Some(0));
+    assert_eq!(
+        &bin[..4],
+        [0xA9, 0x1B, 0x85, 0x00],
+        "lda #<greeting / sta text"
+    );
+    let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).expect("written");
+    insta::assert_snapshot!("build_map", read("hello.map"));
+    assert!(read("hello.lbl").contains("al 000800 .start"));
+    // No object files were written.
+    assert!(!dir.path().join("main.o").exists());
+}
+
+#[test]
+fn assembler_and_linker_errors_point_at_the_source() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_sources(dir.path());
+    std::fs::write(
+        dir.path().join("typo.s"),
+        ".import prnt\n.code\n        jsr prnt\n        lda #300\n",
+    )
+    .expect("write typo.s");
+    std::fs::write(
+        dir.path().join("far.s"),
+        ".import print\n.code\n        bne print\n        .res 200\n",
+    )
+    .expect("write far.s");
+    let asm_error = scorpion(
+        dir.path(),
+        &[
+            "build", "typo.s", "-o", "t.bin", "--target", "flat", "--start", "$1000",
+        ],
+    );
+    assert_eq!(asm_error.status.code(), Some(1));
+    std::fs::write(
+        dir.path().join("typo.s"),
+        ".import prnt\n.code\n        jsr prnt\n",
+    )
+    .expect("rewrite typo.s");
+    let link_error = scorpion(
+        dir.path(),
+        &[
+            "build", "typo.s", "far.s", "lib.s", "-o", "t.bin", "--target", "flat", "--start",
+            "$1000",
+        ],
+    );
+    assert_eq!(link_error.status.code(), Some(1));
+    insta::assert_snapshot!(
+        "build_errors",
+        format!("{}{}", transcript(&asm_error), transcript(&link_error))
+    );
+}
