@@ -26,7 +26,7 @@
         ; the jump table
         .export PUTCH, PUTHEX, PUTDEC4, PUTEOL, GETHEX, GETDEC
         .export IOINHIBIT, IOAPPLY, GETCH, CHKCH
-        .export CMD_DONE, BAD_COMMAND, ROM_LOOP, ROM_RESET
+        .export CMD_DONE, BAD_COMMAND, ROM_LOOP, ROM_RESET, INJECT, PENDING
 
         .segment "CODE"
         .include "loop.s"
@@ -53,6 +53,8 @@ CMD_DONE:       jmp cmd_done        ; $FF1E a command is finished: back to the c
 BAD_COMMAND:    jmp bad_command     ; $FF21 HOOK_UNKNOWN's first target: drop the command
 ROM_LOOP:       jmp rom_loop        ; $FF24 HOOK_LOOP's first target: one pass of the ROM's loop
 ROM_RESET:      jmp soft_reset      ; $FF27 what /1R does
+INJECT:         jmp inject          ; $FF2A feed A to the command parser as if received (A, X, Y kept)
+PENDING:        jmp pending         ; $FF2D A = received bytes not yet parsed, Z set if none (X, Y kept)
 
         .segment "VECTORS"
         .addr nmi, reset, irq

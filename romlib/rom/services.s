@@ -219,6 +219,32 @@ chkch:
         sec
         rts
 
+; INJECT: puts A into the receive ring as if it had arrived on the line,
+; so a program in RAM can give the ROM commands ("/4C+40"). Feed a whole
+; command between SEI and CLI if the host may be sending at the same time.
+inject:
+        php
+        sei
+        pha
+        txa
+        pha
+        tsx
+        lda $0102,x             ; A as it came
+        jsr rx_put
+        pla
+        tax
+        pla
+        plp
+        rts
+
+; PENDING: how many received (or injected) bytes the parser has not seen
+; yet. Zero means every command fed so far has been dispatched.
+pending:
+        lda RXHEAD
+        sec
+        sbc RXTAIL
+        rts
+
 ; Puts A into the receive ring (X lost); a full ring drops it. Called with
 ; interrupts off.
 rx_put:

@@ -108,6 +108,8 @@ pub struct Board {
     /// The port B levels the stepper drivers last saw.
     port_b: u8,
     kim: Vec<KimSlot>,
+    /// Bytes the host received and has not taken yet.
+    inbox: Vec<HostByte>,
     via_line: Line,
     acia_line: Line,
     /// The OR of every device's interrupt output: the CPU's IRQ input.
@@ -164,6 +166,7 @@ impl Board {
             motors: Default::default(),
             port_b: 0xFF,
             kim: Vec::new(),
+            inbox: Vec::new(),
             via_line: Line::new(),
             acia_line: Line::new(),
             irq: Line::new(),
@@ -430,12 +433,28 @@ impl Board {
         end
     }
 
-    /// What the host has received from the robot by `cycle`.
+    /// What the host has received from the robot by `cycle` and not taken
+    /// yet.
     pub fn host_receive(&mut self, cycle: u64) -> Vec<HostByte> {
+        self.pull(cycle);
+        std::mem::take(&mut self.inbox)
+    }
+
+    /// The bytes the host has received by `cycle` up to and including the
+    /// first `end` byte, if one has arrived; later bytes stay for the next
+    /// call.
+    pub fn host_receive_until(&mut self, cycle: u64, end: u8) -> Option<Vec<HostByte>> {
+        self.pull(cycle);
+        let position = self.inbox.iter().position(|b| b.byte == end)?;
+        let rest = self.inbox.split_off(position + 1);
+        Some(std::mem::replace(&mut self.inbox, rest))
+    }
+
+    fn pull(&mut self, cycle: u64) {
         self.catch_up(cycle);
         let received = self.acia.host_receive(cycle);
+        self.inbox.extend(received);
         self.refresh(cycle);
-        received
     }
 
     /// Attempted writes to the ROM since power-up (they change nothing).
@@ -726,34 +745,31 @@ impl Machine<Board> {
 
     /// Runs the robot until the host has received a carriage return (the
     /// end of an answer) or `timeout` cycles passed. Returns what the host
-    /// received, the carriage return included.
+    /// received up to and including the carriage return; bytes after it
+    /// stay for the next call.
     ///
     /// # Errors
     /// [`AnswerTimeout`] with the bytes received before the time ran out
     /// (or the CPU jammed).
     pub fn read_answer(&mut self, timeout: u64) -> Result<Vec<u8>, AnswerTimeout> {
         let deadline = self.now().saturating_add(timeout);
-        let mut answer = Vec::new();
         loop {
-            // Slices of about one character time at 9600 baud.
-            let until = (self.now() + 1000).min(deadline);
-            let stop = self.run(until);
-            for byte in self.receive() {
-                answer.push(byte);
-                if byte == b'\r' {
-                    return Ok(answer);
-                }
+            let now = self.now();
+            if let Some(answer) = self.bus.host_receive_until(now, b'\r') {
+                return Ok(answer.iter().map(|b| b.byte).collect());
             }
-            if let Stop::Jam { .. } = stop {
+            if now >= deadline {
                 return Err(AnswerTimeout {
-                    received: answer,
-                    stop: Some(stop),
+                    received: self.receive(),
+                    stop: None,
                 });
             }
-            if self.now() >= deadline {
+            // Slices of about one character time at 9600 baud.
+            let until = (now + 1000).min(deadline);
+            if let stop @ Stop::Jam { .. } = self.run(until) {
                 return Err(AnswerTimeout {
-                    received: answer,
-                    stop: None,
+                    received: self.receive(),
+                    stop: Some(stop),
                 });
             }
         }

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use emulator::board::{CPU_HZ, Motor};
 use romlib::VirtualScorpion;
-use romlib::protocol::{Answer, Command};
+use romlib::protocol::{Answer, Command, ReadSpan, WordWrite};
 
 /// A host talking to the virtual Scorpion at 9600 baud, writing down what
 /// crosses the line.
@@ -145,7 +145,18 @@ pub(crate) fn build(sources: &[PathBuf], target: &str) -> linker::Image {
         .collect();
     let rom =
         linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("romlib's ROM ELF parses");
-    let target = linker::Target::builtin(target, None).expect("a built-in target");
+    let target = if Path::new(target)
+        .extension()
+        .is_some_and(|ext| ext == "toml")
+    {
+        let text = std::fs::read_to_string(target).expect("the layout file is readable");
+        linker::Target::Custom(
+            linker::Layout::from_toml(target, &text)
+                .unwrap_or_else(|error| panic!("{target}: {error:?}")),
+        )
+    } else {
+        linker::Target::builtin(target, None).expect("a built-in target")
+    };
     let just_symbols = [linker::SymbolFile {
         name: "scorpion-rom.elf",
         image: &rom,
@@ -160,4 +171,91 @@ pub(crate) fn build(sources: &[PathBuf], target: &str) -> linker::Image {
     )
     .unwrap_or_else(|error| panic!("the example does not link: {error:?}"));
     linked.image
+}
+
+/// Writes `image` into the robot the way an uploader does, through the
+/// serial line only: every loaded area with back-to-back `/9W` commands
+/// (`/7W` for an odd last byte), read back with `/7R` and compared, then
+/// each hook installed: its previous target read, written into the image's
+/// chain slot, and the hook re-pointed with one `/9W`. Returns the number of
+/// write commands sent; notes a summary in the transcript.
+pub(crate) fn upload(s: &mut Session, image: &linker::Image) -> usize {
+    let mut writes = Vec::new();
+    let mut bytes = 0;
+    for area in &image.areas {
+        let start = u16::try_from(area.load).expect("areas load below $10000");
+        bytes += area.bytes.len();
+        for (index, pair) in area.bytes.chunks(2).enumerate() {
+            let address = start + u16::try_from(2 * index).expect("areas are under 64 KiB");
+            let command = match pair {
+                [first, second] => Command::WriteWord(
+                    WordWrite::new(address, [*first, *second]).expect("inside the address space"),
+                ),
+                [only] => Command::WriteByte {
+                    address,
+                    value: *only,
+                },
+                _ => unreachable!("chunks of 1 or 2"),
+            };
+            writes.push(command);
+        }
+    }
+    let mut stream = Vec::new();
+    for command in &writes {
+        stream.extend(command.encode());
+    }
+    s.robot.receive();
+    s.robot.send(&stream);
+    s.robot.settle().expect("the CPU runs");
+    assert!(s.robot.receive().is_empty(), "writes are not answered");
+    for area in &image.areas {
+        let start = u16::try_from(area.load).expect("areas load below $10000");
+        for (index, chunk) in area.bytes.chunks(99).enumerate() {
+            let address = start + u16::try_from(99 * index).expect("areas are under 64 KiB");
+            let count = u8::try_from(chunk.len()).expect("99 at most");
+            let read = Command::ReadMemory(
+                ReadSpan::new(address, count).expect("inside the address space"),
+            );
+            match s.robot.exchange(&read) {
+                Ok(Some(Answer::Memory(found))) => {
+                    assert_eq!(found, chunk, "verifying ${address:04X}");
+                }
+                other => panic!("reading back ${address:04X}: {other:?}"),
+            }
+        }
+    }
+    let mut installed = Vec::new();
+    for record in &image.hooks.records {
+        let hook = romlib::symbols::find(record.kind.rom_symbol())
+            .expect("the ROM exports its hooks")
+            .value;
+        let read = Command::ReadMemory(ReadSpan::new(hook + 1, 2).expect("in RAM"));
+        let Ok(Some(Answer::Memory(previous))) = s.robot.exchange(&read) else {
+            panic!("reading {}", record.kind.rom_symbol())
+        };
+        if let Some(slot) = record.chain {
+            let chain = Command::WriteWord(
+                WordWrite::new(slot, [previous[0], previous[1]]).expect("in RAM"),
+            );
+            s.robot.exchange(&chain).expect("the chain slot is written");
+            writes.push(chain);
+        }
+        let [low, high] = record.handler.to_le_bytes();
+        let point = Command::WriteWord(WordWrite::new(hook + 1, [low, high]).expect("in RAM"));
+        s.robot.exchange(&point).expect("the hook is written");
+        writes.push(point);
+        installed.push(format!(
+            "{} -> ${:04X} (was ${:02X}{:02X})",
+            record.kind.rom_symbol(),
+            record.handler,
+            previous[1],
+            previous[0]
+        ));
+    }
+    s.note(&format!(
+        "uploaded {bytes} bytes with {} write commands, verified; hooks: {}",
+        writes.len(),
+        installed.join(", ")
+    ));
+    writes.len()
 }
