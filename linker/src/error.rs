@@ -156,17 +156,14 @@ pub enum Error {
 
     /// A Scorpion layout needs the ROM's symbols and has none.
     #[error("target {target} needs the ROM's symbols {missing}")]
-    #[diagnostic(
-        code(linker::rom_symbols),
-        help(
-            "pass the ROM's linked ELF image with `--just-symbols ROM.elf`; the layout takes the user zero page and RAM bounds (USER_ZP_START/USER_ZP_END, USER_RAM_START/USER_RAM_END) from it"
-        )
-    )]
+    #[diagnostic(code(linker::rom_symbols), help("{help}"))]
     MissingRomSymbols {
         /// The layout.
         target: String,
         /// The symbols it could not find.
         missing: String,
+        /// Where they come from.
+        help: String,
     },
 
     /// An input section has no segment in the layout.

@@ -76,7 +76,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         listing: args.listing.is_some(),
         max_errors: args.max_errors,
         undocumented: args.undocumented,
-        ..assembler::Options::default()
+        // `.include "scorpion.inc"` finds the ROM's names without a path.
+        builtin_includes: [(
+            "scorpion.inc".to_owned(),
+            romlib::SCORPION_INC.as_bytes().to_vec(),
+        )]
+        .into(),
     };
     let mut objects = Vec::with_capacity(args.sources.len());
     let mut listings = String::new();

@@ -35,9 +35,13 @@ pub(crate) struct LinkArgs {
     pub(crate) labels: Option<PathBuf>,
     /// Take absolute symbols from a linked ELF image (the ROM, for an
     /// extension); also gives the Scorpion targets their RAM bounds.
+    /// Default for scorpion-ext and scorpion-os: the built-in reference ROM.
     #[arg(long = "just-symbols", value_name = "FILE")]
     pub(crate) just_symbols: Vec<PathBuf>,
 }
+
+/// How messages and maps name romlib's ROM image.
+const BUILTIN_ROM: &str = "the built-in reference ROM";
 
 fn parse_format(text: &str) -> Result<Format, String> {
     text.parse()
@@ -98,6 +102,13 @@ pub(crate) fn link_and_write(
     for path in &args.just_symbols {
         let name = path.display().to_string();
         let image = Image::parse(&name, &read(path)?)?;
+        symbol_images.push((name, image));
+    }
+    // Code for the robot links against the ROM it will run with: the
+    // reference ROM unless the user names their own.
+    if symbol_images.is_empty() && matches!(target, Target::ScorpionExt | Target::ScorpionOs) {
+        let name = BUILTIN_ROM.to_owned();
+        let image = Image::parse(&name, romlib::ROM_ELF)?;
         symbol_images.push((name, image));
     }
     let symbol_files: Vec<SymbolFile<'_>> = symbol_images

@@ -141,3 +141,26 @@ fn assembler_and_linker_errors_point_at_the_source() {
         format!("{}{}", transcript(&asm_error), transcript(&link_error))
     );
 }
+
+#[test]
+fn an_extension_builds_with_no_options_against_the_built_in_rom() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("ext.s"),
+        ".include \"scorpion.inc\"\n.code\nSCORPION_UNKNOWN_HANDLER\n        cmp #'Q'\n        bne @not_mine\n        jsr PUTEOL\n        jmp CMD_DONE\n@not_mine:\nSCORPION_CHAIN_UNKNOWN\n",
+    )
+    .expect("write ext.s");
+    let output = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
+    insta::assert_snapshot!("build_extension", transcript(&output));
+    let image = Image::parse(
+        "ext.elf",
+        &std::fs::read(dir.path().join("ext.elf")).expect("written"),
+    )
+    .expect("reads back");
+    let hook = image.hooks.records[0];
+    assert_eq!(hook.handler, 0x0400);
+    assert_eq!(
+        image.byte_at(u32::from(hook.chain.expect("chain")) - 1),
+        Some(0x4C)
+    );
+}

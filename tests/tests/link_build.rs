@@ -294,3 +294,68 @@ fn an_extension_links_against_a_rom_built_by_the_same_tools() {
     assert_eq!(&bytes[jsr..jsr + 3], [0x20, 0x00, 0xFF]);
     insta::assert_snapshot!("extension_map", ext.map());
 }
+
+const QUERY_S: &str = "\
+; Answers /1Q with how often it was asked, in hex; passes the rest on.
+.include \"scorpion.inc\"
+
+.zeropage
+asked:  .res 1
+
+.code
+SCORPION_UNKNOWN_HANDLER
+        cmp #'Q'
+        bne @not_mine
+        inc asked
+        lda asked
+        jsr PUTHEX
+        jsr PUTEOL
+        jmp CMD_DONE
+@not_mine:
+SCORPION_CHAIN_UNKNOWN
+";
+
+#[test]
+fn a_linked_extension_answers_on_the_virtual_scorpion() {
+    let options = assembler::Options {
+        builtin_includes: [(
+            "scorpion.inc".to_owned(),
+            romlib::SCORPION_INC.as_bytes().to_vec(),
+        )]
+        .into(),
+        ..assembler::Options::default()
+    };
+    let object = assembler::assemble_str("query.s", QUERY_S, &options)
+        .unwrap_or_else(|error| panic!("query.s does not assemble: {error:?}"))
+        .object;
+    let rom = Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("romlib's ROM image");
+    let linked = link(
+        &[("query.s", object)],
+        &Target::ScorpionExt,
+        &[SymbolFile {
+            name: "scorpion-rom.elf",
+            image: &rom,
+        }],
+    );
+    // Through the ELF file, as the uploader and `scorpion sim` get it.
+    let image = Image::parse("query.elf", &Format::Elf.write(&linked.image).expect("elf"))
+        .expect("reads back");
+    let mut robot = romlib::sim::VirtualScorpion::new();
+    let installed = robot.load_image(&image).expect("loads and hooks");
+    assert_eq!(installed.len(), 1);
+    for expected in [b"01\r", b"02\r"] {
+        let answer = robot
+            .transact(b"/1Q", 500_000)
+            .expect("the extension answers");
+        assert!(
+            answer.ends_with(expected),
+            "{}",
+            romlib::sim::escape(&answer)
+        );
+    }
+    // The ROM still answers its own questions past the extension.
+    let busy = robot
+        .transact(b"/1X", 500_000)
+        .expect("the ROM answers /1X");
+    assert!(busy.starts_with(b"X"), "{}", romlib::sim::escape(&busy));
+}

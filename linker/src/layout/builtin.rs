@@ -50,9 +50,15 @@ impl RomSymbols {
             .filter(|name| self.get(name).is_none())
             .collect();
         if !missing.is_empty() {
+            let help = if target == "scorpion-rom" {
+                "export them from the ROM's sources (`.exportzp USER_ZP_START`, `.export USER_RAM_START`): the ROM's own zero page and RAM end where the user's begin".to_owned()
+            } else {
+                "pass the ROM's linked ELF image with `--just-symbols ROM.elf`; the layout takes the user zero page and RAM bounds (USER_ZP_START/USER_ZP_END, USER_RAM_START/USER_RAM_END) from it".to_owned()
+            };
             return Err(Error::MissingRomSymbols {
                 target: target.to_owned(),
                 missing: missing.join(", "),
+                help,
             });
         }
         let mut values = [0u64; N];
