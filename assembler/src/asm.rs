@@ -237,6 +237,11 @@ impl<'a> Asm<'a> {
         self.report(diag::error(code, span, message))
     }
 
+    /// Joins two spans on one line (see [`Files::join`]).
+    pub(crate) fn join(&self, a: Span, b: Span) -> Span {
+        self.files.join(a, b)
+    }
+
     pub(crate) fn loc(&mut self, span: Span) -> LocId {
         self.prog.loc(span, self.line_ctx)
     }
@@ -1029,11 +1034,19 @@ impl<'a> Asm<'a> {
                     Keyword::Mnemonic(mnemonic) => self.instruction(mnemonic, t, p),
                     _ => {
                         let name = self.names.name(head.name()).to_string();
-                        let help = if t.get(p + 1).map(|t| t.kind) == Some(Tok::Colon) {
-                            None
-                        } else {
-                            Some(format!("a label needs a colon: `{name}:`"))
+                        // `name` alone, or before an instruction: a label
+                        // missing its colon.
+                        let label_like = match t.get(p + 1) {
+                            None => true,
+                            Some(next) if next.kind == Tok::Directive => true,
+                            Some(next) if next.kind == Tok::Ident => {
+                                let info = self.names.info[next.value as usize];
+                                matches!(info.keyword, Keyword::Mnemonic(_))
+                                    || info.macro_id.is_some()
+                            }
+                            _ => false,
                         };
+                        let help = label_like.then(|| format!("a label needs a colon: `{name}:`"));
                         let mut diag = diag::error(
                             "asm::unknown",
                             head.span,
@@ -1095,7 +1108,7 @@ impl<'a> Asm<'a> {
                 self.prog.node(crate::model::Node::Const(value))
             }
             Ok(_) | Err(crate::expr::EvalErr::NotYet(_)) => expr,
-            Err(error) => return Err(self.eval_error(error, t[2].span.to(t[p - 1].span))),
+            Err(error) => return Err(self.eval_error(error, self.join(t[2].span, t[p - 1].span))),
         };
         self.keep_nodes = true;
         self.cheap_epoch += 1;
@@ -1126,7 +1139,7 @@ impl<'a> Asm<'a> {
             let last = t[t.len() - 1].span;
             return Err(self.err(
                 "asm::syntax",
-                extra.span.to(last),
+                self.join(extra.span, last),
                 "unexpected text at the end of this statement",
             ));
         }
@@ -1174,7 +1187,7 @@ impl<'a> Asm<'a> {
             let count = macro_def.params.len();
             return Err(self.err(
                 "asm::macro-args",
-                head.span.to(t[t.len() - 1].span),
+                self.join(head.span, t[t.len() - 1].span),
                 format!(
                     "macro `{name}` takes {count} parameter{}, {} given",
                     if count == 1 { "" } else { "s" },
@@ -1400,20 +1413,27 @@ fn expanded_text(
     out
 }
 
-/// The source text of a run of tokens (a macro argument).
+/// The source text of a run of tokens (a macro argument): the source as
+/// written when the tokens are contiguous, else their texts with spaces.
 fn token_run_text(files: &Files, toks: &[Token]) -> String {
-    match (toks.first(), toks.last()) {
-        (Some(first), Some(last))
-            if first.span.file == last.span.file && first.span.start <= last.span.end =>
+    if let (Some(first), Some(last)) = (toks.first(), toks.last()) {
+        let joined = files.join(first.span, last.span);
+        if joined.end == last.span.end.max(first.span.end)
+            && toks
+                .windows(2)
+                .all(|w| w[0].span.end <= w[1].span.start && w[0].span.file == w[1].span.file)
         {
-            files.snippet(Span {
-                file: first.span.file,
-                start: first.span.start,
-                end: last.span.end,
-            })
+            return files.snippet(joined);
         }
-        _ => String::new(),
     }
+    let mut out = String::new();
+    for (i, tok) in toks.iter().enumerate() {
+        if i > 0 && toks[i - 1].span.end != tok.span.start {
+            out.push(' ');
+        }
+        out.push_str(&files.snippet(tok.span));
+    }
+    out
 }
 
 /// Source map entries need the symbol's place; kept beside the symbol.

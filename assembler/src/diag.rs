@@ -23,20 +23,6 @@ pub(crate) struct Span {
     pub(crate) end: u32,
 }
 
-impl Span {
-    /// The smallest span covering both (same file assumed; else `self`).
-    pub(crate) fn to(self, other: Span) -> Span {
-        if self.file != other.file {
-            return self;
-        }
-        Span {
-            file: self.file,
-            start: self.start.min(other.start),
-            end: self.end.max(other.end),
-        }
-    }
-}
-
 /// One source file the assembler read.
 #[derive(Debug)]
 pub(crate) struct SourceFile {
@@ -66,6 +52,25 @@ impl Files {
         self.files
             .get(file as usize)
             .map_or("<unknown>", |f| f.name.as_str())
+    }
+
+    /// The span from `a` to `b` when both are on one line of one file in
+    /// order; else `a`. Tokens of a macro expansion come from the body and
+    /// from the arguments, and a span must never run across lines.
+    pub(crate) fn join(&self, a: Span, b: Span) -> Span {
+        if a.file != b.file || b.end < a.start {
+            return a;
+        }
+        let text = self.text(a.file);
+        let (start, end) = (a.start as usize, (b.end as usize).min(text.len()));
+        if start > end || text[start..end].contains(&b'\n') {
+            return a;
+        }
+        Span {
+            file: a.file,
+            start: a.start,
+            end: b.end.max(a.end),
+        }
     }
 
     /// The text of a span, lossily decoded.

@@ -37,7 +37,7 @@ impl Asm<'_> {
                 let value = self.const_expr(t, &mut i, "`.org`")?;
                 self.expect_end(t, i)?;
                 if !(0..=0xFF_FFFF).contains(&value) {
-                    let span = t[p + 1].span.to(t[i - 1].span);
+                    let span = self.join(t[p + 1].span, t[i - 1].span);
                     return Err(self.report(crate::layout::range_diag(
                         span,
                         "`.org` address",
@@ -137,7 +137,7 @@ impl Asm<'_> {
                 self.expect_end(t, i)?;
                 for value in [from, to] {
                     if !(0..=255).contains(&value) {
-                        let span = t[p + 1].span.to(t[i - 1].span);
+                        let span = self.join(t[p + 1].span, t[i - 1].span);
                         return Err(self.report(crate::layout::range_diag(
                             span,
                             "`.charmap` code",
@@ -187,7 +187,7 @@ impl Asm<'_> {
                 Ok(())
             }
             Dir::Feature => {
-                let span = head.span.to(t[t.len() - 1].span);
+                let span = self.join(head.span, t[t.len() - 1].span);
                 let diag = diag::warning(
                     "asm::feature",
                     span,
@@ -289,7 +289,7 @@ impl Asm<'_> {
             } else {
                 let start = i;
                 let mut expr = self.expression(t, &mut i)?;
-                let span = t[start].span.to(t[i - 1].span);
+                let span = self.join(t[start].span, t[i - 1].span);
                 let wrap = match dir {
                     Dir::Lobytes => Some(UnaryOp::LoByte),
                     Dir::Hibytes => Some(UnaryOp::HiByte),
@@ -320,12 +320,19 @@ impl Asm<'_> {
     /// segment `PROGBITS` unless a fill value is given.
     fn reserve(&mut self, count: i64, fill: Option<u8>, span: Span) -> PResult<()> {
         if count < 0 || self.total_bytes.saturating_add(count as usize) > MAX_BYTES {
-            return Err(self.report(crate::layout::range_diag(
-                span,
-                "reserved size",
-                count,
-                (0, (MAX_BYTES - self.total_bytes.min(MAX_BYTES)) as i64),
-            )));
+            let diag = if count < 0 {
+                crate::layout::range_diag(span, "reserved size", count, (0, MAX_BYTES as i64))
+            } else {
+                diag::error(
+                    "asm::too-big",
+                    span,
+                    format!(
+                        "reserving {count} bytes makes the program larger than {} MiB",
+                        MAX_BYTES >> 20
+                    ),
+                )
+            };
+            return Err(self.report(diag));
         }
         let count = count as usize;
         let seg = &mut self.prog.segs[self.seg as usize];
@@ -349,7 +356,7 @@ impl Asm<'_> {
             let start = i;
             let value = self.const_expr(t, &mut i, "the `.res` fill value")?;
             if !(0..=255).contains(&value) {
-                let span = t[start].span.to(t[i - 1].span);
+                let span = self.join(t[start].span, t[i - 1].span);
                 return Err(self.report(crate::layout::range_diag(
                     span,
                     "fill value",
@@ -361,21 +368,21 @@ impl Asm<'_> {
         }
         self.expect_end(t, i)?;
         self.item(head.span, 0);
-        let span = t[p + 1].span.to(t[i - 1].span);
+        let span = self.join(t[p + 1].span, t[i - 1].span);
         self.reserve(count, fill, span)
     }
 
     fn align(&mut self, t: &[Token], p: usize) -> PResult<()> {
         let mut i = p + 1;
         let align = self.const_expr(t, &mut i, "`.align`")?;
-        let span = t[p + 1].span.to(t[i - 1].span);
+        let span = self.join(t[p + 1].span, t[i - 1].span);
         let mut fill = 0u8;
         let mut filled = false;
         if t.get(i).map(|t| t.kind) == Some(Tok::Comma) {
             i += 1;
             let value = self.const_expr(t, &mut i, "the `.align` fill value")?;
             if !(0..=255).contains(&value) {
-                let span = t[p + 1].span.to(t[i - 1].span);
+                let span = self.join(t[p + 1].span, t[i - 1].span);
                 return Err(self.report(crate::layout::range_diag(
                     span,
                     "fill value",
@@ -813,7 +820,7 @@ impl Asm<'_> {
                 let name = self.names.name(tok.name()).to_string();
                 return Err(self.err(
                     "asm::undefined",
-                    start.to(tok.span),
+                    self.join(start, tok.span),
                     format!("no struct, union or scope named `{name}` is defined here"),
                 ));
             };
@@ -1066,7 +1073,7 @@ impl Asm<'_> {
         let mut i = p + 1;
         let start = i;
         let expr = self.expression(t, &mut i)?;
-        let span = self.span_at(t, start).to(t[i - 1].span);
+        let span = self.join(self.span_at(t, start), t[i - 1].span);
         self.comma(t, &mut i)?;
         let Some(action) = t.get(i).filter(|t| t.kind == Tok::Ident).copied() else {
             let span = self.span_at(t, i);
@@ -1125,7 +1132,7 @@ impl Asm<'_> {
         };
         self.expect_end(t, p + 2)?;
         let message = String::from_utf8_lossy(&self.string_bytes(&text)).into_owned();
-        let span = head.span.to(text.span);
+        let span = self.join(head.span, text.span);
         match dir {
             Dir::Out => self.messages.push(message),
             Dir::Warning => {
@@ -1253,7 +1260,7 @@ impl Asm<'_> {
         let Some((path, bytes)) = self.find_file(&name, &dir) else {
             return Err(self.not_found(tok, &name));
         };
-        let ctx = self.new_ctx(CtxKind::Include, t[p].span.to(tok.span));
+        let ctx = self.new_ctx(CtxKind::Include, self.join(t[p].span, tok.span));
         let parent = path.parent().map(Path::to_path_buf).unwrap_or_default();
         self.push_file(path.display().to_string(), bytes, parent, ctx);
         Ok(())
@@ -1285,7 +1292,7 @@ impl Asm<'_> {
         if offset < 0 || offset > len || end < offset || end > len {
             return Err(self.err(
                 "asm::range",
-                tok.span.to(t[i - 1].span),
+                self.join(tok.span, t[i - 1].span),
                 format!(
                     "`{name}` has {len} bytes; offset {offset} and size {} do not fit",
                     end - offset

@@ -60,22 +60,56 @@ impl Asm<'_> {
         }
     }
 
-    fn operand(&mut self, mnemonic: Mnemonic, t: &[Token], mut p: usize) -> PResult<Operand> {
+    /// The span of the tokens `from..to` (an expression's own tokens).
+    fn tokens_span(&self, t: &[Token], from: usize, to: usize) -> Span {
+        match (t.get(from), to.checked_sub(1).and_then(|last| t.get(last))) {
+            (Some(first), Some(last)) if to > from => self.join(first.span, last.span),
+            _ => self.span_at(t, from),
+        }
+    }
+
+    /// The operand and the span of its expression.
+    fn operand(&mut self, mnemonic: Mnemonic, t: &[Token], p: usize) -> PResult<(Operand, Span)> {
+        let start = p;
+        let mut expr_start = p;
+        let operand = self.operand_inner(mnemonic, t, p, &mut expr_start)?;
+        let end = match operand.1 {
+            0 => t.len(),
+            end => end,
+        };
+        let span = if expr_start < end {
+            self.tokens_span(t, expr_start, end)
+        } else {
+            self.tokens_span(t, start, t.len())
+        };
+        Ok((operand.0, span))
+    }
+
+    /// Parses the operand; returns it with the end of its expression's
+    /// tokens (0 for "to the end"), and sets `expr_start`.
+    fn operand_inner(
+        &mut self,
+        mnemonic: Mnemonic,
+        t: &[Token],
+        mut p: usize,
+        expr_start: &mut usize,
+    ) -> PResult<(Operand, usize)> {
         let n = t.len();
         if p == n {
-            return Ok(Operand::None);
+            return Ok((Operand::None, 0));
         }
         if p + 1 == n
             && self.reg(t.get(p)) == Some(Keyword::RegA)
             && isa::has_mode(mnemonic, Mode::Accumulator)
         {
-            return Ok(Operand::Acc);
+            return Ok((Operand::Acc, 0));
         }
         if t[p].kind == Tok::Hash {
             p += 1;
+            *expr_start = p;
             let expr = self.expression(t, &mut p)?;
             self.expect_end(t, p)?;
-            return Ok(Operand::Imm(expr));
+            return Ok((Operand::Imm(expr), p));
         }
         let mut size = Size::Auto;
         if t[p].kind == Tok::Ident && t.get(p + 1).map(|t| t.kind) == Some(Tok::Colon) {
@@ -92,7 +126,7 @@ impl Asm<'_> {
                 _ => {
                     return Err(self.err(
                         "asm::syntax",
-                        t[p].span.to(t[p + 1].span),
+                        self.join(t[p].span, t[p + 1].span),
                         "an address-size prefix is `z:` (zero page) or `a:` (absolute)",
                     ));
                 }
@@ -102,27 +136,31 @@ impl Asm<'_> {
         if t.get(p).map(|t| t.kind) == Some(Tok::LParen) {
             let save = p;
             p += 1;
+            *expr_start = p;
             let inner = self.expression(t, &mut p)?;
+            let inner_end = p;
             if t.get(p).map(|t| t.kind) == Some(Tok::Comma)
                 && self.reg(t.get(p + 1)) == Some(Keyword::RegX)
                 && t.get(p + 2).map(|t| t.kind) == Some(Tok::RParen)
             {
                 self.expect_end(t, p + 3)?;
-                return Ok(Operand::IndX(inner));
+                return Ok((Operand::IndX(inner), inner_end));
             }
             if t.get(p).map(|t| t.kind) == Some(Tok::RParen) {
                 if p + 1 == n {
-                    return Ok(Operand::Ind(inner));
+                    return Ok((Operand::Ind(inner), inner_end));
                 }
                 if t[p + 1].kind == Tok::Comma && self.reg(t.get(p + 2)) == Some(Keyword::RegY) {
                     self.expect_end(t, p + 3)?;
-                    return Ok(Operand::IndY(inner));
+                    return Ok((Operand::IndY(inner), inner_end));
                 }
             }
             // `(a+b)*2`: a parenthesised expression, not indirection.
             p = save;
         }
+        *expr_start = p;
         let expr = self.expression(t, &mut p)?;
+        let expr_end = p;
         let mut index = Index::None;
         if t.get(p).map(|t| t.kind) == Some(Tok::Comma) {
             index = match self.reg(t.get(p + 1)) {
@@ -140,19 +178,14 @@ impl Asm<'_> {
             p += 2;
         }
         self.expect_end(t, p)?;
-        Ok(Operand::Direct(expr, index, size))
+        Ok((Operand::Direct(expr, index, size), expr_end))
     }
 
     /// Encodes one instruction.
     pub(crate) fn instruction(&mut self, mnemonic: Mnemonic, t: &[Token], p: usize) -> PResult<()> {
         let head = t[p];
-        let operand = self.operand(mnemonic, t, p + 1)?;
-        let operand_span = if p + 1 < t.len() {
-            t[p + 1].span.to(t[t.len() - 1].span)
-        } else {
-            head.span
-        };
-        let whole = head.span.to(t[t.len() - 1].span);
+        let (operand, operand_span) = self.operand(mnemonic, t, p + 1)?;
+        let whole = self.join(head.span, t[t.len() - 1].span);
         match operand {
             Operand::None => {
                 let mode = if isa::has_mode(mnemonic, Mode::Implied) {
@@ -275,9 +308,8 @@ impl Asm<'_> {
                     "asm::undocumented",
                     span,
                     format!(
-                        "`{} {}` (opcode ${code:02X}) is an undocumented NMOS opcode",
+                        "`{}` ({mode}, opcode ${code:02X}) is an undocumented NMOS opcode",
                         mnemonic.name().to_ascii_lowercase(),
-                        mode
                     ),
                 )
                 .help("enable the undocumented opcodes with `.setcpu \"6502X\"`");

@@ -144,10 +144,9 @@ pub(crate) fn range_diag(span: Span, what: &str, value: i64, range: (i64, i64)) 
     diag::error(
         "asm::range",
         span,
-        format!("{what} {} is out of range", show(value)),
+        format!("{what} {} is outside {bounds}", show(value)),
     )
     .label(format!("this is {}", show(value)))
-    .help(format!("a {what} must be {bounds}"))
 }
 
 /// A branch that does not reach.

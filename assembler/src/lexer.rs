@@ -266,7 +266,12 @@ impl Lexer {
                             i = j;
                         }
                         None => {
-                            let j = (i + 3).min(end);
+                            // Skip to the closing quote, if any, so one bad
+                            // constant is one error.
+                            let j = text[i + 1..end]
+                                .iter()
+                                .position(|b| *b == b'\'')
+                                .map_or((i + 2).min(end), |len| i + 1 + len + 1);
                             errors.push((
                                 self.span(i, j),
                                 "a character constant is one character between quotes (`'a'`)"

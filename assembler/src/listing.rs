@@ -49,6 +49,8 @@ pub(crate) struct ListingBuilder {
     lines: Vec<Line>,
     /// The expanded text of the next line, when it comes from an expansion.
     pub(crate) expanded: Option<String>,
+    /// The last line was begun and awaits its end position.
+    open: bool,
 }
 
 fn depth(frames: &[Frame]) -> u8 {
@@ -61,6 +63,7 @@ impl ListingBuilder {
             enabled: true,
             lines: Vec::new(),
             expanded: None,
+            open: false,
         }
     }
 
@@ -100,6 +103,7 @@ impl ListingBuilder {
         seg: SegId,
     ) {
         let text = self.text(info);
+        self.open = self.enabled;
         if !self.enabled {
             return;
         }
@@ -115,6 +119,9 @@ impl ListingBuilder {
     }
 
     pub(crate) fn end_line(&mut self, prog: &Program, seg: SegId) {
+        if !std::mem::take(&mut self.open) {
+            return;
+        }
         let Some(line) = self.lines.last_mut() else {
             return;
         };

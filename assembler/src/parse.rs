@@ -264,16 +264,12 @@ impl Asm<'_> {
         let index = if count < 0 {
             let back = count.unsigned_abs() as usize;
             if back > self.unnamed_count {
-                return Err(self.err(
-                    "asm::undefined",
-                    tok.span,
-                    format!(
-                        "there {} only {} unnamed label{} before this",
-                        if self.unnamed_count == 1 { "is" } else { "are" },
-                        self.unnamed_count,
-                        if self.unnamed_count == 1 { "" } else { "s" }
-                    ),
-                ));
+                let message = match self.unnamed_count {
+                    0 => "there is no unnamed label `:` before this".to_string(),
+                    1 => "there is only one unnamed label before this".to_string(),
+                    n => format!("there are only {n} unnamed labels before this"),
+                };
+                return Err(self.err("asm::undefined", tok.span, message));
             }
             self.unnamed_count - back
         } else {
@@ -323,7 +319,7 @@ impl Asm<'_> {
             name = t[*p + 1];
             *p += 2;
         }
-        let span = start.to(name.span);
+        let span = self.join(start, name.span);
         match scope {
             None => Ok(self.ref_sym(name.name(), span)),
             Some(s) => {
@@ -543,7 +539,7 @@ impl Asm<'_> {
                 let name = self.names.name(tok.name()).to_string();
                 return Err(self.err(
                     "asm::undefined",
-                    start.to(tok.span),
+                    self.join(start, tok.span),
                     format!("`.sizeof` needs a struct, union, enum or scope; `{name}` is none of these (yet)"),
                 ));
             };
@@ -576,9 +572,7 @@ impl Asm<'_> {
     pub(crate) fn const_expr(&mut self, t: &[Token], p: &mut usize, what: &str) -> PResult<i64> {
         let start = *p;
         let node = self.expression(t, p)?;
-        let span = self
-            .span_at(t, start)
-            .to(self.span_at(t, p.saturating_sub(1)));
+        let span = self.join(self.span_at(t, start), self.span_at(t, p.saturating_sub(1)));
         match self.prog.eval(node) {
             Ok(Value::Const(value)) => Ok(value),
             Ok(_) => {

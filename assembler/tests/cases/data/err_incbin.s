@@ -1,0 +1,3 @@
+        .incbin "data.bin", 2, 10
+        .incbin "missing.bin"
+        .incbin "data.bin", -1

@@ -1,0 +1,3 @@
+.define LOOP LOOP + 1
+        .byte LOOP
+.define

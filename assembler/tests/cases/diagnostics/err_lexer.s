@@ -1,0 +1,5 @@
+        lda #"unterminated
+        lda #$1G
+        lda ?
+        .byte @
+        lda #99999999999

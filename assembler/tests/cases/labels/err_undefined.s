@@ -1,0 +1,7 @@
+        jmp nowhere
+        lda missing,x
+first:  bne @later
+second:
+@later: rts
+        bne :+
+        jmp :--

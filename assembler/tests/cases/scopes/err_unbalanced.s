@@ -1,0 +1,7 @@
+.proc one
+        rts
+.endscope
+.endproc
+.endproc
+.scope two
+        nop

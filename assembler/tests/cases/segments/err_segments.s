@@ -1,0 +1,4 @@
+        .segment CODE
+        .segment "bad name"
+        .segment "CODE": zeropage
+        .segment "X": sometimes
