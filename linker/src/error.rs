@@ -24,7 +24,7 @@ pub enum Error {
     Failed {
         /// How many errors.
         count: usize,
-        /// The errors, in a stable order.
+        /// The errors in a stable order, then any warnings.
         #[related]
         errors: Vec<Error>,
     },

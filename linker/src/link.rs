@@ -313,7 +313,10 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
 
     let hooks = hooks(&globals, &mut errors);
     if !errors.is_empty() {
-        return Err(failed(errors));
+        // Warnings still matter when the link fails: show them after the errors.
+        let count = errors.len();
+        errors.append(&mut warnings);
+        return Err(Error::Failed { count, errors });
     }
 
     let placement = Placement {

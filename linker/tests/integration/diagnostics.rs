@@ -431,3 +431,67 @@ fn every_error_has_a_code() {
         Some("linker::unknown_target".into())
     );
 }
+
+#[test]
+fn inconsistent_layouts() {
+    let twice = Layout::from_toml(
+        "twice.toml",
+        "[[area]]\nname = \"RAM\"\nstart = 0\nsize = 16\n[[area]]\nname = \"RAM\"\nstart = 16\nsize = 16\n",
+    )
+    .expect_err("RAM twice");
+    let empty = Layout::from_toml(
+        "empty.toml",
+        "[[area]]\nname = \"RAM\"\nstart = 0\nsize = 0\n",
+    )
+    .expect_err("size 0");
+    let both = Layout::from_toml(
+        "both.toml",
+        "[[area]]\nname = \"RAM\"\nstart = 0\nsize = 16\nend = 15\n",
+    )
+    .expect_err("size and end");
+    let rom = fake_rom(&[("USER_RAM_END", 0x0100)]);
+    let backwards = link_with(
+        &[],
+        &Target::ScorpionExt,
+        &[SymbolFile {
+            name: "odd-rom.elf",
+            image: &rom,
+        }],
+        &MemorySources::default(),
+    )
+    .expect_err("RAM end below its start");
+    // A user symbol that the layout also defines.
+    let layout = Layout::from_toml(
+        "def.toml",
+        "[[area]]\nname = \"RAM\"\nstart = \"$400\"\nsize = 16\n[[segment]]\nname = \"CODE\"\nload = \"RAM\"\ndefine = true\n",
+    )
+    .expect("parses");
+    let mut obj = ObjectBuilder::new();
+    obj.code("CODE", &[0x60]);
+    obj.global("__CODE_RUN__", SymbolDef::Absolute(1));
+    let clash = link_with(
+        &[("a.o", obj.build())],
+        &Target::Custom(layout),
+        &[],
+        &MemorySources::default(),
+    )
+    .expect_err("defined twice");
+    let all = [twice, empty, both, backwards, clash]
+        .iter()
+        .map(|error| render(error))
+        .collect::<Vec<_>>()
+        .join("\n");
+    insta::assert_snapshot!("inconsistent_layouts", all);
+}
+
+#[test]
+fn a_failed_link_still_shows_its_warnings() {
+    let mut obj = ObjectBuilder::new();
+    obj.code("CODE", &[0xEA; 3]);
+    let rodata = obj.code("RODATA", &[0, 0]);
+    obj.align(rodata, 2);
+    let missing = obj.import("nowhere", false);
+    obj.reloc(rodata, 0, R_MOS_ADDR16, missing, 0);
+    let error = link_flat(&[("a.o", obj.build())], 0x1000).expect_err("undefined");
+    insta::assert_snapshot!("failure_with_warning", render(&error));
+}

@@ -39,15 +39,16 @@ pub(crate) fn render(error: &dyn miette::Diagnostic) -> String {
     out
 }
 
-/// A ROM image exporting the user-area bounds, as issue 5's ROM will.
+/// A ROM image exporting the user-area bounds, as the reference ROM does.
 pub(crate) fn fake_rom(extra: &[(&str, u32)]) -> Image {
-    let mut symbols = vec![
+    // `extra` comes first, so it can override a bound (the first wins).
+    let mut symbols = extra.to_vec();
+    symbols.extend_from_slice(&[
         ("USER_ZP_START", 0x80),
         ("USER_ZP_END", 0xFF),
         ("USER_RAM_START", 0x0400),
         ("USER_RAM_END", 0x0FFF),
-    ];
-    symbols.extend_from_slice(extra);
+    ]);
     Image {
         symbols: symbols
             .into_iter()
