@@ -27,6 +27,8 @@ enum Command {
     Asm(cmd::asm::Args),
     /// Disassemble a raw binary file.
     Disasm(cmd::disasm::Args),
+    /// Run 6502 code on the emulator.
+    Emu(cmd::emu::Args),
     /// Link 6502 ELF objects into a Scorpion image.
     Link(cmd::link::Args),
     /// Assemble ca65-syntax sources and link them into a Scorpion image.
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Asm(args) => cmd::asm::run(&args),
         Command::Disasm(args) => cmd::disasm::run(&args),
+        Command::Emu(args) => cmd::emu::run(&args),
         Command::Link(args) => cmd::link::run(&args),
         Command::Build(args) => cmd::build::run(&args),
         Command::Upload(args) => cmd::upload::run(&args),

@@ -9,7 +9,7 @@ pub enum Error {
     #[error("an image of {len} bytes loaded at ${address:04X} runs past $FFFF")]
     #[diagnostic(
         code(emulator::image_too_large),
-        help("load it lower, or cut it to {} bytes", 0x1_0000 - usize::from(*address))
+        help("{}", fit_help(*len))
     )]
     ImageTooLarge {
         /// Where the image was to be loaded.
@@ -50,4 +50,12 @@ pub enum Error {
         /// Why not.
         reason: &'static str,
     },
+}
+
+/// Where an image of `len` bytes still fits.
+fn fit_help(len: usize) -> String {
+    match 0x1_0000usize.checked_sub(len) {
+        Some(highest) => format!("an image this long fits at ${highest:04X} or lower"),
+        None => "the image is larger than the 64 KiB address space".to_string(),
+    }
 }

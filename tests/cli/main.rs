@@ -3,6 +3,7 @@
 
 mod build;
 mod disasm;
+mod emu;
 mod link;
 mod read;
 mod upload;

@@ -6,6 +6,7 @@
 mod cycles;
 mod dormann;
 mod interrupts;
+mod programs;
 mod py65;
 
 use std::path::PathBuf;
