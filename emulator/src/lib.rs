@@ -11,9 +11,12 @@
 //!   breakpoints, stopping at traps. Off means absent from the compiled loop.
 //! - [`machine`]: a [`Cpu`] with its [`Bus`]; [`RamMachine`] is the plain
 //!   64 KiB machine test programs run on.
+//! - [`board`]: the Scorpion controller card (6522, 6551, latches, motors,
+//!   sensors, KIM-bus slots) and [`board::Scorpion`], the virtual robot.
 //!
 //! The emulator knows nothing of ELF: callers load bytes into it.
 
+pub mod board;
 pub mod bus;
 pub mod cpu;
 mod error;
