@@ -52,6 +52,8 @@ pub struct ImageSection {
     pub size: u32,
     /// What it holds.
     pub kind: SegmentKind,
+    /// Holds code (`SHF_EXECINSTR`): disassemblers and debuggers start here.
+    pub exec: bool,
 }
 
 /// A symbol of the image.
@@ -187,6 +189,7 @@ impl Image {
             let nobits = header.sh_type == sh::SHT_NOBITS;
             let zeropage = header.sh_flags & u64::from(mos::SHF_MOS_ZEROPAGE) != 0;
             let write = header.sh_flags & u64::from(sh::SHF_WRITE) != 0;
+            let exec = header.sh_flags & u64::from(sh::SHF_EXECINSTR) != 0;
             let kind = match (nobits, zeropage, write) {
                 (true, true, _) => SegmentKind::ZeroPage,
                 (true, false, _) => SegmentKind::Bss,
@@ -218,6 +221,7 @@ impl Image {
                 load,
                 size,
                 kind,
+                exec,
             });
         }
 

@@ -42,6 +42,8 @@ pub(crate) struct Section {
     pub(crate) align: u32,
     pub(crate) nobits: bool,
     pub(crate) zeropage: bool,
+    /// `SHF_EXECINSTR`: holds code.
+    pub(crate) exec: bool,
     pub(crate) relocs: Vec<Reloc>,
 }
 
@@ -295,6 +297,7 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
             align,
             nobits,
             zeropage: header.sh_flags & u64::from(mos::SHF_MOS_ZEROPAGE) != 0,
+            exec: header.sh_flags & u64::from(sh::SHF_EXECINSTR) != 0,
             relocs: Vec::new(),
         });
     }

@@ -527,6 +527,7 @@ fn build_image(
             run: segment.run as u32,
             load: segment.load as u32,
             size: segment.size as u32,
+            exec: segment.exec,
             kind: if segment.written
                 || !matches!(segment.rule.kind, SegmentKind::Bss | SegmentKind::ZeroPage)
             {

@@ -37,6 +37,8 @@ pub(crate) struct Placed {
     pub(crate) written: bool,
     /// Its inputs hold zero-page sections, or it is a zero-page segment.
     pub(crate) zeropage: bool,
+    /// Some input holds code.
+    pub(crate) exec: bool,
 }
 
 impl Placed {
@@ -97,6 +99,7 @@ pub(crate) fn place(
             bytes: Vec::new(),
             written: false,
             zeropage: rule.kind == SegmentKind::ZeroPage,
+            exec: false,
         })
         .collect();
     let mut sections = Vec::with_capacity(objects.len());
@@ -135,6 +138,7 @@ pub(crate) fn place(
             segment.size = offset + u64::from(section.size);
             segment.align = segment.align.max(align);
             segment.zeropage |= section.zeropage;
+            segment.exec |= section.exec;
             positions[section_index] = Some((segment_index, offset));
         }
         sections.push(positions);

@@ -130,6 +130,13 @@ fn a_multi_file_program_runs_from_every_format() {
     let read = Image::parse("prog.elf", &elf).expect("reads back");
     assert_eq!(&read, image);
     assert_eq!(run(&read), ram);
+    let exec = |name: &str| {
+        read.sections
+            .iter()
+            .find(|s| s.name == name)
+            .map(|s| s.exec)
+    };
+    assert_eq!((exec("CODE"), exec("RODATA")), (Some(true), Some(false)));
 
     // The record formats decode to the raw binary.
     let bin = Format::Bin.write(image).expect("bin");

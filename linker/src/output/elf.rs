@@ -151,8 +151,11 @@ pub fn write_elf(image: &Image) -> Result<Vec<u8>, Error> {
             })
             .map(|(area, offset)| offset + u64::from(section.load - area.load));
         let mut flags = elf::SHF_ALLOC.0;
+        if section.exec {
+            flags |= elf::SHF_EXECINSTR.0;
+        }
         match section.kind {
-            SegmentKind::ReadOnly => flags |= elf::SHF_EXECINSTR.0,
+            SegmentKind::ReadOnly => {}
             SegmentKind::ReadWrite | SegmentKind::Bss => flags |= elf::SHF_WRITE.0,
             SegmentKind::ZeroPage => flags |= elf::SHF_WRITE.0 | u64::from(mos::SHF_MOS_ZEROPAGE),
         }
