@@ -8,6 +8,7 @@ mod dormann;
 mod interrupts;
 mod programs;
 mod py65;
+mod undocumented;
 
 use std::path::PathBuf;
 use std::process::Command;
