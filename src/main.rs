@@ -39,6 +39,10 @@ enum Command {
     Ports(cmd::ports::Args),
     /// Dump robot memory with `/7R` questions.
     Read(cmd::read::Args),
+    /// Run the virtual Scorpion on a pseudo-terminal or stdin/stdout.
+    Sim(cmd::sim::Args),
+    /// Send commands to a robot and print the answers.
+    Ask(cmd::ask::Args),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +56,8 @@ fn main() -> ExitCode {
         Command::Upload(args) => cmd::upload::run(&args),
         Command::Ports(args) => cmd::ports::run(&args),
         Command::Read(args) => cmd::read::run(&args),
+        Command::Sim(args) => cmd::sim::run(&args),
+        Command::Ask(args) => cmd::ask::run(&args),
     };
     match result {
         Ok(code) => code,

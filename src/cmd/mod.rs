@@ -8,3 +8,5 @@ pub(crate) mod link;
 pub(crate) mod ports;
 pub(crate) mod read;
 pub(crate) mod upload;
+pub(crate) mod ask;
+pub(crate) mod sim;

@@ -1,11 +1,13 @@
 //! The `scorpion` binary run as a process: arguments in, output and exit
 //! status out, snapshotted with insta. One module per subcommand.
 
+mod ask;
 mod build;
 mod disasm;
 mod emu;
 mod link;
 mod read;
+mod sim;
 mod upload;
 
 use std::process::{Command, Output};

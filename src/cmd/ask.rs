@@ -1,0 +1,250 @@
+//! `scorpion ask`: send commands to a robot (or the virtual one) and print
+//! the answers, raw or field by field.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use miette::{Context, IntoDiagnostic};
+use romlib::VirtualScorpion;
+use romlib::protocol::{Answer, BusyByte, Command, MoveCount, Pair, Status};
+use uploader::{Client, ClientConfig, Transport};
+
+use crate::cmd::{ports, sim};
+
+/// Send commands to a robot and print each answer, one per line.
+///
+/// Commands are written as on the line: `/1P`, `/8C+501000`, `/7R020010`.
+/// Instructions print nothing; an extension's command prints its answer if
+/// one comes within --timeout. `--port emu` talks to the virtual Scorpion
+/// in this process.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// The serial port the robot is on, or `emu` for the virtual Scorpion.
+    #[arg(long)]
+    port: String,
+    /// The line's baud rate.
+    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
+    baud: u32,
+    /// Print each answer field by field.
+    #[arg(long)]
+    decode: bool,
+    /// How long an extension's command may take to answer, in milliseconds.
+    #[arg(long, default_value_t = 500, value_name = "MS")]
+    timeout: u64,
+    /// With `--port emu`: a linked image to load first (repeatable).
+    #[arg(long = "image", value_name = "ELF")]
+    images: Vec<PathBuf>,
+    /// The commands, in order.
+    #[arg(required = true, value_name = "CMD", value_parser = command)]
+    commands: Vec<Command>,
+}
+
+fn command(text: &str) -> Result<Command, String> {
+    Command::parse(text.as_bytes()).map_err(|error| error.to_string())
+}
+
+/// One robot: the virtual one or a serial line.
+enum Robot {
+    Virtual(Box<VirtualScorpion>),
+    Serial(Client<Box<dyn uploader::Transport>>),
+}
+
+impl Robot {
+    /// Sends `command`; returns its answer, if it has one.
+    fn exchange(&mut self, command: &Command, timeout: Duration) -> miette::Result<Option<Answer>> {
+        let extension = matches!(command, Command::Extension(_));
+        match self {
+            Robot::Virtual(robot) => {
+                if !extension {
+                    return Ok(robot.exchange(command)?);
+                }
+                let cycles = u64::try_from(timeout.as_micros()).unwrap_or(u64::MAX);
+                match robot.transact(&command.encode(), cycles) {
+                    Ok(raw) => Ok(Some(command.parse_answer(&raw)?)),
+                    Err(romlib::Error::NoAnswer { received, .. }) if received.is_empty() => {
+                        Ok(None)
+                    }
+                    Err(error) => Err(error.into()),
+                }
+            }
+            Robot::Serial(client) => {
+                if command.is_question() {
+                    return Ok(Some(client.ask(command)?));
+                }
+                client.send(command)?;
+                if !extension {
+                    return Ok(None);
+                }
+                let transport = client.transport();
+                let mut raw = Vec::new();
+                let deadline = transport.now() + timeout;
+                while !raw.contains(&b'\r') {
+                    let now = transport.now();
+                    if now >= deadline {
+                        break;
+                    }
+                    transport.receive(&mut raw, deadline - now)?;
+                }
+                if raw.is_empty() {
+                    return Ok(None);
+                }
+                Ok(Some(command.parse_answer(&raw)?))
+            }
+        }
+    }
+}
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let mut robot = if args.port == "emu" {
+        Robot::Virtual(Box::new(sim::robot(args.baud, None, &args.images)?))
+    } else {
+        if !args.images.is_empty() {
+            miette::bail!(
+                help = "upload them with `scorpion upload IMAGE --port PORT`",
+                "--image loads images into the virtual Scorpion only (--port emu)"
+            );
+        }
+        let transport = ports::open(&args.port, args.baud)?;
+        Robot::Serial(Client::new(transport, ClientConfig::default()))
+    };
+    let timeout = Duration::from_millis(args.timeout);
+    let mut out = std::io::stdout().lock();
+    for command in &args.commands {
+        let answer = robot
+            .exchange(command, timeout)
+            .wrap_err_with(|| format!("`{command}`"))?;
+        if args.decode {
+            write!(out, "{}", decode(command, answer.as_ref())).into_diagnostic()?;
+        } else if let Some(answer) = answer {
+            let text = answer.encode();
+            let text = String::from_utf8_lossy(text.strip_suffix(b"\r").unwrap_or(&text));
+            writeln!(out, "{text}").into_diagnostic()?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A command and its answer, a field a line.
+fn decode(command: &Command, answer: Option<&Answer>) -> String {
+    let Some(answer) = answer else {
+        return if matches!(command, Command::Extension(_)) {
+            format!("{command}: no answer\n")
+        } else {
+            format!("{command}: done (an instruction has no answer)\n")
+        };
+    };
+    let raw = answer.encode();
+    let raw = String::from_utf8_lossy(raw.strip_suffix(b"\r").unwrap_or(&raw)).into_owned();
+    let mut lines = vec![format!("{command} -> {raw}")];
+    let mut field = |name: &str, value: String| lines.push(format!("  {name:<13}{value}"));
+    match answer {
+        Answer::Bumpers(bumpers) => field("bumpers", bits(bumpers.0, "closed")),
+        Answer::Scan(scan) => {
+            field("direction", format!("{:?}", scan.axis).to_lowercase());
+            field("readings", format!("{}", scan.data.len()));
+            for (row, chunk) in scan.data.chunks(16).enumerate() {
+                let hex: Vec<String> = chunk.iter().map(|b| format!("{b:02X}")).collect();
+                field(&format!("  [{:3}]", row * 16), hex.join(" "));
+            }
+        }
+        Answer::Eyes(pair) => field("eyes", pair_text(*pair)),
+        Answer::Lamps(on) => field("lamps", on_off(*on)),
+        Answer::Tracker(pair) => field("tracker", pair_text(*pair)),
+        Answer::Moves(moves) => {
+            field("left moved", count(moves.left));
+            field("right moved", count(moves.right));
+        }
+        Answer::Busy(busy) => field("busy", busy_text(*busy)),
+        Answer::Memory(bytes) => {
+            for (row, chunk) in bytes.chunks(16).enumerate() {
+                let hex: Vec<String> = chunk.iter().map(|b| format!("{b:02X}")).collect();
+                field(&format!("+{:02}", row * 16), hex.join(" "));
+            }
+        }
+        Answer::Remaining { motor, steps } => field(
+            &format!("{motor:?} to go").to_lowercase(),
+            format!("{} steps", steps.get()),
+        ),
+        Answer::Everything(status) => status_fields(status, &mut field),
+        Answer::Text(text) => field("text", text.clone()),
+    }
+    let mut text = lines.join("\n");
+    text.push('\n');
+    text
+}
+
+fn status_fields(status: &Status, field: &mut impl FnMut(&str, String)) {
+    field("bumpers", bits(status.bumpers.0, "closed"));
+    field("eyes", pair_text(status.eyes));
+    field("lamps", on_off(status.lamps));
+    field("tracker", pair_text(status.tracker));
+    field("left moved", count(status.moves.left));
+    field("right moved", count(status.moves.right));
+    field("master I/O", bits(status.io, "set"));
+    field("busy", busy_text(status.busy));
+    field(
+        "left to go",
+        format!("{} steps", status.left_remaining.get()),
+    );
+    field(
+        "right to go",
+        format!("{} steps", status.right_remaining.get()),
+    );
+}
+
+fn bits(value: u8, what: &str) -> String {
+    if value == 0 {
+        return format!("{value:02X} (none {what})");
+    }
+    let set: Vec<String> = (0..8)
+        .filter(|bit| value & (1 << bit) != 0)
+        .map(|bit| bit.to_string())
+        .collect();
+    format!("{value:02X} (bits {} {what})", set.join(", "))
+}
+
+fn pair_text(pair: Pair) -> String {
+    let text = match (pair.left, pair.right) {
+        (false, false) => "none",
+        (false, true) => "right",
+        (true, false) => "left",
+        (true, true) => "both",
+    };
+    format!("{} ({text})", char::from(pair.digit()))
+}
+
+fn on_off(on: bool) -> String {
+    if on { "on" } else { "off" }.to_owned()
+}
+
+fn count(count: MoveCount) -> String {
+    format!(
+        "{}{} steps",
+        char::from(count.direction.sign()),
+        count.steps.get()
+    )
+}
+
+fn busy_text(busy: BusyByte) -> String {
+    let names = [
+        (BusyByte::TONE, "tone"),
+        (BusyByte::EYE, "eyes"),
+        (BusyByte::LAMPS, "lamps"),
+        (BusyByte::H_SCANNER, "H scanner"),
+        (BusyByte::V_SCANNER, "V scanner"),
+        (BusyByte::LEFT_MOTOR, "left motor"),
+        (BusyByte::RIGHT_MOTOR, "right motor"),
+    ];
+    let active: Vec<&str> = names
+        .iter()
+        .filter(|(bit, _)| busy.0 & bit != 0)
+        .map(|(_, name)| *name)
+        .collect();
+    if active.is_empty() {
+        format!("{:02X} (idle)", busy.0)
+    } else {
+        format!("{:02X} ({})", busy.0, active.join(", "))
+    }
+}

@@ -1,0 +1,272 @@
+//! `scorpion sim`: the virtual Scorpion, serving a pseudo-terminal or the
+//! terminal it runs in, at the baud rate's pace.
+
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use emulator::board::{CPU_HZ, acia};
+use miette::{Context, IntoDiagnostic};
+use romlib::VirtualScorpion;
+
+use crate::cmd::ports;
+
+/// Run the virtual Scorpion: the reference ROM (or your ROM profile) on the
+/// emulated board, extensions loaded as an upload leaves them.
+///
+/// With `--pty` it opens a pseudo-terminal, prints its path as the first
+/// line on stdout and serves it until interrupted: point a terminal program
+/// or `scorpion upload --port PATH` at it. Without, it reads commands from
+/// stdin and prints the answers, one per line, until stdin ends.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// Serve a pseudo-terminal instead of stdin and stdout.
+    #[arg(long)]
+    pty: bool,
+    /// The line's baud rate (the robot's DIP switches are set to match).
+    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
+    baud: u32,
+    /// A linked image (ELF) to load into RAM before serving, hooks
+    /// installed last; repeat to chain extensions, in order.
+    #[arg(long = "image", value_name = "ELF")]
+    images: Vec<PathBuf>,
+    /// Bumper microswitches closed at power-up, one bit each: `01`, `$80`.
+    #[arg(long, value_name = "HEX", value_parser = bumper_mask)]
+    bumpers: Option<u8>,
+    /// A ROM profile (the ROM's linked ELF) to run instead of the
+    /// reference ROM.
+    #[arg(long, value_name = "ELF")]
+    rom: Option<PathBuf>,
+}
+
+/// A bumper mask in hex: `05`, `$05` or `0x05`.
+fn bumper_mask(text: &str) -> Result<u8, String> {
+    let digits = text
+        .trim()
+        .trim_start_matches('$')
+        .trim_start_matches("0x")
+        .trim_start_matches("0X");
+    u8::from_str_radix(digits, 16)
+        .map_err(|_| format!("`{text}` is not a hex byte (write 05 or $80: a bit per bumper)"))
+}
+
+/// The virtual robot as the options describe it, powered up.
+pub(crate) fn robot(
+    baud: u32,
+    rom: Option<&PathBuf>,
+    images: &[PathBuf],
+) -> miette::Result<VirtualScorpion> {
+    let mut robot = match rom {
+        Some(path) => {
+            let bytes = std::fs::read(path)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot read the ROM profile {}", path.display()))?;
+            let image = linker::Image::parse(&path.display().to_string(), &bytes)?;
+            VirtualScorpion::with_rom(&path.display().to_string(), &image)?
+        }
+        None => VirtualScorpion::new(),
+    };
+    if !robot.set_baud(baud) {
+        let rates: Vec<String> = (1u8..16)
+            .filter_map(acia::code_rate)
+            .map(|rate| format!("{}", rate.bits_per_second()))
+            .collect();
+        miette::bail!(
+            help = format!("the 6551's rates: {}", rates.join(", ")),
+            "the Scorpion's 6551 cannot run at {baud} baud"
+        );
+    }
+    for path in images {
+        let bytes = std::fs::read(path)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot read {}", path.display()))?;
+        let image = linker::Image::parse(&path.display().to_string(), &bytes)?;
+        let hooks = robot
+            .load_image(&image)
+            .wrap_err_with(|| format!("cannot load {}", path.display()))?;
+        let mut err = std::io::stderr().lock();
+        for area in &image.areas {
+            writeln!(
+                err,
+                "loaded {}: ${:04X}-${:04X}",
+                path.display(),
+                area.load,
+                u64::from(area.load) + area.bytes.len() as u64 - 1
+            )
+            .into_diagnostic()?;
+        }
+        for hook in hooks {
+            writeln!(
+                err,
+                "{} -> ${:04X} (was ${:04X})",
+                hook.kind.rom_symbol(),
+                hook.handler,
+                hook.previous
+            )
+            .into_diagnostic()?;
+        }
+    }
+    Ok(robot)
+}
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let mut robot = robot(args.baud, args.rom.as_ref(), &args.images)?;
+    if let Some(mask) = args.bumpers {
+        robot.robot_mut().set_bumpers(mask);
+    }
+    if args.pty {
+        serve_pty(&mut robot, args.baud)
+    } else {
+        serve_stdio(&mut robot)
+    }
+}
+
+/// Emulated cycles for a wall-clock duration (the CPU runs at 1 MHz).
+fn cycles(elapsed: Duration) -> u64 {
+    u64::try_from(elapsed.as_micros()).unwrap_or(u64::MAX) * CPU_HZ / 1_000_000
+}
+
+/// Keeps the robot's clock level with the wall clock.
+struct Pace {
+    started: Instant,
+    first_cycle: u64,
+}
+
+impl Pace {
+    fn new(robot: &VirtualScorpion) -> Pace {
+        Pace {
+            started: Instant::now(),
+            first_cycle: robot.cycles(),
+        }
+    }
+
+    fn catch_up(&self, robot: &mut VirtualScorpion) -> miette::Result<()> {
+        let target = self.first_cycle + cycles(self.started.elapsed());
+        let behind = target.saturating_sub(robot.cycles());
+        robot.run_for(behind)?;
+        Ok(())
+    }
+}
+
+#[cfg(unix)]
+fn serve_pty(robot: &mut VirtualScorpion, baud: u32) -> miette::Result<ExitCode> {
+    use std::io::Read;
+
+    use serialport::{SerialPort, TTYPort};
+
+    let (mut master, slave) = TTYPort::pair()
+        .into_diagnostic()
+        .wrap_err("cannot open a pseudo-terminal")?;
+    let path = slave
+        .name()
+        .ok_or_else(|| miette::miette!("the pseudo-terminal has no path"))?;
+    {
+        let mut out = std::io::stdout().lock();
+        writeln!(out, "{path}").into_diagnostic()?;
+        out.flush().into_diagnostic()?;
+    }
+    writeln!(
+        std::io::stderr().lock(),
+        "the virtual Scorpion is on {path} at {baud} baud; Ctrl-C stops it"
+    )
+    .into_diagnostic()?;
+    master
+        .set_timeout(Duration::from_millis(2))
+        .into_diagnostic()?;
+    // Our end of the slave stays open, so the master never sees a hang-up
+    // between the clients' opens and closes.
+    let _slave = slave;
+    let pace = Pace::new(robot);
+    let mut buffer = [0u8; 512];
+    loop {
+        match master.read(&mut buffer) {
+            Ok(count) => robot.send(&buffer[..count]),
+            Err(error) if error.kind() == std::io::ErrorKind::TimedOut => {}
+            Err(error) if error.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(error) => {
+                return Err(error)
+                    .into_diagnostic()
+                    .wrap_err("the pseudo-terminal failed");
+            }
+        }
+        pace.catch_up(robot)?;
+        let answer = robot.receive();
+        if !answer.is_empty() {
+            master
+                .write_all(&answer)
+                .into_diagnostic()
+                .wrap_err("cannot write to the pseudo-terminal")?;
+        }
+    }
+}
+
+#[cfg(not(unix))]
+fn serve_pty(_robot: &mut VirtualScorpion, _baud: u32) -> miette::Result<ExitCode> {
+    miette::bail!(
+        help = "run `scorpion sim` without --pty and type commands, or use --port emu",
+        "pseudo-terminals are a Unix feature"
+    )
+}
+
+/// Robot time the stdin mode waits after the last command for answers.
+const QUIET_TIME: u64 = CPU_HZ / 5;
+
+/// Commands from stdin (line ends and all: the ROM ignores bytes outside
+/// commands), answers to stdout with their carriage returns as line ends.
+fn serve_stdio(robot: &mut VirtualScorpion) -> miette::Result<ExitCode> {
+    let (sender, lines) = mpsc::channel::<Option<Vec<u8>>>();
+    std::thread::spawn(move || {
+        let stdin = std::io::stdin();
+        let mut input = stdin.lock();
+        loop {
+            let mut line = Vec::new();
+            match input.read_until(b'\n', &mut line) {
+                Ok(0) | Err(_) => {
+                    let _ = sender.send(None);
+                    return;
+                }
+                Ok(_) => {
+                    if sender.send(Some(line)).is_err() {
+                        return;
+                    }
+                }
+            }
+        }
+    });
+    let pace = Pace::new(robot);
+    let mut out = std::io::stdout().lock();
+    let mut ended = false;
+    let mut quiet_since = robot.cycles();
+    loop {
+        match lines.recv_timeout(Duration::from_millis(2)) {
+            Ok(Some(line)) => {
+                robot.send(&line);
+                quiet_since = robot.cycles();
+            }
+            Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => ended = true,
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        if ended {
+            // No more input: no need to wait for the wall clock.
+            robot.run_for(1000)?;
+        } else {
+            pace.catch_up(robot)?;
+        }
+        let answer = robot.receive();
+        if !answer.is_empty() {
+            quiet_since = robot.cycles();
+            let text: Vec<u8> = answer
+                .iter()
+                .map(|&b| if b == b'\r' { b'\n' } else { b })
+                .collect();
+            out.write_all(&text).into_diagnostic()?;
+            out.flush().into_diagnostic()?;
+        }
+        let line_idle = robot.robot().board().acia().host_line_free_at() <= robot.cycles();
+        if ended && line_idle && robot.cycles() >= quiet_since + QUIET_TIME {
+            return Ok(ExitCode::SUCCESS);
+        }
+    }
+}

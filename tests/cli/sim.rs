@@ -1,0 +1,161 @@
+//! `scorpion sim`: commands on stdin, answers on stdout; a pseudo-terminal
+//! served at the line's pace; loaded images; bad options.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::{scorpion, transcript};
+
+/// Runs `scorpion sim ARGS` with `input` on stdin.
+fn sim(args: &[&str], input: &str) -> std::process::Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .arg("sim")
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .env("NO_COLOR", "1")
+        .env("COLUMNS", "100")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the scorpion binary runs");
+    child
+        .stdin
+        .take()
+        .expect("stdin is piped")
+        .write_all(input.as_bytes())
+        .expect("the commands are written");
+    child
+        .wait_with_output()
+        .expect("scorpion sim ends at the end of stdin")
+}
+
+#[test]
+fn sim_answers_commands_from_stdin() {
+    let output = sim(&[], "/1P\n/2E3\n/2G1\n/1E\n/1G\n/7RF00004\n/1Q\n/1X\n");
+    insta::assert_snapshot!(transcript(&output));
+}
+
+#[test]
+fn sim_closes_bumpers_at_power_up() {
+    let output = sim(&["--bumpers", "05"], "/1B\n/1P\n");
+    insta::assert_snapshot!(transcript(&output));
+}
+
+#[test]
+fn sim_runs_at_another_baud_rate() {
+    let output = sim(&["--baud", "19200"], "/1X\n");
+    insta::assert_snapshot!(transcript(&output));
+}
+
+#[test]
+fn sim_refuses_a_rate_the_6551_lacks() {
+    let output = sim(&["--baud", "1000"], "");
+    insta::assert_snapshot!(transcript(&output));
+}
+
+#[test]
+fn sim_loads_images_and_chains_their_hooks() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let rangefinder = examples.join("rangefinder/rangefinder.s");
+    let checksum = examples.join("checksum/checksum.s");
+    let layout = examples.join("checksum/checksum.toml");
+    let built = scorpion(
+        dir.path(),
+        &[
+            "build",
+            rangefinder.to_str().expect("UTF-8"),
+            "-o",
+            "first.elf",
+        ],
+    );
+    assert!(built.status.success(), "{}", transcript(&built));
+    let built = scorpion(
+        dir.path(),
+        &[
+            "build",
+            checksum.to_str().expect("UTF-8"),
+            "-o",
+            "second.elf",
+            "--target",
+            layout.to_str().expect("UTF-8"),
+        ],
+    );
+    assert!(built.status.success(), "{}", transcript(&built));
+    let first = dir.path().join("first.elf");
+    let second = dir.path().join("second.elf");
+    let output = sim(
+        &[
+            "--image",
+            first.to_str().expect("UTF-8"),
+            "--image",
+            second.to_str().expect("UTF-8"),
+        ],
+        "/7R020102\n/9KF0000010\n/1U\n",
+    );
+    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn sim_reports_an_image_that_is_not_one() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(dir.path().join("junk.elf"), b"not an ELF").expect("written");
+    let output = scorpion(dir.path(), &["sim", "--image", "junk.elf"]);
+    insta::assert_snapshot!(transcript(&output));
+}
+
+/// A child process killed when dropped, so a failing test leaves no
+/// simulator behind.
+struct Child(std::process::Child);
+
+impl Drop for Child {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn sim_serves_a_pseudo_terminal_at_the_baud_rate() {
+    let mut child = Child(
+        Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(["sim", "--pty"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the scorpion binary runs"),
+    );
+    let mut stdout = BufReader::new(child.0.stdout.take().expect("stdout is piped"));
+    let mut path = String::new();
+    stdout
+        .read_line(&mut path)
+        .expect("the first line is the path");
+    let path = path.trim();
+    assert!(path.starts_with("/dev/"), "{path}");
+    let mut port = serialport::new(path, 9600)
+        .timeout(Duration::from_millis(50))
+        .open()
+        .expect("the pseudo-terminal opens");
+    let started = Instant::now();
+    port.write_all(b"/2E3/1E/1P").expect("commands are written");
+    let mut answer = Vec::new();
+    let mut buffer = [0u8; 64];
+    while answer.iter().filter(|&&b| b == b'\r').count() < 2
+        && started.elapsed() < Duration::from_secs(5)
+    {
+        if let Ok(count) = port.read(&mut buffer) {
+            answer.extend_from_slice(&buffer[..count]);
+        }
+    }
+    let elapsed = started.elapsed();
+    assert_eq!(
+        String::from_utf8_lossy(&answer),
+        "E3\rPB00E3G0T0M+0000+0000Y00X82C0000D0000\r"
+    );
+    // 10 characters out and 41 back take 53 ms on a 9600-baud line: the
+    // simulator keeps the line's pace rather than answering at once.
+    assert!(elapsed >= Duration::from_millis(50), "{elapsed:?}");
+}
