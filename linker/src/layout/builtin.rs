@@ -76,6 +76,25 @@ impl RomSymbols {
     }
 }
 
+/// A built-in segment: takes the ca65 segment of its name and the sections
+/// llvm-mos's compiler and assembler name for the same purpose, so their
+/// objects link with the built-in targets too.
+fn segment(name: &str, load: &str, kind: SegmentKind) -> Segment {
+    let mut segment = Segment::new(name, load, kind);
+    let llvm_mos: &[&str] = match name {
+        "CODE" => &[".text", ".text.*"],
+        "RODATA" => &[".rodata", ".rodata.*"],
+        "DATA" => &[".data", ".data.*"],
+        "BSS" => &[".bss", ".bss.*", ".noinit", ".noinit.*"],
+        "ZEROPAGE" => &[".zp", ".zp.*", ".zeropage", ".zeropage.*"],
+        _ => &[],
+    };
+    segment
+        .sections
+        .extend(llvm_mos.iter().map(|pattern| (*pattern).to_owned()));
+    segment
+}
+
 fn area(name: &str, start: u64, end_inclusive: u64, output: bool) -> Area {
     Area {
         name: name.to_owned(),
@@ -107,11 +126,11 @@ pub(crate) fn flat(start: u64) -> Layout {
             area("MAIN", start, 0xFFFF, true),
         ],
         segments: vec![
-            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
-            Segment::new("CODE", "MAIN", SegmentKind::ReadOnly),
-            Segment::new("RODATA", "MAIN", SegmentKind::ReadOnly),
-            Segment::new("DATA", "MAIN", SegmentKind::ReadWrite),
-            Segment::new("BSS", "MAIN", SegmentKind::Bss),
+            segment("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            segment("CODE", "MAIN", SegmentKind::ReadOnly),
+            segment("RODATA", "MAIN", SegmentKind::ReadOnly),
+            segment("DATA", "MAIN", SegmentKind::ReadWrite),
+            segment("BSS", "MAIN", SegmentKind::Bss),
         ],
         ld65_alignment: true,
     }
@@ -138,11 +157,11 @@ pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
             area("RAM", ram_start, ram_end, true),
         ],
         segments: vec![
-            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
-            Segment::new("CODE", "RAM", SegmentKind::ReadOnly),
-            Segment::new("RODATA", "RAM", SegmentKind::ReadOnly),
-            Segment::new("DATA", "RAM", SegmentKind::ReadWrite),
-            Segment::new("BSS", "RAM", SegmentKind::Bss),
+            segment("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            segment("CODE", "RAM", SegmentKind::ReadOnly),
+            segment("RODATA", "RAM", SegmentKind::ReadOnly),
+            segment("DATA", "RAM", SegmentKind::ReadWrite),
+            segment("BSS", "RAM", SegmentKind::Bss),
         ],
         ld65_alignment: false,
     })
@@ -170,11 +189,11 @@ pub(crate) fn scorpion_os(rom: &RomSymbols) -> Result<Layout, Error> {
             area("URAM", ram_start, ram_end, false),
         ],
         segments: vec![
-            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
-            Segment::new("CODE", "KIM", SegmentKind::ReadOnly),
-            Segment::new("RODATA", "KIM", SegmentKind::ReadOnly),
-            Segment::new("DATA", "KIM", SegmentKind::ReadWrite),
-            Segment::new("BSS", "URAM", SegmentKind::Bss),
+            segment("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            segment("CODE", "KIM", SegmentKind::ReadOnly),
+            segment("RODATA", "KIM", SegmentKind::ReadOnly),
+            segment("DATA", "KIM", SegmentKind::ReadWrite),
+            segment("BSS", "URAM", SegmentKind::Bss),
         ],
         ld65_alignment: false,
     })
@@ -195,12 +214,12 @@ pub(crate) fn scorpion_rom(rom: &RomSymbols) -> Result<Layout, Error> {
     let mut rom_area = area("ROM", ROM_START, ROM_START + ROM_SIZE - 1, true);
     rom_area.fill = true;
     rom_area.fill_value = ROM_FILL;
-    let mut data = Segment::new("DATA", "ROM", SegmentKind::ReadWrite);
+    let mut data = segment("DATA", "ROM", SegmentKind::ReadWrite);
     data.run = Some("RAM".into());
     data.define = true;
-    let mut jumptable = Segment::new("JUMPTABLE", "ROM", SegmentKind::ReadOnly);
+    let mut jumptable = segment("JUMPTABLE", "ROM", SegmentKind::ReadOnly);
     jumptable.start = Some(JUMPTABLE_START);
-    let mut vectors = Segment::new("VECTORS", "ROM", SegmentKind::ReadOnly);
+    let mut vectors = segment("VECTORS", "ROM", SegmentKind::ReadOnly);
     vectors.start = Some(VECTORS_START);
     vectors.optional = false;
     Ok(Layout {
@@ -211,11 +230,11 @@ pub(crate) fn scorpion_rom(rom: &RomSymbols) -> Result<Layout, Error> {
             rom_area,
         ],
         segments: vec![
-            Segment::new("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
-            Segment::new("CODE", "ROM", SegmentKind::ReadOnly),
-            Segment::new("RODATA", "ROM", SegmentKind::ReadOnly),
+            segment("ZEROPAGE", "ZP", SegmentKind::ZeroPage),
+            segment("CODE", "ROM", SegmentKind::ReadOnly),
+            segment("RODATA", "ROM", SegmentKind::ReadOnly),
             data,
-            Segment::new("BSS", "RAM", SegmentKind::Bss),
+            segment("BSS", "RAM", SegmentKind::Bss),
             jumptable,
             vectors,
         ],

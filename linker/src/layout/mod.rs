@@ -13,6 +13,11 @@
 //! | `scorpion-os` | `ZP` (user zero page), `KIM` = $1000-$BFFF (KIM-bus expansion RAM), `URAM` (user RAM, not written) | `ZEROPAGE` in `ZP`; `CODE`, `RODATA`, `DATA` in `KIM`; `BSS` in `URAM` |
 //! | `scorpion-rom` | `ZP` = $0000..`USER_ZP_START`, `RAM` = $0200..`USER_RAM_START` (the ROM's own, not written), `ROM` = $F000-$FFFF filled with $FF | `ZEROPAGE` in `ZP`; `CODE`, `RODATA` in `ROM`; `DATA` loaded in `ROM`, run in `RAM` (with `__DATA_LOAD__`/`__DATA_RUN__`/`__DATA_SIZE__` for the start-up copy); `BSS` in `RAM`; optional `JUMPTABLE` at $FF00; `VECTORS` at $FFFA |
 //!
+//! Each built-in segment also takes the sections llvm-mos names for the same
+//! purpose (`CODE`: `.text`, `.text.*`; `RODATA`: `.rodata*`; `DATA`:
+//! `.data*`; `BSS`: `.bss*`, `.noinit*`; `ZEROPAGE`: `.zp*`, `.zeropage*`),
+//! so other producers' objects link without a layout file.
+//!
 //! `flat` is exactly what ld65 produces with
 //!
 //! ```text

@@ -119,3 +119,57 @@ fn weak_symbols_yield_to_strong_ones_and_default_to_zero() {
         [0xAD, 0xEF, 0xBE, 0xAD, 0x00, 0x00]
     );
 }
+
+/// An object laid out as llvm-mos writes them: `.text.*`/`.rodata.*`/
+/// `.zp.*` sections, relocations against section symbols with addends,
+/// debug sections with their own relocations, BCD in `e_flags`. The
+/// built-in targets place llvm-mos section names with ca65's segments.
+#[test]
+fn llvm_mos_style_objects_link_with_the_built_in_targets() {
+    let mut obj = ObjectBuilder::new();
+    obj.flags(EF_MOS_ARCH_6502 | EF_MOS_ARCH_6502_BCD);
+    // main: lda .rodata.str+1 / sta __rc0 / jmp helper
+    let text = obj.code(".text.main", &[0xAD, 0, 0, 0x85, 0, 0x4C, 0, 0]);
+    let helper = obj.code(".text.helper", &[0x60]);
+    let rodata = obj.code(".rodata.str1.1", b"hi\0");
+    let zp = obj.zeropage(".zp.bss", 2);
+    obj.bss(".bss", 8);
+    obj.data(".data", &[0x11]);
+    obj.progbits(".comment", b"clang version 19\0", 0);
+    let debug = obj.progbits(".debug_info", &[0; 8], 0);
+    let text_sym = obj.section_symbol(text);
+    let rodata_sym = obj.section_symbol(rodata);
+    let helper_sym = obj.section_symbol(helper);
+    let zp_sym = obj.section_symbol(zp);
+    obj.reloc(text, 1, R_MOS_ADDR16, rodata_sym, 1)
+        .reloc(text, 4, R_MOS_ADDR8, zp_sym, 0)
+        .reloc(text, 6, R_MOS_ADDR16, helper_sym, 0)
+        .reloc(debug, 0, R_MOS_FK_DATA_4, text_sym, 0)
+        .reloc(debug, 4, R_MOS_FK_DATA_4, rodata_sym, 0);
+    obj.global("main", SymbolDef::Section(text, 0));
+    obj.global("__rc0", SymbolDef::Section(zp, 0));
+    let rom = crate::support::fake_rom(&[]);
+    let linked = crate::support::link_with(
+        &[("main.c.o", obj.build())],
+        &linker::Target::ScorpionExt,
+        &[linker::SymbolFile {
+            name: "rom.elf",
+            image: &rom,
+        }],
+        &linker::MemorySources::default(),
+    )
+    .expect("links");
+    let image = &linked.image;
+    // CODE $0400: main (8 bytes), helper at $0408; RODATA "hi" at $0409;
+    // DATA at $040C; __rc0 at the user zero page's start.
+    assert_eq!(
+        image.areas[0].bytes,
+        [
+            0xAD, 0x0A, 0x04, 0x85, 0x80, 0x4C, 0x08, 0x04, 0x60, b'h', b'i', 0, 0x11
+        ]
+    );
+    assert_eq!(image.symbol("__rc0"), Some(0x80));
+    assert_eq!(image.flags, EF_MOS_ARCH_6502 | EF_MOS_ARCH_6502_BCD);
+    // Debug sections are not placed; their relocations go with them.
+    assert!(image.sections.iter().all(|s| !s.name.starts_with(".debug")));
+}
