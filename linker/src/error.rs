@@ -412,7 +412,7 @@ pub enum Error {
         code(linker::misaligned_segment),
         severity(Warning),
         help(
-            "`.align` inside it will not hold; the flat layout places segments back to back as ld65 does"
+            "`.align` inside it will not hold: give the segment `align = {align}` in a layout file (the flat target places segments back to back, as ld65 does)"
         )
     )]
     MisalignedSegment {

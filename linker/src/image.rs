@@ -160,6 +160,10 @@ impl Image {
             if header.p_memsz < header.p_filesz {
                 return Err(bad(format!("{what} has p_memsz < p_filesz")));
             }
+            if header.p_filesz == 0 {
+                // Only reserves memory (another linker's BSS): nothing to load.
+                continue;
+            }
             let data = file_range(header.p_offset, header.p_filesz, &what)?;
             let load = address(header.p_paddr, &what)?;
             let run = address(header.p_vaddr, &what)?;

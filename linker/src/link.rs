@@ -518,7 +518,9 @@ fn build_image(
     let mut sections = Vec::new();
     let mut section_of_segment = vec![None; placement.segments.len()];
     for (index, segment) in placement.segments.iter().enumerate() {
-        if segment.fragments.is_empty() {
+        // Empty segments get no section header (their labels are plain
+        // constants): a zero-size section has no place in any PT_LOAD.
+        if segment.size == 0 {
             continue;
         }
         section_of_segment[index] = Some(sections.len());

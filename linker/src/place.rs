@@ -237,7 +237,7 @@ pub(crate) fn place(
     }
 
     for segment in &mut segments {
-        if layout.ld65_alignment && segment.run % segment.align != 0 && segment.size > 0 {
+        if segment.run % segment.align != 0 && segment.size > 0 {
             warnings.push(Error::MisalignedSegment {
                 segment: segment.rule.name.clone(),
                 start: segment.run,

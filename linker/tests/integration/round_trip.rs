@@ -196,3 +196,18 @@ fn load_and_run_addresses_survive_the_round_trip() {
         .expect("DATA");
     assert_eq!((data_section.run, data_section.load), (0x0200, 0xF004));
 }
+
+#[test]
+fn empty_sections_and_labels_at_their_start_round_trip() {
+    let mut obj = ObjectBuilder::new();
+    let empty = obj.code("RODATA", &[]);
+    obj.global("nothing", SymbolDef::Section(empty, 0));
+    obj.code("CODE", &[0x60]);
+    obj.bss("BSS", 0);
+    let linked = crate::support::link_flat(&[("e.o", obj.build())], 0x3000).expect("links");
+    assert_eq!(linked.image.symbol("nothing"), Some(0x3001));
+    let read = Image::parse("e.elf", &Format::Elf.write(&linked.image).expect("writes"))
+        .expect("reads back");
+    assert_eq!(read, linked.image);
+    assert_eq!(read.sections.len(), 1, "only CODE has bytes");
+}
