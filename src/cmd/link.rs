@@ -24,7 +24,8 @@ pub(crate) struct LinkArgs {
     /// First address of the flat target's area.
     #[arg(long, value_name = "ADDR", value_parser = args::address)]
     pub(crate) start: Option<u16>,
-    /// Output format.
+    /// Output format: elf (the linked image the emulator and uploader load),
+    /// bin, ihex (Intel HEX), srec (Motorola S-record) or kim (KIM-1 tape).
     #[arg(long, value_name = "FORMAT", default_value = "elf", value_parser = parse_format)]
     pub(crate) format: Format,
     /// Also write a map file (areas, segments, modules, symbols).
