@@ -66,7 +66,7 @@ impl Cpu {
     #[inline(always)]
     pub(super) fn bit(&mut self, value: u8) {
         self.n = value;
-        self.v = value & 0x40 != 0;
+        self.set_v(value & 0x40 != 0);
         self.z = self.a & value;
     }
 
@@ -94,7 +94,7 @@ impl Cpu {
 
     #[inline(always)]
     pub(super) fn adc(&mut self, value: u8) {
-        if self.d {
+        if self.d() {
             self.adc_decimal(value);
         } else {
             self.adc_binary(value);
@@ -105,7 +105,7 @@ impl Cpu {
     fn adc_binary(&mut self, value: u8) {
         let sum = u16::from(self.a) + u16::from(value) + u16::from(self.c);
         let result = sum as u8;
-        self.v = (!(self.a ^ value) & (self.a ^ result) & 0x80) != 0;
+        self.set_v((!(self.a ^ value) & (self.a ^ result) & 0x80) != 0);
         self.c = sum > 0xFF;
         self.a = result;
         self.nz(result);
@@ -125,7 +125,7 @@ impl Cpu {
         // as a signed byte; Z from the plain binary sum.
         let intermediate = sum as u8;
         self.n = intermediate;
-        self.v = (!(a ^ value) & (a ^ intermediate) & 0x80) != 0;
+        self.set_v((!(a ^ value) & (a ^ intermediate) & 0x80) != 0);
         self.z = (u16::from(a) + u16::from(value) + carry) as u8;
         if sum >= 0xA0 {
             sum += 0x60;
@@ -136,7 +136,7 @@ impl Cpu {
 
     #[inline(always)]
     pub(super) fn sbc(&mut self, value: u8) {
-        if self.d {
+        if self.d() {
             self.sbc_decimal(value);
         } else {
             self.adc_binary(!value);
@@ -276,14 +276,14 @@ impl Cpu {
         let masked = self.a & value;
         let rotated = (masked >> 1) | (u8::from(self.c) << 7);
         self.nz(rotated);
-        if !self.d {
+        if !self.d() {
             self.c = rotated & 0x40 != 0;
-            self.v = ((rotated >> 6) ^ (rotated >> 5)) & 1 != 0;
+            self.set_v(((rotated >> 6) ^ (rotated >> 5)) & 1 != 0);
             self.a = rotated;
             return;
         }
         // V: bit 6 changed between the AND and the rotation.
-        self.v = (masked ^ rotated) & 0x40 != 0;
+        self.set_v((masked ^ rotated) & 0x40 != 0);
         let mut result = rotated;
         let (high, low) = (masked >> 4, masked & 0x0F);
         if low + (low & 1) > 5 {

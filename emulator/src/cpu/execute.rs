@@ -3,8 +3,11 @@
 //! Each arm names the addressing helper and the operation; the helpers make
 //! the bus accesses (see `access`), so each arm's cycle count follows from
 //! its mode and kind. The arms were laid out from `isa::OPCODES` (mnemonic and
-//! mode per byte), and the `matches_the_isa_table` tests check every arm's
-//! mnemonic-visible behaviour, length and cycle count against that table.
+//! mode per byte); the test
+//! `cycles::every_opcode_takes_the_cycles_and_length_of_the_isa_table` checks
+//! every arm's length, cycle count (with page-cross and branch penalties) and
+//! one-access-per-cycle bus traffic against that table, and the py65 and
+//! Dormann tests check what the arms compute.
 
 use super::{Cpu, JAM, LATE_POLL, NO_POLL, OLD_I, TRAP, flag};
 use crate::bus::Bus;
@@ -155,23 +158,23 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.a = self.lsr(self.a);
             }
-            0x4B => read!(imm, alr),                      // ALR Immediate
-            0x4C => return self.jmp(bus, pc),             // JMP Absolute
-            0x4D => read!(abs, eor),                      // EOR Absolute
-            0x4E => rmw!(abs, lsr),                       // LSR Absolute
-            0x4F => rmw!(abs, sre),                       // SRE Absolute
-            0x50 => return self.branch(bus, !self.v, pc), // BVC Relative
-            0x51 => read!(izy, eor),                      // EOR IndirectY
-            0x52 => return JAM,                           // JAM Implied
-            0x53 => rmw!(izy_w, sre),                     // SRE IndirectY
-            0x54 => read!(zpx, nop),                      // NOP ZeroPageX
-            0x55 => read!(zpx, eor),                      // EOR ZeroPageX
-            0x56 => rmw!(zpx, lsr),                       // LSR ZeroPageX
-            0x57 => rmw!(zpx, sre),                       // SRE ZeroPageX
+            0x4B => read!(imm, alr),                        // ALR Immediate
+            0x4C => return self.jmp(bus, pc),               // JMP Absolute
+            0x4D => read!(abs, eor),                        // EOR Absolute
+            0x4E => rmw!(abs, lsr),                         // LSR Absolute
+            0x4F => rmw!(abs, sre),                         // SRE Absolute
+            0x50 => return self.branch(bus, !self.v(), pc), // BVC Relative
+            0x51 => read!(izy, eor),                        // EOR IndirectY
+            0x52 => return JAM,                             // JAM Implied
+            0x53 => rmw!(izy_w, sre),                       // SRE IndirectY
+            0x54 => read!(zpx, nop),                        // NOP ZeroPageX
+            0x55 => read!(zpx, eor),                        // EOR ZeroPageX
+            0x56 => rmw!(zpx, lsr),                         // LSR ZeroPageX
+            0x57 => rmw!(zpx, sre),                         // SRE ZeroPageX
             // CLI Implied
             0x58 => {
                 self.dummy_pc(bus);
-                self.i = false;
+                self.set_i(false);
                 return OLD_I;
             }
             0x59 => read!(aby, eor),    // EOR AbsoluteY
@@ -202,23 +205,23 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.a = self.ror(self.a);
             }
-            0x6B => read!(imm, arr),                     // ARR Immediate
-            0x6C => return self.jmp_indirect(bus, pc),   // JMP Indirect
-            0x6D => read!(abs, adc),                     // ADC Absolute
-            0x6E => rmw!(abs, ror),                      // ROR Absolute
-            0x6F => rmw!(abs, rra),                      // RRA Absolute
-            0x70 => return self.branch(bus, self.v, pc), // BVS Relative
-            0x71 => read!(izy, adc),                     // ADC IndirectY
-            0x72 => return JAM,                          // JAM Implied
-            0x73 => rmw!(izy_w, rra),                    // RRA IndirectY
-            0x74 => read!(zpx, nop),                     // NOP ZeroPageX
-            0x75 => read!(zpx, adc),                     // ADC ZeroPageX
-            0x76 => rmw!(zpx, ror),                      // ROR ZeroPageX
-            0x77 => rmw!(zpx, rra),                      // RRA ZeroPageX
+            0x6B => read!(imm, arr),                       // ARR Immediate
+            0x6C => return self.jmp_indirect(bus, pc),     // JMP Indirect
+            0x6D => read!(abs, adc),                       // ADC Absolute
+            0x6E => rmw!(abs, ror),                        // ROR Absolute
+            0x6F => rmw!(abs, rra),                        // RRA Absolute
+            0x70 => return self.branch(bus, self.v(), pc), // BVS Relative
+            0x71 => read!(izy, adc),                       // ADC IndirectY
+            0x72 => return JAM,                            // JAM Implied
+            0x73 => rmw!(izy_w, rra),                      // RRA IndirectY
+            0x74 => read!(zpx, nop),                       // NOP ZeroPageX
+            0x75 => read!(zpx, adc),                       // ADC ZeroPageX
+            0x76 => rmw!(zpx, ror),                        // ROR ZeroPageX
+            0x77 => rmw!(zpx, rra),                        // RRA ZeroPageX
             // SEI Implied
             0x78 => {
                 self.dummy_pc(bus);
-                self.i = true;
+                self.set_i(true);
                 return OLD_I;
             }
             0x79 => read!(aby, adc),              // ADC AbsoluteY
@@ -332,7 +335,7 @@ impl Cpu {
             // CLV Implied
             0xB8 => {
                 self.dummy_pc(bus);
-                self.v = false;
+                self.set_v(false);
             }
             0xB9 => read!(aby, lda), // LDA AbsoluteY
             // TSX Implied
@@ -380,7 +383,7 @@ impl Cpu {
             // CLD Implied
             0xD8 => {
                 self.dummy_pc(bus);
-                self.d = false;
+                self.set_d(false);
             }
             0xD9 => read!(aby, cmp),    // CMP AbsoluteY
             0xDA => self.dummy_pc(bus), // NOP Implied
@@ -420,7 +423,7 @@ impl Cpu {
             // SED Implied
             0xF8 => {
                 self.dummy_pc(bus);
-                self.d = true;
+                self.set_d(true);
             }
             0xF9 => read!(aby, sbc),    // SBC AbsoluteY
             0xFA => self.dummy_pc(bus), // NOP Implied

@@ -138,9 +138,9 @@ pub struct Cpu {
     n: u8,
     z: u8,
     c: bool,
-    v: bool,
-    d: bool,
-    i: bool,
+    // V, D and I in their P positions: one byte keeps a register free in
+    // the run loop.
+    vdi: u8,
     cycles: u64,
     instructions: u64,
     // The NMI level seen at the previous poll (edge detection).
@@ -208,9 +208,7 @@ impl Cpu {
             n: 0,
             z: 1,
             c: false,
-            v: false,
-            d: false,
-            i: true,
+            vdi: flag::I,
             cycles: 0,
             instructions: 0,
             nmi_line: false,
@@ -225,10 +223,8 @@ impl Cpu {
     #[must_use]
     pub fn p(&self) -> u8 {
         (self.n & flag::N)
-            | if self.v { flag::V } else { 0 }
+            | self.vdi
             | flag::U
-            | if self.d { flag::D } else { 0 }
-            | if self.i { flag::I } else { 0 }
             | if self.z == 0 { flag::Z } else { 0 }
             | u8::from(self.c)
     }
@@ -238,11 +234,44 @@ impl Cpu {
     #[inline]
     pub fn set_p(&mut self, p: u8) {
         self.n = p;
-        self.v = p & flag::V != 0;
-        self.d = p & flag::D != 0;
-        self.i = p & flag::I != 0;
+        self.vdi = p & (flag::V | flag::D | flag::I);
         self.z = u8::from(p & flag::Z == 0);
         self.c = p & flag::C != 0;
+    }
+
+    #[inline(always)]
+    fn v(&self) -> bool {
+        self.vdi & flag::V != 0
+    }
+
+    #[inline(always)]
+    fn d(&self) -> bool {
+        self.vdi & flag::D != 0
+    }
+
+    #[inline(always)]
+    fn i(&self) -> bool {
+        self.vdi & flag::I != 0
+    }
+
+    #[inline(always)]
+    fn set_flag(&mut self, mask: u8, on: bool) {
+        self.vdi = (self.vdi & !mask) | if on { mask } else { 0 };
+    }
+
+    #[inline(always)]
+    fn set_v(&mut self, on: bool) {
+        self.set_flag(flag::V, on);
+    }
+
+    #[inline(always)]
+    fn set_d(&mut self, on: bool) {
+        self.set_flag(flag::D, on);
+    }
+
+    #[inline(always)]
+    fn set_i(&mut self, on: bool) {
+        self.set_flag(flag::I, on);
     }
 
     /// Bus cycles since the CPU was created (every access is one cycle).
@@ -277,7 +306,7 @@ impl Cpu {
             self.read(bus, 0x0100 | u16::from(self.s));
             self.s = self.s.wrapping_sub(1);
         }
-        self.i = true;
+        self.set_i(true);
         self.nmi_pending = false;
         self.irq_pending = false;
         let lo = self.read(bus, RESET_VECTOR);
@@ -378,7 +407,7 @@ impl Cpu {
     #[inline(always)]
     fn instruction<B: Bus>(&mut self, bus: &mut B) -> u8 {
         let pc = self.pc;
-        let i_before = self.i;
+        let i_before = self.i();
         let opcode = self.fetch(bus);
         let flow = self.execute(bus, opcode, pc);
         if flow & (JAM | NO_POLL) != 0 {
@@ -394,7 +423,11 @@ impl Cpu {
         }
         self.instructions += 1;
         let poll_at = self.cycles - 2 - u64::from(flow & LATE_POLL);
-        let i = if flow & OLD_I != 0 { i_before } else { self.i };
+        let i = if flow & OLD_I != 0 {
+            i_before
+        } else {
+            self.i()
+        };
         self.poll(bus, poll_at, i);
         flow
     }
@@ -433,7 +466,7 @@ impl Cpu {
         self.nmi_pending = false;
         let p = self.p() | b;
         self.push(bus, p);
-        self.i = true;
+        self.set_i(true);
         self.irq_pending = false;
         let vector = if nmi { NMI_VECTOR } else { IRQ_VECTOR };
         let lo = self.read(bus, vector);
