@@ -239,6 +239,20 @@ impl<'a> Asm<'a> {
 
     /// Joins two spans on one line (see [`Files::join`]).
     pub(crate) fn join(&self, a: Span, b: Span) -> Span {
+        let line = &self.line;
+        if a.file == line.file
+            && b.file == line.file
+            && a.start >= line.start
+            && b.end <= line.end
+            && a.start <= b.end
+        {
+            // Both on the current line: no newline can be between them.
+            return Span {
+                file: a.file,
+                start: a.start,
+                end: b.end.max(a.end),
+            };
+        }
         self.files.join(a, b)
     }
 
@@ -259,6 +273,9 @@ impl<'a> Asm<'a> {
     pub(crate) fn column_of(&self, span: Span) -> u32 {
         if span.file != self.line.file || span.start < self.line.start {
             return 1;
+        }
+        if self.line.ascii {
+            return span.start - self.line.start + 1;
         }
         let text = self.files.text(span.file);
         let start = self.line.start as usize;
@@ -346,7 +363,14 @@ impl<'a> Asm<'a> {
     /// Appends bytes to the current chunk.
     pub(crate) fn emit(&mut self, bytes: &[u8]) {
         let seg = &mut self.prog.segs[self.seg as usize];
-        seg.data.extend_from_slice(bytes);
+        if bytes.len() <= 4 {
+            // Instructions: a call to memcpy costs more than the bytes.
+            for &byte in bytes {
+                seg.data.push(byte);
+            }
+        } else {
+            seg.data.extend_from_slice(bytes);
+        }
         seg.has_data = true;
         seg.used = true;
         self.prog.chunks[seg.cur as usize].len += bytes.len() as u32;
@@ -611,6 +635,16 @@ impl<'a> Asm<'a> {
 
     /// Pushes a file to read next.
     pub(crate) fn push_file(&mut self, name: String, bytes: Vec<u8>, dir: PathBuf, ctx: CtxId) {
+        if self.frames.is_empty() {
+            // About one item per 16 bytes of source: reserving once saves
+            // the repeated growth of the biggest vectors.
+            let estimate = bytes.len() / 16;
+            self.prog.items.reserve(estimate);
+            self.prog.segs[self.seg as usize].data.reserve(estimate * 2);
+            self.prog.nodes.reserve(estimate / 2);
+            self.prog.locs.reserve(estimate / 4);
+            self.prog.fixups.reserve(estimate / 4);
+        }
         let text: Arc<[u8]> = Arc::from(bytes);
         let file = self.files.add(name, Arc::clone(&text));
         self.frames.push(Frame::File {

@@ -158,7 +158,7 @@ pub(crate) struct NameInfo {
 /// The interner.
 #[derive(Debug, Default)]
 pub(crate) struct Interner {
-    map: FxHashMap<Rc<str>, NameId>,
+    map: FxHashMap<Rc<[u8]>, NameId>,
     names: Vec<Rc<str>>,
     pub(crate) info: Vec<NameInfo>,
 }
@@ -170,15 +170,22 @@ impl Interner {
 
     /// The id of `name`, interning it on first sight.
     pub(crate) fn intern(&mut self, name: &str) -> NameId {
-        if let Some(id) = self.map.get(name) {
+        self.intern_bytes(name.as_bytes())
+    }
+
+    /// Interns a name given as bytes; the lexer passes ASCII identifier
+    /// bytes and this avoids re-validating them as UTF-8 on every lookup.
+    pub(crate) fn intern_bytes(&mut self, bytes: &[u8]) -> NameId {
+        if let Some(id) = self.map.get(bytes) {
             return *id;
         }
+        let name = String::from_utf8_lossy(bytes);
         let id = self.names.len() as NameId;
-        let rc: Rc<str> = Rc::from(name);
-        self.map.insert(Rc::clone(&rc), id);
-        self.names.push(rc);
+        let rc: Rc<str> = Rc::from(name.as_ref());
+        self.map.insert(Rc::from(bytes), id);
+        self.names.push(Rc::clone(&rc));
         self.info.push(NameInfo {
-            keyword: keyword_of(name),
+            keyword: keyword_of(&rc),
             macro_id: None,
             define_id: None,
         });

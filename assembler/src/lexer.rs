@@ -85,6 +85,8 @@ pub(crate) struct LineInfo {
     pub(crate) start: u32,
     /// Offset after the last byte (before `\r\n` / `\n`).
     pub(crate) end: u32,
+    /// The line is ASCII, so columns are byte offsets.
+    pub(crate) ascii: bool,
 }
 
 /// A lexing problem: where and what.
@@ -98,12 +100,25 @@ pub(crate) struct Lexer {
     line: u32,
 }
 
+/// Bytes that continue an identifier: a table, as the lexer asks for
+/// every byte of every name.
+const IDENT: [bool; 256] = {
+    let mut table = [false; 256];
+    let mut b = 0;
+    while b < 256 {
+        let c = b as u8;
+        table[b] = c.is_ascii_alphanumeric() || c == b'_';
+        b += 1;
+    }
+    table
+};
+
 fn is_ident_start(byte: u8) -> bool {
     byte.is_ascii_alphabetic() || byte == b'_'
 }
 
 fn is_ident_char(byte: u8) -> bool {
-    byte.is_ascii_alphanumeric() || byte == b'_'
+    IDENT[usize::from(byte)]
 }
 
 impl Lexer {
@@ -153,6 +168,9 @@ impl Lexer {
             let (kind, len) = match byte {
                 b' ' | b'\t' | b'\x0C' => {
                     i += 1;
+                    while i < end && matches!(text[i], b' ' | b'\t') {
+                        i += 1;
+                    }
                     continue;
                 }
                 b';' => break,
@@ -161,8 +179,7 @@ impl Lexer {
                     while j < end && is_ident_char(text[j]) {
                         j += 1;
                     }
-                    let name = ascii(&text[i..j]);
-                    let id = names.intern(name);
+                    let id = names.intern_bytes(&text[i..j]);
                     out.push(Token {
                         kind: Tok::Ident,
                         span: self.span(i, j),
@@ -177,7 +194,7 @@ impl Lexer {
                         while j < end && is_ident_char(text[j]) {
                             j += 1;
                         }
-                        let id = names.intern(ascii(&text[i..j]));
+                        let id = names.intern_bytes(&text[i..j]);
                         out.push(Token {
                             kind: if byte == b'@' {
                                 Tok::Local
@@ -370,6 +387,7 @@ impl Lexer {
             line: self.line,
             start: line_start as u32,
             end: end as u32,
+            ascii: text[line_start..end].is_ascii(),
         })
     }
 }
@@ -379,11 +397,6 @@ fn memchr_newline(text: &[u8], from: usize) -> usize {
         .iter()
         .position(|b| *b == b'\n')
         .map_or(text.len(), |p| from + p)
-}
-
-/// The bytes are ASCII identifier characters, so this cannot fail.
-fn ascii(bytes: &[u8]) -> &str {
-    std::str::from_utf8(bytes).unwrap_or("")
 }
 
 fn digits_value(digits: &[u8], radix: u32) -> Result<u64, String> {

@@ -236,6 +236,7 @@ fn define_symbols(asm: &mut asm::Asm<'_>, defines: &[(String, i64)]) {
             line: line as u32 + 1,
             start,
             end,
+            ascii: name.is_ascii(),
         };
         let span = diag::Span { file, start, end };
         let valid = !name.is_empty()

@@ -57,75 +57,100 @@ impl Asm<'_> {
 
     /// Parses an expression starting at `*p`.
     pub(crate) fn expression(&mut self, t: &[Token], p: &mut usize) -> PResult<NodeId> {
+        // Fast path for the commonest operand: a lone number or name.
+        if let Some(tok) = t.get(*p)
+            && matches!(
+                t.get(*p + 1).map(|t| t.kind),
+                None | Some(Tok::Comma | Tok::RParen)
+            )
+        {
+            match tok.kind {
+                Tok::Number => {
+                    *p += 1;
+                    return Ok(self.prog.node(Node::Const(tok.value as i64)));
+                }
+                Tok::Ident => {
+                    let sym = self.symbol_ref(t, p)?;
+                    return Ok(self.sym_node(sym));
+                }
+                _ => {}
+            }
+        }
         self.level7(t, p, 0)
     }
 
+    /// Precedence climbing: parses operators of level `max_level` and
+    /// tighter (2 is tightest among binary operators, 7 is `!`), left to
+    /// right, in one loop rather than one recursive call per level.
     fn level7(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
+        self.climb(t, p, 7, depth)
+    }
+
+    fn climb(&mut self, t: &[Token], p: &mut usize, max_level: u8, depth: u32) -> PResult<NodeId> {
         if depth > MAX_NESTING {
             let span = self.span_at(t, *p);
             return Err(self.err("asm::too-deep", span, "expression nested too deeply"));
         }
-        if let Some(tok) = t.get(*p)
-            && (tok.kind == Tok::Bang || self.directive_of(tok) == Some(Dir::Not))
-        {
-            *p += 1;
-            let inner = self.level7(t, p, depth + 1)?;
-            return Ok(self.prog.node(Node::Unary(UnaryOp::LogNot, inner)));
-        }
-        self.binary_level(t, p, 6, depth)
-    }
-
-    fn binary_op(&self, tok: &Token, level: u8) -> Option<BinaryOp> {
-        let dir = self.directive_of(tok);
-        Some(match (level, tok.kind, dir) {
-            (2, Tok::Star, _) => BinaryOp::Mul,
-            (2, Tok::Slash, _) => BinaryOp::Div,
-            (2, Tok::Amp, _) | (2, _, Some(Dir::Bitand)) => BinaryOp::BitAnd,
-            (2, Tok::Caret, _) | (2, _, Some(Dir::Bitxor)) => BinaryOp::BitXor,
-            (2, Tok::Shl, _) | (2, _, Some(Dir::Shl)) => BinaryOp::Shl,
-            (2, Tok::Shr, _) | (2, _, Some(Dir::Shr)) => BinaryOp::Shr,
-            (2, _, Some(Dir::Mod)) => BinaryOp::Mod,
-            (3, Tok::Plus, _) => BinaryOp::Add,
-            (3, Tok::Minus, _) => BinaryOp::Sub,
-            (3, Tok::Pipe, _) | (3, _, Some(Dir::Bitor)) => BinaryOp::BitOr,
-            (4, Tok::Eq, _) => BinaryOp::Eq,
-            (4, Tok::Ne, _) => BinaryOp::Ne,
-            (4, Tok::Lt, _) => BinaryOp::Lt,
-            (4, Tok::Gt, _) => BinaryOp::Gt,
-            (4, Tok::Le, _) => BinaryOp::Le,
-            (4, Tok::Ge, _) => BinaryOp::Ge,
-            (5, Tok::AndAnd, _) | (5, _, Some(Dir::And)) => BinaryOp::LogAnd,
-            (5, _, Some(Dir::Xor)) => BinaryOp::LogXor,
-            (6, Tok::OrOr, _) | (6, _, Some(Dir::Or)) => BinaryOp::LogOr,
-            _ => return None,
-        })
-    }
-
-    fn binary_level(
-        &mut self,
-        t: &[Token],
-        p: &mut usize,
-        level: u8,
-        depth: u32,
-    ) -> PResult<NodeId> {
-        let mut left = if level == 2 {
-            self.unary(t, p, depth + 1)?
-        } else {
-            self.binary_level(t, p, level - 1, depth + 1)?
+        let mut left = match t.get(*p) {
+            Some(tok)
+                if max_level == 7
+                    && (tok.kind == Tok::Bang || self.directive_of(tok) == Some(Dir::Not)) =>
+            {
+                *p += 1;
+                let inner = self.climb(t, p, 7, depth + 1)?;
+                return Ok(self.unary_node(UnaryOp::LogNot, inner));
+            }
+            _ => self.unary(t, p, depth + 1)?,
         };
         while let Some(tok) = t.get(*p) {
-            let Some(op) = self.binary_op(tok, level) else {
+            let Some((op, level)) = self.binary_op(tok) else {
                 break;
             };
+            if level > max_level {
+                break;
+            }
             *p += 1;
-            let right = if level == 2 {
-                self.unary(t, p, depth + 1)?
-            } else {
-                self.binary_level(t, p, level - 1, depth + 1)?
-            };
+            // Left-associative: the right operand binds tighter.
+            let right = self.climb(t, p, level - 1, depth + 1)?;
             left = self.fold(op, left, right);
         }
         Ok(left)
+    }
+
+    /// A binary operator and its level.
+    fn binary_op(&self, tok: &Token) -> Option<(BinaryOp, u8)> {
+        Some(match tok.kind {
+            Tok::Star => (BinaryOp::Mul, 2),
+            Tok::Slash => (BinaryOp::Div, 2),
+            Tok::Amp => (BinaryOp::BitAnd, 2),
+            Tok::Caret => (BinaryOp::BitXor, 2),
+            Tok::Shl => (BinaryOp::Shl, 2),
+            Tok::Shr => (BinaryOp::Shr, 2),
+            Tok::Plus => (BinaryOp::Add, 3),
+            Tok::Minus => (BinaryOp::Sub, 3),
+            Tok::Pipe => (BinaryOp::BitOr, 3),
+            Tok::Eq => (BinaryOp::Eq, 4),
+            Tok::Ne => (BinaryOp::Ne, 4),
+            Tok::Lt => (BinaryOp::Lt, 4),
+            Tok::Gt => (BinaryOp::Gt, 4),
+            Tok::Le => (BinaryOp::Le, 4),
+            Tok::Ge => (BinaryOp::Ge, 4),
+            Tok::AndAnd => (BinaryOp::LogAnd, 5),
+            Tok::OrOr => (BinaryOp::LogOr, 6),
+            Tok::Directive => match self.directive_of(tok)? {
+                Dir::Bitand => (BinaryOp::BitAnd, 2),
+                Dir::Bitxor => (BinaryOp::BitXor, 2),
+                Dir::Shl => (BinaryOp::Shl, 2),
+                Dir::Shr => (BinaryOp::Shr, 2),
+                Dir::Mod => (BinaryOp::Mod, 2),
+                Dir::Bitor => (BinaryOp::BitOr, 3),
+                Dir::And => (BinaryOp::LogAnd, 5),
+                Dir::Xor => (BinaryOp::LogXor, 5),
+                Dir::Or => (BinaryOp::LogOr, 6),
+                _ => return None,
+            },
+            _ => return None,
+        })
     }
 
     /// Builds a binary node, folding two constants on the spot.

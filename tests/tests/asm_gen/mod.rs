@@ -700,10 +700,14 @@ pub(crate) fn generate(seed: u64, lines: usize, flavor: Flavor) -> Program {
             g.block();
         }
         if flavor == Flavor::Benchmark && g.chunk_bytes > 60_000 {
+            // Close the chunk with a label for pending `:+` branches, and
+            // start the next one with its own, so no branch crosses.
+            g.block();
             g.ca.push_str("        .org $1000\n");
             g.tass.push_str("        .here\n        .logical $1000\n");
             g.lines += 1;
             g.chunk_bytes = 0;
+            g.block();
         }
         let size = g.statement();
         g.block_bytes += size;
