@@ -70,6 +70,10 @@ fn define(text: &str) -> Result<(String, i64), String> {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    #[allow(
+        clippy::needless_update,
+        reason = "options the assembler adds later keep their defaults"
+    )]
     let options = assembler::Options {
         include_dirs: args.include_dirs.clone(),
         defines: args.defines.clone(),
@@ -82,6 +86,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             romlib::SCORPION_INC.as_bytes().to_vec(),
         )]
         .into(),
+        ..assembler::Options::default()
     };
     let mut objects = Vec::with_capacity(args.sources.len());
     let mut listings = String::new();
