@@ -10,7 +10,8 @@
 //!
 //! Our CPU runs with `StopAtTrap` (how the programs end), and once more with
 //! an empty breakpoint set, to show what an active hook costs; with no hooks
-//! the loop has no hook code at all.
+//! the loop has no hook code at all. Each emulator gets 7 tries, taking turns
+//! (so that a busy machine slows them alike), and reports its best.
 #![allow(clippy::print_stdout, reason = "a benchmark reports on stdout")]
 #![allow(clippy::print_stderr, reason = "a benchmark reports on stdout")]
 
@@ -31,59 +32,50 @@ struct Workload {
     runs: u32,
 }
 
-/// Best-of-`TRIES` timing of each emulator.
-const TRIES: usize = 5;
+/// Tries per emulator; each reports its best. The emulators take turns, so
+/// that a busy machine slows them alike.
+const TRIES: usize = 7;
 
-/// Runs `workload` on our CPU with `hooks`; returns (cycles, seconds, trap).
-fn ours<H: Hooks>(workload: &Workload, mut hooks: H) -> (u64, f64, u16) {
-    let mut best = f64::INFINITY;
+/// One timed pass of `workload` on our CPU with `hooks`: (cycles, seconds,
+/// trap address).
+fn ours<H: Hooks>(workload: &Workload, hooks: &mut H) -> (u64, f64, u16) {
     let mut cycles = 0;
     let mut trap = 0;
-    for _ in 0..TRIES {
-        let mut total = 0;
-        let started = Instant::now();
-        for _ in 0..workload.runs {
-            let mut machine = RamMachine::with_image(0, &workload.image).expect("64 KiB image");
-            machine.cpu.pc = workload.start;
-            let stop = machine.run_with(u64::MAX, &mut hooks);
-            let Stop::Trap { pc } = stop else {
-                panic!("{}: stopped with {stop:?}", workload.name)
-            };
-            trap = pc;
-            total += black_box(machine.cpu.cycles());
-        }
-        best = best.min(started.elapsed().as_secs_f64());
-        cycles = total;
+    let started = Instant::now();
+    for _ in 0..workload.runs {
+        let mut machine = RamMachine::with_image(0, &workload.image).expect("64 KiB image");
+        machine.cpu.pc = workload.start;
+        let stop = machine.run_with(u64::MAX, hooks);
+        let Stop::Trap { pc } = stop else {
+            panic!("{}: stopped with {stop:?}", workload.name)
+        };
+        trap = pc;
+        cycles += black_box(machine.cpu.cycles());
     }
-    (cycles, best, trap)
+    (cycles, started.elapsed().as_secs_f64(), trap)
 }
 
-/// Runs `workload` on the mos6502 crate until its PC reaches `trap`, then
-/// executes the trap once (as our CPU does before it stops).
+/// One timed pass of `workload` on the mos6502 crate, each run until its PC
+/// reaches `trap`, which it then executes once (as our CPU does before it
+/// stops): (cycles, seconds).
 fn theirs(workload: &Workload, trap: u16) -> (u64, f64) {
     use mos6502::memory::Bus as _;
-    let mut best = f64::INFINITY;
     let mut cycles = 0;
-    for _ in 0..TRIES {
-        let mut total = 0;
-        let started = Instant::now();
-        for _ in 0..workload.runs {
-            let mut cpu = mos6502::cpu::CPU::new(
-                mos6502::memory::Memory::new(),
-                mos6502::instruction::Nmos6502,
-            );
-            cpu.memory.set_bytes(0, &workload.image);
-            cpu.registers.program_counter = workload.start;
-            while cpu.registers.program_counter != trap {
-                cpu.single_step();
-            }
+    let started = Instant::now();
+    for _ in 0..workload.runs {
+        let mut cpu = mos6502::cpu::CPU::new(
+            mos6502::memory::Memory::new(),
+            mos6502::instruction::Nmos6502,
+        );
+        cpu.memory.set_bytes(0, &workload.image);
+        cpu.registers.program_counter = workload.start;
+        while cpu.registers.program_counter != trap {
             cpu.single_step();
-            total += black_box(cpu.cycles);
         }
-        best = best.min(started.elapsed().as_secs_f64());
-        cycles = total;
+        cpu.single_step();
+        cycles += black_box(cpu.cycles);
     }
-    (cycles, best)
+    (cycles, started.elapsed().as_secs_f64())
 }
 
 fn dormann_image() -> Option<Vec<u8>> {
@@ -132,33 +124,41 @@ fn main() {
         "workload", "emulator", "cycles", "seconds", "M cycles/s", "vs mos6502"
     );
     for workload in &workloads {
-        let (cycles, seconds, trap) = ours(workload, StopAtTrap);
-        let (hooked_cycles, hooked_seconds, _) = ours(workload, (StopAtTrap, Breakpoints::new()));
-        let (their_cycles, their_seconds) = theirs(workload, trap);
-        assert_eq!(
-            cycles, their_cycles,
-            "{}: the two CPUs disagree on the cycle count",
+        let mut best = [f64::INFINITY; 3];
+        let mut cycles = [0u64; 3];
+        for _ in 0..TRIES {
+            let (plain, seconds, trap) = ours(workload, &mut StopAtTrap);
+            cycles[0] = plain;
+            best[0] = best[0].min(seconds);
+            let (hooked, seconds, _) = ours(workload, &mut (StopAtTrap, Breakpoints::new()));
+            cycles[1] = hooked;
+            best[1] = best[1].min(seconds);
+            let (their_cycles, seconds) = theirs(workload, trap);
+            cycles[2] = their_cycles;
+            best[2] = best[2].min(seconds);
+        }
+        assert!(
+            cycles[0] == cycles[2] && cycles[1] == cycles[2],
+            "{}: the CPUs disagree on the cycle count: {cycles:?}",
             workload.name
         );
-        let rate = |cycles: u64, seconds: f64| cycles as f64 / seconds / 1e6;
-        let theirs_rate = rate(their_cycles, their_seconds);
-        for (label, cycles, seconds) in [
-            ("scorpion emulator", cycles, seconds),
-            (
-                "scorpion + empty breakpoints",
-                hooked_cycles,
-                hooked_seconds,
-            ),
-            ("mos6502 0.10.1", their_cycles, their_seconds),
-        ] {
+        let rate = |index: usize| cycles[index] as f64 / best[index] / 1e6;
+        for (index, label) in [
+            "scorpion emulator",
+            "scorpion + empty breakpoints",
+            "mos6502 0.10.1",
+        ]
+        .into_iter()
+        .enumerate()
+        {
             println!(
                 "{:<9} {:<28} {:>13} {:>9.3} {:>12.1} {:>7.2}x",
                 workload.name,
                 label,
-                cycles,
-                seconds,
-                rate(cycles, seconds),
-                rate(cycles, seconds) / theirs_rate
+                cycles[index],
+                best[index],
+                rate(index),
+                rate(index) / rate(2)
             );
         }
     }
