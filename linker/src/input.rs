@@ -302,10 +302,22 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
         });
     }
 
-    // Symbols.
+    // Symbols. Names are read from the string table directly: goblin's
+    // lookup binary-searches an index, which dominates big links.
+    let strtab = elf
+        .section_headers
+        .iter()
+        .find(|header| header.sh_type == sh::SHT_SYMTAB)
+        .and_then(|symtab| elf.section_headers.get(symtab.sh_link as usize))
+        .and_then(|header| {
+            let start = usize::try_from(header.sh_offset).ok()?;
+            let len = usize::try_from(header.sh_size).ok()?;
+            input.bytes.get(start..start.checked_add(len)?)
+        })
+        .unwrap_or(&[]);
     let mut symbols = Vec::with_capacity(elf.syms.len());
     for (index, entry) in elf.syms.iter().enumerate() {
-        let name = elf.strtab.get_at(entry.st_name).unwrap_or("").to_owned();
+        let name = string_at(strtab, entry.st_name).to_owned();
         let binding = match entry.st_bind() {
             sym::STB_LOCAL => Binding::Local,
             sym::STB_GLOBAL => Binding::Global,
@@ -445,4 +457,17 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
         srcmap,
         asserts,
     })
+}
+
+/// The NUL-terminated string at `offset` in a string table; empty when it
+/// is out of bounds or not UTF-8 (a name is only ever shown to people).
+fn string_at(table: &[u8], offset: usize) -> &str {
+    let Some(rest) = table.get(offset..) else {
+        return "";
+    };
+    let end = rest
+        .iter()
+        .position(|byte| *byte == 0)
+        .unwrap_or(rest.len());
+    std::str::from_utf8(&rest[..end]).unwrap_or("")
 }

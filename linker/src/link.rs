@@ -292,12 +292,11 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         });
     }
 
-    let mut segments = placement.segments.clone();
+    let mut placement = placement;
     crate::relocate::apply(
         &objects,
-        &placement,
         &values,
-        &mut segments,
+        &mut placement.segments,
         options.sources,
         &mut errors,
     );
@@ -319,10 +318,6 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         return Err(Error::Failed { count, errors });
     }
 
-    let placement = Placement {
-        segments,
-        ..placement
-    };
     let image = build_image(&objects, &placement, &values, &globals, hooks);
     if let Err(Error::BadImage { reason, .. }) = image.check_hooks("") {
         return Err(failed(vec![Error::Hook { reason }]));

@@ -20,7 +20,7 @@ use isa::elf as mos;
 use crate::error::Error;
 use crate::input::{Definition, Object};
 use crate::link::relocation_name;
-use crate::place::{Placed, Placement};
+use crate::place::Placed;
 use crate::source::SourceProvider;
 
 /// Patches every relocation into `segments`' bytes; range errors go to
@@ -28,16 +28,20 @@ use crate::source::SourceProvider;
 /// (undefined, or in an unplaced section) and are skipped.
 pub(crate) fn apply(
     objects: &[Object],
-    placement: &Placement,
     values: &[Vec<Option<i64>>],
     segments: &mut [Placed],
     sources: &dyn SourceProvider,
     errors: &mut Vec<Error>,
 ) {
-    for (segment_index, segment) in segments.iter_mut().enumerate() {
+    for segment in segments.iter_mut() {
         let base = segment.run;
         let has_bytes = !segment.bytes.is_empty();
-        for fragment in &placement.segments[segment_index].fragments {
+        let Placed {
+            fragments,
+            bytes: segment_bytes,
+            ..
+        } = segment;
+        for fragment in fragments.iter() {
             let object = &objects[fragment.object];
             let section = &object.sections[fragment.section];
             for reloc in &section.relocs {
@@ -150,7 +154,7 @@ pub(crate) fn apply(
                 };
                 if let (Some(bytes), true) = (patch, has_bytes) {
                     let start = at_offset as usize;
-                    if let Some(target) = segment.bytes.get_mut(start..start + bytes.len()) {
+                    if let Some(target) = segment_bytes.get_mut(start..start + bytes.len()) {
                         target.copy_from_slice(&bytes);
                     }
                 }
