@@ -25,9 +25,10 @@ pub(crate) struct Reported;
 
 pub(crate) type PResult<T> = Result<T, Reported>;
 
-/// Most lines, macro-expanded lines included, that one assembly may read:
-/// a guard against runaway `.repeat` and recursive macros.
-const MAX_LINES: u64 = 20_000_000;
+/// Most lines, macro-expanded lines included, that one assembly may read
+/// (twenty times the 200,000-line benchmark): a guard against runaway
+/// `.repeat`s and recursive macros.
+const MAX_LINES: u64 = 4_000_000;
 /// Deepest nesting of includes, macros and `.repeat`s.
 const MAX_FRAMES: usize = 256;
 /// Largest total of bytes in all segments (the 6502 sees 64 KiB, but a
@@ -375,6 +376,22 @@ impl<'a> Asm<'a> {
         seg.used = true;
         self.prog.chunks[seg.cur as usize].len += bytes.len() as u32;
         self.total_bytes += bytes.len();
+        if self.total_bytes > MAX_BYTES && !self.stop {
+            let span = Span {
+                file: self.line.file,
+                start: self.line.start,
+                end: self.line.end,
+            };
+            self.err(
+                "asm::too-big",
+                span,
+                format!(
+                    "the program grows past {} MiB here; assembly stops",
+                    MAX_BYTES >> 20
+                ),
+            );
+            self.stop = true;
+        }
     }
 
     /// Records an instruction or data item for the source map.

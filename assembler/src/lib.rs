@@ -161,6 +161,23 @@ pub fn assemble(
     asm.finish_front();
     asm.layout();
     let out = asm.resolve();
+    // In source order: by where each came from in the main file (the
+    // outermost include or macro call), then by its own place.
+    let ctx = &asm.ctx;
+    asm.rep.diags.sort_by_key(|raw| {
+        let mut outer = raw.span;
+        let mut id = raw.ctx;
+        let mut guard = 0;
+        while id != 0 && guard < 256 {
+            let Some(node) = ctx.get(id as usize) else {
+                break;
+            };
+            outer = node.span;
+            id = node.parent;
+            guard += 1;
+        }
+        (outer.file, outer.start, raw.span.file, raw.span.start)
+    });
     let mut diagnostics: Vec<Diagnostic> = asm
         .rep
         .diags

@@ -2,6 +2,7 @@
 //! status out, snapshotted with insta. One module per subcommand.
 
 mod ask;
+mod asm;
 mod build;
 mod disasm;
 mod emu;
