@@ -212,10 +212,14 @@ impl Image {
                     .filter(|p| p.p_type == ph::PT_LOAD)
                     .find(|p| {
                         header.sh_offset >= p.p_offset
-                            && header.sh_offset + header.sh_size <= p.p_offset + p.p_filesz
+                            && header.sh_offset.saturating_add(header.sh_size)
+                                <= p.p_offset.saturating_add(p.p_filesz)
                     })
                     .map_or(Ok(run), |p| {
-                        address(p.p_paddr + (header.sh_offset - p.p_offset), section_name)
+                        address(
+                            p.p_paddr.saturating_add(header.sh_offset - p.p_offset),
+                            section_name,
+                        )
                     })?
             };
             position_of[index] = Some(sections.len());

@@ -157,6 +157,8 @@ pub(crate) fn place(
     let mut areas = Vec::with_capacity(layout.areas.len());
     for area in &layout.areas {
         let mut cursor = area.start;
+        // The highest address reached: a fixed start may move the cursor back.
+        let mut reached = area.start;
         let mut written_end = area.start;
         let mut last: Option<usize> = None;
         let mut overflow: Option<usize> = None;
@@ -213,6 +215,7 @@ pub(crate) fn place(
                 }
             }
             cursor = address + segment.size;
+            reached = reached.max(cursor);
             if cursor > area.end() && overflow.is_none() {
                 overflow = Some(index);
             }
@@ -222,7 +225,7 @@ pub(crate) fn place(
             errors.push(Error::Overflow {
                 segment: segments[index].rule.name.clone(),
                 area: area.name.clone(),
-                amount: cursor - area.end(),
+                amount: reached - area.end(),
                 contributors: contributors(objects, &segments, &area.name),
             });
         }
@@ -231,7 +234,7 @@ pub(crate) fn place(
         }
         areas.push(PlacedArea {
             area: area.clone(),
-            used_end: cursor,
+            used_end: reached,
             written_end,
         });
     }

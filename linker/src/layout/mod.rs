@@ -98,6 +98,10 @@ pub use builtin::{BUILTIN_TARGETS, RomSymbols};
 
 use crate::error::Error;
 
+/// The largest area `fill = true` may write whole: a typo in a size must not
+/// make the linker allocate gigabytes.
+pub const MAX_FILLED_AREA: u64 = 1 << 24;
+
 /// A memory area.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Area {
@@ -233,6 +237,12 @@ impl Layout {
             }
             if area.end() > 1 << 32 {
                 return Err(invalid(format!("area {} ends past $FFFFFFFF", area.name)));
+            }
+            if area.fill && area.size > MAX_FILLED_AREA {
+                return Err(invalid(format!(
+                    "area {} is filled (fill = true) but is {} bytes; filled areas are written whole, so at most {MAX_FILLED_AREA} bytes (16 MiB)",
+                    area.name, area.size
+                )));
             }
         }
         for (index, segment) in self.segments.iter().enumerate() {

@@ -495,3 +495,27 @@ fn a_failed_link_still_shows_its_warnings() {
     let error = link_flat(&[("a.o", obj.build())], 0x1000).expect_err("undefined");
     insta::assert_snapshot!("failure_with_warning", render(&error));
 }
+
+#[test]
+fn overflow_past_a_fixed_segment_counts_the_furthest_byte() {
+    let layout = Layout::from_toml(
+        "rom.toml",
+        "[[area]]\nname = \"ROM\"\nstart = \"$FFF0\"\nsize = 16\n[[segment]]\nname = \"CODE\"\nload = \"ROM\"\n[[segment]]\nname = \"VECTORS\"\nload = \"ROM\"\nstart = \"$FFFA\"\n",
+    )
+    .expect("parses");
+    let mut obj = ObjectBuilder::new();
+    obj.code("CODE", &[0xEA; 20]);
+    obj.code("VECTORS", &[0; 6]);
+    let rendered = failure(
+        &[("big.o", obj.build())],
+        &Target::Custom(layout),
+        &MemorySources::default(),
+    );
+    insta::assert_snapshot!("overflow_past_fixed_segment", rendered);
+    let filled = Layout::from_toml(
+        "huge.toml",
+        "[[area]]\nname = \"ALL\"\nstart = 0\nsize = \"$100000000\"\nfill = true\n",
+    )
+    .expect_err("a 4 GiB filled area");
+    insta::assert_snapshot!("filled_area_too_big", render(&filled));
+}
