@@ -117,6 +117,18 @@ pub struct Board {
     /// The earliest cycle at which a device raises its interrupt output by
     /// itself (`u64::MAX`: none).
     next_event: u64,
+    /// Polls before this cycle have nothing to do: the IRQ line is released
+    /// (and reads released for every cycle a poll can ask about) and no
+    /// device event is due. 0 while the line is asserted or just changed.
+    attention: u64,
+    /// The cycle the IRQ line last changed.
+    irq_changed_at: u64,
+    /// The cycle of the last poll.
+    last_poll: u64,
+    /// Addresses from here up to the ROM take the slow path (the I/O page,
+    /// unconnected space, and KIM-bus pages holding a device); everything
+    /// below, and the ROM, is plain memory.
+    slow_start: u16,
     rom_writes: u64,
 }
 
@@ -171,6 +183,10 @@ impl Board {
             acia_line: Line::new(),
             irq: Line::new(),
             next_event: u64::MAX,
+            attention: 0,
+            irq_changed_at: 0,
+            last_poll: 0,
+            slow_start: map::IO_START,
             rom_writes: 0,
         };
         board.set_bumpers(0, 0);
@@ -268,6 +284,7 @@ impl Board {
         for page in (start >> 8)..=(end >> 8) {
             self.pages[usize::from(page)] = Page::Kim;
         }
+        self.slow_start = self.slow_start.min(start & 0xFF00);
         self.kim.push(KimSlot {
             start,
             end,
@@ -492,6 +509,9 @@ impl Board {
             slot.line.set(slot.device.irq(), cycle);
             any |= slot.line.is_asserted();
         }
+        if any != self.irq.is_asserted() {
+            self.irq_changed_at = cycle;
+        }
         self.irq.set(any, cycle);
         self.refresh_next_event();
     }
@@ -503,6 +523,30 @@ impl Board {
             next = next.min(slot.device.next_event().unwrap_or(u64::MAX));
         }
         self.next_event = next;
+        self.set_attention();
+    }
+
+    /// Lets polls skip all work until the next device event, unless the IRQ
+    /// line is asserted or changed after the last poll (a poll may still
+    /// ask about a cycle before the change).
+    fn set_attention(&mut self) {
+        self.attention = if self.irq.is_asserted() || self.irq_changed_at > self.last_poll {
+            0
+        } else {
+            self.next_event
+        };
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn poll_slow(&mut self, cycle: u64) -> Interrupts {
+        if cycle >= self.next_event {
+            self.catch_up(cycle);
+        }
+        self.last_poll = cycle;
+        let irq = self.irq.at(cycle);
+        self.set_attention();
+        Interrupts { irq, nmi: false }
     }
 
     /// Feeds the port B levels and the driver enables to the stepper
@@ -587,6 +631,7 @@ impl Board {
     }
 
     #[cold]
+    #[inline(never)]
     fn slow_read(&mut self, address: u16, cycle: u64) -> u8 {
         match self.pages[usize::from(address >> 8)] {
             Page::Io => self.io_read(address, cycle),
@@ -606,6 +651,7 @@ impl Board {
     }
 
     #[cold]
+    #[inline(never)]
     fn slow_write(&mut self, address: u16, value: u8, cycle: u64) {
         match self.pages[usize::from(address >> 8)] {
             Page::Io => self.io_write(address, value, cycle),
@@ -628,15 +674,18 @@ impl Board {
 impl Bus for Board {
     #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
-        match self.pages[usize::from(address >> 8)] {
-            Page::Ram | Page::Rom => self.memory[usize::from(address)],
-            _ => self.slow_read(address, cycle),
+        // Two comparisons on the address and no table: the CPU's fetches
+        // and RAM accesses must cost no more than on a plain RAM bus.
+        if address < self.slow_start || address >= map::ROM_START {
+            self.memory[usize::from(address)]
+        } else {
+            self.slow_read(address, cycle)
         }
     }
 
     #[inline(always)]
     fn write(&mut self, address: u16, value: u8, cycle: u64) {
-        if self.pages[usize::from(address >> 8)] == Page::Ram {
+        if address < self.slow_start {
             self.memory[usize::from(address)] = value;
         } else {
             self.slow_write(address, value, cycle);
@@ -660,13 +709,11 @@ impl Bus for Board {
 
     #[inline(always)]
     fn poll(&mut self, cycle: u64) -> Interrupts {
-        if cycle >= self.next_event {
-            self.catch_up(cycle);
+        // One comparison per instruction while nothing happens.
+        if cycle < self.attention {
+            return Interrupts::NONE;
         }
-        Interrupts {
-            irq: self.irq.at(cycle),
-            nmi: false,
-        }
+        self.poll_slow(cycle)
     }
 }
 
