@@ -310,7 +310,7 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         &mut warnings,
     );
 
-    let hooks = hooks(&globals, &mut errors);
+    let hooks = hooks(&objects, &globals, &mut errors);
     if !errors.is_empty() {
         // Warnings still matter when the link fails: show them after the errors.
         let count = errors.len();
@@ -320,7 +320,17 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
 
     let image = build_image(&objects, &placement, &values, &globals, hooks);
     if let Err(Error::BadImage { reason, .. }) = image.check_hooks("") {
-        return Err(failed(vec![Error::Hook { reason }]));
+        // Name where the hook symbols are defined, so the user finds them.
+        let places: Vec<String> = HookKind::ALL
+            .iter()
+            .flat_map(|kind| [kind.handler_symbol(), kind.chain_symbol()])
+            .map(|name| (name, defined_at(&objects, &globals, name)))
+            .filter(|(_, place)| !place.is_empty())
+            .map(|(name, place)| format!("{name}{place}"))
+            .collect();
+        return Err(failed(vec![Error::Hook {
+            reason: format!("{reason}; {}", places.join(", ")),
+        }]));
     }
     let map = map_data(&objects, &layout, &placement, &globals);
     Ok(Linked {
@@ -417,7 +427,20 @@ fn check_asserts(
     }
 }
 
-fn hooks(globals: &BTreeMap<String, Global>, errors: &mut Vec<Error>) -> Hooks {
+/// " (defined at main.s:12:1)" for a global an object defines, else "".
+fn defined_at(objects: &[Object], globals: &BTreeMap<String, Global>, name: &str) -> String {
+    match globals.get(name).map(|global| &global.origin) {
+        Some(Origin::Object { object, symbol }) => {
+            format!(
+                " (defined at {})",
+                objects[*object].place_of_symbol(*symbol).text
+            )
+        }
+        _ => String::new(),
+    }
+}
+
+fn hooks(objects: &[Object], globals: &BTreeMap<String, Global>, errors: &mut Vec<Error>) -> Hooks {
     let mut hooks = Hooks::default();
     let address = |name: &str, errors: &mut Vec<Error>| -> Option<u16> {
         let value = globals.get(name)?.value?;
@@ -425,7 +448,10 @@ fn hooks(globals: &BTreeMap<String, Global>, errors: &mut Vec<Error>) -> Hooks {
             Ok(address) => Some(address),
             Err(_) => {
                 errors.push(Error::Hook {
-                    reason: format!("{name} = {value:#X} is not a 16-bit address"),
+                    reason: format!(
+                        "{name}{} = {value:#X} is not a 16-bit address",
+                        defined_at(objects, globals, name)
+                    ),
                 });
                 None
             }
@@ -442,8 +468,9 @@ fn hooks(globals: &BTreeMap<String, Global>, errors: &mut Vec<Error>) -> Hooks {
             }),
             (None, Some(_)) => errors.push(Error::Hook {
                 reason: format!(
-                    "{} is exported but {} is not: a chain slot needs a handler",
+                    "{}{} is exported but {} is not: a chain slot needs a handler",
                     kind.chain_symbol(),
+                    defined_at(objects, globals, kind.chain_symbol()),
                     kind.handler_symbol()
                 ),
             }),
