@@ -113,3 +113,43 @@ fn srecords_above_64k_use_wider_addresses() {
         );
     }
 }
+
+/// binutils' readelf reads our images (and the objects objbuild writes)
+/// without a warning, load/run split and hooks section included.
+#[test]
+fn readelf_reads_images_without_warnings() {
+    let test = "linker formats::readelf_reads_images_without_warnings";
+    let Some(readelf) = scorpion_tests::tools::require("readelf", test) else {
+        return;
+    };
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let extension = link_extension();
+    let files = [
+        ("ext.elf", Format::Elf.write(&extension.image).expect("elf")),
+        ("main.o", crate::round_trip::extension().remove(0).1),
+    ];
+    for (name, bytes) in files {
+        let path = dir.path().join(name);
+        std::fs::write(&path, &bytes).expect("write");
+        let output = Command::new(&readelf)
+            .args(["-a", "-W"])
+            .arg(&path)
+            .output()
+            .expect("readelf runs");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{name}: {stderr}");
+        assert!(
+            !stderr.contains("Warning") && !stderr.contains("Error"),
+            "{name}: {stderr}"
+        );
+        if name.ends_with(".elf") {
+            assert!(stdout.contains("EXEC (Executable file)"), "{stdout}");
+            assert!(stdout.contains("LOAD"), "{stdout}");
+            assert!(stdout.contains(".scorpion.hooks"), "{stdout}");
+        } else {
+            assert!(stdout.contains("REL (Relocatable file)"), "{stdout}");
+            assert!(stdout.contains(".relaCODE"), "{stdout}");
+        }
+    }
+}

@@ -7,6 +7,7 @@ mod diagnostics;
 mod formats;
 mod layouts;
 mod ld65;
+mod properties;
 mod relocations;
 mod robustness;
 pub(crate) mod round_trip;
