@@ -339,3 +339,176 @@ pub fn escape(bytes: &[u8]) -> String {
         .map(char::from)
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use isa::objfmt::{HookRecord, Hooks};
+    use linker::LoadArea;
+
+    use super::*;
+    use crate::protocol::{Answer, BusyByte};
+
+    /// An image of `bytes` at `load` taking `hooks`.
+    fn image(load: u32, bytes: &[u8], hooks: Vec<HookRecord>) -> Image {
+        Image {
+            entry: load,
+            areas: vec![LoadArea {
+                load,
+                run: load,
+                bytes: bytes.to_vec(),
+            }],
+            hooks: Hooks { records: hooks },
+            ..Image::default()
+        }
+    }
+
+    /// A handler: if the letter is `letter`, answer `letter` and end the
+    /// command; else `JMP` through its chain slot (the handler's byte 14).
+    fn handler(letter: u8) -> Vec<u8> {
+        let [pl, ph] = symbols::PUTCH.to_le_bytes();
+        let [el, eh] = symbols::PUTEOL.to_le_bytes();
+        let [dl, dh] = symbols::CMD_DONE.to_le_bytes();
+        vec![
+            0xC9, letter, // CMP #letter
+            0xD0, 0x09, // BNE chain (skip 9 bytes)
+            0x20, pl, ph, // JSR PUTCH
+            0x20, el, eh, // JSR PUTEOL
+            0x4C, dl, dh, // JMP CMD_DONE
+            0x4C, 0x00, 0x00, // chain: JMP (filled in by the loader)
+        ]
+    }
+
+    #[test]
+    fn boots_and_answers() {
+        let mut robot = VirtualScorpion::new();
+        let answer = robot.exchange(&Command::Busy).expect("an answer");
+        assert_eq!(answer, Some(Answer::Busy(BusyByte(0))));
+        assert!(robot.cycles() > BOOT_TIME);
+    }
+
+    #[test]
+    fn images_load_and_hooks_chain_in_order() {
+        let mut robot = VirtualScorpion::new();
+        let first = image(
+            0x0400,
+            &handler(b'Q'),
+            vec![HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0400,
+                chain: Some(0x0400 + 14),
+            }],
+        );
+        let second = image(
+            0x0500,
+            &handler(b'J'),
+            vec![HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0500,
+                chain: Some(0x0500 + 14),
+            }],
+        );
+        let hooks = robot.load_image(&first).expect("fits in RAM");
+        assert_eq!(hooks[0].previous, symbols::BAD_COMMAND);
+        let hooks = robot.load_image(&second).expect("fits in RAM");
+        assert_eq!(hooks[0].previous, 0x0400, "the second chains to the first");
+        assert_eq!(robot.transact(b"/1J", ANSWER_TIMEOUT).expect("J"), b"J\r");
+        assert_eq!(robot.transact(b"/1Q", ANSWER_TIMEOUT).expect("Q"), b"Q\r");
+        let error = robot
+            .transact(b"/1Z", 50_000)
+            .expect_err("nobody answers /1Z");
+        assert!(matches!(error, Error::NoAnswer { .. }), "{error}");
+        // The ROM's own commands still work.
+        assert_eq!(robot.transact(b"/1E", ANSWER_TIMEOUT).expect("E"), b"E0\r");
+    }
+
+    #[test]
+    fn an_image_outside_ram_is_refused_whole() {
+        let mut robot = VirtualScorpion::new();
+        let mut bad = image(0x0FFE, &[1, 2, 3, 4], Vec::new());
+        // $0FFE-$1001 is card RAM then KIM-bus RAM: fine.
+        robot.load_image(&bad).expect("RAM all the way");
+        bad.areas[0].load = 0xBFFE;
+        let error = robot.load_image(&bad).expect_err("runs into the I/O page");
+        assert!(
+            matches!(
+                error,
+                Error::Emulator(emulator::Error::NotRam {
+                    address: 0xC000,
+                    ..
+                })
+            ),
+            "{error}"
+        );
+        assert_eq!(robot.robot().board().memory()[0xBFFE], 0, "nothing written");
+        bad.areas[0].load = 0xFFFE;
+        assert!(robot.load_image(&bad).is_err(), "past $FFFF");
+    }
+
+    #[test]
+    fn a_hook_that_is_not_a_jmp_is_not_installed() {
+        let mut robot = VirtualScorpion::new();
+        robot
+            .robot_mut()
+            .board_mut()
+            .load(symbols::HOOK_LOOP, &[0xEA])
+            .expect("RAM");
+        let error = robot
+            .install_hook(HookKind::Loop, 0x0400, None)
+            .expect_err("a NOP is not a JMP");
+        assert!(
+            matches!(error, Error::HookNotJmp { found: 0xEA, .. }),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn a_jam_is_reported() {
+        let mut robot = VirtualScorpion::new();
+        // A handler that is a JAM opcode.
+        robot
+            .load_image(&image(0x0400, &[0x02], Vec::new()))
+            .expect("RAM");
+        robot
+            .install_hook(HookKind::Unknown, 0x0400, None)
+            .expect("a JMP");
+        let error = robot
+            .transact(b"/1Z", ANSWER_TIMEOUT)
+            .expect_err("the CPU jams");
+        assert!(
+            matches!(
+                error,
+                Error::Jam {
+                    pc: 0x0400,
+                    opcode: 0x02
+                }
+            ),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn the_baud_rate_is_set_on_both_ends() {
+        let mut robot = VirtualScorpion::new();
+        assert!(!robot.set_baud(1000), "the 6551 has no 1000 baud");
+        assert!(robot.set_baud(19_200));
+        assert_eq!(robot.transact(b"/1X", ANSWER_TIMEOUT).expect("X"), b"X00\r");
+        // Host and robot at different rates: garbage, no answer.
+        robot.robot_mut().set_baud(9600);
+        assert!(robot.transact(b"/1X", 100_000).is_err());
+    }
+
+    #[test]
+    fn a_rom_profile_needs_the_whole_rom_and_its_hooks() {
+        let rom = Image::parse("rom", crate::ROM_ELF).expect("the reference ROM's ELF");
+        let mut robot = VirtualScorpion::with_rom("reference", &rom).expect("a valid profile");
+        assert_eq!(robot.transact(b"/1E", ANSWER_TIMEOUT).expect("E"), b"E0\r");
+        let mut short = rom.clone();
+        short.areas[0].bytes.truncate(100);
+        let error = VirtualScorpion::with_rom("short", &short).expect_err("missing bytes");
+        assert!(error.to_string().contains("no byte for"), "{error}");
+        let mut nameless = rom;
+        nameless.symbols.retain(|symbol| symbol.name != "HOOK_LOOP");
+        let error = VirtualScorpion::with_rom("nameless", &nameless).expect_err("no HOOK_LOOP");
+        assert!(error.to_string().contains("HOOK_LOOP"), "{error}");
+    }
+}
