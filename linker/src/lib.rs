@@ -16,6 +16,8 @@
 //! The library never prints; sources for diagnostics come through
 //! [`SourceProvider`].
 
+mod checks;
+mod emit;
 mod error;
 pub mod image;
 mod input;
