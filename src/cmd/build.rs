@@ -80,12 +80,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         listing: args.listing.is_some(),
         max_errors: args.max_errors,
         undocumented: args.undocumented,
-        // `.include "scorpion.inc"` finds the ROM's names without a path.
-        builtin_includes: [(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]
-        .into(),
+        // `.include "scorpion.inc"` finds the ROM's names, as in `scorpion asm`.
+        builtin_includes: crate::cmd::asm::builtin_includes(),
         ..assembler::Options::default()
     };
     let mut objects = Vec::with_capacity(args.sources.len());
