@@ -120,6 +120,11 @@ impl Image {
             file: name.to_owned(),
             reason,
         };
+        if let Some(reason) = crate::input::not_elf(bytes) {
+            return Err(bad(format!(
+                "{reason} (a raw binary has no addresses or symbols)"
+            )));
+        }
         let elf = Elf::parse(bytes).map_err(|error| bad(format!("not ELF: {error}")))?;
         if elf.is_64 || !elf.little_endian {
             return Err(bad("not ELF32 little-endian".into()));

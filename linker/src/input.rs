@@ -188,6 +188,12 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
         file: file.to_owned(),
         reason,
     };
+    if let Some(reason) = not_elf(input.bytes) {
+        return Err(Error::NotElf {
+            file: file.to_owned(),
+            reason,
+        });
+    }
     let elf = Elf::parse(input.bytes).map_err(|error| Error::NotElf {
         file: file.to_owned(),
         reason: error.to_string(),
@@ -470,4 +476,27 @@ fn string_at(table: &[u8], offset: usize) -> &str {
         .position(|byte| *byte == 0)
         .unwrap_or(rest.len());
     std::str::from_utf8(&rest[..end]).unwrap_or("")
+}
+
+/// Why `bytes` is plainly not an ELF file, naming what it looks like.
+pub(crate) fn not_elf(bytes: &[u8]) -> Option<String> {
+    if bytes.starts_with(b"\x7fELF") {
+        return None;
+    }
+    // ca65's object files start with the magic $616E7A55, little-endian.
+    if bytes.starts_with(&[0x55, 0x7A, 0x6E, 0x61]) {
+        return Some(
+            "this is a ca65 (xo65) object; assemble the source with `scorpion asm` for an ELF object"
+                .into(),
+        );
+    }
+    Some(format!(
+        "it does not start with the ELF magic (7F 45 4C 46) but with {}",
+        bytes
+            .iter()
+            .take(4)
+            .map(|byte| format!("{byte:02X}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    ))
 }

@@ -183,3 +183,23 @@ fn flat_matches_ld65_byte_for_byte() {
         assert!(!linked.warnings.is_empty() || start % 8 == 0);
     }
 }
+
+#[test]
+fn a_ca65_object_is_recognised_and_refused() {
+    let test = "linker ld65::a_ca65_object_is_recognised_and_refused";
+    let Some(ca65) = scorpion_tests::tools::require("ca65", test) else {
+        return;
+    };
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("a.s"), A_S).expect("write source");
+    let status = Command::new(ca65)
+        .current_dir(dir.path())
+        .arg("a.s")
+        .status()
+        .expect("ca65 runs");
+    assert!(status.success());
+    let xo65 = std::fs::read(dir.path().join("a.o")).expect("ca65 wrote a.o");
+    let error = link_flat(&[("a.o", xo65)], 0x1000).expect_err("not ELF");
+    let text = format!("{:?}", miette::Report::new(error));
+    assert!(text.contains("ca65 (xo65) object"), "{text}");
+}
