@@ -760,10 +760,14 @@ impl<'a> Asm<'a> {
                 ..
             } => {
                 self.line_ctx = *ctx;
+                if *iter >= *count || body.lines.is_empty() {
+                    // Stays ended, however often it is asked.
+                    return Some(None);
+                }
                 if *line >= body.lines.len() {
                     *iter += 1;
                     *line = 0;
-                    if *iter >= *count || body.lines.is_empty() {
+                    if *iter >= *count {
                         return Some(None);
                     }
                 }
@@ -795,6 +799,9 @@ impl<'a> Asm<'a> {
     /// Reads the next raw line for a macro or `.repeat` body (no defines,
     /// no conditionals). `None` when the innermost frame ends.
     pub(crate) fn fetch_raw(&mut self) -> Option<LineInfo> {
+        if self.lines_read > MAX_LINES {
+            return None;
+        }
         match self.fetch() {
             Some(Some(info)) => {
                 self.lex_errors.clear();
@@ -832,6 +839,10 @@ impl<'a> Asm<'a> {
     /// Runs the whole input.
     pub(crate) fn run(&mut self) {
         while !self.stop {
+            if self.rep.overwhelmed() {
+                self.rep.stopped = true;
+                break;
+            }
             match self.fetch() {
                 None => break,
                 Some(None) => self.pop_frame(),

@@ -172,6 +172,8 @@ pub(crate) struct Reporter {
     pub(crate) max_errors: usize,
     pub(crate) dropped: usize,
     warnings_kept: usize,
+    /// Reading stopped early because of the number of errors.
+    pub(crate) stopped: bool,
 }
 
 impl Reporter {
@@ -182,6 +184,7 @@ impl Reporter {
             max_errors: max_errors.max(1),
             dropped: 0,
             warnings_kept: 0,
+            stopped: false,
         }
     }
 
@@ -204,6 +207,12 @@ impl Reporter {
             }
         }
         self.diags.push(diag);
+    }
+
+    /// So many errors that going on only costs time (ten times the cap):
+    /// the front end stops reading.
+    pub(crate) fn overwhelmed(&self) -> bool {
+        self.errors >= self.max_errors.saturating_mul(10)
     }
 
     pub(crate) fn has_errors(&self) -> bool {

@@ -270,29 +270,69 @@ impl Asm<'_> {
                     (Some(_), None, Size::Abs) => {
                         return Err(self.no_mode(mnemonic, abs_mode, whole));
                     }
-                    (Some(_), Some(_), Size::Auto) => self.fit(expr, operand_span)?,
+                    (Some(_), Some(_), Size::Auto) => {
+                        let value = self.prog.eval(expr);
+                        let fit = self.fit(value, operand_span)?;
+                        // Evaluated once: the operand bytes use the same value.
+                        return self.direct(
+                            mnemonic,
+                            fit,
+                            (zp_mode, abs_mode),
+                            expr,
+                            value,
+                            head.span,
+                            operand_span,
+                            whole,
+                        );
+                    }
                 };
-                match choice {
-                    Fit::Zp => {
-                        let code = self.opcode(mnemonic, zp_mode, head.span, whole)?;
-                        self.item(head.span, 2);
-                        self.emit(&[code]);
-                        self.operand_bytes(expr, FixKind::Zp, operand_span)
-                    }
-                    Fit::Abs => {
-                        let code = self.opcode(mnemonic, abs_mode, head.span, whole)?;
-                        self.item(head.span, 3);
-                        self.emit(&[code]);
-                        self.operand_bytes(expr, FixKind::Abs, operand_span)
-                    }
-                    Fit::Unknown => {
-                        let narrow = self.opcode(mnemonic, zp_mode, head.span, whole)?;
-                        let wide = self.opcode(mnemonic, abs_mode, head.span, whole)?;
-                        self.item(head.span, 2);
-                        self.pending(narrow, wide, expr, operand_span);
-                        Ok(())
-                    }
-                }
+                let value = self.prog.eval(expr);
+                self.direct(
+                    mnemonic,
+                    choice,
+                    (zp_mode, abs_mode),
+                    expr,
+                    value,
+                    head.span,
+                    operand_span,
+                    whole,
+                )
+            }
+        }
+    }
+
+    /// Emits a direct-addressed instruction once its size is chosen.
+    #[allow(clippy::too_many_arguments)]
+    fn direct(
+        &mut self,
+        mnemonic: Mnemonic,
+        choice: Fit,
+        (zp_mode, abs_mode): (Mode, Mode),
+        expr: NodeId,
+        value: Result<Value, EvalErr>,
+        head: Span,
+        operand_span: Span,
+        whole: Span,
+    ) -> PResult<()> {
+        match choice {
+            Fit::Zp => {
+                let code = self.opcode(mnemonic, zp_mode, head, whole)?;
+                self.item(head, 2);
+                self.emit(&[code]);
+                self.operand_value(expr, value, FixKind::Zp, operand_span)
+            }
+            Fit::Abs => {
+                let code = self.opcode(mnemonic, abs_mode, head, whole)?;
+                self.item(head, 3);
+                self.emit(&[code]);
+                self.operand_value(expr, value, FixKind::Abs, operand_span)
+            }
+            Fit::Unknown => {
+                let narrow = self.opcode(mnemonic, zp_mode, head, whole)?;
+                let wide = self.opcode(mnemonic, abs_mode, head, whole)?;
+                self.item(head, 2);
+                self.pending(narrow, wide, expr, operand_span);
+                Ok(())
             }
         }
     }
@@ -351,8 +391,8 @@ impl Asm<'_> {
     }
 
     /// Whether an operand is zero-page, absolute or not known yet.
-    fn fit(&mut self, expr: NodeId, span: Span) -> PResult<Fit> {
-        match self.prog.eval(expr) {
+    fn fit(&mut self, value: Result<Value, EvalErr>, span: Span) -> PResult<Fit> {
+        match value {
             Ok(value) => Ok(match self.value_fit(value) {
                 Some(true) => Fit::Zp,
                 Some(false) => Fit::Abs,
@@ -392,7 +432,19 @@ impl Asm<'_> {
     /// Writes an operand or data value: bytes now if constant, else a
     /// placeholder and a fixup resolved after layout.
     pub(crate) fn operand_bytes(&mut self, expr: NodeId, kind: FixKind, span: Span) -> PResult<()> {
-        match self.prog.eval(expr) {
+        let value = self.prog.eval(expr);
+        self.operand_value(expr, value, kind, span)
+    }
+
+    /// [`Asm::operand_bytes`] with the value already evaluated.
+    fn operand_value(
+        &mut self,
+        expr: NodeId,
+        value: Result<Value, EvalErr>,
+        kind: FixKind,
+        span: Span,
+    ) -> PResult<()> {
+        match value {
             Ok(Value::Const(value)) => {
                 let bytes = crate::layout::const_bytes(kind, value).map_err(|(what, range)| {
                     self.report(crate::layout::range_diag(span, what, value, range))

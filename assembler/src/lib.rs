@@ -185,11 +185,16 @@ pub fn assemble(
         .map(|raw| Diagnostic::render(&asm.files, &asm.ctx, raw))
         .collect();
     if asm.rep.dropped > 0 {
+        let stopped = if asm.rep.stopped {
+            "; assembly stopped early because of the number of errors"
+        } else {
+            ""
+        };
         diagnostics.push(Diagnostic::plain(
             Severity::Error,
             "asm::too-many-errors",
             format!(
-                "{} more diagnostic{} not shown",
+                "{} more diagnostic{} not shown{stopped}",
                 asm.rep.dropped,
                 if asm.rep.dropped == 1 { "" } else { "s" }
             ),

@@ -305,6 +305,11 @@ fn pathological_inputs_end_with_errors() {
     check(b".macro m\nm\nm\n.endmacro\nm\n");
     check(b".define A B\n.define B A\nlda #A\n");
     check(&vec![b'x'; 100_000]);
+    // A struct whose `.union` never closes, inside a `.repeat`: reading
+    // members must stop at the end of the expansion (found by cargo-fuzz;
+    // it used to restart the expansion forever).
+    check(b".repeat 2\n.struct s\n.union\nm .byte\n.endrepeat\n");
+    check(b".macro m\n.struct s\nf .byte\n.endmacro\nm\nm\n");
     check("é ü\u{0}\r\n\t;\u{feff}".as_bytes());
     let many_errors = ".byte 300\n".repeat(10_000);
     check(many_errors.as_bytes());
