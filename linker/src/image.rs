@@ -277,18 +277,17 @@ impl Image {
                 HookKind::Unknown => "HOOK_UNKNOWN",
                 HookKind::Loop => "HOOK_LOOP",
             };
-            if self.run_byte(u32::from(record.handler)).is_none() {
+            if !self.loaded_in_place(u32::from(record.handler)) {
                 return Err(Error::BadImage {
                     file: name.to_owned(),
                     reason: format!(
-                        "the {kind} handler ${:04X} is not inside a loaded area",
+                        "the {kind} handler ${:04X} is not inside a loaded area that runs where it loads",
                         record.handler
                     ),
                 });
             }
             let slot_missing = record.chain.is_some_and(|slot| {
-                self.run_byte(u32::from(slot)).is_none()
-                    || self.run_byte(u32::from(slot) + 1).is_none()
+                !self.loaded_in_place(u32::from(slot)) || !self.loaded_in_place(u32::from(slot) + 1)
             });
             if let (true, Some(slot)) = (slot_missing, record.chain) {
                 return Err(Error::BadImage {
@@ -298,6 +297,15 @@ impl Image {
             }
         }
         Ok(())
+    }
+
+    /// Whether an area loads a byte at `address` and runs it there: an
+    /// uploader installs a hook right after writing the image, before any
+    /// start-up code could copy bytes to their run address.
+    fn loaded_in_place(&self, address: u32) -> bool {
+        self.areas.iter().any(|area| {
+            area.load == area.run && address >= area.load && u64::from(address) < area.end()
+        })
     }
 
     /// The byte that runs at `address`, if a loaded area holds it.

@@ -519,3 +519,29 @@ fn overflow_past_a_fixed_segment_counts_the_furthest_byte() {
     .expect_err("a 4 GiB filled area");
     insta::assert_snapshot!("filled_area_too_big", render(&filled));
 }
+
+#[test]
+fn a_hook_into_bytes_that_run_elsewhere_is_refused() {
+    let layout = Layout::from_toml(
+        "copy.toml",
+        "[[area]]\nname = \"RAM\"\nstart = \"$0400\"\nsize = \"$100\"\noutput = false\n\
+         [[area]]\nname = \"KIM\"\nstart = \"$1000\"\nsize = \"$100\"\n\
+         [[segment]]\nname = \"CODE\"\nload = \"KIM\"\n\
+         [[segment]]\nname = \"DATA\"\nload = \"KIM\"\nrun = \"RAM\"\nkind = \"rw\"\n",
+    )
+    .expect("parses");
+    let mut obj = ObjectBuilder::new();
+    obj.code("CODE", &[0x60]);
+    let data = obj.data("DATA", &[0x4C, 0, 0]);
+    obj.global("__scorpion_hook_unknown", SymbolDef::Section(data, 0));
+    let error = link_with(
+        &[("copy.o", obj.build())],
+        &Target::Custom(layout),
+        &[],
+        &MemorySources::default(),
+    )
+    .expect_err("the handler needs a start-up copy first");
+    let text = render(&error);
+    assert!(text.contains("runs where it loads"), "{text}");
+    assert!(text.contains("$0400"), "{text}");
+}
