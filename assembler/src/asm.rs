@@ -808,7 +808,7 @@ impl<'a> Asm<'a> {
                 self.lines_read += 1;
                 self.line = info;
                 if let Some(listing) = self.listing.as_mut() {
-                    listing.text_line(&self.frames, info, &self.toks);
+                    listing.text_line(&self.frames, info);
                 }
                 Some(info)
             }
@@ -879,7 +879,7 @@ impl<'a> Asm<'a> {
 
     fn process_line(&mut self) {
         if let Some(listing) = self.listing.as_mut() {
-            listing.begin_line(&self.frames, self.line, &self.toks, &self.prog, self.seg);
+            listing.begin_line(&self.frames, self.line, &self.prog, self.seg);
         }
         if !self.active() {
             self.lex_errors.clear();
@@ -1057,10 +1057,10 @@ impl<'a> Asm<'a> {
         // Labels and assignments.
         match (t[0].kind, t.get(1).map(|t| t.kind)) {
             (Tok::Ident | Tok::Local, Some(Tok::Eq)) => {
-                return self.assignment(t, false);
+                return self.assignment(t);
             }
             (Tok::Ident | Tok::Local, Some(Tok::Assign)) => {
-                return self.assignment(t, true);
+                return self.assignment(t);
             }
             (Tok::Ident, Some(Tok::Directive))
                 if self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set) =>
@@ -1141,7 +1141,7 @@ impl<'a> Asm<'a> {
     }
 
     /// `name = expr` and `name := expr`.
-    fn assignment(&mut self, t: &[Token], _label_like: bool) -> PResult<()> {
+    fn assignment(&mut self, t: &[Token]) -> PResult<()> {
         let mut p = 2;
         let expr = self.expression(t, &mut p)?;
         self.expect_end(t, p)?;
@@ -1420,7 +1420,7 @@ impl<'a> Asm<'a> {
         let result = match dir {
             Dir::If => self.const_expr(t, &mut p, "`.if`")? != 0,
             Dir::Ifdef | Dir::Ifndef | Dir::Ifref | Dir::Ifnref => {
-                let sym = self.parse_symbol_name(t, &mut p, false)?;
+                let sym = self.parse_symbol_name(t, &mut p)?;
                 let defined = sym.is_some_and(|s| {
                     if matches!(dir, Dir::Ifref | Dir::Ifnref) {
                         self.prog.syms[s as usize].ref_loc.is_some()

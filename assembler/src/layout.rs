@@ -456,7 +456,10 @@ impl Asm<'_> {
             let place = Some(s.place());
             let export_loc = s.export_loc;
             let kind = match s.def {
-                SymDef::Undefined | SymDef::Alias(_) | SymDef::Var(_) => continue,
+                SymDef::Undefined | SymDef::Alias(_) => continue,
+                // A `.set` variable is written with its last value, and only
+                // when exported (its value changes along the file).
+                SymDef::Var(_) if !exported => continue,
                 SymDef::Import { zp } => {
                     if s.ref_loc.is_none() && !s.global {
                         continue;
@@ -464,23 +467,24 @@ impl Asm<'_> {
                     OutSymKind::Undef { zp }
                 }
                 SymDef::Const(value) => OutSymKind::Abs(value),
-                SymDef::Label { .. } | SymDef::Expr(_) => match self.prog.eval_sym(sym as SymId) {
-                    Ok(Value::Const(value)) => OutSymKind::Abs(value),
-                    Ok(Value::Addr {
-                        base: Base::Sec(seg),
-                        off,
-                    }) => match out.seg_section[seg as usize] {
-                        Some(section) => OutSymKind::Sec(section, off as u32),
-                        None => continue,
-                    },
-                    other => {
-                        if exported
-                            && let Some(loc) = export_loc
-                            && !matches!(other, Err(EvalErr::Undefined(_)))
-                        {
-                            let name = self.sym_name(sym as SymId);
-                            let span = self.loc_span(loc);
-                            self.report_at(
+                SymDef::Label { .. } | SymDef::Expr(_) | SymDef::Var(_) => {
+                    match self.prog.eval_sym(sym as SymId) {
+                        Ok(Value::Const(value)) => OutSymKind::Abs(value),
+                        Ok(Value::Addr {
+                            base: Base::Sec(seg),
+                            off,
+                        }) => match out.seg_section[seg as usize] {
+                            Some(section) => OutSymKind::Sec(section, off as u32),
+                            None => continue,
+                        },
+                        other => {
+                            if exported
+                                && let Some(loc) = export_loc
+                                && !matches!(other, Err(EvalErr::Undefined(_)))
+                            {
+                                let name = self.sym_name(sym as SymId);
+                                let span = self.loc_span(loc);
+                                self.report_at(
                                 loc,
                                 diag::error(
                                     "asm::export",
@@ -488,10 +492,11 @@ impl Asm<'_> {
                                     format!("`{name}` cannot be exported: its value is neither a constant nor an address in this file"),
                                 ),
                             );
+                            }
+                            continue;
                         }
-                        continue;
                     }
-                },
+                }
             };
             let global = exported || matches!(kind, OutSymKind::Undef { .. });
             *slot = Some(out.symbols.len());

@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 use crate::asm::Frame;
 use crate::diag::Files;
 use crate::layout::Output;
-use crate::lexer::{LineInfo, Token};
+use crate::lexer::LineInfo;
 use crate::model::{ChunkId, Program, SegId};
 
 /// Bytes shown for one line at most; the rest is summarised.
@@ -79,7 +79,7 @@ impl ListingBuilder {
     }
 
     /// A line that produces nothing (a macro or `.repeat` body being read).
-    pub(crate) fn text_line(&mut self, frames: &[Frame], info: LineInfo, _toks: &[Token]) {
+    pub(crate) fn text_line(&mut self, frames: &[Frame], info: LineInfo) {
         let text = self.text(info);
         if !self.enabled {
             return;
@@ -98,7 +98,6 @@ impl ListingBuilder {
         &mut self,
         frames: &[Frame],
         info: LineInfo,
-        _toks: &[Token],
         prog: &Program,
         seg: SegId,
     ) {

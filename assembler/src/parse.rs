@@ -360,7 +360,6 @@ impl Asm<'_> {
         &mut self,
         t: &[Token],
         p: &mut usize,
-        _create: bool,
     ) -> PResult<Option<SymId>> {
         let Some(tok) = t.get(*p).copied() else {
             let span = self.span_at(t, *p);
@@ -465,7 +464,7 @@ impl Asm<'_> {
             }
             Dir::Defined | Dir::Referenced => {
                 self.expect(t, p, Tok::LParen, "`(`")?;
-                let sym = self.parse_symbol_name(t, p, false)?;
+                let sym = self.parse_symbol_name(t, p)?;
                 self.expect(t, p, Tok::RParen, "`)`")?;
                 let answer = sym.is_some_and(|s| {
                     let sym = &self.prog.syms[s as usize];

@@ -223,11 +223,15 @@ fn random_programs_match_ld65() {
         return;
     };
     // Many small programs (each feature in many contexts) and a few big ones.
-    let seeds = 1..=40u64;
+    let seeds = 1..=100u64;
     let total = seeds.clone().count();
     let mut failures = Vec::new();
     for seed in seeds {
-        let lines = if seed % 10 == 0 { 3000 } else { 300 };
+        let lines = match seed % 10 {
+            0 => 3000,
+            5 => 1000,
+            _ => 300,
+        };
         let program = asm_gen::generate(seed, lines, asm_gen::Flavor::Differential);
         if let Err(failure) = compare(
             &format!("seed {seed} ({lines} lines)"),
