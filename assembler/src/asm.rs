@@ -512,6 +512,7 @@ impl<'a> Asm<'a> {
                 ));
             }
         }
+        self.prog.defs = self.prog.defs.wrapping_add(1);
         let loc = self.loc(span);
         let column = self.column_of(span);
         // As in ca65, defining any normal symbol (label, constant, struct
@@ -1174,6 +1175,7 @@ impl<'a> Asm<'a> {
         };
         self.keep_nodes = true;
         self.cheap_epoch += 1;
+        self.prog.defs = self.prog.defs.wrapping_add(1);
         let s = &mut self.prog.syms[sym as usize];
         match s.def {
             SymDef::Undefined | SymDef::Var(_) => {

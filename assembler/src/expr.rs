@@ -209,6 +209,14 @@ impl Program {
                     if let Some(value) = s.front {
                         return Ok(value);
                     }
+                    // "Not yet" stays true until another symbol is defined:
+                    // without this a chain of forward definitions could be
+                    // re-evaluated exponentially often.
+                    if let Some((defs, result)) = s.memo
+                        && defs == self.defs
+                    {
+                        return result;
+                    }
                 } else if let Some((stamp, result)) = s.memo
                     && stamp == self.stamp
                 {
@@ -223,9 +231,12 @@ impl Program {
                 s.busy = false;
                 if self.placed {
                     s.memo = Some((self.stamp, result));
-                } else if let Ok(
-                    value @ (Value::Const(_) | Value::Addr { .. } | Value::Byte { .. }),
-                ) = result
+                } else {
+                    s.memo = Some((self.defs, result));
+                }
+                if !self.placed
+                    && let Ok(value @ (Value::Const(_) | Value::Addr { .. } | Value::Byte { .. })) =
+                        result
                 {
                     // Front-end values without unplaced positions are final.
                     s.front = Some(value);

@@ -8,16 +8,16 @@
 //! source and the macro/include backtrace, ready for miette.
 //!
 //! How it works, in four stages:
-//! 1. the front end ([`asm`]) lexes each line once ([`lexer`]), expands
+//! 1. the front end (`asm`) lexes each line once (`lexer`), expands
 //!    macros, `.repeat`s and `.define`s, evaluates conditionals and builds
-//!    a [`model::Program`]: segments cut into chunks of known size, symbols,
+//!    a `model::Program`: segments cut into chunks of known size, symbols,
 //!    expression nodes, fixups;
-//! 2. the layout passes ([`layout`]) settle the operands that could be
+//! 2. the layout passes (`layout`) settle the operands that could be
 //!    zero-page or absolute (symbols defined later, `.importzp`) by a
 //!    widening fixpoint;
 //! 3. resolution turns every fixup into bytes or an `R_MOS_*` relocation,
 //!    checks ranges, branches and `.assert`s;
-//! 4. [`elf`] writes the object (docs/ARCHITECTURE.md, "The object format").
+//! 4. `elf` writes the object (docs/ARCHITECTURE.md, "The object format").
 //!
 //! Constant folding uses `isa::objfmt`'s operators, so the linker computes
 //! deferred assertions exactly as the assembler would.

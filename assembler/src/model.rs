@@ -84,7 +84,8 @@ pub(crate) struct Sym {
     pub(crate) export_loc: Option<LocId>,
     /// Cached front-end value, once it can no longer change.
     pub(crate) front: Option<crate::expr::Value>,
-    /// Final-phase memo: (pass stamp, result).
+    /// Memo: (layout pass stamp, result) after layout; (definitions
+    /// count, result) before.
     pub(crate) memo: Option<(u32, Result<crate::expr::Value, crate::expr::EvalErr>)>,
     pub(crate) busy: bool,
     /// Where it was defined (file, line, column), for the source map.
@@ -302,6 +303,8 @@ pub(crate) struct Program {
     pub(crate) placed: bool,
     /// Budget of evaluation steps left, against pathological expressions.
     pub(crate) budget: u32,
+    /// Symbol definitions so far (front-end memo validity).
+    pub(crate) defs: u32,
 }
 
 impl Program {

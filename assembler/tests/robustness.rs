@@ -310,6 +310,14 @@ fn pathological_inputs_end_with_errors() {
     // it used to restart the expansion forever).
     check(b".repeat 2\n.struct s\n.union\nm .byte\n.endrepeat\n");
     check(b".macro m\n.struct s\nf .byte\n.endmacro\nm\nm\n");
+    // Forward definitions that double at each step: evaluated once each.
+    let mut doubling = String::from("a0 = later + later\n");
+    for i in 1..60 {
+        doubling.push_str(&format!("a{i} = a{} + a{}\n", i - 1, i - 1));
+    }
+    doubling.push_str(&" .word a59 & 1\n".repeat(500));
+    doubling.push_str("later = 0\n");
+    check(doubling.as_bytes());
     check("é ü\u{0}\r\n\t;\u{feff}".as_bytes());
     let many_errors = ".byte 300\n".repeat(10_000);
     check(many_errors.as_bytes());
