@@ -15,7 +15,9 @@
 //! the time per line stays flat (linear time).
 //!
 //! Run: `cargo bench -p scorpion-tests --bench asm_200k`
-//! (`ASM_BENCH_RUNS=N` sets the repetitions; ca65 takes seconds per run).
+//! (`ASM_BENCH_RUNS=N` sets the repetitions, ca65 taking seconds per run;
+//! `ASM_BENCH_OURS_ONLY=1` skips the peers; `ASM_BENCH_KEEP=1` keeps the
+//! generated sources and prints where).
 
 #[path = "../tests/asm_gen/mod.rs"]
 mod asm_gen;
@@ -170,16 +172,17 @@ fn main() {
         seconds(assemble_only),
         lines_per_second(assemble_only)
     );
-    if std::env::var_os("ASM_BENCH_KEEP").is_some() {
-        let kept = dir.path().to_path_buf();
-        std::mem::forget(dir);
-        println!("  sources kept in {}", kept.display());
-        return;
-    }
 
-    let ca65 = scorpion_tests::tools::require("ca65", "asm_200k");
-    let ld65 = scorpion_tests::tools::require("ld65", "asm_200k");
-    let tass = scorpion_tests::tools::require("64tass", "asm_200k");
+    let peers = std::env::var_os("ASM_BENCH_OURS_ONLY").is_none();
+    let ca65 = peers
+        .then(|| scorpion_tests::tools::require("ca65", "asm_200k"))
+        .flatten();
+    let ld65 = peers
+        .then(|| scorpion_tests::tools::require("ld65", "asm_200k"))
+        .flatten();
+    let tass = peers
+        .then(|| scorpion_tests::tools::require("64tass", "asm_200k"))
+        .flatten();
 
     if let (Some(ca65), Some(ld65)) = (&ca65, &ld65) {
         let cc65_runs = runs.min(3);
@@ -269,4 +272,7 @@ fn main() {
     println!(
         "  time per line varies by {spread:.2}x from 25k to 200k lines (1.00 = perfectly linear)"
     );
+    if std::env::var_os("ASM_BENCH_KEEP").is_some() {
+        println!("sources kept in {}", dir.keep().display());
+    }
 }
