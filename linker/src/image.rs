@@ -120,10 +120,8 @@ impl Image {
             file: name.to_owned(),
             reason,
         };
-        if let Some(reason) = crate::input::not_elf(bytes) {
-            return Err(bad(format!(
-                "{reason} (a raw binary has no addresses or symbols)"
-            )));
+        if bytes.starts_with(&crate::input::XO65_MAGIC) {
+            return Err(bad(crate::input::XO65_REASON.into()));
         }
         let elf = Elf::parse(bytes).map_err(|error| bad(format!("not ELF: {error}")))?;
         if elf.is_64 || !elf.little_endian {

@@ -478,17 +478,19 @@ fn string_at(table: &[u8], offset: usize) -> &str {
     std::str::from_utf8(&rest[..end]).unwrap_or("")
 }
 
+/// ca65's object files start with the magic $616E7A55, little-endian.
+pub(crate) const XO65_MAGIC: [u8; 4] = [0x55, 0x7A, 0x6E, 0x61];
+/// What to tell someone who gives the linker a ca65 object.
+pub(crate) const XO65_REASON: &str =
+    "this is a ca65 (xo65) object; assemble the source with `scorpion asm` for an ELF object";
+
 /// Why `bytes` is plainly not an ELF file, naming what it looks like.
 pub(crate) fn not_elf(bytes: &[u8]) -> Option<String> {
     if bytes.starts_with(b"\x7fELF") {
         return None;
     }
-    // ca65's object files start with the magic $616E7A55, little-endian.
-    if bytes.starts_with(&[0x55, 0x7A, 0x6E, 0x61]) {
-        return Some(
-            "this is a ca65 (xo65) object; assemble the source with `scorpion asm` for an ELF object"
-                .into(),
-        );
+    if bytes.starts_with(&XO65_MAGIC) {
+        return Some(XO65_REASON.into());
     }
     Some(format!(
         "it does not start with the ELF magic (7F 45 4C 46) but with {}",
