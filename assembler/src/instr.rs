@@ -447,7 +447,9 @@ impl Asm<'_> {
         match value {
             Ok(Value::Const(value)) => {
                 let bytes = crate::layout::const_bytes(kind, value).map_err(|(what, range)| {
-                    self.report(crate::layout::range_diag(span, what, value, range))
+                    self.report(crate::layout::field_range_diag(
+                        span, kind, value, what, range,
+                    ))
                 });
                 match bytes {
                     Ok(bytes) => {

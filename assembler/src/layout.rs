@@ -149,6 +149,24 @@ pub(crate) fn range_diag(span: Span, what: &str, value: i64, range: (i64, i64)) 
     .label(format!("this is {}", show(value)))
 }
 
+/// A range error for a value stored as `kind`, with advice where the
+/// usual mistake is clear.
+pub(crate) fn field_range_diag(
+    span: Span,
+    kind: FixKind,
+    value: i64,
+    what: &str,
+    range: (i64, i64),
+) -> RawDiag {
+    let diag = range_diag(span, what, value, range);
+    match kind {
+        FixKind::Imm8 | FixKind::Byte if value > 0xFF => diag.help(
+            "to take one byte of a 16-bit value, write `<value` (low byte) or `>value` (high byte)",
+        ),
+        _ => diag,
+    }
+}
+
 /// A branch that does not reach.
 pub(crate) fn branch_diag(span: Span, distance: i64) -> RawDiag {
     diag::error(
@@ -627,7 +645,9 @@ impl Asm<'_> {
                             slots.copy_from_slice(&bytes[..len]);
                         }
                     }
-                    Err((what, range)) => self.report_at(loc, range_diag(span, what, v, range)),
+                    Err((what, range)) => {
+                        self.report_at(loc, field_range_diag(span, kind, v, what, range))
+                    }
                 }
                 return;
             }
