@@ -1,0 +1,12 @@
+; An .align after an instruction whose size is not known yet: the padding
+; is recomputed by every layout pass.
+        lda later               ; absolute once `later` is known: 3 bytes
+        .align 4
+aligned:
+        nop
+        .org $10
+        lda small               ; stays zero page: 2 bytes
+        .align 8, $EA
+eight:  nop
+later = $1234
+small = $42
