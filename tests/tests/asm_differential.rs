@@ -226,6 +226,7 @@ fn random_programs_match_ld65() {
     let seeds = 1..=100u64;
     let total = seeds.clone().count();
     let mut failures = Vec::new();
+    let mut covered = std::collections::BTreeSet::new();
     for seed in seeds {
         let lines = match seed % 10 {
             0 => 3000,
@@ -233,6 +234,7 @@ fn random_programs_match_ld65() {
             _ => 300,
         };
         let program = asm_gen::generate(seed, lines, asm_gen::Flavor::Differential);
+        covered.extend(program.covered.iter().copied());
         if let Err(failure) = compare(
             &format!("seed {seed} ({lines} lines)"),
             &program.files,
@@ -243,6 +245,11 @@ fn random_programs_match_ld65() {
         }
     }
     report(failures, total);
+    assert_eq!(
+        covered.len(),
+        asm_gen::documented_count(),
+        "the random programs use every documented opcode in every mode"
+    );
 }
 
 #[test]

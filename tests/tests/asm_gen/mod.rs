@@ -71,6 +71,9 @@ pub(crate) struct Program {
     pub(crate) tass: String,
     /// Source lines in the ca65 version, macro bodies not expanded.
     pub(crate) lines: usize,
+    /// The documented (mnemonic, mode) pairs the program's random
+    /// instructions use.
+    pub(crate) covered: std::collections::BTreeSet<(&'static str, Mode)>,
 }
 
 const ZP_CONSTS: [(&str, u8); 4] = [
@@ -115,6 +118,7 @@ struct Gen {
     chunk_bytes: usize,
     procs: Vec<usize>,
     sets: usize,
+    covered: std::collections::BTreeSet<(&'static str, Mode)>,
 }
 
 impl Gen {
@@ -330,6 +334,7 @@ impl Gen {
     /// One random documented instruction; returns its size.
     fn instruction(&mut self) -> usize {
         let (mnemonic, mode) = *self.rng.pick(&self.ops.clone());
+        self.covered.insert((mnemonic, mode));
         let m = mnemonic.to_ascii_lowercase();
         let (ca, tass, size) = match mode {
             Mode::Implied => (m.clone(), m.clone(), 1),
@@ -687,6 +692,7 @@ pub(crate) fn generate(seed: u64, lines: usize, flavor: Flavor) -> Program {
         chunk_bytes: 0,
         procs: Vec::new(),
         sets: 0,
+        covered: std::collections::BTreeSet::new(),
     };
     header(&mut g);
     if flavor == Flavor::Benchmark {
@@ -727,6 +733,7 @@ pub(crate) fn generate(seed: u64, lines: usize, flavor: Flavor) -> Program {
             files: vec![("bench.s".to_string(), std::mem::take(&mut g.ca))],
             tass: g.tass,
             lines: g.lines,
+            covered: g.covered,
         };
     }
     // Data segments referring back to code.
@@ -778,5 +785,11 @@ libdata: .byte $DE, $AD, $BE, $EF
         files: vec![("main.s".to_string(), g.ca), ("lib.s".to_string(), lib)],
         tass: String::new(),
         lines: g.lines,
+        covered: g.covered,
     }
+}
+
+/// How many documented (mnemonic, mode) pairs there are.
+pub(crate) fn documented_count() -> usize {
+    documented().len()
 }
