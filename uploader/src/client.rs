@@ -39,7 +39,7 @@ pub struct ClientConfig {
 impl Default for ClientConfig {
     fn default() -> Self {
         ClientConfig {
-            window: 48,
+            window: crate::RomProfile::reference().window(),
             max_questions: 4,
             margin: Duration::from_millis(150),
             stall_limit: Duration::from_secs(3),
@@ -331,6 +331,20 @@ impl<T: Transport> Client<T> {
             }
         }
         self.in_flight.clear();
+        self.rx.clear();
+        Ok(())
+    }
+
+    /// Lets the line run until `until` on the transport's clock, dropping
+    /// whatever arrives (after a command that changes the rate, say).
+    pub(crate) fn wait_until(&mut self, until: Duration) -> Result<()> {
+        loop {
+            let now = self.transport.now();
+            if now >= until {
+                break;
+            }
+            self.fill(until - now)?;
+        }
         self.rx.clear();
         Ok(())
     }

@@ -54,12 +54,41 @@ pub enum Error {
         source: std::io::Error,
     },
 
+    /// The line's rate could not be changed.
+    #[error("cannot set {port} to {baud} baud: {message}")]
+    #[diagnostic(
+        code(uploader::baud_change),
+        help("the upload stays at the rate it connected at; --loader never avoids the switch")
+    )]
+    BaudChange {
+        /// The transport's name.
+        port: String,
+        /// The rate asked for.
+        baud: u32,
+        /// Why not.
+        message: String,
+    },
+
+    /// The virtual Scorpion's CPU executed a JAM opcode: the code it ran
+    /// (an uploaded extension, most likely) is broken.
+    #[error("the virtual Scorpion's CPU jammed at ${pc:04X} (opcode ${opcode:02X})")]
+    #[diagnostic(
+        code(uploader::robot_jammed),
+        help("the image's code ran off into data; `scorpion emu` can trace it")
+    )]
+    RobotJammed {
+        /// The address of the JAM opcode.
+        pc: u16,
+        /// The opcode.
+        opcode: u8,
+    },
+
     /// Nothing came back at all.
     #[error("no answer from the robot on {port} at {baud} baud (`{question}` waited {waited:?})")]
     #[diagnostic(
         code(uploader::no_answer),
         help(
-            "check that the robot is on, the cable is a null-modem cable, and the ROM is running (not an operating system that took HOOK_LOOP)"
+            "check that the robot is on, the cable is a null-modem cable, the baud rate is the robot's (the reference ROM's is 9600), and the ROM is running (not an operating system that took HOOK_LOOP)"
         )
     )]
     NoAnswer {
@@ -205,6 +234,43 @@ pub enum Error {
     BadImage {
         /// Why.
         reason: String,
+    },
+
+    /// A ROM profile lacks what the uploader needs.
+    #[error("ROM profile {name} cannot be used: {reason}")]
+    #[diagnostic(
+        code(uploader::bad_rom_profile),
+        help(
+            "give the linked ELF of the robot's ROM, which exports the names of PLATFORM.md section 4"
+        )
+    )]
+    BadRomProfile {
+        /// The profile's name.
+        name: String,
+        /// Why.
+        reason: String,
+    },
+
+    /// `--loader always`, but the RAM loader cannot be used for this upload.
+    #[error("the RAM loader cannot be used: {reason}")]
+    #[diagnostic(
+        code(uploader::loader_unavailable),
+        help("--loader auto uses it only where it can, --loader never never")
+    )]
+    LoaderUnavailable {
+        /// Why.
+        reason: String,
+    },
+
+    /// The RAM loader could not be linked (a ROM profile without the
+    /// services it calls, or no room).
+    #[error("cannot link the RAM loader at ${address:04X}: {message}")]
+    #[diagnostic(code(uploader::loader_link))]
+    LoaderLink {
+        /// Where it was to go.
+        address: u16,
+        /// The linker's complaint.
+        message: String,
     },
 
     /// A chain slot or handler of a hook record lies outside the image.

@@ -7,6 +7,9 @@ use isa::objfmt::{HookKind, HookRecord};
 
 use crate::{Error, Result};
 
+/// The KIM-bus expansion space (docs/ARCHITECTURE.md's memory map).
+const KIM_BUS: RangeInclusive<u16> = 0x1000..=0xBFFF;
+
 /// Bytes to load at an address.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Area {
@@ -155,9 +158,13 @@ impl TryFrom<&linker::Image> for UploadImage {
     }
 }
 
-/// Where a ROM keeps its hooks and which memory an upload may write: the
-/// reference ROM's values by default (PLATFORM.md section 4,
-/// docs/ARCHITECTURE.md's memory map).
+/// What the uploader must know about the ROM in the robot: where its hooks
+/// are and what they point at after a reset, which memory an upload may
+/// write, where the RAM loader may run and which services it calls, and
+/// how much its receive buffer holds (which bounds pipelining).
+///
+/// [`RomProfile::reference`] (the default) is the reference ROM's, taken
+/// from the names it exports (`romlib::symbols`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RomProfile {
     /// `HOOK_UNKNOWN`'s address (a `JMP` in RAM).
@@ -166,26 +173,127 @@ pub struct RomProfile {
     pub hook_loop: u16,
     /// The targets the ROM's reset gives the two hooks (unknown, loop), when
     /// known: used to disarm a hook that points into memory being
-    /// overwritten.
+    /// overwritten, and to recognise a reset.
     pub reset_targets: Option<(u16, u16)>,
     /// Memory an upload may write.
     pub writable: Vec<RangeInclusive<u16>>,
+    /// RAM every robot with this ROM has and the ROM leaves to extensions:
+    /// where the RAM loader may run when the image leaves room.
+    pub user_ram: RangeInclusive<u16>,
+    /// The ROM services the RAM loader calls; `None` if the ROM lacks
+    /// one (then there is no loader).
+    pub loader_services: Option<Services>,
+    /// Characters the ROM buffers while it is busy (answering, say) without
+    /// losing any: the most the host may send ahead of an answer.
+    pub rx_buffer: usize,
 }
+
+/// The ROM services the RAM loader calls (jump-table entries).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Services {
+    /// `GETCH`: wait for the next received byte.
+    pub getch: u16,
+    /// `CHKCH`: the next received byte, or carry set if none.
+    pub chkch: u16,
+    /// `CMD_DONE`: back to the control loop.
+    pub cmd_done: u16,
+}
+
+/// The reference ROM's serial receive ring: 256 bytes at `RXBUF` ($0300,
+/// romlib/rom/ram.inc), filled by the interrupt handler and by `PUTCH`
+/// while it waits to send; `rx_put` (romlib/rom/services.s) keeps one slot
+/// free to tell full from empty, so 255 characters fit. The ROM does not
+/// export this figure; `uploader`'s tests measure it on the emulated ROM
+/// (`the_reference_rom_buffers_255_characters`).
+pub const REFERENCE_RX_BUFFER: usize = 255;
+
+/// The receive buffer assumed for a ROM profile that does not export
+/// `RXBUF_SIZE`: small enough for a ROM that polls its 6551 one command
+/// at a time with a modest buffer.
+pub const CONSERVATIVE_RX_BUFFER: usize = 64;
 
 impl Default for RomProfile {
     fn default() -> Self {
-        RomProfile {
-            hook_unknown: 0x0200,
-            hook_loop: 0x0203,
-            reset_targets: None,
-            // Extension RAM and the KIM-bus expansion space; never the
-            // ROM's zero page, stack and state, the I/O page or the ROM.
-            writable: vec![0x0400..=0xBFFF],
-        }
+        RomProfile::reference()
     }
 }
 
 impl RomProfile {
+    /// The reference ROM's profile, from its exported names: hooks and
+    /// their reset targets (`BAD_COMMAND`, `ROM_LOOP`), the user zero page
+    /// and user RAM, and the KIM-bus expansion space (RAM on the virtual
+    /// Scorpion, a peripheral card's business on a real one).
+    #[must_use]
+    pub fn reference() -> RomProfile {
+        use romlib::symbols as rom;
+        RomProfile {
+            hook_unknown: rom::HOOK_UNKNOWN,
+            hook_loop: rom::HOOK_LOOP,
+            reset_targets: Some((rom::BAD_COMMAND, rom::ROM_LOOP)),
+            writable: vec![
+                rom::USER_ZP_START..=rom::USER_ZP_END,
+                rom::USER_RAM_START..=rom::USER_RAM_END,
+                KIM_BUS,
+            ],
+            user_ram: rom::USER_RAM_START..=rom::USER_RAM_END,
+            loader_services: Some(Services {
+                getch: rom::GETCH,
+                chkch: rom::CHKCH,
+                cmd_done: rom::CMD_DONE,
+            }),
+            rx_buffer: REFERENCE_RX_BUFFER,
+        }
+    }
+
+    /// The profile of another ROM, from its linked ELF (the file its
+    /// extensions link against): the names of PLATFORM.md section 4, and
+    /// `RXBUF_SIZE` if it exports one.
+    ///
+    /// # Errors
+    /// [`Error::BadRomProfile`] naming the first missing symbol.
+    pub fn from_rom_image(name: &str, rom: &linker::Image) -> Result<RomProfile> {
+        let symbol = |symbol: &str| {
+            rom.symbols
+                .iter()
+                .find(|s| s.global && s.name == symbol)
+                .and_then(|s| u16::try_from(s.value).ok())
+        };
+        let need = |wanted: &str| {
+            symbol(wanted).ok_or_else(|| Error::BadRomProfile {
+                name: name.to_owned(),
+                reason: format!("it does not export {wanted}"),
+            })
+        };
+        let zp = need("USER_ZP_START")?..=need("USER_ZP_END")?;
+        let ram = need("USER_RAM_START")?..=need("USER_RAM_END")?;
+        let reset_targets = symbol("BAD_COMMAND").zip(symbol("ROM_LOOP"));
+        Ok(RomProfile {
+            hook_unknown: need("HOOK_UNKNOWN")?,
+            hook_loop: need("HOOK_LOOP")?,
+            reset_targets,
+            writable: vec![zp, ram.clone(), KIM_BUS],
+            user_ram: ram,
+            loader_services: match (symbol("GETCH"), symbol("CHKCH"), symbol("CMD_DONE")) {
+                (Some(getch), Some(chkch), Some(cmd_done)) => Some(Services {
+                    getch,
+                    chkch,
+                    cmd_done,
+                }),
+                _ => None,
+            },
+            rx_buffer: symbol("RXBUF_SIZE").map_or(CONSERVATIVE_RX_BUFFER, |size| {
+                usize::from(size).saturating_sub(1).max(1)
+            }),
+        })
+    }
+
+    /// The most characters the client sends ahead of an answer: the
+    /// receive buffer less room for one whole command in progress.
+    #[must_use]
+    pub fn window(&self) -> usize {
+        self.rx_buffer.saturating_sub(16).max(1)
+    }
+
     /// The address of a hook's `JMP`.
     #[must_use]
     pub fn hook_address(&self, kind: HookKind) -> u16 {

@@ -17,23 +17,27 @@
 //! Nothing here prints: progress goes through [`Progress`], failures are
 //! [`Error`]s.
 
+mod body;
 mod client;
 mod error;
 mod expect;
+mod hooks;
 mod image;
+mod loader;
 mod progress;
+mod session;
 pub mod transport;
 mod upload;
-
-#[cfg(test)]
-mod model;
-#[cfg(test)]
-mod tests;
 
 pub use client::{Client, ClientConfig, ClientStats};
 pub use error::{Error, Result};
 pub use expect::{Expectation, Expectations, Required};
-pub use image::{Area, RomProfile, UploadImage};
+pub use image::{
+    Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, RomProfile, Services, UploadImage,
+};
+pub use loader::{FAST_BAUD, LoaderPlan, loader_estimate, loader_plan, rom_only_estimate};
 pub use progress::{Event, NoProgress, Phase, Progress};
 pub use transport::Transport;
-pub use upload::{InstalledHook, UploadOptions, UploadReport, client, upload};
+pub use upload::{
+    InstalledHook, LoaderChoice, LoaderReport, UploadOptions, UploadReport, client, upload,
+};

@@ -69,6 +69,18 @@ pub enum Event {
     LoaderInstalled {
         /// Where it runs.
         address: u16,
+        /// Its size in bytes.
+        len: usize,
+        /// The rate the transfer runs at.
+        baud: u32,
+    },
+    /// The RAM loader was found unhooked or the line at the wrong rate
+    /// (a reset), and was restored.
+    LoaderRestored {
+        /// Where `HOOK_UNKNOWN` pointed, when it could be read.
+        hook: Option<u16>,
+        /// The rate the robot answered at.
+        baud: u32,
     },
     /// The RAM loader was removed.
     LoaderRemoved,

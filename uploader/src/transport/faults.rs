@@ -24,8 +24,10 @@ pub struct FaultConfig {
     pub to_robot: bool,
     /// Apply the rates to robot-to-host bytes.
     pub to_host: bool,
-    /// Send `/1R` into the host's stream after this many host bytes (a
-    /// robot that resets in the middle).
+    /// Send `/1R` into the host's stream at the first command boundary
+    /// (before a `/`) after this many host bytes: a robot that resets in
+    /// the middle. At a boundary, so that it is obeyed: inside a loader
+    /// frame it would only be data.
     pub reset_after: Option<usize>,
     /// After this many host bytes, the line goes dead: nothing passes either
     /// way for [`FaultConfig::stall_for`] (on the transport's clock).
@@ -178,11 +180,14 @@ impl<T: Transport> Transport for FaultyTransport<T> {
     fn send(&mut self, bytes: &[u8]) -> Result<()> {
         let mut bytes = bytes.to_vec();
         if let Some(at) = self.config.reset_after
-            && self.sent <= at
+            && self.stats.resets == 0
             && at < self.sent + bytes.len()
         {
-            bytes.splice(at - self.sent..at - self.sent, *b"/1R");
-            self.stats.resets += 1;
+            let from = at.saturating_sub(self.sent);
+            if let Some(slash) = bytes[from..].iter().position(|&b| b == b'/') {
+                bytes.splice(from + slash..from + slash, *b"/1R");
+                self.stats.resets += 1;
+            }
         }
         self.sent += bytes.len();
         if self.stalled() {
@@ -207,6 +212,10 @@ impl<T: Transport> Transport for FaultyTransport<T> {
 
     fn baud(&self) -> u32 {
         self.inner.baud()
+    }
+
+    fn set_baud(&mut self, baud: u32) -> Result<()> {
+        self.inner.set_baud(baud)
     }
 
     fn now(&self) -> Duration {

@@ -8,11 +8,13 @@
 
 mod faults;
 mod serial;
+mod sim;
 
 use std::time::Duration;
 
 pub use faults::{FaultConfig, FaultStats, FaultyTransport};
 pub use serial::{PortInfo, SerialTransport, list_ports};
+pub use sim::VirtualTransport;
 
 use crate::Result;
 
@@ -35,6 +37,20 @@ pub trait Transport {
 
     /// The line's baud rate (8N1: ten bits per character).
     fn baud(&self) -> u32;
+
+    /// Changes the host's end of the line to `baud`, after everything
+    /// already sent has left at the old rate. The robot's end is the
+    /// robot's business (the RAM loader reprograms its 6551).
+    ///
+    /// # Errors
+    /// [`crate::Error::BaudChange`] if this line cannot run at `baud`.
+    fn set_baud(&mut self, baud: u32) -> Result<()> {
+        Err(crate::Error::BaudChange {
+            port: self.name(),
+            baud,
+            message: "this transport has a fixed rate".into(),
+        })
+    }
 
     /// The transport's clock: time since it was opened.
     fn now(&self) -> Duration;
@@ -59,6 +75,9 @@ impl<T: Transport + ?Sized> Transport for &mut T {
     fn baud(&self) -> u32 {
         (**self).baud()
     }
+    fn set_baud(&mut self, baud: u32) -> Result<()> {
+        (**self).set_baud(baud)
+    }
     fn now(&self) -> Duration {
         (**self).now()
     }
@@ -79,6 +98,9 @@ impl<T: Transport + ?Sized> Transport for Box<T> {
     }
     fn baud(&self) -> u32 {
         (**self).baud()
+    }
+    fn set_baud(&mut self, baud: u32) -> Result<()> {
+        (**self).set_baud(baud)
     }
     fn now(&self) -> Duration {
         (**self).now()

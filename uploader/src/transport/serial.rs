@@ -112,6 +112,20 @@ impl Transport for SerialTransport {
         self.baud
     }
 
+    fn set_baud(&mut self, baud: u32) -> Result<()> {
+        // Characters still in the output buffer must leave at the old rate.
+        self.port.flush().map_err(|error| self.io(error))?;
+        self.port
+            .set_baud_rate(baud)
+            .map_err(|error| Error::BaudChange {
+                port: self.path.clone(),
+                baud,
+                message: error.description,
+            })?;
+        self.baud = baud;
+        Ok(())
+    }
+
     fn now(&self) -> Duration {
         self.opened.elapsed()
     }

@@ -1,0 +1,154 @@
+//! What the upload tests share: extension images that are real code, an
+//! upload run against the virtual Scorpion, and the one invariant every
+//! case checks in the emulated RAM afterwards.
+#![allow(dead_code, unreachable_pub, reason = "each test file uses a part")]
+
+use isa::objfmt::{HookKind, HookRecord};
+use romlib::VirtualScorpion;
+use romlib::symbols::{BAD_COMMAND, HOOK_LOOP, HOOK_UNKNOWN, ROM_LOOP};
+use uploader::transport::{Transport, VirtualTransport};
+use uploader::{
+    Area, LoaderChoice, LoaderPlan, NoProgress, RomProfile, UploadImage, UploadOptions,
+    UploadReport, loader_plan, upload,
+};
+
+/// The 8N1 control value for 9600 baud (emulator::board::acia).
+pub const CTRL_9600: u8 = 0x1E;
+
+/// An extension of `len` bytes at $0400 that is real code: `$0400: JMP
+/// chain` (the chain slot is its operand, $0401), `$0403: JMP $0400` (the
+/// handler owns nothing and falls through), then pseudo-random bytes.
+pub fn extension(len: usize, seed: u32) -> UploadImage {
+    let mut bytes: Vec<u8> = (0..len as u32)
+        .map(|i| (i ^ seed).wrapping_mul(2_246_822_519).to_le_bytes()[2])
+        .collect();
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
+    UploadImage::new(
+        vec![Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        }],
+    )
+    .expect("a valid image")
+}
+
+/// Options for one of the two paths.
+pub fn options(loader: LoaderChoice) -> UploadOptions {
+    UploadOptions {
+        loader,
+        ..UploadOptions::default()
+    }
+}
+
+/// Uploads `image` over `transport` with the default client pacing.
+pub fn run<T: Transport>(
+    transport: T,
+    image: &UploadImage,
+    options: &UploadOptions,
+) -> (uploader::Result<UploadReport>, T) {
+    let mut client = uploader::client(transport, &options.profile);
+    let result = upload(&mut client, image, options, &mut NoProgress);
+    (result, client.into_transport())
+}
+
+/// A fresh virtual Scorpion behind a transport.
+pub fn robot() -> VirtualTransport {
+    VirtualTransport::new(VirtualScorpion::new())
+}
+
+fn target(memory: &[u8], hook: u16) -> (u8, u16) {
+    let at = usize::from(hook);
+    (
+        memory[at],
+        u16::from_le_bytes([memory[at + 1], memory[at + 2]]),
+    )
+}
+
+/// The invariant, checked in the emulated RAM: whatever happened, each
+/// hook points at the ROM, at the RAM loader's verified code, or at the
+/// image's handler with every byte of the image in place.
+pub fn assert_safe(robot: &VirtualScorpion, image: &UploadImage, outcome: &str) {
+    let memory = robot.robot().board().memory();
+    let plan: Option<LoaderPlan> =
+        loader_plan(&RomProfile::reference(), image, (9600, uploader::FAST_BAUD))
+            .expect("the loader links");
+    let (opcode, hook) = target(memory, HOOK_UNKNOWN);
+    assert_eq!(opcode, 0x4C, "HOOK_UNKNOWN is no JMP ({outcome})");
+    assert_eq!(
+        target(memory, HOOK_LOOP),
+        (0x4C, ROM_LOOP),
+        "HOOK_LOOP ({outcome})"
+    );
+    let area = &image.areas()[0];
+    let start = usize::from(area.address);
+    let loaded = &memory[start..start + area.bytes.len()];
+    if hook == 0x0403 {
+        let previous = u16::from_le_bytes([loaded[1], loaded[2]]);
+        assert_eq!(previous, BAD_COMMAND, "the chain slot ({outcome})");
+        let mut expected = area.bytes.clone();
+        expected[1..3].copy_from_slice(&previous.to_le_bytes());
+        assert!(
+            loaded == expected.as_slice(),
+            "the hook points at code that did not verify ({outcome}): first difference at ${:04X}",
+            (0..expected.len())
+                .find(|&i| loaded[i] != expected[i])
+                .map_or(0, |i| start + i)
+        );
+        return;
+    }
+    if hook == BAD_COMMAND {
+        return;
+    }
+    let plan = plan.unwrap_or_else(|| panic!("HOOK_UNKNOWN points at ${hook:04X} ({outcome})"));
+    let stage = if hook == plan.frames_handler {
+        &plan.frames
+    } else if hook == plan.fast_handler {
+        &plan.fast
+    } else {
+        panic!(
+            "HOOK_UNKNOWN points at ${hook:04X}, neither the ROM, the loader nor the image ({outcome})"
+        );
+    };
+    for (i, &byte) in stage.bytes.iter().enumerate() {
+        let at = stage.address + i as u16;
+        if !plan.scratch.contains(&at) {
+            assert_eq!(
+                memory[usize::from(at)],
+                byte,
+                "HOOK_UNKNOWN points at a loader stage that differs at ${at:04X} ({outcome})"
+            );
+        }
+    }
+    if hook == plan.frames_handler {
+        let chain = plan.scratch[plan.scratch.len() - 2];
+        assert_eq!(
+            u16::from_le_bytes([memory[usize::from(chain)], memory[usize::from(chain) + 1]]),
+            BAD_COMMAND,
+            "the loader falls through to the original target ({outcome})"
+        );
+    }
+}
+
+/// After a successful upload: the image hooked, the 6551 back at 9600
+/// baud, and the robot answering there.
+pub fn assert_done(transport: VirtualTransport, image: &UploadImage, outcome: &str) {
+    let mut client = uploader::client(transport, &RomProfile::reference());
+    assert_eq!(client.transport().baud(), 9600, "{outcome}");
+    client
+        .probe()
+        .unwrap_or_else(|error| panic!("the robot answers at 9600 ({outcome}): {error}"));
+    let robot = client.into_transport().into_robot();
+    assert_eq!(
+        robot.robot().board().acia().control(),
+        CTRL_9600,
+        "the 6551 is back at 9600 ({outcome})"
+    );
+    let memory = robot.robot().board().memory();
+    assert_eq!(target(memory, HOOK_UNKNOWN), (0x4C, 0x0403), "{outcome}");
+    assert_safe(&robot, image, outcome);
+}
