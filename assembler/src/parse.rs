@@ -300,7 +300,7 @@ impl Asm<'_> {
         } else {
             self.unnamed_count + count as usize - 1
         };
-        if index > self.unnamed_count + 1_000_000 {
+        if index > self.unnamed_count + 0x1_0000 {
             return Err(self.err(
                 "asm::undefined",
                 tok.span,
