@@ -22,6 +22,58 @@ use crate::layout::Output;
 use crate::lexer::LineInfo;
 use crate::model::{ChunkId, Program, SegId};
 
+/// Two upper-case hex digits.
+fn hex_byte(byte: u8) -> [u8; 2] {
+    const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
+    [
+        DIGITS[usize::from(byte >> 4)],
+        DIGITS[usize::from(byte & 15)],
+    ]
+}
+
+/// Six upper-case hex digits (a listing address).
+fn push_hex6(text: &mut String, value: i64) {
+    let value = (value & 0xFF_FFFF) as u32;
+    for shift in [16, 8, 0] {
+        let [high, low] = hex_byte((value >> shift) as u8);
+        text.push(char::from(high));
+        text.push(char::from(low));
+    }
+}
+
+/// The depth digit, the byte cells padded to 12 columns, the source line
+/// (tabs as eight spaces, no trailing blanks) and the newline. The
+/// listing is written by hand: `format!` cost more than assembling.
+fn push_row_tail(text: &mut String, depth: u8, cells: &[[u8; 2]], source: &str) {
+    text.push(char::from(b'0' + depth.min(9)));
+    text.push_str("  ");
+    let mut width = 0;
+    for (i, cell) in cells.iter().enumerate() {
+        if i > 0 {
+            text.push(' ');
+            width += 1;
+        }
+        text.push(char::from(cell[0]));
+        text.push(char::from(cell[1]));
+        width += 2;
+    }
+    for _ in width..12 {
+        text.push(' ');
+    }
+    text.push(' ');
+    let trimmed = source.trim_end();
+    if trimmed.contains('\t') {
+        text.push_str(&trimmed.replace('\t', "        "));
+    } else {
+        text.push_str(trimmed);
+    }
+    // A row with no source ends at its cells, as before.
+    while text.ends_with(' ') {
+        text.pop();
+    }
+    text.push('\n');
+}
+
 /// Bytes shown for one line at most; the rest is summarised.
 const MAX_BYTES: usize = 16;
 
@@ -160,25 +212,18 @@ impl ListingBuilder {
             })
             .collect();
         for line in &self.lines {
-            let source = match &line.text {
+            let source: std::borrow::Cow<'_, str> = match &line.text {
                 Text::Source { file, start, end } => {
                     let bytes = files.text(*file);
                     let start = (*start as usize).min(bytes.len());
                     let end = (*end as usize).clamp(start, bytes.len());
-                    String::from_utf8_lossy(&bytes[start..end]).into_owned()
+                    String::from_utf8_lossy(&bytes[start..end])
                 }
-                Text::Expanded(text) => text.clone(),
+                Text::Expanded(text) => std::borrow::Cow::Borrowed(text.as_str()),
             };
-            let source = source.replace('\t', "        ");
             let Some((end_seg, end_chunk, end_off)) = line.end else {
-                let _ = writeln!(
-                    text,
-                    "{:7} {}  {:12} {}",
-                    "",
-                    line.depth,
-                    "",
-                    source.trim_end()
-                );
+                text.push_str("        ");
+                push_row_tail(&mut text, line.depth, &[], &source);
                 continue;
             };
             let chunk = &prog.chunks[line.chunk as usize];
@@ -189,42 +234,39 @@ impl ListingBuilder {
             } else {
                 start
             };
-            let address = if chunk.org {
-                format!("{:06X} ", chunk.abs + i64::from(line.off))
+            if chunk.org {
+                push_hex6(&mut text, chunk.abs + i64::from(line.off));
+                text.push(' ');
             } else {
-                format!("{start:06X}r")
-            };
-            let mut cells: Vec<String> = Vec::new();
+                push_hex6(&mut text, i64::from(start));
+                text.push('r');
+            }
+            text.push(' ');
+            // Up to MAX_BYTES cells of two characters, four to a row.
+            let mut cells = [[b'?'; 2]; MAX_BYTES];
+            let mut count = 0;
             if let Some(section) = section {
                 let s = &out.sections[section];
                 for offset in start..end.max(start) {
-                    if cells.len() == MAX_BYTES {
+                    if count == MAX_BYTES {
                         break;
                     }
-                    let cell = if relocated[section].binary_search(&offset).is_ok() {
-                        "rr".to_string()
+                    cells[count] = if relocated[section].binary_search(&offset).is_ok() {
+                        *b"rr"
                     } else if s.nobits {
-                        "xx".to_string()
+                        *b"xx"
                     } else {
-                        s.data
-                            .get(offset as usize)
-                            .map_or_else(|| "??".to_string(), |b| format!("{b:02X}"))
+                        s.data.get(offset as usize).map_or(*b"??", |b| hex_byte(*b))
                     };
-                    cells.push(cell);
+                    count += 1;
                 }
             }
-            let total = end.saturating_sub(start) as usize;
-            let mut rows = cells.chunks(4);
-            let first = rows.next().map(|r| r.join(" ")).unwrap_or_default();
-            let _ = writeln!(
-                text,
-                "{address} {}  {first:12} {}",
-                line.depth,
-                source.trim_end()
-            );
-            for row in rows {
-                let _ = writeln!(text, "{:7} {}  {:12}", "", line.depth, row.join(" "));
+            push_row_tail(&mut text, line.depth, &cells[..count.min(4)], &source);
+            for from in (4..count).step_by(4) {
+                text.push_str("        ");
+                push_row_tail(&mut text, line.depth, &cells[from..count.min(from + 4)], "");
             }
+            let total = end.saturating_sub(start) as usize;
             if total > MAX_BYTES {
                 let _ = writeln!(text, "{:7} {}  ({} bytes in all)", "", line.depth, total);
             }
