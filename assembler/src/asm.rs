@@ -25,10 +25,6 @@ pub(crate) struct Reported;
 
 pub(crate) type PResult<T> = Result<T, Reported>;
 
-/// Most lines, macro-expanded lines included, that one assembly may read
-/// (twenty times the 200,000-line benchmark): a guard against runaway
-/// `.repeat`s and recursive macros.
-const MAX_LINES: u64 = 4_000_000;
 /// Deepest nesting of includes, macros and `.repeat`s.
 const MAX_FRAMES: usize = 256;
 /// Largest total of bytes in all segments (the 6502 sees 64 KiB, but a
@@ -800,7 +796,7 @@ impl<'a> Asm<'a> {
     /// Reads the next raw line for a macro or `.repeat` body (no defines,
     /// no conditionals). `None` when the innermost frame ends.
     pub(crate) fn fetch_raw(&mut self) -> Option<LineInfo> {
-        if self.lines_read > MAX_LINES {
+        if self.lines_read > self.opts.max_lines {
             return None;
         }
         match self.fetch() {
@@ -849,7 +845,7 @@ impl<'a> Asm<'a> {
                 Some(None) => self.pop_frame(),
                 Some(Some(info)) => {
                     self.lines_read += 1;
-                    if self.lines_read > MAX_LINES {
+                    if self.lines_read > self.opts.max_lines {
                         let span = self.toks.first().map_or(
                             Span {
                                 file: info.file,
@@ -862,7 +858,8 @@ impl<'a> Asm<'a> {
                             "asm::too-many-lines",
                             span,
                             format!(
-                                "more than {MAX_LINES} lines to assemble (a runaway `.repeat` or recursive macro?)"
+                                "more than {} lines to assemble (a runaway `.repeat` or recursive macro?)",
+                                self.opts.max_lines
                             ),
                         );
                         break;

@@ -61,6 +61,10 @@ pub struct Options {
     /// Accept the undocumented NMOS opcodes from the start (as
     /// `.setcpu "6502X"`).
     pub undocumented: bool,
+    /// Most source lines read, expansions included, before assembly stops
+    /// with an error: the guard against runaway `.repeat`s and recursive
+    /// macros (default 4,000,000, twenty times the 200,000-line benchmark).
+    pub max_lines: u64,
 }
 
 impl Default for Options {
@@ -72,6 +76,7 @@ impl Default for Options {
             listing: false,
             max_errors: 50,
             undocumented: false,
+            max_lines: 4_000_000,
         }
     }
 }
