@@ -82,6 +82,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         max_errors: args.max_errors,
         undocumented: args.undocumented,
         builtin_includes: builtin_includes(),
+        ..assembler::Options::default()
     };
     let assembly = assembler::assemble(&assembler::FsSource, &args.source, &options)?;
     report_warnings(&assembly.warnings);
