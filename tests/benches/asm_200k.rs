@@ -9,10 +9,11 @@
 //!   with a custom layout whose area is large enough, the binary written to
 //!   disk (what `scorpion build` does, minus process start-up),
 //!
-//! in the same run, printing each wall time (median of several runs), lines
-//! per second and our ratios, checking that the three binaries are
-//! identical, and timing us at 25k, 50k, 100k and 200k lines to show that
-//! the time per line stays flat (linear time).
+//! in the same run, in interleaved rounds (so that other load on the
+//! machine falls on all three alike), printing each wall time (median and
+//! best of the rounds), lines per second and our ratios, checking that the
+//! three binaries are identical, and timing us at 25k, 50k, 100k and 200k
+//! lines to show that the time per line stays flat (linear time).
 //!
 //! Run: `cargo bench -p scorpion-tests --bench asm_200k`
 //! (`ASM_BENCH_RUNS=N` sets the repetitions, ca65 taking seconds per run;
@@ -97,21 +98,18 @@ fn ours(source: &Path, out: &Path, target: &linker::Target) -> Vec<u8> {
     binary
 }
 
-fn time_ours(
-    source: &Path,
-    out: &Path,
-    target: &linker::Target,
-    runs: usize,
-) -> (Duration, Vec<u8>) {
-    let mut binary = ours(source, out, target); // warm-up
-    let times = (0..runs)
+/// Our best time over `runs` (after a warm-up): the least disturbed by
+/// other load, for the linearity table.
+fn time_ours(source: &Path, out: &Path, target: &linker::Target, runs: usize) -> Duration {
+    ours(source, out, target);
+    (0..runs)
         .map(|_| {
             let start = Instant::now();
-            binary = ours(source, out, target);
+            ours(source, out, target);
             start.elapsed()
         })
-        .collect();
-    (median(times), binary)
+        .min()
+        .unwrap_or_default()
 }
 
 fn seconds(duration: Duration) -> String {
@@ -123,7 +121,7 @@ fn main() {
     let runs: usize = std::env::var("ASM_BENCH_RUNS")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(5)
+        .unwrap_or(9)
         .max(1);
     let dir = tempfile::tempdir().expect("a temporary directory");
     let layout =
@@ -136,21 +134,105 @@ fn main() {
     std::fs::write(&source, ca65_text).expect("write the ca65 source");
     std::fs::write(dir.path().join("bench.asm"), &program.tass).expect("write the 64tass source");
     std::fs::write(dir.path().join("bench.cfg"), LD65_CONFIG).expect("write the ld65 config");
+    let peers = std::env::var_os("ASM_BENCH_OURS_ONLY").is_none();
+    let ca65 = peers
+        .then(|| scorpion_tests::tools::require("ca65", "asm_200k"))
+        .flatten();
+    let ld65 = peers
+        .then(|| scorpion_tests::tools::require("ld65", "asm_200k"))
+        .flatten();
+    let tass = peers
+        .then(|| scorpion_tests::tools::require("64tass", "asm_200k"))
+        .flatten();
+    let cc65_runs = runs.min(3);
     println!(
-        "asm_200k: {} lines ({} KiB of source), {} runs each, median wall time",
+        "asm_200k: {} lines ({} KiB of source); rounds of scorpion, 64tass and ca65+ld65 interleaved \
+         ({runs} rounds, ca65 in the first {cc65_runs}) so that load on the machine hits all alike",
         program.lines,
         ca65_text.len() / 1024,
-        runs
     );
 
-    let (our_time, our_binary) = time_ours(&source, &dir.path().join("ours.bin"), &target, runs);
+    // Warm-up (file cache, page faults) for every tool.
+    let mut our_binary = ours(&source, &dir.path().join("ours.bin"), &target);
+    let tass_command = |tass: &Path| {
+        let mut command = Command::new(tass);
+        command
+            .current_dir(dir.path())
+            .args(["-q", "--flat", "-o", "64tass.bin", "bench.asm"]);
+        command
+    };
+    if let Some(tass) = &tass {
+        run(&mut tass_command(tass), "64tass");
+    }
+    let (mut our_times, mut tass_times, mut cc65_times) = (Vec::new(), Vec::new(), Vec::new());
+    for round in 0..runs {
+        let start = Instant::now();
+        our_binary = ours(&source, &dir.path().join("ours.bin"), &target);
+        our_times.push(start.elapsed());
+        if let Some(tass) = &tass {
+            let start = Instant::now();
+            run(&mut tass_command(tass), "64tass");
+            tass_times.push(start.elapsed());
+        }
+        if let (Some(ca65), Some(ld65)) = (&ca65, &ld65)
+            && round < cc65_runs
+        {
+            let start = Instant::now();
+            run(
+                Command::new(ca65)
+                    .current_dir(dir.path())
+                    .args(["bench.s", "-o", "bench.o"]),
+                "ca65",
+            );
+            run(
+                Command::new(ld65).current_dir(dir.path()).args([
+                    "-C",
+                    "bench.cfg",
+                    "-o",
+                    "ld65.bin",
+                    "bench.o",
+                ]),
+                "ld65",
+            );
+            cc65_times.push(start.elapsed());
+        }
+    }
     let lines_per_second = |time: Duration| program.lines as f64 / time.as_secs_f64();
+    let best = |times: &[Duration]| times.iter().copied().min().unwrap_or_default();
+    let (our_median, our_best) = (median(our_times.clone()), best(&our_times));
+    println!("                              median     lines/s      best   output");
     println!(
-        "  scorpion (assemble + link): {:>9}  {:>10.0} lines/s  {} bytes",
-        seconds(our_time),
-        lines_per_second(our_time),
+        "  scorpion (assemble + link): {:>9}  {:>10.0}  {:>9}  {} bytes",
+        seconds(our_median),
+        lines_per_second(our_median),
+        seconds(our_best),
         our_binary.len()
     );
+    let compare = |name: &str, times: &[Duration], binary: &[u8]| {
+        let (time, fastest) = (median(times.to_vec()), best(times));
+        println!(
+            "  {name:<27} {:>9}  {:>10.0}  {:>9}  {} bytes  -> scorpion is {:.2}x faster (median), {:.2}x (best)",
+            seconds(time),
+            lines_per_second(time),
+            seconds(fastest),
+            binary.len(),
+            time.as_secs_f64() / our_median.as_secs_f64(),
+            fastest.as_secs_f64() / our_best.as_secs_f64()
+        );
+    };
+    if !cc65_times.is_empty() {
+        let binary = std::fs::read(dir.path().join("ld65.bin")).expect("ld65 wrote its output");
+        compare("ca65 + ld65:", &cc65_times, &binary);
+        assert!(binary == our_binary, "ld65's binary differs from ours");
+    }
+    if !tass_times.is_empty() {
+        let binary = std::fs::read(dir.path().join("64tass.bin")).expect("64tass wrote its output");
+        compare("64tass:", &tass_times, &binary);
+        assert!(binary == our_binary, "64tass's binary differs from ours");
+    }
+    if !cc65_times.is_empty() && !tass_times.is_empty() {
+        println!("  the three binaries are identical");
+    }
 
     // Where our time goes.
     let assemble_only = median(
@@ -168,96 +250,18 @@ fn main() {
             .collect(),
     );
     println!(
-        "    of which assembling:       {:>9}  {:>10.0} lines/s",
+        "  scorpion's assembling alone: {:>9}  {:>10.0} lines/s (median)",
         seconds(assemble_only),
         lines_per_second(assemble_only)
     );
 
-    let peers = std::env::var_os("ASM_BENCH_OURS_ONLY").is_none();
-    let ca65 = peers
-        .then(|| scorpion_tests::tools::require("ca65", "asm_200k"))
-        .flatten();
-    let ld65 = peers
-        .then(|| scorpion_tests::tools::require("ld65", "asm_200k"))
-        .flatten();
-    let tass = peers
-        .then(|| scorpion_tests::tools::require("64tass", "asm_200k"))
-        .flatten();
-
-    if let (Some(ca65), Some(ld65)) = (&ca65, &ld65) {
-        let cc65_runs = runs.min(3);
-        let times: Vec<Duration> = (0..cc65_runs)
-            .map(|_| {
-                let start = Instant::now();
-                run(
-                    Command::new(ca65)
-                        .current_dir(dir.path())
-                        .args(["bench.s", "-o", "bench.o"]),
-                    "ca65",
-                );
-                run(
-                    Command::new(ld65).current_dir(dir.path()).args([
-                        "-C",
-                        "bench.cfg",
-                        "-o",
-                        "ld65.bin",
-                        "bench.o",
-                    ]),
-                    "ld65",
-                );
-                start.elapsed()
-            })
-            .collect();
-        let time = median(times);
-        let binary = std::fs::read(dir.path().join("ld65.bin")).expect("ld65 wrote its output");
-        println!(
-            "  ca65 + ld65:                {:>9}  {:>10.0} lines/s  {} bytes  -> scorpion is {:.1}x faster",
-            seconds(time),
-            lines_per_second(time),
-            binary.len(),
-            time.as_secs_f64() / our_time.as_secs_f64()
-        );
-        assert!(binary == our_binary, "ld65's binary differs from ours");
-    }
-    if let Some(tass) = &tass {
-        let times: Vec<Duration> = (0..runs)
-            .map(|_| {
-                let start = Instant::now();
-                run(
-                    Command::new(tass).current_dir(dir.path()).args([
-                        "-q",
-                        "--flat",
-                        "-o",
-                        "64tass.bin",
-                        "bench.asm",
-                    ]),
-                    "64tass",
-                );
-                start.elapsed()
-            })
-            .collect();
-        let time = median(times);
-        let binary = std::fs::read(dir.path().join("64tass.bin")).expect("64tass wrote its output");
-        println!(
-            "  64tass:                     {:>9}  {:>10.0} lines/s  {} bytes  -> scorpion is {:.2}x faster",
-            seconds(time),
-            lines_per_second(time),
-            binary.len(),
-            time.as_secs_f64() / our_time.as_secs_f64()
-        );
-        assert!(binary == our_binary, "64tass's binary differs from ours");
-    }
-    if ca65.is_some() && ld65.is_some() && tass.is_some() {
-        println!("  the three binaries are identical");
-    }
-
-    println!("linearity (scorpion, same generator, median of {runs}):");
+    println!("linearity (scorpion, same generator, best of {runs}):");
     let mut per_line = Vec::new();
     for lines in [25_000, 50_000, 100_000, 200_000] {
         let program = asm_gen::generate(2024, lines, asm_gen::Flavor::Benchmark);
         let path = dir.path().join(format!("lines{lines}.s"));
         std::fs::write(&path, &program.files[0].1).expect("write a source");
-        let (time, _) = time_ours(&path, &dir.path().join("lines.bin"), &target, runs);
+        let time = time_ours(&path, &dir.path().join("lines.bin"), &target, runs);
         let nanos = time.as_secs_f64() * 1e9 / program.lines as f64;
         per_line.push(nanos);
         println!(
