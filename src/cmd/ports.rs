@@ -4,8 +4,9 @@
 use std::process::ExitCode;
 
 use miette::IntoDiagnostic;
+use romlib::VirtualScorpion;
 use uploader::Transport;
-use uploader::transport::{SerialTransport, list_ports};
+use uploader::transport::{SerialTransport, VirtualTransport, list_ports};
 
 /// List the serial ports of this machine.
 #[derive(Debug, clap::Args)]
@@ -21,13 +22,38 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
     for port in ports {
         writeln!(out, "{}\t{}", port.path, port.description).into_diagnostic()?;
     }
+    writeln!(
+        out,
+        "{EMU}\tthe virtual Scorpion in this process (the reference ROM, emulated)"
+    )
+    .into_diagnostic()?;
     Ok(ExitCode::SUCCESS)
 }
 
 /// The default baud rate: the reference ROM's (PLATFORM.md section 3).
 pub(crate) const DEFAULT_BAUD: u32 = 9600;
 
-/// Opens `--port`: a serial device path.
+/// The `--port` value that names the in-process virtual Scorpion.
+pub(crate) const EMU: &str = "emu";
+
+/// A fresh virtual Scorpion whose DIP switches and host line are at `baud`.
+pub(crate) fn virtual_robot(baud: u32) -> miette::Result<VirtualScorpion> {
+    let mut robot = VirtualScorpion::new();
+    if !robot.set_baud(baud) {
+        miette::bail!(
+            help = "the 6551 runs at 50 to 19200 baud; the reference ROM's rate is 9600",
+            "the Scorpion's 6551 has no {baud} baud rate"
+        );
+    }
+    Ok(robot)
+}
+
+/// Opens `--port`: a serial device path, or `emu` for a fresh virtual
+/// Scorpion in this process (the transport's clock is then its emulated
+/// time).
 pub(crate) fn open(port: &str, baud: u32) -> miette::Result<Box<dyn Transport>> {
+    if port == EMU {
+        return Ok(Box::new(VirtualTransport::new(virtual_robot(baud)?)));
+    }
     Ok(Box::new(SerialTransport::open(port, baud)?))
 }

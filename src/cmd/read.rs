@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use miette::{Context, IntoDiagnostic};
-use uploader::{Client, ClientConfig};
 
 use crate::args;
 use crate::cmd::ports;
@@ -14,7 +13,8 @@ use crate::cmd::ports;
 /// answers agree) and print it as hex, or write it raw to a file.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// The serial port the robot is on.
+    /// The serial port the robot is on, or `emu` for a fresh virtual
+    /// Scorpion in this process.
     #[arg(long)]
     port: String,
     /// The line's baud rate.
@@ -40,7 +40,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         );
     }
     let transport = ports::open(&args.port, args.baud)?;
-    let mut client = Client::new(transport, ClientConfig::default());
+    let mut client = uploader::client(transport, &uploader::RomProfile::reference());
     client.probe()?;
     let bytes = client.read_memory(args.address, args.length as usize)?;
     match &args.output {

@@ -1,34 +1,99 @@
-//! `scorpion upload`: put a linked image into a robot, verify every byte,
-//! then switch its hooks.
+//! `scorpion upload`: rehearse an image on the virtual Scorpion, put it
+//! into a robot, verify every byte, then switch its hooks.
 
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use miette::{Context, IntoDiagnostic};
-use uploader::{Client, ClientConfig, Event, Phase, Progress, UploadImage, UploadOptions};
+use romlib::protocol::{Answer, Command};
+use uploader::transport::VirtualTransport;
+use uploader::{
+    Client, ClientConfig, Event, Expectations, LoaderChoice, NoProgress, Phase, Progress,
+    RomProfile, Transport, UploadImage, UploadOptions, UploadReport,
+};
 
 use crate::cmd::ports;
 
-/// Upload a linked image (`scorpion link` output) into the robot with its
-/// own RAM-write commands: every byte verified with `/7R` reads while the
-/// writes go out, what differs rewritten, hooks switched only after the
-/// whole body verified.
+/// Upload a linked image (`scorpion link` or `scorpion build` output) into
+/// the robot with its own RAM-write commands: every byte verified with
+/// `/7R` reads while the writes go out, what differs rewritten, hooks
+/// switched only after the whole body verified.
+///
+/// First the same upload is rehearsed on the virtual Scorpion in this
+/// process and, with --expect, the image is put through its paces there:
+/// any difference stops before the robot is touched. Larger images go
+/// through a RAM loader (two small programs the uploader installs, verified,
+/// and removes afterwards) that carries about one byte per character
+/// instead of the ROM's two per eleven, at 19200 baud when the line allows.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     /// The linked ELF image.
     image: PathBuf,
-    /// The serial port the robot is on.
+    /// The serial port the robot is on, or `emu` for the virtual Scorpion in
+    /// this process.
     #[arg(long)]
     port: String,
-    /// The line's baud rate.
+    /// The line's baud rate (the robot's).
     #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
     baud: u32,
-    /// Characters sent after a question whose answer has not arrived (the
-    /// robot's receive buffer); 0 waits for every answer.
-    #[arg(long, default_value_t = ClientConfig::default().window)]
-    window: usize,
+    /// Commands and the answers they must produce (`/1Q => QHELLO`, one a
+    /// line, `#` comments): checked on the rehearsal, and on `emu` after the
+    /// upload.
+    #[arg(long, value_name = "FILE")]
+    expect: Option<PathBuf>,
+    /// Skip the rehearsal on the virtual Scorpion.
+    #[arg(long)]
+    no_dry_run: bool,
+    /// The RAM loader: `auto` uses it when it is faster and safe to place.
+    #[arg(long, value_enum, default_value_t = Loader::Auto)]
+    loader: Loader,
+    /// The rate the loader switches the line to for the transfer; 0 keeps
+    /// --baud (for a line whose far end cannot follow).
+    #[arg(long, default_value_t = uploader::FAST_BAUD, value_name = "BAUD")]
+    fast_baud: u32,
+    /// Characters sent ahead of an answer not yet received; 0 waits for
+    /// each answer. By default the reference ROM's receive buffer, less one
+    /// command.
+    #[arg(long)]
+    window: Option<usize>,
+}
+
+/// `--loader`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Loader {
+    /// When the estimate says it is faster and it can be placed safely.
+    Auto,
+    /// Never: the ROM's `/9W` for every byte.
+    Never,
+    /// Always, or fail saying why not.
+    Always,
+}
+
+impl Args {
+    fn options(&self) -> UploadOptions {
+        UploadOptions {
+            loader: match self.loader {
+                Loader::Auto => LoaderChoice::Auto,
+                Loader::Never => LoaderChoice::Never,
+                Loader::Always => LoaderChoice::Always,
+            },
+            fast_baud: (self.fast_baud != 0).then_some(self.fast_baud),
+            ..UploadOptions::default()
+        }
+    }
+
+    fn client<T: Transport>(&self, transport: T, profile: &RomProfile) -> Client<T> {
+        Client::new(
+            transport,
+            ClientConfig {
+                window: self.window.unwrap_or_else(|| profile.window()),
+                ..ClientConfig::default()
+            },
+        )
+    }
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal), with
@@ -49,15 +114,24 @@ impl Bar {
         );
         Bar { bar }
     }
+
+    fn say(&self, line: &str) {
+        self.bar.suspend(|| {
+            #[allow(clippy::print_stderr, reason = "the CLI reports progress")]
+            {
+                eprintln!("{line}");
+            }
+        });
+    }
 }
 
 impl Progress for Bar {
     fn phase(&mut self, phase: Phase, total: usize) {
         let name = match phase {
             Phase::Connect => "connecting",
+            Phase::Loader => "loader",
             Phase::Write => "writing",
             Phase::FinalVerify => "verifying",
-            Phase::Loader => "loader",
             Phase::Hooks => "hooking",
         };
         self.bar.set_message(name);
@@ -70,8 +144,8 @@ impl Progress for Bar {
     }
 
     fn event(&mut self, event: &Event) {
-        // Faults are routine and the summary counts them; only changes to
-        // the robot's hooks deserve a line of their own.
+        // Line faults are routine and the summary counts them; changes to
+        // the robot's hooks and rate deserve a line of their own.
         let line = match event {
             Event::HookChanged {
                 kind,
@@ -82,71 +156,151 @@ impl Progress for Bar {
                 kind.rom_symbol()
             ),
             Event::HookDisarmed { kind, from, to } => format!(
-                "{} pointed into the upload (${from:04X}); reset it to ${to:04X} first",
+                "{} pointed into the upload (${from:04X}); pointed it at ${to:04X} first",
                 kind.rom_symbol()
+            ),
+            Event::LoaderRestored { baud, .. } => format!(
+                "warning: the RAM loader was lost (a reset?); restored, robot found at {baud} baud"
             ),
             _ => return,
         };
-        self.bar.suspend(|| {
-            #[allow(clippy::print_stderr, reason = "the CLI reports progress")]
-            {
-                eprintln!("{line}");
-            }
-        });
+        self.say(&line);
     }
 }
 
-pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let name = args.image.display().to_string();
-    let bytes = std::fs::read(&args.image)
+fn read_image(path: &PathBuf) -> miette::Result<UploadImage> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot read {name}"))?;
     let linked = linker::Image::parse(&name, &bytes)?;
-    let image = UploadImage::try_from(&linked)?;
-    let transport = ports::open(&args.port, args.baud)?;
-    let config = ClientConfig {
-        window: args.window,
-        ..ClientConfig::default()
-    };
-    let mut client = Client::new(transport, config);
-    let mut bar = Bar::new();
-    let result = uploader::upload(&mut client, &image, &UploadOptions::default(), &mut bar);
-    bar.bar.finish_and_clear();
-    let report = result?;
+    Ok(UploadImage::try_from(&linked)?)
+}
+
+fn read_expectations(path: &PathBuf) -> miette::Result<Expectations> {
+    let text = std::fs::read_to_string(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
+    Expectations::parse(&text).wrap_err_with(|| format!("in {}", path.display()))
+}
+
+/// `> command` and `< answer` lines.
+fn transcript(lines: &[(Command, Option<Answer>)]) -> String {
+    let mut text = String::new();
+    for (command, answer) in lines {
+        let _ = writeln!(text, "  > {command}");
+        if let Some(answer) = answer {
+            let raw = answer.encode();
+            let raw = String::from_utf8_lossy(raw.strip_suffix(b"\r").unwrap_or(&raw)).into_owned();
+            let _ = writeln!(text, "  < {raw}");
+        }
+    }
+    text
+}
+
+/// How the upload went, for people.
+fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String {
     let seconds = report
         .device_time
         .max(Duration::from_millis(1))
         .as_secs_f64();
-    let mut summary = format!(
-        "uploaded and verified {} bytes in {:.2} s ({:.0} bytes/s)",
+    let mut text = format!(
+        "uploaded and verified {} bytes in {seconds:.2} s{} ({:.0} bytes/s)",
         report.bytes,
-        seconds,
+        if emulated { " of robot time" } else { "" },
         report.bytes as f64 / seconds
     );
+    if let Some(loader) = &report.loader {
+        let _ = write!(
+            text,
+            ", through the RAM loader (${:04X}, {} bytes) at {} baud",
+            loader.address, loader.len, loader.baud
+        );
+    }
     for area in image.areas() {
-        summary.push_str(&format!(
-            "\n  ${:04X}-${:04X}",
-            area.address,
-            area.end() - 1
-        ));
+        let _ = write!(text, "\n  ${:04X}-${:04X}", area.address, area.end() - 1);
     }
     if report.rewrites > 0 || report.lost_answers > 0 {
-        summary.push_str(&format!(
+        let _ = write!(
+            text,
             "\n  line faults: {} bytes rewritten, {} answers lost, {} extra verification passes",
             report.rewrites, report.lost_answers, report.final_passes
-        ));
+        );
     }
     for hook in &report.hooks {
-        summary.push_str(&format!(
+        let _ = write!(
+            text,
             "\n  {} -> ${:04X} (falls through to ${:04X})",
             hook.kind.rom_symbol(),
             hook.handler,
             hook.previous
-        ));
+        );
     }
+    text
+}
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let image = read_image(&args.image)?;
+    let expectations = args.expect.as_ref().map(read_expectations).transpose()?;
+    let options = args.options();
+    let profile = &options.profile;
+    profile.check(&image)?;
+    let emulated = args.port == ports::EMU;
+    let mut out = String::new();
+
+    // The rehearsal: the same upload into a virtual Scorpion, then the
+    // expectations, before the robot is touched.
+    if !emulated && !args.no_dry_run {
+        let robot = ports::virtual_robot(args.baud)?;
+        let mut client = args.client(VirtualTransport::new(robot), profile);
+        let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
+            "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot",
+        )?;
+        let _ = write!(
+            out,
+            "rehearsed on the virtual Scorpion: {} bytes verified in {:.2} s of robot time",
+            report.bytes,
+            report.device_time.as_secs_f64()
+        );
+        if let Some(expectations) = &expectations {
+            let lines = expectations.check(&mut client)?;
+            let _ = write!(
+                out,
+                ", {} expectation{} met\n{}",
+                lines.len(),
+                if lines.len() == 1 { "" } else { "s" },
+                transcript(&lines)
+            );
+        } else {
+            out.push('\n');
+        }
+        print(&out);
+        out.clear();
+    }
+
+    let transport = ports::open(&args.port, args.baud)?;
+    let mut client = args.client(transport, profile);
+    let mut bar = Bar::new();
+    let result = uploader::upload(&mut client, &image, &options, &mut bar);
+    bar.bar.finish_and_clear();
+    let report = result?;
+    out.push_str(&summary(&report, &image, emulated));
+    out.push('\n');
+    if emulated && let Some(expectations) = &expectations {
+        let lines = expectations.check(&mut client)?;
+        let _ = write!(
+            out,
+            "the virtual Scorpion, after the upload:\n{}",
+            transcript(&lines)
+        );
+    }
+    print(&out);
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print(text: &str) {
     #[allow(clippy::print_stdout, reason = "the CLI reports the result")]
     {
-        println!("{summary}");
+        print!("{text}");
     }
-    Ok(ExitCode::SUCCESS)
 }

@@ -1,6 +1,10 @@
-//! `scorpion upload` through a real pseudo-terminal to the robot double of
-//! `read.rs`: the body verified, the chain slot filled with the hook's old
-//! target, the hook switched last; and images it must refuse.
+//! `scorpion upload`: into the in-process virtual Scorpion (`--port emu`)
+//! with expectations checked after; end to end through a real
+//! pseudo-terminal to `scorpion sim --pty`, rehearsal first; a rehearsal
+//! that fails touching nothing; and images it must refuse.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
 
 use isa::objfmt::{HookKind, HookRecord, Hooks};
 use linker::{Format, Image, LoadArea};
@@ -8,18 +12,19 @@ use linker::{Format, Image, LoadArea};
 use crate::read::{PtyRobot, memory};
 use crate::{scorpion, transcript};
 
-/// An extension image of `len` bytes at $0400: handler at $0403, chain
-/// slot at $0401 (the operand of a `JMP` at $0400).
-fn extension_elf(len: usize) -> (Vec<u8>, Vec<u8>) {
+/// An extension image of `len` bytes at $0400 that is real code: `$0400:
+/// JMP chain` (the chain slot, $0401, is its operand), `$0403: JMP $0400`
+/// (the handler owns nothing and falls through), then filler.
+fn extension_elf(len: usize) -> Vec<u8> {
     let mut bytes: Vec<u8> = (0..len).map(|i| (i * 31 + 7) as u8).collect();
-    bytes[0] = 0x4C;
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
     let image = Image {
         entry: 0x0403,
         flags: 0,
         areas: vec![LoadArea {
             load: 0x0400,
             run: 0x0400,
-            bytes: bytes.clone(),
+            bytes,
         }],
         sections: vec![],
         symbols: vec![],
@@ -31,36 +36,250 @@ fn extension_elf(len: usize) -> (Vec<u8>, Vec<u8>) {
             }],
         },
     };
-    (Format::Elf.write(&image).expect("an ELF image"), bytes)
+    Format::Elf.write(&image).expect("an ELF image")
 }
 
-/// Replaces the timing figures of the summary line.
-fn without_timing(text: &str) -> String {
-    let Some(start) = text.find(" bytes in ") else {
-        return text.to_owned();
-    };
-    let end = text[start..]
-        .find(")\n")
-        .map_or(text.len(), |end| start + end + 1);
-    format!("{} bytes in [TIME]{}", &text[..start], &text[end..])
+/// `scorpion sim --pty`, stopped when dropped.
+struct Sim {
+    child: Child,
+    path: String,
+}
+
+impl Sim {
+    fn start() -> Sim {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(["sim", "--pty"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the scorpion binary runs");
+        let mut stdout = BufReader::new(child.stdout.take().expect("stdout is piped"));
+        let mut path = String::new();
+        stdout
+            .read_line(&mut path)
+            .expect("the first line is the pseudo-terminal's path");
+        Sim {
+            child,
+            path: path.trim().to_owned(),
+        }
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The checksum example, built by `scorpion build` into `dir`.
+fn checksum_example(dir: &std::path::Path) -> String {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/checksum");
+    let source = root.join("checksum.s").display().to_string();
+    let layout = root.join("checksum.toml").display().to_string();
+    let output = scorpion(
+        dir,
+        &["build", &source, "--target", &layout, "-o", "checksum.elf"],
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    "checksum.elf".into()
 }
 
 #[test]
-fn uploads_verifies_and_hooks_through_a_pseudo_terminal() {
-    let robot = PtyRobot::spawn(memory());
+fn uploads_into_the_virtual_scorpion_and_checks_expectations() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    let (elf, bytes) = extension_elf(600);
-    std::fs::write(dir.path().join("ext.elf"), elf).expect("write the image");
-    let output = scorpion(dir.path(), &["upload", "ext.elf", "--port", &robot.path]);
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(2048)).expect("write the image");
+    std::fs::write(
+        dir.path().join("ext.expect"),
+        "# the extension passes unknown commands on; the ROM still answers\n\
+         /1Q\n/1X => X00\n/7R020003 => R4C0304\n/7R040103 => R21FF4C\n",
+    )
+    .expect("write the expectations");
+    let output = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "ext.elf",
+            "--port",
+            "emu",
+            "--expect",
+            "ext.expect",
+        ],
+    );
     let text = transcript(&output);
     assert_eq!(output.status.code(), Some(0), "{text}");
-    insta::assert_snapshot!("upload_summary", without_timing(&text));
-    let memory = robot.memory.lock().expect("the robot's memory");
-    let mut expected = bytes;
-    expected[1..3].copy_from_slice(&[0x23, 0xF1]);
+    // Robot time on the virtual Scorpion is exact, so the figures are too.
+    insta::assert_snapshot!("upload_emu_loader", text);
+
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", "emu", "--loader", "never"],
+    );
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{text}");
+    insta::assert_snapshot!("upload_emu_rom_only", text);
+}
+
+#[test]
+fn end_to_end_through_a_pseudo_terminal_to_scorpion_sim() {
+    let sim = Sim::start();
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let checksum = checksum_example(dir.path());
+    std::fs::write(
+        dir.path().join("checksum.expect"),
+        "/9W10000102\n/9K10000002 => K0003\n",
+    )
+    .expect("write the expectations");
+    // A larger extension first, through the RAM loader (at 9600: a
+    // pseudo-terminal has no line rate to raise), then the checksum
+    // example chained behind it, rehearsed with its expectations.
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(1200)).expect("write the image");
+    let output = scorpion(dir.path(), &["upload", "ext.elf", "--port", &sim.path]);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("rehearsed on the virtual Scorpion: 1200 bytes verified"),
+        "{text}"
+    );
+    assert!(
+        text.contains("through the RAM loader") && text.contains("at 9600 baud"),
+        "{text}"
+    );
+    let output = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            &checksum,
+            "--port",
+            &sim.path,
+            "--expect",
+            "checksum.expect",
+        ],
+    );
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{text}");
+    assert!(text.contains("2 expectations met"), "{text}");
+    assert!(text.contains("< K0003"), "{text}");
+    assert!(text.contains("(falls through to $0403)"), "{text}");
+
+    // The robot behind the pseudo-terminal answers the new command, and
+    // the chain runs through both extensions to the ROM.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "ask",
+            "--port",
+            &sim.path,
+            "/9W20001020",
+            "/9K20000002",
+            "/1Q",
+            "/1X",
+        ],
+    );
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{text}");
+    assert!(text.contains("K0030\nX00\n"), "{text}");
+    let output = scorpion(
+        dir.path(),
+        &[
+            "read", "--port", &sim.path, "$0400", "1200", "-o", "dump.bin",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let mut expected: Vec<u8> = (0..1200).map(|i| (i * 31 + 7) as u8).collect();
+    expected[..6].copy_from_slice(&[0x4C, 0x21, 0xFF, 0x4C, 0x00, 0x04]);
     assert_eq!(
-        &memory[0x0400..0x0400 + expected.len()],
-        expected.as_slice()
+        std::fs::read(dir.path().join("dump.bin")).expect("the dump"),
+        expected,
+        "the extension, its chain slot holding BAD_COMMAND"
+    );
+}
+
+#[test]
+fn a_failed_rehearsal_touches_nothing() {
+    let robot = PtyRobot::spawn(memory());
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(300)).expect("write the image");
+    std::fs::write(
+        dir.path().join("wrong.expect"),
+        "/7R040301 => R00   # it is a JMP\n",
+    )
+    .expect("write the expectations");
+    let output = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "ext.elf",
+            "--port",
+            &robot.path,
+            "--expect",
+            "wrong.expect",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(1));
+    insta::assert_snapshot!(
+        "upload_rehearsal_failed",
+        transcript(&output).replace(&robot.path, "[PTY]")
+    );
+    assert_eq!(
+        *robot.memory.lock().expect("the robot's memory"),
+        memory(),
+        "the robot was not touched"
+    );
+
+    let output = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "ext.elf",
+            "--port",
+            "emu",
+            "--expect",
+            "missing.expect",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(1));
+    assert!(transcript(&output).contains("missing.expect"));
+    std::fs::write(dir.path().join("bad.expect"), "/1X => B00\n").expect("write");
+    let output = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "ext.elf",
+            "--port",
+            "emu",
+            "--expect",
+            "bad.expect",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(1));
+    assert!(
+        transcript(&output).contains("line 1"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+#[test]
+fn uploads_to_a_robot_with_another_rom_through_a_pseudo_terminal() {
+    // The double's hooks point at $F123 and $F045, not the reference ROM's
+    // targets: the uploader takes them for installed extensions, keeps the
+    // loader out and chains to them.
+    let robot = PtyRobot::spawn(memory());
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(600)).expect("write the image");
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", &robot.path, "--no-dry-run"],
+    );
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{text}");
+    assert!(text.contains("uploaded and verified 600 bytes"), "{text}");
+    assert!(!text.contains("rehearsed"), "{text}");
+    let memory = robot.memory.lock().expect("the robot's memory");
+    assert_eq!(
+        &memory[0x0400..0x0406],
+        &[0x4C, 0x23, 0xF1, 0x4C, 0x00, 0x04]
     );
     assert_eq!(&memory[0x0200..0x0203], &[0x4C, 0x03, 0x04]);
     assert_eq!(
@@ -105,6 +324,17 @@ fn refuses_what_it_cannot_upload_safely() {
     assert_eq!(output.status.code(), Some(1));
     assert!(
         transcript(&output).contains("junk.elf"),
+        "{}",
+        transcript(&output)
+    );
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(100)).expect("write the image");
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", "emu", "--baud", "12345"],
+    );
+    assert_eq!(output.status.code(), Some(1));
+    assert!(
+        transcript(&output).contains("no 12345 baud rate"),
         "{}",
         transcript(&output)
     );

@@ -21,29 +21,19 @@
 ; next command's first byte as its last, and the ROM then ignores the rest
 ; of that command (it has no slash): the uploader asks again.
 ;
-; /1N switches the 6551 back to the rate of the DIP switches, as the ROM
-; programmed it at power-up. Anything else falls through to the hook's
-; previous target.
+; Anything else falls through to the chain slot: the uploader points it
+; at the rate switch (fast.s), whose /1F puts the line back on the base
+; rate at the end, and which drops every other command as BAD_COMMAND
+; would.
 
         .import GETCH, CHKCH, CMD_DONE, BAD_COMMAND
-
-ACIA_CTRL    = $C013    ; the 6551's control register (emulator/src/board/map.rs)
-SWITCHES     = $C022    ; the DIP switches: bits 0-3 the 6551 rate code
-CTRL_8N1     = $10      ; 8N1, receiver on the baud generator; OR the rate code
 
         .export __scorpion_hook_unknown, __scorpion_chain_unknown
         .segment "CODE"
 __scorpion_hook_unknown:
         cmp #'L'
         beq frame
-        cmp #'N'
-        bne chain
-        lda SWITCHES
-        and #$0F
-        ora #CTRL_8N1
-        sta ACIA_CTRL
-        bne done                ; always: A holds CTRL_8N1
-chain:  .byte $4C               ; JMP to the hook's previous target
+        .byte $4C               ; JMP to the chain slot's target
 __scorpion_chain_unknown:
         .addr BAD_COMMAND
 

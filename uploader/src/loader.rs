@@ -5,10 +5,10 @@
 //!
 //! - `fast.s` (15 bytes): hooked through `HOOK_UNKNOWN` after it verified,
 //!   `/1F` toggles the 6551 between the base rate and 19200 baud.
-//! - `frames.s`: hooked next (its fallthrough is the hook's original
-//!   target), it takes `/1L` frames that carry up to 255 bytes at about one
-//!   character a byte (the ROM's `/9W` needs 5.5), and `/1N`, which puts
-//!   the 6551 back on the DIP switches' rate.
+//! - `frames.s`: hooked next, it takes `/1L` frames that carry up to 255
+//!   bytes at about one character a byte (the ROM's `/9W` needs 5.5) and
+//!   falls through to the rate switch, whose `/1F` puts the line back on
+//!   the base rate at the end.
 //!
 //! This module links the stages, finds them room, encodes frames and
 //! estimates whether the loader pays for itself; `session` runs it.

@@ -91,11 +91,19 @@ impl Session {
         (self.loader.address(), self.loader.len())
     }
 
-    /// The frames stage with its chain slot holding the original target.
+    /// The frames stage with its chain slot filled: the rate switch, whose
+    /// `/1F` takes the line back to the base rate (and which drops other
+    /// commands, as the ROM's `BAD_COMMAND` does), or without a switch the
+    /// hook's original target.
     fn frames_image(&self) -> UploadImage {
         let mut image = self.loader.frames.image.clone();
+        let fallthrough = if self.fast.is_some() {
+            self.loader.fast.handler
+        } else {
+            self.original
+        };
         if let Some(slot) = self.loader.frames.chain {
-            let [low, high] = self.original.to_le_bytes();
+            let [low, high] = fallthrough.to_le_bytes();
             image.set_byte(slot, low);
             image.set_byte(slot + 1, high);
         }
@@ -157,7 +165,7 @@ impl Session {
             let stage = self.loader.fast.clone();
             self.put(client, &stage.image, start)?;
             switch_hook(client, self.hook, stage.handler, self.limits.max_writes)?;
-            self.target = if self.switch_rate(client, b"F", fast)? {
+            self.target = if self.switch_rate(client, fast)? {
                 fast
             } else {
                 self.base
@@ -192,18 +200,13 @@ impl Session {
         }
     }
 
-    /// Sends a rate command (`/1F` to the fast stage, `/1N` to the frames
-    /// stage), then moves the host to `to` and checks the robot answers
-    /// there. If it does not, the robot is looked for at the rate it was
+    /// Sends `/1F` (the rate switch toggles the line, directly or through
+    /// the frames stage), then moves the host to `to` and checks the robot
+    /// answers there. If it does not, the robot is looked for at the rate it was
     /// at: `false` means it never left it.
-    fn switch_rate<T: Transport>(
-        &mut self,
-        client: &mut Client<T>,
-        letter: &[u8],
-        to: u32,
-    ) -> Result<bool> {
+    fn switch_rate<T: Transport>(&mut self, client: &mut Client<T>, to: u32) -> Result<bool> {
         let from = client.transport().baud();
-        let command = Command::Extension(Extension::new(letter)?);
+        let command = Command::Extension(Extension::new(b"F".as_slice())?);
         for _ in 0..client.config().question_attempts.max(1) {
             client.drain()?;
             client.send(&command)?;
@@ -321,11 +324,11 @@ impl Session {
     ) -> Result<()> {
         if client.transport().baud() != self.base {
             for _ in 0..=MAX_RECOVERIES {
-                if self.switch_rate(client, b"N", self.base)? {
+                if self.switch_rate(client, self.base)? {
                     break;
                 }
                 // Still fast: the loader may be gone (a `/1R`); restore it
-                // so that its `/1N` can be obeyed.
+                // so that its `/1F` can be obeyed.
                 self.ensure(client, progress)?;
             }
             if client.transport().baud() != self.base {

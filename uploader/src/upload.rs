@@ -147,22 +147,13 @@ fn connect<T: Transport>(
     if client.transport().set_baud(fast).is_err() {
         return Err(error);
     }
-    // At the fast rate, the frame stage (`/1N`) or the rate switch (`/1F`)
-    // of an interrupted upload may still be hooked.
-    for letter in [b"N", b"F"] {
-        client.transport().set_baud(fast)?;
-        client.transport().clear_input()?;
-        if client.probe().is_err() {
-            break;
-        }
-        client.send(&Command::Extension(Extension::new(letter.as_slice())?))?;
+    // At the fast rate, the loader of an interrupted upload may still be
+    // hooked: its `/1F` toggles the line back.
+    client.transport().clear_input()?;
+    if client.probe().is_ok() {
+        client.send(&Command::Extension(Extension::new(b"F".as_slice())?))?;
         let until = client.transport().now() + char_time(3, fast) + Duration::from_millis(3);
         client.wait_until(until)?;
-        client.transport().set_baud(base)?;
-        client.transport().clear_input()?;
-        if client.probe().is_ok() {
-            return read_hooks(client, &options.profile);
-        }
     }
     client.transport().set_baud(base)?;
     client.transport().clear_input()?;
@@ -353,7 +344,14 @@ pub fn upload<T: Transport>(
         let mut known = vec![before];
         known.extend(reset);
         known.extend(ours);
-        let current = read_hook(client, record.kind, address, &known)?;
+        // When the hook started at the ROM's own target, nothing it can
+        // have turned into since (a reset: the same target; the loader; a
+        // write gone astray) is anything to chain to: no need to look.
+        let current = if reset == Some(before) {
+            before
+        } else {
+            read_hook(client, record.kind, address, &known)?
+        };
         let fallthrough = if current == before || Some(current) == ours {
             before
         } else if image.contains(current) {

@@ -19,6 +19,8 @@ pub struct SerialTransport {
     baud: u32,
     opened: Instant,
     buffer: Vec<u8>,
+    /// A pseudo-terminal: no line rate, the far end is a program.
+    pseudo: bool,
 }
 
 impl std::fmt::Debug for SerialTransport {
@@ -72,6 +74,7 @@ impl SerialTransport {
             baud,
             opened: Instant::now(),
             buffer: vec![0; 4096],
+            pseudo: is_pseudo_terminal(path),
         })
     }
 
@@ -113,6 +116,15 @@ impl Transport for SerialTransport {
     }
 
     fn set_baud(&mut self, baud: u32) -> Result<()> {
+        if self.pseudo && baud != self.baud {
+            // Nothing to gain, and the program at the far end (`scorpion
+            // sim --pty`) keeps the pace it was started with.
+            return Err(Error::BaudChange {
+                port: self.path.clone(),
+                baud,
+                message: "a pseudo-terminal has no line rate to raise".into(),
+            });
+        }
         // Characters still in the output buffer must leave at the old rate.
         self.port.flush().map_err(|error| self.io(error))?;
         self.port
@@ -142,6 +154,15 @@ impl Transport for SerialTransport {
     fn name(&self) -> String {
         self.path.clone()
     }
+}
+
+/// Whether `path` names a pseudo-terminal's slave (Linux `/dev/pts/N`,
+/// macOS `/dev/ttysNNN`).
+fn is_pseudo_terminal(path: &str) -> bool {
+    path.starts_with("/dev/pts/")
+        || path
+            .strip_prefix("/dev/ttys")
+            .is_some_and(|rest| !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()))
 }
 
 /// One serial port of this machine.

@@ -125,12 +125,23 @@ pub fn assert_safe(robot: &VirtualScorpion, image: &UploadImage, outcome: &str) 
         }
     }
     if hook == plan.frames_handler {
+        // It falls through to the rate switch, which must be intact too.
         let chain = plan.scratch[plan.scratch.len() - 2];
-        assert_eq!(
-            u16::from_le_bytes([memory[usize::from(chain)], memory[usize::from(chain) + 1]]),
-            BAD_COMMAND,
-            "the loader falls through to the original target ({outcome})"
+        let fallthrough =
+            u16::from_le_bytes([memory[usize::from(chain)], memory[usize::from(chain) + 1]]);
+        assert!(
+            fallthrough == BAD_COMMAND || fallthrough == plan.fast_handler,
+            "the loader falls through to ${fallthrough:04X} ({outcome})"
         );
+        if fallthrough == plan.fast_handler {
+            let fast = &plan.fast;
+            let start = usize::from(fast.address);
+            assert_eq!(
+                &memory[start..start + fast.bytes.len()],
+                fast.bytes.as_slice(),
+                "the rate switch the loader falls through to ({outcome})"
+            );
+        }
     }
 }
 

@@ -1,0 +1,126 @@
+//! Issue 6's benchmark: device time (emulated seconds on the virtual
+//! Scorpion, the reference ROM at real baud timing) to upload and fully
+//! verify a 2 KiB extension at 9600 baud, through the ROM's commands and
+//! through the RAM loader (with and without its switch to 19200 baud),
+//! printed beside the line-rate bound (bytes x 10 / baud) and the
+//! ROM-only bound (11 characters per 2 bytes).
+//!
+//! `cargo bench -p uploader` (or `cargo run -p uploader --release
+//! --example`-free: this is a `harness = false` bench). Device time is
+//! deterministic, so one run of each is the figure.
+
+#![allow(clippy::print_stdout, reason = "a benchmark prints its figures")]
+
+use std::time::{Duration, Instant};
+
+use isa::objfmt::{HookKind, HookRecord};
+use uploader::transport::{VirtualTransport, char_time};
+use uploader::{Area, LoaderChoice, NoProgress, UploadImage, UploadOptions, UploadReport};
+
+const BYTES: usize = 2048;
+const BAUD: u32 = 9600;
+
+/// A 2 KiB extension at $0400: a chaining `JMP`, a handler that falls
+/// through, then pseudo-random bytes (incompressible, every value present).
+fn image() -> UploadImage {
+    let mut bytes: Vec<u8> = (0..BYTES as u32)
+        .map(|i| i.wrapping_mul(2_246_822_519).to_le_bytes()[2])
+        .collect();
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
+    UploadImage::new(
+        vec![Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        }],
+    )
+    .unwrap_or_else(|error| panic!("the benchmark image: {error}"))
+}
+
+fn upload(options: &UploadOptions) -> (UploadReport, Duration) {
+    let started = Instant::now();
+    let mut client = uploader::client(VirtualTransport::default(), &options.profile);
+    let report = uploader::upload(&mut client, &image(), options, &mut NoProgress)
+        .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
+    (report, started.elapsed())
+}
+
+fn main() {
+    let line_bound = char_time(BYTES, BAUD);
+    let rom_bound = char_time(BYTES / 2 * 11, BAUD);
+    println!(
+        "upload and verify {BYTES} bytes on the virtual Scorpion at {BAUD} baud (device time)"
+    );
+    println!(
+        "  line-rate bound (bytes x 10 / baud):     {:>7.3} s",
+        line_bound.as_secs_f64()
+    );
+    println!(
+        "  ROM-only bound (11 chars per 2 bytes):   {:>7.3} s",
+        rom_bound.as_secs_f64()
+    );
+    println!();
+    println!(
+        "  {:<34} {:>9} {:>10} {:>10} {:>8} {:>8}",
+        "path", "device s", "x line", "x ROM-only", "chars", "wall ms"
+    );
+    let runs = [
+        (
+            "ROM only (/9W, /7R)",
+            LoaderChoice::Never,
+            None,
+            Some(rom_bound),
+            1.1,
+        ),
+        (
+            "RAM loader, 9600 throughout",
+            LoaderChoice::Always,
+            None,
+            None,
+            f64::INFINITY,
+        ),
+        (
+            "RAM loader, line at 19200",
+            LoaderChoice::Always,
+            Some(uploader::FAST_BAUD),
+            None,
+            1.3,
+        ),
+    ];
+    let mut missed = Vec::new();
+    for (name, loader, fast_baud, against_rom, target) in runs {
+        let options = UploadOptions {
+            loader,
+            fast_baud,
+            ..UploadOptions::default()
+        };
+        let (report, wall) = upload(&options);
+        let seconds = report.device_time.as_secs_f64();
+        let x_line = seconds / line_bound.as_secs_f64();
+        let x_rom = seconds / rom_bound.as_secs_f64();
+        println!(
+            "  {name:<34} {seconds:>9.3} {x_line:>9.3}x {x_rom:>9.3}x {:>8} {:>8}",
+            report.chars_sent + report.chars_received,
+            wall.as_millis()
+        );
+        let ratio = if against_rom.is_some() { x_rom } else { x_line };
+        if ratio > target {
+            missed.push(format!("{name}: {ratio:.3}x, target {target}x"));
+        }
+    }
+    println!();
+    println!(
+        "  targets: ROM only within 1.1x of the ROM-only bound; loader at 19200 within 1.3x of the line-rate bound"
+    );
+    if missed.is_empty() {
+        println!("  all targets met");
+    } else {
+        for line in missed {
+            println!("  MISSED {line}");
+        }
+    }
+}
