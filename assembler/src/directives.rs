@@ -186,6 +186,17 @@ impl Asm<'_> {
                 self.cpu_x = false;
                 Ok(())
             }
+            Dir::NoEffect => {
+                let name = self.names.name(head.name()).to_string();
+                let span = self.join(head.span, t[t.len() - 1].span);
+                let diag = diag::warning(
+                    "asm::no-effect",
+                    span,
+                    format!("`{name}` has no effect with this assembler; the line is ignored"),
+                );
+                self.report(diag);
+                Ok(())
+            }
             Dir::Feature => {
                 let span = self.join(head.span, t[t.len() - 1].span);
                 let diag = diag::warning(

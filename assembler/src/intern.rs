@@ -13,7 +13,8 @@ pub(crate) type NameId = u32;
 
 macro_rules! directives {
     ($( $variant:ident = $($name:literal)|+ ;)*) => {
-        /// A directive or pseudo-function (`.byte`, `.lobyte`...).
+        /// A directive or pseudo-function (`.byte`, `.lobyte`...);
+        /// `NoEffect` gathers ca65's listing and debug-info switches.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub(crate) enum Dir { $( $variant, )* }
 
@@ -67,6 +68,7 @@ directives! {
     Fatal = "fatal";
     Feature = "feature";
     Global = "global";
+    NoEffect = "debuginfo" | "dbg" | "smart" | "listbytes" | "pagelength" | "fopt" | "fileopt";
     Globalzp = "globalzp";
     Hibyte = "hibyte";
     Hibytes = "hibytes";

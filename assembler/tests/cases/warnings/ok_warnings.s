@@ -10,6 +10,7 @@ start:  bne *+3                 ; lands on the next instruction's operand
         beq start + 1           ; inside an instruction
         .warning "a user warning"
         .feature labels_without_colons
+        .debuginfo on
         .assert 1 = 2, warning, "a failed warning assertion"
         .assert * > $FFFF, warning, "an address check: deferred to the linker"
         .out "this line goes to stdout"
