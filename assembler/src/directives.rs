@@ -1041,7 +1041,7 @@ impl Asm<'_> {
             self.toks = t;
             match result {
                 Ok(Some(value)) => {
-                    next = value.wrapping_add(1);
+                    next = isa::objfmt::BinaryOp::Add.apply(value, 1).unwrap_or(value);
                     count += 1;
                 }
                 Ok(None) => break,
