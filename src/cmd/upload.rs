@@ -40,8 +40,8 @@ pub(crate) struct Args {
     #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
     baud: u32,
     /// Commands and the answers they must produce (`/1Q => QHELLO`, one a
-    /// line, `#` comments): checked on the rehearsal, and on `emu` after the
-    /// upload.
+    /// line, `#` comments): checked on the rehearsal, and with `--port emu`
+    /// again after the upload.
     #[arg(long, value_name = "FILE")]
     expect: Option<PathBuf>,
     /// Skip the rehearsal on the virtual Scorpion.
@@ -249,8 +249,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let mut out = String::new();
 
     // The rehearsal: the same upload into a virtual Scorpion, then the
-    // expectations, before the robot is touched.
-    if !emulated && !args.no_dry_run {
+    // expectations, before the robot is touched. (Into `emu` without
+    // expectations it would be the upload itself over again.)
+    if !args.no_dry_run && (!emulated || expectations.is_some()) {
         let robot = ports::virtual_robot(args.baud)?;
         let mut client = args.client(VirtualTransport::new(robot), profile);
         let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
@@ -264,13 +265,16 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         );
         if let Some(expectations) = &expectations {
             let lines = expectations.check(&mut client)?;
-            let _ = write!(
+            let _ = writeln!(
                 out,
-                ", {} expectation{} met\n{}",
+                ", {} expectation{} met",
                 lines.len(),
                 if lines.len() == 1 { "" } else { "s" },
-                transcript(&lines)
             );
+            // On `emu` the transcript follows the upload itself.
+            if !emulated {
+                out.push_str(&transcript(&lines));
+            }
         } else {
             out.push('\n');
         }
@@ -290,7 +294,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let lines = expectations.check(&mut client)?;
         let _ = write!(
             out,
-            "the virtual Scorpion, after the upload:\n{}",
+            "the virtual Scorpion answers, after the upload:\n{}",
             transcript(&lines)
         );
     }

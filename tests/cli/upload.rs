@@ -339,3 +339,62 @@ fn refuses_what_it_cannot_upload_safely() {
         transcript(&output)
     );
 }
+
+#[test]
+fn the_readme_main_job_prints_what_the_readme_says() {
+    // demo/main-job.sh, step by step, with this build's binary.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let build = scorpion(
+        dir.path(),
+        &[
+            "build",
+            &root
+                .join("examples/checksum/checksum.s")
+                .display()
+                .to_string(),
+            "--target",
+            &root
+                .join("examples/checksum/checksum.toml")
+                .display()
+                .to_string(),
+            "-o",
+            "checksum.elf",
+        ],
+    );
+    assert_eq!(build.status.code(), Some(0), "{}", transcript(&build));
+    let upload = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "checksum.elf",
+            "--port",
+            "emu",
+            "--expect",
+            &root.join("demo/checksum.expect").display().to_string(),
+        ],
+    );
+    assert_eq!(upload.status.code(), Some(0), "{}", transcript(&upload));
+    let printed = format!(
+        "== build examples/checksum (a /9K command: the sum of a memory range)\n{}{}\n\
+         == rehearse, upload, verify, ask (demo/checksum.expect)\n{}",
+        String::from_utf8_lossy(&build.stdout),
+        String::from_utf8_lossy(&build.stderr),
+        String::from_utf8_lossy(&upload.stdout),
+    );
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    let block = readme
+        .split("bash demo/main-job.sh\n```\n\n```text\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .expect("the README shows the main job's output");
+    assert_eq!(block, printed, "README.md's main-job output is stale");
+    let script = std::fs::read_to_string(root.join("demo/main-job.sh")).expect("demo/main-job.sh");
+    for step in [
+        "examples/checksum/checksum.s",
+        "--port emu --expect",
+        "demo/checksum.expect",
+    ] {
+        assert!(script.contains(step), "demo/main-job.sh lost `{step}`");
+    }
+}

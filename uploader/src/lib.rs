@@ -2,14 +2,17 @@
 //!
 //! Layers, bottom up:
 //! - [`transport`]: the [`Transport`] trait (bytes with deadlines on the
-//!   transport's own clock) and its implementations: a serial port, a
-//!   fault-injecting wrapper for tests.
+//!   transport's own clock) and its implementations: a serial port, the
+//!   in-process virtual Scorpion (emulated time), a fault-injecting wrapper
+//!   for tests.
 //! - [`Client`]: the command protocol over a transport, through
 //!   [`romlib::protocol`]: probe (`/1X`), questions with timeouts from the
 //!   baud rate, pipelined `/7R` reads.
-//! - [`upload()`]: writes an [`UploadImage`] with `/9W`/`/7W`, verifies every
+//! - [`upload()`]: writes an [`UploadImage`] with `/9W`/`/7W` or through the
+//!   RAM loader (`uploader/loader/`, frames at 19200 baud), verifies every
 //!   byte with overlapping `/7R` reads, rewrites what differs, and installs
-//!   hooks only after the body verified.
+//!   hooks only after the body verified. [`RomProfile`] says where the
+//!   hooks are and what may be written, from the ROM's exported names.
 //!
 //! - [`Expectations`]: commands and the answers they must produce, checked
 //!   on the virtual Scorpion before a real robot is touched.
@@ -35,7 +38,9 @@ pub use expect::{Expectation, Expectations, Required};
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, RomProfile, Services, UploadImage,
 };
-pub use loader::{FAST_BAUD, LoaderPlan, loader_estimate, loader_plan, rom_only_estimate};
+pub use loader::{
+    FAST_BAUD, FRAME_MAX, LoaderPlan, loader_estimate, loader_frame, loader_plan, rom_only_estimate,
+};
 pub use progress::{Event, NoProgress, Phase, Progress};
 pub use transport::Transport;
 pub use upload::{

@@ -36,7 +36,7 @@ pub const FAST_BAUD: u32 = 19200;
 /// to 255). The upload sends one frame per `/7R` span of the verification
 /// (up to 99 bytes), so a frame and the read that checks it travel
 /// together; at 128, a frame's 133 bytes leave most of the 256 keys free.
-pub(crate) const FRAME_MAX: usize = 128;
+pub const FRAME_MAX: usize = 128;
 
 /// Characters a frame adds to its data: `/1L`, the key, four header bytes
 /// and two check bytes.
@@ -320,9 +320,16 @@ fn free_space(profile: &RomProfile, image: &UploadImage, len: usize) -> Option<u
     None
 }
 
-/// A `/1L` frame that writes `data` (1 to [`FRAME_MAX`] bytes) at
-/// `address`: the command, the key, the encoded header with its checksum,
-/// the encoded data. No byte after the command is a slash.
+/// A `/1L` frame for the RAM loader that writes `data` (1 to
+/// [`FRAME_MAX`] bytes; more are cut) at `address`: the command, the key,
+/// the encoded header with its checksum, the encoded data. No byte after
+/// the command is a slash. (See `uploader/loader/frames.s`.)
+#[must_use]
+pub fn loader_frame(address: u16, data: &[u8]) -> Vec<u8> {
+    frame(address, data)
+}
+
+/// [`loader_frame`].
 pub(crate) fn frame(address: u16, data: &[u8]) -> Vec<u8> {
     let [lo, hi] = address.to_le_bytes();
     let count = data.len().clamp(1, FRAME_MAX) as u8;

@@ -1,0 +1,147 @@
+//! The examples in `examples/`, built with our assembler and linker
+//! against the reference ROM, then put into the virtual Scorpion by the
+//! uploader itself (`uploader::upload` over the emulated serial line, the
+//! RAM loader at 19200 baud where it pays), and used through the
+//! expectation files of `scorpion upload --expect`: the whole main job,
+//! across the crates.
+
+mod rom_support;
+
+use rom_support::{build, examples_dir};
+use romlib::symbols::{BAD_COMMAND, HOOK_LOOP, HOOK_UNKNOWN, ROM_LOOP};
+use uploader::transport::VirtualTransport;
+use uploader::{
+    Expectations, LoaderChoice, NoProgress, RomProfile, UploadImage, UploadOptions, UploadReport,
+};
+
+fn image(source: &str, target: &str) -> UploadImage {
+    let linked = build(&[examples_dir().join(source)], target);
+    UploadImage::try_from(&linked).expect("an example is an uploadable image")
+}
+
+fn upload(
+    transport: VirtualTransport,
+    image: &UploadImage,
+    loader: LoaderChoice,
+) -> (UploadReport, VirtualTransport) {
+    let options = UploadOptions {
+        loader,
+        ..UploadOptions::default()
+    };
+    let mut client = uploader::client(transport, &options.profile);
+    let report = uploader::upload(&mut client, image, &options, &mut NoProgress)
+        .unwrap_or_else(|error| panic!("the upload fails: {error:?}"));
+    (report, client.into_transport())
+}
+
+fn check(transport: VirtualTransport, expectations: &str) -> VirtualTransport {
+    let expectations = Expectations::parse(expectations).expect("the expectations parse");
+    let mut client = uploader::client(transport, &RomProfile::reference());
+    expectations
+        .check(&mut client)
+        .unwrap_or_else(|error| panic!("{error}"));
+    client.into_transport()
+}
+
+fn hook(transport: &VirtualTransport, at: u16) -> u16 {
+    let memory = transport.robot().robot().board().memory();
+    u16::from_le_bytes([memory[usize::from(at) + 1], memory[usize::from(at) + 2]])
+}
+
+#[test]
+fn the_patrol_os_goes_in_through_the_loader_and_the_checksum_chains_behind() {
+    // An operating system in KIM-bus RAM: big enough for the loader.
+    let patrol = image("patrol/patrol.s", "scorpion-os");
+    let (report, transport) = upload(VirtualTransport::default(), &patrol, LoaderChoice::Auto);
+    let loader = report.loader.expect("the loader carried it");
+    assert_eq!(loader.baud, uploader::FAST_BAUD);
+    assert_eq!(report.final_passes, 0);
+    let handler = |kind| {
+        patrol
+            .hooks()
+            .iter()
+            .find(|record| record.kind == kind)
+            .expect("patrol takes both hooks")
+            .handler
+    };
+    assert_eq!(
+        hook(&transport, HOOK_LOOP),
+        handler(isa::objfmt::HookKind::Loop)
+    );
+    assert_eq!(
+        hook(&transport, HOOK_UNKNOWN),
+        handler(isa::objfmt::HookKind::Unknown)
+    );
+    let transport = check(transport, "/1X\n/2A0   # patrol stands still\n/1X => X00\n");
+
+    // A second extension: the loader stays out (an extension is installed),
+    // and it chains to patrol's handler.
+    let checksum = image(
+        "checksum/checksum.s",
+        &examples_dir()
+            .join("checksum/checksum.toml")
+            .display()
+            .to_string(),
+    );
+    let (report, transport) = upload(transport, &checksum, LoaderChoice::Auto);
+    assert_eq!(report.loader, None);
+    assert_eq!(
+        report.hooks[0].previous,
+        handler(isa::objfmt::HookKind::Unknown)
+    );
+    let transport = check(
+        transport,
+        "/9W20000102\n/9K20000002 => K0003\n/2A0\n/1X => X00\n",
+    );
+    assert_eq!(
+        hook(&transport, HOOK_LOOP),
+        handler(isa::objfmt::HookKind::Loop)
+    );
+}
+
+#[test]
+fn every_example_uploads_on_both_paths() {
+    for (source, target) in [
+        ("rangefinder/rangefinder.s", "scorpion-ext".to_owned()),
+        (
+            "checksum/checksum.s",
+            examples_dir()
+                .join("checksum/checksum.toml")
+                .display()
+                .to_string(),
+        ),
+        ("patrol/patrol.s", "scorpion-os".to_owned()),
+    ] {
+        let image = image(source, &target);
+        for loader in [LoaderChoice::Never, LoaderChoice::Always] {
+            let (report, transport) = upload(VirtualTransport::default(), &image, loader);
+            assert_eq!(
+                report.loader.is_some(),
+                loader == LoaderChoice::Always,
+                "{source}"
+            );
+            // Every loaded byte is in the robot, and the chain ends in the ROM.
+            let memory = transport.robot().robot().board().memory();
+            for area in image.areas() {
+                let start = usize::from(area.address);
+                let chains: Vec<u16> = image.hooks().iter().filter_map(|r| r.chain).collect();
+                for (i, &byte) in area.bytes.iter().enumerate() {
+                    let at = area.address + i as u16;
+                    if !chains.iter().any(|&slot| at == slot || at == slot + 1) {
+                        assert_eq!(memory[start + i], byte, "{source} at ${at:04X}");
+                    }
+                }
+            }
+            for record in image.hooks() {
+                if let Some(slot) = record.chain {
+                    let to = u16::from_le_bytes([
+                        memory[usize::from(slot)],
+                        memory[usize::from(slot) + 1],
+                    ]);
+                    assert!(to == BAD_COMMAND || to == ROM_LOOP, "{source}: ${to:04X}");
+                }
+            }
+            assert_eq!(transport.robot().robot().board().acia().control(), 0x1E);
+        }
+    }
+}
