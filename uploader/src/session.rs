@@ -159,12 +159,17 @@ impl Session {
         let at_fast = self
             .fast
             .is_some_and(|fast| client.transport().baud() == fast);
+        if self.fast.is_some() {
+            // The frames stage falls through to it, so it is verified
+            // whether or not the line still needs switching.
+            let stage = self.loader.fast.image.clone();
+            self.put(client, &stage, start)?;
+        }
         if let Some(fast) = self.fast
             && !at_fast
         {
-            let stage = self.loader.fast.clone();
-            self.put(client, &stage.image, start)?;
-            switch_hook(client, self.hook, stage.handler, self.limits.max_writes)?;
+            let handler = self.loader.fast.handler;
+            switch_hook(client, self.hook, handler, self.limits.max_writes)?;
             self.target = if self.switch_rate(client, fast)? {
                 fast
             } else {
