@@ -49,6 +49,23 @@
 //! instruction boundary at or after a caller-given cycle, for hosts that
 //! slice time (real-time pacing, cycle limits).
 //!
+//! **A bus may let the CPU skip polls.** [`Bus::quiet_until`] names a
+//! cycle before which every poll would answer [`Interrupts::NONE`] and change
+//! nothing; the CPU compares each instruction's poll point with it (one
+//! comparison) and calls `poll` only from there on. The default, 0, has
+//! every poll made; [`Ram`] answers `u64::MAX`; the Scorpion board answers
+//! the cycle of its next device event while its IRQ line rests released.
+//! A skipped poll counts as NMI released, so a bus must not report a quiet
+//! stretch while the NMI level it last answered was asserted.
+//!
+//! **Dummy reads are marked.** A read whose value the CPU throws away (the
+//! byte after a one-byte opcode, the stack read before a pull, an indexed
+//! mode's un-carried address, a taken branch's extra fetches, the interrupt
+//! sequences' suppressed fetches) is made with [`Bus::dummy_read`]. It still
+//! happens in its own cycle and must have every side effect a read has; the
+//! default calls [`Bus::read`]. A bus may skip the work for addresses where
+//! a read has no effect (plain memory), which is all the marking is for.
+//!
 //! **`peek` has no side effects.** Tracers, disassemblers and debuggers read
 //! memory through [`Bus::peek`], which must not change any state (no flag
 //! cleared, no catch-up); a register that cannot be read without a side
@@ -85,6 +102,14 @@ pub trait Bus {
     /// Writes `value` to `address` during bus cycle `cycle`.
     fn write(&mut self, address: u16, value: u8, cycle: u64);
 
+    /// A read of `address` during bus cycle `cycle` whose value the CPU
+    /// ignores (see the [module documentation](self)). Its side effects are
+    /// those of [`Bus::read`]; a bus may skip the rest.
+    #[inline(always)]
+    fn dummy_read(&mut self, address: u16, cycle: u64) {
+        self.read(address, cycle);
+    }
+
     /// The byte a read of `address` would return now, without any side
     /// effect. For tracers and debuggers.
     fn peek(&self, address: u16) -> u8;
@@ -97,6 +122,30 @@ pub trait Bus {
     fn poll(&mut self, cycle: u64) -> Interrupts {
         let _ = cycle;
         Interrupts::NONE
+    }
+
+    /// A cycle before which [`Bus::poll`] would answer
+    /// [`Interrupts::NONE`] for every cycle and change nothing, so the CPU
+    /// skips those polls. Read after every instruction, so it may move
+    /// either way with any access or poll. A skipped poll counts as NMI
+    /// released: while the NMI level last answered by `poll` is asserted,
+    /// return no more than the next poll's cycle (0 will do). The default,
+    /// 0, has every poll made.
+    #[inline(always)]
+    fn quiet_until(&self) -> u64 {
+        0
+    }
+
+    /// True if a read of `address` has no side effect and returns what the
+    /// CPU last wrote there (or a loader put there): memory that nothing
+    /// but the CPU's writes changes, as long as the CPU runs. What lets
+    /// [`crate::Cpu::run`] skip iterations of a loop that only reads such
+    /// memory (see [`crate::Cpu::set_idle_skip`]). The default, false for
+    /// every address, never allows it.
+    #[inline(always)]
+    fn is_plain_memory(&self, address: u16) -> bool {
+        let _ = address;
+        false
     }
 }
 
@@ -112,6 +161,11 @@ impl<B: Bus + ?Sized> Bus for &mut B {
     }
 
     #[inline(always)]
+    fn dummy_read(&mut self, address: u16, cycle: u64) {
+        (**self).dummy_read(address, cycle);
+    }
+
+    #[inline(always)]
     fn peek(&self, address: u16) -> u8 {
         (**self).peek(address)
     }
@@ -119,6 +173,16 @@ impl<B: Bus + ?Sized> Bus for &mut B {
     #[inline(always)]
     fn poll(&mut self, cycle: u64) -> Interrupts {
         (**self).poll(cycle)
+    }
+
+    #[inline(always)]
+    fn quiet_until(&self) -> u64 {
+        (**self).quiet_until()
+    }
+
+    #[inline(always)]
+    fn is_plain_memory(&self, address: u16) -> bool {
+        (**self).is_plain_memory(address)
     }
 }
 
@@ -258,8 +322,22 @@ impl Bus for Ram {
     }
 
     #[inline(always)]
+    fn dummy_read(&mut self, _address: u16, _cycle: u64) {}
+
+    #[inline(always)]
     fn peek(&self, address: u16) -> u8 {
         self.bytes[usize::from(address)]
+    }
+
+    #[inline(always)]
+    fn quiet_until(&self) -> u64 {
+        // No interrupt source: every poll would answer NONE.
+        u64::MAX
+    }
+
+    #[inline(always)]
+    fn is_plain_memory(&self, _address: u16) -> bool {
+        true
     }
 }
 

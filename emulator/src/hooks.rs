@@ -24,6 +24,12 @@ pub enum Control {
 /// Called by [`Cpu::run`] around what it executes. Methods receive the CPU
 /// and a shared view of the bus (read it with [`Bus::peek`] only).
 pub trait Hooks {
+    /// True for hooks whose methods do nothing and never stop the run
+    /// ([`NoHooks`]): only then may [`Cpu::run`] skip iterations of an idle
+    /// loop instead of running them ([`Cpu::set_idle_skip`]). Hooks that
+    /// trace or stop must see every instruction, so the default is false.
+    const PASSIVE: bool = false;
+
     /// Before each instruction, with the registers as the instruction will
     /// see them. [`Control::Stop`] ends the run before it executes.
     #[inline(always)]
@@ -53,7 +59,9 @@ pub trait Hooks {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoHooks;
 
-impl Hooks for NoHooks {}
+impl Hooks for NoHooks {
+    const PASSIVE: bool = true;
+}
 
 /// Ends the run at the first trap (an instruction that jumps or branches to
 /// itself).
@@ -68,6 +76,8 @@ impl Hooks for StopAtTrap {
 }
 
 impl<H: Hooks + ?Sized> Hooks for &mut H {
+    const PASSIVE: bool = H::PASSIVE;
+
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
         (**self).before_instruction(cpu, bus)
@@ -86,6 +96,8 @@ impl<H: Hooks + ?Sized> Hooks for &mut H {
 
 /// Both hooks, the first one first; either can stop the run.
 impl<H1: Hooks, H2: Hooks> Hooks for (H1, H2) {
+    const PASSIVE: bool = H1::PASSIVE && H2::PASSIVE;
+
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
         match self.0.before_instruction(cpu, bus) {

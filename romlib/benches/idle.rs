@@ -63,64 +63,164 @@ fn run(robot: &mut VirtualScorpion, cycles: u64) -> u64 {
     black_box(robot.cycles() - start)
 }
 
+/// A robot past boot, idle-loop skipping as `skip` says.
+fn robot(skip: bool) -> VirtualScorpion {
+    let mut robot = VirtualScorpion::new();
+    robot.robot_mut().cpu.set_idle_skip(skip);
+    robot
+}
+
+/// The same idle code on the plain RAM machine: the ROM's memory after
+/// boot copied into 64 KiB of RAM, the CPU as the board's (no interrupt
+/// comes: nothing is sent and no timer runs while the ROM idles). Idle-loop
+/// skipping off: this is the CPU's own speed on that code.
+fn same_code_machine() -> RamMachine {
+    let robot = robot(false);
+    let mut plain = RamMachine::with_image(0, robot.robot().board().memory()).expect("64 KiB");
+    plain.cpu = robot.robot().cpu.clone();
+    plain
+}
+
+/// A robot with both drives stepping (the 1 kHz motion tick interrupting).
+fn moving(skip: bool) -> VirtualScorpion {
+    let mut robot = robot(skip);
+    robot.send(b"/4C+50/4D-50");
+    robot.settle().expect("the ROM does not jam");
+    robot
+}
+
+/// Two seconds of back-to-back `/9W` at 9600 baud sent to `robot`, and the
+/// two seconds run.
+fn writes(robot: &mut VirtualScorpion) -> u64 {
+    let burst: Vec<u8> = b"/9W10001234".repeat(174);
+    robot.send(&burst);
+    run(robot, 2_000_000)
+}
+
+/// `IDLE_BENCH_ONLY=<workload> [IDLE_BENCH_CYCLES=n]`: runs that one
+/// workload once, untimed, and prints the cycles it ran: for
+/// `valgrind --tool=callgrind --toggle-collect='emulator::cpu::Cpu::run*'`,
+/// whose instruction count divided by the cycles is the host cost of an
+/// emulated cycle, repeatable on a busy machine. Workloads: `sieve`,
+/// `idle` (skipping off), `idle-skip`, `same-code`, `motors` (skipping
+/// off), `motors-skip`.
+fn only(workload: &str) {
+    let cycles: u64 = std::env::var("IDLE_BENCH_CYCLES")
+        .ok()
+        .and_then(|text| text.parse().ok())
+        .unwrap_or(20_000_000);
+    let ran = match workload {
+        "sieve" => sieve() / 10,
+        "idle" => run(&mut robot(false), cycles),
+        "idle-skip" => run(&mut robot(true), cycles),
+        "motors" => run(&mut moving(false), cycles),
+        "motors-skip" => run(&mut moving(true), cycles),
+        "same-code" => {
+            let mut plain = same_code_machine();
+            let start = plain.cpu.cycles();
+            plain.run(start + cycles);
+            plain.cpu.cycles() - start
+        }
+        other => panic!("IDLE_BENCH_ONLY: no workload {other:?}"),
+    };
+    println!("{workload}: {ran} cycles");
+}
+
 fn main() {
-    let mut idle_robot = VirtualScorpion::new();
-    // The same idle code on the plain RAM machine: the ROM's memory after
-    // boot copied into 64 KiB of RAM (no interrupt comes: nothing is sent
-    // and no timer runs while the ROM idles).
-    let mut plain = RamMachine::with_image(0, idle_robot.robot().board().memory()).expect("64 KiB");
-    plain.cpu = idle_robot.robot().cpu.clone();
-    let mut moving = VirtualScorpion::new();
-    moving.send(b"/4C+50/4D-50");
-    moving.settle().expect("the ROM does not jam");
-    let mut writing = VirtualScorpion::new();
-    let mut cpu = sieve;
-    let mut idle = || run(&mut idle_robot, 50_000_000);
+    if let Ok(workload) = std::env::var("IDLE_BENCH_ONLY") {
+        only(&workload);
+        return;
+    }
+    let mut idle_skip = robot(true);
+    let mut idle_exact = robot(false);
+    let mut plain = same_code_machine();
+    let mut moving_skip = moving(true);
+    let mut moving_exact = moving(false);
+    let mut writing_skip = robot(true);
+    let mut writing_exact = robot(false);
+    let mut cpu = || sieve();
+    let mut idle_on = || run(&mut idle_skip, 50_000_000);
+    let mut idle_off = || run(&mut idle_exact, 50_000_000);
     let mut same_code = || {
         let start = plain.cpu.cycles();
         plain.run(start + 50_000_000);
         black_box(plain.cpu.cycles() - start)
     };
-    let mut motors = || run(&mut moving, 20_000_000);
-    let mut writes = || {
-        // Two seconds of back-to-back /9W at 9600 baud.
-        let burst: Vec<u8> = b"/9W10001234".repeat(174);
-        writing.send(&burst);
-        run(&mut writing, 2_000_000)
-    };
+    let mut motors_on = || run(&mut moving_skip, 20_000_000);
+    let mut motors_off = || run(&mut moving_exact, 20_000_000);
+    let mut writes_on = || writes(&mut writing_skip);
+    let mut writes_off = || writes(&mut writing_exact);
     let measured = rates(&mut [
         &mut cpu,
-        &mut idle,
+        &mut idle_on,
+        &mut idle_off,
         &mut same_code,
-        &mut motors,
-        &mut writes,
+        &mut motors_on,
+        &mut motors_off,
+        &mut writes_on,
+        &mut writes_off,
     ]);
-    let [cpu, idle, same_code, motors, writes] = measured[..] else {
-        unreachable!("five workloads")
+    let [
+        cpu,
+        idle_on,
+        idle_off,
+        same_code,
+        motors_on,
+        motors_off,
+        writes_on,
+        writes_off,
+    ] = measured[..]
+    else {
+        unreachable!("eight workloads")
     };
     let mega = |rate: f64| rate / 1e6;
+    let share = |robot: &VirtualScorpion| {
+        let cpu = &robot.robot().cpu;
+        #[allow(clippy::cast_precision_loss, reason = "a share")]
+        let share = cpu.skipped_cycles() as f64 / cpu.cycles() as f64;
+        share
+    };
     println!(
-        "CPU benchmark (sieve, RAM machine): {:8.1} M cycles/s",
+        "CPU benchmark (sieve, RAM machine):      {:10.1} M cycles/s",
         mega(cpu)
     );
     println!(
-        "board, ROM idle:                    {:8.1} M cycles/s  {:.2} of the CPU benchmark (target >= 0.80)",
-        mega(idle),
-        idle / cpu
+        "board, ROM idle, idle skipping on:       {:10.1} M cycles/s  {:8.2} of the CPU benchmark (target >= 0.80)  {:.3} of its cycles skipped",
+        mega(idle_on),
+        idle_on / cpu,
+        share(&idle_skip)
     );
     println!(
-        "same idle code, RAM machine:        {:8.1} M cycles/s  the board keeps {:.2} of it",
+        "board, ROM idle, every cycle run:        {:10.1} M cycles/s  {:8.2} of the CPU benchmark",
+        mega(idle_off),
+        idle_off / cpu
+    );
+    println!(
+        "same idle code, RAM machine, run:        {:10.1} M cycles/s  {:8.2}  (the board keeps {:.2} of it)",
         mega(same_code),
-        idle / same_code
+        same_code / cpu,
+        idle_off / same_code
     );
     println!(
-        "board, both drives stepping:        {:8.1} M cycles/s  {:.2}",
-        mega(motors),
-        motors / cpu
+        "board, both drives stepping, skipping:   {:10.1} M cycles/s  {:8.2}  {:.3} skipped",
+        mega(motors_on),
+        motors_on / cpu,
+        share(&moving_skip)
     );
     println!(
-        "board, receiving /9W at 9600 baud:  {:8.1} M cycles/s  {:.2}",
-        mega(writes),
-        writes / cpu
+        "board, both drives stepping, run:        {:10.1} M cycles/s  {:8.2}",
+        mega(motors_off),
+        motors_off / cpu
+    );
+    println!(
+        "board, /9W at 9600 baud, skipping:       {:10.1} M cycles/s  {:8.2}  {:.3} skipped",
+        mega(writes_on),
+        writes_on / cpu,
+        share(&writing_skip)
+    );
+    println!(
+        "board, /9W at 9600 baud, run:            {:10.1} M cycles/s  {:8.2}",
+        mega(writes_off),
+        writes_off / cpu
     );
 }

@@ -91,11 +91,42 @@ impl Motor {
     }
 }
 
+/// The 64 KiB behind the address space, held in the board itself rather
+/// than behind a pointer: the run loop then reaches a byte with one load
+/// from the board's address, which it keeps in a register (a pointer field
+/// would be reloaded after every call the loop might make).
+#[derive(Clone)]
+struct Memory([u8; 0x1_0000]);
+
+impl core::fmt::Debug for Memory {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        // 64 KiB of bytes helps nobody; the vectors identify the ROM.
+        let word = |at: usize| u16::from_le_bytes([self.0[at], self.0[at + 1]]);
+        f.debug_struct("Memory")
+            .field("reset_vector", &format_args!("${:04X}", word(0xFFFC)))
+            .field("irq_vector", &format_args!("${:04X}", word(0xFFFE)))
+            .finish_non_exhaustive()
+    }
+}
+
+impl core::ops::Deref for Memory {
+    type Target = [u8; 0x1_0000];
+    fn deref(&self) -> &[u8; 0x1_0000] {
+        &self.0
+    }
+}
+
+impl core::ops::DerefMut for Memory {
+    fn deref_mut(&mut self) -> &mut [u8; 0x1_0000] {
+        &mut self.0
+    }
+}
+
 /// The Scorpion controller card: memory, chips, latches and what they are
 /// wired to.
 #[derive(Debug)]
 pub struct Board {
-    memory: Box<[u8; 0x1_0000]>,
+    memory: Memory,
     pages: [Page; 256],
     via: Via,
     acia: Acia,
@@ -129,6 +160,9 @@ pub struct Board {
     /// unconnected space, and KIM-bus pages holding a device); everything
     /// below, and the ROM, is plain memory.
     slow_start: u16,
+    /// `$F000 - slow_start`: the length of the slow span, so that one
+    /// wrapping subtraction and one comparison place an address.
+    slow_span: u16,
     rom_writes: u64,
 }
 
@@ -147,10 +181,7 @@ impl Board {
         if rom.len() != map::ROM_SIZE {
             return Err(crate::Error::RomSize { len: rom.len() });
         }
-        let mut memory: Box<[u8; 0x1_0000]> = vec![0u8; 0x1_0000]
-            .into_boxed_slice()
-            .try_into()
-            .unwrap_or_else(|_| unreachable!("the vector has exactly 64 KiB"));
+        let mut memory = Memory([0; 0x1_0000]);
         memory[usize::from(map::ROM_START)..].copy_from_slice(rom);
         let mut pages = [Page::Open; 256];
         for (index, page) in pages.iter_mut().enumerate() {
@@ -187,6 +218,7 @@ impl Board {
             irq_changed_at: 0,
             last_poll: 0,
             slow_start: map::IO_START,
+            slow_span: map::ROM_START - map::IO_START,
             rom_writes: 0,
         };
         board.set_bumpers(0, 0);
@@ -285,6 +317,7 @@ impl Board {
             self.pages[usize::from(page)] = Page::Kim;
         }
         self.slow_start = self.slow_start.min(start & 0xFF00);
+        self.slow_span = map::ROM_START - self.slow_start;
         self.kim.push(KimSlot {
             start,
             end,
@@ -478,6 +511,21 @@ impl Board {
     #[must_use]
     pub fn rom_writes(&self) -> u64 {
         self.rom_writes
+    }
+
+    /// Whether a read of `address` is a plain memory read (outside
+    /// `slow_start..$F000`): one subtraction and one comparison, so that
+    /// fetches and RAM accesses cost about what they cost on a RAM bus.
+    #[inline(always)]
+    fn is_plain_read(&self, address: u16) -> bool {
+        address <= map::RAM_END || address.wrapping_sub(self.slow_start) >= self.slow_span
+    }
+
+    /// Whether a write to `address` is a plain memory write (the ROM is
+    /// not: a write there is counted and dropped).
+    #[inline(always)]
+    fn is_plain_write(&self, address: u16) -> bool {
+        address <= map::RAM_END || address < self.slow_start
     }
 
     /// Processes every device event up to `cycle`, each at its own cycle.
@@ -674,9 +722,7 @@ impl Board {
 impl Bus for Board {
     #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
-        // Two comparisons on the address and no table: the CPU's fetches
-        // and RAM accesses must cost no more than on a plain RAM bus.
-        if address < self.slow_start || address >= map::ROM_START {
+        if self.is_plain_read(address) {
             self.memory[usize::from(address)]
         } else {
             self.slow_read(address, cycle)
@@ -685,10 +731,18 @@ impl Bus for Board {
 
     #[inline(always)]
     fn write(&mut self, address: u16, value: u8, cycle: u64) {
-        if address < self.slow_start {
+        if self.is_plain_write(address) {
             self.memory[usize::from(address)] = value;
         } else {
             self.slow_write(address, value, cycle);
+        }
+    }
+
+    #[inline(always)]
+    fn dummy_read(&mut self, address: u16, cycle: u64) {
+        // Reading memory has no effect: only device addresses are visited.
+        if !self.is_plain_read(address) {
+            self.slow_read(address, cycle);
         }
     }
 
@@ -714,6 +768,20 @@ impl Bus for Board {
             return Interrupts::NONE;
         }
         self.poll_slow(cycle)
+    }
+
+    #[inline(always)]
+    fn quiet_until(&self) -> u64 {
+        // Below `attention` a poll returns NONE without touching anything
+        // (see `poll`); NMI is not connected.
+        self.attention
+    }
+
+    #[inline(always)]
+    fn is_plain_memory(&self, address: u16) -> bool {
+        // RAM, KIM-bus RAM and the ROM; not the I/O page, unconnected
+        // space or a KIM-bus device's page.
+        self.is_plain_read(address)
     }
 }
 

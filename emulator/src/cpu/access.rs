@@ -15,6 +15,14 @@ impl Cpu {
         value
     }
 
+    /// One read cycle whose value is ignored (a dummy read, see
+    /// [`Bus::dummy_read`]).
+    #[inline(always)]
+    pub(super) fn dummy_read<B: Bus>(&mut self, bus: &mut B, address: u16) {
+        bus.dummy_read(address, self.cycles);
+        self.cycles += 1;
+    }
+
     /// One write cycle.
     #[inline(always)]
     pub(super) fn write<B: Bus>(&mut self, bus: &mut B, address: u16, value: u8) {
@@ -42,14 +50,14 @@ impl Cpu {
     /// is read and ignored; PC does not move.
     #[inline(always)]
     pub(super) fn dummy_pc<B: Bus>(&mut self, bus: &mut B) {
-        self.read(bus, self.pc);
+        self.dummy_read(bus, self.pc);
     }
 
     /// The dummy read of the stack top that precedes a pull (and JSR's
     /// internal cycle).
     #[inline(always)]
     pub(super) fn dummy_stack<B: Bus>(&mut self, bus: &mut B) {
-        self.read(bus, 0x0100 | u16::from(self.s));
+        self.dummy_read(bus, 0x0100 | u16::from(self.s));
     }
 
     /// Pushes a byte: write at `$0100 + S`, then S decreases.
@@ -85,7 +93,7 @@ impl Cpu {
     #[inline(always)]
     pub(super) fn zpx<B: Bus>(&mut self, bus: &mut B) -> u16 {
         let base = self.fetch(bus);
-        self.read(bus, u16::from(base));
+        self.dummy_read(bus, u16::from(base));
         u16::from(base.wrapping_add(self.x))
     }
 
@@ -93,7 +101,7 @@ impl Cpu {
     #[inline(always)]
     pub(super) fn zpy<B: Bus>(&mut self, bus: &mut B) -> u16 {
         let base = self.fetch(bus);
-        self.read(bus, u16::from(base));
+        self.dummy_read(bus, u16::from(base));
         u16::from(base.wrapping_add(self.y))
     }
 
@@ -112,7 +120,7 @@ impl Cpu {
     fn indexed<B: Bus>(&mut self, bus: &mut B, base: u16, index: u8, always: bool) -> u16 {
         let address = base.wrapping_add(u16::from(index));
         if always || (base ^ address) & 0xFF00 != 0 {
-            self.read(bus, (base & 0xFF00) | (address & 0x00FF));
+            self.dummy_read(bus, (base & 0xFF00) | (address & 0x00FF));
         }
         address
     }
@@ -150,7 +158,7 @@ impl Cpu {
     #[inline(always)]
     pub(super) fn izx<B: Bus>(&mut self, bus: &mut B) -> u16 {
         let base = self.fetch(bus);
-        self.read(bus, u16::from(base));
+        self.dummy_read(bus, u16::from(base));
         let pointer = base.wrapping_add(self.x);
         let lo = self.read(bus, u16::from(pointer));
         let hi = self.read(bus, u16::from(pointer.wrapping_add(1)));

@@ -9,7 +9,7 @@
 //! one-access-per-cycle bus traffic against that table, and the py65 and
 //! Dormann tests check what the arms compute.
 
-use super::{Cpu, JAM, LATE_POLL, NO_POLL, OLD_I, TRAP, flag};
+use super::{Cpu, JAM, LATE_POLL, NO_POLL, TRAP, flag};
 use crate::bus::Bus;
 
 impl Cpu {
@@ -105,8 +105,9 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.dummy_stack(bus);
                 let p = self.pull(bus);
+                let flow = self.old_i();
                 self.set_p(p);
-                return OLD_I;
+                return flow;
             }
             0x29 => read!(imm, and), // AND Immediate
             // ROL Accumulator
@@ -174,8 +175,9 @@ impl Cpu {
             // CLI Implied
             0x58 => {
                 self.dummy_pc(bus);
+                let flow = self.old_i();
                 self.set_i(false);
-                return OLD_I;
+                return flow;
             }
             0x59 => read!(aby, eor),    // EOR AbsoluteY
             0x5A => self.dummy_pc(bus), // NOP Implied
@@ -221,8 +223,9 @@ impl Cpu {
             // SEI Implied
             0x78 => {
                 self.dummy_pc(bus);
+                let flow = self.old_i();
                 self.set_i(true);
-                return OLD_I;
+                return flow;
             }
             0x79 => read!(aby, adc),              // ADC AbsoluteY
             0x7A => self.dummy_pc(bus),           // NOP Implied
@@ -454,7 +457,7 @@ impl Cpu {
         self.dummy_pc(bus);
         let target = self.pc.wrapping_add_signed(i16::from(offset));
         let mut flow = if (target ^ self.pc) & 0xFF00 != 0 {
-            self.read(bus, (self.pc & 0xFF00) | (target & 0x00FF));
+            self.dummy_read(bus, (self.pc & 0xFF00) | (target & 0x00FF));
             0
         } else {
             LATE_POLL
@@ -506,7 +509,8 @@ impl Cpu {
         let lo = self.pull(bus);
         let hi = self.pull(bus);
         self.pc = u16::from_le_bytes([lo, hi]);
-        self.fetch(bus);
+        self.dummy_read(bus, self.pc);
+        self.pc = self.pc.wrapping_add(1);
     }
 
     /// RTI (6 cycles): pull P, then PC. The restored I flag is in force for
@@ -526,7 +530,8 @@ impl Cpu {
     /// interrupt sequence pushes P with B set.
     #[inline(always)]
     fn brk<B: Bus>(&mut self, bus: &mut B) -> u8 {
-        self.fetch(bus);
+        self.dummy_read(bus, self.pc);
+        self.pc = self.pc.wrapping_add(1);
         self.interrupt_tail(bus, flag::B);
         NO_POLL
     }

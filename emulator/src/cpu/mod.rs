@@ -22,9 +22,11 @@
 mod access;
 mod alu;
 mod execute;
+mod idle;
 
 use crate::bus::Bus;
 use crate::hooks::{Control, Hooks, NoHooks};
+use idle::IdleSkip;
 
 /// Bits of the processor status register P.
 pub mod flag {
@@ -109,7 +111,8 @@ pub enum Step {
 // What an instruction tells the step about its interrupt poll and outcome.
 /// Poll one cycle earlier (a taken branch that stays in its page).
 const LATE_POLL: u8 = 1;
-/// Poll with the I flag as it was before the instruction (CLI, SEI, PLP).
+/// Poll with the I flag as it was before the instruction (CLI, SEI, PLP),
+/// which `I_WAS_SET` gives.
 const OLD_I: u8 = 2;
 /// The instruction jumped or branched to its own address.
 const TRAP: u8 = 4;
@@ -117,11 +120,18 @@ const TRAP: u8 = 4;
 const JAM: u8 = 8;
 /// No poll at the end (BRK: the interrupt sequence has its own).
 const NO_POLL: u8 = 16;
+/// With `OLD_I`: I was set before the instruction.
+const I_WAS_SET: u8 = 32;
+/// The instruction's poll was made (not skipped as quiet).
+const POLLED: u8 = 64;
 
 /// An NMOS 6502. Registers are public fields; the status register is read
 /// and written through [`Cpu::p`] and [`Cpu::set_p`] because the CPU keeps
 /// its flags unpacked.
-#[derive(Clone, PartialEq, Eq)]
+///
+/// Two CPUs are equal when their registers, flags, counters and interrupt
+/// state are; the idle-skip setting and schedule are not compared.
+#[derive(Clone)]
 pub struct Cpu {
     /// Accumulator.
     pub a: u8,
@@ -148,7 +158,42 @@ pub struct Cpu {
     nmi_pending: bool,
     // An IRQ was asserted with I clear at the last poll.
     irq_pending: bool,
+    // Idle-loop skipping (see `idle`): not machine state.
+    idle: IdleSkip,
 }
+
+impl PartialEq for Cpu {
+    fn eq(&self, other: &Cpu) -> bool {
+        (
+            self.a,
+            self.x,
+            self.y,
+            self.s,
+            self.pc,
+            self.n,
+            self.z,
+            self.c,
+            self.vdi,
+            self.cycles,
+            self.instructions,
+        ) == (
+            other.a,
+            other.x,
+            other.y,
+            other.s,
+            other.pc,
+            other.n,
+            other.z,
+            other.c,
+            other.vdi,
+            other.cycles,
+            other.instructions,
+        ) && (self.nmi_line, self.nmi_pending, self.irq_pending)
+            == (other.nmi_line, other.nmi_pending, other.irq_pending)
+    }
+}
+
+impl Eq for Cpu {}
 
 impl Default for Cpu {
     fn default() -> Cpu {
@@ -214,7 +259,34 @@ impl Cpu {
             nmi_line: false,
             nmi_pending: false,
             irq_pending: false,
+            idle: IdleSkip::new(),
         }
+    }
+
+    /// Allows or forbids idle-loop skipping in [`Cpu::run`] (allowed by
+    /// default). When the program goes round a loop that makes no write and
+    /// reads only plain memory, with every register back as it was, the
+    /// run advances whole iterations up to the next moment a device could
+    /// act (the bus's [`Bus::quiet_until`]) or the run's limit, counting
+    /// their cycles and instructions as if it had run them: the state
+    /// afterwards is exactly the state running them would leave. It only
+    /// happens with hooks that observe nothing ([`Hooks::PASSIVE`]) and a
+    /// bus that vouches for its memory ([`Bus::is_plain_memory`]).
+    pub fn set_idle_skip(&mut self, allowed: bool) {
+        self.idle.enabled = allowed;
+    }
+
+    /// Whether idle-loop skipping is allowed (see [`Cpu::set_idle_skip`]).
+    #[must_use]
+    pub const fn idle_skip(&self) -> bool {
+        self.idle.enabled
+    }
+
+    /// Cycles this CPU advanced by skipping idle-loop iterations rather
+    /// than running them (included in [`Cpu::cycles`]).
+    #[must_use]
+    pub const fn skipped_cycles(&self) -> u64 {
+        self.idle.skipped_cycles
     }
 
     /// The status register as PHP would push it without the B bit (bit 5
@@ -300,10 +372,10 @@ impl Cpu {
     /// the vector at `$FFFC`. Sets I; D is left alone, as on the NMOS part.
     /// Pending interrupts are forgotten.
     pub fn reset<B: Bus>(&mut self, bus: &mut B) {
-        self.read(bus, self.pc);
-        self.read(bus, self.pc);
+        self.dummy_read(bus, self.pc);
+        self.dummy_read(bus, self.pc);
         for _ in 0..3 {
-            self.read(bus, 0x0100 | u16::from(self.s));
+            self.dummy_read(bus, 0x0100 | u16::from(self.s));
             self.s = self.s.wrapping_sub(1);
         }
         self.set_i(true);
@@ -361,6 +433,8 @@ impl Cpu {
 
     #[inline(always)]
     fn run_local<B: Bus, H: Hooks>(&mut self, bus: &mut B, until: u64, hooks: &mut H) -> Stop {
+        // A constant `false` unless the hooks observe nothing.
+        let probing = H::PASSIVE && self.idle.enabled;
         loop {
             if self.cycles >= until {
                 return Stop::Limit;
@@ -370,27 +444,52 @@ impl Cpu {
                 hooks.interrupt(self, &*bus, kind);
                 continue;
             }
+            if probing && self.cycles >= self.idle.next_probe {
+                // On a copy, so that this loop's CPU never has its address
+                // taken and stays in machine registers.
+                let mut cpu = self.clone();
+                let flow = cpu.probe_idle(bus, until);
+                *self = cpu;
+                if flow & JAM != 0 {
+                    return Stop::Jam {
+                        pc: self.pc,
+                        opcode: bus.peek(self.pc),
+                    };
+                }
+                continue;
+            }
+            // The inner loop also ends at the next probe: the comparison it
+            // makes anyway.
+            let limit = if probing {
+                until.min(self.idle.next_probe)
+            } else {
+                until
+            };
             // Instructions back to back until a poll finds an interrupt or
-            // the limit is reached. Nothing here reads P as a whole, and with
-            // a bus that has no interrupt source the pending check folds
-            // away.
+            // the limit is reached. Nothing here reads P as a whole; the
+            // pending flags can only change where a poll was made, and with
+            // a bus that has no interrupt source the polls fold away.
             loop {
                 if let Control::Stop = hooks.before_instruction(self, &*bus) {
                     return Stop::Hook { pc: self.pc };
                 }
                 let flow = self.instruction(bus);
-                if flow & (TRAP | JAM) != 0 {
-                    if flow & JAM != 0 {
-                        return Stop::Jam {
-                            pc: self.pc,
-                            opcode: bus.peek(self.pc),
-                        };
-                    }
+                if flow & JAM != 0 {
+                    return Stop::Jam {
+                        pc: self.pc,
+                        opcode: bus.peek(self.pc),
+                    };
+                }
+                // Without a trap hook this folds away, and so does the
+                // instructions' trap detection.
+                if flow & TRAP != 0 {
                     if let Control::Stop = hooks.trap(self, &*bus) {
                         return Stop::Trap { pc: self.pc };
                     }
                 }
-                if self.nmi_pending || self.irq_pending || self.cycles >= until {
+                if (flow & POLLED != 0 && (self.nmi_pending || self.irq_pending))
+                    || self.cycles >= limit
+                {
                     break;
                 }
             }
@@ -404,10 +503,14 @@ impl Cpu {
     }
 
     /// One instruction and its interrupt poll. Returns the flow bits.
+    ///
+    /// The poll is skipped when the bus says it would find nothing
+    /// ([`Bus::quiet_until`]); a skipped poll changes nothing here either,
+    /// since the run loop only runs instructions with no interrupt pending
+    /// and a bus only reports quiet while NMI rests released.
     #[inline(always)]
     fn instruction<B: Bus>(&mut self, bus: &mut B) -> u8 {
         let pc = self.pc;
-        let i_before = self.i();
         let opcode = self.fetch(bus);
         let flow = self.execute(bus, opcode, pc);
         if flow & (JAM | NO_POLL) != 0 {
@@ -422,14 +525,27 @@ impl Cpu {
             return flow;
         }
         self.instructions += 1;
+        // Every poll point lies before the instruction's end (two cycles
+        // or more before it): one comparison decides, and with a bus that
+        // is always quiet (`u64::MAX`) it folds away.
+        if self.cycles <= bus.quiet_until() {
+            return flow;
+        }
         let poll_at = self.cycles - 2 - u64::from(flow & LATE_POLL);
         let i = if flow & OLD_I != 0 {
-            i_before
+            flow & I_WAS_SET != 0
         } else {
             self.i()
         };
         self.poll(bus, poll_at, i);
-        flow
+        flow | POLLED
+    }
+
+    /// The flow bits of CLI, SEI and PLP, taken before they change I: their
+    /// poll sees I as it was.
+    #[inline(always)]
+    fn old_i(&self) -> u8 {
+        if self.i() { OLD_I | I_WAS_SET } else { OLD_I }
     }
 
     /// Samples the interrupt inputs for bus cycle `cycle`, with I as it was
@@ -446,8 +562,8 @@ impl Cpu {
     /// common tail with B clear.
     #[inline(always)]
     fn interrupt_sequence<B: Bus>(&mut self, bus: &mut B) -> Interrupt {
-        self.read(bus, self.pc);
-        self.read(bus, self.pc);
+        self.dummy_read(bus, self.pc);
+        self.dummy_read(bus, self.pc);
         self.interrupt_tail(bus, 0)
     }
 

@@ -1,0 +1,225 @@
+//! Idle-loop skipping: when the program goes round a loop that can only
+//! repeat itself until a device acts, the run advances whole iterations at
+//! once, counting their cycles and instructions as if it had run them.
+//!
+//! # Why it is exact
+//!
+//! A probe runs real instructions (nothing is executed twice or undone)
+//! through [`ProbeBus`], which passes every call on and notes whether any of
+//! them was a write or a read of something other than plain memory
+//! ([`Bus::is_plain_memory`]: no side effect, and a value only the CPU's own
+//! writes change). When the PC comes back to where the probe started, with
+//! every register and flag byte-for-byte as it was and nothing but plain
+//! reads in between, the next iteration would start from the same state and
+//! read the same memory, which nothing can have changed, so it would take
+//! the same path, the same accesses and the same `C` cycles and `I`
+//! instructions; and so would every iteration after it, as long as none of
+//! their interrupt polls could find anything. The polls are the only way the
+//! outside world reaches the CPU, so the skip is bounded by
+//! [`Bus::quiet_until`] (every instruction of the skipped iterations ends at
+//! or before it, so each of their polls would have been skipped too) and by
+//! the run's limit (every instruction of them ends before it, so the run
+//! would not have stopped among them). The state after `k` skipped
+//! iterations is then the state now with `k * C` more cycles and `k * I`
+//! more instructions, which is what the skip produces.
+//!
+//! Skipping is off with any hook that is not [`Hooks::PASSIVE`](crate::Hooks)
+//! (tracing and breakpoints see every instruction), off in [`Cpu::step`],
+//! off for a bus that does not vouch for its memory (the default), and can
+//! be switched off with [`Cpu::set_idle_skip`] (the equivalence test runs a
+//! whole session both ways and compares everything).
+//!
+//! # Cost
+//!
+//! Probes run at most every few dozen cycles after a success and back off
+//! to every 64K cycles while the program is busy, so code that never idles
+//! pays almost nothing; the run loop only compares its cycle counter with
+//! the earlier of the run's limit and the next probe, one comparison it
+//! makes anyway.
+
+use super::{Cpu, JAM, POLLED};
+use crate::bus::{Bus, Interrupts};
+
+/// Cycles from a success (or a skip) to the next probe.
+const MIN_GAP: u64 = 64;
+/// The longest wait between probes while nothing is found.
+const MAX_GAP: u64 = 1 << 16;
+/// The longest loop a probe recognises, in instructions.
+const MAX_LOOP: u32 = 32;
+/// Instructions one probe may run before giving up.
+const BUDGET: u32 = 3 * MAX_LOOP;
+/// No skip carries the cycle counter past this: a host that runs "forever"
+/// (a limit of `u64::MAX`) keeps room for the counter to go on counting.
+const CYCLE_CAP: u64 = u64::MAX >> 2;
+
+/// When to look for an idle loop next, and what skipping saved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct IdleSkip {
+    /// Skipping is allowed (see [`Cpu::set_idle_skip`]).
+    pub(super) enabled: bool,
+    /// The cycle from which the next probe may run.
+    pub(super) next_probe: u64,
+    /// The wait after the next failed probe.
+    gap: u64,
+    /// Cycles advanced by skipping rather than by running.
+    pub(super) skipped_cycles: u64,
+}
+
+impl IdleSkip {
+    pub(super) const fn new() -> IdleSkip {
+        IdleSkip {
+            enabled: true,
+            next_probe: 0,
+            gap: MIN_GAP,
+            skipped_cycles: 0,
+        }
+    }
+
+    fn found(&mut self, now: u64) {
+        self.gap = MIN_GAP;
+        self.next_probe = now.saturating_add(MIN_GAP);
+    }
+
+    fn missed(&mut self, now: u64) {
+        self.next_probe = now.saturating_add(self.gap);
+        self.gap = (self.gap * 2).min(MAX_GAP);
+    }
+}
+
+/// Everything that decides what the next instruction does, apart from
+/// memory: the registers and the flags as the CPU keeps them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct LoopState {
+    a: u8,
+    x: u8,
+    y: u8,
+    s: u8,
+    pc: u16,
+    n: u8,
+    z: u8,
+    c: bool,
+    vdi: u8,
+    nmi_line: bool,
+}
+
+/// A bus that passes everything on and notes whether an access could have
+/// changed anything or read anything that can change.
+struct ProbeBus<'a, B> {
+    bus: &'a mut B,
+    clean: bool,
+}
+
+impl<B: Bus> Bus for ProbeBus<'_, B> {
+    #[inline(always)]
+    fn read(&mut self, address: u16, cycle: u64) -> u8 {
+        self.clean &= self.bus.is_plain_memory(address);
+        self.bus.read(address, cycle)
+    }
+
+    #[inline(always)]
+    fn write(&mut self, address: u16, value: u8, cycle: u64) {
+        self.clean = false;
+        self.bus.write(address, value, cycle);
+    }
+
+    #[inline(always)]
+    fn dummy_read(&mut self, address: u16, cycle: u64) {
+        self.clean &= self.bus.is_plain_memory(address);
+        self.bus.dummy_read(address, cycle);
+    }
+
+    #[inline(always)]
+    fn peek(&self, address: u16) -> u8 {
+        self.bus.peek(address)
+    }
+
+    #[inline(always)]
+    fn poll(&mut self, cycle: u64) -> Interrupts {
+        self.bus.poll(cycle)
+    }
+
+    #[inline(always)]
+    fn quiet_until(&self) -> u64 {
+        self.bus.quiet_until()
+    }
+
+    #[inline(always)]
+    fn is_plain_memory(&self, address: u16) -> bool {
+        self.bus.is_plain_memory(address)
+    }
+}
+
+impl Cpu {
+    fn loop_state(&self) -> LoopState {
+        LoopState {
+            a: self.a,
+            x: self.x,
+            y: self.y,
+            s: self.s,
+            pc: self.pc,
+            n: self.n,
+            z: self.z,
+            c: self.c,
+            vdi: self.vdi,
+            nmi_line: self.nmi_line,
+        }
+    }
+
+    /// Runs instructions (at most [`BUDGET`], and not past `until` or an
+    /// interrupt) looking for an idle loop, and skips the iterations it may
+    /// when one is found. Returns the last instruction's flow bits (`JAM`
+    /// ends the run). Never inlined, and called on a copy of the run's CPU,
+    /// so that the run loop keeps its registers.
+    #[inline(never)]
+    pub(super) fn probe_idle<B: Bus>(&mut self, bus: &mut B, until: u64) -> u8 {
+        let mut probe = ProbeBus { bus, clean: true };
+        let mut start = (self.loop_state(), self.cycles, self.instructions);
+        let mut window = 0;
+        let mut flow = 0;
+        for _ in 0..BUDGET {
+            if self.cycles >= until || self.nmi_pending || self.irq_pending {
+                break;
+            }
+            flow = self.instruction(&mut probe);
+            if flow & JAM != 0 {
+                break;
+            }
+            if flow & POLLED != 0 && (self.nmi_pending || self.irq_pending) {
+                break;
+            }
+            window += 1;
+            if self.pc == start.0.pc && probe.clean && self.loop_state() == start.0 {
+                let cycles = self.cycles - start.1;
+                let instructions = self.instructions - start.2;
+                self.skip_iterations(probe.bus, until, cycles, instructions);
+                return flow;
+            }
+            if self.pc == start.0.pc || !probe.clean || window == MAX_LOOP {
+                // Not (or not yet) a clean lap: look for one from here.
+                start = (self.loop_state(), self.cycles, self.instructions);
+                probe.clean = true;
+                window = 0;
+            }
+        }
+        self.idle.missed(self.cycles);
+        flow
+    }
+
+    /// Advances as many whole `cycles`-long iterations as end before
+    /// `until` and no later than the bus's quiet horizon.
+    fn skip_iterations<B: Bus>(&mut self, bus: &B, until: u64, cycles: u64, instructions: u64) {
+        let last_end = until
+            .saturating_sub(1)
+            .min(bus.quiet_until())
+            .min(CYCLE_CAP);
+        let laps = last_end.saturating_sub(self.cycles) / cycles;
+        if laps == 0 {
+            self.idle.missed(self.cycles);
+            return;
+        }
+        self.cycles += laps * cycles;
+        self.instructions += laps * instructions;
+        self.idle.skipped_cycles += laps * cycles;
+        self.idle.found(self.cycles);
+    }
+}

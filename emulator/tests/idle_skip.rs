@@ -1,0 +1,201 @@
+//! Idle-loop skipping changes nothing but the host's time: the reference ROM
+//! on the Scorpion board goes through a conformance-style session twice,
+//! once with skipping allowed and once running every cycle, and ends in the
+//! same state (registers, counters, memory, every chip, motor and latch, the
+//! KIM-bus card) having sent the host the same bytes at the same cycles.
+//! Skipping must also really happen, or the test proves nothing.
+
+use std::any::Any;
+
+use emulator::board::{Device, HostByte, Scorpion};
+use emulator::{Machine, NoHooks, Ram, Stop};
+
+/// A KIM-bus card with a clock: it catches up every 10,000 cycles (device
+/// events that raise no interrupt but bound every skip) and reads back how
+/// many it has counted, with a read side effect (a read counter).
+#[derive(Debug, Default)]
+struct ClockCard {
+    now: u64,
+    ticks: u64,
+    reads: u8,
+}
+
+const TICK: u64 = 10_000;
+
+impl Device for ClockCard {
+    fn read(&mut self, offset: u16, cycle: u64) -> u8 {
+        self.sync(cycle);
+        self.reads = self.reads.wrapping_add(1);
+        match offset {
+            0 => self.ticks.to_le_bytes()[0],
+            _ => self.reads,
+        }
+    }
+
+    fn write(&mut self, _offset: u16, _value: u8, cycle: u64) {
+        self.sync(cycle);
+    }
+
+    fn peek(&self, offset: u16) -> u8 {
+        match offset {
+            0 => self.ticks.to_le_bytes()[0],
+            _ => self.reads,
+        }
+    }
+
+    fn sync(&mut self, cycle: u64) {
+        if cycle > self.now {
+            self.ticks = cycle / TICK;
+            self.now = cycle;
+        }
+    }
+
+    fn next_event(&self) -> Option<u64> {
+        Some((self.now / TICK + 1) * TICK)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// What the host does, and when (in milliseconds of robot time).
+enum Action {
+    Send(&'static [u8]),
+    Bumpers(u8),
+}
+
+/// A session touching every part of the board: questions, lamps, eyes, the
+/// speaker (timer 1 running free), both drives in both modes, a scan, the
+/// bumpers and the Master I/O byte, RAM writes and reads, the KIM-bus card,
+/// a reset, a burst of back-to-back commands, and long idle stretches.
+const SCRIPT: &[(u64, Action)] = &[
+    (5, Action::Send(b"/1P")),
+    (30, Action::Send(b"/2E3/2G1")),
+    (60, Action::Send(b"/3K20")),
+    (90, Action::Send(b"/1X/1E/1G")),
+    (120, Action::Send(b"/3K00/4C+50")),
+    (200, Action::Send(b"/8D-100500")),
+    (400, Action::Send(b"/1C/1D/1M")),
+    (450, Action::Send(b"/3H05")),
+    (700, Action::Send(b"/1S")),
+    (750, Action::Bumpers(0x04)),
+    (800, Action::Send(b"/1B/1P")),
+    (850, Action::Bumpers(0x00)),
+    (900, Action::Send(b"/3Z7F/3Y00/3ZFF/1P")),
+    (1000, Action::Send(b"/9W04031234/9W0405BEEF/7R040304")),
+    (1100, Action::Send(b"/7R800002/7R800002")),
+    (1200, Action::Send(b"/1R")),
+    (1250, Action::Send(b"/1P")),
+    (
+        1300,
+        Action::Send(b"/9W10001234/9W10021234/9W10041234/9W10061234/9W10081234/7R100010"),
+    ),
+    (4000, Action::Send(b"/1P/7R800002")),
+];
+
+const END_MS: u64 = 5_000;
+
+/// Runs the session; returns the robot and everything the host received.
+fn session(skip: bool) -> (Scorpion, Vec<HostByte>) {
+    let mut robot = Scorpion::scorpion(romlib::ROM).expect("the reference ROM is 4 KiB");
+    robot.cpu.set_idle_skip(skip);
+    robot
+        .map_kim(0x8000, 0x8001, Box::new(ClockCard::default()))
+        .expect("free KIM-bus space");
+    let mut received = Vec::new();
+    let mut script = SCRIPT.iter().peekable();
+    // Slices of odd lengths, so that runs end in every phase of the loops.
+    let mut slice = 0u64;
+    while robot.now() < END_MS * 1000 {
+        while let Some((_, action)) = script.next_if(|(at, _)| *at * 1000 <= robot.now()) {
+            match action {
+                Action::Send(bytes) => {
+                    robot.send(bytes);
+                }
+                Action::Bumpers(closed) => robot.set_bumpers(*closed),
+            }
+        }
+        slice = (slice * 7 + 613) % 5_000 + 1;
+        let stop = robot.run(robot.now() + slice);
+        assert_eq!(stop, Stop::Limit, "the ROM runs on");
+        received.extend(robot.receive_detailed());
+    }
+    (robot, received)
+}
+
+#[test]
+fn skipping_idle_loops_leaves_the_board_exactly_as_running_them() {
+    let (skipped, skipped_bytes) = session(true);
+    let (run, run_bytes) = session(false);
+    assert_eq!(skipped.cpu, run.cpu, "registers, flags and counters");
+    assert_eq!(
+        skipped.cpu.instructions(),
+        run.cpu.instructions(),
+        "instructions"
+    );
+    assert_eq!(skipped.board().memory(), run.board().memory(), "memory");
+    assert_eq!(
+        format!("{:?}", skipped.board()),
+        format!("{:?}", run.board()),
+        "the chips, motors, latches, lines, device schedule and KIM-bus card"
+    );
+    assert_eq!(skipped_bytes, run_bytes, "what the host received, and when");
+    let text: Vec<u8> = run_bytes.iter().map(|b| b.byte).collect();
+    let text = String::from_utf8_lossy(&text);
+    assert!(
+        text.contains("R1234BEEF"),
+        "the session did its work: {text}"
+    );
+    assert!(
+        text.matches("\r").count() >= 15,
+        "every question answered: {text}"
+    );
+    // Skipping happened, and most of a mostly idle session was skipped.
+    assert_eq!(run.cpu.skipped_cycles(), 0);
+    let share = skipped.cpu.skipped_cycles() * 100 / skipped.cpu.cycles();
+    assert!(share >= 50, "only {share}% of the cycles were skipped");
+}
+
+#[test]
+fn a_loop_on_plain_ram_is_skipped_to_the_limit_and_counted_exactly() {
+    // $0400: LDX $10 / INX / DEX / CPX $11 / BNE $0400 / JMP $0400 - the
+    // BNE falls through (X equals $11's zero), so the loop is LDX..JMP.
+    let program = [
+        0xA6, 0x10, 0xE8, 0xCA, 0xE4, 0x11, 0xD0, 0xF8, 0x4C, 0x00, 0x04,
+    ];
+    let machines = [true, false].map(|skip| {
+        let mut ram = Ram::new();
+        ram.load(0x0400, &program).expect("fits");
+        let mut machine = Machine::new(ram);
+        machine.cpu.pc = 0x0400;
+        machine.cpu.set_idle_skip(skip);
+        let stop = machine.run_with(1_000_003, &mut NoHooks);
+        assert_eq!(stop, Stop::Limit);
+        machine
+    });
+    let [skipped, run] = machines;
+    assert_eq!(skipped.cpu, run.cpu);
+    assert!(skipped.cpu.cycles() >= 1_000_003 && skipped.cpu.cycles() < 1_000_003 + 4);
+    assert!(skipped.cpu.skipped_cycles() > 990_000);
+    assert_eq!(run.cpu.skipped_cycles(), 0);
+}
+
+#[test]
+fn loops_that_write_or_touch_io_are_run() {
+    // $F000: INC $0300 / JMP $F000 writes every lap; $F006: LDA $C011 /
+    // JMP $F006 reads the 6551's status (an I/O read) every lap.
+    for (entry, what) in [(0xF000u16, "a write"), (0xF006, "an I/O read")] {
+        let mut rom = vec![0xEA; 4096];
+        rom[..9].copy_from_slice(&[0xEE, 0x00, 0x03, 0x4C, 0x00, 0xF0, 0xAD, 0x11, 0xC0]);
+        rom[9..12].copy_from_slice(&[0x4C, 0x06, 0xF0]);
+        rom[0xFFC..].copy_from_slice(&entry.to_le_bytes().repeat(2));
+        let mut robot = Scorpion::scorpion(&rom).expect("4 KiB");
+        robot.run(200_000);
+        assert_eq!(robot.cpu.skipped_cycles(), 0, "{what}");
+    }
+}
