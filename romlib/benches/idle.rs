@@ -110,7 +110,7 @@ fn only(workload: &str) {
         .and_then(|text| text.parse().ok())
         .unwrap_or(20_000_000);
     let ran = match workload {
-        "sieve" => sieve() / 10,
+        "sieve" => sieve(),
         "idle" => run(&mut robot(false), cycles),
         "idle-skip" => run(&mut robot(true), cycles),
         "motors" => run(&mut moving(false), cycles),

@@ -130,6 +130,11 @@ pub struct Board {
     pages: [Page; 256],
     via: Via,
     acia: Acia,
+    /// The 6551's next event as last computed, and whether the 6551 changed
+    /// since: its receiver decodes the line to answer, which every access
+    /// to any chip would otherwise pay for.
+    acia_next: Option<u64>,
+    acia_stale: bool,
     drive: u8,
     sense: u8,
     switches: u8,
@@ -201,6 +206,8 @@ impl Board {
             pages,
             via: Via::new(),
             acia: Acia::new(),
+            acia_next: None,
+            acia_stale: true,
             drive: 0,
             sense: 0,
             switches: map::DEFAULT_SWITCHES,
@@ -229,7 +236,7 @@ impl Board {
     /// state (RAM keeps its contents, the world outside keeps its state).
     pub fn reset(&mut self, cycle: u64) {
         self.via.reset(cycle);
-        self.acia.reset(cycle);
+        self.acia_mut().reset(cycle);
         for slot in &mut self.kim {
             slot.device.sync(cycle);
         }
@@ -468,7 +475,7 @@ impl Board {
 
     /// Sets the host's end of the serial line.
     pub fn set_host_line(&mut self, baud: Baud, format: FrameFormat) {
-        self.acia.set_host_line(baud, format);
+        self.acia_mut().set_host_line(baud, format);
     }
 
     /// The host sends `bytes`, back to back from `cycle` (or after what it
@@ -477,7 +484,7 @@ impl Board {
         self.catch_up(cycle);
         let mut end = self.acia.host_line_free_at();
         for &byte in bytes {
-            end = self.acia.host_send(byte, cycle);
+            end = self.acia_mut().host_send(byte, cycle);
         }
         self.refresh(cycle);
         end
@@ -502,7 +509,7 @@ impl Board {
 
     fn pull(&mut self, cycle: u64) {
         self.catch_up(cycle);
-        let received = self.acia.host_receive(cycle);
+        let received = self.acia_mut().host_receive(cycle);
         self.inbox.extend(received);
         self.refresh(cycle);
     }
@@ -518,14 +525,30 @@ impl Board {
     /// fetches and RAM accesses cost about what they cost on a RAM bus.
     #[inline(always)]
     fn is_plain_read(&self, address: u16) -> bool {
-        address <= map::RAM_END || address.wrapping_sub(self.slow_start) >= self.slow_span
+        address.wrapping_sub(self.slow_start) >= self.slow_span
     }
 
     /// Whether a write to `address` is a plain memory write (the ROM is
     /// not: a write there is counted and dropped).
     #[inline(always)]
     fn is_plain_write(&self, address: u16) -> bool {
-        address <= map::RAM_END || address < self.slow_start
+        address < self.slow_start
+    }
+
+    /// The 6551, to change it: its next event will be computed afresh.
+    fn acia_mut(&mut self) -> &mut Acia {
+        self.acia_stale = true;
+        &mut self.acia
+    }
+
+    /// [`Device::next_event`] of the 6551, computed again only after it
+    /// changed (it depends on nothing else).
+    fn acia_next_event(&mut self) -> Option<u64> {
+        if self.acia_stale {
+            self.acia_next = self.acia.next_event();
+            self.acia_stale = false;
+        }
+        self.acia_next
     }
 
     /// Processes every device event up to `cycle`, each at its own cycle.
@@ -535,8 +558,8 @@ impl Board {
             if self.via.next_event().is_some_and(|e| e <= at) {
                 self.via.sync(at);
             }
-            if self.acia.next_event().is_some_and(|e| e <= at) {
-                self.acia.sync(at);
+            if self.acia_next_event().is_some_and(|e| e <= at) {
+                self.acia_mut().sync(at);
             }
             for slot in &mut self.kim {
                 if slot.device.next_event().is_some_and(|e| e <= at) {
@@ -566,7 +589,7 @@ impl Board {
 
     fn refresh_next_event(&mut self) {
         let mut next = self.via.next_event().unwrap_or(u64::MAX);
-        next = next.min(self.acia.next_event().unwrap_or(u64::MAX));
+        next = next.min(self.acia_next_event().unwrap_or(u64::MAX));
         for slot in &self.kim {
             next = next.min(slot.device.next_event().unwrap_or(u64::MAX));
         }
@@ -622,7 +645,7 @@ impl Board {
                 value
             }
             0xC010..=0xC013 => {
-                let value = self.acia.read(address - map::ACIA, cycle);
+                let value = self.acia_mut().read(address - map::ACIA, cycle);
                 self.refresh(cycle);
                 value
             }
@@ -649,7 +672,7 @@ impl Board {
                 self.refresh(cycle);
             }
             0xC010..=0xC013 => {
-                self.acia.write(address - map::ACIA, value, cycle);
+                self.acia_mut().write(address - map::ACIA, value, cycle);
                 self.refresh(cycle);
             }
             map::DRIVE => {

@@ -14,10 +14,17 @@ use crate::bus::Bus;
 
 impl Cpu {
     /// Executes the instruction whose opcode was just fetched from `pc`.
-    /// Returns the flow bits (see the constants in the parent module).
+    /// Returns the flow bits (see the constants in the parent module);
+    /// `TRAPS` asks for the `TRAP` bit (a run whose hooks ignore traps
+    /// saves its comparisons).
     #[inline(always)]
     #[allow(clippy::too_many_lines, reason = "one arm per opcode, all 256")]
-    pub(super) fn execute<B: Bus>(&mut self, bus: &mut B, opcode: u8, pc: u16) -> u8 {
+    pub(super) fn execute<B: Bus, const TRAPS: bool>(
+        &mut self,
+        bus: &mut B,
+        opcode: u8,
+        pc: u16,
+    ) -> u8 {
         // Defined here so they can name `self` and `bus`.
         // Reads the operand through an addressing mode and applies `$op`.
         macro_rules! read {
@@ -72,7 +79,7 @@ impl Cpu {
             0x0D => read!(abs, ora), // ORA Absolute
             0x0E => rmw!(abs, asl),  // ASL Absolute
             0x0F => rmw!(abs, slo),  // SLO Absolute
-            0x10 => return self.branch(bus, self.n & 0x80 == 0, pc), // BPL Relative
+            0x10 => return self.branch::<_, TRAPS>(bus, self.n & 0x80 == 0, pc), // BPL Relative
             0x11 => read!(izy, ora), // ORA IndirectY
             0x12 => return JAM,      // JAM Implied
             0x13 => rmw!(izy_w, slo), // SLO IndirectY
@@ -120,7 +127,7 @@ impl Cpu {
             0x2D => read!(abs, and), // AND Absolute
             0x2E => rmw!(abs, rol),  // ROL Absolute
             0x2F => rmw!(abs, rla),  // RLA Absolute
-            0x30 => return self.branch(bus, self.n & 0x80 != 0, pc), // BMI Relative
+            0x30 => return self.branch::<_, TRAPS>(bus, self.n & 0x80 != 0, pc), // BMI Relative
             0x31 => read!(izy, and), // AND IndirectY
             0x32 => return JAM,      // JAM Implied
             0x33 => rmw!(izy_w, rla), // RLA IndirectY
@@ -159,19 +166,19 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.a = self.lsr(self.a);
             }
-            0x4B => read!(imm, alr),                        // ALR Immediate
-            0x4C => return self.jmp(bus, pc),               // JMP Absolute
-            0x4D => read!(abs, eor),                        // EOR Absolute
-            0x4E => rmw!(abs, lsr),                         // LSR Absolute
-            0x4F => rmw!(abs, sre),                         // SRE Absolute
-            0x50 => return self.branch(bus, !self.v(), pc), // BVC Relative
-            0x51 => read!(izy, eor),                        // EOR IndirectY
-            0x52 => return JAM,                             // JAM Implied
-            0x53 => rmw!(izy_w, sre),                       // SRE IndirectY
-            0x54 => read!(zpx, nop),                        // NOP ZeroPageX
-            0x55 => read!(zpx, eor),                        // EOR ZeroPageX
-            0x56 => rmw!(zpx, lsr),                         // LSR ZeroPageX
-            0x57 => rmw!(zpx, sre),                         // SRE ZeroPageX
+            0x4B => read!(imm, alr),                      // ALR Immediate
+            0x4C => return self.jmp::<_, TRAPS>(bus, pc), // JMP Absolute
+            0x4D => read!(abs, eor),                      // EOR Absolute
+            0x4E => rmw!(abs, lsr),                       // LSR Absolute
+            0x4F => rmw!(abs, sre),                       // SRE Absolute
+            0x50 => return self.branch::<_, TRAPS>(bus, !self.v(), pc), // BVC Relative
+            0x51 => read!(izy, eor),                      // EOR IndirectY
+            0x52 => return JAM,                           // JAM Implied
+            0x53 => rmw!(izy_w, sre),                     // SRE IndirectY
+            0x54 => read!(zpx, nop),                      // NOP ZeroPageX
+            0x55 => read!(zpx, eor),                      // EOR ZeroPageX
+            0x56 => rmw!(zpx, lsr),                       // LSR ZeroPageX
+            0x57 => rmw!(zpx, sre),                       // SRE ZeroPageX
             // CLI Implied
             0x58 => {
                 self.dummy_pc(bus);
@@ -207,19 +214,19 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.a = self.ror(self.a);
             }
-            0x6B => read!(imm, arr),                       // ARR Immediate
-            0x6C => return self.jmp_indirect(bus, pc),     // JMP Indirect
-            0x6D => read!(abs, adc),                       // ADC Absolute
-            0x6E => rmw!(abs, ror),                        // ROR Absolute
-            0x6F => rmw!(abs, rra),                        // RRA Absolute
-            0x70 => return self.branch(bus, self.v(), pc), // BVS Relative
-            0x71 => read!(izy, adc),                       // ADC IndirectY
-            0x72 => return JAM,                            // JAM Implied
-            0x73 => rmw!(izy_w, rra),                      // RRA IndirectY
-            0x74 => read!(zpx, nop),                       // NOP ZeroPageX
-            0x75 => read!(zpx, adc),                       // ADC ZeroPageX
-            0x76 => rmw!(zpx, ror),                        // ROR ZeroPageX
-            0x77 => rmw!(zpx, rra),                        // RRA ZeroPageX
+            0x6B => read!(imm, arr), // ARR Immediate
+            0x6C => return self.jmp_indirect::<_, TRAPS>(bus, pc), // JMP Indirect
+            0x6D => read!(abs, adc), // ADC Absolute
+            0x6E => rmw!(abs, ror),  // ROR Absolute
+            0x6F => rmw!(abs, rra),  // RRA Absolute
+            0x70 => return self.branch::<_, TRAPS>(bus, self.v(), pc), // BVS Relative
+            0x71 => read!(izy, adc), // ADC IndirectY
+            0x72 => return JAM,      // JAM Implied
+            0x73 => rmw!(izy_w, rra), // RRA IndirectY
+            0x74 => read!(zpx, nop), // NOP ZeroPageX
+            0x75 => read!(zpx, adc), // ADC ZeroPageX
+            0x76 => rmw!(zpx, ror),  // ROR ZeroPageX
+            0x77 => rmw!(zpx, rra),  // RRA ZeroPageX
             // SEI Implied
             0x78 => {
                 self.dummy_pc(bus);
@@ -253,14 +260,14 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.lda(self.x);
             }
-            0x8B => read!(imm, ane),                      // ANE Immediate
-            0x8C => write!(abs, self.y),                  // STY Absolute
-            0x8D => write!(abs, self.a),                  // STA Absolute
-            0x8E => write!(abs, self.x),                  // STX Absolute
-            0x8F => write!(abs, self.a & self.x),         // SAX Absolute
-            0x90 => return self.branch(bus, !self.c, pc), // BCC Relative
-            0x91 => write!(izy_w, self.a),                // STA IndirectY
-            0x92 => return JAM,                           // JAM Implied
+            0x8B => read!(imm, ane),              // ANE Immediate
+            0x8C => write!(abs, self.y),          // STY Absolute
+            0x8D => write!(abs, self.a),          // STA Absolute
+            0x8E => write!(abs, self.x),          // STX Absolute
+            0x8F => write!(abs, self.a & self.x), // SAX Absolute
+            0x90 => return self.branch::<_, TRAPS>(bus, !self.c, pc), // BCC Relative
+            0x91 => write!(izy_w, self.a),        // STA IndirectY
+            0x92 => return JAM,                   // JAM Implied
             // SHA IndirectY
             0x93 => {
                 let base = self.zp_pointer(bus);
@@ -322,19 +329,19 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.ldx(self.a);
             }
-            0xAB => read!(imm, lxa),                     // LXA Immediate
-            0xAC => read!(abs, ldy),                     // LDY Absolute
-            0xAD => read!(abs, lda),                     // LDA Absolute
-            0xAE => read!(abs, ldx),                     // LDX Absolute
-            0xAF => read!(abs, lax),                     // LAX Absolute
-            0xB0 => return self.branch(bus, self.c, pc), // BCS Relative
-            0xB1 => read!(izy, lda),                     // LDA IndirectY
-            0xB2 => return JAM,                          // JAM Implied
-            0xB3 => read!(izy, lax),                     // LAX IndirectY
-            0xB4 => read!(zpx, ldy),                     // LDY ZeroPageX
-            0xB5 => read!(zpx, lda),                     // LDA ZeroPageX
-            0xB6 => read!(zpy, ldx),                     // LDX ZeroPageY
-            0xB7 => read!(zpy, lax),                     // LAX ZeroPageY
+            0xAB => read!(imm, lxa), // LXA Immediate
+            0xAC => read!(abs, ldy), // LDY Absolute
+            0xAD => read!(abs, lda), // LDA Absolute
+            0xAE => read!(abs, ldx), // LDX Absolute
+            0xAF => read!(abs, lax), // LAX Absolute
+            0xB0 => return self.branch::<_, TRAPS>(bus, self.c, pc), // BCS Relative
+            0xB1 => read!(izy, lda), // LDA IndirectY
+            0xB2 => return JAM,      // JAM Implied
+            0xB3 => read!(izy, lax), // LAX IndirectY
+            0xB4 => read!(zpx, ldy), // LDY ZeroPageX
+            0xB5 => read!(zpx, lda), // LDA ZeroPageX
+            0xB6 => read!(zpy, ldx), // LDX ZeroPageY
+            0xB7 => read!(zpy, lax), // LAX ZeroPageY
             // CLV Implied
             0xB8 => {
                 self.dummy_pc(bus);
@@ -375,7 +382,7 @@ impl Cpu {
             0xCD => read!(abs, cmp), // CMP Absolute
             0xCE => rmw!(abs, dec),  // DEC Absolute
             0xCF => rmw!(abs, dcp),  // DCP Absolute
-            0xD0 => return self.branch(bus, self.z != 0, pc), // BNE Relative
+            0xD0 => return self.branch::<_, TRAPS>(bus, self.z != 0, pc), // BNE Relative
             0xD1 => read!(izy, cmp), // CMP IndirectY
             0xD2 => return JAM,      // JAM Implied
             0xD3 => rmw!(izy_w, dcp), // DCP IndirectY
@@ -415,7 +422,7 @@ impl Cpu {
             0xED => read!(abs, sbc),    // SBC Absolute
             0xEE => rmw!(abs, inc),     // INC Absolute
             0xEF => rmw!(abs, isc),     // ISC Absolute
-            0xF0 => return self.branch(bus, self.z == 0, pc), // BEQ Relative
+            0xF0 => return self.branch::<_, TRAPS>(bus, self.z == 0, pc), // BEQ Relative
             0xF1 => read!(izy, sbc),    // SBC IndirectY
             0xF2 => return JAM,         // JAM Implied
             0xF3 => rmw!(izy_w, isc),   // ISC IndirectY
@@ -449,7 +456,7 @@ impl Cpu {
     /// byte in the old page). A taken branch that stays in its page polls
     /// interrupts one cycle early.
     #[inline(always)]
-    fn branch<B: Bus>(&mut self, bus: &mut B, taken: bool, pc: u16) -> u8 {
+    fn branch<B: Bus, const TRAPS: bool>(&mut self, bus: &mut B, taken: bool, pc: u16) -> u8 {
         let offset = self.fetch(bus) as i8;
         if !taken {
             return 0;
@@ -463,7 +470,7 @@ impl Cpu {
             LATE_POLL
         };
         self.pc = target;
-        if target == pc {
+        if TRAPS && target == pc {
             flow |= TRAP;
         }
         flow
@@ -471,20 +478,20 @@ impl Cpu {
 
     /// JMP nnnn (3 cycles).
     #[inline(always)]
-    fn jmp<B: Bus>(&mut self, bus: &mut B, pc: u16) -> u8 {
+    fn jmp<B: Bus, const TRAPS: bool>(&mut self, bus: &mut B, pc: u16) -> u8 {
         self.pc = self.fetch_word(bus);
-        if self.pc == pc { TRAP } else { 0 }
+        if TRAPS && self.pc == pc { TRAP } else { 0 }
     }
 
     /// JMP (nnnn) (5 cycles): the NMOS part does not carry into the
     /// pointer's high byte, so `JMP ($12FF)` reads `$12FF` and `$1200`.
     #[inline(always)]
-    fn jmp_indirect<B: Bus>(&mut self, bus: &mut B, pc: u16) -> u8 {
+    fn jmp_indirect<B: Bus, const TRAPS: bool>(&mut self, bus: &mut B, pc: u16) -> u8 {
         let pointer = self.fetch_word(bus);
         let lo = self.read(bus, pointer);
         let hi = self.read(bus, (pointer & 0xFF00) | (pointer.wrapping_add(1) & 0x00FF));
         self.pc = u16::from_le_bytes([lo, hi]);
-        if self.pc == pc { TRAP } else { 0 }
+        if TRAPS && self.pc == pc { TRAP } else { 0 }
     }
 
     /// JSR nnnn (6 cycles): low byte, a dummy stack read, push the address

@@ -467,29 +467,50 @@ impl Cpu {
             };
             // Instructions back to back until a poll finds an interrupt or
             // the limit is reached. Nothing here reads P as a whole; the
-            // pending flags can only change where a poll was made, and with
+            // pending flags can only change where a poll is made, and with
             // a bus that has no interrupt source the polls fold away.
             loop {
                 if let Control::Stop = hooks.before_instruction(self, &*bus) {
                     return Stop::Hook { pc: self.pc };
                 }
-                let flow = self.instruction(bus);
-                if flow & JAM != 0 {
-                    return Stop::Jam {
-                        pc: self.pc,
-                        opcode: bus.peek(self.pc),
-                    };
+                let pc = self.pc;
+                let opcode = self.fetch(bus);
+                // Passive hooks ignore traps: no trap comparisons then.
+                let flow = if H::PASSIVE {
+                    self.execute::<B, false>(bus, opcode, pc)
+                } else {
+                    self.execute::<B, true>(bus, opcode, pc)
+                };
+                let mut interrupted = false;
+                if flow & (JAM | NO_POLL) != 0 {
+                    if flow & JAM != 0 {
+                        // The processor locks up on the opcode: leave it
+                        // there, uncounted, so the fault is reported where
+                        // it happened.
+                        self.pc = pc;
+                        self.cycles -= 1;
+                        return Stop::Jam {
+                            pc,
+                            opcode: bus.peek(pc),
+                        };
+                    }
+                    // BRK: its sequence polled.
+                    self.instructions += 1;
+                } else {
+                    self.instructions += 1;
+                    // One comparison while the bus is quiet (see
+                    // `instruction`).
+                    if self.cycles > bus.quiet_until() {
+                        self.poll_after(bus, flow);
+                        interrupted = self.nmi_pending || self.irq_pending;
+                    }
                 }
-                // Without a trap hook this folds away, and so does the
-                // instructions' trap detection.
                 if flow & TRAP != 0 {
                     if let Control::Stop = hooks.trap(self, &*bus) {
                         return Stop::Trap { pc: self.pc };
                     }
                 }
-                if (flow & POLLED != 0 && (self.nmi_pending || self.irq_pending))
-                    || self.cycles >= limit
-                {
+                if interrupted || self.cycles >= limit {
                     break;
                 }
             }
@@ -502,17 +523,19 @@ impl Cpu {
         self.run(bus, until, &mut NoHooks)
     }
 
-    /// One instruction and its interrupt poll. Returns the flow bits.
+    /// One instruction and its interrupt poll, for [`Cpu::step`] and the
+    /// idle probe (the run loop has its own copy). Returns the flow bits,
+    /// with `POLLED` if the poll was made.
     ///
     /// The poll is skipped when the bus says it would find nothing
     /// ([`Bus::quiet_until`]); a skipped poll changes nothing here either,
-    /// since the run loop only runs instructions with no interrupt pending
-    /// and a bus only reports quiet while NMI rests released.
+    /// since instructions only run with no interrupt pending and a bus only
+    /// reports quiet while NMI rests released.
     #[inline(always)]
     fn instruction<B: Bus>(&mut self, bus: &mut B) -> u8 {
         let pc = self.pc;
         let opcode = self.fetch(bus);
-        let flow = self.execute(bus, opcode, pc);
+        let flow = self.execute::<B, true>(bus, opcode, pc);
         if flow & (JAM | NO_POLL) != 0 {
             if flow & JAM != 0 {
                 // The processor locks up on the opcode: leave it there,
@@ -531,6 +554,15 @@ impl Cpu {
         if self.cycles <= bus.quiet_until() {
             return flow;
         }
+        self.poll_after(bus, flow);
+        flow | POLLED
+    }
+
+    /// The poll of the instruction that just ended with `flow`: at its
+    /// second-to-last cycle (one earlier for `LATE_POLL`), with I as the
+    /// instruction left it or, for `OLD_I`, as it was before.
+    #[inline(always)]
+    fn poll_after<B: Bus>(&mut self, bus: &mut B, flow: u8) {
         let poll_at = self.cycles - 2 - u64::from(flow & LATE_POLL);
         let i = if flow & OLD_I != 0 {
             flow & I_WAS_SET != 0
@@ -538,7 +570,6 @@ impl Cpu {
             self.i()
         };
         self.poll(bus, poll_at, i);
-        flow | POLLED
     }
 
     /// The flow bits of CLI, SEI and PLP, taken before they change I: their
