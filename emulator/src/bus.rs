@@ -66,6 +66,13 @@
 //! default calls [`Bus::read`]. A bus may skip the work for addresses where
 //! a read has no effect (plain memory), which is all the marking is for.
 //!
+//! **Page zero and the stack are marked too.** Accesses the addressing
+//! mode confines to `$0000-$01FF` (zero-page modes, their pointers, pushes
+//! and pulls) go through [`Bus::read_zp_stack`] and
+//! [`Bus::write_zp_stack`], which default to `read` and `write`; a bus
+//! whose low pages are always RAM serves them without decoding the
+//! address.
+//!
 //! **`peek` has no side effects.** Tracers, disassemblers and debuggers read
 //! memory through [`Bus::peek`], which must not change any state (no flag
 //! cleared, no catch-up); a register that cannot be read without a side
@@ -108,6 +115,22 @@ pub trait Bus {
     #[inline(always)]
     fn dummy_read(&mut self, address: u16, cycle: u64) {
         self.read(address, cycle);
+    }
+
+    /// A read in page zero or the stack page (`address < $0200`: the CPU
+    /// knows it from the addressing mode). Same contract as [`Bus::read`],
+    /// which the default calls; a bus whose two low pages are always RAM
+    /// reads it without decoding the address.
+    #[inline(always)]
+    fn read_zp_stack(&mut self, address: u16, cycle: u64) -> u8 {
+        self.read(address, cycle)
+    }
+
+    /// A write in page zero or the stack page, as
+    /// [`Bus::read_zp_stack`]; the default calls [`Bus::write`].
+    #[inline(always)]
+    fn write_zp_stack(&mut self, address: u16, value: u8, cycle: u64) {
+        self.write(address, value, cycle);
     }
 
     /// The byte a read of `address` would return now, without any side
@@ -163,6 +186,16 @@ impl<B: Bus + ?Sized> Bus for &mut B {
     #[inline(always)]
     fn dummy_read(&mut self, address: u16, cycle: u64) {
         (**self).dummy_read(address, cycle);
+    }
+
+    #[inline(always)]
+    fn read_zp_stack(&mut self, address: u16, cycle: u64) -> u8 {
+        (**self).read_zp_stack(address, cycle)
+    }
+
+    #[inline(always)]
+    fn write_zp_stack(&mut self, address: u16, value: u8, cycle: u64) {
+        (**self).write_zp_stack(address, value, cycle);
     }
 
     #[inline(always)]

@@ -762,6 +762,18 @@ impl Bus for Board {
     }
 
     #[inline(always)]
+    fn read_zp_stack(&mut self, address: u16, _cycle: u64) -> u8 {
+        // $0000-$01FF is the card's RAM, always (KIM-bus devices start at
+        // $1000).
+        self.memory[usize::from(address)]
+    }
+
+    #[inline(always)]
+    fn write_zp_stack(&mut self, address: u16, value: u8, _cycle: u64) {
+        self.memory[usize::from(address)] = value;
+    }
+
+    #[inline(always)]
     fn dummy_read(&mut self, address: u16, cycle: u64) {
         // Reading memory has no effect: only device addresses are visited.
         if !self.is_plain_read(address) {

@@ -23,6 +23,21 @@ impl Cpu {
         self.cycles += 1;
     }
 
+    /// One read cycle in page zero or the stack page.
+    #[inline(always)]
+    pub(super) fn read_zs<B: Bus>(&mut self, bus: &mut B, address: u16) -> u8 {
+        let value = bus.read_zp_stack(address, self.cycles);
+        self.cycles += 1;
+        value
+    }
+
+    /// One write cycle in page zero or the stack page.
+    #[inline(always)]
+    pub(super) fn write_zs<B: Bus>(&mut self, bus: &mut B, address: u16, value: u8) {
+        bus.write_zp_stack(address, value, self.cycles);
+        self.cycles += 1;
+    }
+
     /// One write cycle.
     #[inline(always)]
     pub(super) fn write<B: Bus>(&mut self, bus: &mut B, address: u16, value: u8) {
@@ -63,7 +78,7 @@ impl Cpu {
     /// Pushes a byte: write at `$0100 + S`, then S decreases.
     #[inline(always)]
     pub(super) fn push<B: Bus>(&mut self, bus: &mut B, value: u8) {
-        self.write(bus, 0x0100 | u16::from(self.s), value);
+        self.write_zs(bus, 0x0100 | u16::from(self.s), value);
         self.s = self.s.wrapping_sub(1);
     }
 
@@ -71,7 +86,7 @@ impl Cpu {
     #[inline(always)]
     pub(super) fn pull<B: Bus>(&mut self, bus: &mut B) -> u8 {
         self.s = self.s.wrapping_add(1);
-        self.read(bus, 0x0100 | u16::from(self.s))
+        self.read_zs(bus, 0x0100 | u16::from(self.s))
     }
 
     /// `#nn`: the operand is the byte at PC.
@@ -160,8 +175,8 @@ impl Cpu {
         let base = self.fetch(bus);
         self.dummy_read(bus, u16::from(base));
         let pointer = base.wrapping_add(self.x);
-        let lo = self.read(bus, u16::from(pointer));
-        let hi = self.read(bus, u16::from(pointer.wrapping_add(1)));
+        let lo = self.read_zs(bus, u16::from(pointer));
+        let hi = self.read_zs(bus, u16::from(pointer.wrapping_add(1)));
         u16::from_le_bytes([lo, hi])
     }
 
@@ -170,8 +185,8 @@ impl Cpu {
     #[inline(always)]
     pub(super) fn zp_pointer<B: Bus>(&mut self, bus: &mut B) -> u16 {
         let pointer = self.fetch(bus);
-        let lo = self.read(bus, u16::from(pointer));
-        let hi = self.read(bus, u16::from(pointer.wrapping_add(1)));
+        let lo = self.read_zs(bus, u16::from(pointer));
+        let hi = self.read_zs(bus, u16::from(pointer.wrapping_add(1)));
         u16::from_le_bytes([lo, hi])
     }
 

@@ -25,9 +25,24 @@ impl Cpu {
         opcode: u8,
         pc: u16,
     ) -> u8 {
-        // Defined here so they can name `self` and `bus`.
+        // Defined here so they can name `self` and `bus`. The zero-page
+        // modes access page zero only, which they tell the bus.
         // Reads the operand through an addressing mode and applies `$op`.
         macro_rules! read {
+            (zp, $op:ident) => {
+                read!(@low zp, $op)
+            };
+            (zpx, $op:ident) => {
+                read!(@low zpx, $op)
+            };
+            (zpy, $op:ident) => {
+                read!(@low zpy, $op)
+            };
+            (@low $mode:ident, $op:ident) => {{
+                let address = self.$mode(bus);
+                let value = self.read_zs(bus, address);
+                self.$op(value);
+            }};
             ($mode:ident, $op:ident) => {{
                 let address = self.$mode(bus);
                 let value = self.read(bus, address);
@@ -36,6 +51,20 @@ impl Cpu {
         }
         // Writes a value through an addressing mode.
         macro_rules! write {
+            (zp, $value:expr) => {
+                write!(@low zp, $value)
+            };
+            (zpx, $value:expr) => {
+                write!(@low zpx, $value)
+            };
+            (zpy, $value:expr) => {
+                write!(@low zpy, $value)
+            };
+            (@low $mode:ident, $value:expr) => {{
+                let address = self.$mode(bus);
+                let value = $value;
+                self.write_zs(bus, address, value);
+            }};
             ($mode:ident, $value:expr) => {{
                 let address = self.$mode(bus);
                 let value = $value;
@@ -45,6 +74,19 @@ impl Cpu {
         // Read-modify-write: read, write the old value back (the NMOS part's
         // double write, which I/O registers see), write the result.
         macro_rules! rmw {
+            (zp, $op:ident) => {
+                rmw!(@low zp, $op)
+            };
+            (zpx, $op:ident) => {
+                rmw!(@low zpx, $op)
+            };
+            (@low $mode:ident, $op:ident) => {{
+                let address = self.$mode(bus);
+                let value = self.read_zs(bus, address);
+                self.write_zs(bus, address, value);
+                let result = self.$op(value);
+                self.write_zs(bus, address, result);
+            }};
             ($mode:ident, $op:ident) => {{
                 let address = self.$mode(bus);
                 let value = self.read(bus, address);
