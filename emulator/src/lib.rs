@@ -6,7 +6,9 @@
 //!   64 KiB machine memory.
 //! - [`cpu`]: the [`Cpu`]: every opcode of the NMOS part, documented or not,
 //!   exact in result, flags, cycles and bus accesses; the run loop and the
-//!   interrupt sequences.
+//!   interrupt sequences; idle-loop skipping ([`Cpu::set_idle_skip`]), which
+//!   advances the iterations of a loop that can only repeat itself until a
+//!   device acts without running them, to the same state.
 //! - [`hooks`]: what a run does besides executing ([`Hooks`]): tracing,
 //!   breakpoints, stopping at traps. Off means absent from the compiled loop.
 //! - [`machine`]: a [`Cpu`] with its [`Bus`]; [`RamMachine`] is the plain

@@ -4,11 +4,19 @@
 //! sieve of `emulator/benches/cpu.rs`) on the plain RAM machine, in the
 //! same process. Target: the board keeps at least 80% of the CPU's speed.
 //!
-//! Also printed, for information: the board with both drive motors running
-//! (the 1 kHz motion tick interrupting) and while receiving a steady stream
-//! of `/9W` writes at 9600 baud.
+//! Every board workload is measured twice: as the robot runs by default,
+//! with idle-loop skipping (the CPU advances whole iterations of a loop
+//! that can only repeat itself until a device acts, exactly as if it had
+//! run them: `emulator::Cpu::set_idle_skip`), and with skipping off, every
+//! cycle executed, which is the board's own cost. The same idle code on the
+//! plain RAM machine (skipping off) separates the board's cost from the
+//! CPU's. Also printed, for information: the board with both drive motors
+//! running (the 1 kHz motion tick interrupting) and while receiving a
+//! steady stream of `/9W` writes at 9600 baud, with the share of their
+//! cycles that skipping saved.
 //!
-//! `cargo bench -p romlib --bench idle`
+//! `cargo bench -p romlib --bench idle`; one workload under callgrind:
+//! see [`only`].
 #![allow(clippy::print_stdout, reason = "a benchmark reports on stdout")]
 
 use std::hint::black_box;

@@ -172,6 +172,12 @@ impl Cpu {
     /// so that the run loop keeps its registers.
     #[inline(never)]
     pub(super) fn probe_idle<B: Bus>(&mut self, bus: &mut B, until: u64) -> u8 {
+        if !bus.is_plain_memory(self.pc) {
+            // Code outside plain memory (or a bus that vouches for none):
+            // no lap can be clean.
+            self.idle.missed(self.cycles);
+            return 0;
+        }
         let mut probe = ProbeBus { bus, clean: true };
         let mut start = (self.loop_state(), self.cycles, self.instructions);
         let mut window = 0;
