@@ -111,27 +111,34 @@ fn writes(robot: &mut VirtualScorpion) -> u64 {
 /// whose instruction count divided by the cycles is the host cost of an
 /// emulated cycle, repeatable on a busy machine. Workloads: `sieve`,
 /// `idle` (skipping off), `idle-skip`, `same-code`, `motors` (skipping
-/// off), `motors-skip`.
+/// off), `motors-skip`, `writes` (skipping off, two seconds whatever
+/// `IDLE_BENCH_CYCLES` says), `writes-skip`.
 fn only(workload: &str) {
     let cycles: u64 = std::env::var("IDLE_BENCH_CYCLES")
         .ok()
         .and_then(|text| text.parse().ok())
         .unwrap_or(20_000_000);
-    let ran = match workload {
-        "sieve" => sieve(),
-        "idle" => run(&mut robot(false), cycles),
-        "idle-skip" => run(&mut robot(true), cycles),
-        "motors" => run(&mut moving(false), cycles),
-        "motors-skip" => run(&mut moving(true), cycles),
+    let with_robot = |mut robot: VirtualScorpion, work: &dyn Fn(&mut VirtualScorpion) -> u64| {
+        let ran = work(&mut robot);
+        (ran, robot.robot().cpu.skipped_cycles())
+    };
+    let (ran, skipped) = match workload {
+        "sieve" => (sieve(), 0),
+        "idle" => with_robot(robot(false), &|r| run(r, cycles)),
+        "idle-skip" => with_robot(robot(true), &|r| run(r, cycles)),
+        "motors" => with_robot(moving(false), &|r| run(r, cycles)),
+        "motors-skip" => with_robot(moving(true), &|r| run(r, cycles)),
+        "writes" => with_robot(robot(false), &writes),
+        "writes-skip" => with_robot(robot(true), &writes),
         "same-code" => {
             let mut plain = same_code_machine();
             let start = plain.cpu.cycles();
             plain.run(start + cycles);
-            plain.cpu.cycles() - start
+            (plain.cpu.cycles() - start, 0)
         }
         other => panic!("IDLE_BENCH_ONLY: no workload {other:?}"),
     };
-    println!("{workload}: {ran} cycles");
+    println!("{workload}: {ran} cycles, {skipped} of them skipped");
 }
 
 fn main() {

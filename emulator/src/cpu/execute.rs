@@ -9,7 +9,7 @@
 //! one-access-per-cycle bus traffic against that table, and the py65 and
 //! Dormann tests check what the arms compute.
 
-use super::{Cpu, JAM, LATE_POLL, NO_POLL, TRAP, flag};
+use super::{Cpu, JAM, LATE_POLL, NO_POLL, RETURNED, TRAP, flag};
 use crate::bus::Bus;
 
 impl Cpu {
@@ -182,21 +182,21 @@ impl Cpu {
                 self.dummy_pc(bus);
                 self.c = true;
             }
-            0x39 => read!(aby, and),    // AND AbsoluteY
-            0x3A => self.dummy_pc(bus), // NOP Implied
-            0x3B => rmw!(aby_w, rla),   // RLA AbsoluteY
-            0x3C => read!(abx, nop),    // NOP AbsoluteX
-            0x3D => read!(abx, and),    // AND AbsoluteX
-            0x3E => rmw!(abx_w, rol),   // ROL AbsoluteX
-            0x3F => rmw!(abx_w, rla),   // RLA AbsoluteX
-            0x40 => self.rti(bus),      // RTI Implied
-            0x41 => read!(izx, eor),    // EOR IndirectX
-            0x42 => return JAM,         // JAM Implied
-            0x43 => rmw!(izx, sre),     // SRE IndirectX
-            0x44 => read!(zp, nop),     // NOP ZeroPage
-            0x45 => read!(zp, eor),     // EOR ZeroPage
-            0x46 => rmw!(zp, lsr),      // LSR ZeroPage
-            0x47 => rmw!(zp, sre),      // SRE ZeroPage
+            0x39 => read!(aby, and),      // AND AbsoluteY
+            0x3A => self.dummy_pc(bus),   // NOP Implied
+            0x3B => rmw!(aby_w, rla),     // RLA AbsoluteY
+            0x3C => read!(abx, nop),      // NOP AbsoluteX
+            0x3D => read!(abx, and),      // AND AbsoluteX
+            0x3E => rmw!(abx_w, rol),     // ROL AbsoluteX
+            0x3F => rmw!(abx_w, rla),     // RLA AbsoluteX
+            0x40 => return self.rti(bus), // RTI Implied
+            0x41 => read!(izx, eor),      // EOR IndirectX
+            0x42 => return JAM,           // JAM Implied
+            0x43 => rmw!(izx, sre),       // SRE IndirectX
+            0x44 => read!(zp, nop),       // NOP ZeroPage
+            0x45 => read!(zp, eor),       // EOR ZeroPage
+            0x46 => rmw!(zp, lsr),        // LSR ZeroPage
+            0x47 => rmw!(zp, sre),        // SRE ZeroPage
             // PHA Implied
             0x48 => {
                 self.dummy_pc(bus);
@@ -565,7 +565,7 @@ impl Cpu {
     /// RTI (6 cycles): pull P, then PC. The restored I flag is in force for
     /// this instruction's own interrupt poll.
     #[inline(always)]
-    fn rti<B: Bus>(&mut self, bus: &mut B) {
+    fn rti<B: Bus>(&mut self, bus: &mut B) -> u8 {
         self.dummy_pc(bus);
         self.dummy_stack(bus);
         let p = self.pull(bus);
@@ -573,6 +573,7 @@ impl Cpu {
         let lo = self.pull(bus);
         let hi = self.pull(bus);
         self.pc = u16::from_le_bytes([lo, hi]);
+        RETURNED
     }
 
     /// BRK (7 cycles): the padding byte is read and skipped, then the

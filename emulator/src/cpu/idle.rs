@@ -31,23 +31,27 @@
 //!
 //! # Cost
 //!
-//! Probes run at most every few dozen cycles after a success and back off
-//! to every 64K cycles while the program is busy, so code that never idles
-//! pays almost nothing; the run loop only compares its cycle counter with
-//! the earlier of the run's limit and the next probe, one comparison it
-//! makes anyway.
+//! A probe gives up at the first write or device read (the program is at
+//! work) or after [`BUDGET`] instructions; probes come [`MIN_GAP`] cycles
+//! after a success and back off to every 64K cycles while the program is
+//! busy, so code that never idles pays almost nothing. An RTI that goes
+//! back into the loop last found (an interrupt-driven program returning to
+//! its wait) probes at once, without slowing the schedule down if the
+//! program has work first. The run loop itself only compares its cycle
+//! counter with the earlier of the run's limit and the next probe, a
+//! comparison it makes anyway, and leaves its inner loop at an RTI.
 
 use super::{Cpu, JAM, POLLED};
 use crate::bus::{Bus, Interrupts};
 
 /// Cycles from a success (or a skip) to the next probe.
-const MIN_GAP: u64 = 64;
+const MIN_GAP: u64 = 128;
 /// The longest wait between probes while nothing is found.
 const MAX_GAP: u64 = 1 << 16;
 /// The longest loop a probe recognises, in instructions.
-const MAX_LOOP: u32 = 32;
+const MAX_LOOP: usize = 16;
 /// Instructions one probe may run before giving up.
-const BUDGET: u32 = 3 * MAX_LOOP;
+const BUDGET: usize = 2 * MAX_LOOP;
 /// No skip carries the cycle counter past this: a host that runs "forever"
 /// (a limit of `u64::MAX`) keeps room for the counter to go on counting.
 const CYCLE_CAP: u64 = u64::MAX >> 2;
@@ -63,6 +67,11 @@ pub(super) struct IdleSkip {
     gap: u64,
     /// Cycles advanced by skipping rather than by running.
     pub(super) skipped_cycles: u64,
+    /// The addresses of the instructions of the idle loop last found.
+    lap: [u16; MAX_LOOP],
+    lap_len: usize,
+    /// The coming probe is a look on the way back from a handler.
+    woken: bool,
 }
 
 impl IdleSkip {
@@ -72,15 +81,30 @@ impl IdleSkip {
             next_probe: 0,
             gap: MIN_GAP,
             skipped_cycles: 0,
+            lap: [0; MAX_LOOP],
+            lap_len: 0,
+            woken: false,
         }
     }
 
+    /// Whether `pc` is an instruction of the idle loop last found.
+    fn returns_to_loop(&self, pc: u16) -> bool {
+        self.lap[..self.lap_len].contains(&pc)
+    }
+
     fn found(&mut self, now: u64) {
+        self.woken = false;
         self.gap = MIN_GAP;
         self.next_probe = now.saturating_add(MIN_GAP);
     }
 
     fn missed(&mut self, now: u64) {
+        if self.woken {
+            // Back from a handler with work to do: the program goes back
+            // to its loop when done, so look again soon.
+            self.woken = false;
+            self.gap = MIN_GAP;
+        }
         self.next_probe = now.saturating_add(self.gap);
         self.gap = (self.gap * 2).min(MAX_GAP);
     }
@@ -170,8 +194,19 @@ impl Cpu {
     /// when one is found. Returns the last instruction's flow bits (`JAM`
     /// ends the run). Never inlined, and called on a copy of the run's CPU,
     /// so that the run loop keeps its registers.
+    ///
+    /// After an RTI (`returned`) it looks only if the RTI went back into
+    /// the idle loop last found, where an interrupt-driven program waits
+    /// again once its handler is done; a failure then does not slow the
+    /// probes down.
     #[inline(never)]
-    pub(super) fn probe_idle<B: Bus>(&mut self, bus: &mut B, until: u64) -> u8 {
+    pub(super) fn probe_idle<B: Bus>(&mut self, bus: &mut B, until: u64, returned: bool) -> u8 {
+        if returned {
+            if !self.idle.returns_to_loop(self.pc) {
+                return 0;
+            }
+            self.idle.woken = true;
+        }
         if !bus.is_plain_memory(self.pc) {
             // Code outside plain memory (or a bus that vouches for none):
             // no lap can be clean.
@@ -180,6 +215,8 @@ impl Cpu {
         }
         let mut probe = ProbeBus { bus, clean: true };
         let mut start = (self.loop_state(), self.cycles, self.instructions);
+        let mut lap = [0; MAX_LOOP];
+        lap[0] = self.pc;
         let mut window = 0;
         let mut flow = 0;
         for _ in 0..BUDGET {
@@ -193,18 +230,27 @@ impl Cpu {
             if flow & POLLED != 0 && (self.nmi_pending || self.irq_pending) {
                 break;
             }
+            if !probe.clean {
+                // A write or a device read: the program is at work, not
+                // idling. Cheap to find out, so the next probe comes soon.
+                break;
+            }
             window += 1;
-            if self.pc == start.0.pc && probe.clean && self.loop_state() == start.0 {
+            if self.pc == start.0.pc && self.loop_state() == start.0 {
                 let cycles = self.cycles - start.1;
                 let instructions = self.instructions - start.2;
+                (self.idle.lap, self.idle.lap_len) = (lap, window);
                 self.skip_iterations(probe.bus, until, cycles, instructions);
                 return flow;
             }
-            if self.pc == start.0.pc || !probe.clean || window == MAX_LOOP {
-                // Not (or not yet) a clean lap: look for one from here.
+            if self.pc == start.0.pc || window == MAX_LOOP {
+                // Back with other registers (the first lap after entering
+                // a loop), or no loop through here: look from here.
                 start = (self.loop_state(), self.cycles, self.instructions);
-                probe.clean = true;
+                lap[0] = self.pc;
                 window = 0;
+            } else {
+                lap[window] = self.pc;
             }
         }
         self.idle.missed(self.cycles);

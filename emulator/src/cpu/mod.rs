@@ -124,6 +124,9 @@ const NO_POLL: u8 = 16;
 const I_WAS_SET: u8 = 32;
 /// The instruction's poll was made (not skipped as quiet).
 const POLLED: u8 = 64;
+/// RTI: the end of an interrupt handler, where an idle program goes back
+/// to waiting (the run loop then looks for its idle loop at once).
+const RETURNED: u8 = 128;
 
 /// An NMOS 6502. Registers are public fields; the status register is read
 /// and written through [`Cpu::p`] and [`Cpu::set_p`] because the CPU keeps
@@ -435,6 +438,8 @@ impl Cpu {
     fn run_local<B: Bus, H: Hooks>(&mut self, bus: &mut B, until: u64, hooks: &mut H) -> Stop {
         // A constant `false` unless the hooks observe nothing.
         let probing = H::PASSIVE && self.idle.enabled;
+        // The inner loop ended on an RTI (only with passive hooks).
+        let mut returned = false;
         loop {
             if self.cycles >= until {
                 return Stop::Limit;
@@ -442,14 +447,16 @@ impl Cpu {
             if self.nmi_pending || self.irq_pending {
                 let kind = self.interrupt_sequence(bus);
                 hooks.interrupt(self, &*bus, kind);
+                returned = false;
                 continue;
             }
-            if probing && self.cycles >= self.idle.next_probe {
+            if probing && (returned || self.cycles >= self.idle.next_probe) {
                 // On a copy, so that this loop's CPU never has its address
                 // taken and stays in machine registers.
                 let mut cpu = self.clone();
-                let flow = cpu.probe_idle(bus, until);
+                let flow = cpu.probe_idle(bus, until, returned);
                 *self = cpu;
+                returned = false;
                 if flow & JAM != 0 {
                     return Stop::Jam {
                         pc: self.pc,
@@ -469,7 +476,7 @@ impl Cpu {
             // the limit is reached. Nothing here reads P as a whole; the
             // pending flags can only change where a poll is made, and with
             // a bus that has no interrupt source the polls fold away.
-            loop {
+            returned = loop {
                 if let Control::Stop = hooks.before_instruction(self, &*bus) {
                     return Stop::Hook { pc: self.pc };
                 }
@@ -482,7 +489,7 @@ impl Cpu {
                     self.execute::<B, true>(bus, opcode, pc)
                 };
                 let mut interrupted = false;
-                if flow & (JAM | NO_POLL) != 0 {
+                if flow & (JAM | NO_POLL | RETURNED) != 0 {
                     if flow & JAM != 0 {
                         // The processor locks up on the opcode: leave it
                         // there, uncounted, so the fault is reported where
@@ -494,8 +501,19 @@ impl Cpu {
                             opcode: bus.peek(pc),
                         };
                     }
-                    // BRK: its sequence polled.
                     self.instructions += 1;
+                    // BRK's sequence polled; RTI polls as usual.
+                    if flow & RETURNED != 0 {
+                        if self.cycles > bus.quiet_until() {
+                            self.poll_after(bus, flow);
+                            interrupted = self.nmi_pending || self.irq_pending;
+                        }
+                        if H::PASSIVE {
+                            // Maybe back into the idle loop last found:
+                            // the probe decides, out of this loop.
+                            break true;
+                        }
+                    }
                 } else {
                     self.instructions += 1;
                     // One comparison while the bus is quiet (see
@@ -511,9 +529,9 @@ impl Cpu {
                     }
                 }
                 if interrupted || self.cycles >= limit {
-                    break;
+                    break false;
                 }
-            }
+            };
         }
     }
 
