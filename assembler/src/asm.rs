@@ -25,6 +25,10 @@ pub(crate) struct Reported;
 
 pub(crate) type PResult<T> = Result<T, Reported>;
 
+/// Most tokens in one line after macro arguments and `.define`s are
+/// substituted: a recursive macro whose argument contains itself would
+/// otherwise double the line at every level.
+const MAX_LINE_TOKENS: usize = 16_384;
 /// Deepest nesting of includes, macros and `.repeat`s.
 const MAX_FRAMES: usize = 256;
 /// Largest total of bytes in all segments (the 6502 sees 64 KiB, but a
@@ -134,6 +138,8 @@ pub(crate) struct Asm<'a> {
     pub(crate) toks: Vec<Token>,
     tmp: Vec<Token>,
     lex_errors: Vec<LexError>,
+    /// The current line was cut at [`MAX_LINE_TOKENS`].
+    overlong: bool,
     /// The line being processed.
     pub(crate) line: LineInfo,
     pub(crate) line_ctx: CtxId,
@@ -190,6 +196,7 @@ impl<'a> Asm<'a> {
             toks: Vec::with_capacity(64),
             tmp: Vec::with_capacity(64),
             lex_errors: Vec::new(),
+            overlong: false,
             line: LineInfo::default(),
             line_ctx: 0,
             listing: None,
@@ -729,6 +736,10 @@ impl<'a> Asm<'a> {
                     match tok.kind {
                         Tok::Param => {
                             if let Some(arg) = args.get(tok.value as usize) {
+                                if self.toks.len() + arg.len() > MAX_LINE_TOKENS {
+                                    self.overlong = true;
+                                    break;
+                                }
                                 self.toks.extend_from_slice(arg);
                             }
                         }
@@ -804,6 +815,7 @@ impl<'a> Asm<'a> {
                 self.lex_errors.clear();
                 self.lines_read += 1;
                 self.line = info;
+                self.check_overlong(info);
                 if let Some(listing) = self.listing.as_mut() {
                     listing.text_line(&self.frames, info);
                 }
@@ -811,6 +823,26 @@ impl<'a> Asm<'a> {
             }
             _ => None,
         }
+    }
+
+    /// Reports (and empties) a line that macro substitution made too long.
+    fn check_overlong(&mut self, info: LineInfo) {
+        if !std::mem::take(&mut self.overlong) {
+            return;
+        }
+        let span = Span {
+            file: info.file,
+            start: info.start,
+            end: info.end,
+        };
+        self.err(
+            "asm::too-long",
+            span,
+            format!(
+                "this line grows past {MAX_LINE_TOKENS} tokens when its macro arguments are substituted (a macro whose argument contains itself?)"
+            ),
+        );
+        self.toks.clear();
     }
 
     fn pop_frame(&mut self) {
@@ -845,6 +877,7 @@ impl<'a> Asm<'a> {
                 Some(None) => self.pop_frame(),
                 Some(Some(info)) => {
                     self.lines_read += 1;
+                    self.check_overlong(info);
                     if self.lines_read > self.opts.max_lines {
                         let span = self.toks.first().map_or(
                             Span {
@@ -963,6 +996,9 @@ impl<'a> Asm<'a> {
             let mut i = 0;
             let toks = std::mem::take(&mut self.toks);
             while i < toks.len() {
+                if self.tmp.len() > MAX_LINE_TOKENS {
+                    break;
+                }
                 let tok = toks[i];
                 let define = if tok.kind == Tok::Ident {
                     self.names
@@ -1032,7 +1068,7 @@ impl<'a> Asm<'a> {
             if !changed {
                 break;
             }
-            if rounds > 64 || self.toks.len() > 100_000 {
+            if rounds > 64 || self.toks.len() > MAX_LINE_TOKENS {
                 let span = self.toks.first().map(|t| t.span).unwrap_or_default();
                 self.err(
                     "asm::define-loop",

@@ -310,6 +310,10 @@ fn pathological_inputs_end_with_errors() {
     // it used to restart the expansion forever).
     check(b".repeat 2\n.struct s\n.union\nm .byte\n.endrepeat\n");
     check(b".macro m\n.struct s\nf .byte\n.endmacro\nm\nm\n");
+    // A macro whose argument contains itself doubles its line at every
+    // level (found by cargo-fuzz: it used to exhaust memory).
+    check(b".macro grow n\n        grow n n\n.endmacro\n        grow 1\n");
+    check(b".define TWICE(v) v v\n.define X TWICE(X)\n        .byte X\n");
     // Forward definitions that double at each step: evaluated once each.
     let mut doubling = String::from("a0 = later + later\n");
     for i in 1..60 {
