@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub(crate) mod ask;
 pub(crate) mod asm;
 pub(crate) mod build;
 pub(crate) mod disasm;
@@ -7,6 +8,5 @@ pub(crate) mod emu;
 pub(crate) mod link;
 pub(crate) mod ports;
 pub(crate) mod read;
-pub(crate) mod upload;
-pub(crate) mod ask;
 pub(crate) mod sim;
+pub(crate) mod upload;
