@@ -136,10 +136,11 @@ pub(crate) fn flat(start: u64) -> Layout {
     }
 }
 
-/// `scorpion-ext`: everything in the user's zero page and RAM.
-pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
-    let target = "scorpion-ext";
-    let [zp_start, zp_end, ram_start, ram_end] = rom.require(
+/// The user's zero page and RAM as the ROM exports them (inclusive
+/// bounds: `[zp_start, zp_end, ram_start, ram_end]`), checked to be
+/// ranges: what the extension and OS layouts are built from.
+fn user_space(rom: &RomSymbols, target: &str) -> Result<[u64; 4], Error> {
+    let bounds = rom.require(
         target,
         [
             "USER_ZP_START",
@@ -148,8 +149,16 @@ pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
             "USER_RAM_END",
         ],
     )?;
+    let [zp_start, zp_end, ram_start, ram_end] = bounds;
     inclusive(target, "user zero page", zp_start, zp_end)?;
     inclusive(target, "user RAM", ram_start, ram_end)?;
+    Ok(bounds)
+}
+
+/// `scorpion-ext`: everything in the user's zero page and RAM.
+pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
+    let target = "scorpion-ext";
+    let [zp_start, zp_end, ram_start, ram_end] = user_space(rom, target)?;
     Ok(Layout {
         name: target.into(),
         areas: vec![
@@ -170,17 +179,7 @@ pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
 /// `scorpion-os`: code and data in KIM-bus RAM, BSS in user RAM.
 pub(crate) fn scorpion_os(rom: &RomSymbols) -> Result<Layout, Error> {
     let target = "scorpion-os";
-    let [zp_start, zp_end, ram_start, ram_end] = rom.require(
-        target,
-        [
-            "USER_ZP_START",
-            "USER_ZP_END",
-            "USER_RAM_START",
-            "USER_RAM_END",
-        ],
-    )?;
-    inclusive(target, "user zero page", zp_start, zp_end)?;
-    inclusive(target, "user RAM", ram_start, ram_end)?;
+    let [zp_start, zp_end, ram_start, ram_end] = user_space(rom, target)?;
     Ok(Layout {
         name: target.into(),
         areas: vec![
