@@ -9,7 +9,9 @@ use std::sync::Arc;
 use rustc_hash::FxHashMap;
 
 use crate::Options;
-use crate::diag::{self, CtxId, CtxKind, CtxNode, Files, RawDiag, Reporter, Span, count_chars};
+use crate::diag::{
+    self, CtxId, CtxKind, CtxNode, Files, RawDiag, Reporter, Span, Text, count_chars,
+};
 use crate::intern::{Dir, Interner, Keyword, NameId};
 use crate::lexer::{LexError, Lexer, LineInfo, Tok, Token};
 use crate::listing::ListingBuilder;
@@ -66,7 +68,7 @@ pub(crate) struct Define {
 #[derive(Debug)]
 pub(crate) enum Frame {
     File {
-        text: Arc<[u8]>,
+        text: Text,
         lexer: Lexer,
         ctx: CtxId,
         conds: usize,
@@ -120,7 +122,10 @@ pub(crate) struct Asm<'a> {
     pub(crate) source: &'a dyn FileSource,
     pub(crate) opts: &'a Options,
 
+    /// Symbols of scopes other than the global one, by (scope, name).
     sym_map: FxHashMap<u64, SymId>,
+    /// Global symbols by name ([`NO_SYM`] where there is none).
+    global_syms: Vec<SymId>,
     pub(crate) scope_map: FxHashMap<u64, ScopeId>,
     cheap_map: FxHashMap<u64, SymId>,
     pub(crate) unnamed: Vec<SymId>,
@@ -157,6 +162,9 @@ pub(crate) struct Asm<'a> {
     pub(crate) main_name: String,
 }
 
+/// No symbol, in [`Asm::global_syms`].
+const NO_SYM: SymId = SymId::MAX;
+
 fn key(a: u32, b: u32) -> u64 {
     (u64::from(a) << 32) | u64::from(b)
 }
@@ -180,6 +188,7 @@ impl<'a> Asm<'a> {
             source,
             opts,
             sym_map: FxHashMap::default(),
+            global_syms: Vec::new(),
             scope_map: FxHashMap::default(),
             cheap_map: FxHashMap::default(),
             unnamed: Vec::new(),
@@ -420,17 +429,40 @@ impl<'a> Asm<'a> {
 
     /// The symbol `name` exactly in `scope`, created if missing.
     pub(crate) fn sym_in(&mut self, scope: ScopeId, name: NameId) -> SymId {
-        if let Some(&sym) = self.sym_map.get(&key(scope, name)) {
+        if let Some(sym) = self.find_sym(scope, name) {
             return sym;
         }
         let sym = self.new_sym(name, scope, SymKind::Normal);
-        self.sym_map.insert(key(scope, name), sym);
+        self.bind_sym(scope, name, sym);
         sym
     }
 
     /// Looks `name` up in `scope` only.
     pub(crate) fn find_sym(&self, scope: ScopeId, name: NameId) -> Option<SymId> {
+        if scope == GLOBAL_SCOPE {
+            // Most lookups end here: a dense table indexed by name stays
+            // in cache where a hash probe into a table of every symbol of
+            // a large program would not.
+            return self
+                .global_syms
+                .get(name as usize)
+                .copied()
+                .filter(|&sym| sym != NO_SYM);
+        }
         self.sym_map.get(&key(scope, name)).copied()
+    }
+
+    /// Records `sym` as `name` in `scope`.
+    fn bind_sym(&mut self, scope: ScopeId, name: NameId, sym: SymId) {
+        if scope == GLOBAL_SCOPE {
+            let index = name as usize;
+            if self.global_syms.len() <= index {
+                self.global_syms.resize(index + 1, NO_SYM);
+            }
+            self.global_syms[index] = sym;
+        } else {
+            self.sym_map.insert(key(scope, name), sym);
+        }
     }
 
     /// A reference to `name` from the current scope: an existing symbol in
@@ -439,12 +471,12 @@ impl<'a> Asm<'a> {
     pub(crate) fn ref_sym(&mut self, name: NameId, span: Span) -> SymId {
         let mut scope = self.scope;
         let sym = loop {
-            if let Some(&sym) = self.sym_map.get(&key(scope, name)) {
+            if let Some(sym) = self.find_sym(scope, name) {
                 break sym;
             }
             if scope == GLOBAL_SCOPE {
                 let sym = self.new_sym(name, self.scope, SymKind::Normal);
-                self.sym_map.insert(key(self.scope, name), sym);
+                self.bind_sym(self.scope, name, sym);
                 break sym;
             }
             scope = self.prog.scopes[scope as usize].parent;
@@ -468,6 +500,22 @@ impl<'a> Asm<'a> {
         let sym = self.new_sym(name, self.scope, SymKind::Cheap);
         self.cheap_map.insert(key(self.cheap_epoch, name), sym);
         sym
+    }
+
+    /// Starts a new region for cheap locals. The old region's names can
+    /// never be reached again, so the map forgets them: it stays as small
+    /// as one region (in cache), not as large as the program.
+    pub(crate) fn new_cheap_region(&mut self) {
+        self.cheap_epoch += 1;
+        if !self.cheap_map.is_empty() {
+            if self.cheap_map.capacity() > 1024 {
+                // After a region with very many locals: clearing costs the
+                // capacity, so start small again.
+                self.cheap_map = FxHashMap::default();
+            } else {
+                self.cheap_map.clear();
+            }
+        }
     }
 
     /// The unnamed label with index `index`.
@@ -523,7 +571,7 @@ impl<'a> Asm<'a> {
         if self.prog.syms[sym as usize].kind == SymKind::Normal
             && !matches!(def, SymDef::Import { .. })
         {
-            self.cheap_epoch += 1;
+            self.new_cheap_region();
         }
         let s = &mut self.prog.syms[sym as usize];
         s.def = def;
@@ -666,7 +714,8 @@ impl<'a> Asm<'a> {
             self.prog.locs.reserve(estimate / 4);
             self.prog.fixups.reserve(estimate / 4);
         }
-        let text: Arc<[u8]> = Arc::from(bytes);
+        // Shared with the file table for diagnostics, without a copy.
+        let text: Text = Arc::new(bytes);
         let file = self.files.add(name, Arc::clone(&text));
         self.frames.push(Frame::File {
             text,
@@ -1207,7 +1256,7 @@ impl<'a> Asm<'a> {
             Err(error) => return Err(self.eval_error(error, self.join(t[2].span, t[p - 1].span))),
         };
         self.keep_nodes = true;
-        self.cheap_epoch += 1;
+        self.new_cheap_region();
         self.prog.defs = self.prog.defs.wrapping_add(1);
         let s = &mut self.prog.syms[sym as usize];
         match s.def {

@@ -7,6 +7,7 @@
 //! text, line and column, and a backtrace of macro expansions and includes
 //! as related notes.
 
+use std::cell::OnceCell;
 use std::fmt;
 use std::sync::Arc;
 
@@ -23,13 +24,20 @@ pub(crate) struct Span {
     pub(crate) end: u32,
 }
 
+/// A source file's bytes, shared by the reader and the diagnostics.
+pub(crate) type Text = Arc<Vec<u8>>;
+
 /// One source file the assembler read.
 #[derive(Debug)]
 pub(crate) struct SourceFile {
     /// The name shown to users (the path as given or as resolved).
     pub(crate) name: String,
     /// The bytes.
-    pub(crate) text: Arc<[u8]>,
+    pub(crate) text: Text,
+    /// Offsets of the line starts, built on the first diagnostic that
+    /// needs a line number (a scan from the top per diagnostic made 50
+    /// diagnostics in a large file cost 50 reads of it).
+    line_starts: OnceCell<Vec<u32>>,
 }
 
 /// Every file read during one assembly, indexed by [`Span::file`].
@@ -39,8 +47,12 @@ pub(crate) struct Files {
 }
 
 impl Files {
-    pub(crate) fn add(&mut self, name: String, text: Arc<[u8]>) -> u32 {
-        self.files.push(SourceFile { name, text });
+    pub(crate) fn add(&mut self, name: String, text: Text) -> u32 {
+        self.files.push(SourceFile {
+            name,
+            text,
+            line_starts: OnceCell::new(),
+        });
         (self.files.len() - 1) as u32
     }
 
@@ -83,16 +95,26 @@ impl Files {
 
     /// Line and column (both from 1, the column in characters) of a byte offset.
     pub(crate) fn line_col(&self, file: u32, offset: u32) -> (u32, u32) {
-        let text = self.text(file);
+        let Some(source) = self.files.get(file as usize) else {
+            return (1, 1);
+        };
+        let text = &source.text;
         let offset = (offset as usize).min(text.len());
-        let before = &text[..offset];
-        let line = before.iter().filter(|b| **b == b'\n').count() as u32 + 1;
-        let line_start = before
-            .iter()
-            .rposition(|b| *b == b'\n')
-            .map_or(0, |p| p + 1);
+        let starts = source.line_starts.get_or_init(|| {
+            std::iter::once(0)
+                .chain(
+                    text.iter()
+                        .enumerate()
+                        .filter(|(_, b)| **b == b'\n')
+                        .map(|(i, _)| i as u32 + 1),
+                )
+                .collect()
+        });
+        // The last line start at or before `offset` (there is always one: 0).
+        let line = starts.partition_point(|&start| start as usize <= offset);
+        let line_start = starts.get(line.wrapping_sub(1)).map_or(0, |&s| s as usize);
         let column = count_chars(&text[line_start..offset]) + 1;
-        (line, column)
+        (line as u32, column)
     }
 }
 
@@ -267,7 +289,7 @@ pub struct Diagnostic {
     code: &'static str,
     message: String,
     location: Option<Location>,
-    source: Option<NamedSource<Arc<[u8]>>>,
+    source: Option<NamedSource<Text>>,
     labels: Vec<LabeledSpan>,
     help: Option<String>,
     related: Vec<Diagnostic>,

@@ -5,8 +5,7 @@
 
 use isa::elf::{EM_MOS, SHF_MOS_ZEROPAGE, STO_MOS_ZEROPAGE};
 use isa::objfmt::{
-    ASSERT_SECTION, AssertAction, Assertion, Expr, SRCMAP_SECTION, SourceLoc, SrcMap, SrcMapEntry,
-    SymbolLoc,
+    ASSERT_SECTION, AssertAction, Assertion, Expr, SRCMAP_SECTION, SourceLoc, SrcMap, SymbolLoc,
 };
 use object::Endianness;
 use object::elf;
@@ -29,9 +28,10 @@ fn section_flags(name: &str, zp: bool) -> u64 {
     flags
 }
 
-/// Serialises `out` as an ELF object.
+/// Serialises `out` as an ELF object (its source map items are moved
+/// into the object, not copied).
 pub(crate) fn write_object(
-    out: &Output,
+    out: &mut Output,
     files: &Files,
     file_name: &str,
     e_flags: u32,
@@ -104,17 +104,17 @@ pub(crate) fn write_object(
             Target::Absolute => Some(0),
         }
     };
+    let mut entries = std::mem::take(&mut out.items);
+    for entry in &mut entries {
+        entry.section = section_index
+            .get(entry.section as usize)
+            .map_or(0, |index| index.0);
+    }
+    // Sorted here, in place, so that encoding needs no sorted copy.
+    entries.sort_unstable();
     let srcmap = SrcMap {
         files: files.files.iter().map(|f| f.name.clone()).collect(),
-        entries: out
-            .items
-            .iter()
-            .map(|&(section, offset, file, line, column)| SrcMapEntry {
-                section: section_index[section].0,
-                offset,
-                loc: SourceLoc { file, line, column },
-            })
-            .collect(),
+        entries,
         symbols: out
             .symbols
             .iter()

@@ -205,19 +205,20 @@ impl Program {
             SymDef::Alias(other) => self.sym_value(other, depth + 1),
             SymDef::Var(node) => self.eval_at(node, depth + 1),
             SymDef::Expr(node) => {
+                let memo = s.memo.as_deref().copied().unwrap_or_default();
                 if !self.placed {
-                    if let Some(value) = s.front {
+                    if let Some(value) = memo.front {
                         return Ok(value);
                     }
                     // "Not yet" stays true until another symbol is defined:
                     // without this a chain of forward definitions could be
                     // re-evaluated exponentially often.
-                    if let Some((defs, result)) = s.memo
+                    if let Some((defs, result)) = memo.result
                         && defs == self.defs
                     {
                         return result;
                     }
-                } else if let Some((stamp, result)) = s.memo
+                } else if let Some((stamp, result)) = memo.result
                     && stamp == self.stamp
                 {
                     return result;
@@ -227,19 +228,17 @@ impl Program {
                 }
                 self.syms[sym as usize].busy = true;
                 let result = self.eval_at(node, depth + 1);
+                let (placed, stamp, defs) = (self.placed, self.stamp, self.defs);
                 let s = &mut self.syms[sym as usize];
                 s.busy = false;
-                if self.placed {
-                    s.memo = Some((self.stamp, result));
-                } else {
-                    s.memo = Some((self.defs, result));
-                }
-                if !self.placed
+                let memo = s.memo.get_or_insert_with(Box::default);
+                memo.result = Some((if placed { stamp } else { defs }, result));
+                if !placed
                     && let Ok(value @ (Value::Const(_) | Value::Addr { .. } | Value::Byte { .. })) =
                         result
                 {
                     // Front-end values without unplaced positions are final.
-                    s.front = Some(value);
+                    memo.front = Some(value);
                 }
                 result
             }

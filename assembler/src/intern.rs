@@ -160,9 +160,28 @@ pub(crate) struct NameInfo {
 /// The interner.
 #[derive(Debug, Default)]
 pub(crate) struct Interner {
-    map: FxHashMap<Rc<[u8]>, NameId>,
+    /// Names of up to 16 bytes (nearly all), held in the table itself: a
+    /// lookup compares in the bucket instead of following a pointer to the
+    /// name, which in a large program is a cache miss per identifier.
+    short: FxHashMap<[u64; 2], NameId>,
+    /// Longer names, and any containing a NUL byte (the padding of `short`).
+    long: FxHashMap<Rc<[u8]>, NameId>,
     names: Vec<Rc<str>>,
     pub(crate) info: Vec<NameInfo>,
+}
+
+/// `bytes` zero-padded to 16, when that is unambiguous.
+fn short_key(bytes: &[u8]) -> Option<[u64; 2]> {
+    if bytes.len() > 16 || bytes.contains(&0) {
+        return None;
+    }
+    let mut padded = [0u8; 16];
+    padded[..bytes.len()].copy_from_slice(bytes);
+    let (low, high) = padded.split_at(8);
+    Some([
+        u64::from_le_bytes(low.try_into().ok()?),
+        u64::from_le_bytes(high.try_into().ok()?),
+    ])
 }
 
 impl Interner {
@@ -178,13 +197,21 @@ impl Interner {
     /// Interns a name given as bytes; the lexer passes ASCII identifier
     /// bytes and this avoids re-validating them as UTF-8 on every lookup.
     pub(crate) fn intern_bytes(&mut self, bytes: &[u8]) -> NameId {
-        if let Some(id) = self.map.get(bytes) {
+        let short = short_key(bytes);
+        let found = match short {
+            Some(key) => self.short.get(&key),
+            None => self.long.get(bytes),
+        };
+        if let Some(id) = found {
             return *id;
         }
         let name = String::from_utf8_lossy(bytes);
         let id = self.names.len() as NameId;
         let rc: Rc<str> = Rc::from(name.as_ref());
-        self.map.insert(Rc::from(bytes), id);
+        match short {
+            Some(key) => self.short.insert(key, id),
+            None => self.long.insert(Rc::from(bytes), id),
+        };
         self.names.push(Rc::clone(&rc));
         self.info.push(NameInfo {
             keyword: keyword_of(&rc),
@@ -246,5 +273,24 @@ mod tests {
         assert_eq!(names.keyword(label), Keyword::None);
         assert_eq!(names.intern("lda"), lower);
         assert_eq!(names.name(upper), "LDA");
+    }
+
+    #[test]
+    fn short_long_and_padded_names_stay_apart() {
+        let mut names = Interner::new();
+        let sixteen = names.intern("abcdefghijklmnop");
+        let seventeen = names.intern("abcdefghijklmnopq");
+        let nul = names.intern("a\0");
+        let a = names.intern("a");
+        assert_eq!(
+            [sixteen, seventeen, nul, a],
+            [0, 1, 2, 3],
+            "four different names"
+        );
+        assert_eq!(names.intern("abcdefghijklmnopq"), seventeen);
+        assert_eq!(names.intern("a\0"), nul);
+        assert_eq!(names.intern("abcdefghijklmnop"), sixteen);
+        assert_eq!(names.name(nul), "a\0");
+        assert_eq!(names.intern_bytes(b""), names.intern(""));
     }
 }

@@ -12,7 +12,7 @@ use isa::elf::{
     R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_ADDR16_HI, R_MOS_ADDR16_LO, R_MOS_ADDR24_BANK, R_MOS_IMM8,
     R_MOS_PCREL_8,
 };
-use isa::objfmt::{BinaryOp, ExprOp, UnaryOp};
+use isa::objfmt::{BinaryOp, ExprOp, SourceLoc, SrcMapEntry, UnaryOp};
 
 use crate::asm::Asm;
 use crate::diag::{self, RawDiag, Span};
@@ -92,8 +92,9 @@ pub(crate) struct OutAssert {
 pub(crate) struct Output {
     pub(crate) sections: Vec<OutSection>,
     pub(crate) symbols: Vec<OutSym>,
-    /// (section, offset, file, line, column) of every item.
-    pub(crate) items: Vec<(usize, u32, u32, u32, u32)>,
+    /// Where every item came from; `section` is the index in
+    /// [`Output::sections`] until the object writer numbers the sections.
+    pub(crate) items: Vec<SrcMapEntry>,
     pub(crate) asserts: Vec<OutAssert>,
     /// Output section of each segment (`None` when the segment is empty).
     pub(crate) seg_section: Vec<Option<usize>>,
@@ -441,8 +442,15 @@ impl Asm<'_> {
         for item in &self.prog.items {
             let (seg, offset) = self.chunk_pos(item.chunk, item.off);
             if let Some(section) = out.seg_section[seg as usize] {
-                out.items
-                    .push((section, offset, item.file, item.line, item.column));
+                out.items.push(SrcMapEntry {
+                    section: section as u32,
+                    offset,
+                    loc: SourceLoc {
+                        file: item.file,
+                        line: item.line,
+                        column: item.column,
+                    },
+                });
             }
         }
         self.check_asserts(&mut out, &sym_index);

@@ -165,7 +165,7 @@ pub fn assemble(
     asm.run();
     asm.finish_front();
     asm.layout();
-    let out = asm.resolve();
+    let mut out = asm.resolve();
     // In source order: by where each came from in the main file (the
     // outermost include or macro call), then by its own place.
     let ctx = &asm.ctx;
@@ -216,7 +216,7 @@ pub fn assemble(
     if asm.used_undoc {
         e_flags |= isa::elf::EF_MOS_ARCH_6502X;
     }
-    let object = elf::write_object(&out, &asm.files, &asm.main_name, e_flags)
+    let object = elf::write_object(&mut out, &asm.files, &asm.main_name, e_flags)
         .map_err(|error| Error::Object(error.to_string()))?;
     let listing = asm
         .listing
@@ -256,7 +256,7 @@ fn define_symbols(asm: &mut asm::Asm<'_>, defines: &[(String, i64)]) {
     }
     let file = asm
         .files
-        .add("<command line>".to_string(), Arc::from(text.into_bytes()));
+        .add("<command line>".to_string(), Arc::new(text.into_bytes()));
     for (line, (name, value, start, end)) in spans.into_iter().enumerate() {
         asm.line = lexer::LineInfo {
             file,

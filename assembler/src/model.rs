@@ -82,11 +82,10 @@ pub(crate) struct Sym {
     pub(crate) def_loc: Option<LocId>,
     pub(crate) ref_loc: Option<LocId>,
     pub(crate) export_loc: Option<LocId>,
-    /// Cached front-end value, once it can no longer change.
-    pub(crate) front: Option<crate::expr::Value>,
-    /// Memo: (layout pass stamp, result) after layout; (definitions
-    /// count, result) before.
-    pub(crate) memo: Option<(u32, Result<crate::expr::Value, crate::expr::EvalErr>)>,
+    /// Evaluation caches of a symbol defined by an expression, boxed:
+    /// most symbols are labels, and a small `Sym` keeps the symbol table
+    /// of a large program in cache.
+    pub(crate) memo: Option<Box<Memo>>,
     pub(crate) busy: bool,
     /// Where it was defined (file, line, column), for the source map.
     pub(crate) def_file: u32,
@@ -106,7 +105,6 @@ impl Sym {
             def_loc: None,
             ref_loc: None,
             export_loc: None,
-            front: None,
             memo: None,
             busy: false,
             def_file: 0,
@@ -118,6 +116,16 @@ impl Sym {
     pub(crate) fn is_defined(&self) -> bool {
         !matches!(self.def, SymDef::Undefined)
     }
+}
+
+/// The evaluation caches of a symbol defined by an expression.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Memo {
+    /// Cached front-end value, once it can no longer change.
+    pub(crate) front: Option<crate::expr::Value>,
+    /// (layout pass stamp, result) after layout; (definitions count,
+    /// result) before.
+    pub(crate) result: Option<(u32, Result<crate::expr::Value, crate::expr::EvalErr>)>,
 }
 
 /// What kind of scope.

@@ -62,15 +62,27 @@ impl SrcMap {
     /// Serialises the map (entries are sorted first).
     #[must_use]
     pub fn encode(&self) -> Vec<u8> {
-        let mut entries = self.entries.clone();
-        entries.sort_unstable();
+        // Entries usually arrive sorted: no copy then (a large program's
+        // map runs to megabytes).
+        let sorted_copy;
+        let entries = if self.entries.is_sorted() {
+            &self.entries
+        } else {
+            let mut copy = self.entries.clone();
+            copy.sort_unstable();
+            sorted_copy = copy;
+            &sorted_copy
+        };
         let mut out = Writer::header(MAGIC, VERSION);
+        let strings: usize = self.files.iter().map(|f| 4 + f.len()).sum();
+        out.bytes
+            .reserve(12 + strings + 20 * entries.len() + 16 * self.symbols.len());
         out.len32(self.files.len());
         for file in &self.files {
             out.string(file);
         }
         out.len32(entries.len());
-        for entry in &entries {
+        for entry in entries {
             out.u32(entry.section);
             out.u32(entry.offset);
             write_loc(&mut out, entry.loc);
