@@ -37,9 +37,64 @@ pub(crate) fn length(text: &str) -> Result<u32, String> {
     parse_number(text, 0x1_0000).map(|value| value as u32)
 }
 
+/// A `-D` symbol definition: `NAME` (value 1) or `NAME=VALUE`, the value
+/// as `42`, `$2A`, `0x2A` or `%101010`, optionally negative, within 32 bits.
+pub(crate) fn define(text: &str) -> Result<(String, i64), String> {
+    let (name, value) = text.split_once('=').unwrap_or((text, "1"));
+    let valid = name
+        .bytes()
+        .next()
+        .is_some_and(|b| b.is_ascii_alphabetic() || b == b'_')
+        && name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_');
+    if !valid {
+        return Err(format!(
+            "`{name}` is not a symbol name (letters, digits and `_`)"
+        ));
+    }
+    let value = value.trim();
+    let (negative, digits) = value
+        .strip_prefix('-')
+        .map_or((false, value), |rest| (true, rest));
+    let (digits, radix) = if let Some(hex) = digits
+        .strip_prefix('$')
+        .or_else(|| digits.strip_prefix("0x"))
+        .or_else(|| digits.strip_prefix("0X"))
+    {
+        (hex, 16)
+    } else if let Some(binary) = digits.strip_prefix('%') {
+        (binary, 2)
+    } else {
+        (digits, 10)
+    };
+    let number = i64::from_str_radix(digits, radix)
+        .ok()
+        .filter(|n| (0..=i64::from(u32::MAX)).contains(n))
+        .ok_or_else(|| format!("`{value}` is not a number (write 42, $2A, 0x2A or %101010)"))?;
+    Ok((name.to_owned(), if negative { -number } else { number }))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn defines_in_every_spelling() {
+        assert_eq!(define("DEBUG"), Ok(("DEBUG".into(), 1)));
+        assert_eq!(define("_x1=7"), Ok(("_x1".into(), 7)));
+        assert_eq!(define("X=$2A"), Ok(("X".into(), 42)));
+        assert_eq!(define("X=0x2a"), Ok(("X".into(), 42)));
+        assert_eq!(define("X=%101"), Ok(("X".into(), 5)));
+        assert_eq!(define("X=-3"), Ok(("X".into(), -3)));
+        assert_eq!(define("X=-0x10"), Ok(("X".into(), -16)));
+        assert_eq!(define("X=$FFFFFFFF"), Ok(("X".into(), 0xFFFF_FFFF)));
+        assert!(define("X=$100000000").is_err());
+        assert!(define("X=--1").is_err(), "one sign only");
+        assert!(define("1X=2").unwrap_err().contains("not a symbol name"));
+        assert!(define("9X").is_err());
+        assert!(define("=1").is_err());
+        assert!(define("X=zz").unwrap_err().contains("not a number"));
+        assert!(define("X=").is_err());
+    }
 
     #[test]
     fn addresses_in_three_spellings() {

@@ -999,17 +999,7 @@ impl<'a> Asm<'a> {
             return;
         };
         match dir {
-            Dir::If
-            | Dir::Ifdef
-            | Dir::Ifndef
-            | Dir::Ifblank
-            | Dir::Ifnblank
-            | Dir::Ifconst
-            | Dir::Ifref
-            | Dir::Ifnref
-            | Dir::Ifp02
-            | Dir::Ifpc02
-            | Dir::Ifp816 => self.conds.push(Cond {
+            _ if dir.opens_conditional() => self.conds.push(Cond {
                 span: first.span,
                 parent_active: false,
                 active: false,

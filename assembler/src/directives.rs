@@ -85,20 +85,8 @@ impl Asm<'_> {
             Dir::Local => self.local(t, p),
             Dir::Exitmacro => self.exit_macro(t, p),
             Dir::Repeat => self.repeat(t, p),
-            Dir::If
-            | Dir::Elseif
-            | Dir::Else
-            | Dir::Endif
-            | Dir::Ifdef
-            | Dir::Ifndef
-            | Dir::Ifblank
-            | Dir::Ifnblank
-            | Dir::Ifconst
-            | Dir::Ifref
-            | Dir::Ifnref
-            | Dir::Ifp02
-            | Dir::Ifpc02
-            | Dir::Ifp816 => self.conditional(dir, &t[p..]),
+            Dir::Elseif | Dir::Else | Dir::Endif => self.conditional(dir, &t[p..]),
+            _ if dir.opens_conditional() => self.conditional(dir, &t[p..]),
             Dir::Define => self.define_text(t, p),
             Dir::Undefine => {
                 let Some(name) = t.get(p + 1).filter(|t| t.kind == Tok::Ident).copied() else {

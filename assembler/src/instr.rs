@@ -264,29 +264,22 @@ impl Asm<'_> {
                         let mode = abs_mode;
                         return Err(self.no_mode(mnemonic, mode, whole));
                     }
-                    (Some(_), _, Size::Zp) | (Some(_), None, Size::Auto) => Fit::Zp,
-                    (_, Some(_), Size::Abs) | (None, Some(_), Size::Auto) => Fit::Abs,
+                    (Some(_), _, Size::Zp) | (Some(_), None, Size::Auto) => Some(Fit::Zp),
+                    (_, Some(_), Size::Abs) | (None, Some(_), Size::Auto) => Some(Fit::Abs),
                     (None, Some(_), Size::Zp) => return Err(self.no_mode(mnemonic, zp_mode, whole)),
                     (Some(_), None, Size::Abs) => {
                         return Err(self.no_mode(mnemonic, abs_mode, whole));
                     }
-                    (Some(_), Some(_), Size::Auto) => {
-                        let value = self.prog.eval(expr);
-                        let fit = self.fit(value, operand_span)?;
-                        // Evaluated once: the operand bytes use the same value.
-                        return self.direct(
-                            mnemonic,
-                            fit,
-                            (zp_mode, abs_mode),
-                            expr,
-                            value,
-                            head.span,
-                            operand_span,
-                            whole,
-                        );
-                    }
+                    // Both exist: the operand's value decides.
+                    (Some(_), Some(_), Size::Auto) => None,
                 };
+                // Evaluated once: the choice and the operand bytes use the
+                // same value.
                 let value = self.prog.eval(expr);
+                let choice = match choice {
+                    Some(fit) => fit,
+                    None => self.fit(value, operand_span)?,
+                };
                 self.direct(
                     mnemonic,
                     choice,

@@ -125,6 +125,26 @@ directives! {
     Zeropage = "zeropage";
 }
 
+impl Dir {
+    /// `.if` and its relatives: the directives that open a conditional.
+    pub(crate) fn opens_conditional(self) -> bool {
+        matches!(
+            self,
+            Dir::If
+                | Dir::Ifdef
+                | Dir::Ifndef
+                | Dir::Ifblank
+                | Dir::Ifnblank
+                | Dir::Ifconst
+                | Dir::Ifref
+                | Dir::Ifnref
+                | Dir::Ifp02
+                | Dir::Ifpc02
+                | Dir::Ifp816
+        )
+    }
+}
+
 /// What a name means before any symbol is looked up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Keyword {

@@ -551,6 +551,33 @@ impl Asm<'_> {
         }
     }
 
+    /// A relocation at `pos` of segment `seg` against `base` (none when the
+    /// segment or the symbol has no place in the object, which an error
+    /// elsewhere has reported).
+    #[allow(clippy::too_many_arguments)]
+    fn push_reloc(
+        &self,
+        out: &mut Output,
+        sym_index: &[Option<usize>],
+        base: Base,
+        seg: SegId,
+        pos: u32,
+        r_type: u32,
+        addend: i64,
+    ) {
+        if let (Some(target), Some(section)) = (
+            self.base_target(base, out, sym_index),
+            out.seg_section[seg as usize],
+        ) {
+            out.sections[section].relocs.push(OutReloc {
+                offset: pos,
+                r_type,
+                target,
+                addend,
+            });
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn resolve_field(
         &mut self,
@@ -666,24 +693,8 @@ impl Asm<'_> {
                     FixKind::Abs | FixKind::Word | FixKind::Dword => R_MOS_ADDR16,
                     FixKind::Dbyt => {
                         // Big-endian: the high byte first, then the low byte.
-                        if let (Some(target), Some(section)) = (
-                            self.base_target(base, out, sym_index),
-                            out.seg_section[seg as usize],
-                        ) {
-                            let relocs = &mut out.sections[section].relocs;
-                            relocs.push(OutReloc {
-                                offset: pos,
-                                r_type: R_MOS_ADDR16_HI,
-                                target,
-                                addend: off,
-                            });
-                            relocs.push(OutReloc {
-                                offset: pos + 1,
-                                r_type: R_MOS_ADDR16_LO,
-                                target,
-                                addend: off,
-                            });
-                        }
+                        self.push_reloc(out, sym_index, base, seg, pos, R_MOS_ADDR16_HI, off);
+                        self.push_reloc(out, sym_index, base, seg, pos + 1, R_MOS_ADDR16_LO, off);
                         return;
                     }
                     FixKind::Branch => R_MOS_PCREL_8,
@@ -698,32 +709,12 @@ impl Asm<'_> {
                 };
                 // `.dbyt <x`: the byte goes in the low (second) position.
                 let pos = if kind == FixKind::Dbyt { pos + 1 } else { pos };
-                if let (Some(target), Some(section)) = (
-                    self.base_target(base, out, sym_index),
-                    out.seg_section[seg as usize],
-                ) {
-                    out.sections[section].relocs.push(OutReloc {
-                        offset: pos,
-                        r_type,
-                        target,
-                        addend: off,
-                    });
-                }
+                self.push_reloc(out, sym_index, base, seg, pos, r_type, off);
                 return;
             }
             Value::Chunk { .. } => return,
         };
-        if let (Some(target), Some(section)) = (
-            self.base_target(base, out, sym_index),
-            out.seg_section[seg as usize],
-        ) {
-            out.sections[section].relocs.push(OutReloc {
-                offset: pos,
-                r_type,
-                target,
-                addend,
-            });
-        }
+        self.push_reloc(out, sym_index, base, seg, pos, r_type, addend);
     }
 
     /// Warns about branches that land inside an instruction (typically
