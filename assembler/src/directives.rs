@@ -340,7 +340,12 @@ impl Asm<'_> {
         if fill.is_some() {
             seg.has_data = true;
         }
-        self.prog.chunks[seg.cur as usize].len += count as u32;
+        let chunk = &mut self.prog.chunks[seg.cur as usize];
+        if fill.is_none() && count > 0 {
+            // As ld65 does, the linker fills these with the area's value.
+            self.prog.fills.push((seg.cur, chunk.len, count as u32));
+        }
+        chunk.len += count as u32;
         self.total_bytes += count;
         Ok(())
     }
@@ -432,7 +437,10 @@ impl Asm<'_> {
                 let loc = self.loc(span);
                 let id = self.prog.vars.len() as u32;
                 self.prog.vars.push(VarItem {
-                    kind: VarKind::Align { align, fill },
+                    kind: VarKind::Align {
+                        align,
+                        fill: filled.then_some(fill),
+                    },
                     loc,
                     size: 0,
                 });

@@ -1,11 +1,12 @@
 //! Writes the ELF32 relocatable object (docs/ARCHITECTURE.md, "The object
 //! format") with `object::write::elf::Writer`: a section per segment, the
 //! symbol table, `.rela<segment>` sections with llvm-mos relocation
-//! numbers, `.scorpion.srcmap` and `.scorpion.assert`.
+//! numbers, `.scorpion.srcmap`, `.scorpion.assert` and `.scorpion.fill`.
 
 use isa::elf::{EM_MOS, SHF_MOS_ZEROPAGE, STO_MOS_ZEROPAGE};
 use isa::objfmt::{
-    ASSERT_SECTION, AssertAction, Assertion, Expr, SRCMAP_SECTION, SourceLoc, SrcMap, SymbolLoc,
+    ASSERT_SECTION, AssertAction, Assertion, Expr, FILL_SECTION, FillRun, SRCMAP_SECTION,
+    SourceLoc, SrcMap, SymbolLoc,
 };
 use object::Endianness;
 use object::elf;
@@ -66,6 +67,12 @@ pub(crate) fn write_object(
     } else {
         let index = w.reserve_section_index();
         Some((index, w.add_section_name(ASSERT_SECTION.as_bytes())))
+    };
+    let fill_section = if out.fills.is_empty() {
+        None
+    } else {
+        w.reserve_section_index();
+        Some(w.add_section_name(FILL_SECTION.as_bytes()))
     };
 
     // Symbols: null, file, sections, locals, then globals.
@@ -150,6 +157,17 @@ pub(crate) fn write_object(
         })
         .collect();
     let assert_bytes = Assertion::encode_all(&asserts);
+    let fills: Vec<FillRun> = out
+        .fills
+        .iter()
+        .filter_map(|run| {
+            Some(FillRun {
+                section: section_index.get(run.section as usize)?.0,
+                ..*run
+            })
+        })
+        .collect();
+    let fill_bytes = FillRun::encode_all(&fills);
 
     // File layout.
     let mut data_offset = Vec::with_capacity(out.sections.len());
@@ -164,6 +182,11 @@ pub(crate) fn write_object(
     let srcmap_offset = w.reserve(srcmap.len() as u64, 1);
     let assert_offset = if assert_section.is_some() {
         w.reserve(assert_bytes.len() as u64, 1)
+    } else {
+        0
+    };
+    let fill_offset = if fill_section.is_some() {
+        w.reserve(fill_bytes.len() as u64, 1)
     } else {
         0
     };
@@ -196,6 +219,9 @@ pub(crate) fn write_object(
     w.write(&srcmap);
     if assert_section.is_some() {
         w.write(&assert_bytes);
+    }
+    if fill_section.is_some() {
+        w.write(&fill_bytes);
     }
     w.write_null_symbol();
     w.write_symbol(&Sym {
@@ -320,6 +346,9 @@ pub(crate) fn write_object(
     metadata(&mut w, srcmap_name, srcmap_offset, srcmap.len());
     if let Some((_, name)) = assert_section {
         metadata(&mut w, name, assert_offset, assert_bytes.len());
+    }
+    if let Some(name) = fill_section {
+        metadata(&mut w, name, fill_offset, fill_bytes.len());
     }
     w.write_symtab_section_header(num_local);
     w.write_symtab_shndx_section_header();

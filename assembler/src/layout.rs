@@ -12,7 +12,7 @@ use isa::elf::{
     R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_ADDR16_HI, R_MOS_ADDR16_LO, R_MOS_ADDR24_BANK, R_MOS_IMM8,
     R_MOS_PCREL_8,
 };
-use isa::objfmt::{BinaryOp, ExprOp, SourceLoc, SrcMapEntry, UnaryOp};
+use isa::objfmt::{BinaryOp, ExprOp, FillRun, SourceLoc, SrcMapEntry, UnaryOp};
 
 use crate::asm::Asm;
 use crate::diag::{self, RawDiag, Span};
@@ -98,6 +98,8 @@ pub(crate) struct Output {
     pub(crate) asserts: Vec<OutAssert>,
     /// Output section of each segment (`None` when the segment is empty).
     pub(crate) seg_section: Vec<Option<usize>>,
+    /// Reserved bytes the linker fills; `section` as in [`Output::items`].
+    pub(crate) fills: Vec<FillRun>,
 }
 
 /// The bytes of a constant stored as `kind`, or what and which range.
@@ -383,7 +385,7 @@ impl Asm<'_> {
                             data.extend_from_slice(&[0; 2][..kind.len() as usize]);
                         }
                         VarKind::Align { fill, .. } => {
-                            data.resize(data.len() + var.size as usize, fill);
+                            data.resize(data.len() + var.size as usize, fill.unwrap_or(0));
                         }
                     }
                 }
@@ -437,6 +439,7 @@ impl Asm<'_> {
                 }
             }
         }
+        self.collect_fills(&mut out);
         // Source map items.
         out.items.reserve(self.prog.items.len());
         for item in &self.prog.items {
@@ -455,6 +458,36 @@ impl Asm<'_> {
         }
         self.check_asserts(&mut out, &sym_index);
         out
+    }
+
+    /// The reserved runs of sections that have bytes: `.res`s, and
+    /// `.align`s without a fill value (placed now that layout is done).
+    fn collect_fills(&self, out: &mut Output) {
+        let vars = self
+            .prog
+            .chunks
+            .iter()
+            .enumerate()
+            .filter_map(|(c, chunk)| {
+                let var = self.prog.vars.get(chunk.var? as usize)?;
+                match var.kind {
+                    VarKind::Align { fill: None, .. } => Some((c as ChunkId, chunk.len, var.size)),
+                    _ => None,
+                }
+            });
+        for (chunk, off, length) in self.prog.fills.iter().copied().chain(vars) {
+            let (seg, offset) = self.chunk_pos(chunk, off);
+            let Some(section) = out.seg_section[seg as usize] else {
+                continue;
+            };
+            if length > 0 && !out.sections[section].nobits {
+                out.fills.push(FillRun {
+                    section: section as u32,
+                    offset,
+                    length,
+                });
+            }
+        }
     }
 
     /// The output symbols; returns, per symbol id, its output index.

@@ -182,8 +182,9 @@ pub(crate) enum VarKind {
         /// Widened (never narrowed again).
         is_wide: bool,
     },
-    /// `.align` at a position unknown when read.
-    Align { align: u32, fill: u8 },
+    /// `.align` at a position unknown when read; without a fill value the
+    /// padding is reserved (the linker's fill value).
+    Align { align: u32, fill: Option<u8> },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -302,6 +303,9 @@ pub(crate) struct Program {
     pub(crate) locs: Vec<Loc>,
     pub(crate) items: Vec<Item>,
     pub(crate) asserts: Vec<AssertRec>,
+    /// Reserved bytes in chunks' fixed data (chunk, offset, length):
+    /// `.res` and `.align` without a fill value, which the linker fills.
+    pub(crate) fills: Vec<(ChunkId, u32, u32)>,
     /// Branch operands (chunk, offset of the operand byte, location), for
     /// the check that a branch does not land inside an instruction.
     pub(crate) branches: Vec<(ChunkId, u32, LocId)>,

@@ -184,6 +184,25 @@ fn dump(object: &[u8]) -> String {
             );
         }
     }
+    if let Some((_, sh)) = elf
+        .section_headers
+        .iter()
+        .enumerate()
+        .find(|(i, _)| name(*i) == isa::objfmt::FILL_SECTION)
+    {
+        let start = sh.sh_offset as usize;
+        let runs = isa::objfmt::FillRun::decode_all(&object[start..start + sh.sh_size as usize])
+            .expect("the fill runs decode");
+        for run in runs {
+            let _ = writeln!(
+                out,
+                "fill {}+{:04X} {} bytes",
+                name(run.section as usize),
+                run.offset,
+                run.length
+            );
+        }
+    }
     out
 }
 

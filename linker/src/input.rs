@@ -7,7 +7,7 @@
 
 use goblin::elf::{Elf, section_header as sh, sym};
 use isa::elf as mos;
-use isa::objfmt::{ASSERT_SECTION, Assertion, SRCMAP_SECTION, SrcMap};
+use isa::objfmt::{ASSERT_SECTION, Assertion, FILL_SECTION, FillRun, SRCMAP_SECTION, SrcMap};
 
 use crate::error::Error;
 use crate::source::Place;
@@ -45,6 +45,9 @@ pub(crate) struct Section {
     /// `SHF_EXECINSTR`: holds code.
     pub(crate) exec: bool,
     pub(crate) relocs: Vec<Reloc>,
+    /// Reserved byte ranges `(offset, length)` (`.scorpion.fill`): they
+    /// take the fill value of the area the section is loaded into.
+    pub(crate) fills: Vec<(u32, u32)>,
 }
 
 /// Where a symbol is defined.
@@ -255,6 +258,7 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
     let mut position_of = vec![None; elf.section_headers.len()];
     let mut srcmap = None;
     let mut asserts = Vec::new();
+    let mut fills = Vec::new();
     for (index, header) in elf.section_headers.iter().enumerate() {
         let name = section_name(index);
         if header.sh_flags & u64::from(sh::SHF_ALLOC) == 0 {
@@ -264,6 +268,9 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
                 srcmap = Some(map);
             } else if name == ASSERT_SECTION {
                 asserts = Assertion::decode_all(section_bytes(index)?)
+                    .map_err(|error| malformed(error.to_string()))?;
+            } else if name == FILL_SECTION {
+                fills = FillRun::decode_all(section_bytes(index)?)
                     .map_err(|error| malformed(error.to_string()))?;
             }
             continue;
@@ -305,6 +312,7 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
             zeropage: header.sh_flags & u64::from(mos::SHF_MOS_ZEROPAGE) != 0,
             exec: header.sh_flags & u64::from(sh::SHF_EXECINSTR) != 0,
             relocs: Vec::new(),
+            fills: Vec::new(),
         });
     }
 
@@ -428,6 +436,28 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
                 symbol: reloc.r_sym,
                 addend: reloc.r_addend.unwrap_or(0),
             });
+        }
+    }
+
+    // Fill runs must lie in the bytes of an allocated section.
+    for run in &fills {
+        let section = position_of
+            .get(run.section as usize)
+            .copied()
+            .flatten()
+            .map(|position| &mut sections[position]);
+        match section {
+            Some(section) if !section.nobits && run.end() as usize <= section.data.len() => {
+                section.fills.push((run.offset, run.length));
+            }
+            _ => {
+                return Err(malformed(format!(
+                    "{FILL_SECTION} names bytes {}..{} of section {}, which has no such bytes",
+                    run.offset,
+                    run.end(),
+                    run.section
+                )));
+            }
         }
     }
 

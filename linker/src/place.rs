@@ -266,10 +266,18 @@ pub(crate) fn place(
             let size = usize::try_from(segment.size).unwrap_or(0);
             let mut bytes = vec![fill; size];
             for fragment in &segment.fragments {
-                let data = &objects[fragment.object].sections[fragment.section].data;
+                let section = &objects[fragment.object].sections[fragment.section];
                 let start = fragment.offset as usize;
-                if let Some(target) = bytes.get_mut(start..start + data.len()) {
-                    target.copy_from_slice(data);
+                if let Some(target) = bytes.get_mut(start..start + section.data.len()) {
+                    target.copy_from_slice(&section.data);
+                    // Reserved bytes (`.res`, `.align` without a value)
+                    // take the area's fill value, as ld65 gives them.
+                    for &(offset, length) in &section.fills {
+                        let run = offset as usize..(offset + length) as usize;
+                        if let Some(gap) = target.get_mut(run) {
+                            gap.fill(fill);
+                        }
+                    }
                 }
             }
             segment.bytes = bytes;

@@ -21,12 +21,13 @@ use scorpion_tests::tools;
 /// Where the flat image starts.
 const START: u16 = 0x0800;
 
-/// The ld65 config equivalent to our `flat` target.
-fn ld65_config(start: u16) -> String {
+/// The ld65 config equivalent to our `flat` target, with `fill` as the
+/// main area's `fillval` (what `.res` and `.align` without a value get).
+fn ld65_config(start: u16, fill: u8) -> String {
     format!(
         "MEMORY {{
     ZP:   start = $0000, size = $0100, type = rw;
-    MAIN: start = ${start:04X}, size = ${:04X}, file = %O;
+    MAIN: start = ${start:04X}, size = ${:04X}, file = %O, fillval = ${fill:02X};
 }}
 SEGMENTS {{
     ZEROPAGE: load = ZP,   type = zp;
@@ -44,8 +45,8 @@ SEGMENTS {{
 fn reference(
     dir: &Path,
     files: &[(String, String)],
-    ca65: &Path,
-    ld65: &Path,
+    (ca65, ld65): (&Path, &Path),
+    fill: u8,
 ) -> Result<Vec<u8>, String> {
     let mut objects = Vec::new();
     for (name, text) in files {
@@ -64,7 +65,7 @@ fn reference(
         }
         objects.push(object);
     }
-    std::fs::write(dir.join("flat.cfg"), ld65_config(START)).expect("write the config");
+    std::fs::write(dir.join("flat.cfg"), ld65_config(START, fill)).expect("write the config");
     let output = Command::new(ld65)
         .current_dir(dir)
         .args(["-C", "flat.cfg", "-o", "ld65.bin"])
@@ -80,8 +81,9 @@ fn reference(
     Ok(std::fs::read(dir.join("ld65.bin")).expect("ld65 wrote its output"))
 }
 
-/// Our assembler and linker, in memory.
-fn ours(files: &[(String, String)]) -> Result<Vec<u8>, String> {
+/// Our assembler and linker, in memory: the `flat` target, its main
+/// area's fill value set to `fill` (the layout files' `fill-value`).
+fn ours(files: &[(String, String)], fill: u8) -> Result<Vec<u8>, String> {
     let mut source = assembler::MemorySource::new();
     for (name, text) in files {
         source.insert(name.as_str(), text.as_bytes());
@@ -104,8 +106,13 @@ fn ours(files: &[(String, String)]) -> Result<Vec<u8>, String> {
         .iter()
         .map(|(name, bytes)| linker::Input { name, bytes })
         .collect();
-    let target =
-        linker::Target::builtin("flat", Some(u64::from(START))).map_err(|e| format!("{e:?}"))?;
+    let mut layout = linker::Target::builtin("flat", Some(u64::from(START)))
+        .and_then(|target| target.resolve(&linker::layout::RomSymbols::default()))
+        .map_err(|e| format!("{e:?}"))?;
+    for area in &mut layout.areas {
+        area.fill_value = fill;
+    }
+    let target = linker::Target::Custom(layout);
     let linked = linker::link(
         &inputs,
         &linker::LinkOptions {
@@ -120,10 +127,16 @@ fn ours(files: &[(String, String)]) -> Result<Vec<u8>, String> {
         .map_err(|error| format!("cannot write the binary: {error:?}"))
 }
 
-/// Compares both toolchains on one program; the differences, if any.
-fn compare(what: &str, files: &[(String, String)], ca65: &Path, ld65: &Path) -> Result<(), String> {
+/// Compares both toolchains on one program with the main area's fill
+/// value `fill`; the differences, if any.
+fn compare(
+    what: &str,
+    files: &[(String, String)],
+    tools: (&Path, &Path),
+    fill: u8,
+) -> Result<(), String> {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let expected = match reference(dir.path(), files, ca65, ld65) {
+    let expected = match reference(dir.path(), files, tools, fill) {
         Ok(bytes) => bytes,
         Err(message) => {
             let kept = dir.keep();
@@ -133,7 +146,7 @@ fn compare(what: &str, files: &[(String, String)], ca65: &Path, ld65: &Path) -> 
             ));
         }
     };
-    let actual = match ours(files) {
+    let actual = match ours(files, fill) {
         Ok(bytes) => bytes,
         Err(message) => {
             let kept = dir.keep();
@@ -193,6 +206,7 @@ fn hand_written_corpus_matches_ld65() {
     let Some((ca65, ld65)) = toolchain("hand_written_corpus_matches_ld65") else {
         return;
     };
+    let tools = (ca65.as_path(), ld65.as_path());
     let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/asm_corpus");
     let mut names: Vec<_> = std::fs::read_dir(&corpus)
         .expect("the corpus directory exists")
@@ -210,11 +224,16 @@ fn hand_written_corpus_matches_ld65() {
             .to_string_lossy()
             .into_owned();
         let text = std::fs::read_to_string(&path).expect("a corpus file");
-        if let Err(failure) = compare(&name, &[(name.clone(), text)], &ca65, &ld65) {
-            failures.push(failure);
+        // Twice: reserved bytes (`.res`, `.align` without a value) take the
+        // area's fill value in both toolchains, zero by default.
+        for fill in [0x00, 0xFF] {
+            let what = format!("{name} (fill ${fill:02X})");
+            if let Err(failure) = compare(&what, &[(name.clone(), text.clone())], tools, fill) {
+                failures.push(failure);
+            }
         }
     }
-    report(failures, total);
+    report(failures, 2 * total);
 }
 
 #[test]
@@ -238,8 +257,8 @@ fn random_programs_match_ld65() {
         if let Err(failure) = compare(
             &format!("seed {seed} ({lines} lines)"),
             &program.files,
-            &ca65,
-            &ld65,
+            (&ca65, &ld65),
+            0,
         ) {
             failures.push(failure);
         }
@@ -260,7 +279,7 @@ fn benchmark_flavour_matches_ld65() {
     // The benchmark's program shape (`.org` chunks), small: one chunk at
     // $1000 linked at START gives the same bytes.
     let program = asm_gen::generate(7, 2000, asm_gen::Flavor::Benchmark);
-    if let Err(failure) = compare("benchmark flavour", &program.files, &ca65, &ld65) {
+    if let Err(failure) = compare("benchmark flavour", &program.files, (&ca65, &ld65), 0) {
         report(vec![failure], 1);
     }
 }

@@ -1,12 +1,13 @@
 //! Our own metadata sections in 6502 ELF files, beside llvm-mos's numbering.
 //!
-//! ELF has no place for three things our tools pass along, so they travel in
+//! ELF has no place for four things our tools pass along, so they travel in
 //! non-allocated `SHT_PROGBITS` sections that other tools ignore:
 //!
 //! | section | written by | read by | holds |
 //! |---|---|---|---|
 //! | [`SRCMAP_SECTION`] | assembler | linker | where each instruction, data item and symbol came from (file:line:col) |
 //! | [`ASSERT_SECTION`] | assembler | linker | `.assert`s that depend on addresses, as expression bytecode |
+//! | [`FILL_SECTION`] | assembler | linker | reserved bytes (`.res`, `.align` without a fill value) that take the load area's fill value |
 //! | [`HOOKS_SECTION`] | linker | uploader, `scorpion sim` | which ROM hooks an image takes over, and where its fallthrough lives |
 //!
 //! Every section starts with a four-byte magic and a version byte; all
@@ -16,11 +17,13 @@
 
 mod assert;
 mod codec;
+mod fill;
 mod hooks;
 mod srcmap;
 
 pub use assert::{AssertAction, Assertion, BinaryOp, EvalError, Expr, ExprOp, UnaryOp};
 pub use codec::FormatError;
+pub use fill::FillRun;
 pub use hooks::{
     CHAIN_LOOP_SYMBOL, CHAIN_UNKNOWN_SYMBOL, HOOK_LOOP_SYMBOL, HOOK_UNKNOWN_SYMBOL, HookKind,
     HookRecord, Hooks,
@@ -31,5 +34,8 @@ pub use srcmap::{SourceLoc, SrcMap, SrcMapEntry, SymbolLoc};
 pub const SRCMAP_SECTION: &str = ".scorpion.srcmap";
 /// Deferred assertions (assembler to linker).
 pub const ASSERT_SECTION: &str = ".scorpion.assert";
+/// Reserved byte ranges that take the load area's fill value (assembler to
+/// linker).
+pub const FILL_SECTION: &str = ".scorpion.fill";
 /// Hook records of a linked image (linker to uploader and simulator).
 pub const HOOKS_SECTION: &str = ".scorpion.hooks";

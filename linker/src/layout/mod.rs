@@ -61,7 +61,7 @@
 //! start = "$F000"
 //! size = "$1000"                  # may exceed 64 KiB, e.g. "$1000000"
 //! fill = true                     # write the whole area, gaps included
-//! fill-value = "$FF"              # for gaps, alignment and `fill`
+//! fill-value = "$FF"              # for gaps, alignment, `fill` and reserved bytes
 //! define = true                   # __ROM_START__, __ROM_SIZE__, __ROM_LAST__
 //!
 //! [[segment]]
@@ -113,7 +113,9 @@ pub struct Area {
     pub size: u64,
     /// Write the whole area to the image, gaps filled.
     pub fill: bool,
-    /// The byte for gaps, alignment padding and `fill`.
+    /// The byte for gaps, alignment padding, `fill`, and the reserved bytes
+    /// of the sections loaded here (`.res` and `.align` without a value,
+    /// listed in `.scorpion.fill`), as ld65's `fillval`.
     pub fill_value: u8,
     /// Whether the area's bytes are part of the image.
     pub output: bool,

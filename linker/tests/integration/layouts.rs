@@ -194,3 +194,68 @@ fn the_extension_map() {
     insta::assert_snapshot!("extension_map", linked.map());
     insta::assert_snapshot!("extension_labels", linked.vice_labels());
 }
+
+#[test]
+fn reserved_bytes_take_the_load_area_fill_value() {
+    // CODE is section 1: `.res 3` (zeros in the object, listed in
+    // `.scorpion.fill`) between two bytes, as ld65 fills with `fillval`.
+    let object = |runs: &[isa::objfmt::FillRun]| {
+        let mut obj = ObjectBuilder::new();
+        obj.code("CODE", &[1, 0, 0, 0, 2]);
+        obj.progbits(
+            isa::objfmt::FILL_SECTION,
+            &isa::objfmt::FillRun::encode_all(runs),
+            0,
+        );
+        obj.build()
+    };
+    let run = |offset, length| isa::objfmt::FillRun {
+        section: 1,
+        offset,
+        length,
+    };
+    let filled = |fill: &str| {
+        Layout::from_toml(
+            "filled.toml",
+            &format!(
+                "[[area]]\nname = \"ROM\"\nstart = \"$F000\"\nsize = \"$100\"\nfill-value = \"{fill}\"\n\
+                 [[segment]]\nname = \"CODE\"\nload = \"ROM\"\n"
+            ),
+        )
+        .expect("parses")
+    };
+    let bytes = |object: Vec<u8>, layout: Layout| {
+        let linked = link_with(
+            &[("a.o", object)],
+            &Target::Custom(layout),
+            &[],
+            &MemorySources::default(),
+        )
+        .expect("links");
+        linker::Format::Bin.write(&linked.image).expect("a binary")
+    };
+    assert_eq!(
+        bytes(object(&[run(1, 3)]), filled("$FF")),
+        [1, 0xFF, 0xFF, 0xFF, 2]
+    );
+    assert_eq!(
+        bytes(object(&[run(1, 1), run(3, 1)]), filled("$EA")),
+        [1, 0xEA, 0, 0xEA, 2]
+    );
+    assert_eq!(bytes(object(&[run(1, 3)]), filled("0")), [1, 0, 0, 0, 2]);
+    // No runs: the object's bytes stand, whatever the fill.
+    assert_eq!(bytes(object(&[]), filled("$FF")), [1, 0, 0, 0, 2]);
+
+    // A run outside the section's bytes is a malformed object.
+    let error = link_with(
+        &[("a.o", object(&[run(3, 4)]))],
+        &Target::Custom(filled("$FF")),
+        &[],
+        &MemorySources::default(),
+    )
+    .expect_err("a run past the end");
+    assert!(
+        format!("{error:?}").contains("has no such bytes"),
+        "{error:?}"
+    );
+}
