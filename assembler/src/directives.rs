@@ -120,12 +120,15 @@ impl Asm<'_> {
             Dir::Charmap => {
                 let mut i = p + 1;
                 let from = self.const_expr(t, &mut i, "`.charmap`")?;
+                let from_span = self.join(t[p + 1].span, t[i - 1].span);
                 self.comma(t, &mut i)?;
+                let to_start = i;
                 let to = self.const_expr(t, &mut i, "`.charmap`")?;
+                let to_span = self.join(t[to_start].span, t[i - 1].span);
                 self.expect_end(t, i)?;
-                for value in [from, to] {
+                // The caret goes under the code that is out of range.
+                for (value, span) in [(from, from_span), (to, to_span)] {
                     if !(0..=255).contains(&value) {
-                        let span = self.join(t[p + 1].span, t[i - 1].span);
                         return Err(self.report(crate::layout::range_diag(
                             span,
                             "`.charmap` code",

@@ -185,7 +185,12 @@ impl Asm<'_> {
     pub(crate) fn instruction(&mut self, mnemonic: Mnemonic, t: &[Token], p: usize) -> PResult<()> {
         let head = t[p];
         let (operand, operand_span) = self.operand(mnemonic, t, p + 1)?;
-        let whole = self.join(head.span, t[t.len() - 1].span);
+        // The whole operand as written (`#3`, `table,x`, `($12),y`): where
+        // a mode error points.
+        let whole = match t.get(p + 1) {
+            Some(first) => self.join(first.span, t[t.len() - 1].span),
+            None => head.span,
+        };
         match operand {
             Operand::None => {
                 let mode = if isa::has_mode(mnemonic, Mode::Implied) {
@@ -369,6 +374,7 @@ impl Asm<'_> {
         )
     }
 
+    /// `span` is the operand as written.
     fn no_mode(&mut self, mnemonic: Mnemonic, mode: Mode, span: Span) -> crate::asm::Reported {
         let help = self.mode_help(mnemonic);
         let diag = diag::error(
@@ -379,6 +385,7 @@ impl Asm<'_> {
                 mnemonic.name().to_ascii_lowercase()
             ),
         )
+        .label(format!("this operand is {mode}"))
         .help(help);
         self.report(diag)
     }

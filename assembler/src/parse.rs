@@ -91,6 +91,7 @@ impl Asm<'_> {
             let span = self.span_at(t, *p);
             return Err(self.err("asm::too-deep", span, "expression nested too deeply"));
         }
+        let start = *p;
         let mut left = match t.get(*p) {
             Some(tok)
                 if max_level == 7
@@ -112,6 +113,17 @@ impl Asm<'_> {
             *p += 1;
             // Left-associative: the right operand binds tighter.
             let right = self.climb(t, p, level - 1, depth + 1)?;
+            if matches!(op, BinaryOp::Div | BinaryOp::Mod)
+                && matches!(self.prog.nodes.get(right as usize), Some(Node::Const(0)))
+            {
+                // Caught here, the caret goes under the division itself
+                // rather than the whole operand.
+                let span = self.join(self.span_at(t, start), t[*p - 1].span);
+                return Err(self.report(
+                    diag::error("asm::div-zero", span, "division by zero")
+                        .label("the divisor is 0"),
+                ));
+            }
             left = self.fold(op, left, right);
         }
         Ok(left)
@@ -610,9 +622,10 @@ impl Asm<'_> {
             }
             Err(EvalErr::NotYet(Some(sym))) => {
                 let name = self.sym_name(sym);
+                let at = self.name_within(t, sym, span).unwrap_or(span);
                 Err(self.err(
                     "asm::not-constant",
-                    span,
+                    at,
                     format!("{what} needs a value known here, but `{name}` is not defined yet"),
                 ))
             }
@@ -627,8 +640,50 @@ impl Asm<'_> {
         }
     }
 
-    /// Reports an evaluation failure at `span`.
+    /// Where `sym` is named inside `span` on the current line, if it is:
+    /// the sub-expression an error about that symbol points at.
+    fn name_within(&self, toks: &[Token], sym: SymId, span: Span) -> Option<Span> {
+        let name = self.prog.syms.get(sym as usize)?.name;
+        let token = toks.iter().find(|tok| {
+            tok.kind == Tok::Ident
+                && tok.name() == name
+                && tok.span.file == span.file
+                && tok.span.start >= span.start
+                && tok.span.end <= span.end
+        });
+        if let Some(token) = token {
+            return Some(token.span);
+        }
+        // Reported after the line was read (layout): find the name, as a
+        // whole word, in the span's text.
+        let text = self.files.text(span.file);
+        let (start, end) = (span.start as usize, (span.end as usize).min(text.len()));
+        let needle = self.names.name(name).as_bytes();
+        let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'@';
+        let within = text.get(start..end)?;
+        (0..within.len().saturating_sub(needle.len()) + 1)
+            .filter(|&at| within[at..].starts_with(needle))
+            .find(|&at| {
+                let before = at.checked_sub(1).map(|i| within[i]);
+                let after = within.get(at + needle.len()).copied();
+                !needle.is_empty() && !before.is_some_and(word) && !after.is_some_and(word)
+            })
+            .map(|at| Span {
+                file: span.file,
+                start: (start + at) as u32,
+                end: (start + at + needle.len()) as u32,
+            })
+    }
+
+    /// Reports an evaluation failure at `span` (narrowed to the symbol at
+    /// fault when the failure names one).
     pub(crate) fn eval_error(&mut self, error: EvalErr, span: Span) -> Reported {
+        let span = match error {
+            EvalErr::NotYet(Some(sym)) | EvalErr::Circular(sym) => {
+                self.name_within(&self.toks, sym, span).unwrap_or(span)
+            }
+            _ => span,
+        };
         let (code, message, help) = match error {
             EvalErr::Undefined(_) => return Reported,
             EvalErr::NotYet(Some(sym)) => (
