@@ -18,6 +18,12 @@ fn is_abi_name(name: &str) -> bool {
     !name.starts_with("__")
 }
 
+/// Whether an exported name is a size (`RXBUF_SIZE`) rather than an
+/// address.
+fn is_size(name: &str) -> bool {
+    name.ends_with("_SIZE")
+}
+
 /// The text after `;` on the line that defines `name`, without a leading
 /// `$FFxx` address (the jump table repeats its addresses in comments).
 fn descriptions(rom_dir: &Path) -> BTreeMap<String, String> {
@@ -161,18 +167,20 @@ fn main() {
          ; Do not edit: change the ROM source instead.\n",
         fnv1a(&bin)
     );
-    type Member = fn(u32) -> bool;
-    let groups: [(&str, Member); 3] = [
-        ("zero page and RAM the ROM owns or leaves free", |v| {
-            v < 0x1000
+    // Sizes (`RXBUF_SIZE`) are no addresses: they get a group of their own.
+    type Member = fn(&str, u32) -> bool;
+    let groups: [(&str, Member); 4] = [
+        ("zero page and RAM the ROM owns or leaves free", |n, v| {
+            v < 0x1000 && !is_size(n)
         }),
-        ("services (the jump table at fixed addresses)", |v| {
-            v >= 0xF000
+        ("services (the jump table at fixed addresses)", |n, v| {
+            v >= 0xF000 && !is_size(n)
         }),
-        ("other", |v| (0x1000..0xF000).contains(&v)),
+        ("other", |n, v| (0x1000..0xF000).contains(&v) && !is_size(n)),
+        ("sizes", |n, _| is_size(n)),
     ];
     for (title, member) in groups {
-        let names: Vec<_> = symbols.iter().filter(|s| member(s.1)).collect();
+        let names: Vec<_> = symbols.iter().filter(|s| member(s.0, s.1)).collect();
         if names.is_empty() {
             continue;
         }

@@ -23,6 +23,10 @@
         .export IOBYTE, OBEYMASK, BUSY, LASTMOVE
         .exportzp USER_ZP_START, USER_ZP_END
         .export USER_RAM_START, USER_RAM_END
+        ; the receive ring: how much a host may send ahead of an answer, and
+        ; for a handler that reads its own data faster than CHKCH does
+        .export RXBUF, RXBUF_SIZE
+        .exportzp RXHEAD, RXTAIL
         ; the jump table
         .export PUTCH, PUTHEX, PUTDEC4, PUTEOL, GETHEX, GETDEC
         .export IOINHIBIT, IOAPPLY, GETCH, CHKCH

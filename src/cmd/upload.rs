@@ -25,9 +25,10 @@ use crate::cmd::ports;
 /// First the same upload is rehearsed on the virtual Scorpion in this
 /// process and, with --expect, the image is put through its paces there:
 /// any difference stops before the robot is touched. Larger images go
-/// through a RAM loader (two small programs the uploader installs, verified,
-/// and removes afterwards) that carries about one byte per character
-/// instead of the ROM's two per eleven, at 19200 baud when the line allows.
+/// through a RAM loader (a small 6502 program the uploader installs in two
+/// parts, each verified before it is hooked, and removes afterwards) that
+/// carries about one byte per character instead of the ROM's two per
+/// eleven, at 19200 baud when the line allows.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     /// The linked ELF image.

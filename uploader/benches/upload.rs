@@ -5,9 +5,12 @@
 //! printed beside the line-rate bound (bytes x 10 / baud) and the
 //! ROM-only bound (11 characters per 2 bytes).
 //!
-//! `cargo bench -p uploader` (or `cargo run -p uploader --release
-//! --example`-free: this is a `harness = false` bench). Device time is
-//! deterministic, so one run of each is the figure.
+//! `cargo bench -p uploader` (a `harness = false` bench). Device time is
+//! deterministic, so one run of each is the figure. The 1.3x target is
+//! met with the loader switching the line to 19200 baud, as esptool's stub
+//! raises the rate (the lead's decision); the loader at a line kept at
+//! 9600 is printed too, and does not meet it. `cargo run -p uploader
+//! --release --example trace` shows where each run's time goes.
 
 #![allow(clippy::print_stdout, reason = "a benchmark prints its figures")]
 
@@ -77,7 +80,7 @@ fn main() {
             1.1,
         ),
         (
-            "RAM loader, 9600 throughout",
+            "RAM loader, line kept at 9600",
             LoaderChoice::Always,
             None,
             None,
@@ -114,7 +117,9 @@ fn main() {
     }
     println!();
     println!(
-        "  targets: ROM only within 1.1x of the ROM-only bound; loader at 19200 within 1.3x of the line-rate bound"
+        "  targets: ROM only within 1.1x of the ROM-only bound ({:.3} s); the loader, line at 19200, within 1.3x of the line-rate bound ({:.3} s)",
+        rom_bound.as_secs_f64() * 1.1,
+        line_bound.as_secs_f64() * 1.3
     );
     if missed.is_empty() {
         println!("  all targets met");

@@ -16,6 +16,7 @@ use crate::client::{Client, Outcome, pieces};
 use crate::image::UploadImage;
 use crate::loader::{FRAME_MAX, frame};
 use crate::progress::{Event, Phase, Progress};
+use crate::taper::{TAIL, rom_tail};
 use crate::transport::Transport;
 use crate::{Error, Result};
 
@@ -25,12 +26,7 @@ use crate::{Error, Result};
 /// question go out (one character a byte, eighteen more) and are taken,
 /// so the spans grow by less than double. They differ by at least eight
 /// bytes, so their questions can be in flight together.
-const RAMP: [usize; 3] = [36, 44, 60];
-
-/// The last spans of a transfer through the ROM, from the end: each
-/// answer (two characters a byte) ends while the next span (five and a
-/// half a byte) is written.
-const TAPER: [usize; 3] = [5, 14, 38];
+const RAMP: [usize; 4] = [20, 28, 44, 60];
 
 /// How bytes are written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,6 +104,10 @@ pub(crate) struct Body {
     pass: u32,
     /// Frames sent since the loader was last checked.
     frames_unchecked: usize,
+    /// An answer just ended and another is due: the robot is between
+    /// answers, taking in the frames it holds. Frames wait until the next
+    /// answer starts (see [`Body::pump`]).
+    between_answers: bool,
     /// Bytes written again after reading back wrong.
     pub(crate) rewrites: usize,
 }
@@ -139,6 +139,7 @@ impl Body {
             writer,
             pass: 0,
             frames_unchecked: 0,
+            between_answers: false,
             rewrites: 0,
         }
     }
@@ -161,12 +162,13 @@ impl Body {
         })
     }
 
-    /// Writes of every byte, with a verifying read after each span.
-    pub(crate) fn plan_writes(&mut self, progress: &mut dyn Progress) {
+    /// Writes of every byte, with a verifying read after each span, for
+    /// a line at `baud`.
+    pub(crate) fn plan_writes(&mut self, baud: u32, progress: &mut dyn Progress) {
         progress.phase(Phase::Write, self.expected.len());
         let mut area = None;
         let mut next_write = 0u32;
-        for (start, len, span) in self.write_spans() {
+        for (start, len, span) in self.write_spans(baud) {
             let end = u32::from(start) + len as u32;
             if area != Some(start) {
                 area = Some(start);
@@ -194,9 +196,9 @@ impl Body {
     /// length). Frames: a short first span, so the return wire, which
     /// carries two characters a byte against the frames' one, starts
     /// early. The ROM's commands: the sending wire is the slow one, so the
-    /// last spans taper (each answer then ends while the next, smaller
-    /// span is written) and the last answer is short.
-    fn write_spans(&self) -> Vec<(u16, usize, ReadSpan)> {
+    /// last spans taper (see `taper`): each answer ends about when the
+    /// writes behind it are in, and the last answer is short.
+    fn write_spans(&self, baud: u32) -> Vec<(u16, usize, ReadSpan)> {
         let mut out = Vec::new();
         let areas = self.index.len();
         for (i, &(start, _, len)) in self.index.iter().enumerate() {
@@ -212,12 +214,14 @@ impl Body {
             }
             let mut tail = Vec::new();
             if self.writer == Writer::Rom && i + 1 == areas {
-                for size in TAPER {
-                    if left > size + size / 2 {
-                        tail.push(size);
-                        left -= size;
-                    }
-                }
+                // The tail starts on a `/9W` boundary.
+                let bytes = if len <= TAIL {
+                    len
+                } else {
+                    TAIL - (len - TAIL) % 2
+                };
+                tail = rom_tail(bytes, baud);
+                left -= bytes;
             }
             let mut at = start;
             for size in sizes {
@@ -226,7 +230,7 @@ impl Body {
             }
             out.extend(pieces(at, left, MAX_READ).map(|span| (start, len, span)));
             at += left as u16;
-            for size in tail.into_iter().rev() {
+            for size in tail {
                 out.extend(pieces(at, size, MAX_READ).map(|span| (start, len, span)));
                 at += size as u16;
             }
@@ -268,18 +272,53 @@ impl Body {
 
     /// Sends queued work while the client has room. Returns `false` when
     /// the loader should be checked before going on.
+    ///
+    /// Frames are held back while the robot is between answers. The ROM
+    /// cannot answer while it takes in a frame, so those pauses of the
+    /// return wire are its work on the frames it holds; characters that
+    /// arrive then cost it an interrupt each and lengthen them, while
+    /// characters that arrive during an answer are taken in the time the
+    /// ROM spends waiting for its 6551 to send. So the next frame goes out
+    /// when the next answer starts.
     fn pump<T: Transport>(&mut self, client: &mut Client<T>, limits: Limits) -> Result<bool> {
+        if self.between_answers && (client.robot_sending() || client.in_flight() == 0) {
+            self.between_answers = false;
+        }
         while let Some(&work) = self.queue.front() {
             match work {
                 Work::Write { address, len } => {
                     let bytes = self.encode(address, len)?;
-                    if client.room() < bytes.len() {
+                    if bytes.is_empty() && len > 1 {
+                        // No key for this frame: two smaller ones.
+                        let half = len / 2;
+                        self.queue.pop_front();
+                        self.queue.push_front(Work::Write {
+                            address: address + u16::from(half),
+                            len: len - half,
+                        });
+                        self.queue.push_front(Work::Write { address, len: half });
+                        continue;
+                    }
+                    if client.room() < bytes.len()
+                        || (self.writer == Writer::Frames && self.between_answers)
+                    {
                         break;
                     }
-                    let rewrite = (address..address + u16::from(len))
+                    // A byte written twice already: noise, or the loader is
+                    // gone (a `/1R` that noise made from a frame's `/1L`).
+                    // Look after every 16 frames; after a third failure of
+                    // the same byte, at once.
+                    let writes = (address..address + u16::from(len))
                         .filter_map(|at| self.offset(at))
-                        .any(|offset| self.state[offset].writes >= 2);
-                    if self.writer == Writer::Frames && rewrite && self.frames_unchecked >= 16 {
+                        .map(|offset| self.state[offset].writes)
+                        .max()
+                        .unwrap_or(0);
+                    let due = match writes {
+                        0 | 1 => usize::MAX,
+                        2 => 16,
+                        _ => 1,
+                    };
+                    if self.writer == Writer::Frames && self.frames_unchecked >= due {
                         self.frames_unchecked = 0;
                         return Ok(false);
                     }
@@ -540,6 +579,7 @@ impl Body {
                 match outcome {
                     Outcome::Answered { span, tag, data } => {
                         self.answered(span, tag, &data, progress);
+                        self.between_answers = true;
                     }
                     Outcome::Lost { span, tag } => {
                         progress.event(&Event::LostAnswer {

@@ -207,6 +207,12 @@ impl<T: Transport> Client<T> {
         self.in_flight.len()
     }
 
+    /// Whether part of an answer has arrived: the robot is sending now.
+    /// (After [`Client::poll`], every complete answer is taken.)
+    pub(crate) fn robot_sending(&self) -> bool {
+        !self.rx.is_empty()
+    }
+
     /// Sends a `/7R` question into the pipeline; its answer comes back
     /// through [`Client::poll`].
     pub(crate) fn ask_read(&mut self, span: ReadSpan) -> Result<u64> {
@@ -357,13 +363,19 @@ impl<T: Transport> Client<T> {
     /// [`Error::WrongBaud`] when only garbage did, or the last
     /// [`ProtocolError`] when answers kept being malformed.
     pub fn ask(&mut self, command: &Command) -> Result<Answer> {
+        self.ask_with(command, self.config.question_attempts)
+    }
+
+    /// [`Client::ask`] with `attempts` attempts (at least one).
+    fn ask_with(&mut self, command: &Command, attempts: u32) -> Result<Answer> {
+        let attempts = attempts.max(1);
         let bytes = command.encode();
         // `/1S` and extensions: allow the longest answer there is.
         let answer_len = command.answer_len().unwrap_or(2 * 199 + 3);
         let timeout = self.chars(bytes.len() + answer_len) + self.config.margin * 2;
         let mut heard = Vec::new();
         let mut last_error = None;
-        for _ in 0..self.config.question_attempts.max(1) {
+        for _ in 0..attempts {
             self.drain()?;
             self.transport.clear_input()?;
             self.send_raw(&bytes)?;
@@ -393,7 +405,7 @@ impl<T: Transport> Client<T> {
                 port: self.transport.name(),
                 baud: self.transport.baud(),
                 question: command.to_string(),
-                waited: timeout * self.config.question_attempts.max(1),
+                waited: timeout * attempts,
             });
         }
         if heard
@@ -425,7 +437,14 @@ impl<T: Transport> Client<T> {
     /// # Errors
     /// As [`Client::ask`].
     pub fn probe(&mut self) -> Result<BusyByte> {
-        match self.ask(&Command::Busy)? {
+        self.probe_with(self.config.question_attempts)
+    }
+
+    /// [`Client::probe`] with `attempts` attempts: after a rate switch,
+    /// where a silent line is better checked at the other rate than asked
+    /// again.
+    pub(crate) fn probe_with(&mut self, attempts: u32) -> Result<BusyByte> {
+        match self.ask_with(&Command::Busy, attempts)? {
             Answer::Busy(busy) => Ok(busy),
             // `parse_answer` only accepts `X` answers to `/1X`.
             other => Err(Error::Protocol(ProtocolError::UnexpectedAnswer {

@@ -69,6 +69,28 @@ pub enum Error {
         message: String,
     },
 
+    /// The robot answers only at the RAM loader's fast rate (an upload
+    /// through the loader was interrupted there and a `/1R` unhooked it),
+    /// and this upload does not use the loader, which alone brings the line
+    /// back.
+    #[error(
+        "the robot on {port} answers at {found} baud, not {base}: an upload through the RAM loader was interrupted there"
+    )]
+    #[diagnostic(
+        code(uploader::left_at_fast_rate),
+        help(
+            "press the robot's reset button (its 6551 goes back to the DIP switches' rate), or upload with --loader always: the loader's `/1F` brings the line back"
+        )
+    )]
+    LeftAtFastRate {
+        /// The transport's name.
+        port: String,
+        /// The rate the robot answers at.
+        found: u32,
+        /// The rate the upload was asked to run at.
+        base: u32,
+    },
+
     /// The virtual Scorpion's CPU executed a JAM opcode: the code it ran
     /// (an uploaded extension, most likely) is broken.
     #[error("the virtual Scorpion's CPU jammed at ${pc:04X} (opcode ${opcode:02X})")]

@@ -178,6 +178,20 @@ pub(crate) fn write_word_verified<T: Transport>(
     })
 }
 
+/// Where a hook must point once [`settle_hooks`] returns.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Wanted {
+    /// The hook's `JMP`.
+    pub(crate) address: u16,
+    /// Its target.
+    pub(crate) target: u16,
+    /// Another target it may keep without being written (the ROM's own,
+    /// after a reset), for a hook that is only checked.
+    pub(crate) also: Option<u16>,
+    /// Whether the upload writes it, or only checks it.
+    pub(crate) write: bool,
+}
+
 /// Points the hook at `address` to `target`, verified.
 pub(crate) fn switch_hook<T: Transport>(
     client: &mut Client<T>,
@@ -185,5 +199,107 @@ pub(crate) fn switch_hook<T: Transport>(
     target: u16,
     max_writes: u32,
 ) -> Result<()> {
-    write_word_verified(client, address + 1, target.to_le_bytes(), max_writes)
+    settle_hooks(
+        client,
+        &[Wanted {
+            address,
+            target,
+            also: None,
+            write: true,
+        }],
+        max_writes,
+    )
+}
+
+/// Writes the hooks `wanted` says to (each operand with one `/9W`), then
+/// reads every hook in `wanted` back whole, opcode included (with one
+/// question when they lie within nine bytes, as on the reference ROM), and
+/// puts right whatever reads wrong: a `/9W` whose address digits noise
+/// changed lands beside its target, on a hook's `JMP` opcode or on the
+/// other hook, and only a read of all of them finds that.
+///
+/// # Errors
+/// [`Error::VerifyFailed`] after `max_writes` rounds, or the client's.
+pub(crate) fn settle_hooks<T: Transport>(
+    client: &mut Client<T>,
+    wanted: &[Wanted],
+    max_writes: u32,
+) -> Result<()> {
+    let write = |client: &mut Client<T>, hook: &Wanted| {
+        client.send(&Command::WriteWord(WordWrite::new(
+            hook.address + 1,
+            hook.target.to_le_bytes(),
+        )?))
+    };
+    for hook in wanted.iter().filter(|hook| hook.write) {
+        write(client, hook)?;
+    }
+    let first = wanted.iter().map(|hook| hook.address).min().unwrap_or(0);
+    let last = wanted.iter().map(|hook| hook.address).max().unwrap_or(0);
+    let together = u32::from(last) + 3 - u32::from(first) <= 9;
+    let mut wrong = None;
+    for _ in 0..max_writes.max(1) {
+        let mut found: Vec<(Wanted, [u8; 3])> = Vec::new();
+        if together {
+            let span = ReadSpan::new(first, (last - first + 3) as u8)?;
+            if let Some(Answer::Memory(bytes)) = ask_again(client, span)? {
+                for hook in wanted {
+                    let at = usize::from(hook.address - first);
+                    found.push((*hook, [bytes[at], bytes[at + 1], bytes[at + 2]]));
+                }
+            }
+        } else {
+            for hook in wanted {
+                let span = ReadSpan::new(hook.address, 3)?;
+                if let Some(Answer::Memory(bytes)) = ask_again(client, span)? {
+                    found.push((*hook, [bytes[0], bytes[1], bytes[2]]));
+                }
+            }
+        }
+        // An answer that never came clean is a round without news.
+        wrong = (found.len() < wanted.len()).then_some((first, JMP, 0));
+        for (hook, [opcode, low, high]) in found {
+            let target = u16::from_le_bytes([low, high]);
+            if opcode == JMP && (target == hook.target || Some(target) == hook.also) {
+                continue;
+            }
+            if opcode != JMP {
+                let [low, _] = hook.target.to_le_bytes();
+                client.send(&Command::WriteWord(WordWrite::new(
+                    hook.address,
+                    [JMP, low],
+                )?))?;
+                wrong = Some((hook.address, JMP, opcode));
+            } else {
+                let [want_low, want_high] = hook.target.to_le_bytes();
+                wrong = Some(if low == want_low {
+                    (hook.address + 2, want_high, high)
+                } else {
+                    (hook.address + 1, want_low, low)
+                });
+            }
+            write(client, &hook)?;
+        }
+        if wrong.is_none() {
+            return Ok(());
+        }
+    }
+    let (address, expected, found) = wrong.unwrap_or((first, JMP, 0));
+    Err(Error::VerifyFailed {
+        address,
+        expected,
+        found,
+        attempts: max_writes,
+    })
+}
+
+/// Reads `span`; `None` when every answer came back garbled (the caller
+/// reads again), rather than an error: noise must not end an upload that
+/// is one read from done.
+fn ask_again<T: Transport>(client: &mut Client<T>, span: ReadSpan) -> Result<Option<Answer>> {
+    match client.ask(&Command::ReadMemory(span)) {
+        Ok(answer) => Ok(Some(answer)),
+        Err(Error::Protocol(_)) => Ok(None),
+        Err(error) => Err(error),
+    }
 }

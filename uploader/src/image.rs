@@ -180,11 +180,16 @@ pub struct RomProfile {
     /// RAM every robot with this ROM has and the ROM leaves to extensions:
     /// where the RAM loader may run when the image leaves room.
     pub user_ram: RangeInclusive<u16>,
+    /// The zero page the ROM leaves to extensions, when known: the RAM
+    /// loader keeps its state in eight bytes of it that the image does not
+    /// load (no loader without it).
+    pub user_zero_page: Option<RangeInclusive<u8>>,
     /// The ROM services the RAM loader calls; `None` if the ROM lacks
     /// one (then there is no loader).
     pub loader_services: Option<Services>,
     /// Characters the ROM buffers while it is busy (answering, say) without
-    /// losing any: the most the host may send ahead of an answer.
+    /// losing any: the most the host may send ahead of an answer. From the
+    /// ROM's exported `RXBUF_SIZE` (less the slot a ring keeps free).
     pub rx_buffer: usize,
 }
 
@@ -197,20 +202,61 @@ pub struct Services {
     pub chkch: u16,
     /// `CMD_DONE`: back to the control loop.
     pub cmd_done: u16,
+    /// The receive ring, when the ROM exports it (`RXBUF`, `RXHEAD`,
+    /// `RXTAIL`) and it is 256 bytes (`RXBUF_SIZE`), so that its indexes
+    /// wrap by themselves: the loader then takes its data straight from
+    /// the ring, in half the time `CHKCH` takes.
+    pub ring: Option<ReceiveRing>,
 }
 
-/// The reference ROM's serial receive ring: 256 bytes at `RXBUF` ($0300,
-/// romlib/rom/ram.inc), filled by the interrupt handler and by `PUTCH`
-/// while it waits to send; `rx_put` (romlib/rom/services.s) keeps one slot
-/// free to tell full from empty, so 255 characters fit. The ROM does not
-/// export this figure; `uploader`'s tests measure it on the emulated ROM
+/// Where the ROM's serial receive ring is: bytes wait at `buffer + tail`
+/// up to `buffer + head`; the interrupt handler advances `head`, the main
+/// loop (a command handler reading its own data) advances `tail`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReceiveRing {
+    /// `RXBUF`: the ring's 256 bytes.
+    pub buffer: u16,
+    /// `RXHEAD` (zero page): the next free slot.
+    pub head: u8,
+    /// `RXTAIL` (zero page): the next byte to take.
+    pub tail: u8,
+}
+
+impl ReceiveRing {
+    /// The ring, if every part of it is known and it is 256 bytes long.
+    fn new(
+        buffer: Option<u16>,
+        size: Option<u16>,
+        head: Option<u16>,
+        tail: Option<u16>,
+    ) -> Option<Self> {
+        let byte = |at: Option<u16>| at.and_then(|at| u8::try_from(at).ok());
+        match (buffer, size, byte(head), byte(tail)) {
+            (Some(buffer), Some(0x100), Some(head), Some(tail)) => {
+                Some(ReceiveRing { buffer, head, tail })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// The characters the reference ROM's serial receive ring holds: its
+/// exported `RXBUF_SIZE` (256 bytes at `RXBUF`, romlib/rom/ram.inc) less
+/// the one slot `rx_put` (romlib/rom/services.s) keeps free to tell full
+/// from empty. `uploader`'s tests measure it on the emulated ROM
 /// (`the_reference_rom_buffers_255_characters`).
-pub const REFERENCE_RX_BUFFER: usize = 255;
+pub const REFERENCE_RX_BUFFER: usize = romlib::symbols::RXBUF_SIZE as usize - 1;
 
 /// The receive buffer assumed for a ROM profile that does not export
 /// `RXBUF_SIZE`: small enough for a ROM that polls its 6551 one command
 /// at a time with a modest buffer.
 pub const CONSERVATIVE_RX_BUFFER: usize = 64;
+
+/// The characters a receive ring of `size` bytes holds: one slot stays
+/// free to tell a full ring from an empty one.
+fn ring_capacity(size: u16) -> usize {
+    usize::from(size).saturating_sub(1).max(1)
+}
 
 impl Default for RomProfile {
     fn default() -> Self {
@@ -221,8 +267,9 @@ impl Default for RomProfile {
 impl RomProfile {
     /// The reference ROM's profile, from its exported names: hooks and
     /// their reset targets (`BAD_COMMAND`, `ROM_LOOP`), the user zero page
-    /// and user RAM, and the KIM-bus expansion space (RAM on the virtual
-    /// Scorpion, a peripheral card's business on a real one).
+    /// and user RAM, the KIM-bus expansion space (RAM on the virtual
+    /// Scorpion, a peripheral card's business on a real one), and the
+    /// receive ring's size (`RXBUF_SIZE`).
     #[must_use]
     pub fn reference() -> RomProfile {
         use romlib::symbols as rom;
@@ -236,12 +283,22 @@ impl RomProfile {
                 KIM_BUS,
             ],
             user_ram: rom::USER_RAM_START..=rom::USER_RAM_END,
+            user_zero_page: u8::try_from(rom::USER_ZP_START)
+                .ok()
+                .zip(u8::try_from(rom::USER_ZP_END).ok())
+                .map(|(first, last)| first..=last),
             loader_services: Some(Services {
                 getch: rom::GETCH,
                 chkch: rom::CHKCH,
                 cmd_done: rom::CMD_DONE,
+                ring: ReceiveRing::new(
+                    Some(rom::RXBUF),
+                    Some(rom::RXBUF_SIZE),
+                    Some(rom::RXHEAD),
+                    Some(rom::RXTAIL),
+                ),
             }),
-            rx_buffer: REFERENCE_RX_BUFFER,
+            rx_buffer: ring_capacity(rom::RXBUF_SIZE),
         }
     }
 
@@ -271,6 +328,10 @@ impl RomProfile {
             hook_unknown: need("HOOK_UNKNOWN")?,
             hook_loop: need("HOOK_LOOP")?,
             reset_targets,
+            user_zero_page: u8::try_from(*zp.start())
+                .ok()
+                .zip(u8::try_from(*zp.end()).ok())
+                .map(|(first, last)| first..=last),
             writable: vec![zp, ram.clone(), KIM_BUS],
             user_ram: ram,
             loader_services: match (symbol("GETCH"), symbol("CHKCH"), symbol("CMD_DONE")) {
@@ -278,12 +339,16 @@ impl RomProfile {
                     getch,
                     chkch,
                     cmd_done,
+                    ring: ReceiveRing::new(
+                        symbol("RXBUF"),
+                        symbol("RXBUF_SIZE"),
+                        symbol("RXHEAD"),
+                        symbol("RXTAIL"),
+                    ),
                 }),
                 _ => None,
             },
-            rx_buffer: symbol("RXBUF_SIZE").map_or(CONSERVATIVE_RX_BUFFER, |size| {
-                usize::from(size).saturating_sub(1).max(1)
-            }),
+            rx_buffer: symbol("RXBUF_SIZE").map_or(CONSERVATIVE_RX_BUFFER, ring_capacity),
         })
     }
 

@@ -29,6 +29,7 @@ mod image;
 mod loader;
 mod progress;
 mod session;
+mod taper;
 pub mod transport;
 mod upload;
 
@@ -36,7 +37,8 @@ pub use client::{Client, ClientConfig, ClientStats};
 pub use error::{Error, Result};
 pub use expect::{Expectation, Expectations, Required};
 pub use image::{
-    Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, RomProfile, Services, UploadImage,
+    Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
+    UploadImage,
 };
 pub use loader::{
     FAST_BAUD, FRAME_MAX, LoaderPlan, loader_estimate, loader_frame, loader_plan, rom_only_estimate,

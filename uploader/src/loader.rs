@@ -1,20 +1,29 @@
-//! The RAM loader, after esptool's stub: two small 6502 programs in
-//! `uploader/loader/`, assembled by our assembler when this crate is built
-//! and linked here, at an address the image leaves free, against the ROM
-//! profile's services.
+//! The RAM loader, after esptool's stub: a small 6502 program
+//! (`uploader/loader/loader.s`), assembled by our assembler when this
+//! crate is built and linked here, at an address the image leaves free,
+//! against the ROM profile's services. Two parts, one piece of code:
 //!
-//! - `fast.s` (15 bytes): hooked through `HOOK_UNKNOWN` after it verified,
-//!   `/1F` toggles the 6551 between the base rate and 19200 baud.
-//! - `frames.s`: hooked next, it takes `/1L` frames that carry up to 255
-//!   bytes at about one character a byte (the ROM's `/9W` needs 5.5) and
-//!   falls through to the rate switch, whose `/1F` puts the line back on
-//!   the base rate at the end.
+//! - `rate` (15 bytes, first): `/1F` toggles the 6551 between the base
+//!   rate and 19200 baud; every other command is dropped. Written alone
+//!   at the base rate, verified, hooked: the rest goes in at 19200.
+//! - `frames`: `/1L` frames that carry up to 255 bytes at about one
+//!   character a byte (the ROM's `/9W` needs 5.5); every other command
+//!   falls into `rate`, whose `/1F` takes the line back at the end.
 //!
-//! This module links the stages, finds them room, encodes frames and
-//! estimates whether the loader pays for itself; `session` runs it.
+//! The rate is switched by code the uploader verified, never by writing
+//! the 6551's control register with the ROM's `/7W`: line noise can change
+//! the digits of a `/7W`, and a control value it makes up (another word
+//! length, the external receiver clock, a write to the 6551's reset
+//! register beside it) leaves a robot that no host can reach until its
+//! reset button is pressed.
+//!
+//! This module links the loader, finds it room (RAM and eight bytes of
+//! user zero page for its state), encodes frames and estimates whether it
+//! pays for itself; `session` runs it.
 
 use std::time::Duration;
 
+use emulator::board::{acia, map};
 use isa::objfmt::HookKind;
 use linker::{Image, ImageSymbol};
 
@@ -22,72 +31,77 @@ use crate::image::{Area, RomProfile, Services, UploadImage};
 use crate::transport::char_time;
 use crate::{Error, Result};
 
-/// `loader/fast.s`, assembled.
-const FAST_OBJECT: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/fast.o"));
+/// `loader/loader.s`, assembled to take its data through `CHKCH`.
+const LOADER_OBJECT: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/loader.o"));
 
-/// `loader/frames.s`, assembled.
-const FRAMES_OBJECT: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/frames.o"));
+/// `loader/loader.s`, assembled to take its data straight from the ROM's
+/// receive ring.
+const LOADER_RING_OBJECT: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/loader_ring.o"));
 
 /// The fastest rate of the 6551's internal generator: what the loader
-/// switches to.
+/// switches the line to.
 pub const FAST_BAUD: u32 = 19200;
 
-/// The most data bytes the uploader puts in one frame (`frames.s` takes up
+/// The most data bytes the uploader puts in one frame (`loader.s` takes up
 /// to 255). The upload sends one frame per `/7R` span of the verification
 /// (up to 99 bytes), so a frame and the read that checks it travel
-/// together; at 128, a frame's 133 bytes leave most of the 256 keys free.
+/// together, and the next frame fits the ROM's receive ring beside the
+/// answer being sent (two frames a span would not: the window of
+/// characters ahead of an answer would hold them back). At 128, a frame's
+/// 137 bytes leave at least 127 of the 256 keys free of a slash.
 pub const FRAME_MAX: usize = 128;
 
-/// Characters a frame adds to its data: `/1L`, the key, four header bytes
-/// and two check bytes.
+/// Characters a frame adds to its data: `/1L`, the key, three header
+/// bytes and two check bytes.
 pub(crate) const FRAME_OVERHEAD: usize = 3 + 1 + 3 + 2;
 
 /// The slash that starts every command.
 const SLASH: u8 = b'/';
 
-/// One linked stage of the loader.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) struct Stage {
-    /// Its bytes, as an image with its hook record.
-    pub(crate) image: UploadImage,
-    /// Where `HOOK_UNKNOWN` must point to run it.
-    pub(crate) handler: u16,
-    /// Its chain slot, if it falls through.
-    pub(crate) chain: Option<u16>,
-    /// The operands it rewrites as it runs (self-modifying code).
-    pub(crate) scratch: Vec<u16>,
-}
+/// The user zero page the loader keeps its state in (`LZP` in
+/// `loader.s`): the key, two sums, the five header bytes.
+const ZERO_PAGE_LEN: u8 = 8;
 
-/// The 6551's control value for 8N1 at `baud` (receiver on the baud
-/// generator), if it has the rate.
-pub(crate) fn acia_control(baud: u32) -> Option<u8> {
-    emulator::board::acia::baud_code(baud).map(|code| 0x10 | code)
-}
+/// The 6551's control register on the reference board
+/// (`emulator/src/board/map.rs`; `ACIA_CTRL` in the ROM's `hardware.inc`).
+pub(crate) const ACIA_CONTROL: u16 = map::ACIA + acia::reg::CONTROL;
 
-/// What `fast.s` XORs the control register with: the base rate's value
-/// XOR the fast rate's; 0 (no change) if either is no 6551 rate.
-fn rate_toggle((base, fast): (u32, u32)) -> u8 {
-    acia_control(base)
-        .zip(acia_control(fast))
+/// What `rate` XORs the 6551's control register with: the baud codes of
+/// the two rates XORed, so the framing bits stay as they are; 0 (no
+/// change) when either is not a rate of the 6551.
+pub(crate) fn rate_toggle((base, fast): (u32, u32)) -> u8 {
+    acia::baud_code(base)
+        .zip(acia::baud_code(fast))
         .map_or(0, |(base, fast)| base ^ fast)
+}
+
+/// The loader, linked and placed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct Loader {
+    /// Its bytes: one area, `rate` first.
+    image: UploadImage,
+    /// `rate`'s address: where `HOOK_UNKNOWN` points while the line is
+    /// switched.
+    pub(crate) rate: u16,
+    /// `frames`' address: where `HOOK_UNKNOWN` points while frames land.
+    pub(crate) frames: u16,
+    /// The first of its zero-page bytes.
+    zero_page: u8,
 }
 
 /// Where the RAM loader goes for an upload, and what it is: for tests
 /// and tools that check the robot's memory afterwards.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LoaderPlan {
-    /// The rate switch (`loader/fast.s`), as linked.
-    pub fast: Area,
-    /// The frame handler (`loader/frames.s`), as linked (its chain slot
-    /// still holds `BAD_COMMAND`).
-    pub frames: Area,
-    /// Where `HOOK_UNKNOWN` points while the rate switch is in.
-    pub fast_handler: u16,
-    /// Where `HOOK_UNKNOWN` points while the frame handler is in.
+    /// The loader (`loader/loader.s`) as linked: `rate`, then `frames`.
+    /// No byte of it changes while it runs.
+    pub code: Area,
+    /// `rate`'s address (`HOOK_UNKNOWN`'s target while the line switches).
+    pub rate_handler: u16,
+    /// `frames`' address (`HOOK_UNKNOWN`'s target while frames land).
     pub frames_handler: u16,
-    /// Bytes of the frame handler that differ from the linked ones while it
-    /// runs: the operands it rewrites itself, and its chain slot.
-    pub scratch: Vec<u16>,
+    /// The user zero page it keeps its state in (eight bytes).
+    pub zero_page: std::ops::RangeInclusive<u8>,
 }
 
 /// The RAM loader an upload of `image` with `profile` would use, for a
@@ -101,37 +115,24 @@ pub fn loader_plan(
     image: &UploadImage,
     rates: (u32, u32),
 ) -> Result<Option<LoaderPlan>> {
-    Ok(Loader::place(profile, image, rates)?.map(|loader| {
-        let mut scratch = loader.frames.scratch.clone();
-        if let Some(slot) = loader.frames.chain {
-            scratch.extend([slot, slot + 1]);
-        }
-        LoaderPlan {
-            fast: loader.fast.image.areas()[0].clone(),
-            frames: loader.frames.image.areas()[0].clone(),
-            fast_handler: loader.fast.handler,
-            frames_handler: loader.frames.handler,
-            scratch,
-        }
-    }))
-}
-
-/// Both stages, placed.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) struct Loader {
-    /// The rate switch.
-    pub(crate) fast: Stage,
-    /// The frame handler.
-    pub(crate) frames: Stage,
+    Ok(
+        Loader::place(profile, image, rates)?.map(|loader| LoaderPlan {
+            code: loader.image.areas()[0].clone(),
+            rate_handler: loader.rate,
+            frames_handler: loader.frames,
+            zero_page: loader.zero_page..=loader.zero_page + (ZERO_PAGE_LEN - 1),
+        }),
+    )
 }
 
 impl Loader {
-    /// Links both stages for `profile`, in RAM the image leaves free:
-    /// `None` when there is no room or the ROM lacks the services.
+    /// Links the loader for `profile` and a line at `rates`, in RAM and
+    /// zero page the image leaves free: `None` when there is no room or
+    /// the ROM lacks the services.
     ///
     /// # Errors
-    /// [`Error::LoaderLink`] if the objects do not link (a defect of this
-    /// crate, since they are built with it).
+    /// [`Error::LoaderLink`] if the object does not link (a defect of this
+    /// crate, since it is built with it).
     pub(crate) fn place(
         profile: &RomProfile,
         image: &UploadImage,
@@ -140,99 +141,108 @@ impl Loader {
         let Some(services) = profile.loader_services else {
             return Ok(None);
         };
-        let toggle = rate_toggle(rates);
-        let start = *profile.user_ram.start();
-        // The sizes do not depend on the address: link once to learn them.
-        let fast_len = link(FAST_OBJECT, "fast.s", start, profile, services, toggle)?
-            .0
-            .len();
-        let frames_len = link(FRAMES_OBJECT, "frames.s", start, profile, services, toggle)?
-            .0
-            .len();
-        let Some(address) = free_space(profile, image, fast_len + frames_len) else {
+        let Some(zero_page) = free_zero_page(profile, image) else {
             return Ok(None);
         };
-        let fast = stage(link(
-            FAST_OBJECT,
-            "fast.s",
-            address,
-            profile,
+        let object = if services.ring.is_some() {
+            LOADER_RING_OBJECT
+        } else {
+            LOADER_OBJECT
+        };
+        let symbols = Symbols {
             services,
-            toggle,
-        )?)?;
-        let frames = stage(link(
-            FRAMES_OBJECT,
-            "frames.s",
-            address + fast_len as u16,
-            profile,
-            services,
-            toggle,
-        )?)?;
-        Ok(Some(Loader { fast, frames }))
+            zero_page,
+            toggle: rate_toggle(rates),
+        };
+        // The size does not depend on the address: link once to learn it.
+        let start = *profile.user_ram.start();
+        let len = link(object, start, &symbols)?.0.len();
+        let Some(address) = free_space(profile, image, len) else {
+            return Ok(None);
+        };
+        let (image, linked) = link(object, address, &symbols)?;
+        let label = |name: &str| {
+            linked
+                .symbol(name)
+                .and_then(|at| u16::try_from(at).ok())
+                .ok_or_else(|| Error::LoaderLink {
+                    address,
+                    message: format!("the loader has no `{name}`"),
+                })
+        };
+        let (rate, frames) = (label("rate")?, label("frames")?);
+        let hooked = image
+            .hooks()
+            .iter()
+            .any(|record| record.kind == HookKind::Unknown && record.handler == frames);
+        if rate != address || !image.contains(frames) || !hooked {
+            return Err(Error::LoaderLink {
+                address,
+                message: "`rate` must come first and `frames` take HOOK_UNKNOWN".into(),
+            });
+        }
+        Ok(Some(Loader {
+            image,
+            rate,
+            frames,
+            zero_page,
+        }))
     }
 
-    /// Bytes of both stages.
+    /// Bytes of the loader.
     pub(crate) fn len(&self) -> usize {
-        self.fast.image.len() + self.frames.image.len()
+        self.image.len()
     }
 
     /// The first address of the loader.
     pub(crate) fn address(&self) -> u16 {
-        self.fast.image.areas()[0].address
+        self.image.areas()[0].address
     }
 
-    /// Whether `address` is in one of the stages.
+    /// Whether `address` is in the loader.
     pub(crate) fn contains(&self, address: u16) -> bool {
-        self.fast.image.contains(address) || self.frames.image.contains(address)
+        self.image.contains(address)
+    }
+
+    /// The whole loader, as an image to put into the robot.
+    pub(crate) fn whole(&self) -> &UploadImage {
+        &self.image
+    }
+
+    /// `rate` alone: what goes in at the base rate.
+    pub(crate) fn rate_part(&self) -> Result<UploadImage> {
+        self.part(self.rate, self.frames)
+    }
+
+    /// `frames` alone: what goes in at the fast rate.
+    pub(crate) fn frames_part(&self) -> Result<UploadImage> {
+        let end = self.image.areas()[0].end();
+        self.part(self.frames, end)
+    }
+
+    fn part(&self, from: u16, to: impl Into<u32>) -> Result<UploadImage> {
+        let area = &self.image.areas()[0];
+        let start = usize::from(from - area.address);
+        let end = (to.into() - u32::from(area.address)) as usize;
+        UploadImage::new(
+            vec![Area {
+                address: from,
+                bytes: area.bytes[start..end].to_vec(),
+            }],
+            Vec::new(),
+        )
     }
 }
 
-/// The stage's handler and chain from its one hook record, and the
-/// operands it rewrites: those of the instructions labelled in
-/// [`SELF_MODIFIED`].
-fn stage((image, linked): (UploadImage, Image)) -> Result<Stage> {
-    let mut scratch = Vec::new();
-    for &(label, len) in SELF_MODIFIED {
-        if let Some(at) = linked.symbol(label).and_then(|at| u16::try_from(at).ok()) {
-            scratch.extend((1..=len).map(|i| at + i));
-        }
-    }
-    let record = image
-        .hooks()
-        .iter()
-        .find(|record| record.kind == HookKind::Unknown)
-        .copied()
-        .ok_or_else(|| Error::LoaderLink {
-            address: image.areas()[0].address,
-            message: "the stage does not take HOOK_UNKNOWN".into(),
-        })?;
-    Ok(Stage {
-        handler: record.handler,
-        chain: record.chain,
-        scratch,
-        image,
-    })
-}
-
-/// Labels of `loader/frames.s` whose instruction operands it rewrites,
-/// with the operand's length.
-const SELF_MODIFIED: &[(&str, u16)] = &[
-    ("key", 1),
-    ("sum0", 1),
-    ("sum1", 1),
-    ("dest", 2),
-    ("count", 1),
-];
-
-/// Links one stage at `address` against the profile's services.
-fn link(
-    object: &[u8],
-    name: &str,
-    address: u16,
-    profile: &RomProfile,
+/// What the loader is linked against besides its own code.
+struct Symbols {
     services: Services,
+    zero_page: u8,
     toggle: u8,
-) -> Result<(UploadImage, Image)> {
+}
+
+/// Links the loader at `address` against the profile's services.
+fn link(object: &[u8], address: u16, symbols: &Symbols) -> Result<(UploadImage, Image)> {
     let failed = |message: String| Error::LoaderLink { address, message };
     let symbol = |name: &str, value: u16| ImageSymbol {
         name: name.to_owned(),
@@ -241,22 +251,26 @@ fn link(
         global: true,
         section: None,
     };
+    let services = symbols.services;
     // The services as a symbol file, so any ROM profile that has them will do.
+    let mut list = vec![
+        symbol("GETCH", services.getch),
+        symbol("CHKCH", services.chkch),
+        symbol("CMD_DONE", services.cmd_done),
+        symbol("ACIA_CTRL", ACIA_CONTROL),
+        symbol("RATE_TOGGLE", u16::from(symbols.toggle)),
+        symbol("LZP", u16::from(symbols.zero_page)),
+    ];
+    if let Some(ring) = services.ring {
+        list.extend([
+            symbol("RXBUF", ring.buffer),
+            symbol("RXHEAD", u16::from(ring.head)),
+            symbol("RXTAIL", u16::from(ring.tail)),
+        ]);
+    }
+    let name = "loader.s";
     let rom = Image {
-        symbols: vec![
-            symbol("GETCH", services.getch),
-            symbol("CHKCH", services.chkch),
-            symbol("CMD_DONE", services.cmd_done),
-            symbol("RATE_TOGGLE", u16::from(toggle)),
-            // The chain slot's initial value: the uploader overwrites it with
-            // the hook's target before the stage is hooked.
-            symbol(
-                "BAD_COMMAND",
-                profile
-                    .reset_target(HookKind::Unknown)
-                    .unwrap_or(services.cmd_done),
-            ),
-        ],
+        symbols: list,
         ..Image::default()
     };
     let target = linker::Target::builtin("flat", Some(u64::from(address)))
@@ -320,10 +334,30 @@ fn free_space(profile: &RomProfile, image: &UploadImage, len: usize) -> Option<u
     None
 }
 
+/// The highest eight bytes of the profile's user zero page that the image
+/// does not load.
+fn free_zero_page(profile: &RomProfile, image: &UploadImage) -> Option<u8> {
+    let zero_page = profile.user_zero_page.clone()?;
+    let (first, last) = (*zero_page.start(), *zero_page.end());
+    let mut base = last.checked_sub(ZERO_PAGE_LEN - 1)?;
+    while base >= first {
+        let clash = (0..ZERO_PAGE_LEN)
+            .rev()
+            .find(|&i| image.contains(u16::from(base + i)));
+        match clash {
+            None => return Some(base),
+            // Below the loaded byte that clashed.
+            Some(i) => base = (base + i).checked_sub(ZERO_PAGE_LEN)?,
+        }
+    }
+    None
+}
+
 /// A `/1L` frame for the RAM loader that writes `data` (1 to
 /// [`FRAME_MAX`] bytes; more are cut) at `address`: the command, the key,
-/// the encoded header with its checksum, the encoded data. No byte after
-/// the command is a slash. (See `uploader/loader/frames.s`.)
+/// the encoded header with its checksum, the encoded data last byte
+/// first. No byte after the command is a slash. (See
+/// `uploader/loader/loader.s`.)
 #[must_use]
 pub fn loader_frame(address: u16, data: &[u8]) -> Vec<u8> {
     frame(address, data)
@@ -335,7 +369,7 @@ pub(crate) fn frame(address: u16, data: &[u8]) -> Vec<u8> {
     let count = data.len().clamp(1, FRAME_MAX) as u8;
     let data = &data[..usize::from(count).min(data.len())];
     // Each data byte rules out one key (byte ^ slash); a frame of at most
-    // 128 bytes leaves at least 128 keys to try with the header's.
+    // 128 bytes leaves at least 127 keys to try with the header's.
     let mut ruled_out = [false; 256];
     ruled_out[usize::from(SLASH)] = true;
     for &byte in data {
@@ -348,22 +382,27 @@ pub(crate) fn frame(address: u16, data: &[u8]) -> Vec<u8> {
         // Both sums start at the key; the check bytes bring them to zero:
         // c0 = -(s0 + s1), c1 = s1.
         let (mut sum0, mut sum1) = (key, key);
-        for byte in [lo, hi, count] {
+        for byte in [hi, lo, count] {
             sum0 = sum0.wrapping_add(byte);
             sum1 = sum1.wrapping_add(sum0);
         }
-        let header = [lo, hi, count, sum0.wrapping_add(sum1).wrapping_neg(), sum1];
+        let header = [hi, lo, count, sum0.wrapping_add(sum1).wrapping_neg(), sum1];
         if header.iter().any(|&byte| byte ^ key == SLASH) {
             continue;
         }
         let mut out = Vec::with_capacity(FRAME_OVERHEAD + data.len());
         out.extend_from_slice(b"/1L");
         out.push(key);
-        out.extend(header.iter().chain(data).map(|&byte| byte ^ key));
+        out.extend(
+            header
+                .iter()
+                .chain(data.iter().rev())
+                .map(|&byte| byte ^ key),
+        );
         return out;
     }
-    // Unreachable for frames of FRAME_MAX bytes or fewer (at most 134 of
-    // the 256 keys are ruled out); an empty frame writes nothing.
+    // Only if every key left makes a header byte a slash (each does with
+    // a chance of about 5 in 256): an empty frame, which the caller splits.
     Vec::new()
 }
 
@@ -375,19 +414,20 @@ pub fn rom_only_estimate(len: usize, baud: u32) -> Duration {
     char_time(len.div_ceil(2) * 11 + questions * 9, baud)
 }
 
-/// How long the same upload takes through the loader: the two stages
-/// through the ROM (the second at `fast`), then the bytes in frames, where
-/// the `/7R` answers (two characters a byte) on the return wire are what
-/// take longest; plus the round trips of the hooks and rate switches.
+/// How long the same upload takes through a loader of `loader_len` bytes,
+/// the line at `fast` for the transfer: `rate` (15 bytes) through the ROM
+/// at `baud`, the rest at `fast`, then the bytes in frames, where the `/7R`
+/// answers (two characters a byte) on the return wire take longest; plus
+/// the round trips of the hooks and the rate switches.
 #[must_use]
 pub fn loader_estimate(len: usize, loader_len: usize, baud: u32, fast: u32) -> Duration {
-    let fast_stage = 15;
-    let install = rom_only_estimate(fast_stage, baud)
-        + rom_only_estimate(loader_len.saturating_sub(fast_stage), fast);
+    let rate_part = 15;
+    let install = rom_only_estimate(rate_part, baud)
+        + rom_only_estimate(loader_len.saturating_sub(rate_part), fast);
     let questions = len.div_ceil(99);
     let out = len + len.div_ceil(99) * FRAME_OVERHEAD + questions * 9;
     let back = 2 * len + 2 * questions;
-    let round_trips = char_time(200, baud) + char_time(100, fast);
+    let round_trips = char_time(120, baud) + char_time(60, fast);
     install + char_time(out.max(back), fast) + round_trips
 }
 
@@ -395,7 +435,7 @@ pub fn loader_estimate(len: usize, loader_len: usize, baud: u32, fast: u32) -> D
 mod tests {
     use super::*;
 
-    /// Decodes a frame as `frames.s` does: `None` where it would write
+    /// Decodes a frame as `loader.s` does: `None` where it would write
     /// nothing.
     fn decode(frame: &[u8]) -> Option<(u16, Vec<u8>)> {
         let (command, rest) = frame.split_at(3);
@@ -415,8 +455,9 @@ mod tests {
         if s0 != 0 || s1 != 0 {
             return None;
         }
-        let data: Vec<u8> = bytes.take(usize::from(header[2])).collect();
-        Some((u16::from_le_bytes([header[0], header[1]]), data))
+        let mut data: Vec<u8> = bytes.take(usize::from(header[2])).collect();
+        data.reverse();
+        Some((u16::from_le_bytes([header[1], header[0]]), data))
     }
 
     #[test]
@@ -454,8 +495,17 @@ mod tests {
     }
 
     #[test]
-    fn stages_link_and_fit_around_the_image() {
+    fn the_toggle_keeps_the_framing_bits() {
+        assert_eq!(ACIA_CONTROL, 0xC013);
+        assert_eq!(rate_toggle((9600, FAST_BAUD)), 0x0E ^ 0x0F);
+        assert_eq!(rate_toggle((4800, FAST_BAUD)), 0x0C ^ 0x0F);
+        assert_eq!(rate_toggle((9600, 12345)), 0);
+    }
+
+    #[test]
+    fn the_loader_links_and_fits_around_the_image() {
         let profile = RomProfile::reference();
+        let rates = (9600, FAST_BAUD);
         let image = UploadImage::new(
             vec![Area {
                 address: 0x0400,
@@ -464,32 +514,22 @@ mod tests {
             vec![],
         )
         .expect("an image");
-        let rates = (9600, FAST_BAUD);
         let loader = Loader::place(&profile, &image, rates)
             .expect("links")
             .expect("room above $0F00");
-        assert_eq!(loader.fast.image.len(), 15);
-        assert_eq!(
-            loader.fast.image.areas()[0].bytes[4..9],
-            [0xAD, 0x13, 0xC0, 0x49, 0x01],
-            "LDA ACIA_CTRL / EOR #$1E^$1F"
-        );
-        assert!(loader.len() < 120, "{} bytes", loader.len());
+        assert!(loader.len() < 80, "{} bytes", loader.len());
         assert_eq!(
             usize::from(loader.address()) + loader.len(),
             0x1000,
             "the top of user RAM"
         );
-        assert_eq!(loader.fast.handler, loader.address());
-        assert_eq!(loader.frames.handler, loader.address() + 15);
-        assert!(loader.frames.chain.is_some());
-        assert_eq!(loader.fast.chain, None);
-        assert_eq!(
-            loader.frames.scratch.len(),
-            6,
-            "{:?}",
-            loader.frames.scratch
-        );
+        assert_eq!(loader.rate, loader.address());
+        assert_eq!(usize::from(loader.frames - loader.rate), 15, "rate's size");
+        let rate = loader.rate_part().expect("a part");
+        let frames = loader.frames_part().expect("a part");
+        assert_eq!(rate.len() + frames.len(), loader.len());
+        assert_eq!(frames.areas()[0].address, loader.frames);
+        assert_eq!(loader.zero_page, 0xF8, "the top of user zero page");
 
         let full = UploadImage::new(
             vec![Area {
@@ -520,5 +560,35 @@ mod tests {
             .expect("room in the gap");
         assert!(loader.address() >= 0x0500);
         assert!(usize::from(loader.address()) + loader.len() <= 0x0700);
+    }
+
+    #[test]
+    fn the_loaders_zero_page_avoids_the_image() {
+        let profile = RomProfile::reference();
+        let zero_page = |areas: Vec<(u16, usize)>| {
+            let image = UploadImage::new(
+                areas
+                    .into_iter()
+                    .map(|(address, len)| Area {
+                        address,
+                        bytes: vec![0; len],
+                    })
+                    .collect(),
+                vec![],
+            )
+            .expect("an image");
+            free_zero_page(&profile, &image)
+        };
+        assert_eq!(zero_page(vec![(0x0400, 1)]), Some(0xF8));
+        assert_eq!(zero_page(vec![(0x00FF, 1)]), Some(0xF7));
+        assert_eq!(zero_page(vec![(0x00FB, 1), (0x0400, 1)]), Some(0xF3));
+        assert_eq!(zero_page(vec![(0x00F3, 1), (0x0400, 1)]), Some(0xF8));
+        assert_eq!(zero_page(vec![(0x00F2, 0x0E)]), Some(0xEA));
+        assert_eq!(
+            zero_page(vec![(0x0037, 0xC9)]),
+            None,
+            "$30-$36 is too small"
+        );
+        assert_eq!(zero_page(vec![(0x0038, 0xC8)]), Some(0x30));
     }
 }

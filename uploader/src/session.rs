@@ -1,15 +1,16 @@
-//! Running the RAM loader: install its stages through the ROM (each
-//! verified before it is hooked), switch the line to the fast rate, carry
-//! the body in frames, recover the loader after a reset, and put the line
-//! back on the base rate at the end.
+//! Running the RAM loader: `rate` put in through the ROM at the base rate,
+//! verified and hooked; `/1F` and the host moved to the fast rate; the
+//! rest of the loader put in there, verified and hooked; the body carried
+//! in frames; the loader recovered after a reset; `/1F` again at the end,
+//! which puts the line back on the base rate.
 //!
 //! Resets are why this is more than a sequence of steps. A `/1R` (the
 //! ROM's soft reset) puts the hooks back but leaves the 6551 at whatever
 //! rate it runs; the reset button also puts the 6551 back on its DIP
 //! switches. Either way the loader is no longer hooked, so frames stop
-//! landing. [`Session::ensure`] finds the rate the robot answers at, checks
-//! `HOOK_UNKNOWN`, verifies the stages (they are still in RAM, so that is a
-//! read) and hooks them again.
+//! landing. [`Session::ensure`] finds the rate the robot answers at,
+//! checks `HOOK_UNKNOWN`, verifies the loader (it is still in RAM, so that
+//! is a read), hooks it again and switches the line again if it has to.
 
 use std::time::Duration;
 
@@ -20,7 +21,7 @@ use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::Client;
 use crate::hooks::{read_hook, switch_hook};
 use crate::image::{RomProfile, UploadImage};
-use crate::loader::Loader;
+use crate::loader::{Loader, rate_toggle};
 use crate::progress::{Event, NoProgress, Phase, Progress};
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
@@ -28,13 +29,18 @@ use crate::{Error, Result};
 /// How often the loader is restored before the upload gives up.
 const MAX_RECOVERIES: u32 = 6;
 
+/// Time the robot is given to obey `/1F` once its last character has
+/// arrived: the ROM's dispatch and `rate`'s toggle take well under a
+/// millisecond at 1 MHz.
+const SWITCH_SETTLE: Duration = Duration::from_millis(2);
+
 /// The loader during one upload.
 #[derive(Debug)]
 pub(crate) struct Session {
     loader: Loader,
     hook: u16,
-    /// `HOOK_UNKNOWN`'s target before the upload: the frames stage's
-    /// fallthrough.
+    /// `HOOK_UNKNOWN`'s target before the upload (the ROM's own: the
+    /// loader is used only then), where it goes back to at the end.
     original: u16,
     /// The ROM's reset target of `HOOK_UNKNOWN`, if known.
     reset: Option<u16>,
@@ -42,6 +48,8 @@ pub(crate) struct Session {
     /// The rate the transfer runs at once the loader is in: `fast` if the
     /// switch worked, else `base`.
     target: u32,
+    /// The rate to switch to; `None` once a switch failed (the transfer
+    /// then runs at the base rate).
     fast: Option<u32>,
     limits: Limits,
     /// Times the loader was restored.
@@ -49,13 +57,12 @@ pub(crate) struct Session {
 }
 
 impl Session {
-    /// A session for `loader`; `fast` is the rate to switch to, if any.
+    /// A session for `loader`, linked for a line at `base` and `fast`.
     pub(crate) fn new(
         loader: Loader,
         profile: &RomProfile,
         original: u16,
-        base: u32,
-        fast: Option<u32>,
+        (base, fast): (u32, Option<u32>),
         limits: Limits,
     ) -> Self {
         Session {
@@ -65,20 +72,15 @@ impl Session {
             reset: profile.reset_target(HookKind::Unknown),
             base,
             target: base,
-            fast: fast.filter(|&fast| {
-                fast != base
-                    && crate::loader::acia_control(fast).is_some()
-                    && crate::loader::acia_control(base).is_some()
-            }),
+            fast: fast.filter(|&fast| fast != base && rate_toggle((base, fast)) != 0),
             limits,
             recoveries: 0,
         }
     }
 
-    /// Where the frames stage runs: `HOOK_UNKNOWN`'s target while the
-    /// loader is in.
+    /// Where `frames` runs: `HOOK_UNKNOWN`'s target while the loader is in.
     pub(crate) fn handler(&self) -> u16 {
-        self.loader.frames.handler
+        self.loader.frames
     }
 
     /// The rate the transfer ran at.
@@ -91,28 +93,8 @@ impl Session {
         (self.loader.address(), self.loader.len())
     }
 
-    /// The frames stage with its chain slot filled: the rate switch, whose
-    /// `/1F` takes the line back to the base rate (and which drops other
-    /// commands, as the ROM's `BAD_COMMAND` does), or without a switch the
-    /// hook's original target.
-    fn frames_image(&self) -> UploadImage {
-        let mut image = self.loader.frames.image.clone();
-        let fallthrough = if self.fast.is_some() {
-            self.loader.fast.handler
-        } else {
-            self.original
-        };
-        if let Some(slot) = self.loader.frames.chain {
-            let [low, high] = fallthrough.to_le_bytes();
-            image.set_byte(slot, low);
-            image.set_byte(slot + 1, high);
-        }
-        image
-    }
-
-    /// Installs the loader: the fast stage at the base rate, the switch,
-    /// the frames stage at the fast rate. Every stage verifies before it
-    /// is hooked.
+    /// Installs the loader: `rate` at the base rate, the switch, `frames`
+    /// at the fast rate. Each part verifies before it is hooked.
     pub(crate) fn install<T: Transport>(
         &mut self,
         client: &mut Client<T>,
@@ -121,15 +103,15 @@ impl Session {
         progress.phase(Phase::Loader, self.loader.len());
         if let Some(fast) = self.fast {
             // Can the host's end run at the fast rate at all?
-            let base = client.transport().baud();
+            let now = client.transport().baud();
             if client.transport().set_baud(fast).is_err() {
                 self.fast = None;
             }
-            client.transport().set_baud(base)?;
+            client.transport().set_baud(now)?;
         }
         let mut start = Start::Write;
         loop {
-            let error = match self.hook_stages(client, start) {
+            let error = match self.hook_loader(client, start) {
                 Ok(()) => break,
                 Err(error) if recoverable(&error) && self.recoveries < MAX_RECOVERIES => error,
                 Err(error) => return Err(error),
@@ -153,42 +135,33 @@ impl Session {
         Ok(())
     }
 
-    /// Verifies (or writes) the stages and hooks them, switching the rate
-    /// on the way. The robot answers at the host's rate when this starts.
-    fn hook_stages<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
-        let at_fast = self
-            .fast
-            .is_some_and(|fast| client.transport().baud() == fast);
-        if self.fast.is_some() {
-            // The frames stage falls through to it, so it is verified
-            // whether or not the line still needs switching.
-            let stage = self.loader.fast.image.clone();
-            self.put(client, &stage, start)?;
+    /// Verifies (or writes) the loader and hooks `frames`, switching the
+    /// line to the fast rate on the way if it is not there. The robot
+    /// answers at the host's rate when this starts.
+    fn hook_loader<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
+        match self.fast {
+            Some(fast) if client.transport().baud() != fast => {
+                self.put(client, &self.loader.rate_part()?, start)?;
+                switch_hook(client, self.hook, self.loader.rate, self.limits.max_writes)?;
+                if !self.switch_rate(client, fast)? {
+                    // This robot does not follow: the transfer runs at the
+                    // base rate, and no later recovery tries again.
+                    self.fast = None;
+                }
+                self.put(client, &self.loader.frames_part()?, start)?;
+            }
+            _ => self.put(client, self.loader.whole(), start)?,
         }
-        if let Some(fast) = self.fast
-            && !at_fast
-        {
-            let handler = self.loader.fast.handler;
-            switch_hook(client, self.hook, handler, self.limits.max_writes)?;
-            self.target = if self.switch_rate(client, fast)? {
-                fast
-            } else {
-                self.base
-            };
-        } else {
-            self.target = client.transport().baud();
-        }
-        let frames = self.frames_image();
-        self.put(client, &frames, start)?;
+        self.target = client.transport().baud();
         switch_hook(
             client,
             self.hook,
-            self.loader.frames.handler,
+            self.loader.frames,
             self.limits.max_writes,
         )
     }
 
-    /// Puts a stage's bytes into the robot through the ROM, verified.
+    /// Puts loader bytes into the robot through the ROM, verified.
     fn put<T: Transport>(
         &self,
         client: &mut Client<T>,
@@ -197,7 +170,7 @@ impl Session {
     ) -> Result<()> {
         let mut body = Body::new(image, Writer::Rom);
         match start {
-            Start::Write => body.plan_writes(&mut NoProgress),
+            Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
             Start::Verify => body.plan_reads(&mut NoProgress),
         }
         match body.run(client, self.limits, &mut NoProgress)? {
@@ -205,27 +178,22 @@ impl Session {
         }
     }
 
-    /// Sends `/1F` (the rate switch toggles the line, directly or through
-    /// the frames stage), then moves the host to `to` and checks the robot
-    /// answers there. If it does not, the robot is looked for at the rate it was
-    /// at: `false` means it never left it.
+    /// Sends `/1F` (`rate` toggles the line, reached directly or through
+    /// `frames`), then moves the host to `to` and checks the robot answers
+    /// there. If it does not, the robot is looked for: `false` means it
+    /// stayed at the rate it was at.
     fn switch_rate<T: Transport>(&mut self, client: &mut Client<T>, to: u32) -> Result<bool> {
         let from = client.transport().baud();
-        let command = Command::Extension(Extension::new(b"F".as_slice())?);
         for _ in 0..client.config().question_attempts.max(1) {
-            client.drain()?;
-            client.send(&command)?;
-            // The command's three characters, then the ROM's dispatch.
-            let settle = char_time(3, from) + Duration::from_millis(3);
-            let until = client.transport().now() + settle;
-            client.wait_until(until)?;
-            client.transport().set_baud(to)?;
-            client.transport().clear_input()?;
-            if client.probe().is_ok() {
+            send_toggle(client, to)?;
+            // Two asks at each rate: a lost answer is rare, and
+            // `find_rate` asks again at both if neither answers.
+            if client.probe_with(2).is_ok() {
                 return Ok(true);
             }
             client.transport().set_baud(from)?;
-            if client.probe().is_err() {
+            client.transport().clear_input()?;
+            if client.probe_with(2).is_err() {
                 break;
             }
             // Still at the old rate: the command was lost; again.
@@ -238,9 +206,15 @@ impl Session {
     /// Finds the rate the robot answers at among the host's current rate,
     /// the base and the fast rate, and leaves the host there.
     fn find_rate<T: Transport>(&self, client: &mut Client<T>) -> Result<u32> {
-        let mut rates = vec![client.transport().baud(), self.base];
-        rates.extend(self.fast);
-        rates.dedup();
+        let mut rates = vec![client.transport().baud()];
+        for rate in [Some(self.base), self.fast, Some(self.target)]
+            .into_iter()
+            .flatten()
+        {
+            if !rates.contains(&rate) {
+                rates.push(rate);
+            }
+        }
         let mut last = None;
         for _ in 0..2 {
             for &rate in &rates {
@@ -260,30 +234,32 @@ impl Session {
         }))
     }
 
-    /// Makes sure the frames stage is hooked and the line at the
-    /// transfer's rate, restoring both after a reset.
+    /// Makes sure `frames` is hooked and the line at the transfer's rate,
+    /// restoring both after a reset.
     fn ensure<T: Transport>(
         &mut self,
         client: &mut Client<T>,
         progress: &mut dyn Progress,
     ) -> Result<()> {
         let rate = self.find_rate(client)?;
-        let mut known = vec![
-            self.loader.frames.handler,
-            self.loader.fast.handler,
-            self.original,
-        ];
+        let mut known = vec![self.loader.frames, self.loader.rate, self.original];
         known.extend(self.reset);
-        let current = read_hook(client, HookKind::Unknown, self.hook, &known)?;
-        if current == self.loader.frames.handler && rate == self.target {
+        // A hook that no longer holds a `JMP` (a `/9W` whose address noise
+        // changed) is written whole again by `hook_loader`.
+        let current = match read_hook(client, HookKind::Unknown, self.hook, &known) {
+            Ok(current) => Some(current),
+            Err(Error::NotAHook { .. }) => None,
+            Err(error) => return Err(error),
+        };
+        if current == Some(self.loader.frames) && rate == self.target {
             return Ok(());
         }
         progress.event(&Event::LoaderRestored {
-            hook: Some(current),
+            hook: current,
             baud: rate,
         });
         self.recoveries += 1;
-        self.hook_stages(client, Start::Verify)
+        self.hook_loader(client, Start::Verify)
     }
 
     /// Carries the body in frames, checking and restoring the loader when
@@ -318,43 +294,65 @@ impl Session {
         }
     }
 
-    /// Puts the line back on the base rate and, unless `keep_hooked` (the
-    /// image takes `HOOK_UNKNOWN` next, replacing the loader in one
-    /// switch), points `HOOK_UNKNOWN` back at its original target.
-    pub(crate) fn finish<T: Transport>(
+    /// Puts the line back on the base rate: `/1F` through the loader,
+    /// restored first if a reset unhooked it. Unless `confirm`, the host
+    /// moves without asking whether the robot followed: the questions the
+    /// upload asks next (the hooks) tell, and if it did not, they reached
+    /// it as characters at half its rate, which its 6551 takes as even
+    /// bytes, never a slash, so the ROM ignores them; the caller then finds
+    /// the robot and calls this again with `confirm`.
+    pub(crate) fn back_to_base<T: Transport>(
         &mut self,
         client: &mut Client<T>,
-        keep_hooked: bool,
+        confirm: bool,
         progress: &mut dyn Progress,
     ) -> Result<()> {
-        if client.transport().baud() != self.base {
-            for _ in 0..=MAX_RECOVERIES {
-                if self.switch_rate(client, self.base)? {
-                    break;
-                }
-                // Still fast: the loader may be gone (a `/1R`); restore it
-                // so that its `/1F` can be obeyed.
+        if client.transport().baud() == self.base {
+            return Ok(());
+        }
+        if !confirm && self.base < client.transport().baud() {
+            return send_toggle(client, self.base);
+        }
+        for _ in 0..=MAX_RECOVERIES {
+            if client.transport().baud() == self.base || self.switch_rate(client, self.base)? {
+                return Ok(());
+            }
+            // Still fast: the loader may be gone (a `/1R`); restore it so
+            // that its `/1F` can be obeyed.
+            if client.transport().baud() != self.base {
                 self.ensure(client, progress)?;
             }
-            if client.transport().baud() != self.base {
-                return Err(Error::BaudChange {
-                    port: client.transport().name(),
-                    baud: self.base,
-                    message: "the robot did not come back to its base rate".into(),
-                });
-            }
         }
-        if !keep_hooked {
-            switch_hook(client, self.hook, self.original, self.limits.max_writes)?;
-            progress.event(&Event::LoaderRemoved);
-        }
-        Ok(())
+        Err(Error::BaudChange {
+            port: client.transport().name(),
+            baud: self.base,
+            message: "the robot did not come back to its base rate".into(),
+        })
     }
+
+    /// Finds the robot after an error a reset explains, and leaves the
+    /// host at its rate.
+    pub(crate) fn find<T: Transport>(&mut self, client: &mut Client<T>) -> Result<u32> {
+        self.find_rate(client)
+    }
+}
+
+/// Sends `/1F` once every answer is in (the 6551 must not be sending when
+/// its rate changes), waits until the robot has obeyed it, and moves the
+/// host to `to`.
+fn send_toggle<T: Transport>(client: &mut Client<T>, to: u32) -> Result<()> {
+    let from = client.transport().baud();
+    client.drain()?;
+    client.send(&Command::Extension(Extension::new(b"F".as_slice())?))?;
+    let until = client.transport().now() + char_time(3, from) + SWITCH_SETTLE;
+    client.wait_until(until)?;
+    client.transport().set_baud(to)?;
+    client.transport().clear_input()
 }
 
 /// Errors a reset or a passing line fault explains: the robot may answer
 /// again, at one of the two rates.
-fn recoverable(error: &Error) -> bool {
+pub(crate) fn recoverable(error: &Error) -> bool {
     matches!(
         error,
         Error::Stalled { .. }
@@ -364,7 +362,8 @@ fn recoverable(error: &Error) -> bool {
     )
 }
 
-/// Whether a stage is written or only verified (it may be there already).
+/// Whether loader bytes are written or only verified (they may be there
+/// already).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Start {
     Write,

@@ -19,11 +19,13 @@ use romlib::protocol::{Command, Extension};
 
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::{Client, ClientConfig};
-use crate::hooks::{read_hook, read_hooks, read_word, switch_hook, write_word_verified};
+use crate::hooks::{
+    Wanted, read_hook, read_hooks, read_word, settle_hooks, switch_hook, write_word_verified,
+};
 use crate::image::{RomProfile, UploadImage};
 use crate::loader::{FAST_BAUD, Loader, loader_estimate, rom_only_estimate};
 use crate::progress::{Event, Phase, Progress};
-use crate::session::Session;
+use crate::session::{Session, recoverable};
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
 
@@ -96,7 +98,7 @@ pub struct InstalledHook {
 pub struct LoaderReport {
     /// Where it ran.
     pub address: u16,
-    /// Its size in bytes (both stages).
+    /// Its size in bytes (both parts).
     pub len: usize,
     /// The rate the body travelled at.
     pub baud: u32,
@@ -128,39 +130,51 @@ pub struct UploadReport {
     pub loader: Option<LoaderReport>,
 }
 
-/// Reads the hooks (the first question of an upload). If the robot does
-/// not answer at the host's rate but the host can try the loader's fast
-/// rate, an upload interrupted there may have left it so: it is asked
-/// (through a loader that may still be hooked) to go back.
+/// Reads the hooks (the first question of an upload), and returns them
+/// with the rate the robot answered at. If the robot does not answer at
+/// the host's rate but the host can try the loader's fast rate, an upload
+/// interrupted there may have left it so: `/1F` (which a loader still
+/// hooked obeys, and anything else drops) asks it back. A robot that stays
+/// at the fast rate (a `/1R` there unhooked the loader) is read there: only
+/// the loader can bring it back.
 fn connect<T: Transport>(
     client: &mut Client<T>,
     options: &UploadOptions,
-) -> Result<Vec<(HookKind, u16)>> {
+) -> Result<(Vec<(HookKind, u16)>, u32)> {
+    let base = client.transport().baud();
     let error = match read_hooks(client, &options.profile) {
         Err(error @ (Error::NoAnswer { .. } | Error::WrongBaud { .. })) => error,
-        other => return other,
+        other => return other.map(|hooks| (hooks, base)),
     };
-    let base = client.transport().baud();
     let Some(fast) = options.fast_baud.filter(|&fast| fast != base) else {
         return Err(error);
     };
     if client.transport().set_baud(fast).is_err() {
         return Err(error);
     }
-    // At the fast rate, the loader of an interrupted upload may still be
-    // hooked: its `/1F` toggles the line back.
-    client.transport().clear_input()?;
-    if client.probe().is_ok() {
-        client.send(&Command::Extension(Extension::new(b"F".as_slice())?))?;
-        let until = client.transport().now() + char_time(3, fast) + Duration::from_millis(3);
-        client.wait_until(until)?;
-    }
-    client.transport().set_baud(base)?;
     client.transport().clear_input()?;
     if client.probe().is_err() {
+        client.transport().set_baud(base)?;
+        client.transport().clear_input()?;
         return Err(error);
     }
-    read_hooks(client, &options.profile)
+    client.send(&Command::Extension(Extension::new(b"F".as_slice())?))?;
+    let until = client.transport().now() + char_time(3, fast) + Duration::from_millis(2);
+    client.wait_until(until)?;
+    client.transport().set_baud(base)?;
+    client.transport().clear_input()?;
+    if client.probe().is_ok() {
+        return read_hooks(client, &options.profile).map(|hooks| (hooks, base));
+    }
+    client.transport().set_baud(fast)?;
+    client.transport().clear_input()?;
+    match read_hooks(client, &options.profile) {
+        Ok(hooks) => Ok((hooks, fast)),
+        Err(_) => {
+            client.transport().set_baud(base)?;
+            Err(error)
+        }
+    }
 }
 
 /// Whether the loader carries this upload, and where it goes.
@@ -193,7 +207,7 @@ fn choose_loader(
     }
     let Some(loader) = Loader::place(profile, image, (baud, fast))? else {
         return refuse(
-            "the image leaves no room for it in user RAM, or the ROM has no GETCH".into(),
+            "the image leaves no room for it in user RAM or user zero page, or the ROM lacks GETCH, CHKCH or CMD_DONE".into(),
         );
     };
     if options.loader == LoaderChoice::Auto {
@@ -209,7 +223,7 @@ fn choose_loader(
 ///
 /// # Errors
 /// Any [`Error`]; on every error path, no hook points at code that did not
-/// verify (hooks are the last thing written, each stage of the loader
+/// verify (hooks are the last thing written, each part of the loader
 /// verified before it is hooked).
 pub fn upload<T: Transport>(
     client: &mut Client<T>,
@@ -231,19 +245,20 @@ pub fn upload<T: Transport>(
     let base = client.transport().baud();
     let rates = (base, options.fast_baud.unwrap_or(base));
     let leftover = Loader::place(profile, image, rates)?;
+    let (hooks_now, found_at) = connect(client, options)?;
     let mut initial = Vec::new();
-    for (kind, mut target) in connect(client, options)? {
+    for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
         let loader = leftover.as_ref().filter(|loader| {
-            kind == HookKind::Unknown
-                && (target == loader.frames.handler || target == loader.fast.handler)
+            kind == HookKind::Unknown && (target == loader.frames || target == loader.rate)
         });
         if image.contains(target) || loader.is_some() {
-            // An earlier copy of this image (or its loader), probably: the
-            // hook goes back to where that fell through (its chain slot),
-            // so the chain behind it survives; else to the ROM's target.
+            // An earlier copy of this image, probably: the hook goes back
+            // to where that fell through (its chain slot), so the chain
+            // behind it survives; else to the ROM's target. (The loader
+            // falls through to nothing: it is only ever hooked in place of
+            // the ROM's own target.)
             let slot = match loader {
-                Some(loader) if target == loader.frames.handler => loader.frames.chain,
                 Some(_) => None,
                 None => image
                     .hooks()
@@ -273,12 +288,7 @@ pub fn upload<T: Transport>(
         }
         initial.push((kind, target));
     }
-    let before = |kind: HookKind| {
-        initial
-            .iter()
-            .find(|(k, _)| *k == kind)
-            .map_or(0, |&(_, target)| target)
-    };
+    let before = |kind: HookKind| target_before(&initial, kind);
 
     // Chain slots get the hooks' current targets before the body goes out,
     // so they are verified with it.
@@ -292,55 +302,125 @@ pub fn upload<T: Transport>(
     }
 
     let loader = choose_loader(options, &image, &initial, rates)?;
+    if loader.is_none() && found_at != base {
+        return Err(Error::LeftAtFastRate {
+            port: client.transport().name(),
+            found: found_at,
+            base,
+        });
+    }
     let mut session = None;
     let mut body;
+    let hooks;
     if let Some(loader) = loader {
         let mut running = Session::new(
             loader,
             profile,
             before(HookKind::Unknown),
-            base,
-            options.fast_baud,
+            (base, options.fast_baud),
             limits,
         );
         body = Body::new(&image, Writer::Frames);
-        let replaced_next = image
-            .hooks()
-            .iter()
-            .any(|record| record.kind == HookKind::Unknown);
         let result = running
             .install(client, progress)
             .and_then(|()| {
-                body.plan_writes(progress);
+                body.plan_writes(client.transport().baud(), progress);
                 running.transfer(client, &mut body, progress)
             })
-            .and_then(|()| running.finish(client, replaced_next, progress));
-        if let Err(error) = result {
-            // The host goes back to the rate it was given; the robot may be
-            // left at the fast rate with the (verified) loader hooked, which
-            // the next upload's `connect` undoes.
-            let _ = client.transport().set_baud(base);
-            return Err(error);
+            .and_then(|()| {
+                // `/1F` through the loader, its last job; then the hooks
+                // (the loader's replaced by the image's, or back to its
+                // target before). A reset meanwhile, or a `/1F` that did
+                // not arrive, is found and the end taken again.
+                let mut attempts = 0;
+                loop {
+                    let ours = Some(running.handler());
+                    let end = running
+                        .back_to_base(client, attempts > 0, progress)
+                        .and_then(|()| {
+                            install_hooks(client, &image, options, &initial, ours, progress)
+                        });
+                    match end {
+                        Err(error) if recoverable(&error) && attempts < 3 => {
+                            attempts += 1;
+                            running.find(client).map_err(|_| error)?;
+                        }
+                        other => return other,
+                    }
+                }
+            });
+        match result {
+            Ok(installed) => hooks = installed,
+            Err(error) => {
+                // The host goes back to the rate it was given; the robot may
+                // be left at the fast rate with the (verified) loader hooked,
+                // which the next upload's `connect` undoes.
+                let _ = client.transport().set_baud(base);
+                return Err(error);
+            }
         }
         session = Some(running);
     } else {
         body = Body::new(&image, Writer::Rom);
-        body.plan_writes(progress);
+        body.plan_writes(client.transport().baud(), progress);
         while body.run(client, limits, progress)? != RunEnd::Done {}
+        hooks = install_hooks(client, &image, options, &initial, None, progress)?;
     }
 
-    // Hooks last.
+    let stats = client.stats();
+    Ok(UploadReport {
+        bytes: image.len(),
+        device_time: client.transport().now().saturating_sub(start),
+        chars_sent: stats.sent - stats_before.sent,
+        chars_received: stats.received - stats_before.received,
+        rewrites: body.rewrites,
+        lost_answers: stats.lost - stats_before.lost,
+        final_passes: body.passes(),
+        hooks,
+        loader: session.map(|session| {
+            let (address, len) = session.placement();
+            LoaderReport {
+                address,
+                len,
+                baud: session.rate(),
+                recoveries: session.recoveries,
+            }
+        }),
+    })
+}
+
+/// A hook's target when the upload began (after any disarming).
+fn target_before(initial: &[(HookKind, u16)], kind: HookKind) -> u16 {
+    initial
+        .iter()
+        .find(|(k, _)| *k == kind)
+        .map_or(0, |&(_, target)| target)
+}
+
+/// Points the image's hooks at its handlers, the last thing an upload
+/// does: each chain slot holds what the hook pointed at before (or, after
+/// a reset, the ROM's target), each hook is switched by one `/9W`; `ours`
+/// is the RAM loader's handler, if it holds `HOOK_UNKNOWN`, which goes
+/// back to its target before the upload unless the image takes it. Then
+/// both hooks are read back whole, and whatever noise changed is put
+/// right, the hooks the image does not take included.
+fn install_hooks<T: Transport>(
+    client: &mut Client<T>,
+    image: &UploadImage,
+    options: &UploadOptions,
+    initial: &[(HookKind, u16)],
+    ours: Option<u16>,
+    progress: &mut dyn Progress,
+) -> Result<Vec<InstalledHook>> {
+    let profile = &options.profile;
     progress.phase(Phase::Hooks, image.hooks().len());
     let mut hooks = Vec::new();
     for record in image.hooks() {
         let address = profile.hook_address(record.kind);
-        let before = before(record.kind);
+        let before = target_before(initial, record.kind);
         let reset = profile.reset_target(record.kind);
         // The loader, if the image replaces it here.
-        let ours = session
-            .as_ref()
-            .filter(|_| record.kind == HookKind::Unknown)
-            .map(Session::handler);
+        let ours = ours.filter(|_| record.kind == HookKind::Unknown);
         let mut known = vec![before];
         known.extend(reset);
         known.extend(ours);
@@ -379,43 +459,51 @@ pub fn upload<T: Transport>(
         {
             write_word_verified(client, slot, fallthrough.to_le_bytes(), options.max_writes)?;
         }
-        switch_hook(client, address, record.handler, options.max_writes)?;
-        if ours.is_some() {
-            progress.event(&Event::LoaderRemoved);
-        }
-        let installed = InstalledHook {
+        hooks.push(InstalledHook {
             kind: record.kind,
             handler: record.handler,
             previous: fallthrough,
-        };
+        });
+    }
+    let mut wanted = Vec::new();
+    for kind in HookKind::ALL {
+        let address = profile.hook_address(kind);
+        let reset = profile.reset_target(kind);
+        wanted.push(match hooks.iter().find(|hook| hook.kind == kind) {
+            Some(hook) => Wanted {
+                address,
+                target: hook.handler,
+                also: None,
+                write: true,
+            },
+            // The loader leaves.
+            None if kind == HookKind::Unknown && ours.is_some() => Wanted {
+                address,
+                target: target_before(initial, kind),
+                also: None,
+                write: true,
+            },
+            // Only checked: as it was, or the ROM's own after a reset.
+            None => Wanted {
+                address,
+                target: target_before(initial, kind),
+                also: reset,
+                write: false,
+            },
+        });
+    }
+    settle_hooks(client, &wanted, options.max_writes)?;
+    if ours.is_some() {
+        progress.event(&Event::LoaderRemoved);
+    }
+    for installed in &hooks {
         progress.event(&Event::HookInstalled {
             kind: installed.kind,
             handler: installed.handler,
             previous: installed.previous,
         });
-        hooks.push(installed);
     }
-
-    let stats = client.stats();
-    Ok(UploadReport {
-        bytes: image.len(),
-        device_time: client.transport().now().saturating_sub(start),
-        chars_sent: stats.sent - stats_before.sent,
-        chars_received: stats.received - stats_before.received,
-        rewrites: body.rewrites,
-        lost_answers: stats.lost - stats_before.lost,
-        final_passes: body.passes(),
-        hooks,
-        loader: session.map(|session| {
-            let (address, len) = session.placement();
-            LoaderReport {
-                address,
-                len,
-                baud: session.rate(),
-                recoveries: session.recoveries,
-            }
-        }),
-    })
+    Ok(hooks)
 }
 
 /// A client paced for `profile`'s receive buffer.

@@ -2,9 +2,10 @@
 //! virtual Scorpion, on both paths (the ROM's commands and the RAM loader
 //! at 19200 baud): 1% of bytes dropped, corrupted or duplicated; a reset
 //! in the middle (a `/1R`, and the reset button, with and without RAM
-//! lost); a stalled line, short and for good. Every case either ends
-//! verified or fails with a clear error, and in every case the emulated
-//! RAM shows no hook pointing at code that did not verify.
+//! lost); a stalled line, short and for good; a write gone astray onto a
+//! hook (what a `/9W` whose address digits noise changed does). Every case
+//! either ends verified or fails with a clear error, and in every case the
+//! emulated RAM shows no hook pointing at code that did not verify.
 
 mod common;
 
@@ -46,7 +47,7 @@ fn one_percent_noise_ends_verified() {
     ];
     for path in PATHS {
         for (name, make) in kinds {
-            for seed in 0..3 {
+            for seed in 0..5 {
                 let (result, faulty) = faulty(robot(), make(seed), &image, path);
                 let stats = faulty.stats();
                 let outcome = format!("{path:?}, {name}, seed {seed}: {stats:?} {result:?}");
@@ -176,5 +177,60 @@ fn a_dead_line_fails_clearly_and_the_next_upload_succeeds() {
             result.unwrap_or_else(|error| panic!("{outcome}, then: {error}"));
             assert_done(transport, &image, &outcome);
         }
+    }
+}
+
+#[test]
+fn a_write_gone_astray_onto_a_hook_is_put_right() {
+    // Noise on a `/9W`'s address digits (`/9W0201...` with a `0` doubled
+    // writes `$0200`) can land a write on a hook. The upload reads both
+    // hooks back whole, opcodes included, and repairs them: here `$1C` on
+    // HOOK_UNKNOWN's opcode (an NMOS NOP that falls into HOOK_LOOP, so the
+    // loader's frames stop landing) and, through the ROM's commands (no
+    // unknown command goes through the hook before the end), a changed
+    // operand.
+    let image = extension(1024, 16);
+    for path in PATHS {
+        let (times, hits): (&[u64], &[(u16, u8)]) = match path {
+            LoaderChoice::Never => (&[500, 3000, 6000], &[(0x0200, 0x1C), (0x0202, 0x12)]),
+            _ => (&[150, 400, 900], &[(0x0200, 0x1C)]),
+        };
+        for &ms in times {
+            for &(at, value) in hits {
+                let mut transport = robot();
+                transport.at(Duration::from_millis(ms), move |robot| {
+                    robot
+                        .robot_mut()
+                        .board_mut()
+                        .load(at, &[value])
+                        .expect("the hooks are RAM");
+                });
+                let (result, transport) = run(transport, &image, &options(path));
+                let outcome =
+                    format!("{path:?}, ${value:02X} at ${at:04X} after {ms} ms: {result:?}");
+                result.unwrap_or_else(|error| panic!("{outcome}: {error}"));
+                assert_done(transport, &image, &outcome);
+            }
+        }
+        // HOOK_LOOP's `JMP` gone: the ROM's own loop runs into it at once
+        // and stops. Nothing can put that right over the line; the upload
+        // fails and says so.
+        let mut transport = robot();
+        transport.at(Duration::from_millis(times[1]), |robot| {
+            robot
+                .robot_mut()
+                .board_mut()
+                .load(0x0203, &[0x02])
+                .expect("the hooks are RAM");
+        });
+        let (result, _) = run(transport, &image, &options(path));
+        let error = result.expect_err("a robot that stopped");
+        assert!(
+            matches!(
+                error,
+                Error::RobotJammed { .. } | Error::Stalled { .. } | Error::NoAnswer { .. }
+            ),
+            "{path:?}: {error:?}"
+        );
     }
 }

@@ -1,39 +1,38 @@
-//! The RAM loader's 6502 code (`loader/fast.s`, `loader/frames.s`, as the
-//! uploader links them) running on the virtual Scorpion, fed frames by
-//! hand: a good frame lands; a frame whose header is damaged writes
-//! nothing anywhere; a frame that lost a data byte writes nothing outside
-//! its own range; `/1F` toggles the 6551 between 9600 and 19200 baud; and
-//! commands that are not the loader's fall through to the ROM.
+//! The RAM loader's 6502 code (`loader/loader.s`, as the uploader links
+//! it) running on the virtual Scorpion, fed frames by hand: a good frame
+//! lands; a frame whose header is damaged writes nothing anywhere; a frame
+//! that lost a data byte writes nothing outside its own range; `/1F`
+//! toggles the 6551 between 9600 and 19200 baud, through `frames` or with
+//! `rate` hooked alone; every other command is dropped.
 
 mod common;
 
 use common::{CTRL_9600, extension};
 use isa::objfmt::HookKind;
 use romlib::VirtualScorpion;
-use romlib::protocol::{Answer, Command};
+use romlib::protocol::{Answer, BusyByte, Command};
 use uploader::{FAST_BAUD, LoaderPlan, RomProfile, loader_frame, loader_plan};
 
-/// A robot with both stages in RAM and the frame stage hooked, falling
-/// through to the rate switch.
-fn robot_with_loader() -> (VirtualScorpion, LoaderPlan) {
-    let plan = loader_plan(
+/// The loader for a 2 KiB extension at $0400, as an upload at 9600 baud
+/// would place it.
+fn plan() -> LoaderPlan {
+    loader_plan(
         &RomProfile::reference(),
         &extension(2048, 1),
         (9600, FAST_BAUD),
     )
     .expect("links")
-    .expect("room");
+    .expect("room")
+}
+
+/// A robot with the loader in RAM and `frames` hooked.
+fn robot_with_loader() -> (VirtualScorpion, LoaderPlan) {
+    let plan = plan();
     let mut robot = VirtualScorpion::new();
-    let board = robot.robot_mut().board_mut();
-    board
-        .load(plan.fast.address, &plan.fast.bytes)
-        .expect("RAM");
-    board
-        .load(plan.frames.address, &plan.frames.bytes)
-        .expect("RAM");
-    let chain = plan.scratch[plan.scratch.len() - 2];
-    board
-        .load(chain, &plan.fast_handler.to_le_bytes())
+    robot
+        .robot_mut()
+        .board_mut()
+        .load(plan.code.address, &plan.code.bytes)
         .expect("RAM");
     robot
         .install_hook(HookKind::Unknown, plan.frames_handler, None)
@@ -46,14 +45,17 @@ fn send(robot: &mut VirtualScorpion, bytes: &[u8]) {
     robot.settle().expect("the CPU runs");
 }
 
-/// The hooks, user RAM and the KIM-bus RAM, without the loader's own
-/// bytes, as (address, byte).
+/// The hooks, user zero page, user RAM and the KIM-bus RAM, without the
+/// loader's own bytes and state, as (address, byte).
 fn ram(robot: &VirtualScorpion, plan: &LoaderPlan) -> Vec<(usize, u8)> {
     let memory = robot.robot().board().memory();
-    let loader = usize::from(plan.fast.address)..usize::from(plan.frames.address) + 256;
-    (0x0200..0x0206)
+    let code =
+        usize::from(plan.code.address)..usize::from(plan.code.address) + plan.code.bytes.len();
+    let state = usize::from(*plan.zero_page.start())..=usize::from(*plan.zero_page.end());
+    (0x0030..0x0100)
+        .chain(0x0200..0x0206)
         .chain(0x0400..0xC000)
-        .filter(|at| !loader.contains(at))
+        .filter(|at| !code.contains(at) && !state.contains(at))
         .map(|at| (at, memory[at]))
         .collect()
 }
@@ -138,14 +140,22 @@ fn a_frame_that_lost_data_stays_in_its_range() {
 }
 
 #[test]
-fn f_toggles_the_line_and_other_commands_fall_through() {
-    let (mut robot, _) = robot_with_loader();
-    // Not the loader's: dropped as BAD_COMMAND would; the ROM answers on.
-    send(&mut robot, b"/1Q/3Qxyz");
+fn other_commands_are_dropped_and_f_toggles_the_line() {
+    let (mut robot, plan) = robot_with_loader();
+    assert_eq!(plan.rate_handler, plan.code.address, "`rate` comes first");
+    // Not the loader's: dropped as BAD_COMMAND drops them; the ROM answers on.
+    let before = ram(&robot, &plan);
+    send(&mut robot, b"/1Q/3Qxyz/1f/2Gx");
     assert_eq!(
         robot.exchange(&Command::Busy).expect("answers"),
-        Some(Answer::Busy(romlib::protocol::BusyByte(0)))
+        Some(Answer::Busy(BusyByte(0)))
     );
+    assert!(
+        ram(&robot, &plan) == before,
+        "a dropped command wrote something"
+    );
+    assert_eq!(robot.robot().board().acia().control(), CTRL_9600);
+    // /1F, through `frames` into `rate`: 19200 baud, framing kept.
     send(&mut robot, b"/1F");
     assert_eq!(robot.robot().board().acia().control(), 0x1F, "19200 baud");
     robot.robot_mut().set_baud(19200);
@@ -160,9 +170,41 @@ fn f_toggles_the_line_and_other_commands_fall_through() {
 }
 
 #[test]
+fn rate_alone_switches_the_line_and_drops_the_rest() {
+    // How an upload starts: only `rate` is in RAM (15 bytes), hooked.
+    let plan = plan();
+    let rate_len = usize::from(plan.frames_handler - plan.rate_handler);
+    assert_eq!(rate_len, 15);
+    let mut robot = VirtualScorpion::new();
+    robot
+        .robot_mut()
+        .board_mut()
+        .load(plan.code.address, &plan.code.bytes[..rate_len])
+        .expect("RAM");
+    robot
+        .install_hook(HookKind::Unknown, plan.rate_handler, None)
+        .expect("HOOK_UNKNOWN is a JMP");
+    // Two stop bits stay two stop bits: only the baud code changes.
+    send(&mut robot, b"/7WC0139E");
+    send(&mut robot, b"/1L/1Q/1F");
+    assert_eq!(robot.robot().board().acia().control(), 0x9F, "19200 baud");
+    robot.robot_mut().set_baud(19200);
+    assert_eq!(
+        robot.exchange(&Command::Busy).expect("answers at 19200"),
+        Some(Answer::Busy(BusyByte(0)))
+    );
+}
+
+#[test]
 fn the_loader_uses_the_boards_io_addresses() {
-    // fast.s and frames.s name the 6551's control register themselves (the
-    // ROM does not export it): it must be the ROM's.
+    // The uploader links `rate` against the 6551's control register as
+    // the emulator's board map places it: it must be the ROM's.
     let rom = linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("parses");
     assert_eq!(rom.symbol("ACIA_CTRL"), Some(0xC013));
+    let plan = plan();
+    let code = &plan.code.bytes;
+    assert!(
+        code.windows(3).any(|w| w == [0x8D, 0x13, 0xC0]),
+        "`rate` stores to $C013"
+    );
 }

@@ -429,11 +429,22 @@ fn the_rom_profile_comes_from_the_roms_symbols() {
     let rom = linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("parses");
     assert_eq!(
         RomProfile::from_rom_image("scorpion-rom.elf", &rom).expect("a profile"),
-        RomProfile {
-            rx_buffer: uploader::CONSERVATIVE_RX_BUFFER,
-            ..profile.clone()
-        },
-        "everything but the ring's size, which the ROM does not export"
+        profile,
+        "the ring's size included: the ROM exports RXBUF_SIZE"
+    );
+    assert_eq!(profile.rx_buffer, REFERENCE_RX_BUFFER);
+    assert_eq!(
+        usize::from(romlib::symbols::RXBUF_SIZE),
+        REFERENCE_RX_BUFFER + 1
+    );
+    // A ROM that does not say how much it buffers gets the cautious window.
+    let mut quiet = rom.clone();
+    quiet.symbols.retain(|symbol| symbol.name != "RXBUF_SIZE");
+    assert_eq!(
+        RomProfile::from_rom_image("quiet", &quiet)
+            .expect("a profile")
+            .rx_buffer,
+        uploader::CONSERVATIVE_RX_BUFFER
     );
     assert_eq!(
         profile.reset_targets,

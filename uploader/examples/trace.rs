@@ -1,0 +1,192 @@
+//! The timeline of one upload on the virtual Scorpion: every command the
+//! host sends and every burst of answer characters, in device time, then
+//! where the robot-to-host wire sat idle. The benchmark's figure is one
+//! number; this shows where its time goes.
+//!
+//! ```text
+//! cargo run -p uploader --release --example trace            # the loader, 19200 baud
+//! cargo run -p uploader --release --example trace -- 9600    # the loader at 9600 throughout
+//! cargo run -p uploader --release --example trace -- rom     # the ROM's commands only
+//! ```
+//!
+//! The image is the benchmark's: a 2 KiB extension at `$0400`.
+
+#![allow(clippy::print_stdout, reason = "an example prints its timeline")]
+
+use std::time::Duration;
+
+use isa::objfmt::{HookKind, HookRecord};
+use uploader::transport::{VirtualTransport, char_time};
+use uploader::{Area, LoaderChoice, NoProgress, Transport, UploadImage, UploadOptions};
+
+/// One thing that crossed the line.
+enum Entry {
+    /// Bytes the host sent, at the host's rate.
+    Sent(Vec<u8>),
+    /// Bytes that arrived from the robot.
+    Received(usize),
+    /// The host changed its rate.
+    Rate(u32),
+}
+
+/// A transport that records what crosses it, with the time and the rate.
+struct Log<T> {
+    inner: T,
+    entries: Vec<(Duration, u32, Entry)>,
+}
+
+impl<T: Transport> Log<T> {
+    fn note(&mut self, entry: Entry) {
+        let (now, baud) = (self.inner.now(), self.inner.baud());
+        self.entries.push((now, baud, entry));
+    }
+}
+
+impl<T: Transport> Transport for Log<T> {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        self.note(Entry::Sent(bytes.to_vec()));
+        self.inner.send(bytes)
+    }
+    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
+        let count = self.inner.receive(into, timeout)?;
+        if count > 0 {
+            self.note(Entry::Received(count));
+        }
+        Ok(count)
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn set_baud(&mut self, baud: u32) -> uploader::Result<()> {
+        self.inner.set_baud(baud)?;
+        self.note(Entry::Rate(baud));
+        Ok(())
+    }
+    fn now(&self) -> Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        self.inner.clear_input()
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+}
+
+/// The benchmark's image: a chaining `JMP`, a handler that falls
+/// through, then pseudo-random bytes.
+fn image() -> uploader::Result<UploadImage> {
+    let mut bytes: Vec<u8> = (0..2048u32)
+        .map(|i| i.wrapping_mul(2_246_822_519).to_le_bytes()[2])
+        .collect();
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
+    UploadImage::new(
+        vec![Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        }],
+    )
+}
+
+/// A command for the timeline: frames by size, the rest as text.
+fn describe(bytes: &[u8]) -> String {
+    if bytes.starts_with(b"/1L") && bytes.len() > 9 {
+        format!("/1L frame, {} bytes of data", bytes.len() - 9)
+    } else {
+        bytes.escape_ascii().to_string()
+    }
+}
+
+fn main() -> uploader::Result<()> {
+    let (loader, fast_baud) = match std::env::args().nth(1).as_deref() {
+        Some("rom") => (LoaderChoice::Never, None),
+        Some("9600") => (LoaderChoice::Always, None),
+        _ => (LoaderChoice::Always, Some(uploader::FAST_BAUD)),
+    };
+    let options = UploadOptions {
+        loader,
+        fast_baud,
+        ..UploadOptions::default()
+    };
+    let log = Log {
+        inner: VirtualTransport::default(),
+        entries: Vec::new(),
+    };
+    let mut client = uploader::client(log, &options.profile);
+    let report = uploader::upload(&mut client, &image()?, &options, &mut NoProgress)?;
+    let log = client.into_transport();
+
+    // Answer characters arrive in bursts; print each burst once.
+    let mut burst: Option<(Duration, Duration, usize)> = None;
+    let flush = |burst: &mut Option<(Duration, Duration, usize)>| {
+        if let Some((first, last, count)) = burst.take() {
+            println!(
+                "{:9.4}-{:.4}  <- {count} chars",
+                first.as_secs_f64(),
+                last.as_secs_f64()
+            );
+        }
+    };
+    for (at, baud, entry) in &log.entries {
+        match entry {
+            Entry::Received(count) => {
+                burst = Some(match burst {
+                    Some((first, _, total)) => (first, *at, total + count),
+                    None => (*at, *at, *count),
+                });
+            }
+            Entry::Sent(bytes) => {
+                flush(&mut burst);
+                println!("{:9.4}  -> {} @{baud}", at.as_secs_f64(), describe(bytes));
+            }
+            Entry::Rate(baud) => {
+                flush(&mut burst);
+                println!("{:9.4}  host now at {baud} baud", at.as_secs_f64());
+            }
+        }
+    }
+    flush(&mut burst);
+
+    // The return wire's idle spells longer than two characters: the time
+    // the robot spent on something other than answering.
+    let mut previous: Option<Duration> = None;
+    let mut idle = Duration::ZERO;
+    let mut spells = Vec::new();
+    for (at, baud, entry) in &log.entries {
+        let Entry::Received(count) = entry else {
+            continue;
+        };
+        if let Some(previous) = previous {
+            let gap = at.saturating_sub(previous);
+            let busy = char_time(*count, *baud);
+            if gap > busy + char_time(2, *baud) {
+                idle += gap - busy;
+                spells.push((previous, gap - busy));
+            }
+        }
+        previous = Some(*at);
+    }
+    println!();
+    println!("the return wire idle (more than two characters' time):");
+    for (after, length) in &spells {
+        println!(
+            "{:9.4}  {:6.1} ms",
+            after.as_secs_f64(),
+            length.as_secs_f64() * 1000.0
+        );
+    }
+    println!(
+        "device time {:.3} s; {} chars sent, {} received; the return wire idle {:.3} s in {} spells",
+        report.device_time.as_secs_f64(),
+        report.chars_sent,
+        report.chars_received,
+        idle.as_secs_f64(),
+        spells.len()
+    );
+    Ok(())
+}

@@ -1,0 +1,116 @@
+; loader.s: the uploader's RAM loader (see README.md), hooked through
+; HOOK_UNKNOWN while an upload runs, removed when it ends. Two parts,
+; linked as one piece:
+;
+; rate    (15 bytes, first): /1F toggles the 6551 between the base rate
+;         and the fast one (RATE_TOGGLE is the XOR of their baud codes,
+;         so the framing bits stay as the robot has them). Every other
+;         command is dropped, as the ROM's BAD_COMMAND drops it: a command
+;         that line noise made up must not move the rate. The uploader
+;         writes this part alone at the base rate, verifies it, hooks it
+;         and sends /1F, so the rest goes in at the fast rate.
+; frames  (the rest): /1L and a binary frame, written straight to memory;
+;         anything else falls into `rate`, so /1F still brings the line
+;         back at the end.
+;
+; A frame, after /1L:
+;
+;       key  hi^key  lo^key  count^key  c0^key  c1^key  data^key...
+;
+; Every byte but the key is XORed with the key, which the uploader picks
+; so that no byte of the frame is a slash: if the loader is not running
+; (the /1L was damaged, a reset unhooked it), the ROM ignores the whole
+; frame, since outside a command only a slash means anything.
+;
+; The header (address, count) carries a Fletcher-16 checksum: two sums
+; mod 256, both starting at the key; c0 and c1 bring both to zero.
+; Nothing is written unless the header checks, so a damaged header never
+; writes anywhere. The data comes last byte first and is written down
+; from address + count - 1 to address, so damaged or missing data lands
+; only within the frame's own range, where the uploader's /7R
+; verification of every byte finds it. A frame that lost a byte takes the
+; next command's first byte as its last, and the ROM then ignores the rest
+; of that command (it has no slash): the uploader asks again.
+;
+; Assembled twice (build.rs): with RING = 1 the data bytes are taken
+; straight from the ROM's receive ring (RXBUF, RXHEAD, RXTAIL: a 256-byte
+; ring whose indexes wrap by themselves), 25 cycles a byte against about
+; 60 through CHKCH. The ROM cannot answer while a frame is taken in, so
+; that is time the return wire idles. The ring's tail stays in X and is
+; given back when the frame is in: the frame's bytes come before any
+; that follow it, so the ring holds at most the frame meanwhile (up to
+; 128 bytes: it never fills). The uploader links the RING = 1 build when
+; the ROM profile exports the ring.
+;
+; State lives in eight bytes of user zero page that the image does not
+; load (LZP, chosen by the uploader): no operand is rewritten, so every
+; byte of the loader reads back as it was verified.
+
+        .import GETCH, CMD_DONE, ACIA_CTRL, RATE_TOGGLE
+        .importzp LZP
+.if RING
+        .import RXBUF
+        .importzp RXHEAD, RXTAIL
+.else
+        .import CHKCH
+.endif
+
+KEY     = LZP                   ; the frame's key
+SUM0    = LZP + 1               ; the Fletcher sums of the header
+SUM1    = LZP + 2
+HEAD    = LZP + 3               ; the header, last byte first: c1 c0 count lo hi
+COUNT   = HEAD + 2
+DEST    = HEAD + 3              ; lo, hi: the frame's first address
+
+        .export __scorpion_hook_unknown, rate, frames
+        .segment "CODE"
+
+rate:   cmp #'F'
+        bne drop
+        lda ACIA_CTRL           ; the 6551 is idle: the uploader waited for every answer
+        eor #RATE_TOGGLE
+        sta ACIA_CTRL
+drop:   jmp CMD_DONE
+
+__scorpion_hook_unknown:
+frames: cmp #'L'
+        bne rate
+        jsr GETCH               ; the key
+        sta KEY
+        sta SUM0
+        sta SUM1
+        ldx #4
+head:   jsr GETCH
+        eor KEY
+        sta HEAD,x
+        clc
+        adc SUM0
+        sta SUM0
+        clc
+        adc SUM1
+        sta SUM1
+        dex
+        bpl head
+        ora SUM0                ; A = SUM1
+        bne drop                ; a damaged header: nothing is written
+        ldy COUNT
+.if RING
+        ldx RXTAIL              ; the ring's tail in X until the frame is in
+data:   cpx RXHEAD
+        beq data                ; not here yet
+        lda RXBUF,x
+        inx
+        eor KEY
+        dey
+        sta (DEST),y
+        bne data
+        stx RXTAIL
+.else
+data:   jsr CHKCH               ; the bytes are usually in the ring already
+        bcs data
+        eor KEY
+        dey
+        sta (DEST),y
+        bne data
+.endif
+        beq drop
