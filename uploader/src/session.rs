@@ -330,6 +330,22 @@ impl Session {
         })
     }
 
+    /// Takes the loader out after an upload failed on a line that still
+    /// works (a byte that would not hold, say): the line back on the base
+    /// rate, `HOOK_UNKNOWN` back on its target before the upload. A failed
+    /// upload then leaves the robot answering where the user expects it,
+    /// with nothing of this upload hooked.
+    pub(crate) fn remove<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        progress: &mut dyn Progress,
+    ) -> Result<()> {
+        self.back_to_base(client, true, progress)?;
+        switch_hook(client, self.hook, self.original, self.limits.max_writes)?;
+        progress.event(&Event::LoaderRemoved);
+        Ok(())
+    }
+
     /// Finds the robot after an error a reset explains, and leaves the
     /// host at its rate.
     pub(crate) fn find<T: Transport>(&mut self, client: &mut Client<T>) -> Result<u32> {

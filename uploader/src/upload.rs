@@ -352,9 +352,15 @@ pub fn upload<T: Transport>(
         match result {
             Ok(installed) => hooks = installed,
             Err(error) => {
-                // The host goes back to the rate it was given; the robot may
-                // be left at the fast rate with the (verified) loader hooked,
-                // which the next upload's `connect` undoes.
+                // Where the line still works, the loader goes (best effort:
+                // the error that stopped the upload is the one to report).
+                // On a dead line the robot may be left at the fast rate with
+                // the (verified) loader hooked, which the next upload's
+                // `connect` undoes; the host goes back to the rate it was
+                // given either way.
+                if line_works(&error) {
+                    let _ = running.remove(client, progress);
+                }
                 let _ = client.transport().set_baud(base);
                 return Err(error);
             }
@@ -387,6 +393,21 @@ pub fn upload<T: Transport>(
             }
         }),
     })
+}
+
+/// Whether the robot still answers after `error`: worth asking it to take
+/// the loader out.
+fn line_works(error: &Error) -> bool {
+    !recoverable(error)
+        && !matches!(
+            error,
+            Error::RobotJammed { .. }
+                | Error::Io { .. }
+                | Error::Port { .. }
+                | Error::PortBusy { .. }
+                | Error::PortNotFound { .. }
+                | Error::BaudChange { .. }
+        )
 }
 
 /// A hook's target when the upload began (after any disarming).

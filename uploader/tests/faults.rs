@@ -234,3 +234,142 @@ fn a_write_gone_astray_onto_a_hook_is_put_right() {
         );
     }
 }
+
+/// A KIM-bus RAM card with one cell that holds `stuck` whatever is written
+/// to it (a failed chip): it counts the writes that cell takes.
+#[derive(Debug)]
+struct CardWithABadCell {
+    bytes: Vec<u8>,
+    bad: u16,
+    stuck: u8,
+    writes_to_bad: u32,
+}
+
+impl emulator::board::Device for CardWithABadCell {
+    fn read(&mut self, offset: u16, _cycle: u64) -> u8 {
+        self.peek(offset)
+    }
+    fn write(&mut self, offset: u16, value: u8, _cycle: u64) {
+        if offset == self.bad {
+            self.writes_to_bad += 1;
+        } else {
+            self.bytes[usize::from(offset)] = value;
+        }
+    }
+    fn peek(&self, offset: u16) -> u8 {
+        if offset == self.bad {
+            self.stuck
+        } else {
+            self.bytes[usize::from(offset)]
+        }
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
+}
+
+#[test]
+fn a_byte_that_will_not_hold_fails_naming_it_and_hooks_nothing() {
+    // The extension at $0400 hooks HOOK_UNKNOWN; its table at $2000 lies on
+    // a card whose cell $2037 reads $5A whatever is written. The upload
+    // rewrites that byte a bounded number of times, then fails naming the
+    // address, the byte it wanted and the byte it found; the hook stays on
+    // the ROM and the RAM loader, when it carried the body, is taken out.
+    let extension = extension(512, 21);
+    let table: Vec<u8> = (0..64u8).map(|i| i.wrapping_mul(3)).collect();
+    let image = uploader::UploadImage::new(
+        vec![
+            extension.areas()[0].clone(),
+            uploader::Area {
+                address: 0x2000,
+                bytes: table.clone(),
+            },
+        ],
+        extension.hooks().to_vec(),
+    )
+    .expect("a valid image");
+    for path in PATHS {
+        let mut transport = robot();
+        let slot = transport
+            .robot_mut()
+            .robot_mut()
+            .board_mut()
+            .map_kim(
+                0x2000,
+                0x20FF,
+                Box::new(CardWithABadCell {
+                    bytes: vec![0; 256],
+                    bad: 0x37,
+                    stuck: 0x5A,
+                    writes_to_bad: 0,
+                }),
+            )
+            .expect("free KIM-bus space");
+        let options = options(path);
+        let (result, transport) = run(transport, &image, &options);
+        let outcome = format!("{path:?}: {result:?}");
+        let error = result.expect_err("a byte that never verifies");
+        let Error::VerifyFailed {
+            address,
+            expected,
+            found,
+            attempts,
+        } = error
+        else {
+            panic!("not a verification failure ({outcome})");
+        };
+        assert_eq!(
+            (address, expected, found),
+            (0x2037, table[0x37], 0x5A),
+            "{outcome}"
+        );
+        assert!(
+            (1..=options.max_writes).contains(&attempts),
+            "{attempts} writes ({outcome})"
+        );
+        let message = error.to_string();
+        for part in ["$2037", &format!("${:02X}", table[0x37]), "$5A"] {
+            assert!(message.contains(part), "`{part}` missing from: {message}");
+        }
+        let card: &CardWithABadCell = transport
+            .robot()
+            .robot()
+            .board()
+            .kim_device(slot)
+            .expect("the card");
+        assert!(
+            (1..=options.max_writes).contains(&card.writes_to_bad),
+            "the bad cell took {} writes ({outcome})",
+            card.writes_to_bad
+        );
+        assert_eq!(
+            card.bytes[..0x37],
+            table[..0x37],
+            "the rest of the table verified ({outcome})"
+        );
+        let memory = transport.robot().robot().board().memory();
+        let hook = u16::from_le_bytes([
+            memory[usize::from(romlib::symbols::HOOK_UNKNOWN) + 1],
+            memory[usize::from(romlib::symbols::HOOK_UNKNOWN) + 2],
+        ]);
+        assert_eq!(
+            hook,
+            romlib::symbols::BAD_COMMAND,
+            "HOOK_UNKNOWN left on the ROM ({outcome})"
+        );
+        assert_safe(transport.robot(), &image, &outcome);
+        // The loader, if it ran, is gone: the robot answers at 9600 again.
+        assert_eq!(
+            transport.robot().robot().board().acia().control(),
+            common::CTRL_9600,
+            "the 6551 is back at 9600 ({outcome})"
+        );
+        let mut client = uploader::client(transport, &options.profile);
+        client
+            .probe()
+            .unwrap_or_else(|error| panic!("the robot answers at 9600 ({outcome}): {error}"));
+    }
+}
