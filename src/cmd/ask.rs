@@ -21,12 +21,8 @@ use crate::cmd::{ports, sim};
 /// in this process.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// The serial port the robot is on, or `emu` for the virtual Scorpion.
-    #[arg(long)]
-    port: String,
-    /// The line's baud rate.
-    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
-    baud: u32,
+    #[command(flatten)]
+    line: ports::Line,
     /// Print each answer field by field.
     #[arg(long)]
     decode: bool,
@@ -97,8 +93,8 @@ impl Robot {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let mut robot = if args.port == "emu" {
-        Robot::Virtual(Box::new(sim::robot(args.baud, None, &args.images)?))
+    let mut robot = if args.line.is_emulated() {
+        Robot::Virtual(Box::new(sim::robot(args.line.baud, None, &args.images)?))
     } else {
         if !args.images.is_empty() {
             miette::bail!(
@@ -106,7 +102,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 "--image loads images into the virtual Scorpion only (--port emu)"
             );
         }
-        let transport = ports::open(&args.port, args.baud)?;
+        let transport = args.line.open()?;
         Robot::Serial(Client::new(transport, ClientConfig::default()))
     };
     let timeout = Duration::from_millis(args.timeout);

@@ -30,6 +30,30 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The line to a robot, for every command that talks to one.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Line {
+    /// The serial port the robot is on (`scorpion ports` lists them), or
+    /// `emu` for the virtual Scorpion in this process.
+    #[arg(long)]
+    pub(crate) port: String,
+    /// The line's baud rate (the robot's).
+    #[arg(long, default_value_t = DEFAULT_BAUD)]
+    pub(crate) baud: u32,
+}
+
+impl Line {
+    /// Whether `--port` names the virtual Scorpion in this process.
+    pub(crate) fn is_emulated(&self) -> bool {
+        self.port == EMU
+    }
+
+    /// Opens the line: see [`open`].
+    pub(crate) fn open(&self) -> miette::Result<Box<dyn Transport>> {
+        open(&self.port, self.baud)
+    }
+}
+
 /// The default baud rate: the reference ROM's (PLATFORM.md section 3).
 pub(crate) const DEFAULT_BAUD: u32 = 9600;
 

@@ -13,13 +13,8 @@ use crate::cmd::ports;
 /// answers agree) and print it as hex, or write it raw to a file.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// The serial port the robot is on, or `emu` for a fresh virtual
-    /// Scorpion in this process.
-    #[arg(long)]
-    port: String,
-    /// The line's baud rate.
-    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
-    baud: u32,
+    #[command(flatten)]
+    line: ports::Line,
     /// The first address: `0x0400`, `$0400` or `1024`.
     #[arg(value_parser = args::address)]
     address: u16,
@@ -39,7 +34,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             args.address
         );
     }
-    let transport = ports::open(&args.port, args.baud)?;
+    let transport = args.line.open()?;
     let mut client = uploader::client(transport, &uploader::RomProfile::reference());
     client.probe()?;
     let bytes = client.read_memory(args.address, args.length as usize)?;

@@ -33,13 +33,8 @@ use crate::cmd::ports;
 pub(crate) struct Args {
     /// The linked ELF image.
     image: PathBuf,
-    /// The serial port the robot is on, or `emu` for the virtual Scorpion in
-    /// this process.
-    #[arg(long)]
-    port: String,
-    /// The line's baud rate (the robot's).
-    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
-    baud: u32,
+    #[command(flatten)]
+    line: ports::Line,
     /// Commands and the answers they must produce (`/1Q => QHELLO`, one a
     /// line, `#` comments): checked on the rehearsal, and with `--port emu`
     /// again after the upload.
@@ -246,14 +241,14 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let options = args.options();
     let profile = &options.profile;
     profile.check(&image)?;
-    let emulated = args.port == ports::EMU;
+    let emulated = args.line.is_emulated();
     let mut out = String::new();
 
     // The rehearsal: the same upload into a virtual Scorpion, then the
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let robot = ports::virtual_robot(args.baud)?;
+        let robot = ports::virtual_robot(args.line.baud)?;
         let mut client = args.client(VirtualTransport::new(robot), profile);
         let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
             "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot",
@@ -283,7 +278,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         out.clear();
     }
 
-    let transport = ports::open(&args.port, args.baud)?;
+    let transport = args.line.open()?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
     let result = uploader::upload(&mut client, &image, &options, &mut bar);
