@@ -16,38 +16,21 @@
 
 use std::time::{Duration, Instant};
 
-use isa::objfmt::{HookKind, HookRecord};
 use uploader::transport::{VirtualTransport, char_time};
-use uploader::{Area, LoaderChoice, NoProgress, UploadImage, UploadOptions, UploadReport};
+use uploader::{LoaderChoice, NoProgress, UploadOptions, UploadReport};
+
+#[path = "../tests/common/image.rs"]
+mod image;
+
+use image::extension;
 
 const BYTES: usize = 2048;
 const BAUD: u32 = 9600;
 
-/// A 2 KiB extension at $0400: a chaining `JMP`, a handler that falls
-/// through, then pseudo-random bytes (incompressible, every value present).
-fn image() -> UploadImage {
-    let mut bytes: Vec<u8> = (0..BYTES as u32)
-        .map(|i| i.wrapping_mul(2_246_822_519).to_le_bytes()[2])
-        .collect();
-    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
-    UploadImage::new(
-        vec![Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        }],
-    )
-    .unwrap_or_else(|error| panic!("the benchmark image: {error}"))
-}
-
 fn upload(options: &UploadOptions) -> (UploadReport, Duration) {
     let started = Instant::now();
     let mut client = uploader::client(VirtualTransport::default(), &options.profile);
-    let report = uploader::upload(&mut client, &image(), options, &mut NoProgress)
+    let report = uploader::upload(&mut client, &extension(BYTES, 0), options, &mut NoProgress)
         .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
     (report, started.elapsed())
 }

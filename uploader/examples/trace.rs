@@ -9,15 +9,20 @@
 //! cargo run -p uploader --release --example trace -- rom     # the ROM's commands only
 //! ```
 //!
-//! The image is the benchmark's: a 2 KiB extension at `$0400`.
+//! The image is the benchmark's: a 2 KiB extension at `$0400`
+//! (`tests/common/image.rs`).
 
 #![allow(clippy::print_stdout, reason = "an example prints its timeline")]
 
 use std::time::Duration;
 
-use isa::objfmt::{HookKind, HookRecord};
 use uploader::transport::{VirtualTransport, char_time};
-use uploader::{Area, LoaderChoice, NoProgress, Transport, UploadImage, UploadOptions};
+use uploader::{LoaderChoice, NoProgress, Transport, UploadOptions};
+
+#[path = "../tests/common/image.rs"]
+mod image;
+
+use image::extension;
 
 /// One thing that crossed the line.
 enum Entry {
@@ -73,26 +78,6 @@ impl<T: Transport> Transport for Log<T> {
     }
 }
 
-/// The benchmark's image: a chaining `JMP`, a handler that falls
-/// through, then pseudo-random bytes.
-fn image() -> uploader::Result<UploadImage> {
-    let mut bytes: Vec<u8> = (0..2048u32)
-        .map(|i| i.wrapping_mul(2_246_822_519).to_le_bytes()[2])
-        .collect();
-    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
-    UploadImage::new(
-        vec![Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        }],
-    )
-}
-
 /// A command for the timeline: frames by size, the rest as text.
 fn describe(bytes: &[u8]) -> String {
     if bytes.starts_with(b"/1L") && bytes.len() > 9 {
@@ -118,7 +103,7 @@ fn main() -> uploader::Result<()> {
         entries: Vec::new(),
     };
     let mut client = uploader::client(log, &options.profile);
-    let report = uploader::upload(&mut client, &image()?, &options, &mut NoProgress)?;
+    let report = uploader::upload(&mut client, &extension(2048, 0), &options, &mut NoProgress)?;
     let log = client.into_transport();
 
     // Answer characters arrive in bursts; print each burst once.

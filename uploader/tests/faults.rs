@@ -11,7 +11,8 @@ mod common;
 
 use std::time::Duration;
 
-use common::{assert_done, assert_safe, extension, options, robot, run};
+use common::{assert_at_9600, assert_done, assert_safe, extension, options, robot, run, target};
+use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
 use uploader::transport::{FaultConfig, FaultyTransport, VirtualTransport};
 use uploader::{Error, LoaderChoice};
 
@@ -351,25 +352,13 @@ fn a_byte_that_will_not_hold_fails_naming_it_and_hooks_nothing() {
             "the rest of the table verified ({outcome})"
         );
         let memory = transport.robot().robot().board().memory();
-        let hook = u16::from_le_bytes([
-            memory[usize::from(romlib::symbols::HOOK_UNKNOWN) + 1],
-            memory[usize::from(romlib::symbols::HOOK_UNKNOWN) + 2],
-        ]);
         assert_eq!(
-            hook,
-            romlib::symbols::BAD_COMMAND,
+            target(memory, HOOK_UNKNOWN),
+            (0x4C, BAD_COMMAND),
             "HOOK_UNKNOWN left on the ROM ({outcome})"
         );
         assert_safe(transport.robot(), &image, &outcome);
         // The loader, if it ran, is gone: the robot answers at 9600 again.
-        assert_eq!(
-            transport.robot().robot().board().acia().control(),
-            common::CTRL_9600,
-            "the 6551 is back at 9600 ({outcome})"
-        );
-        let mut client = uploader::client(transport, &options.profile);
-        client
-            .probe()
-            .unwrap_or_else(|error| panic!("the robot answers at 9600 ({outcome}): {error}"));
+        assert_at_9600(transport, &outcome);
     }
 }

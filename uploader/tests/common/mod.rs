@@ -3,39 +3,20 @@
 //! case checks in the emulated RAM afterwards.
 #![allow(dead_code, unreachable_pub, reason = "each test file uses a part")]
 
-use isa::objfmt::{HookKind, HookRecord};
+mod image;
+
+pub(crate) use image::extension;
+
 use romlib::VirtualScorpion;
 use romlib::symbols::{BAD_COMMAND, HOOK_LOOP, HOOK_UNKNOWN, ROM_LOOP};
 use uploader::transport::{Transport, VirtualTransport};
 use uploader::{
-    Area, LoaderChoice, LoaderPlan, NoProgress, RomProfile, UploadImage, UploadOptions,
-    UploadReport, loader_plan, upload,
+    LoaderChoice, LoaderPlan, NoProgress, RomProfile, UploadImage, UploadOptions, UploadReport,
+    loader_plan, upload,
 };
 
 /// The 8N1 control value for 9600 baud (emulator::board::acia).
 pub const CTRL_9600: u8 = 0x1E;
-
-/// An extension of `len` bytes at $0400 that is real code: `$0400: JMP
-/// chain` (the chain slot is its operand, $0401), `$0403: JMP $0400` (the
-/// handler owns nothing and falls through), then pseudo-random bytes.
-pub fn extension(len: usize, seed: u32) -> UploadImage {
-    let mut bytes: Vec<u8> = (0..len as u32)
-        .map(|i| (i ^ seed).wrapping_mul(2_246_822_519).to_le_bytes()[2])
-        .collect();
-    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
-    UploadImage::new(
-        vec![Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        }],
-    )
-    .expect("a valid image")
-}
 
 /// Options for one of the two paths.
 pub fn options(loader: LoaderChoice) -> UploadOptions {
@@ -61,7 +42,8 @@ pub fn robot() -> VirtualTransport {
     VirtualTransport::new(VirtualScorpion::new())
 }
 
-fn target(memory: &[u8], hook: u16) -> (u8, u16) {
+/// The opcode at `hook` and its operand.
+pub fn target(memory: &[u8], hook: u16) -> (u8, u16) {
     let at = usize::from(hook);
     (
         memory[at],
@@ -131,9 +113,10 @@ pub fn assert_safe(robot: &VirtualScorpion, image: &UploadImage, outcome: &str) 
     );
 }
 
-/// After a successful upload: the image hooked, the 6551 back at 9600
-/// baud, and the robot answering there.
-pub fn assert_done(transport: VirtualTransport, image: &UploadImage, outcome: &str) {
+/// The host and the robot's 6551 both at 9600 baud, and the robot
+/// answering there: how every upload, done or failed on a working line,
+/// leaves them.
+pub fn assert_at_9600(transport: VirtualTransport, outcome: &str) -> VirtualScorpion {
     let mut client = uploader::client(transport, &RomProfile::reference());
     assert_eq!(client.transport().baud(), 9600, "{outcome}");
     client
@@ -145,6 +128,13 @@ pub fn assert_done(transport: VirtualTransport, image: &UploadImage, outcome: &s
         CTRL_9600,
         "the 6551 is back at 9600 ({outcome})"
     );
+    robot
+}
+
+/// After a successful upload: the image hooked, the 6551 back at 9600
+/// baud, and the robot answering there.
+pub fn assert_done(transport: VirtualTransport, image: &UploadImage, outcome: &str) {
+    let robot = assert_at_9600(transport, outcome);
     let memory = robot.robot().board().memory();
     assert_eq!(target(memory, HOOK_UNKNOWN), (0x4C, 0x0403), "{outcome}");
     assert_safe(&robot, image, outcome);
