@@ -155,6 +155,9 @@ pub(crate) struct Asm<'a> {
     pub(crate) messages: Vec<String>,
     lines_read: u64,
     pub(crate) stop: bool,
+    /// A missing include ended the assembly: the back end does not run
+    /// on the part that was read, whose errors would only repeat it.
+    pub(crate) fatal: bool,
     pub(crate) keep_nodes: bool,
     expansions: u32,
     pub(crate) total_bytes: usize,
@@ -215,6 +218,7 @@ impl<'a> Asm<'a> {
             messages: Vec::new(),
             lines_read: 0,
             stop: false,
+            fatal: false,
             keep_nodes: false,
             expansions: 0,
             total_bytes: 0,
@@ -579,11 +583,46 @@ impl<'a> Asm<'a> {
         s.def_file = self.line.file;
         s.def_line = self.line.line;
         s.def_column = column;
+        s.def_ctx = self.line_ctx;
         if let SymDef::Label { chunk, .. } = def {
             let seg = self.prog.chunks[chunk as usize].seg;
             self.prog.segs[seg as usize].used = true;
         }
         Ok(())
+    }
+
+    /// Refuses a name ca65 reserves where a symbol, scope or macro is
+    /// declared: the registers `a`, `x`, `y` everywhere, and the
+    /// instructions (the undocumented ones only under `.setcpu "6502X"`)
+    /// where the name starts a statement or names a macro, since ca65 reads
+    /// `adc:` and `.define adc 5` as the instruction. A typo of this kind
+    /// would otherwise assemble quietly to other bytes than ca65's.
+    pub(crate) fn reserved_name(&mut self, tok: &Token, instructions_too: bool) -> PResult<()> {
+        if tok.kind != Tok::Ident {
+            return Ok(());
+        }
+        let what = match self.names.keyword(tok.name()) {
+            Keyword::RegA | Keyword::RegX | Keyword::RegY => "a register",
+            Keyword::Mnemonic(mnemonic)
+                if instructions_too && (mnemonic.is_documented() || self.cpu_x) =>
+            {
+                "an instruction"
+            }
+            _ => return Ok(()),
+        };
+        let name = self.names.name(tok.name()).to_string();
+        Err(self.report(
+            diag::error(
+                "asm::reserved-name",
+                tok.span,
+                format!("`{name}` is {what} and cannot be used as a name here"),
+            )
+            .label("reserved")
+            .help(format!(
+                "ca65 refuses it too; choose another name, such as `{}_`",
+                name.to_ascii_lowercase()
+            )),
+        ))
     }
 
     /// A label at the current position: `name:`.
@@ -678,23 +717,52 @@ impl<'a> Asm<'a> {
 
     // ----- input -------------------------------------------------------
 
-    /// Reads a file through the source, for the main file, `.include` and
-    /// `.incbin`, following the search order.
-    pub(crate) fn find_file(&self, name: &str, from_dir: &Path) -> Option<(PathBuf, Vec<u8>)> {
-        let path = Path::new(name);
-        let mut candidates: Vec<PathBuf> = Vec::new();
-        if path.is_absolute() {
-            candidates.push(path.to_path_buf());
-        } else {
-            candidates.push(from_dir.join(path));
-            for dir in &self.opts.include_dirs {
-                candidates.push(dir.join(path));
-            }
+    /// The places `.include` (`binary` false) or `.incbin` (`binary` true)
+    /// looks for a relative `name`, in ca65's order: an include next to the
+    /// including file, then in each `-I` directory; a binary file first as
+    /// the name stands (the working directory), then next to the including
+    /// file, then in each `--bin-include-dir` directory. Built-in includes
+    /// come after all of these.
+    pub(crate) fn search_path(&self, binary: bool, from_dir: &Path) -> Vec<PathBuf> {
+        let mut dirs = Vec::new();
+        if binary {
+            dirs.push(PathBuf::new());
         }
+        dirs.push(from_dir.to_path_buf());
+        let extra = if binary {
+            &self.opts.bin_include_dirs
+        } else {
+            &self.opts.include_dirs
+        };
+        dirs.extend(extra.iter().cloned());
+        dirs.dedup();
+        dirs
+    }
+
+    /// Reads a file through the source for `.include` or `.incbin`,
+    /// following [`Asm::search_path`].
+    pub(crate) fn find_file(
+        &self,
+        name: &str,
+        binary: bool,
+        from_dir: &Path,
+    ) -> Option<(PathBuf, Vec<u8>)> {
+        let path = Path::new(name);
+        let candidates = if path.is_absolute() {
+            vec![path.to_path_buf()]
+        } else {
+            self.search_path(binary, from_dir)
+                .into_iter()
+                .map(|dir| dir.join(path))
+                .collect()
+        };
         for candidate in candidates {
             if let Ok(bytes) = self.source.read(&candidate) {
                 return Some((candidate, bytes));
             }
+        }
+        if binary {
+            return None;
         }
         self.opts
             .builtin_includes
@@ -1128,6 +1196,14 @@ impl<'a> Asm<'a> {
         }
         let mut p = 0;
         // Labels and assignments.
+        if matches!(
+            t.get(1).map(|t| t.kind),
+            Some(Tok::Eq | Tok::Assign | Tok::Colon | Tok::Directive)
+        ) && (t[1].kind != Tok::Directive
+            || self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set))
+        {
+            self.reserved_name(&t[0], true)?;
+        }
         match (t[0].kind, t.get(1).map(|t| t.kind)) {
             (Tok::Ident | Tok::Local, Some(Tok::Eq)) => {
                 return self.assignment(t);
@@ -1141,11 +1217,7 @@ impl<'a> Asm<'a> {
                 return self.set_variable(t);
             }
             (Tok::Ident | Tok::Local, Some(Tok::Colon)) => {
-                if t[0].kind == Tok::Ident
-                    && self.names.info[t[0].value as usize].macro_id.is_some()
-                {
-                    // `name:` is still a label even if a macro has the name.
-                }
+                // `name:` is a label even where a macro has the name.
                 self.define_label(&t[0])?;
                 p = 2;
             }
@@ -1181,7 +1253,14 @@ impl<'a> Asm<'a> {
                             }
                             _ => false,
                         };
-                        let help = label_like.then(|| format!("a label needs a colon: `{name}:`"));
+                        let suggestion = self.similar_statement_head(&name);
+                        let help = match suggestion {
+                            Some(similar) if label_like => Some(format!(
+                                "did you mean `{similar}`? (a label needs a colon: `{name}:`)"
+                            )),
+                            Some(similar) => Some(format!("did you mean `{similar}`?")),
+                            None => label_like.then(|| format!("a label needs a colon: `{name}:`")),
+                        };
                         let mut diag = diag::error(
                             "asm::unknown",
                             head.span,
@@ -1197,11 +1276,19 @@ impl<'a> Asm<'a> {
             Tok::Directive => {
                 let Keyword::Directive(dir) = self.names.keyword(head.name()) else {
                     let name = self.names.name(head.name()).to_string();
-                    return Err(self.err(
+                    let mut diag = diag::error(
                         "asm::unknown-directive",
                         head.span,
                         format!("`{name}` is not a directive this assembler knows"),
-                    ));
+                    );
+                    let written = name.trim_start_matches('.');
+                    if let Some(similar) = diag::did_you_mean(
+                        &written.to_ascii_lowercase(),
+                        crate::intern::DIRECTIVE_NAMES.iter().copied(),
+                    ) {
+                        diag = diag.help(format!("did you mean `.{similar}`?"));
+                    }
+                    return Err(self.report(diag));
                 };
                 self.directive(dir, t, p)
             }
@@ -1211,6 +1298,28 @@ impl<'a> Asm<'a> {
                 "expected a label, an instruction, a directive or a macro here",
             )),
         }
+    }
+
+    /// An instruction or macro whose name is near `name`, for the error on
+    /// a statement that starts with an unknown name.
+    fn similar_statement_head(&self, name: &str) -> Option<String> {
+        let lower = name.to_ascii_lowercase();
+        let mnemonics = isa::Mnemonic::ALL
+            .iter()
+            .filter(|m| m.is_documented() || self.cpu_x)
+            .map(|m| m.name().to_ascii_lowercase());
+        let macros = self
+            .macros
+            .iter()
+            .map(|m| self.names.name(m.name).to_string());
+        let candidates: Vec<String> = mnemonics.chain(macros).collect();
+        diag::did_you_mean(&lower, candidates.iter().map(String::as_str)).map(|similar| {
+            if similar.len() == 3 && name.chars().all(|c| c.is_ascii_uppercase()) {
+                similar.to_ascii_uppercase()
+            } else {
+                similar.to_string()
+            }
+        })
     }
 
     /// `name = expr` and `name := expr`.

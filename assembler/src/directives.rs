@@ -553,6 +553,7 @@ impl Asm<'_> {
             if assignment.is_some() {
                 return Err(self.err("asm::syntax", tok.span, "an import has no value here"));
             }
+            self.reserved_name(&tok, false)?;
             let sym = self.sym_in(self.scope, tok.name());
             match self.prog.syms[sym as usize].def {
                 SymDef::Undefined => {
@@ -610,6 +611,7 @@ impl Asm<'_> {
             let _ = self.collect_body(Dir::Macro, Dir::Endmacro, &[], head.span);
             return Err(self.err("asm::syntax", span, "expected the macro's name"));
         };
+        let reserved = self.reserved_name(&name, true);
         let mut params: Vec<NameId> = Vec::new();
         let mut i = p + 2;
         let mut bad = None;
@@ -624,6 +626,10 @@ impl Asm<'_> {
             i += 1;
         }
         let body = self.collect_body(Dir::Macro, Dir::Endmacro, &params, head.span);
+        reserved?;
+        for param in t[p + 2..].iter().filter(|tok| tok.kind == Tok::Ident) {
+            self.reserved_name(param, false)?;
+        }
         if let Some(span) = bad {
             return Err(self.err(
                 "asm::syntax",
@@ -766,6 +772,7 @@ impl Asm<'_> {
             let span = self.span_at(t, p + 1);
             return Err(self.err("asm::syntax", span, "expected the name to define"));
         };
+        self.reserved_name(&name, true)?;
         let mut i = p + 2;
         let mut params = Vec::new();
         let mut has_params = false;
@@ -848,6 +855,10 @@ impl Asm<'_> {
         let head = t[p];
         let name = t.get(p + 1).filter(|t| t.kind == Tok::Ident).copied();
         self.expect_end(t, p + if name.is_some() { 2 } else { 1 })?;
+        if let Some(name) = name {
+            // Reported; the members are still read up to the end.
+            let _ = self.reserved_name(&name, false);
+        }
         let (closer, kind) = if union {
             (Dir::Endunion, ScopeKind::Union)
         } else {
@@ -1014,6 +1025,7 @@ impl Asm<'_> {
         };
         self.expect_end(t, i)?;
         if let Some(name) = name {
+            self.reserved_name(&name, false)?;
             let sym = self.sym_in(scope, name.name());
             let value = if union { 0 } else { offset };
             self.define(sym, SymDef::Const(value), name.span)?;
@@ -1025,6 +1037,10 @@ impl Asm<'_> {
         let head = t[p];
         let name = t.get(p + 1).filter(|t| t.kind == Tok::Ident).copied();
         self.expect_end(t, p + if name.is_some() { 2 } else { 1 })?;
+        if let Some(name) = name {
+            // Reported; the members are still read up to the end.
+            let _ = self.reserved_name(&name, false);
+        }
         let scope = match name {
             Some(name) => self.child_scope_or_new(self.scope, name.name(), ScopeKind::Enum),
             None => self.scope,
@@ -1073,6 +1089,7 @@ impl Asm<'_> {
             value = self.const_expr(t, &mut i, "an `.enum` value")?;
         }
         self.expect_end(t, i)?;
+        self.reserved_name(&first, false)?;
         let sym = self.sym_in(scope, first.name());
         self.define(sym, SymDef::Const(value), first.span)?;
         Ok(Some(value))
@@ -1164,6 +1181,10 @@ impl Asm<'_> {
         let name_tok = t.get(p + 1).filter(|t| t.kind == Tok::Ident).copied();
         let end = p + if name_tok.is_some() { 2 } else { 1 };
         self.expect_end(t, end)?;
+        if let Some(tok) = name_tok {
+            // Reported; the scope still opens, so its end matches.
+            let _ = self.reserved_name(&tok, false);
+        }
         let name = match name_tok {
             Some(tok) => tok.name(),
             None if proc_ => {
@@ -1242,21 +1263,58 @@ impl Asm<'_> {
         Ok((tok, name))
     }
 
-    fn not_found(&mut self, tok: Token, name: &str) -> crate::asm::Reported {
-        let mut places = vec!["next to the including file".to_string()];
-        places.extend(
-            self.opts
-                .include_dirs
-                .iter()
-                .map(|dir| format!("`{}`", dir.display())),
-        );
+    /// A file `.include` or `.incbin` cannot find: the error names every
+    /// place searched, in order. A missing include ends the assembly, as
+    /// in ca65: what follows it depends on it, and every error there would
+    /// only repeat this one.
+    fn not_found(&mut self, tok: Token, name: &str, binary: bool) -> crate::asm::Reported {
+        let including = self.current_dir();
+        let mut places: Vec<String> = self
+            .search_path(binary, &including)
+            .iter()
+            .map(|dir| {
+                let shown = match dir.as_os_str().is_empty() {
+                    true => "`.`".to_string(),
+                    false => format!("`{}`", dir.display()),
+                };
+                let role = if *dir == including {
+                    " (the including file's directory)"
+                } else if dir.as_os_str().is_empty() {
+                    " (the working directory)"
+                } else if binary {
+                    " (--bin-include-dir)"
+                } else {
+                    " (-I)"
+                };
+                format!("{shown}{role}")
+            })
+            .collect();
+        let mut help_tail = String::new();
+        if !binary {
+            let builtin: Vec<&str> = self
+                .opts
+                .builtin_includes
+                .keys()
+                .map(String::as_str)
+                .collect();
+            if !builtin.is_empty() {
+                places.push(format!("the built-in `{}`", builtin.join("`, `")));
+            }
+            if let Some(close) = diag::did_you_mean(name, builtin.iter().copied()) {
+                help_tail = format!("; did you mean `{close}`?");
+            }
+            self.fatal = true;
+            self.stop = true;
+        }
+        let option = if binary { "--bin-include-dir" } else { "-I" };
         let diag = diag::error(
             "asm::file-not-found",
             tok.span,
             format!("cannot find `{name}`"),
         )
+        .label("not found")
         .help(format!(
-            "searched {}, and the built-in files; add a directory with `-I DIR`",
+            "searched {}{help_tail}\nadd a directory to search with `{option} DIR`",
             places.join(", ")
         ));
         self.report(diag)
@@ -1267,8 +1325,8 @@ impl Asm<'_> {
         self.expect_end(t, p + 2)?;
         self.frame_room(tok.span)?;
         let dir = self.current_dir();
-        let Some((path, bytes)) = self.find_file(&name, &dir) else {
-            return Err(self.not_found(tok, &name));
+        let Some((path, bytes)) = self.find_file(&name, false, &dir) else {
+            return Err(self.not_found(tok, &name, false));
         };
         let ctx = self.new_ctx(CtxKind::Include, self.join(t[p].span, tok.span));
         let parent = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -1291,8 +1349,8 @@ impl Asm<'_> {
         }
         self.expect_end(t, i)?;
         let dir = self.current_dir();
-        let Some((_, bytes)) = self.find_file(&name, &dir) else {
-            return Err(self.not_found(tok, &name));
+        let Some((_, bytes)) = self.find_file(&name, true, &dir) else {
+            return Err(self.not_found(tok, &name, true));
         };
         let len = bytes.len() as i64;
         let end = match size {

@@ -131,6 +131,11 @@ pub(crate) fn write_object(
                 (line > 0).then_some(SymbolLoc {
                     symbol: sym_index[i],
                     loc: SourceLoc { file, line, column },
+                    expanded_at: sym.expanded_at.map(|(file, line, column)| SourceLoc {
+                        file,
+                        line,
+                        column,
+                    }),
                 })
             })
             .collect(),

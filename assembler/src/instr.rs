@@ -134,29 +134,7 @@ impl Asm<'_> {
             p += 2;
         }
         if t.get(p).map(|t| t.kind) == Some(Tok::LParen) {
-            let save = p;
-            p += 1;
-            *expr_start = p;
-            let inner = self.expression(t, &mut p)?;
-            let inner_end = p;
-            if t.get(p).map(|t| t.kind) == Some(Tok::Comma)
-                && self.reg(t.get(p + 1)) == Some(Keyword::RegX)
-                && t.get(p + 2).map(|t| t.kind) == Some(Tok::RParen)
-            {
-                self.expect_end(t, p + 3)?;
-                return Ok((Operand::IndX(inner), inner_end));
-            }
-            if t.get(p).map(|t| t.kind) == Some(Tok::RParen) {
-                if p + 1 == n {
-                    return Ok((Operand::Ind(inner), inner_end));
-                }
-                if t[p + 1].kind == Tok::Comma && self.reg(t.get(p + 2)) == Some(Keyword::RegY) {
-                    self.expect_end(t, p + 3)?;
-                    return Ok((Operand::IndY(inner), inner_end));
-                }
-            }
-            // `(a+b)*2`: a parenthesised expression, not indirection.
-            p = save;
+            return self.indirect_operand(t, p + 1, expr_start);
         }
         *expr_start = p;
         let expr = self.expression(t, &mut p)?;
@@ -179,6 +157,66 @@ impl Asm<'_> {
         }
         self.expect_end(t, p)?;
         Ok((Operand::Direct(expr, index, size), expr_end))
+    }
+
+    /// An operand that opens with `(`: `(zp,x)`, `(zp),y` or `(abs)`. As in
+    /// ca65, a leading parenthesis always means indirection, so a typo such
+    /// as `(zp),x` is an error rather than another instruction.
+    fn indirect_operand(
+        &mut self,
+        t: &[Token],
+        mut p: usize,
+        expr_start: &mut usize,
+    ) -> PResult<(Operand, usize)> {
+        *expr_start = p;
+        let inner = self.expression(t, &mut p)?;
+        let inner_end = p;
+        let kind = |i: usize| t.get(i).map(|t| t.kind);
+        let (at, message, help) = match kind(p) {
+            Some(Tok::Comma) if self.reg(t.get(p + 1)) == Some(Keyword::RegX) => {
+                if kind(p + 2) == Some(Tok::RParen) {
+                    self.expect_end(t, p + 3)?;
+                    return Ok((Operand::IndX(inner), inner_end));
+                }
+                (p + 2, "expected `)` to close `(zp,x)`", None)
+            }
+            Some(Tok::Comma) => (
+                p + 1,
+                "expected `x`: inside the parentheses the index is `x`, as in `(zp,x)`",
+                Some("`(zp,x)` indexes before the indirection, `(zp),y` after it"),
+            ),
+            Some(Tok::RParen) if p + 1 == t.len() => return Ok((Operand::Ind(inner), inner_end)),
+            Some(Tok::RParen) if kind(p + 1) == Some(Tok::Comma) => {
+                if self.reg(t.get(p + 2)) == Some(Keyword::RegY) {
+                    self.expect_end(t, p + 3)?;
+                    return Ok((Operand::IndY(inner), inner_end));
+                }
+                (
+                    p + 2,
+                    "expected `y`: after the parentheses the index is `y`, as in `(zp),y`",
+                    Some("the 6502 has `(zp),y` and `(zp,x)`; there is no `(zp),x`"),
+                )
+            }
+            Some(Tok::RParen) => (
+                p + 1,
+                "unexpected text after an indirect operand",
+                Some(
+                    "an operand that starts with `(` is indirect (as in ca65); \
+                     for arithmetic, start it otherwise: `0+(a+b)*2`",
+                ),
+            ),
+            _ => (
+                p,
+                "expected `,x)` or `)` to close the indirect operand",
+                None,
+            ),
+        };
+        let span = self.span_at(t, at);
+        let mut diag = diag::error("asm::syntax", span, message);
+        if let Some(help) = help {
+            diag = diag.help(help);
+        }
+        Err(self.report(diag))
     }
 
     /// Encodes one instruction.

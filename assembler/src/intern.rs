@@ -18,6 +18,10 @@ macro_rules! directives {
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub(crate) enum Dir { $( $variant, )* }
 
+        /// Every directive name and alias, without the dot (for "did you
+        /// mean" suggestions).
+        pub(crate) const DIRECTIVE_NAMES: &[&str] = &[ $( $($name,)+ )* ];
+
         fn directive(lower: &str) -> Option<Dir> {
             match lower {
                 $( $($name)|+ => Some(Dir::$variant), )*

@@ -66,6 +66,9 @@ pub(crate) struct OutSym {
     pub(crate) global: bool,
     /// (file, line, column) of the definition.
     pub(crate) place: Option<(u32, u32, u32)>,
+    /// Where the outermost macro expansion that defined it was written
+    /// (file, line, column), if a macro defined it.
+    pub(crate) expanded_at: Option<(u32, u32, u32)>,
 }
 
 /// One bytecode step of a deferred assertion, before symbol numbering.
@@ -236,6 +239,9 @@ impl Asm<'_> {
                 s.def_loc = s.export_loc;
             }
         }
+        // Built only if a name is undefined: the defined names, for "did
+        // you mean".
+        let mut known: Option<Vec<String>> = None;
         for sym in 0..self.prog.syms.len() {
             let s = &self.prog.syms[sym];
             if s.def != SymDef::Undefined {
@@ -264,14 +270,49 @@ impl Asm<'_> {
                     } else {
                         format!("`{name}` is not defined")
                     };
-                    diag::error("asm::undefined", span, message).help(format!(
-                        "define it, or import it with `.import {}` if another file defines it",
-                        self.names.name(s.name)
-                    ))
+                    let short = self.names.name(s.name).to_string();
+                    let known = known.get_or_insert_with(|| self.defined_names());
+                    let help = match diag::did_you_mean(&name, known.iter().map(String::as_str)) {
+                        Some(similar) => format!("did you mean `{similar}`?"),
+                        None => format!(
+                            "define it, or import it with `.import {short}` if another file defines it"
+                        ),
+                    };
+                    diag::error("asm::undefined", span, message).help(help)
                 }
             };
             self.report_at(loc, diag);
         }
+    }
+
+    /// The place (file, line, column) of the outermost macro call in the
+    /// expansion context `ctx`: the user's line that made the definition.
+    fn outermost_expansion(&self, mut ctx: u32) -> Option<(u32, u32, u32)> {
+        let mut outermost = None;
+        let mut guard = 0;
+        while ctx != 0 && guard < 256 {
+            let node = self.ctx.get(ctx as usize)?;
+            if matches!(node.kind, crate::diag::CtxKind::Macro(_)) {
+                outermost = Some(node.span);
+            }
+            ctx = node.parent;
+            guard += 1;
+        }
+        outermost.map(|span| {
+            let (line, column) = self.files.line_col(span.file, span.start);
+            (span.file, line, column)
+        })
+    }
+
+    /// The full names of the defined ordinary symbols.
+    fn defined_names(&self) -> Vec<String> {
+        (0..self.prog.syms.len())
+            .filter(|&sym| {
+                let s = &self.prog.syms[sym];
+                s.kind == SymKind::Normal && s.is_defined()
+            })
+            .map(|sym| self.sym_name(sym as SymId))
+            .collect()
     }
 
     /// Places every chunk with the current sizes.
@@ -513,6 +554,7 @@ impl Asm<'_> {
             }
             let exported = s.export.is_some();
             let place = Some(s.place());
+            let expanded_at = self.outermost_expansion(s.def_ctx);
             let export_loc = s.export_loc;
             let kind = match s.def {
                 SymDef::Undefined | SymDef::Alias(_) => continue,
@@ -568,6 +610,7 @@ impl Asm<'_> {
                 } else {
                     place
                 },
+                expanded_at,
             });
         }
         index

@@ -46,9 +46,12 @@ pub use source::{FileSource, FsSource, MemorySource};
 /// How to assemble.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Directories searched by `.include` and `.incbin` after the
-    /// including file's own directory (`-I`).
+    /// Directories searched by `.include` after the including file's own
+    /// directory (`-I`, as ca65's).
     pub include_dirs: Vec<PathBuf>,
+    /// Directories searched by `.incbin` after the working directory and
+    /// the including file's directory (ca65's `--bin-include-dir`).
+    pub bin_include_dirs: Vec<PathBuf>,
     /// Symbols defined before the first line (`-D NAME=VALUE`).
     pub defines: Vec<(String, i64)>,
     /// Files that `.include` finds by name when no directory has them
@@ -71,6 +74,7 @@ impl Default for Options {
     fn default() -> Options {
         Options {
             include_dirs: Vec::new(),
+            bin_include_dirs: Vec::new(),
             defines: Vec::new(),
             builtin_includes: BTreeMap::new(),
             listing: false,
@@ -163,9 +167,13 @@ pub fn assemble(
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     asm.push_file(name, bytes, dir, 0);
     asm.run();
-    asm.finish_front();
-    asm.layout();
-    let mut out = asm.resolve();
+    // After a missing include the rest of the source was not read:
+    // checking what was would only report what the include defines.
+    let out = (!asm.fatal).then(|| {
+        asm.finish_front();
+        asm.layout();
+        asm.resolve()
+    });
     // In source order: by where each came from in the main file (the
     // outermost include or macro call), then by its own place.
     let ctx = &asm.ctx;
@@ -205,13 +213,16 @@ pub fn assemble(
             ),
         ));
     }
-    if asm.rep.has_errors() {
-        return Err(Error::Failed {
-            path: path.to_path_buf(),
-            errors: asm.rep.errors,
-            diagnostics,
-        });
-    }
+    let mut out = match out {
+        Some(out) if !asm.rep.has_errors() => out,
+        _ => {
+            return Err(Error::Failed {
+                path: path.to_path_buf(),
+                errors: asm.rep.errors,
+                diagnostics,
+            });
+        }
+    };
     let mut e_flags = isa::elf::EF_MOS_ARCH_6502;
     if asm.used_undoc {
         e_flags |= isa::elf::EF_MOS_ARCH_6502X;

@@ -91,6 +91,9 @@ pub(crate) struct Sym {
     pub(crate) def_file: u32,
     pub(crate) def_line: u32,
     pub(crate) def_column: u32,
+    /// The expansion context of the definition, for the place in the
+    /// user's file that expanded a macro defining it.
+    pub(crate) def_ctx: u32,
 }
 
 impl Sym {
@@ -110,6 +113,7 @@ impl Sym {
             def_file: 0,
             def_line: 0,
             def_column: 0,
+            def_ctx: 0,
         }
     }
 

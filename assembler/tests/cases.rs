@@ -151,7 +151,7 @@ fn dump(object: &[u8]) -> String {
                 .syms
                 .get(symbol.symbol as usize)
                 .expect("a symbol index");
-            let _ = writeln!(
+            let _ = write!(
                 out,
                 "srcmap symbol {} {}:{}:{}",
                 elf.strtab.get_at(sym.st_name).unwrap_or("?"),
@@ -159,6 +159,16 @@ fn dump(object: &[u8]) -> String {
                 symbol.loc.line,
                 symbol.loc.column
             );
+            if let Some(call) = symbol.expanded_at {
+                let _ = write!(
+                    out,
+                    " from the macro call at {}:{}:{}",
+                    map.file_name(call).unwrap_or("?"),
+                    call.line,
+                    call.column
+                );
+            }
+            out.push('\n');
         }
     }
     if let Some((_, sh)) = elf

@@ -194,26 +194,59 @@ pub struct Line<'a> {
 impl fmt::Display for Line<'_> {
     /// `1000  A9 2E     LDA #$2E`: address, up to three bytes, text.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{:04X} ", self.address)?;
-        for slot in 0..3 {
-            match self.bytes.get(slot) {
-                Some(byte) => write!(f, " {byte:02X}")?,
-                None => f.write_str("   ")?,
-            }
+        write_line(f, self, &|_| None)
+    }
+}
+
+impl Line<'_> {
+    /// Formats the line as [`Line`]'s `Display` does, naming operand
+    /// addresses through `label` where it knows them.
+    pub fn display_with<'b, F>(&'b self, label: F) -> impl fmt::Display + 'b
+    where
+        F: Fn(u16) -> Option<&'b str> + 'b,
+    {
+        LabelledLine { line: self, label }
+    }
+}
+
+struct LabelledLine<'a, F> {
+    line: &'a Line<'a>,
+    label: F,
+}
+
+impl<'a, F> fmt::Display for LabelledLine<'a, F>
+where
+    F: Fn(u16) -> Option<&'a str>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_line(f, self.line, &self.label)
+    }
+}
+
+fn write_line<'a>(
+    f: &mut fmt::Formatter<'_>,
+    line: &Line<'_>,
+    label: &dyn Fn(u16) -> Option<&'a str>,
+) -> fmt::Result {
+    write!(f, "{:04X} ", line.address)?;
+    for slot in 0..3 {
+        match line.bytes.get(slot) {
+            Some(byte) => write!(f, " {byte:02X}")?,
+            None => f.write_str("   ")?,
         }
-        f.write_str("  ")?;
-        match &self.instruction {
-            Some(insn) => write!(f, "{insn}"),
-            None => {
-                f.write_str(".byte ")?;
-                for (index, byte) in self.bytes.iter().enumerate() {
-                    if index > 0 {
-                        f.write_str(",")?;
-                    }
-                    write!(f, "${byte:02X}")?;
+    }
+    f.write_str("  ")?;
+    match &line.instruction {
+        Some(insn) => write_insn(f, insn, label),
+        None => {
+            f.write_str(".byte ")?;
+            for (index, byte) in line.bytes.iter().enumerate() {
+                if index > 0 {
+                    f.write_str(",")?;
                 }
-                Ok(())
+                write!(f, "${byte:02X}")?;
             }
+            Ok(())
         }
     }
 }

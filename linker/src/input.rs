@@ -108,8 +108,16 @@ impl Object {
     /// Where symbol `index` was defined.
     pub(crate) fn place_of_symbol(&self, index: usize) -> Place {
         let found = self.srcmap.as_ref().and_then(|map| {
-            let loc = map.symbol(index as u32)?;
-            Some(Place::source(map.file_name(loc)?, loc.line, loc.column))
+            let entry = map.symbol_entry(index as u32)?;
+            let own = Place::source(map.file_name(entry.loc)?, entry.loc.line, entry.loc.column);
+            // A macro's definition is shown at the user's line that called
+            // the macro, its place in the macro's body beside it.
+            let Some(call) = entry.expanded_at else {
+                return Some(own);
+            };
+            let mut place = Place::source(map.file_name(call)?, call.line, call.column);
+            place.text = format!("{} (from the macro at {})", place.text, own.text);
+            Some(place)
         });
         if let Some(place) = found {
             return place;

@@ -358,6 +358,7 @@ impl ObjectBuilder {
                             line: *line,
                             column: *column,
                         },
+                        expanded_at: None,
                     })
                     .collect(),
             }

@@ -173,7 +173,7 @@ check_bumpers:
         sta IOBYTE
 @open:  rts
 
-; (count, letter, handler) for every command of PLATFORM.md section 2.
+; (count, letter, handler) for every command of docs/PROTOCOL.md section 2.
 commands:
         .byte 1, 'R'
         .addr soft_reset

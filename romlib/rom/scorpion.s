@@ -1,6 +1,6 @@
 ; The Scorpion reference ROM.
 ;
-; Implements the command protocol and extension ABI of PLATFORM.md on the
+; Implements the command protocol and extension ABI of docs/PROTOCOL.md on the
 ; board of emulator/src/board/map.rs. Built with our own assembler and
 ; linker (target scorpion-rom): see romlib/README.md for how the image,
 ; romlib's symbol constants and scorpion.inc are regenerated and checked.
@@ -12,7 +12,7 @@
 ;   services.s   serial I/O and parsing services (the jump table's targets)
 ;   motion.s     the interrupt handler: receive, bumpers, the motion tick
 ;
-; Every name of PLATFORM.md section 4 is exported; the jump table at $FF00
+; Every name of docs/PROTOCOL.md section 4 is exported; the jump table at $FF00
 ; keeps the services at fixed addresses across ROM revisions.
 
         .include "hardware.inc"

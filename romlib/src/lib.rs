@@ -5,7 +5,7 @@
 //!   assembled and linked by our own assembler and linker when this crate
 //!   is built. The ELF is the ROM profile extensions link against
 //!   (`--just-symbols`) and loaders read hook addresses from.
-//! - [`symbols`]: every name the ROM exports (PLATFORM.md section 4, plus
+//! - [`symbols`]: every name the ROM exports (docs/PROTOCOL.md section 4, plus
 //!   `USER_*` and more services) as a Rust constant, and [`SCORPION_INC`]:
 //!   the same names as an assembler include file with the hook macros. Both
 //!   are generated from the one linked symbol table.

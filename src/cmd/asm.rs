@@ -24,9 +24,14 @@ pub(crate) struct Args {
 /// The assembler's options, shared by `scorpion asm` and `scorpion build`.
 #[derive(Debug, clap::Args)]
 pub(crate) struct AsmOptions {
-    /// Search this directory for `.include` and `.incbin` files (repeatable).
+    /// Search this directory for `.include` files, after the including
+    /// file's own (repeatable).
     #[arg(short = 'I', long = "include-dir", value_name = "DIR")]
     include_dirs: Vec<PathBuf>,
+    /// Search this directory for `.incbin` files, after the working
+    /// directory and the including file's (repeatable; ca65's order).
+    #[arg(long = "bin-include-dir", value_name = "DIR")]
+    bin_include_dirs: Vec<PathBuf>,
     /// Define a symbol before the first line of each source: NAME or
     /// NAME=VALUE (repeatable; VALUE as 42, $2A, 0x2A or %101010; default 1).
     #[arg(short = 'D', long = "define", value_name = "NAME[=VALUE]", value_parser = crate::args::define)]
@@ -45,6 +50,7 @@ impl AsmOptions {
     pub(crate) fn options(&self, listing: bool) -> assembler::Options {
         assembler::Options {
             include_dirs: self.include_dirs.clone(),
+            bin_include_dirs: self.bin_include_dirs.clone(),
             defines: self.defines.clone(),
             listing,
             max_errors: self.max_errors,

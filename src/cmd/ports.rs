@@ -54,7 +54,7 @@ impl Line {
     }
 }
 
-/// The default baud rate: the reference ROM's (PLATFORM.md section 3).
+/// The default baud rate: the reference ROM's (docs/PROTOCOL.md section 3).
 pub(crate) const DEFAULT_BAUD: u32 = 9600;
 
 /// The `--port` value that names the in-process virtual Scorpion.

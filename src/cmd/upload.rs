@@ -186,9 +186,7 @@ fn transcript(lines: &[(Command, Option<Answer>)]) -> String {
     for (command, answer) in lines {
         let _ = writeln!(text, "  > {command}");
         if let Some(answer) = answer {
-            let raw = answer.encode();
-            let raw = String::from_utf8_lossy(raw.strip_suffix(b"\r").unwrap_or(&raw)).into_owned();
-            let _ = writeln!(text, "  < {raw}");
+            let _ = writeln!(text, "  < {}", uploader::answer_text(answer));
         }
     }
     text

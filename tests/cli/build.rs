@@ -165,3 +165,26 @@ fn an_extension_builds_with_no_options_against_the_built_in_rom() {
         Some(0x4C)
     );
 }
+
+#[test]
+fn two_extensions_in_one_link_name_the_users_lines_that_took_the_hook() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let one = ".include \"scorpion.inc\"\n\n; the first\nSCORPION_UNKNOWN_HANDLER\n        SCORPION_CHAIN_UNKNOWN\n";
+    let two =
+        ".include \"scorpion.inc\"\nSCORPION_UNKNOWN_HANDLER\n        SCORPION_CHAIN_UNKNOWN\n";
+    std::fs::write(dir.path().join("one.s"), one).expect("write");
+    std::fs::write(dir.path().join("two.s"), two).expect("write");
+    let output = scorpion(dir.path(), &["build", "one.s", "two.s", "-o", "both.elf"]);
+    let stderr = String::from_utf8_lossy(&output.stderr).replace('\n', " ");
+    assert!(!output.status.success(), "{stderr}");
+    // The macro's own line is the same for both; the user's lines are not.
+    for wanted in [
+        "`__scorpion_hook_unknown` is defined twice",
+        "one.s:4:1",
+        "two.s:2:1",
+        "one.s:5:9",
+        "two.s:3:9",
+    ] {
+        assert!(stderr.contains(wanted), "`{wanted}` missing from: {stderr}");
+    }
+}

@@ -39,3 +39,48 @@ fn bad_arguments_are_clear_errors() {
     assert_eq!(outside.status.code(), Some(1));
     insta::assert_snapshot!("disasm_start_outside_file", transcript(&outside));
 }
+
+/// `scorpion build`'s default output is an ELF image: it is disassembled at
+/// its addresses with its symbols and the ROM's as labels, not as raw bytes
+/// from its ELF header; an object shows its sections and relocations.
+#[test]
+fn disassembles_elf_images_and_objects_with_their_symbols() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let source = "\
+        .include \"scorpion.inc\"
+        .code
+SCORPION_UNKNOWN_HANDLER
+        cmp #'Q'
+        bne pass
+        lda message
+        jsr PUTCH
+        jmp CMD_DONE
+pass:   SCORPION_CHAIN_UNKNOWN
+        .rodata
+message: .byte \"Q\", 0
+";
+    std::fs::write(dir.path().join("ext.s"), source).expect("write");
+    let built = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let image = scorpion(dir.path(), &["disasm", "ext.elf"]);
+    assert_eq!(image.status.code(), Some(0), "{}", transcript(&image));
+    let text = String::from_utf8_lossy(&image.stdout);
+    assert!(
+        !text.contains("7F 45 4C"),
+        "the ELF header was disassembled:\n{text}"
+    );
+    insta::assert_snapshot!("disasm_elf_image", transcript(&image));
+    let assembled = scorpion(dir.path(), &["asm", "ext.s", "-o", "ext.o"]);
+    assert!(assembled.status.success(), "{}", transcript(&assembled));
+    let object = scorpion(dir.path(), &["disasm", "ext.o"]);
+    assert_eq!(object.status.code(), Some(0), "{}", transcript(&object));
+    insta::assert_snapshot!("disasm_elf_object", transcript(&object));
+    let window = scorpion(
+        dir.path(),
+        &["disasm", "ext.elf", "--start", "$0402", "--length", "5"],
+    );
+    insta::assert_snapshot!("disasm_elf_window", transcript(&window));
+    let base = scorpion(dir.path(), &["disasm", "ext.elf", "--base", "$1000"]);
+    assert_eq!(base.status.code(), Some(1));
+    insta::assert_snapshot!("disasm_elf_with_base", transcript(&base));
+}

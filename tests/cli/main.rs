@@ -8,7 +8,9 @@ mod disasm;
 mod emu;
 mod link;
 mod read;
+mod search_order;
 mod sim;
+mod terminal;
 mod upload;
 
 use std::process::{Command, Output};

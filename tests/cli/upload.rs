@@ -40,13 +40,13 @@ fn extension_elf(len: usize) -> Vec<u8> {
 }
 
 /// `scorpion sim --pty`, stopped when dropped.
-struct Sim {
+pub(crate) struct Sim {
     child: Child,
-    path: String,
+    pub(crate) path: String,
 }
 
 impl Sim {
-    fn start() -> Sim {
+    pub(crate) fn start() -> Sim {
         let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
             .args(["sim", "--pty"])
             .stdout(Stdio::piped())

@@ -1,7 +1,8 @@
 //! Outside tools that differential tests compare against.
 //!
 //! The rule (DEVELOPERS.md): a test that needs an outside tool fails when
-//! the tool is missing and `CI=true`; locally it skips, saying so on stderr.
+//! the tool is missing and `CI=true`; locally it skips, saying so on stderr
+//! past the test harness's capture, so that `cargo test` shows it.
 //! `.ci/install-test-tools` installs every tool named here.
 
 use std::path::PathBuf;
@@ -16,10 +17,19 @@ fn missing(what: &str, test: &str) {
         !in_ci(),
         "{what} is required in CI but missing; run .ci/install-test-tools"
     );
-    #[allow(clippy::print_stderr, reason = "the skip must be visible")]
-    {
-        eprintln!("SKIPPED {test}: {what} is not installed (run .ci/install-test-tools)");
-    }
+    skipped(
+        test,
+        &format!("{what} is not installed (run .ci/install-test-tools)"),
+    );
+}
+
+/// Says that `test` is skipped and why, where `cargo test` shows it: the
+/// test harness captures `eprintln!` of passing tests, so the line goes to
+/// the process's stderr directly and appears among the `ok` lines.
+pub fn skipped(test: &str, why: &str) {
+    use std::io::Write as _;
+    let line = format!("SKIPPED {test}: {why}\n");
+    let _ = std::io::stderr().lock().write_all(line.as_bytes());
 }
 
 fn find_on_path(program: &str) -> Option<PathBuf> {

@@ -1,4 +1,4 @@
-//! Conformance of the reference ROM on the virtual Scorpion to PLATFORM.md
+//! Conformance of the reference ROM on the virtual Scorpion to docs/PROTOCOL.md
 //! section 2: every instruction and question, sent through the emulated
 //! 6551 at 9600 baud, with its answer and its effect on the board checked.
 //! Each test's transcript is an insta snapshot.

@@ -2,7 +2,7 @@
 //! tools build equals ca65/ld65's, the symbol constants equal the linked
 //! symbol table, `examples/scorpion.inc` equals the generated include file,
 //! the ROM's `hardware.inc` equals the emulator's register map, and every
-//! name PLATFORM.md section 4 fixes is exported.
+//! name docs/PROTOCOL.md section 4 fixes is exported.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -17,7 +17,7 @@ fn workspace() -> PathBuf {
         .to_path_buf()
 }
 
-/// The names PLATFORM.md section 4 decides, which every build of the ROM
+/// The names docs/PROTOCOL.md section 4 decides, which every build of the ROM
 /// must export.
 const PLATFORM_NAMES: [&str; 17] = [
     "HOOK_UNKNOWN",

@@ -145,3 +145,47 @@ fn every_example_uploads_on_both_paths() {
         }
     }
 }
+
+/// An expectation file's three kinds of line against an extension's
+/// command: an exact answer, no `=>` (whatever comes back is accepted and
+/// kept for the transcript), and `=> nothing` (silence required).
+#[test]
+fn expectations_keep_every_answer_and_can_require_silence() {
+    let checksum = image(
+        "checksum/checksum.s",
+        &examples_dir()
+            .join("checksum/checksum.toml")
+            .display()
+            .to_string(),
+    );
+    let (_, transport) = upload(VirtualTransport::default(), &checksum, LoaderChoice::Never);
+    let expectations =
+        Expectations::parse("/9W10000102\n/9K10000002\n/1Q => nothing\n/9K10000000 => K0000\n")
+            .expect("the expectations parse");
+    let mut client = uploader::client(transport, &RomProfile::reference());
+    let transcript = expectations
+        .check(&mut client)
+        .unwrap_or_else(|error| panic!("{error}"));
+    let answers: Vec<Option<String>> = transcript
+        .iter()
+        .map(|(_, answer)| answer.as_ref().map(uploader::answer_text))
+        .collect();
+    assert_eq!(
+        answers,
+        [None, Some("K0003".into()), None, Some("K0000".into())],
+        "the extension's answer to a line without `=>` is kept"
+    );
+    // The extension answers: `=> nothing` fails and says what came.
+    let silent = Expectations::parse("/9K10000002 => nothing").expect("parses");
+    let error = silent.check(&mut client).expect_err("an answer came");
+    let text = error.to_string();
+    assert!(
+        text.contains("no answer") && text.contains("K0003"),
+        "{text}"
+    );
+    // A file with nothing to check is an error, not "0 expectations met".
+    for empty in ["", "# only a comment\n\n"] {
+        let error = Expectations::parse(empty).expect_err("nothing to check");
+        assert!(error.to_string().contains("no command"), "{error}");
+    }
+}

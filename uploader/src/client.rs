@@ -366,6 +366,47 @@ impl<T: Transport> Client<T> {
         self.ask_with(command, self.config.question_attempts)
     }
 
+    /// Sends a command that may or may not be answered (an extension's, in
+    /// an expectation file) and waits as long as the longest answer takes:
+    /// the answer if one came, `None` if the line stayed silent. Never
+    /// retried: sending an instruction twice could do it twice.
+    ///
+    /// # Errors
+    /// A line error, or the [`ProtocolError`] of an answer that is not
+    /// printable text ending in a carriage return.
+    pub fn listen(&mut self, command: &Command) -> Result<Option<Answer>> {
+        let bytes = command.encode();
+        let answer_len = command.answer_len().unwrap_or(2 * 199 + 3);
+        let timeout = self.chars(bytes.len() + answer_len) + self.config.margin * 2;
+        self.drain()?;
+        self.transport.clear_input()?;
+        self.send_raw(&bytes)?;
+        let deadline = self.transport.now() + timeout;
+        loop {
+            if let Some(frame) = self.take_frame() {
+                let answer = match command {
+                    Command::Extension(_) => Answer::parse_text(&frame),
+                    _ => Answer::parse(&frame),
+                };
+                return answer.map(Some).map_err(Error::Protocol);
+            }
+            let now = self.transport.now();
+            if now >= deadline {
+                if self.rx.is_empty() {
+                    return Ok(None);
+                }
+                let mut heard = std::mem::take(&mut self.rx);
+                heard.truncate(40);
+                return Err(Error::WrongBaud {
+                    port: self.transport.name(),
+                    baud: self.transport.baud(),
+                    sample: heard.escape_ascii().to_string(),
+                });
+            }
+            self.fill(deadline - now)?;
+        }
+    }
+
     /// [`Client::ask`] with `attempts` attempts (at least one).
     fn ask_with(&mut self, command: &Command, attempts: u32) -> Result<Answer> {
         let attempts = attempts.max(1);

@@ -106,7 +106,10 @@ pub enum Error {
     },
 
     /// Nothing came back at all.
-    #[error("no answer from the robot on {port} at {baud} baud (`{question}` waited {waited:?})")]
+    #[error(
+        "no answer from the robot on {port} at {baud} baud (`{question}` waited {})",
+        human_duration(*.waited)
+    )]
     #[diagnostic(
         code(uploader::no_answer),
         help(
@@ -144,7 +147,8 @@ pub enum Error {
 
     /// The line went quiet in the middle of the work.
     #[error(
-        "the line to {port} stalled: nothing received for {waited:?} with {outstanding} answers due"
+        "the line to {port} stalled: nothing received for {} with {outstanding} answers due",
+        human_duration(*.waited)
     )]
     #[diagnostic(
         code(uploader::stalled),
@@ -263,7 +267,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::bad_rom_profile),
         help(
-            "give the linked ELF of the robot's ROM, which exports the names of PLATFORM.md section 4"
+            "give the linked ELF of the robot's ROM, which exports the names of docs/PROTOCOL.md section 4"
         )
     )]
     BadRomProfile {
@@ -343,3 +347,49 @@ pub enum Error {
 
 /// The uploader's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A duration as people read it: `3.6 s`, `250 ms`, `12 µs`, three
+/// significant figures at most.
+#[must_use]
+pub fn human_duration(duration: Duration) -> String {
+    let seconds = duration.as_secs_f64();
+    let (value, unit) = if seconds >= 1.0 {
+        (seconds, "s")
+    } else if seconds >= 1e-3 {
+        (seconds * 1e3, "ms")
+    } else {
+        (seconds * 1e6, "µs")
+    };
+    let text = if value >= 100.0 {
+        format!("{value:.0}")
+    } else if value >= 10.0 {
+        format!("{value:.1}")
+    } else {
+        format!("{value:.2}")
+    };
+    let text = match text.contains('.') {
+        true => text.trim_end_matches('0').trim_end_matches('.').to_string(),
+        false => text,
+    };
+    format!("{text} {unit}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::human_duration;
+    use std::time::Duration;
+
+    #[test]
+    fn durations_read_as_people_write_them() {
+        assert_eq!(
+            human_duration(Duration::from_secs_f64(3.614_583_33)),
+            "3.61 s"
+        );
+        assert_eq!(human_duration(Duration::from_millis(250)), "250 ms");
+        assert_eq!(human_duration(Duration::from_millis(1500)), "1.5 s");
+        assert_eq!(human_duration(Duration::from_secs(120)), "120 s");
+        assert_eq!(human_duration(Duration::from_micros(12)), "12 µs");
+        assert_eq!(human_duration(Duration::from_micros(10_400)), "10.4 ms");
+        assert_eq!(human_duration(Duration::ZERO), "0 µs");
+    }
+}

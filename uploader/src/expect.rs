@@ -5,11 +5,19 @@
 //! # comment
 //! /1X => X00          a question and its exact answer (no carriage return)
 //! /1Q => QHELLO       an extension's new command
-//! /2E3                an instruction: sent, nothing expected back
 //! /1P => *            any well-formed answer will do
+//! /9Z => nothing      the robot must not answer
+//! /2E3                a ROM instruction: sent (the ROM never answers one)
+//! /9W10000102         an extension's command without `=>`: whatever comes
+//!                     back, an answer or nothing, is accepted and shown
 //! ```
+//!
+//! A file with no command in it is an error: it would check nothing.
 
 use romlib::protocol::{Answer, Command};
+
+/// What an expectation line writes after `=>` for "no answer at all".
+pub const NOTHING: &str = "nothing";
 
 use crate::client::Client;
 use crate::transport::Transport;
@@ -18,8 +26,14 @@ use crate::{Error, Result};
 /// What one line requires.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Required {
-    /// No answer (an instruction).
+    /// A ROM instruction with no `=>`: sent; the ROM never answers one.
+    Sent,
+    /// `=> nothing`: the robot must stay silent for as long as the longest
+    /// answer takes.
     Nothing,
+    /// An extension's command with no `=>`: an answer or none, either is
+    /// accepted, and an answer is kept for the transcript.
+    Whatever,
     /// Any well-formed answer.
     Any,
     /// This exact answer, without its carriage return.
@@ -67,12 +81,16 @@ impl Expectations {
             })?;
             let required = match answer {
                 None if command.is_question() => Required::Any,
-                None => Required::Nothing,
+                None if matches!(command, Command::Extension(_)) => Required::Whatever,
+                None => Required::Sent,
                 Some("*") => Required::Any,
+                Some(NOTHING) => Required::Nothing,
                 Some("") => {
                     return Err(Error::BadExpectations {
                         line,
-                        reason: "nothing after `=>`; write `*` to accept any answer".into(),
+                        reason: format!(
+                            "nothing after `=>`; write `*` to accept any answer, `{NOTHING}` to require silence"
+                        ),
                     });
                 }
                 Some(text) => {
@@ -93,6 +111,12 @@ impl Expectations {
                 required,
             });
         }
+        if lines.is_empty() {
+            return Err(Error::BadExpectations {
+                line: text.lines().count().max(1),
+                reason: "the file has no command in it, so it would check nothing".into(),
+            });
+        }
         Ok(Expectations { lines })
     }
 
@@ -108,9 +132,20 @@ impl Expectations {
         for expectation in &self.lines {
             let command = &expectation.command;
             let answer = match &expectation.required {
-                Required::Nothing => {
+                Required::Sent => {
                     client.send(command)?;
                     None
+                }
+                Required::Nothing | Required::Whatever => {
+                    let heard = client.listen(command)?;
+                    if let (Required::Nothing, Some(answer)) = (&expectation.required, &heard) {
+                        return Err(Error::RehearsalFailed {
+                            command: command.to_string(),
+                            expected: "no answer".into(),
+                            found: answer_text(answer),
+                        });
+                    }
+                    heard
                 }
                 Required::Any | Required::Exactly(_) => {
                     let answer = client
@@ -124,13 +159,12 @@ impl Expectations {
                             found: format!("no valid answer ({error})"),
                         })?;
                     if let Required::Exactly(text) = &expectation.required {
-                        let encoded = answer.encode();
-                        let found = String::from_utf8_lossy(&encoded[..encoded.len() - 1]);
-                        if found != text.as_str() {
+                        let found = answer_text(&answer);
+                        if found != *text {
                             return Err(Error::RehearsalFailed {
                                 command: command.to_string(),
                                 expected: text.clone(),
-                                found: found.into_owned(),
+                                found,
                             });
                         }
                     }
@@ -141,4 +175,14 @@ impl Expectations {
         }
         Ok(transcript)
     }
+}
+
+/// An answer as the robot sent it, without its carriage return.
+#[must_use]
+pub fn answer_text(answer: &Answer) -> String {
+    let encoded = answer.encode();
+    let body = encoded
+        .strip_suffix(&[romlib::protocol::EOL])
+        .unwrap_or(&encoded);
+    String::from_utf8_lossy(body).into_owned()
 }

@@ -303,7 +303,7 @@ impl RomProfile {
     }
 
     /// The profile of another ROM, from its linked ELF (the file its
-    /// extensions link against): the names of PLATFORM.md section 4, and
+    /// extensions link against): the names of docs/PROTOCOL.md section 4, and
     /// `RXBUF_SIZE` if it exports one.
     ///
     /// # Errors

@@ -34,8 +34,8 @@ pub mod transport;
 mod upload;
 
 pub use client::{Client, ClientConfig, ClientStats};
-pub use error::{Error, Result};
-pub use expect::{Expectation, Expectations, Required};
+pub use error::{Error, Result, human_duration};
+pub use expect::{Expectation, Expectations, NOTHING, Required, answer_text};
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
     UploadImage,

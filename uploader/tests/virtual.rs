@@ -395,7 +395,7 @@ fn expectations_parse_and_check() {
         "# rehearsal\n/1X => X00\n/7R020003 => R4C21FF  # HOOK_UNKNOWN\n/2E3\n/1E\n/1E => E3\n";
     let expectations = Expectations::parse(text).expect("parses");
     assert_eq!(expectations.lines.len(), 5);
-    assert_eq!(expectations.lines[2].required, Required::Nothing);
+    assert_eq!(expectations.lines[2].required, Required::Sent);
     assert_eq!(expectations.lines[3].required, Required::Any);
     let mut client = Client::new(robot(), ClientConfig::default());
     let transcript = expectations.check(&mut client).expect("all answered");

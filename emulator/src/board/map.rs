@@ -1,7 +1,7 @@
 //! The Scorpion board's memory map and I/O register map.
 //!
 //! The memory map is fixed by docs/ARCHITECTURE.md; the I/O page's layout
-//! and the wiring of the chips' pins are this board's (PLATFORM.md section
+//! and the wiring of the chips' pins are this board's (docs/PROTOCOL.md section
 //! 3 leaves them to the developers) and are documented here, in
 //! `emulator/src/board/mod.rs` and in docs/ARCHITECTURE.md. The reference
 //! ROM's `hardware.inc` uses the same numbers; a romlib test compares them.

@@ -1,4 +1,4 @@
-//! The Scorpion controller card (PLATFORM.md section 3): its memory map,
+//! The Scorpion controller card (docs/PROTOCOL.md section 3): its memory map,
 //! its chips and what they are wired to, as a [`Bus`](crate::Bus) for the
 //! CPU, plus the host's side of the robot.
 //!

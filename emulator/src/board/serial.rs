@@ -7,7 +7,7 @@
 //! therefore keeps the cycle at which a burst started and the number of
 //! half-bits sent since, and rounds only the absolute times.
 
-/// The CPU clock of the Scorpion (PLATFORM.md section 3): 1 MHz.
+/// The CPU clock of the Scorpion (docs/PROTOCOL.md section 3): 1 MHz.
 pub const CPU_HZ: u64 = 1_000_000;
 
 /// The 6551's crystal: every internal baud rate divides it by 16 and by a

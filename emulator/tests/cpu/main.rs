@@ -42,10 +42,7 @@ pub(crate) fn mos6502_assets(test: &str) -> Option<PathBuf> {
             !in_ci(),
             "the mos6502 package (a dev-dependency) was not found with `cargo metadata`"
         );
-        #[allow(clippy::print_stderr, reason = "the skip must be visible")]
-        {
-            eprintln!("SKIPPED {test}: the mos6502 package's test assets were not found");
-        }
+        scorpion_tests::tools::skipped(test, "the mos6502 package's test assets were not found");
     }
     found
 }

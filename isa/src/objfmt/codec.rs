@@ -110,6 +110,15 @@ impl<'a> Reader<'a> {
     }
 
     pub(crate) fn header(&mut self, magic: &[u8; 4], version: u8) -> Result<(), FormatError> {
+        self.header_versions(magic, version..=version).map(|_| ())
+    }
+
+    /// The header of a format read in any of `versions`; the version found.
+    pub(crate) fn header_versions(
+        &mut self,
+        magic: &[u8; 4],
+        versions: std::ops::RangeInclusive<u8>,
+    ) -> Result<u8, FormatError> {
         if self.take(4)? != magic {
             return Err(FormatError {
                 section: self.section,
@@ -118,12 +127,16 @@ impl<'a> Reader<'a> {
             });
         }
         let found = self.u8()?;
-        if found != version {
+        if !versions.contains(&found) {
+            let expected = match versions.start() == versions.end() {
+                true => versions.start().to_string(),
+                false => format!("{} to {}", versions.start(), versions.end()),
+            };
             return Err(self.error(format!(
-                "version {found} is not supported (expected {version})"
+                "version {found} is not supported (expected {expected})"
             )));
         }
-        Ok(())
+        Ok(found)
     }
 }
 

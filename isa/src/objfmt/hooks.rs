@@ -32,7 +32,7 @@ pub const HOOK_LOOP_SYMBOL: &str = "__scorpion_hook_loop";
 /// Exported by an operating system: the 2-byte slot for `HOOK_LOOP`'s previous target.
 pub const CHAIN_LOOP_SYMBOL: &str = "__scorpion_chain_loop";
 
-/// The two RAM hooks of the Scorpion ROM (PLATFORM.md section 4).
+/// The two RAM hooks of the Scorpion ROM (docs/PROTOCOL.md section 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum HookKind {
     /// `HOOK_UNKNOWN`: unknown commands.

@@ -6,7 +6,11 @@
 //!   column: u32`, sorted by (section, offset). An entry covers the bytes from
 //!   its offset up to the next entry's offset in the same section;
 //! - symbols: count, then `symbol: u32, file: u32, line: u32, column: u32`
-//!   (symbol = index in `.symtab`).
+//!   (symbol = index in `.symtab`);
+//! - version 2 adds expansions: count, then `symbol: u32, file: u32, line:
+//!   u32, column: u32`, the outermost macro call that defined the symbol
+//!   (the user's line, where the definition's own place is in the macro's
+//!   body). Version 1 maps decode with none.
 //!
 //! `section` is an ELF section header index. Lines and columns count from 1.
 
@@ -14,7 +18,7 @@ use super::SRCMAP_SECTION;
 use super::codec::{FormatError, Reader, Writer};
 
 const MAGIC: &[u8; 4] = b"SCSM";
-const VERSION: u8 = 1;
+const VERSION: u8 = 2;
 
 /// A place in a source file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -45,6 +49,10 @@ pub struct SymbolLoc {
     pub symbol: u32,
     /// Where it was defined.
     pub loc: SourceLoc,
+    /// The outermost macro call that expanded to the definition, when a
+    /// macro defined it: `loc` is then in the macro's body, and this is
+    /// the user's line.
+    pub expanded_at: Option<SourceLoc>,
 }
 
 /// The decoded `.scorpion.srcmap` section.
@@ -92,6 +100,16 @@ impl SrcMap {
             out.u32(symbol.symbol);
             write_loc(&mut out, symbol.loc);
         }
+        let expanded: Vec<(u32, SourceLoc)> = self
+            .symbols
+            .iter()
+            .filter_map(|s| Some((s.symbol, s.expanded_at?)))
+            .collect();
+        out.len32(expanded.len());
+        for (symbol, loc) in expanded {
+            out.u32(symbol);
+            write_loc(&mut out, loc);
+        }
         out.bytes
     }
 
@@ -102,7 +120,7 @@ impl SrcMap {
     /// entry names a file that is not in the table.
     pub fn decode(bytes: &[u8]) -> Result<SrcMap, FormatError> {
         let mut input = Reader::new(SRCMAP_SECTION, bytes);
-        input.header(MAGIC, VERSION)?;
+        let version = input.header_versions(MAGIC, 1..=VERSION)?;
         let file_count = input.count(4)?;
         let mut files = Vec::with_capacity(file_count);
         for _ in 0..file_count {
@@ -127,7 +145,28 @@ impl SrcMap {
         for _ in 0..symbol_count {
             let symbol = input.u32()?;
             let loc = read_loc(&mut input, files.len())?;
-            symbols.push(SymbolLoc { symbol, loc });
+            symbols.push(SymbolLoc {
+                symbol,
+                loc,
+                expanded_at: None,
+            });
+        }
+        if version >= 2 {
+            let by_symbol: std::collections::HashMap<u32, usize> = symbols
+                .iter()
+                .enumerate()
+                .map(|(index, s)| (s.symbol, index))
+                .collect();
+            for _ in 0..input.count(16)? {
+                let symbol = input.u32()?;
+                let loc = read_loc(&mut input, files.len())?;
+                let Some(&index) = by_symbol.get(&symbol) else {
+                    return Err(input.error(format!(
+                        "an expansion names symbol {symbol}, which has no place"
+                    )));
+                };
+                symbols[index].expanded_at = Some(loc);
+            }
         }
         if !input.is_empty() {
             return Err(input.error("trailing bytes after the symbol table"));
@@ -153,10 +192,14 @@ impl SrcMap {
     /// Where symbol `symbol` (a `.symtab` index) was defined.
     #[must_use]
     pub fn symbol(&self, symbol: u32) -> Option<SourceLoc> {
-        self.symbols
-            .iter()
-            .find(|entry| entry.symbol == symbol)
-            .map(|entry| entry.loc)
+        self.symbol_entry(symbol).map(|entry| entry.loc)
+    }
+
+    /// The whole record of symbol `symbol`: its place and, when a macro
+    /// defined it, the macro call that did.
+    #[must_use]
+    pub fn symbol_entry(&self, symbol: u32) -> Option<&SymbolLoc> {
+        self.symbols.iter().find(|entry| entry.symbol == symbol)
     }
 
     /// The path of a location's file.
@@ -215,10 +258,18 @@ mod tests {
                     loc: loc(20),
                 },
             ],
-            symbols: vec![SymbolLoc {
-                symbol: 7,
-                loc: loc(9),
-            }],
+            symbols: vec![
+                SymbolLoc {
+                    symbol: 7,
+                    loc: loc(9),
+                    expanded_at: None,
+                },
+                SymbolLoc {
+                    symbol: 9,
+                    loc: loc(30),
+                    expanded_at: Some(loc(40)),
+                },
+            ],
         }
     }
 
@@ -233,6 +284,8 @@ mod tests {
         assert_eq!(map.lookup(4, 1).unwrap().line, 20);
         assert_eq!(map.symbol(7).unwrap().line, 9);
         assert_eq!(map.symbol(8), None);
+        assert_eq!(map.symbol_entry(7).unwrap().expanded_at, None);
+        assert_eq!(map.symbol_entry(9).unwrap().expanded_at.unwrap().line, 40);
     }
 
     #[test]

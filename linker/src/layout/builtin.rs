@@ -13,7 +13,7 @@ pub const BUILTIN_TARGETS: [&str; 4] = ["flat", "scorpion-ext", "scorpion-os", "
 /// property, not a ROM one.
 const KIM_START: u64 = 0x1000;
 const KIM_END: u64 = 0xBFFF;
-/// The ROM (PLATFORM.md section 3).
+/// The ROM (docs/PROTOCOL.md section 3).
 const ROM_START: u64 = 0xF000;
 const ROM_SIZE: u64 = 0x1000;
 /// The ROM's own RAM starts after the stack page (ARCHITECTURE.md).

@@ -1,4 +1,4 @@
-//! Answers: every answer form of PLATFORM.md section 2 parsed into typed
+//! Answers: every answer form of docs/PROTOCOL.md section 2 parsed into typed
 //! structs (and encoded back, for robots modelled in tests).
 
 use super::EOL;
@@ -46,7 +46,7 @@ impl Bumpers {
     }
 }
 
-/// The busy byte of an `Xhh` answer (PLATFORM.md section 2).
+/// The busy byte of an `Xhh` answer (docs/PROTOCOL.md section 2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct BusyByte(pub u8);
 
@@ -327,7 +327,7 @@ fn move_count(cursor: &mut Cursor<'_>) -> Result<MoveCount, Miss> {
 
 fn moves(cursor: &mut Cursor<'_>) -> Result<MoveCounts, Miss> {
     let left = move_count(cursor)?;
-    // PLATFORM.md: hosts accept a space between the two groups.
+    // docs/PROTOCOL.md: hosts accept a space between the two groups.
     cursor.optional(b' ');
     let right = move_count(cursor)?;
     Ok(MoveCounts { left, right })

@@ -1,4 +1,4 @@
-//! Commands: every instruction and question of PLATFORM.md section 2, with
+//! Commands: every instruction and question of docs/PROTOCOL.md section 2, with
 //! checked field types, built into the exact ASCII the ROM reads and parsed
 //! back from it.
 
@@ -269,7 +269,7 @@ impl WordWrite {
     }
 }
 
-/// Every instruction and question of PLATFORM.md section 2, plus commands
+/// Every instruction and question of docs/PROTOCOL.md section 2, plus commands
 /// for extensions.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum Command {

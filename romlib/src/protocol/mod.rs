@@ -1,4 +1,4 @@
-//! The host side of the Scorpion command protocol, typed (PLATFORM.md
+//! The host side of the Scorpion command protocol, typed (docs/PROTOCOL.md
 //! section 2).
 //!
 //! Every instruction and question is a [`Command`]: its fields are value
@@ -31,7 +31,7 @@ pub use command::{
 };
 pub use error::ProtocolError;
 
-/// The carriage return that ends every answer (PLATFORM.md section 2).
+/// The carriage return that ends every answer (docs/PROTOCOL.md section 2).
 pub const EOL: u8 = b'\r';
 
 /// The byte that starts every command.

@@ -1,4 +1,4 @@
-//! Exact encodings from PLATFORM.md, every malformed-answer path, and
+//! Exact encodings from docs/PROTOCOL.md, every malformed-answer path, and
 //! proptest round trips of every command and answer form.
 
 use proptest::prelude::*;

@@ -1,5 +1,5 @@
 ; Errors in an included file and in a macro from it carry the backtrace.
         .include "bad.inc"
         inc_macro 999
-        .include "nothere.inc"
         .include
+        .include "nothere.inc"
