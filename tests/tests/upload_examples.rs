@@ -43,6 +43,18 @@ fn check(transport: VirtualTransport, expectations: &str) -> VirtualTransport {
     client.into_transport()
 }
 
+/// The checksum example, linked with its own layout (beside another
+/// extension at `$0400`).
+fn checksum_image() -> UploadImage {
+    image(
+        "checksum/checksum.s",
+        &examples_dir()
+            .join("checksum/checksum.toml")
+            .display()
+            .to_string(),
+    )
+}
+
 fn hook(transport: &VirtualTransport, at: u16) -> u16 {
     let memory = transport.robot().robot().board().memory();
     u16::from_le_bytes([memory[usize::from(at) + 1], memory[usize::from(at) + 2]])
@@ -76,13 +88,7 @@ fn the_patrol_os_goes_in_through_the_loader_and_the_checksum_chains_behind() {
 
     // A second extension: the loader stays out (an extension is installed),
     // and it chains to patrol's handler.
-    let checksum = image(
-        "checksum/checksum.s",
-        &examples_dir()
-            .join("checksum/checksum.toml")
-            .display()
-            .to_string(),
-    );
+    let checksum = checksum_image();
     let (report, transport) = upload(transport, &checksum, LoaderChoice::Auto);
     assert_eq!(report.loader, None);
     assert_eq!(
@@ -151,13 +157,7 @@ fn every_example_uploads_on_both_paths() {
 /// kept for the transcript), and `=> nothing` (silence required).
 #[test]
 fn expectations_keep_every_answer_and_can_require_silence() {
-    let checksum = image(
-        "checksum/checksum.s",
-        &examples_dir()
-            .join("checksum/checksum.toml")
-            .display()
-            .to_string(),
-    );
+    let checksum = checksum_image();
     let (_, transport) = upload(VirtualTransport::default(), &checksum, LoaderChoice::Never);
     let expectations =
         Expectations::parse("/9W10000102\n/9K10000002\n/1Q => nothing\n/9K10000000 => K0000\n")
