@@ -25,7 +25,7 @@ struct Cli {
 enum Command {
     /// Assemble a ca65-syntax source file into an ELF object.
     Asm(cmd::asm::Args),
-    /// Disassemble a raw binary file.
+    /// Disassemble a linked image, an ELF object or a raw binary.
     Disasm(cmd::disasm::Args),
     /// Run 6502 code on the emulator.
     Emu(cmd::emu::Args),
@@ -39,6 +39,8 @@ enum Command {
     Ports(cmd::ports::Args),
     /// Dump robot memory with `/7R` questions.
     Read(cmd::read::Args),
+    /// List the extensions a robot has installed, and its hooks' chains.
+    Installed(cmd::installed::Args),
     /// Run the virtual Scorpion on a pseudo-terminal or stdin/stdout.
     Sim(cmd::sim::Args),
     /// Send commands to a robot and print the answers.
@@ -56,6 +58,7 @@ fn main() -> ExitCode {
         Command::Upload(args) => cmd::upload::run(&args),
         Command::Ports(args) => cmd::ports::run(&args),
         Command::Read(args) => cmd::read::run(&args),
+        Command::Installed(args) => cmd::installed::run(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Ask(args) => cmd::ask::run(&args),
     };

@@ -47,6 +47,11 @@ soft_reset:
 @ram:   sta CMDLEN,x            ; the ROM's state in $0206-$021F
         dex
         bpl @ram
+        ; Nothing is installed: the hooks are the ROM's. Only the flags
+        ; bytes are cleared, so interrupts stay off no longer than before.
+        .repeat EXTTAB_ENTRIES, entry
+        sta EXTTAB + entry
+        .endrepeat
         lda #$4C                ; JMP
         sta HOOK_UNKNOWN
         sta HOOK_LOOP

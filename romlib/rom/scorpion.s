@@ -26,6 +26,7 @@
         ; the receive ring: how much a host may send ahead of an answer, and
         ; for a handler that reads its own data faster than CHKCH does
         .export RXBUF, RXBUF_SIZE
+        .export EXTTAB, EXTTAB_ENTRIES, EXTTAB_ENTRY_LEN
         .exportzp RXHEAD, RXTAIL
         ; the jump table
         .export PUTCH, PUTHEX, PUTDEC4, PUTEOL, GETHEX, GETDEC

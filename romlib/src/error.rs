@@ -70,6 +70,58 @@ pub enum Error {
         timeout_ms: u64,
     },
 
+    /// An image would overwrite memory an installed extension owns.
+    #[error("the image's memory {new} overlaps {old}, owned by the installed extension {id:06X}")]
+    #[diagnostic(
+        code(romlib::overlap),
+        help(
+            "link the image somewhere else (another layout: --target FILE.toml), replace the installed one (`scorpion upload --replace`), or reset the robot (/1R) to start afresh"
+        )
+    )]
+    Overlap {
+        /// The new image's extent, `$0400-$0452`.
+        new: String,
+        /// The installed extension's extent.
+        old: String,
+        /// The installed extension's id.
+        id: u32,
+    },
+
+    /// The hook already jumps to the handler: installing it again would
+    /// make the chain jump to itself.
+    #[error("{hook} already jumps to ${handler:04X}: that handler is installed already")]
+    #[diagnostic(
+        code(romlib::hooked_twice),
+        help("an image installs once; to load it again, reset the robot (/1R) first")
+    )]
+    HookedTwice {
+        /// The hook's name.
+        hook: &'static str,
+        /// The handler.
+        handler: u16,
+    },
+
+    /// The table of installed extensions has no room for another.
+    #[error("the robot's table of installed extensions is full ({capacity} entries): {reason}")]
+    #[diagnostic(
+        code(romlib::table_full),
+        help("reset the robot (/1R) to remove every extension, or replace one")
+    )]
+    TableFull {
+        /// Entries in the table.
+        capacity: usize,
+        /// What did not fit.
+        reason: String,
+    },
+
+    /// The table of installed extensions holds something no loader wrote.
+    #[error(transparent)]
+    #[diagnostic(
+        code(romlib::damaged_table),
+        help("reset the robot (/1R): the table and the hooks start afresh")
+    )]
+    DamagedTable(#[from] crate::installed::DamagedTable),
+
     /// The emulated CPU hit a JAM opcode.
     #[error("the robot's CPU jammed at ${pc:04X} (opcode ${opcode:02X})")]
     #[diagnostic(

@@ -15,6 +15,7 @@
 //!   protocol at the line's baud rate.
 
 mod error;
+pub mod installed;
 pub mod protocol;
 pub mod sim;
 pub mod symbols;

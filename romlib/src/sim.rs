@@ -16,6 +16,7 @@ use isa::objfmt::HookKind;
 use linker::Image;
 
 use crate::error::Error;
+use crate::installed;
 use crate::protocol::{Answer, Command};
 use crate::symbols;
 
@@ -63,6 +64,9 @@ impl Hooks {
 pub struct VirtualScorpion {
     robot: Scorpion,
     hooks: Hooks,
+    /// The ROM's table of installed extensions (`EXTTAB`) and its entries,
+    /// if the ROM keeps one.
+    table: Option<(u16, usize)>,
 }
 
 impl Default for VirtualScorpion {
@@ -83,6 +87,7 @@ impl VirtualScorpion {
                 unknown: symbols::HOOK_UNKNOWN,
                 main_loop: symbols::HOOK_LOOP,
             },
+            table: Some((installed::TABLE, installed::ENTRIES)),
         };
         scorpion.boot();
         scorpion
@@ -115,9 +120,16 @@ impl VirtualScorpion {
             unknown: symbol("HOOK_UNKNOWN")?,
             main_loop: symbol("HOOK_LOOP")?,
         };
+        // A table in the reference ROM's format, if this ROM keeps one.
+        let table = rom
+            .symbol("EXTTAB")
+            .zip(rom.symbol("EXTTAB_ENTRIES"))
+            .filter(|_| rom.symbol("EXTTAB_ENTRY_LEN") == Some(installed::ENTRY_LEN as u32))
+            .and_then(|(at, entries)| Some((u16::try_from(at).ok()?, entries as usize)));
         let mut scorpion = VirtualScorpion {
             robot: Scorpion::scorpion(&bytes)?,
             hooks,
+            table,
         };
         scorpion.boot();
         Ok(scorpion)
@@ -161,27 +173,102 @@ impl VirtualScorpion {
         true
     }
 
-    /// Loads `image` as an upload leaves it: every loaded area written into
-    /// RAM, then each hook it takes over installed (chain slot first, then
-    /// the hook's operand). Returns the hooks installed.
+    /// Loads `image` as an upload leaves it: the table of installed
+    /// extensions read first (an image that overlaps one is refused), every
+    /// loaded area written into RAM, the image's table entries, then each
+    /// hook it takes over installed (chain slot first, then the hook's
+    /// operand). Returns the hooks installed.
     ///
     /// # Errors
-    /// [`Error::Emulator`] if an area does not fit in RAM, [`Error::HookNotJmp`]
-    /// if a hook does not hold a `JMP`. Nothing is written when an area does
-    /// not fit.
+    /// [`Error::Emulator`] if an area does not fit in RAM,
+    /// [`Error::Overlap`] if it overlaps an installed extension,
+    /// [`Error::TableFull`], [`Error::DamagedTable`], [`Error::HookNotJmp`]
+    /// if a hook does not hold a `JMP`. Nothing is written when any of
+    /// these is found before the first write.
     pub fn load_image(&mut self, image: &Image) -> Result<Vec<InstalledHook>, Error> {
         for area in &image.areas {
             self.check_ram(area.load, area.bytes.len())?;
         }
+        let extents = installed::image_extents(image);
+        let mut entry = None;
+        if let Some((table, capacity)) = self.table {
+            let present = self.installed()?;
+            for old in &present {
+                for new in &extents {
+                    if let Some(owned) = old
+                        .extents
+                        .iter()
+                        .find(|o| o.start() <= new.end() && new.start() <= o.end())
+                    {
+                        return Err(Error::Overlap {
+                            new: installed::extent_text(new),
+                            old: installed::extent_text(owned),
+                            id: old.id,
+                        });
+                    }
+                }
+            }
+            let hooks = image
+                .hooks
+                .records
+                .iter()
+                .map(|record| installed::TakenHook {
+                    kind: record.kind,
+                    handler: record.handler,
+                    chain: record.chain,
+                })
+                .collect();
+            let new = installed::Installed {
+                id: installed::image_id(image.areas.iter().flat_map(|a| a.bytes.iter().copied())),
+                extents,
+                hooks,
+                slot: 0,
+            };
+            let slot =
+                installed::free_slot(&present, new.entries(), capacity).ok_or_else(|| {
+                    Error::TableFull {
+                        capacity,
+                        reason: format!("the image needs {} entries", new.entries()),
+                    }
+                })?;
+            entry = Some((
+                installed::entry_address(table, capacity, slot),
+                new.encode(),
+                installed::flags_address(table, slot),
+                new.flags(),
+            ));
+        }
         for area in &image.areas {
             let start = u16::try_from(area.load).unwrap_or_else(|_| unreachable!("checked"));
             self.robot.board_mut().load(start, &area.bytes)?;
+        }
+        // The entries, then their flags, which make them count.
+        if let Some((at, bytes, flags_at, flags)) = entry {
+            self.robot.board_mut().load(at, &bytes)?;
+            self.robot.board_mut().load(flags_at, &flags)?;
         }
         let mut installed = Vec::new();
         for record in &image.hooks.records {
             installed.push(self.install_hook(record.kind, record.handler, record.chain)?);
         }
         Ok(installed)
+    }
+
+    /// What the robot's table of installed extensions holds (empty if the
+    /// ROM keeps no table).
+    ///
+    /// # Errors
+    /// [`Error::DamagedTable`] if it holds what no loader wrote.
+    pub fn installed(&self) -> Result<Vec<installed::Installed>, Error> {
+        let Some((table, capacity)) = self.table else {
+            return Ok(Vec::new());
+        };
+        let memory = self.robot.board().memory();
+        let start = usize::from(table);
+        let bytes = memory
+            .get(start..start + capacity * (1 + installed::ENTRY_LEN))
+            .unwrap_or_default();
+        Ok(installed::decode_table(table, capacity, bytes)?)
     }
 
     /// Whether `len` bytes from `load` are all RAM the board lets a loader
@@ -227,6 +314,12 @@ impl VirtualScorpion {
             memory[usize::from(hook.wrapping_add(1))],
             memory[usize::from(hook.wrapping_add(2))],
         ]);
+        if previous == handler {
+            return Err(Error::HookedTwice {
+                hook: kind.rom_symbol(),
+                handler,
+            });
+        }
         if let Some(slot) = chain {
             self.robot.board_mut().load(slot, &previous.to_le_bytes())?;
         }

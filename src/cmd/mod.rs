@@ -5,6 +5,7 @@ pub(crate) mod asm;
 pub(crate) mod build;
 pub(crate) mod disasm;
 pub(crate) mod emu;
+pub(crate) mod installed;
 pub(crate) mod link;
 pub(crate) mod ports;
 pub(crate) mod read;

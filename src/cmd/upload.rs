@@ -43,6 +43,11 @@ pub(crate) struct Args {
     /// Skip the rehearsal on the virtual Scorpion.
     #[arg(long)]
     no_dry_run: bool,
+    /// Replace an installed extension the image overlaps: it is taken out
+    /// of its hooks' chains (verified) before the image is written. Without
+    /// it such an upload is refused; `scorpion installed` lists what is there.
+    #[arg(long)]
+    replace: bool,
     /// The RAM loader: `auto` uses it when it is faster and safe to place.
     #[arg(long, value_enum, default_value_t = Loader::Auto)]
     loader: Loader,
@@ -77,6 +82,7 @@ impl Args {
                 Loader::Always => LoaderChoice::Always,
             },
             fast_baud: (self.fast_baud != 0).then_some(self.fast_baud),
+            replace: self.replace,
             ..UploadOptions::default()
         }
     }

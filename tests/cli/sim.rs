@@ -159,3 +159,42 @@ fn sim_serves_a_pseudo_terminal_at_the_baud_rate() {
     // simulator keeps the line's pace rather than answering at once.
     assert!(elapsed >= Duration::from_millis(50), "{elapsed:?}");
 }
+
+/// Issue 11's first reproduction: two extensions built with the defaults
+/// both sit at `$0400`. The second is refused before a byte of it is
+/// loaded, naming both extents, and the sim exits non-zero instead of
+/// chaining the hook to itself.
+#[test]
+fn sim_refuses_an_image_that_overlaps_an_installed_one() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    for (source, output) in [
+        ("rangefinder/rangefinder.s", "first.elf"),
+        ("checksum/checksum.s", "second.elf"),
+    ] {
+        let source = examples.join(source);
+        let built = scorpion(
+            dir.path(),
+            &["build", source.to_str().expect("UTF-8"), "-o", output],
+        );
+        assert!(built.status.success(), "{}", transcript(&built));
+    }
+    let first = dir.path().join("first.elf");
+    let second = dir.path().join("second.elf");
+    let output = sim(
+        &[
+            "--image",
+            first.to_str().expect("UTF-8"),
+            "--image",
+            second.to_str().expect("UTF-8"),
+        ],
+        "/1X\n",
+    );
+    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(
+        !text.contains("(was $0400)"),
+        "the chain points at itself: {text}"
+    );
+    insta::assert_snapshot!(text);
+}

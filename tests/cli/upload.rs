@@ -398,3 +398,55 @@ fn the_readme_main_job_prints_what_the_readme_says() {
         assert!(script.contains(step), "demo/main-job.sh lost `{step}`");
     }
 }
+
+/// Issue 11's second reproduction, through a real pseudo-terminal: a
+/// second extension at `$0400` onto a robot that has the first is refused
+/// with nothing sent but questions; `scorpion installed` shows what is
+/// there; `--replace` takes the first out of the chain and puts the second
+/// in, and the robot answers the new command and no longer the old one.
+#[test]
+fn an_overlapping_upload_is_refused_and_replace_swaps_the_extension() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    for (source, output) in [
+        ("rangefinder/rangefinder.s", "first.elf"),
+        ("checksum/checksum.s", "second.elf"),
+    ] {
+        let source = examples.join(source);
+        let built = scorpion(
+            dir.path(),
+            &["build", source.to_str().expect("UTF-8"), "-o", output],
+        );
+        assert!(built.status.success(), "{}", transcript(&built));
+    }
+    let sim = Sim::start();
+    let port = sim.path.as_str();
+    let first = scorpion(dir.path(), &["upload", "first.elf", "--port", port]);
+    assert_eq!(first.status.code(), Some(0), "{}", transcript(&first));
+    let second = scorpion(dir.path(), &["upload", "second.elf", "--port", port]);
+    let text = transcript(&second);
+    assert_eq!(second.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("romlib::overlap") && text.contains("--replace"),
+        "{text}"
+    );
+    let listed = scorpion(dir.path(), &["installed", "--port", port]);
+    let text = transcript(&listed);
+    assert_eq!(listed.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("HOOK_UNKNOWN: $0400 (") && text.contains(") -> $FF21"),
+        "{text}"
+    );
+    let replaced = scorpion(
+        dir.path(),
+        &["upload", "second.elf", "--port", port, "--replace"],
+    );
+    assert_eq!(replaced.status.code(), Some(0), "{}", transcript(&replaced));
+    let asked = scorpion(dir.path(), &["ask", "--port", port, "/9KF0000002", "/1U"]);
+    let text = transcript(&asked);
+    assert!(text.contains("K"), "the new command answers: {text}");
+    assert!(!text.contains("U0"), "the replaced command is gone: {text}");
+    let listed = scorpion(dir.path(), &["installed", "--port", port]);
+    let text = transcript(&listed);
+    assert_eq!(text.matches("extension ").count(), 1, "{text}");
+}

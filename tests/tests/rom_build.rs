@@ -41,13 +41,25 @@ const PLATFORM_NAMES: [&str; 17] = [
 
 #[test]
 fn every_platform_name_is_exported_with_the_decided_values() {
-    for name in PLATFORM_NAMES.into_iter().chain(["USER_RAM_END"]) {
+    let table = ["EXTTAB", "EXTTAB_ENTRIES", "EXTTAB_ENTRY_LEN"];
+    for name in PLATFORM_NAMES
+        .into_iter()
+        .chain(["USER_RAM_END"])
+        .chain(table)
+    {
         assert!(symbols::find(name).is_some(), "{name} is not exported");
     }
     assert_eq!(symbols::HOOK_UNKNOWN, 0x0200);
     assert_eq!(symbols::HOOK_LOOP, 0x0203);
     assert_eq!(symbols::USER_RAM_START, 0x0400);
-    assert_eq!(symbols::USER_RAM_END, 0x0FFF);
+    // The table of installed extensions ends the controller card's RAM.
+    assert_eq!(symbols::USER_RAM_END, 0x0F7F);
+    assert_eq!(symbols::EXTTAB, symbols::USER_RAM_END + 1);
+    assert_eq!(
+        u32::from(symbols::EXTTAB)
+            + u32::from(symbols::EXTTAB_ENTRIES * (1 + symbols::EXTTAB_ENTRY_LEN)),
+        0x1000
+    );
     assert_eq!(symbols::USER_ZP_END, 0x00FF);
     let user_zp = symbols::find("USER_ZP_START").expect("exported").value;
     assert!(user_zp < 0x80, "most of the zero page is the user's");

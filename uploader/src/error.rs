@@ -314,6 +314,12 @@ pub enum Error {
     #[diagnostic(transparent)]
     Protocol(#[from] ProtocolError),
 
+    /// What the robot's own state refuses: an image that overlaps an
+    /// installed extension, a full or damaged table of installed ones.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Robot(#[from] romlib::Error),
+
     /// The expectation file's commands did not get the answers it requires.
     #[error("rehearsal failed: `{command}` answered `{found}`, expected `{expected}`")]
     #[diagnostic(

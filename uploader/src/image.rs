@@ -37,6 +37,9 @@ impl Area {
 pub struct UploadImage {
     areas: Vec<Area>,
     hooks: Vec<HookRecord>,
+    /// The memory the image owns: its areas, and where a linked image's
+    /// segments run (BSS and zero page too), merged.
+    extents: Vec<std::ops::RangeInclusive<u16>>,
 }
 
 impl UploadImage {
@@ -72,7 +75,12 @@ impl UploadImage {
                 });
             }
         }
-        let image = UploadImage { areas, hooks };
+        let extents = crate::table::extents_of(&areas);
+        let image = UploadImage {
+            areas,
+            hooks,
+            extents,
+        };
         for record in &image.hooks {
             if !image.contains(record.handler) {
                 return Err(Error::BadHookRecord {
@@ -104,6 +112,20 @@ impl UploadImage {
         &self.hooks
     }
 
+    /// The memory the image owns, sorted and merged: what the table of
+    /// installed extensions records for it.
+    #[must_use]
+    pub fn extents(&self) -> &[std::ops::RangeInclusive<u16>] {
+        &self.extents
+    }
+
+    /// Its id in the table of installed extensions (24 bits of a hash of
+    /// its loaded bytes as linked, chain slots unfilled).
+    #[must_use]
+    pub fn id(&self) -> u32 {
+        romlib::installed::image_id(self.areas.iter().flat_map(|a| a.bytes.iter().copied()))
+    }
+
     /// Total bytes loaded.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -123,6 +145,13 @@ impl UploadImage {
             .iter()
             .find(|area| area.contains(address))
             .map(|area| area.bytes[usize::from(address - area.address)])
+    }
+
+    /// Adds an area the upload writes besides the image's own (its entry in
+    /// the table of installed extensions), keeping the areas sorted.
+    pub(crate) fn push_area(&mut self, area: Area) {
+        let at = self.areas.partition_point(|a| a.address < area.address);
+        self.areas.insert(at, area);
     }
 
     /// Overwrites a loaded byte (used to fill chain slots). Returns whether
@@ -154,7 +183,9 @@ impl TryFrom<&linker::Image> for UploadImage {
                 bytes: area.bytes.clone(),
             });
         }
-        UploadImage::new(areas, image.hooks.records.clone())
+        let mut upload = UploadImage::new(areas, image.hooks.records.clone())?;
+        upload.extents = romlib::installed::image_extents(image);
+        Ok(upload)
     }
 }
 
@@ -191,6 +222,10 @@ pub struct RomProfile {
     /// losing any: the most the host may send ahead of an answer. From the
     /// ROM's exported `RXBUF_SIZE` (less the slot a ring keeps free).
     pub rx_buffer: usize,
+    /// The ROM's table of installed extensions (`EXTTAB`, in
+    /// `romlib::installed`'s format) and its entries; `None` for a ROM that
+    /// keeps none, whose robot cannot say what is installed.
+    pub table: Option<(u16, usize)>,
 }
 
 /// The ROM services the RAM loader calls (jump-table entries).
@@ -299,6 +334,7 @@ impl RomProfile {
                 ),
             }),
             rx_buffer: ring_capacity(rom::RXBUF_SIZE),
+            table: Some((romlib::installed::TABLE, romlib::installed::ENTRIES)),
         }
     }
 
@@ -349,6 +385,10 @@ impl RomProfile {
                 _ => None,
             },
             rx_buffer: symbol("RXBUF_SIZE").map_or(CONSERVATIVE_RX_BUFFER, ring_capacity),
+            table: symbol("EXTTAB")
+                .zip(symbol("EXTTAB_ENTRIES"))
+                .filter(|_| symbol("EXTTAB_ENTRY_LEN") == Some(romlib::installed::ENTRY_LEN as u16))
+                .map(|(at, entries)| (at, usize::from(entries))),
         })
     }
 

@@ -29,6 +29,7 @@ mod image;
 mod loader;
 mod progress;
 mod session;
+mod table;
 mod taper;
 pub mod transport;
 mod upload;
@@ -44,6 +45,7 @@ pub use loader::{
     FAST_BAUD, FRAME_MAX, LoaderPlan, loader_estimate, loader_frame, loader_plan, rom_only_estimate,
 };
 pub use progress::{Event, NoProgress, Phase, Progress};
+pub use table::{chain_of, read_installed};
 pub use transport::Transport;
 pub use upload::{
     InstalledHook, LoaderChoice, LoaderReport, UploadOptions, UploadReport, client, upload,

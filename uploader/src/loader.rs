@@ -520,7 +520,7 @@ mod tests {
         assert!(loader.len() < 80, "{} bytes", loader.len());
         assert_eq!(
             usize::from(loader.address()) + loader.len(),
-            0x1000,
+            usize::from(romlib::symbols::USER_RAM_END) + 1,
             "the top of user RAM"
         );
         assert_eq!(loader.rate, loader.address());

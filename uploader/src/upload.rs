@@ -26,6 +26,7 @@ use crate::image::{RomProfile, UploadImage};
 use crate::loader::{FAST_BAUD, Loader, loader_estimate, rom_only_estimate};
 use crate::progress::{Event, Phase, Progress};
 use crate::session::{Session, recoverable};
+use crate::table;
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
 
@@ -57,6 +58,9 @@ pub struct UploadOptions {
     /// The rate the loader switches the line to for the transfer; `None`
     /// keeps the rate the upload connected at.
     pub fast_baud: Option<u32>,
+    /// Take an installed extension that overlaps the image out of its
+    /// chains (and out of the table) instead of refusing the upload.
+    pub replace: bool,
 }
 
 impl Default for UploadOptions {
@@ -68,6 +72,7 @@ impl Default for UploadOptions {
             max_lost: 200,
             loader: LoaderChoice::Auto,
             fast_baud: Some(FAST_BAUD),
+            replace: false,
         }
     }
 }
@@ -245,7 +250,13 @@ pub fn upload<T: Transport>(
     let base = client.transport().baud();
     let rates = (base, options.fast_baud.unwrap_or(base));
     let leftover = Loader::place(profile, image, rates)?;
-    let (hooks_now, found_at) = connect(client, options)?;
+    let (mut hooks_now, found_at) = connect(client, options)?;
+    // What is installed: an overlap is refused (or, with `replace`, the old
+    // extension leaves its chains first, which changes the hooks).
+    let mut plan = table::prepare(client, profile, image, options.replace, options.max_writes)?;
+    if options.replace {
+        hooks_now = read_hooks(client, profile)?;
+    }
     let mut initial = Vec::new();
     for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
@@ -300,6 +311,13 @@ pub fn upload<T: Transport>(
             image.set_byte(slot + 1, high);
         }
     }
+    // The image's entry in the table goes in with the body, verified with
+    // it; its flags, which make it count, once body and entry are in.
+    let bytes = image.len();
+    if let Some(plan) = plan.as_mut() {
+        plan.free_first(client, options.max_writes)?;
+        image.push_area(plan.entry_area());
+    }
 
     let loader = choose_loader(options, &image, &initial, rates)?;
     if loader.is_none() && found_at != base {
@@ -311,7 +329,7 @@ pub fn upload<T: Transport>(
     }
     let mut session = None;
     let mut body;
-    let hooks;
+    let mut hooks;
     if let Some(loader) = loader {
         let mut running = Session::new(
             loader,
@@ -327,6 +345,7 @@ pub fn upload<T: Transport>(
                 body.plan_writes(client.transport().baud(), progress);
                 running.transfer(client, &mut body, progress)
             })
+            .and_then(|()| write_flags(client, plan.as_mut(), options))
             .and_then(|()| {
                 // `/1F` through the loader, its last job; then the hooks
                 // (the loader's replaced by the image's, or back to its
@@ -367,15 +386,22 @@ pub fn upload<T: Transport>(
         }
         session = Some(running);
     } else {
-        body = Body::new(&image, Writer::Rom);
-        body.plan_writes(client.transport().baud(), progress);
-        while body.run(client, limits, progress)? != RunEnd::Done {}
-        hooks = install_hooks(client, &image, options, &initial, None, progress)?;
+        (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+    }
+    // Through the loader, a reset is found and recovered from while the
+    // body goes in; one after its last check clears the entry's flags, and
+    // then the ROM's own path goes over the whole image again.
+    if session.is_some() && !still_installed(client, plan.as_ref())? {
+        unhook(client, &hooks, options)?;
+        if let Some(plan) = plan.as_mut() {
+            plan.forget_flags();
+        }
+        (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
     }
 
     let stats = client.stats();
     Ok(UploadReport {
-        bytes: image.len(),
+        bytes,
         device_time: client.transport().now().saturating_sub(start),
         chars_sent: stats.sent - stats_before.sent,
         chars_received: stats.received - stats_before.received,
@@ -393,6 +419,89 @@ pub fn upload<T: Transport>(
             }
         }),
     })
+}
+
+/// The body (the table entry with it) through the ROM's `/9W` with `/7R`
+/// verification, the entry's flags, then the hooks. A reset clears the
+/// flags: found set after the hooks, no reset undid the body since its
+/// last check; found cleared, the hooks go back and the whole image goes
+/// over again (three times at most).
+fn rom_path<T: Transport>(
+    client: &mut Client<T>,
+    image: &UploadImage,
+    options: &UploadOptions,
+    initial: &[(HookKind, u16)],
+    mut plan: Option<&mut table::Plan>,
+    progress: &mut dyn Progress,
+) -> Result<(Body, Vec<InstalledHook>)> {
+    for _ in 0..3 {
+        let mut body = Body::new(image, Writer::Rom);
+        body.plan_writes(client.transport().baud(), progress);
+        while body.run(client, options.limits(), progress)? != RunEnd::Done {}
+        write_flags(client, plan.as_deref_mut(), options)?;
+        let hooks = install_hooks(client, image, options, initial, None, progress)?;
+        if still_installed(client, plan.as_deref())? {
+            return Ok((body, hooks));
+        }
+        unhook(client, &hooks, options)?;
+        if let Some(plan) = plan.as_deref_mut() {
+            plan.forget_flags();
+        }
+    }
+    Err(reset_error(initial))
+}
+
+/// Whether the image's entry is still flagged in the table (a ROM without
+/// a table cannot tell: yes).
+fn still_installed<T: Transport>(
+    client: &mut Client<T>,
+    plan: Option<&table::Plan>,
+) -> Result<bool> {
+    match plan {
+        Some(plan) => plan.still_there(client),
+        None => Ok(true),
+    }
+}
+
+/// Points every hook the upload switched back at its target from before
+/// (a reset made that the ROM's own), verified.
+fn unhook<T: Transport>(
+    client: &mut Client<T>,
+    hooks: &[InstalledHook],
+    options: &UploadOptions,
+) -> Result<()> {
+    for hook in hooks {
+        let address = options.profile.hook_address(hook.kind);
+        let to = options
+            .profile
+            .reset_target(hook.kind)
+            .unwrap_or(hook.previous);
+        switch_hook(client, address, to, options.max_writes)?;
+    }
+    Ok(())
+}
+
+/// The robot reset while the image went in, more often than retried.
+fn reset_error(initial: &[(HookKind, u16)]) -> Error {
+    let (kind, before) = initial.first().copied().unwrap_or((HookKind::Unknown, 0));
+    Error::RobotReset {
+        hook: kind.rom_symbol(),
+        before,
+        after: before,
+    }
+}
+
+/// Sets the image's entry's flags in the table of installed extensions,
+/// verified (a ROM without a table: nothing).
+fn write_flags<T: Transport>(
+    client: &mut Client<T>,
+    plan: Option<&mut table::Plan>,
+    options: &UploadOptions,
+) -> Result<()> {
+    match plan {
+        Some(plan) => plan.write_flags(client, options.max_writes),
+        None => Ok(()),
+    }
 }
 
 /// Whether the robot still answers after `error`: worth asking it to take

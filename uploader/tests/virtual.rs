@@ -300,7 +300,7 @@ fn images_outside_user_memory_are_refused() {
     let full = UploadImage::new(
         vec![Area {
             address: 0x0400,
-            bytes: vec![0xEA; 0x0C00],
+            bytes: vec![0xEA; usize::from(romlib::symbols::USER_RAM_END) + 1 - 0x0400],
         }],
         vec![],
     )

@@ -1,7 +1,12 @@
 //! What the upload tests share: extension images that are real code, an
 //! upload run against the virtual Scorpion, and the one invariant every
 //! case checks in the emulated RAM afterwards.
-#![allow(dead_code, unreachable_pub, reason = "each test file uses a part")]
+#![allow(
+    dead_code,
+    unreachable_pub,
+    unused_imports,
+    reason = "each test file uses a part"
+)]
 
 mod image;
 

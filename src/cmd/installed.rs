@@ -1,0 +1,79 @@
+//! `scorpion installed`: what a robot has installed, from its table of
+//! installed extensions, and where each hook's chain runs.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::process::ExitCode;
+
+use isa::objfmt::HookKind;
+use miette::IntoDiagnostic;
+use romlib::installed::{Installed, extent_text};
+
+use crate::cmd::ports;
+
+/// List the extensions a robot has installed (the ROM's table, read with
+/// `/7R`): each one's id, memory and hooks, then each hook's chain in the
+/// order a command travels it.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    #[command(flatten)]
+    line: ports::Line,
+}
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let transport = args.line.open()?;
+    let profile = uploader::RomProfile::reference();
+    let mut client = uploader::client(transport, &profile);
+    client.probe()?;
+    let everyone = uploader::read_installed(&mut client, &profile)?;
+    let mut chains = Vec::new();
+    for kind in HookKind::ALL {
+        chains.push((
+            kind,
+            uploader::chain_of(&mut client, &profile, &everyone, kind)?,
+        ));
+    }
+    std::io::stdout()
+        .lock()
+        .write_all(listing(&everyone, &chains).as_bytes())
+        .into_diagnostic()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The listing, for people.
+fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
+    let mut out = String::new();
+    if everyone.is_empty() {
+        out.push_str("nothing installed\n");
+    }
+    for image in everyone {
+        let extents: Vec<String> = image.extents.iter().map(extent_text).collect();
+        let _ = write!(out, "extension {:06X}: {}", image.id, extents.join(", "));
+        for hook in &image.hooks {
+            let _ = write!(out, "; {} -> ${:04X}", hook.kind.rom_symbol(), hook.handler);
+            if let Some(slot) = hook.chain {
+                let _ = write!(out, " (chain slot ${slot:04X})");
+            }
+        }
+        out.push('\n');
+    }
+    for (kind, targets) in chains {
+        let steps: Vec<String> = targets
+            .iter()
+            .map(|target| {
+                let owner = everyone.iter().find(|image| {
+                    image
+                        .hooks
+                        .iter()
+                        .any(|hook| hook.kind == *kind && hook.handler == *target)
+                });
+                match owner {
+                    Some(image) => format!("${target:04X} ({:06X})", image.id),
+                    None => format!("${target:04X}"),
+                }
+            })
+            .collect();
+        let _ = writeln!(out, "{}: {}", kind.rom_symbol(), steps.join(" -> "));
+    }
+    out
+}

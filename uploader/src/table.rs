@@ -1,0 +1,411 @@
+//! The robot's table of installed extensions, from the host side: read
+//! before an upload writes anything (an image that overlaps an installed
+//! one is refused, or with `--replace` the old one is taken out of its
+//! chains first), and the new image's entries written and verified after
+//! its body and before its hooks, so the hook stays the last write.
+//! The format is `romlib::installed`'s.
+
+use std::ops::RangeInclusive;
+
+use isa::objfmt::HookKind;
+use romlib::installed::{self, ENTRY_LEN, Installed, TakenHook};
+use romlib::protocol::{Answer, Command, ReadSpan, WordWrite};
+
+use crate::client::Client;
+use crate::hooks::{read_word, write_word_verified};
+use crate::image::{Area, RomProfile, UploadImage};
+use crate::transport::Transport;
+use crate::{Error, Result};
+
+/// What the table says before an upload: what is installed, and where
+/// the new image's entries go.
+#[derive(Debug, Clone)]
+pub(crate) struct Plan {
+    /// The table's address and entries.
+    table: (u16, usize),
+    /// The new image's entry, at its first slot.
+    entry: Installed,
+    /// Its flags bytes now (set, where an earlier copy of the same image
+    /// left its entry).
+    current_flags: Vec<Option<u8>>,
+}
+
+/// Reads what the robot has installed (nothing, for a ROM without a table).
+///
+/// # Errors
+/// The client's, or [`romlib::Error::DamagedTable`].
+pub fn read_installed<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+) -> Result<Vec<Installed>> {
+    Ok(read_table(client, profile)?.map_or_else(Vec::new, |table| table.installed))
+}
+
+/// What the robot's table holds: its flags bytes, the bytes of the
+/// entries in use (read in one span, from the first in use to the last),
+/// and what they say. `None` for a ROM without a table.
+struct Table {
+    flags: Vec<u8>,
+    /// Entry bytes from the first entry in use on, with that slot.
+    entries: (usize, Vec<u8>),
+    installed: Vec<Installed>,
+}
+
+impl Table {
+    /// Entry `slot`'s bytes, when they were read.
+    fn entry(&self, slot: usize) -> Option<&[u8]> {
+        let start = slot.checked_sub(self.entries.0)? * ENTRY_LEN;
+        self.entries.1.get(start..start + ENTRY_LEN)
+    }
+}
+
+fn read_table<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Option<Table>> {
+    let Some((address, capacity)) = profile.table else {
+        return Ok(None);
+    };
+    let flags = client.read_memory(address, capacity)?;
+    let used: Vec<usize> = (0..capacity)
+        .filter(|&slot| flags[slot] & 0x80 != 0)
+        .collect();
+    let entries = match (used.first(), used.last()) {
+        (Some(&first), Some(&last)) => {
+            let at = installed::entry_address(address, capacity, first);
+            (
+                first,
+                client.read_memory(at, (last + 1 - first) * ENTRY_LEN)?,
+            )
+        }
+        _ => (0, Vec::new()),
+    };
+    let mut table = Table {
+        flags,
+        entries,
+        installed: Vec::new(),
+    };
+    table.installed = installed::decode(address, &table.flags, |slot| {
+        table.entry(slot).unwrap_or_default()
+    })
+    .map_err(|damaged| Error::Robot(damaged.into()))?;
+    Ok(Some(table))
+}
+
+/// Reads the table and decides: an installed image that overlaps `image`
+/// is an error, unless it is an earlier copy of the same image (its slot
+/// is reused) or `replace` is set (it is taken out of its chains and its
+/// entries cleared, verified, before anything else is written). `None`
+/// for a ROM that keeps no table.
+pub(crate) fn prepare<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    image: &UploadImage,
+    replace: bool,
+    max_writes: u32,
+) -> Result<Option<Plan>> {
+    let Some(table) = profile.table else {
+        return Ok(None);
+    };
+    let id = image.id();
+    let mut kept = Vec::new();
+    let mut reused = None;
+    let Some(mut read) = read_table(client, profile)? else {
+        return Ok(None);
+    };
+    let mut removed = false;
+    for old in std::mem::take(&mut read.installed) {
+        let overlap = image.extents().iter().find_map(|new| {
+            old.extents
+                .iter()
+                .find(|o| o.start() <= new.end() && new.start() <= o.end())
+                .map(|o| (new.clone(), o.clone()))
+        });
+        match overlap {
+            None => kept.push(old),
+            Some(_) if old.id == id && old.extents == image.extents() => reused = Some(old),
+            Some(_) if replace => {
+                remove(client, profile, &old, max_writes)?;
+                removed = true;
+            }
+            Some((new, owned)) => {
+                return Err(Error::Robot(romlib::Error::Overlap {
+                    new: installed::extent_text(&new),
+                    old: installed::extent_text(&owned),
+                    id: old.id,
+                }));
+            }
+        }
+    }
+    let mut entry = Installed {
+        id,
+        extents: image.extents().to_vec(),
+        hooks: image
+            .hooks()
+            .iter()
+            .map(|record| TakenHook {
+                kind: record.kind,
+                handler: record.handler,
+                chain: record.chain,
+            })
+            .collect(),
+        slot: 0,
+    };
+    entry.slot = match &reused {
+        Some(old) => old.slot,
+        None => installed::free_slot(&kept, entry.entries(), table.1).ok_or_else(|| {
+            Error::Robot(romlib::Error::TableFull {
+                capacity: table.1,
+                reason: format!(
+                    "the image needs {} entries, one per place its memory is in",
+                    entry.entries()
+                ),
+            })
+        })?,
+    };
+    if removed {
+        read = read_table(client, profile)?.unwrap_or(read);
+    }
+    let current_flags: Vec<Option<u8>> = read.flags[entry.slot..entry.slot + entry.entries()]
+        .iter()
+        .map(|&b| Some(b))
+        .collect();
+    Ok(Some(Plan {
+        table,
+        entry,
+        current_flags,
+    }))
+}
+
+impl Plan {
+    /// The entry's bytes (its flags apart), to go in with the body and be
+    /// verified with it: through the RAM loader at its rate, or with `/9W`.
+    pub(crate) fn entry_area(&self) -> Area {
+        let (table, capacity) = self.table;
+        Area {
+            address: installed::entry_address(table, capacity, self.entry.slot),
+            bytes: self.entry.encode(),
+        }
+    }
+
+    /// Frees the entry's slots first, where an earlier copy of the image
+    /// left them flagged: the body about to rewrite them must not pass for
+    /// a finished entry if the upload stops half way.
+    pub(crate) fn free_first<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        max_writes: u32,
+    ) -> Result<()> {
+        if self.current_flags.iter().all(|flags| *flags == Some(0)) {
+            return Ok(());
+        }
+        let at = installed::flags_address(self.table.0, self.entry.slot);
+        let zeros = vec![0; self.current_flags.len()];
+        write_verified(client, at, &zeros, &self.current_flags, max_writes)?;
+        self.current_flags = vec![Some(0); zeros.len()];
+        Ok(())
+    }
+
+    /// Sets the entry's flags, verified, once the body and the entry are:
+    /// the entry counts from then on.
+    pub(crate) fn write_flags<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        max_writes: u32,
+    ) -> Result<()> {
+        let at = installed::flags_address(self.table.0, self.entry.slot);
+        let flags = self.entry.flags();
+        write_verified(client, at, &flags, &self.current_flags, max_writes)?;
+        self.current_flags = flags.into_iter().map(Some).collect();
+        Ok(())
+    }
+
+    /// The flags are known to be cleared (a reset): the next write sets
+    /// them again.
+    pub(crate) fn forget_flags(&mut self) {
+        self.current_flags = vec![None; self.current_flags.len()];
+    }
+}
+
+impl Plan {
+    /// Whether the entry's flags are still set: a reset since they were
+    /// written clears them (the first byte is enough).
+    pub(crate) fn still_there<T: Transport>(&self, client: &mut Client<T>) -> Result<bool> {
+        let at = installed::flags_address(self.table.0, self.entry.slot);
+        let wanted = &self.entry.flags()[..1];
+        Ok(differs(client, at, wanted)?.is_none())
+    }
+}
+
+/// Writes `wanted` at `at` where it differs from `now` (`None`: not
+/// known), two bytes a `/9W` (the last odd byte with `/7W`), then reads the
+/// range back and writes again what differs, `max_writes` times at most.
+fn write_verified<T: Transport>(
+    client: &mut Client<T>,
+    at: u16,
+    wanted: &[u8],
+    now: &[Option<u8>],
+    max_writes: u32,
+) -> Result<()> {
+    let mut now = now.to_vec();
+    for _ in 0..max_writes {
+        for (index, pair) in wanted.chunks(2).enumerate() {
+            let offset = index * 2;
+            let known = &now[offset..offset + pair.len()];
+            if known.iter().zip(pair).all(|(n, w)| *n == Some(*w)) {
+                continue;
+            }
+            let address = at + offset as u16;
+            let command = match pair {
+                [low, high] => Command::WriteWord(WordWrite::new(address, [*low, *high])?),
+                _ => Command::WriteByte {
+                    address,
+                    value: pair[0],
+                },
+            };
+            client.send(&command)?;
+        }
+        let Some(read) = differs(client, at, wanted)? else {
+            return Ok(());
+        };
+        now = read.into_iter().map(Some).collect();
+    }
+    let (offset, expected, found) = wanted
+        .iter()
+        .zip(&now)
+        .enumerate()
+        .find(|(_, (w, n))| Some(**w) != **n)
+        .map_or((0, 0, 0), |(i, (w, n))| (i, *w, n.unwrap_or(0)));
+    Err(Error::VerifyFailed {
+        address: at + offset as u16,
+        expected,
+        found,
+        attempts: max_writes,
+    })
+}
+
+/// `None` if memory at `at` holds `wanted`: one `/7R` whose answer shows
+/// exactly those bytes settles it (noise does not forge the bytes asked
+/// for); else what it holds, read until two answers agree.
+fn differs<T: Transport>(
+    client: &mut Client<T>,
+    at: u16,
+    wanted: &[u8],
+) -> Result<Option<Vec<u8>>> {
+    let count = u8::try_from(wanted.len()).unwrap_or(u8::MAX);
+    if let Ok(Answer::Memory(bytes)) = client.ask(&Command::ReadMemory(ReadSpan::new(at, count)?))
+        && bytes == wanted
+    {
+        return Ok(None);
+    }
+    let read = client.read_memory(at, wanted.len())?;
+    Ok((read != wanted).then_some(read))
+}
+
+/// Takes `old` out of every chain it is in (the pointer that jumps to its
+/// handler, the hook or another extension's chain slot, re-pointed at
+/// where `old` fell through, verified), then clears its entries.
+///
+/// # Errors
+/// The client's, [`Error::VerifyFailed`].
+pub(crate) fn remove<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    old: &Installed,
+    max_writes: u32,
+) -> Result<()> {
+    let Some((table, _)) = profile.table else {
+        return Ok(());
+    };
+    let everyone = read_installed(client, profile)?;
+    for hook in &old.hooks {
+        unlink(client, profile, &everyone, old, *hook, max_writes)?;
+    }
+    // Clearing its flags bytes frees its entries.
+    let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();
+    let freed = vec![0u8; now.len()];
+    let at = installed::flags_address(table, old.slot);
+    write_verified(client, at, &freed, &now, max_writes)
+}
+
+/// Re-points whatever jumps to `hook.handler` at where `old` fell
+/// through: the hook's own operand, or the chain slot of the extension
+/// before it. Nothing to do where `old` is not in the chain.
+fn unlink<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    old: &Installed,
+    hook: TakenHook,
+    max_writes: u32,
+) -> Result<()> {
+    let after = match hook.chain {
+        Some(slot) => read_word(client, slot)?,
+        None => profile.reset_target(hook.kind),
+    };
+    let Some(after) = after else {
+        return Err(Error::HookInUse {
+            hook: hook.kind.rom_symbol(),
+            target: hook.handler,
+        });
+    };
+    // Follow the chain from the hook: at most one step per extension.
+    let mut pointer = profile.hook_address(hook.kind) + 1;
+    for _ in 0..=everyone.len() {
+        let Some(target) = read_word(client, pointer)? else {
+            return Ok(());
+        };
+        if target == hook.handler {
+            return write_word_verified(client, pointer, after.to_le_bytes(), max_writes);
+        }
+        let next = everyone
+            .iter()
+            .filter(|other| other.id != old.id || other.slot != old.slot)
+            .flat_map(|other| other.hooks.iter())
+            .find(|other| other.kind == hook.kind && other.handler == target)
+            .and_then(|other| other.chain);
+        match next {
+            Some(slot) => pointer = slot,
+            None => return Ok(()),
+        }
+    }
+    Ok(())
+}
+
+/// The extents of `hook`'s chain, in order, for a listing: each handler
+/// the hook reaches, following the installed chain slots, up to the first
+/// target that no installed extension owns (the ROM's, usually).
+///
+/// # Errors
+/// The client's.
+pub fn chain_of<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    kind: HookKind,
+) -> Result<Vec<u16>> {
+    let mut targets = Vec::new();
+    let mut pointer = profile.hook_address(kind) + 1;
+    for _ in 0..=everyone.len() {
+        let Some(target) = read_word(client, pointer)? else {
+            break;
+        };
+        targets.push(target);
+        let next = everyone
+            .iter()
+            .flat_map(|other| other.hooks.iter())
+            .find(|other| other.kind == kind && other.handler == target)
+            .and_then(|other| other.chain);
+        match next {
+            Some(slot) => pointer = slot,
+            None => break,
+        }
+    }
+    Ok(targets)
+}
+
+/// Sorted, merged extents of loaded areas.
+pub(crate) fn extents_of(areas: &[crate::image::Area]) -> Vec<RangeInclusive<u16>> {
+    installed::merge(
+        areas
+            .iter()
+            .map(|area| (u64::from(area.address), area.bytes.len() as u64)),
+    )
+}

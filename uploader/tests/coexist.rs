@@ -1,0 +1,222 @@
+//! Extensions that live together on one robot: the ROM's table of
+//! installed extensions read before every upload, an overlap refused with
+//! nothing written, `replace` taking the old one out of its chain first,
+//! and (a property test) any sequence of uploads, overlapping or not,
+//! leaving every installed extension answering its command and no hook or
+//! chain slot pointing outside verified code.
+
+mod common;
+
+use isa::objfmt::{HookKind, HookRecord};
+use proptest::prelude::*;
+use romlib::installed;
+use romlib::protocol::{Answer, Command, Extension};
+use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
+use uploader::transport::VirtualTransport;
+use uploader::{Area, Client, ClientConfig, Error, LoaderChoice, UploadImage, UploadOptions};
+
+use common::{robot, run};
+
+/// An extension at `base`, `len` bytes (at least 22): `/1<letter>` answers
+/// `<letter>`; anything else falls through its chain slot.
+fn answering(base: u16, len: usize, letter: u8) -> UploadImage {
+    let mut bytes = vec![
+        0xE0, 0x01, // CPX #1
+        0xD0, 0x0F, // BNE chain
+        0xC9, letter, // CMP #letter
+        0xD0, 0x0B, // BNE chain
+        0xA9, letter, // LDA #letter
+        0x20, 0x00, 0xFF, // JSR PUTCH
+        0x20, 0x09, 0xFF, // JSR PUTEOL
+        0x4C, 0x1E, 0xFF, // JMP CMD_DONE
+        0x4C, 0x21, 0xFF, // chain: JMP BAD_COMMAND
+    ];
+    bytes.resize(len.max(bytes.len()), letter);
+    UploadImage::new(
+        vec![Area {
+            address: base,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: base,
+            chain: Some(base + 20),
+        }],
+    )
+    .expect("a valid image")
+}
+
+fn options(replace: bool) -> UploadOptions {
+    UploadOptions {
+        loader: LoaderChoice::Never,
+        replace,
+        ..UploadOptions::default()
+    }
+}
+
+fn ask(transport: VirtualTransport, letter: u8) -> (Option<String>, VirtualTransport) {
+    let mut client = Client::new(transport, ClientConfig::default());
+    let command = Command::Extension(Extension::new(vec![letter]).expect("a command"));
+    let answer = client.listen(&command).expect("the line works");
+    let text = answer.map(|answer| match answer {
+        Answer::Text(text) => text,
+        other => format!("{other:?}"),
+    });
+    (text, client.into_transport())
+}
+
+fn word(memory: &[u8], at: u16) -> u16 {
+    u16::from_le_bytes([memory[usize::from(at)], memory[usize::from(at) + 1]])
+}
+
+#[test]
+fn an_overlapping_upload_is_refused_before_a_byte_is_written() {
+    let first = answering(0x0400, 40, b'Q');
+    let (result, transport) = run(robot(), &first, &options(false));
+    result.expect("the first goes in");
+    // The hooks, the table, user RAM: what an upload writes.
+    let watched = |memory: &[u8]| {
+        let mut kept = memory[usize::from(HOOK_UNKNOWN)..][..6].to_vec();
+        kept.extend_from_slice(&memory[0x0400..0x1000]);
+        kept.extend_from_slice(&memory[0x1000..0x2000]);
+        kept
+    };
+    let before = watched(transport.robot().robot().board().memory());
+    // The reproduction of issue 11: a second extension at $0400 too.
+    let second = answering(0x0410, 40, b'U');
+    let (result, transport) = run(transport, &second, &options(false));
+    let error = result.expect_err("an overlap");
+    let text = error.to_string();
+    assert!(
+        matches!(error, Error::Robot(romlib::Error::Overlap { .. })),
+        "{error:?}"
+    );
+    assert!(
+        text.contains("$0410-$0437") && text.contains("$0400-$0427"),
+        "{text}"
+    );
+    let after = watched(transport.robot().robot().board().memory());
+    assert!(before == after, "something was written");
+    let (answer, transport) = ask(transport, b'Q');
+    assert_eq!(answer.as_deref(), Some("Q"));
+    // With replace, the old one leaves the chain first; its entry goes.
+    let (result, transport) = run(transport, &second, &options(true));
+    result.expect("the replacement goes in");
+    let (answer, transport) = ask(transport, b'U');
+    assert_eq!(answer.as_deref(), Some("U"));
+    let (answer, transport) = ask(transport, b'Q');
+    assert_eq!(answer, None, "the replaced extension is gone");
+    let memory = transport.robot().robot().board().memory();
+    assert_eq!(word(memory, HOOK_UNKNOWN + 1), 0x0410);
+    assert_eq!(word(memory, 0x0410 + 20), BAD_COMMAND);
+    let table = &memory[usize::from(installed::TABLE)..][..installed::TABLE_LEN];
+    let listed =
+        installed::decode_table(installed::TABLE, installed::ENTRIES, table).expect("a good table");
+    assert_eq!(listed.len(), 1);
+    assert_eq!(listed[0].extents, vec![0x0410..=0x0437]);
+}
+
+#[test]
+fn the_same_image_again_reuses_its_entry() {
+    let image = answering(0x2000, 30, b'Q');
+    let (result, transport) = run(robot(), &image, &options(false));
+    result.expect("goes in");
+    let (result, transport) = run(transport, &image, &options(false));
+    result.expect("goes in again, over itself");
+    let memory = transport.robot().robot().board().memory();
+    assert_eq!(word(memory, 0x2000 + 20), BAD_COMMAND, "no chain to itself");
+    let table = &memory[usize::from(installed::TABLE)..][..installed::TABLE_LEN];
+    assert_eq!(
+        installed::decode_table(installed::TABLE, installed::ENTRIES, table)
+            .expect("a good table")
+            .len(),
+        1
+    );
+    let (answer, _) = ask(transport, b'Q');
+    assert_eq!(answer.as_deref(), Some("Q"));
+}
+
+/// The letters of `/1x` commands the ROM does not own (nor the RAM
+/// loader's `/1F` and `/1L`).
+const LETTERS: &[u8] = b"AHIJKNOQUVWYZ";
+
+#[derive(Debug, Clone)]
+struct Step {
+    base: u16,
+    len: usize,
+    replace: bool,
+}
+
+fn step() -> impl Strategy<Value = Step> {
+    (
+        prop_oneof![0x0400u16..0x0F40, 0x1000u16..0x1400],
+        22usize..120,
+        any::<bool>(),
+    )
+        .prop_map(|(base, len, replace)| Step { base, len, replace })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn any_sequence_of_uploads_leaves_every_extension_answering(
+        steps in proptest::collection::vec(step(), 1..7)
+    ) {
+        let mut transport = robot();
+        // The model: what should be installed, (letter, first, last).
+        let mut model: Vec<(u8, u16, u16)> = Vec::new();
+        for (index, step) in steps.iter().enumerate() {
+            let letter = LETTERS[index % LETTERS.len()];
+            let last = (u32::from(step.base) + step.len as u32 - 1).min(0xFFFF) as u16;
+            if step.base <= 0x0F7F && last > 0x0F7F {
+                continue; // past user RAM: refused by the profile, not this test's business
+            }
+            let image = answering(step.base, step.len, letter);
+            let overlapping: Vec<usize> = model
+                .iter()
+                .enumerate()
+                .filter(|(_, (_, first, end))| *first <= last && step.base <= *end)
+                .map(|(i, _)| i)
+                .collect();
+            let (result, back) = run(transport, &image, &options(step.replace));
+            transport = back;
+            if overlapping.is_empty() || step.replace {
+                prop_assert!(result.is_ok(), "step {index} {step:?}: {result:?}");
+                for i in overlapping.into_iter().rev() {
+                    model.remove(i);
+                }
+                model.push((letter, step.base, last));
+            } else {
+                prop_assert!(
+                    matches!(result, Err(Error::Robot(romlib::Error::Overlap { .. }))),
+                    "step {index} {step:?}: {result:?}"
+                );
+            }
+            // A command nobody owns, then each installed one's.
+            let (answer, back) = ask(transport, b'Z' + 1);
+            transport = back;
+            prop_assert_eq!(answer, None);
+            for &(letter, _, _) in &model {
+                let (answer, back) = ask(transport, letter);
+                transport = back;
+                prop_assert_eq!(answer, Some(char::from(letter).to_string()));
+            }
+            // The chain: from the hook through each installed handler to
+            // the ROM, every pointer at a handler that is installed.
+            let memory = transport.robot().robot().board().memory();
+            let mut target = word(memory, HOOK_UNKNOWN + 1);
+            let mut seen = 0;
+            while target != BAD_COMMAND {
+                prop_assert!(
+                    model.iter().any(|&(_, first, _)| first == target),
+                    "the chain reaches ${target:04X}, which holds no installed handler"
+                );
+                seen += 1;
+                prop_assert!(seen <= model.len(), "the chain loops");
+                target = word(memory, target + 20);
+            }
+            prop_assert_eq!(seen, model.len());
+        }
+    }
+}
