@@ -122,6 +122,25 @@ pub enum Error {
     )]
     DamagedTable(#[from] crate::installed::DamagedTable),
 
+    /// The control loop stopped running: a handler that never returns.
+    #[error(
+        "the robot stopped answering: its control loop did not run in {for_ms} ms of robot time; the CPU is at ${pc:04X}{place}"
+    )]
+    #[diagnostic(
+        code(romlib::stuck),
+        help(
+            "a handler must end with JMP CMD_DONE (or its chain) without waiting for ever: check the loop around that address, or a card it waits for"
+        )
+    )]
+    Stuck {
+        /// Where the CPU is.
+        pc: u16,
+        /// ` (handler+$12)`: the nearest label, or nothing.
+        place: String,
+        /// Robot time watched, in milliseconds.
+        for_ms: u64,
+    },
+
     /// The emulated CPU hit a JAM opcode.
     #[error("the robot's CPU jammed at ${pc:04X} (opcode ${opcode:02X})")]
     #[diagnostic(

@@ -27,6 +27,11 @@ pub const ANSWER_TIMEOUT: u64 = CPU_HZ;
 /// arrived, with margin (the command loop, the dispatch, a handler).
 pub const INSTRUCTION_TIME: u64 = 5_000;
 
+/// Robot time [`VirtualScorpion::check_loop`] is given when the robot does
+/// not answer: 100 ms, a hundred times the longest the reference ROM's loop
+/// takes to come round.
+pub const LOOP_WATCH: u64 = CPU_HZ / 10;
+
 /// Robot time from power-up until the reference ROM waits for commands.
 const BOOT_TIME: u64 = 20_000;
 
@@ -67,6 +72,9 @@ pub struct VirtualScorpion {
     /// The ROM's table of installed extensions (`EXTTAB`) and its entries,
     /// if the ROM keeps one.
     table: Option<(u16, usize)>,
+    /// Labels of the ROM and of every image loaded, for naming the place
+    /// a robot that stopped answering is stuck in.
+    labels: Vec<(u16, String)>,
 }
 
 impl Default for VirtualScorpion {
@@ -88,7 +96,11 @@ impl VirtualScorpion {
                 main_loop: symbols::HOOK_LOOP,
             },
             table: Some((installed::TABLE, installed::ENTRIES)),
+            labels: Vec::new(),
         };
+        if let Ok(rom) = Image::parse("scorpion-rom.elf", crate::ROM_ELF) {
+            scorpion.add_labels(&rom);
+        }
         scorpion.boot();
         scorpion
     }
@@ -130,7 +142,9 @@ impl VirtualScorpion {
             robot: Scorpion::scorpion(&bytes)?,
             hooks,
             table,
+            labels: Vec::new(),
         };
+        scorpion.add_labels(rom);
         scorpion.boot();
         Ok(scorpion)
     }
@@ -138,6 +152,80 @@ impl VirtualScorpion {
     fn boot(&mut self) {
         let until = self.robot.now() + BOOT_TIME;
         self.robot.run(until);
+    }
+
+    /// Keeps `image`'s labels (symbols in its sections) for
+    /// [`Error::Stuck`] reports (loading an image keeps its own).
+    pub fn add_labels(&mut self, image: &Image) {
+        self.labels
+            .extend(image.symbols.iter().filter_map(|symbol| {
+                symbol.section?;
+                Some((u16::try_from(symbol.value).ok()?, symbol.name.clone()))
+            }));
+        self.labels.sort();
+    }
+
+    /// The label at or below `pc` (within a page), as `name+$offset`.
+    #[must_use]
+    pub fn place_of(&self, pc: u16) -> Option<String> {
+        let index = self.labels.partition_point(|(at, _)| *at <= pc);
+        let (at, name) = self.labels.get(index.checked_sub(1)?)?;
+        let offset = pc - at;
+        (offset < 0x100).then(|| match offset {
+            0 => name.clone(),
+            _ => format!("{name}+${offset:X}"),
+        })
+    }
+
+    /// Whether `pc` is in the ROM's `GETCH`/`CHKCH` (from `getch` up to the
+    /// label after `chkch`): a handler waiting there for the host's next
+    /// byte is waiting, not stuck.
+    fn waiting_for_input(&self, pc: u16) -> bool {
+        let find = |name: &str| {
+            self.labels
+                .iter()
+                .find(|(_, n)| n == name)
+                .map(|(at, _)| *at)
+        };
+        let (Some(getch), Some(chkch)) = (find("getch"), find("chkch")) else {
+            return false;
+        };
+        let end = self
+            .labels
+            .iter()
+            .map(|(at, _)| *at)
+            .find(|&at| at > chkch)
+            .unwrap_or(chkch);
+        (getch.min(chkch)..end).contains(&pc)
+    }
+
+    /// Watches the control loop for up to `within` cycles: `Ok(())` as soon
+    /// as it passes `HOOK_LOOP` (the ROM's loop, or an operating system's,
+    /// jumps through it every pass) or when a handler waits in `GETCH` for
+    /// the host's next byte, else [`Error::Stuck`] saying where the CPU is. A handler that never
+    /// returns, a JAM or a BRK into nowhere all end here.
+    ///
+    /// # Errors
+    /// [`Error::Stuck`], [`Error::Jam`].
+    pub fn check_loop(&mut self, within: u64) -> Result<(), Error> {
+        let mut watch = emulator::Breakpoints::new();
+        watch.insert(self.hooks.main_loop);
+        let until = self.robot.now().saturating_add(within);
+        match self.robot.run_with(until, &mut watch) {
+            Stop::Hook { .. } => Ok(()),
+            Stop::Jam { pc, opcode } => Err(Error::Jam { pc, opcode }),
+            _ if self.waiting_for_input(self.robot.cpu.pc) => Ok(()),
+            _ => {
+                let pc = self.robot.cpu.pc;
+                Err(Error::Stuck {
+                    pc,
+                    place: self
+                        .place_of(pc)
+                        .map_or_else(String::new, |p| format!(" ({p})")),
+                    for_ms: within * 1000 / CPU_HZ,
+                })
+            }
+        }
     }
 
     /// The emulated robot: the CPU, the board and the host's end of the
@@ -247,6 +335,7 @@ impl VirtualScorpion {
             self.robot.board_mut().load(at, &bytes)?;
             self.robot.board_mut().load(flags_at, &flags)?;
         }
+        self.add_labels(image);
         let mut installed = Vec::new();
         for record in &image.hooks.records {
             installed.push(self.install_hook(record.kind, record.handler, record.chain)?);
@@ -377,6 +466,8 @@ impl VirtualScorpion {
                 if let Some(Stop::Jam { pc, opcode }) = failure.stop {
                     return Err(Error::Jam { pc, opcode });
                 }
+                // No answer: a robot whose loop stopped says where.
+                self.check_loop(LOOP_WATCH)?;
                 Err(Error::NoAnswer {
                     command: escape(bytes),
                     received: escape(&failure.received),

@@ -266,6 +266,9 @@ fn serve_stdio(robot: &mut VirtualScorpion) -> miette::Result<ExitCode> {
         }
         let line_idle = robot.robot().board().acia().host_line_free_at() <= robot.cycles();
         if ended && line_idle && robot.cycles() >= quiet_since + QUIET_TIME {
+            // The answers so far are out; a robot whose loop stopped (a
+            // handler that never returns) fails the run, saying where.
+            robot.check_loop(romlib::sim::LOOP_WATCH)?;
             return Ok(ExitCode::SUCCESS);
         }
     }

@@ -170,13 +170,15 @@ impl Progress for Bar {
     }
 }
 
-fn read_image(path: &PathBuf) -> miette::Result<UploadImage> {
+/// The linked image, and what the uploader sends of it.
+fn read_image(path: &PathBuf) -> miette::Result<(linker::Image, UploadImage)> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot read {name}"))?;
     let linked = linker::Image::parse(&name, &bytes)?;
-    Ok(UploadImage::try_from(&linked)?)
+    let image = UploadImage::try_from(&linked)?;
+    Ok((linked, image))
 }
 
 fn read_expectations(path: &PathBuf) -> miette::Result<Expectations> {
@@ -240,7 +242,7 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let image = read_image(&args.image)?;
+    let (linked, image) = read_image(&args.image)?;
     let expectations = args.expect.as_ref().map(read_expectations).transpose()?;
     let options = args.options();
     let profile = &options.profile;
@@ -252,7 +254,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let robot = ports::virtual_robot(args.line.baud)?;
+        let mut robot = ports::virtual_robot(args.line.baud)?;
+        // A handler that hangs in the rehearsal is named by its label.
+        robot.add_labels(&linked);
         let mut client = args.client(VirtualTransport::new(robot), profile);
         let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
             "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot",

@@ -198,3 +198,46 @@ fn sim_refuses_an_image_that_overlaps_an_installed_one() {
     );
     insta::assert_snapshot!(text);
 }
+
+/// Issue 11's third reproduction: a handler that never returns. `sim`
+/// used to exit 0 with the answers missing; it exits 1 naming the PC and
+/// the label, and `upload --port emu --expect` stops in its rehearsal the
+/// same way instead of blaming the line.
+#[test]
+fn a_handler_that_never_returns_is_reported_where_it_hangs() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("hang.s"),
+        ".include \"scorpion.inc\"\nSCORPION_UNKNOWN_HANDLER\n        cmp #'Q'\n        bne pass\nhang:   jmp hang\npass:   SCORPION_CHAIN_UNKNOWN\n",
+    )
+    .expect("write the source");
+    let built = scorpion(dir.path(), &["build", "hang.s", "-o", "hang.elf"]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let image = dir.path().join("hang.elf");
+    let output = sim(
+        &["--image", image.to_str().expect("UTF-8")],
+        "/1X\n/1Q\n/1X\n",
+    );
+    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("X00"), "the answer before the hang: {text}");
+    insta::assert_snapshot!(text);
+    std::fs::write(dir.path().join("hang.expect"), "/1X => X00\n/1Q\n").expect("write");
+    let upload = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "hang.elf",
+            "--port",
+            "emu",
+            "--expect",
+            "hang.expect",
+        ],
+    );
+    let text = transcript(&upload);
+    assert_eq!(upload.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("romlib::stuck") && text.contains("$0404 (hang)"),
+        "{text}"
+    );
+}

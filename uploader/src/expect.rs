@@ -148,16 +148,21 @@ impl Expectations {
                     heard
                 }
                 Required::Any | Required::Exactly(_) => {
-                    let answer = client
-                        .ask(command)
-                        .map_err(|error| Error::RehearsalFailed {
-                            command: command.to_string(),
-                            expected: match &expectation.required {
-                                Required::Exactly(text) => text.clone(),
-                                _ => "an answer".into(),
-                            },
-                            found: format!("no valid answer ({error})"),
-                        })?;
+                    let answer = match client.ask(command) {
+                        Ok(answer) => answer,
+                        Err(error) => {
+                            // Silence from a robot that can show why says so.
+                            client.transport().diagnose_silence()?;
+                            return Err(Error::RehearsalFailed {
+                                command: command.to_string(),
+                                expected: match &expectation.required {
+                                    Required::Exactly(text) => text.clone(),
+                                    _ => "an answer".into(),
+                                },
+                                found: format!("no valid answer ({error})"),
+                            });
+                        }
+                    };
                     if let Required::Exactly(text) = &expectation.required {
                         let found = answer_text(&answer);
                         if found != *text {
@@ -173,6 +178,10 @@ impl Expectations {
             };
             transcript.push((command.clone(), answer));
         }
+        // The robot must still be running its loop after the last line (a
+        // handler that never returns answers nothing, which a line without
+        // `=>` accepts).
+        client.transport().diagnose_silence()?;
         Ok(transcript)
     }
 }

@@ -63,6 +63,16 @@ pub trait Transport {
 
     /// A name for messages (`/dev/ttyUSB0`, `the virtual Scorpion`).
     fn name(&self) -> String;
+
+    /// Says why the robot is silent where the transport can see inside it
+    /// (the virtual Scorpion: a control loop that stopped, and where); a
+    /// serial line cannot, and says nothing.
+    ///
+    /// # Errors
+    /// The reason, when there is one.
+    fn diagnose_silence(&mut self) -> Result<()> {
+        Ok(())
+    }
 }
 
 impl<T: Transport + ?Sized> Transport for &mut T {
@@ -87,6 +97,9 @@ impl<T: Transport + ?Sized> Transport for &mut T {
     fn name(&self) -> String {
         (**self).name()
     }
+    fn diagnose_silence(&mut self) -> Result<()> {
+        (**self).diagnose_silence()
+    }
 }
 
 impl<T: Transport + ?Sized> Transport for Box<T> {
@@ -110,6 +123,9 @@ impl<T: Transport + ?Sized> Transport for Box<T> {
     }
     fn name(&self) -> String {
         (**self).name()
+    }
+    fn diagnose_silence(&mut self) -> Result<()> {
+        (**self).diagnose_silence()
     }
 }
 

@@ -192,4 +192,10 @@ impl Transport for VirtualTransport {
     fn name(&self) -> String {
         "the virtual Scorpion".into()
     }
+
+    fn diagnose_silence(&mut self) -> Result<()> {
+        self.robot
+            .check_loop(romlib::sim::LOOP_WATCH)
+            .map_err(Error::Robot)
+    }
 }
