@@ -116,17 +116,18 @@ not_mine:
         SCORPION_CHAIN_UNKNOWN
 
 ; Feeds the zero-terminated command text at X (low) / Y (high) to the
-; ROM's parser, in one piece (interrupts off, so no host byte lands inside).
+; ROM's parser. INJECT's queue is the ROM's, apart from the host's bytes,
+; and is parsed between commands only, so nothing here keeps the host out
+; (interrupts stay on: the 6551 is served). Patrol says something only
+; when PENDING shows the queue empty, and its longest text fits the queue.
 say:
         stx text
         sty text+1
-        php
-        sei
         ldy #0
 @next:  lda (text),y
         beq @end
         jsr INJECT
+        bcs @end                ; the queue is full (never, as used here)
         iny
         bne @next
-@end:   plp
-        rts
+@end:   rts

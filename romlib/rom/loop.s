@@ -30,6 +30,13 @@ soft_reset:
         sta VIA_IER             ; every VIA interrupt off
         sta VIA_IFR             ; every flag cleared
         lda #0
+        sta TICKING             ; the motion tick is off
+        ; Only the 6551 interrupts now, and with the tick off its handler
+        ; touches only the receive ring: it keeps being served while the
+        ; rest is reset, so a host byte that arrives meanwhile is never
+        ; lost to an overrun.
+        cli
+        lda #0
         sta VIA_ACR
         sta VIA_PCR             ; CA1 interrupts on its falling edge
         sta VIA_DDRA            ; port A: the bumpers, inputs
@@ -47,11 +54,6 @@ soft_reset:
 @ram:   sta CMDLEN,x            ; the ROM's state in $0206-$021F
         dex
         bpl @ram
-        ; Nothing is installed: the hooks are the ROM's. Only the flags
-        ; bytes are cleared, so interrupts stay off no longer than before.
-        .repeat EXTTAB_ENTRIES, entry
-        sta EXTTAB + entry
-        .endrepeat
         lda #$4C                ; JMP
         sta HOOK_UNKNOWN
         sta HOOK_LOOP
@@ -75,7 +77,16 @@ soft_reset:
         jsr apply_io
         lda #$80 | IRQ_CA1      ; a bumper closing interrupts
         sta VIA_IER
-        cli
+        ; Nothing is installed, the hooks being the ROM's (clearing the
+        ; flags bytes frees the entries), nothing injected, a host command
+        ; next.
+        lda #0
+        .repeat EXTTAB_ENTRIES, entry
+        sta EXTTAB + entry
+        .endrepeat
+        sta INJHEAD
+        sta INJTAIL
+        sta PSOURCE
         ; fall into the control loop
 
 ; The control loop. Every pass goes through HOOK_LOOP, which an operating
@@ -83,14 +94,49 @@ soft_reset:
 main_loop:
         jmp HOOK_LOOP
 
+; Inside a command its bytes come from where it began, so neither the
+; host's commands nor injected ones are ever cut by the other (the other's
+; bytes wait in their queue). Between commands the two take turns: after
+; an injected command the host's waiting bytes go first, after the host's
+; an injected one, so neither starves the other. (The idle path only
+; reads, so the emulator can skip it exactly.)
 rom_loop:
+        lda PSTATE
+        beq @boundary
+        lda PSOURCE
+        bne @injected
+        beq @host
+@boundary:
+        lda PSOURCE
+        beq @inject_turn        ; the last command was the host's
         ldx RXTAIL
+        cpx RXHEAD
+        bne @host               ; the last was injected and the host waits
+@inject_turn:
+        ldx INJTAIL
+        cpx INJHEAD
+        beq @host               ; nothing injected: the host's turn
+@injected:
+        ldx INJTAIL
+        cpx INJHEAD
+        beq main_loop           ; the rest of the command is still being fed
+        lda INJBUF,x
+        inx
+        pha
+        txa
+        and #INJBUF_SIZE - 1
+        sta INJTAIL
+        pla
+        ldy #1                  ; Y: where the byte came from, for a new command
+        bne @parse
+@host:  ldx RXTAIL
         cpx RXHEAD
         beq main_loop           ; nothing received
         lda RXBUF,x
         inx
         stx RXTAIL
-        cmp #'/'
+        ldy #0
+@parse: cmp #'/'
         beq @slash              ; a slash always starts a command (resync)
         ldx PSTATE
         beq main_loop           ; outside a command: ignored
@@ -110,7 +156,8 @@ rom_loop:
 @drop:  lda #0
         sta PSTATE
         jmp main_loop
-@slash: lda #1
+@slash: sty PSOURCE             ; the command's bytes come from here on
+        lda #1
         sta PSTATE
         jmp main_loop
 @byte:  ldx CMDLEN

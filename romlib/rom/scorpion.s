@@ -58,7 +58,7 @@ CMD_DONE:       jmp cmd_done        ; $FF1E a command is finished: back to the c
 BAD_COMMAND:    jmp bad_command     ; $FF21 HOOK_UNKNOWN's first target: drop the command
 ROM_LOOP:       jmp rom_loop        ; $FF24 HOOK_LOOP's first target: one pass of the ROM's loop
 ROM_RESET:      jmp soft_reset      ; $FF27 what /1R does
-INJECT:         jmp inject          ; $FF2A feed A to the command parser as if received (A, X, Y kept)
+INJECT:         jmp inject          ; $FF2A queue A for the command parser, parsed between commands (A, X, Y kept; C set if the queue is full)
 PENDING:        jmp pending         ; $FF2D A = received bytes not yet parsed, Z set if none (X, Y kept)
 
         .segment "VECTORS"

@@ -219,30 +219,49 @@ chkch:
         sec
         rts
 
-; INJECT: puts A into the receive ring as if it had arrived on the line,
-; so a program in RAM can give the ROM commands ("/4C+40"). Feed a whole
-; command between SEI and CLI if the host may be sending at the same time.
+; INJECT: queues A for the command parser, so a program in RAM can give
+; the ROM commands ("/4C+40"). Injected text has a queue of its own and is
+; parsed between commands only: it never cuts into a command the host is
+; sending, and the host's bytes are never lost or reordered by it. Carry
+; set if the queue was full (A not queued: call again on a later pass);
+; A, X, Y kept.
 inject:
-        php
-        sei
         pha
+        stx GTMP
+        ldx INJHEAD
+        sta INJBUF,x            ; (harmless in the free slot when full)
+        inx
         txa
-        pha
-        tsx
-        lda $0102,x             ; A as it came
-        jsr rx_put
+        and #INJBUF_SIZE - 1
+        cmp INJTAIL
+        beq @full               ; one slot stays free
+        sta INJHEAD
         pla
-        tax
-        pla
-        plp
+        ldx GTMP
+        clc
+        rts
+@full:  pla
+        ldx GTMP
+        sec
         rts
 
-; PENDING: how many received (or injected) bytes the parser has not seen
+; PENDING: how many received or injected bytes the parser has not seen
 ; yet. Zero means every command fed so far has been dispatched.
 pending:
         lda RXHEAD
         sec
         sbc RXTAIL
+        cmp #256 - INJBUF_SIZE
+        bcs @many               ; the ring nearly full: the sum could wrap
+        lda INJHEAD
+        sec
+        sbc INJTAIL
+        and #INJBUF_SIZE - 1
+        clc
+        adc RXHEAD
+        sec
+        sbc RXTAIL
+@many:  cmp #0                  ; Z set if none
         rts
 
 ; Puts A into the receive ring (X lost); a full ring drops it. Called with

@@ -241,3 +241,34 @@ fn a_handler_that_never_returns_is_reported_where_it_hangs() {
         "{text}"
     );
 }
+
+/// Issue 11's INJECT reproduction: with patrol cruising (it feeds the ROM
+/// its motor commands through INJECT), the host's `/1P` right behind
+/// `/2A1` used to be cut by the injected text and never answered.
+#[test]
+fn a_host_question_behind_an_injecting_os_is_answered() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let patrol = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol/patrol.s");
+    let built = scorpion(
+        dir.path(),
+        &[
+            "build",
+            patrol.to_str().expect("UTF-8"),
+            "-o",
+            "patrol.elf",
+            "--target",
+            "scorpion-os",
+        ],
+    );
+    assert!(built.status.success(), "{}", transcript(&built));
+    let image = dir.path().join("patrol.elf");
+    for _ in 0..3 {
+        let output = sim(&["--image", image.to_str().expect("UTF-8")], "/2A1\n/1P\n");
+        let text = transcript(&output);
+        assert_eq!(output.status.code(), Some(0), "{text}");
+        assert!(
+            String::from_utf8_lossy(&output.stdout).starts_with("PB00"),
+            "{text}"
+        );
+    }
+}

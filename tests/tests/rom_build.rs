@@ -52,9 +52,10 @@ fn every_platform_name_is_exported_with_the_decided_values() {
     assert_eq!(symbols::HOOK_UNKNOWN, 0x0200);
     assert_eq!(symbols::HOOK_LOOP, 0x0203);
     assert_eq!(symbols::USER_RAM_START, 0x0400);
-    // The table of installed extensions ends the controller card's RAM.
-    assert_eq!(symbols::USER_RAM_END, 0x0F7F);
-    assert_eq!(symbols::EXTTAB, symbols::USER_RAM_END + 1);
+    // INJECT's queue, then the table of installed extensions, end the
+    // controller card's RAM.
+    assert_eq!(symbols::USER_RAM_END, 0x0F3F);
+    assert_eq!(symbols::EXTTAB, 0x0F80);
     assert_eq!(
         u32::from(symbols::EXTTAB)
             + u32::from(symbols::EXTTAB_ENTRIES * (1 + symbols::EXTTAB_ENTRY_LEN)),

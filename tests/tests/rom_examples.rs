@@ -11,6 +11,7 @@ use std::any::Any;
 
 use emulator::board::{Device, Motor};
 use rom_support::{Session, build, examples_dir, upload};
+use romlib::symbols::BUSY;
 
 /// A model of the ultrasonic rangefinder card of `examples/rangefinder`:
 /// four registers, a measurement that takes as long as the echo's round
@@ -213,6 +214,21 @@ fn a_second_extension_chains_behind_the_first() {
     insta::assert_snapshot!(s.transcript);
 }
 
+/// The busy byte's drive bits (left and right motor on).
+const DRIVES: u8 = 0x60;
+
+/// Runs the robot in steps of 100 cycles until neither drive is busy
+/// (within a second); the motors' positions then.
+fn drives_idle(s: &mut Session) -> (i64, i64) {
+    for _ in 0..10_000 {
+        if s.robot.robot().board().memory()[usize::from(BUSY)] & DRIVES == 0 {
+            return (s.position(Motor::Left), s.position(Motor::Right));
+        }
+        s.robot.run_for(100).expect("the CPU does not jam");
+    }
+    panic!("the drives did not stop within a second");
+}
+
 #[test]
 fn an_operating_system_takes_the_control_loop() {
     let mut s = Session::new();
@@ -244,12 +260,22 @@ fn an_operating_system_takes_the_control_loop() {
     let backing = s.position(Motor::Left);
     assert!(backing < cruised, "backing away");
     s.bumpers(0);
-    s.wait_ms(1500);
-    let (left, right) = (s.position(Motor::Left), s.position(Motor::Right));
-    s.note(&format!("left {left}, right {right} after the manoeuvre"));
     // Back 100 steps on both, then the left forward 60 and the right back
-    // 60, then both cruising forward again: the difference is the turn.
-    assert_eq!(left - right, 120, "left {left}, right {right}");
+    // 60, then both cruising forward again. The drives step on their own
+    // phases of the 1 kHz tick, so the turn is measured between the two
+    // moments both drives are idle: when the back-away ends, and when the
+    // turn does (before the next cruise step).
+    let (left0, right0) = drives_idle(&mut s);
+    while s.robot.robot().board().memory()[usize::from(BUSY)] & DRIVES == 0 {
+        s.robot.run_for(100).expect("the CPU does not jam");
+    }
+    let (left, right) = drives_idle(&mut s);
+    s.note(&format!(
+        "the turn: left {:+}, right {:+}",
+        left - left0,
+        right - right0
+    ));
+    assert_eq!((left - left0, right - right0), (60, -60), "the turn");
     s.wait_ms(200);
     assert!(s.position(Motor::Left) > left + 30, "cruising again");
     // The ROM still answers everything while the OS runs.
@@ -263,4 +289,110 @@ fn an_operating_system_takes_the_control_loop() {
     assert_eq!(s.position(Motor::Left), stopped);
     assert_eq!(s.ask("/1X"), "X00\r");
     insta::assert_snapshot!(s.transcript);
+}
+
+/// The soak of issue 11: an operating system that injects a command on
+/// every pass of the control loop (`inject_soak/feeder.s`), the two
+/// example extensions chained behind it (the rangefinder with its card),
+/// and 10,000 host commands of every kind sent back to back at 9600 baud
+/// in bursts of at most 120 characters: every answer is the one a model of
+/// the robot predicts, none is lost, and the injected commands ran.
+#[test]
+fn injected_commands_never_cut_the_hosts() {
+    let (mut s, _) = robot_with_card(Some(42));
+    let feeder = build(
+        &[std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inject_soak/feeder.s")],
+        "scorpion-os",
+    );
+    for image in [&feeder, &checksum(), &rangefinder()] {
+        s.robot
+            .load_image(image)
+            .expect("the images do not overlap");
+    }
+    let fed_at = u16::try_from(feeder.symbol("fed").expect("`fed`")).expect("16-bit");
+    // The host's side: the commands, and the answer each must get.
+    let mut rng: u64 = 0x5EED_CAFE;
+    let mut next = |n: u64| {
+        rng = rng
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (rng >> 33) % n
+    };
+    let mut eyes = 0u8;
+    let mut ram = [0u8; 2];
+    let mut commands: Vec<(String, Option<String>)> = Vec::new();
+    for _ in 0..10_000 {
+        let command = match next(9) {
+            0 => {
+                let busy = if eyes == 0 { 0x00 } else { 0x82 };
+                ("/1X".to_string(), Some(format!("X{busy:02X}")))
+            }
+            1 => {
+                eyes = if eyes == 0 { 3 } else { 0 };
+                (format!("/2E{eyes}"), None)
+            }
+            2 => ("/1E".to_string(), Some(format!("E{eyes}"))),
+            3 => {
+                ram = [next(256) as u8, next(256) as u8];
+                (format!("/9W2000{:02X}{:02X}", ram[0], ram[1]), None)
+            }
+            4 => (
+                "/7R200002".to_string(),
+                Some(format!("R{:02X}{:02X}", ram[0], ram[1])),
+            ),
+            5 => {
+                let sum = u16::from(ram[0]) + u16::from(ram[1]);
+                ("/9K20000002".to_string(), Some(format!("K{sum:04X}")))
+            }
+            6 => ("/1U".to_string(), Some("U0042".to_string())),
+            7 => ("/1Q".to_string(), None),
+            _ => ("/7R050001".to_string(), Some("R42".to_string())),
+        };
+        commands.push(command);
+    }
+    // The first /7R050001 may come before the feeder's first command ran;
+    // the host's two bytes at $2000 start as the model has them.
+    s.robot.send(b"/7W050042/9W20000000");
+    s.robot.settle().expect("the CPU runs");
+    let mut answered = 0;
+    let mut burst: Vec<&(String, Option<String>)> = Vec::new();
+    let mut chars = 0;
+    let mut check = |s: &mut Session, burst: &mut Vec<&(String, Option<String>)>| {
+        let wanted: Vec<&String> = burst.iter().filter_map(|(_, a)| a.as_ref()).collect();
+        let text: String = burst.iter().map(|(c, _)| c.as_str()).collect();
+        s.robot.send(text.as_bytes());
+        let mut got = Vec::new();
+        for expected in &wanted {
+            let raw = s
+                .robot
+                .robot_mut()
+                .read_answer(romlib::sim::ANSWER_TIMEOUT)
+                .unwrap_or_else(|error| panic!("`{text}`: no answer for `{expected}`: {error:?}"));
+            got.push(String::from_utf8_lossy(&raw).trim_end().to_string());
+        }
+        let wanted: Vec<String> = wanted.into_iter().cloned().collect();
+        assert_eq!(got, wanted, "after `{text}`");
+        s.robot.settle().expect("the CPU runs");
+        assert!(
+            s.robot.receive().is_empty(),
+            "an answer nobody asked for, after `{text}`"
+        );
+        answered += got.len();
+        burst.clear();
+    };
+    for command in &commands {
+        if chars + command.0.len() > 120 {
+            check(&mut s, &mut burst);
+            chars = 0;
+        }
+        chars += command.0.len();
+        burst.push(command);
+    }
+    check(&mut s, &mut burst);
+    let expected = commands.iter().filter(|(_, a)| a.is_some()).count();
+    assert_eq!(answered, expected);
+    assert_eq!(s.robot.robot().board().acia().overruns(), 0, "no byte lost");
+    let memory = s.robot.robot().board().memory();
+    let fed = u16::from_le_bytes([memory[usize::from(fed_at)], memory[usize::from(fed_at) + 1]]);
+    assert!(fed > 1000, "the feeder fed only {fed} commands");
 }

@@ -509,14 +509,14 @@ mod tests {
         let image = UploadImage::new(
             vec![Area {
                 address: 0x0400,
-                bytes: vec![0xEA; 0x0B00],
+                bytes: vec![0xEA; 0x0A00],
             }],
             vec![],
         )
         .expect("an image");
         let loader = Loader::place(&profile, &image, rates)
             .expect("links")
-            .expect("room above $0F00");
+            .expect("room above $0E00");
         assert!(loader.len() < 80, "{} bytes", loader.len());
         assert_eq!(
             usize::from(loader.address()) + loader.len(),

@@ -11,7 +11,7 @@ use isa::objfmt::{HookKind, HookRecord};
 use proptest::prelude::*;
 use romlib::installed;
 use romlib::protocol::{Answer, Command, Extension};
-use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
+use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN, USER_RAM_END, USER_RAM_START};
 use uploader::transport::VirtualTransport;
 use uploader::{Area, Client, ClientConfig, Error, LoaderChoice, UploadImage, UploadOptions};
 
@@ -149,7 +149,7 @@ struct Step {
 
 fn step() -> impl Strategy<Value = Step> {
     (
-        prop_oneof![0x0400u16..0x0F40, 0x1000u16..0x1400],
+        prop_oneof![USER_RAM_START..USER_RAM_END - 0x40, 0x1000u16..0x1400],
         22usize..120,
         any::<bool>(),
     )
@@ -169,7 +169,7 @@ proptest! {
         for (index, step) in steps.iter().enumerate() {
             let letter = LETTERS[index % LETTERS.len()];
             let last = (u32::from(step.base) + step.len as u32 - 1).min(0xFFFF) as u16;
-            if step.base <= 0x0F7F && last > 0x0F7F {
+            if step.base <= USER_RAM_END && last > USER_RAM_END {
                 continue; // past user RAM: refused by the profile, not this test's business
             }
             let image = answering(step.base, step.len, letter);
