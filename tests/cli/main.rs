@@ -27,6 +27,18 @@ pub(crate) fn scorpion(dir: &std::path::Path, args: &[&str]) -> Output {
         .expect("the scorpion binary runs")
 }
 
+/// Builds `examples/<source>` into `dir/<output>` with `scorpion build`,
+/// with `extra` arguments (`--target ...`); panics, showing why, if it fails.
+pub(crate) fn build_example(dir: &std::path::Path, source: &str, output: &str, extra: &[&str]) {
+    let source = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(source);
+    let mut args = vec!["build", source.to_str().expect("UTF-8"), "-o", output];
+    args.extend(extra);
+    let built = scorpion(dir, &args);
+    assert!(built.status.success(), "{}", transcript(&built));
+}
+
 /// Exit code, stdout and stderr as one text, for snapshots.
 pub(crate) fn transcript(output: &Output) -> String {
     format!(

@@ -5,7 +5,7 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::{scorpion, transcript};
+use crate::{build_example, scorpion, transcript};
 
 /// Runs `scorpion sim ARGS` with `input` on stdin.
 fn sim(args: &[&str], input: &str) -> std::process::Output {
@@ -167,18 +167,8 @@ fn sim_serves_a_pseudo_terminal_at_the_baud_rate() {
 #[test]
 fn sim_refuses_an_image_that_overlaps_an_installed_one() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
-    for (source, output) in [
-        ("rangefinder/rangefinder.s", "first.elf"),
-        ("checksum/checksum.s", "second.elf"),
-    ] {
-        let source = examples.join(source);
-        let built = scorpion(
-            dir.path(),
-            &["build", source.to_str().expect("UTF-8"), "-o", output],
-        );
-        assert!(built.status.success(), "{}", transcript(&built));
-    }
+    build_example(dir.path(), "rangefinder/rangefinder.s", "first.elf", &[]);
+    build_example(dir.path(), "checksum/checksum.s", "second.elf", &[]);
     let first = dir.path().join("first.elf");
     let second = dir.path().join("second.elf");
     let output = sim(
@@ -248,19 +238,12 @@ fn a_handler_that_never_returns_is_reported_where_it_hangs() {
 #[test]
 fn a_host_question_behind_an_injecting_os_is_answered() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let patrol = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol/patrol.s");
-    let built = scorpion(
+    build_example(
         dir.path(),
-        &[
-            "build",
-            patrol.to_str().expect("UTF-8"),
-            "-o",
-            "patrol.elf",
-            "--target",
-            "scorpion-os",
-        ],
+        "patrol/patrol.s",
+        "patrol.elf",
+        &["--target", "scorpion-os"],
     );
-    assert!(built.status.success(), "{}", transcript(&built));
     let image = dir.path().join("patrol.elf");
     for _ in 0..3 {
         let output = sim(&["--image", image.to_str().expect("UTF-8")], "/2A1\n/1P\n");

@@ -10,7 +10,7 @@ use isa::objfmt::{HookKind, HookRecord, Hooks};
 use linker::{Format, Image, LoadArea};
 
 use crate::read::{PtyRobot, memory};
-use crate::{scorpion, transcript};
+use crate::{build_example, scorpion, transcript};
 
 /// An extension image of `len` bytes at $0400 that is real code: `$0400:
 /// JMP chain` (the chain slot, $0401, is its operand), `$0403: JMP $0400`
@@ -74,14 +74,16 @@ impl Drop for Sim {
 
 /// The checksum example, built by `scorpion build` into `dir`.
 fn checksum_example(dir: &std::path::Path) -> String {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/checksum");
-    let source = root.join("checksum.s").display().to_string();
-    let layout = root.join("checksum.toml").display().to_string();
-    let output = scorpion(
+    let layout = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/checksum/checksum.toml")
+        .display()
+        .to_string();
+    build_example(
         dir,
-        &["build", &source, "--target", &layout, "-o", "checksum.elf"],
+        "checksum/checksum.s",
+        "checksum.elf",
+        &["--target", &layout],
     );
-    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
     "checksum.elf".into()
 }
 
@@ -407,18 +409,8 @@ fn the_readme_main_job_prints_what_the_readme_says() {
 #[test]
 fn an_overlapping_upload_is_refused_and_replace_swaps_the_extension() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
-    for (source, output) in [
-        ("rangefinder/rangefinder.s", "first.elf"),
-        ("checksum/checksum.s", "second.elf"),
-    ] {
-        let source = examples.join(source);
-        let built = scorpion(
-            dir.path(),
-            &["build", source.to_str().expect("UTF-8"), "-o", output],
-        );
-        assert!(built.status.success(), "{}", transcript(&built));
-    }
+    build_example(dir.path(), "rangefinder/rangefinder.s", "first.elf", &[]);
+    build_example(dir.path(), "checksum/checksum.s", "second.elf", &[]);
     let sim = Sim::start();
     let port = sim.path.as_str();
     let first = scorpion(dir.path(), &["upload", "first.elf", "--port", port]);
