@@ -22,15 +22,7 @@ use isa::objfmt::{SRCMAP_SECTION, SrcMap};
 
 const BUILTIN: &str = "; a built-in include, found with no path\nBUILTIN_VALUE = $42\n.macro builtin_macro\n        lda #BUILTIN_VALUE\n.endmacro\n";
 
-/// Renders diagnostics as the CLI shows them, without colour.
-fn render(diagnostic: &dyn miette::Diagnostic) -> String {
-    let mut out = String::new();
-    miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
-        .with_width(100)
-        .render_report(&mut out, diagnostic)
-        .expect("rendering to a String cannot fail");
-    out
-}
+use scorpion_tests::render;
 
 /// A readable dump of an object, read back with goblin.
 fn dump(object: &[u8]) -> String {

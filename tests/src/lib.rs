@@ -5,4 +5,7 @@
 //! (library-level) and `tests/cli/` (the `scorpion` binary, run as a
 //! process; a test target of the root package).
 
+mod render;
 pub mod tools;
+
+pub use render::render;

@@ -29,15 +29,7 @@ pub(crate) fn link_flat(objects: &[(&str, Vec<u8>)], start: u64) -> Result<Linke
     link_with(objects, &target, &[], &MemorySources::default())
 }
 
-/// Renders a diagnostic as the CLI shows it, without colour, for snapshots.
-pub(crate) fn render(error: &dyn miette::Diagnostic) -> String {
-    let mut out = String::new();
-    miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
-        .with_width(100)
-        .render_report(&mut out, error)
-        .expect("rendering to a string cannot fail");
-    out
-}
+pub(crate) use scorpion_tests::render;
 
 /// A ROM image exporting the user-area bounds, as the reference ROM does.
 pub(crate) fn fake_rom(extra: &[(&str, u32)]) -> Image {
