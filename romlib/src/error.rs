@@ -101,6 +101,22 @@ pub enum Error {
         handler: u16,
     },
 
+    /// An image whose memory lies where the ROM keeps its own (or nowhere
+    /// an extension may be).
+    #[error("the image's memory {extent} is not memory an extension may use ({allowed})")]
+    #[diagnostic(
+        code(romlib::not_user_memory),
+        help(
+            "link extensions with --target scorpion-ext (or scorpion-os, or a layout inside those ranges): the rest of the RAM is the ROM's"
+        )
+    )]
+    NotUserMemory {
+        /// The extent outside.
+        extent: String,
+        /// The ranges an extension may use.
+        allowed: String,
+    },
+
     /// The table of installed extensions has no room for another.
     #[error("the robot's table of installed extensions is full ({capacity} entries): {reason}")]
     #[diagnostic(

@@ -11,11 +11,13 @@
 //! 6551 at the line's baud rate and parses the answer.
 
 use emulator::Stop;
-use emulator::board::{CPU_HZ, Scorpion};
+use emulator::board::{CPU_HZ, Scorpion, map};
 use isa::objfmt::HookKind;
 use linker::Image;
 
 use crate::error::Error;
+use std::ops::RangeInclusive;
+
 use crate::installed;
 use crate::protocol::{Answer, Command};
 use crate::symbols;
@@ -26,6 +28,9 @@ pub const ANSWER_TIMEOUT: u64 = CPU_HZ;
 /// Robot time the ROM needs to act on an instruction once its last byte
 /// arrived, with margin (the command loop, the dispatch, a handler).
 pub const INSTRUCTION_TIME: u64 = 5_000;
+
+/// The KIM-bus expansion space, where cards and extra RAM sit.
+const KIM_BUS: RangeInclusive<u16> = map::KIM_START..=map::KIM_END;
 
 /// Robot time [`VirtualScorpion::check_loop`] is given when the robot does
 /// not answer: 100 ms, a hundred times the longest the reference ROM's loop
@@ -72,6 +77,9 @@ pub struct VirtualScorpion {
     /// The ROM's table of installed extensions (`EXTTAB`) and its entries,
     /// if the ROM keeps one.
     table: Option<(u16, usize)>,
+    /// The memory a loaded image may use: the user zero page and RAM the
+    /// ROM exports, and the KIM bus (empty: the ROM does not say).
+    user: Vec<RangeInclusive<u16>>,
     /// Labels of the ROM and of every image loaded, for naming the place
     /// a robot that stopped answering is stuck in.
     labels: Vec<(u16, String)>,
@@ -96,6 +104,11 @@ impl VirtualScorpion {
                 main_loop: symbols::HOOK_LOOP,
             },
             table: Some((installed::TABLE, installed::ENTRIES)),
+            user: vec![
+                symbols::USER_ZP_START..=symbols::USER_ZP_END,
+                symbols::USER_RAM_START..=symbols::USER_RAM_END,
+                KIM_BUS,
+            ],
             labels: Vec::new(),
         };
         if let Ok(rom) = Image::parse("scorpion-rom.elf", crate::ROM_ELF) {
@@ -138,10 +151,23 @@ impl VirtualScorpion {
             .zip(rom.symbol("EXTTAB_ENTRIES"))
             .filter(|_| rom.symbol("EXTTAB_ENTRY_LEN") == Some(installed::ENTRY_LEN as u32))
             .and_then(|(at, entries)| Some((u16::try_from(at).ok()?, entries as usize)));
+        let bounds = |first: &str, last: &str| {
+            let first = u16::try_from(rom.symbol(first)?).ok()?;
+            let last = u16::try_from(rom.symbol(last)?).ok()?;
+            Some(first..=last)
+        };
+        let user = match (
+            bounds("USER_ZP_START", "USER_ZP_END"),
+            bounds("USER_RAM_START", "USER_RAM_END"),
+        ) {
+            (Some(zp), Some(ram)) => vec![zp, ram, KIM_BUS],
+            _ => Vec::new(),
+        };
         let mut scorpion = VirtualScorpion {
             robot: Scorpion::scorpion(&bytes)?,
             hooks,
             table,
+            user,
             labels: Vec::new(),
         };
         scorpion.add_labels(rom);
@@ -278,6 +304,20 @@ impl VirtualScorpion {
             self.check_ram(area.load, area.bytes.len())?;
         }
         let extents = installed::image_extents(image);
+        if !self.user.is_empty()
+            && let Some(outside) = extents.iter().find(|extent| {
+                !self
+                    .user
+                    .iter()
+                    .any(|user| user.start() <= extent.start() && extent.end() <= user.end())
+            })
+        {
+            let allowed: Vec<String> = self.user.iter().map(installed::extent_text).collect();
+            return Err(Error::NotUserMemory {
+                extent: installed::extent_text(outside),
+                allowed: allowed.join(", "),
+            });
+        }
         let mut entry = None;
         if let Some((table, capacity)) = self.table {
             let present = self.installed()?;
@@ -608,9 +648,21 @@ mod tests {
     #[test]
     fn an_image_outside_ram_is_refused_whole() {
         let mut robot = VirtualScorpion::new();
-        let mut bad = image(0x0FFE, &[1, 2, 3, 4], Vec::new());
-        // $0FFE-$1001 is card RAM then KIM-bus RAM: fine.
-        robot.load_image(&bad).expect("RAM all the way");
+        let mut bad = image(0x0F3E, &[1, 2, 3, 4], Vec::new());
+        // $0F3E-$0F41 runs from user RAM into INJECT's queue, the ROM's.
+        let error = robot.load_image(&bad).expect_err("into the ROM's RAM");
+        assert!(
+            matches!(&error, Error::NotUserMemory { extent, .. } if extent == "$0F3E-$0F41"),
+            "{error}"
+        );
+        assert_eq!(robot.robot().board().memory()[0x0F3E], 0, "nothing written");
+        bad.areas[0].load = 0x0200;
+        assert!(
+            matches!(robot.load_image(&bad), Err(Error::NotUserMemory { .. })),
+            "onto the hooks"
+        );
+        bad.areas[0].load = 0x1000;
+        robot.load_image(&bad).expect("KIM-bus RAM");
         bad.areas[0].load = 0xBFFE;
         let error = robot.load_image(&bad).expect_err("runs into the I/O page");
         assert!(
