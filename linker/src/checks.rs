@@ -7,7 +7,7 @@ use isa::objfmt::{AssertAction, EvalError, HookKind, HookRecord, Hooks};
 
 use crate::error::Error;
 use crate::input::Object;
-use crate::link::{Global, Origin};
+use crate::model::{Global, Origin};
 use crate::source::{Place, SourceProvider};
 
 /// Evaluates every object's deferred assertions with `isa`'s evaluator.

@@ -8,8 +8,8 @@ use isa::objfmt::Hooks;
 use crate::image::{Image, ImageSection, ImageSymbol, LoadArea};
 use crate::input::{Binding, Definition, Object};
 use crate::layout::{Layout, SegmentKind};
-use crate::link::{Global, Origin};
 use crate::map::{MapArea, MapData, MapModule, MapPart, MapSegment};
+use crate::model::{Global, Origin};
 use crate::place::{self, Placement};
 
 /// The image: areas split where the run address stops following the load

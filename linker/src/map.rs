@@ -5,7 +5,7 @@ use core::fmt::Write as _;
 use std::collections::BTreeMap;
 
 use crate::layout::SegmentKind;
-use crate::link::Linked;
+use crate::model::Linked;
 
 #[derive(Debug, Clone)]
 pub(crate) struct MapArea {

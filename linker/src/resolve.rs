@@ -1,0 +1,279 @@
+//! Symbol resolution, the stage between placement and relocation: the
+//! value of every symbol of every object, the global symbols (the layout's
+//! `define = yes` ones, the objects' exports, `--just-symbols` files), and
+//! the references nothing defines, each reported with the places that use
+//! it and a "did you mean".
+
+use std::collections::{BTreeMap, HashMap};
+
+use crate::error::Error;
+use crate::input::{Binding, Definition, Object};
+use crate::layout::Layout;
+use crate::model::{Global, Origin};
+use crate::place::Placement;
+use crate::source::{Place, SourceProvider};
+
+/// What resolution found.
+pub(crate) struct Resolved {
+    /// Per object, per symbol: its value (`None` where it has none).
+    pub(crate) values: Vec<Vec<Option<i64>>>,
+    /// The global symbols by name.
+    pub(crate) globals: BTreeMap<String, Global>,
+    /// Per object, per symbol: referenced and defined nowhere.
+    pub(crate) unresolved: Vec<Vec<bool>>,
+}
+
+/// Resolves every symbol of `objects` placed by `placement`; duplicate and
+/// undefined symbols go to `errors`. `file_symbols` are the
+/// `--just-symbols` files' (value, file name) by name; `link_against_rom`
+/// says whether there are any, for the help of an undefined name.
+pub(crate) fn resolve(
+    objects: &[Object],
+    layout: &Layout,
+    placement: &Placement,
+    file_symbols: &HashMap<&str, (i64, &str)>,
+    link_against_rom: bool,
+    sources: &dyn SourceProvider,
+    errors: &mut Vec<Error>,
+) -> Resolved {
+    // Values of defined symbols.
+    let mut values: Vec<Vec<Option<i64>>> = objects
+        .iter()
+        .enumerate()
+        .map(|(object_index, object)| {
+            object
+                .symbols
+                .iter()
+                .map(|symbol| match symbol.definition {
+                    Definition::Undefined => None,
+                    Definition::Absolute(value) => Some(value),
+                    Definition::Section(section, offset) => placement
+                        .section_run(object_index, section)
+                        .map(|run| run as i64 + i64::from(offset)),
+                })
+                .collect()
+        })
+        .collect();
+
+    let mut globals = layout_symbols(layout, placement);
+    for (object_index, object) in objects.iter().enumerate() {
+        for (symbol_index, symbol) in object.symbols.iter().enumerate() {
+            if symbol.binding == Binding::Local
+                || symbol.definition == Definition::Undefined
+                || symbol.name.is_empty()
+            {
+                continue;
+            }
+            let weak = symbol.binding == Binding::Weak;
+            let segment = match symbol.definition {
+                Definition::Section(section, _) => {
+                    placement.sections[object_index][section].map(|(segment, _)| segment)
+                }
+                _ => None,
+            };
+            let new = Global {
+                value: values[object_index][symbol_index],
+                origin: Origin::Object {
+                    object: object_index,
+                    symbol: symbol_index,
+                },
+                weak,
+                segment,
+                size: symbol.size,
+            };
+            match globals.get(&symbol.name) {
+                None => {
+                    globals.insert(symbol.name.clone(), new);
+                }
+                Some(old) if old.weak && !weak => {
+                    globals.insert(symbol.name.clone(), new);
+                }
+                Some(_) if weak => {}
+                Some(old) => {
+                    let first = match &old.origin {
+                        Origin::Object { object, symbol } => {
+                            objects[*object].place_of_symbol(*symbol).text
+                        }
+                        Origin::Layout => format!("layout {} (define = true)", layout.name),
+                        Origin::File(file) => file.clone(),
+                    };
+                    let second = object.place_of_symbol(symbol_index);
+                    let (src, span) = second.snippet(sources);
+                    errors.push(Error::Duplicate {
+                        name: symbol.name.clone(),
+                        first,
+                        second: second.text,
+                        src,
+                        span,
+                    });
+                }
+            }
+        }
+    }
+
+    // Undefined references: globals, then --just-symbols, then weak zero.
+    let mut undefined: BTreeMap<String, Vec<Place>> = BTreeMap::new();
+    let mut unresolved: Vec<Vec<bool>> = Vec::with_capacity(objects.len());
+    for (object_index, object) in objects.iter().enumerate() {
+        let mut missing = vec![false; object.symbols.len()];
+        for (symbol_index, symbol) in object.symbols.iter().enumerate().skip(1) {
+            if symbol.definition != Definition::Undefined {
+                // A global binds to the winning definition (a weak one may
+                // have lost to a strong one elsewhere).
+                if let (false, Some(global)) =
+                    (symbol.binding == Binding::Local, globals.get(&symbol.name))
+                {
+                    values[object_index][symbol_index] = global.value;
+                }
+                continue;
+            }
+            if let Some(global) = globals.get(&symbol.name) {
+                values[object_index][symbol_index] = global.value;
+            } else if let Some((value, file)) = file_symbols.get(symbol.name.as_str()) {
+                values[object_index][symbol_index] = Some(*value);
+                globals.insert(
+                    symbol.name.clone(),
+                    Global {
+                        value: Some(*value),
+                        origin: Origin::File((*file).to_owned()),
+                        weak: false,
+                        segment: None,
+                        size: 0,
+                    },
+                );
+            } else if symbol.binding == Binding::Weak {
+                values[object_index][symbol_index] = Some(0);
+            } else {
+                missing[symbol_index] = true;
+            }
+        }
+        for (section_index, section) in object.sections.iter().enumerate() {
+            for reloc in &section.relocs {
+                if missing[reloc.symbol] {
+                    undefined
+                        .entry(object.symbols[reloc.symbol].name.clone())
+                        .or_default()
+                        .push(object.place_of_byte(section_index, reloc.offset));
+                }
+            }
+        }
+        for assertion in &object.asserts {
+            for symbol in assertion.expr.symbols() {
+                if missing[symbol as usize] {
+                    undefined
+                        .entry(object.symbols[symbol as usize].name.clone())
+                        .or_default()
+                        .push(Place::source(
+                            &assertion.file,
+                            assertion.line,
+                            assertion.column,
+                        ));
+                }
+            }
+        }
+        unresolved.push(missing);
+    }
+    for (name, mut places) in undefined {
+        places.sort();
+        places.dedup();
+        let (src, span) = places[0].snippet(sources);
+        let candidates = globals
+            .keys()
+            .map(String::as_str)
+            .chain(file_symbols.keys().copied());
+        let similar = similar(&name, candidates);
+        let help = if let Some(similar) = similar {
+            format!("did you mean `{similar}`?")
+        } else if name
+            .chars()
+            .all(|c| c.is_ascii_uppercase() || c == '_' || c.is_ascii_digit())
+            && !link_against_rom
+        {
+            format!(
+                "export `{name}` from one of the objects, or link against the ROM with --just-symbols ROM.elf if it is a ROM symbol"
+            )
+        } else {
+            format!(
+                "export `{name}` from one of the objects (`.export {name}`), or check its spelling"
+            )
+        };
+        errors.push(Error::Undefined {
+            name,
+            places: places
+                .iter()
+                .map(|place| place.text.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            help,
+            src,
+            span,
+        });
+    }
+
+    Resolved {
+        values,
+        globals,
+        unresolved,
+    }
+}
+
+/// `__NAME_LOAD__`, `__NAME_RUN__`, `__NAME_SIZE__` for segments and
+/// `__NAME_START__`, `__NAME_SIZE__`, `__NAME_LAST__` for areas with
+/// `define = true`, as ld65 defines them.
+fn layout_symbols(layout: &Layout, placement: &Placement) -> BTreeMap<String, Global> {
+    let mut globals = BTreeMap::new();
+    let mut define = |name: String, value: u64| {
+        globals.insert(
+            name,
+            Global {
+                value: Some(value as i64),
+                origin: Origin::Layout,
+                weak: false,
+                segment: None,
+                size: 0,
+            },
+        );
+    };
+    for segment in placement.segments.iter().filter(|s| s.rule.define) {
+        let name = &segment.rule.name;
+        define(format!("__{name}_LOAD__"), segment.load);
+        define(format!("__{name}_RUN__"), segment.run);
+        define(format!("__{name}_SIZE__"), segment.size);
+    }
+    for area in placement.areas.iter().filter(|a| a.area.define) {
+        let name = &area.area.name;
+        define(format!("__{name}_START__"), area.area.start);
+        define(format!("__{name}_SIZE__"), area.area.size);
+        define(format!("__{name}_LAST__"), area.used_end);
+    }
+    let _ = layout;
+    globals
+}
+
+/// The defined name nearest `name` by edit distance, if near enough to be
+/// a typo of it (two edits, and no more than half its length).
+fn similar<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    candidates
+        .map(|candidate| (strsim::levenshtein(candidate, name), candidate))
+        .filter(|(distance, _)| *distance <= 2.min(name.len() / 2))
+        .min()
+        .map(|(_, candidate)| candidate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::similar;
+
+    #[test]
+    fn a_typo_is_near_and_another_name_is_not() {
+        let names = ["print", "PUTHEX", "pointer"];
+        assert_eq!(similar("prnt", names.into_iter()), Some("print"));
+        assert_eq!(similar("PUTCH", names.into_iter()), None, "three edits");
+        assert_eq!(
+            similar("ab", names.into_iter()),
+            None,
+            "short names need exact"
+        );
+        assert_eq!(similar("pointr", names.into_iter()), Some("pointer"));
+    }
+}
