@@ -2,7 +2,6 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use isa::elf as mos;
 use isa::objfmt::HookKind;
 
 use crate::checks::{check_asserts, defined_at, hooks};
@@ -173,9 +172,4 @@ fn failed(errors: Vec<Error>) -> Error {
         count: errors.len(),
         errors,
     }
-}
-
-/// The `R_MOS_*` name of a relocation type, for messages.
-pub(crate) fn relocation_name(r_type: u32) -> &'static str {
-    mos::relocation_name(r_type).unwrap_or("R_MOS_?")
 }

@@ -19,7 +19,6 @@ use isa::elf as mos;
 
 use crate::error::Error;
 use crate::input::{Definition, Object};
-use crate::link::relocation_name;
 use crate::place::Placed;
 use crate::source::SourceProvider;
 
@@ -161,4 +160,9 @@ pub(crate) fn apply(
             }
         }
     }
+}
+
+/// The `R_MOS_*` name of a relocation type, for messages.
+fn relocation_name(r_type: u32) -> &'static str {
+    isa::elf::relocation_name(r_type).unwrap_or("R_MOS_?")
 }
