@@ -31,6 +31,26 @@ fn sim(args: &[&str], input: &str) -> std::process::Output {
         .expect("scorpion sim ends at the end of stdin")
 }
 
+/// `scorpion sim` with `images` (in `dir`) and `input`; its output, and
+/// the transcript with `dir` as `[TMP]`.
+fn sim_images(
+    dir: &std::path::Path,
+    images: &[&str],
+    input: &str,
+) -> (std::process::Output, String) {
+    let paths: Vec<String> = images
+        .iter()
+        .map(|image| dir.join(image).display().to_string())
+        .collect();
+    let mut args = Vec::new();
+    for path in &paths {
+        args.extend(["--image", path.as_str()]);
+    }
+    let output = sim(&args, input);
+    let text = transcript(&output).replace(dir.to_str().expect("UTF-8"), "[TMP]");
+    (output, text)
+}
+
 #[test]
 fn sim_answers_commands_from_stdin() {
     let output = sim(&[], "/1P\n/2E3\n/2G1\n/1E\n/1G\n/7RF00004\n/1Q\n/1X\n");
@@ -58,44 +78,22 @@ fn sim_refuses_a_rate_the_6551_lacks() {
 #[test]
 fn sim_loads_images_and_chains_their_hooks() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
-    let rangefinder = examples.join("rangefinder/rangefinder.s");
-    let checksum = examples.join("checksum/checksum.s");
-    let layout = examples.join("checksum/checksum.toml");
-    let built = scorpion(
+    let layout = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/checksum/checksum.toml")
+        .display()
+        .to_string();
+    build_example(dir.path(), "rangefinder/rangefinder.s", "first.elf", &[]);
+    build_example(
         dir.path(),
-        &[
-            "build",
-            rangefinder.to_str().expect("UTF-8"),
-            "-o",
-            "first.elf",
-        ],
+        "checksum/checksum.s",
+        "second.elf",
+        &["--target", &layout],
     );
-    assert!(built.status.success(), "{}", transcript(&built));
-    let built = scorpion(
+    let (_, text) = sim_images(
         dir.path(),
-        &[
-            "build",
-            checksum.to_str().expect("UTF-8"),
-            "-o",
-            "second.elf",
-            "--target",
-            layout.to_str().expect("UTF-8"),
-        ],
-    );
-    assert!(built.status.success(), "{}", transcript(&built));
-    let first = dir.path().join("first.elf");
-    let second = dir.path().join("second.elf");
-    let output = sim(
-        &[
-            "--image",
-            first.to_str().expect("UTF-8"),
-            "--image",
-            second.to_str().expect("UTF-8"),
-        ],
+        &["first.elf", "second.elf"],
         "/7R020102\n/9KF0000010\n/1U\n",
     );
-    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
     insta::assert_snapshot!(text);
 }
 
@@ -169,18 +167,7 @@ fn sim_refuses_an_image_that_overlaps_an_installed_one() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     build_example(dir.path(), "rangefinder/rangefinder.s", "first.elf", &[]);
     build_example(dir.path(), "checksum/checksum.s", "second.elf", &[]);
-    let first = dir.path().join("first.elf");
-    let second = dir.path().join("second.elf");
-    let output = sim(
-        &[
-            "--image",
-            first.to_str().expect("UTF-8"),
-            "--image",
-            second.to_str().expect("UTF-8"),
-        ],
-        "/1X\n",
-    );
-    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
+    let (output, text) = sim_images(dir.path(), &["first.elf", "second.elf"], "/1X\n");
     assert_eq!(output.status.code(), Some(1), "{text}");
     assert!(
         !text.contains("(was $0400)"),
@@ -203,12 +190,7 @@ fn a_handler_that_never_returns_is_reported_where_it_hangs() {
     .expect("write the source");
     let built = scorpion(dir.path(), &["build", "hang.s", "-o", "hang.elf"]);
     assert!(built.status.success(), "{}", transcript(&built));
-    let image = dir.path().join("hang.elf");
-    let output = sim(
-        &["--image", image.to_str().expect("UTF-8")],
-        "/1X\n/1Q\n/1X\n",
-    );
-    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
+    let (output, text) = sim_images(dir.path(), &["hang.elf"], "/1X\n/1Q\n/1X\n");
     assert_eq!(output.status.code(), Some(1), "{text}");
     assert!(text.contains("X00"), "the answer before the hang: {text}");
     insta::assert_snapshot!(text);
@@ -244,10 +226,8 @@ fn a_host_question_behind_an_injecting_os_is_answered() {
         "patrol.elf",
         &["--target", "scorpion-os"],
     );
-    let image = dir.path().join("patrol.elf");
     for _ in 0..3 {
-        let output = sim(&["--image", image.to_str().expect("UTF-8")], "/2A1\n/1P\n");
-        let text = transcript(&output);
+        let (output, text) = sim_images(dir.path(), &["patrol.elf"], "/2A1\n/1P\n");
         assert_eq!(output.status.code(), Some(0), "{text}");
         assert!(
             String::from_utf8_lossy(&output.stdout).starts_with("PB00"),
