@@ -24,7 +24,7 @@
 
 use std::ops::RangeInclusive;
 
-use isa::objfmt::HookKind;
+use isa::objfmt::{HookKind, HookRecord};
 
 use crate::symbols::{EXTTAB, EXTTAB_ENTRIES, EXTTAB_ENTRY_LEN};
 
@@ -108,6 +108,25 @@ pub fn image_id(bytes: impl IntoIterator<Item = u8>) -> u32 {
 }
 
 impl Installed {
+    /// An image about to be installed: its id, its memory, and the hooks
+    /// its records take (its slot is set where it goes).
+    #[must_use]
+    pub fn new(id: u32, extents: Vec<RangeInclusive<u16>>, records: &[HookRecord]) -> Installed {
+        Installed {
+            id,
+            extents,
+            hooks: records
+                .iter()
+                .map(|record| TakenHook {
+                    kind: record.kind,
+                    handler: record.handler,
+                    chain: record.chain,
+                })
+                .collect(),
+            slot: 0,
+        }
+    }
+
     /// Table entries needed.
     #[must_use]
     pub fn entries(&self) -> usize {
@@ -157,12 +176,22 @@ impl Installed {
         out
     }
 
-    /// Whether any of its extents meets `range`.
+    /// The refusal of an image with memory `extents`, where one of them
+    /// meets one of this extension's ([`crate::Error::Overlap`], naming
+    /// both); `None` where none does.
     #[must_use]
-    pub fn overlaps(&self, range: &RangeInclusive<u16>) -> bool {
-        self.extents
-            .iter()
-            .any(|extent| extent.start() <= range.end() && range.start() <= extent.end())
+    pub fn overlap(&self, extents: &[RangeInclusive<u16>]) -> Option<crate::Error> {
+        extents.iter().find_map(|new| {
+            let owned = self
+                .extents
+                .iter()
+                .find(|owned| owned.start() <= new.end() && new.start() <= owned.end())?;
+            Some(crate::Error::Overlap {
+                new: extent_text(new),
+                old: extent_text(owned),
+                id: self.id,
+            })
+        })
     }
 }
 
@@ -378,8 +407,13 @@ mod tests {
     #[test]
     fn overlaps_are_inclusive() {
         let image = sample();
-        assert!(image.overlaps(&(0x10FF..=0x1200)));
-        assert!(image.overlaps(&(0x0300..=0x0400)));
-        assert!(!image.overlaps(&(0x0420..=0x0FFF)));
+        let error = image.overlap(&[0x0300..=0x0400]).expect("meets $0400");
+        assert!(
+            matches!(&error, crate::Error::Overlap { new, old, id: 0x00AB_CDEF }
+                if new == "$0300-$0400" && old == "$0400-$041F"),
+            "{error}"
+        );
+        assert!(image.overlap(&[0x0420..=0x0FFF, 0x10FF..=0x1200]).is_some());
+        assert!(image.overlap(&[0x0420..=0x0FFF, 0x1100..=0x1200]).is_none());
     }
 }

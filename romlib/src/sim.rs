@@ -321,37 +321,11 @@ impl VirtualScorpion {
         let mut entry = None;
         if let Some((table, capacity)) = self.table {
             let present = self.installed()?;
-            for old in &present {
-                for new in &extents {
-                    if let Some(owned) = old
-                        .extents
-                        .iter()
-                        .find(|o| o.start() <= new.end() && new.start() <= o.end())
-                    {
-                        return Err(Error::Overlap {
-                            new: installed::extent_text(new),
-                            old: installed::extent_text(owned),
-                            id: old.id,
-                        });
-                    }
-                }
+            if let Some(refusal) = present.iter().find_map(|old| old.overlap(&extents)) {
+                return Err(refusal);
             }
-            let hooks = image
-                .hooks
-                .records
-                .iter()
-                .map(|record| installed::TakenHook {
-                    kind: record.kind,
-                    handler: record.handler,
-                    chain: record.chain,
-                })
-                .collect();
-            let new = installed::Installed {
-                id: installed::image_id(image.areas.iter().flat_map(|a| a.bytes.iter().copied())),
-                extents,
-                hooks,
-                slot: 0,
-            };
+            let id = installed::image_id(image.areas.iter().flat_map(|a| a.bytes.iter().copied()));
+            let new = installed::Installed::new(id, extents, &image.hooks.records);
             let slot =
                 installed::free_slot(&present, new.entries(), capacity).ok_or_else(|| {
                     Error::TableFull {

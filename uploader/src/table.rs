@@ -110,44 +110,19 @@ pub(crate) fn prepare<T: Transport>(
     let Some(mut read) = read_table(client, profile)? else {
         return Ok(None);
     };
-    let mut removed = false;
-    for old in std::mem::take(&mut read.installed) {
-        let overlap = image.extents().iter().find_map(|new| {
-            old.extents
-                .iter()
-                .find(|o| o.start() <= new.end() && new.start() <= o.end())
-                .map(|o| (new.clone(), o.clone()))
-        });
-        match overlap {
-            None => kept.push(old),
-            Some(_) if old.id == id && old.extents == image.extents() => reused = Some(old),
+    for old in &read.installed {
+        match old.overlap(image.extents()) {
+            None => kept.push(old.clone()),
+            Some(_) if old.id == id && old.extents == image.extents() => reused = Some(old.clone()),
             Some(_) if replace => {
-                remove(client, profile, &old, max_writes)?;
-                removed = true;
+                remove(client, profile, &read.installed, old, max_writes)?;
+                // Its flags are cleared now, verified.
+                read.flags[old.slot..old.slot + old.entries()].fill(0);
             }
-            Some((new, owned)) => {
-                return Err(Error::Robot(romlib::Error::Overlap {
-                    new: installed::extent_text(&new),
-                    old: installed::extent_text(&owned),
-                    id: old.id,
-                }));
-            }
+            Some(refusal) => return Err(Error::Robot(refusal)),
         }
     }
-    let mut entry = Installed {
-        id,
-        extents: image.extents().to_vec(),
-        hooks: image
-            .hooks()
-            .iter()
-            .map(|record| TakenHook {
-                kind: record.kind,
-                handler: record.handler,
-                chain: record.chain,
-            })
-            .collect(),
-        slot: 0,
-    };
+    let mut entry = Installed::new(id, image.extents().to_vec(), image.hooks());
     entry.slot = match &reused {
         Some(old) => old.slot,
         None => installed::free_slot(&kept, entry.entries(), table.1).ok_or_else(|| {
@@ -160,9 +135,6 @@ pub(crate) fn prepare<T: Transport>(
             })
         })?,
     };
-    if removed {
-        read = read_table(client, profile)?.unwrap_or(read);
-    }
     let current_flags: Vec<Option<u8>> = read.flags[entry.slot..entry.slot + entry.entries()]
         .iter()
         .map(|&b| Some(b))
@@ -305,18 +277,18 @@ fn differs<T: Transport>(
 ///
 /// # Errors
 /// The client's, [`Error::VerifyFailed`].
-pub(crate) fn remove<T: Transport>(
+fn remove<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
+    everyone: &[Installed],
     old: &Installed,
     max_writes: u32,
 ) -> Result<()> {
     let Some((table, _)) = profile.table else {
         return Ok(());
     };
-    let everyone = read_installed(client, profile)?;
     for hook in &old.hooks {
-        unlink(client, profile, &everyone, old, *hook, max_writes)?;
+        unlink(client, profile, everyone, *hook, max_writes)?;
     }
     // Clearing its flags bytes frees its entries.
     let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();
@@ -325,14 +297,13 @@ pub(crate) fn remove<T: Transport>(
     write_verified(client, at, &freed, &now, max_writes)
 }
 
-/// Re-points whatever jumps to `hook.handler` at where `old` fell
-/// through: the hook's own operand, or the chain slot of the extension
-/// before it. Nothing to do where `old` is not in the chain.
+/// Re-points whatever jumps to `hook.handler` at where that extension
+/// fell through: the hook's own operand, or the chain slot of the extension
+/// before it. Nothing to do where it is not in the chain.
 fn unlink<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     everyone: &[Installed],
-    old: &Installed,
     hook: TakenHook,
     max_writes: u32,
 ) -> Result<()> {
@@ -346,30 +317,16 @@ fn unlink<T: Transport>(
             target: hook.handler,
         });
     };
-    // Follow the chain from the hook: at most one step per extension.
-    let mut pointer = profile.hook_address(hook.kind) + 1;
-    for _ in 0..=everyone.len() {
-        let Some(target) = read_word(client, pointer)? else {
-            return Ok(());
-        };
-        if target == hook.handler {
-            return write_word_verified(client, pointer, after.to_le_bytes(), max_writes);
+    let chain = walk(client, profile, everyone, hook.kind, Some(hook.handler))?;
+    match chain.last() {
+        Some(&(pointer, target)) if target == hook.handler => {
+            write_word_verified(client, pointer, after.to_le_bytes(), max_writes)
         }
-        let next = everyone
-            .iter()
-            .filter(|other| other.id != old.id || other.slot != old.slot)
-            .flat_map(|other| other.hooks.iter())
-            .find(|other| other.kind == hook.kind && other.handler == target)
-            .and_then(|other| other.chain);
-        match next {
-            Some(slot) => pointer = slot,
-            None => return Ok(()),
-        }
+        _ => Ok(()),
     }
-    Ok(())
 }
 
-/// The extents of `hook`'s chain, in order, for a listing: each handler
+/// The targets of `kind`'s chain, in order, for a listing: each handler
 /// the hook reaches, following the installed chain slots, up to the first
 /// target that no installed extension owns (the ROM's, usually).
 ///
@@ -381,13 +338,31 @@ pub fn chain_of<T: Transport>(
     everyone: &[Installed],
     kind: HookKind,
 ) -> Result<Vec<u16>> {
-    let mut targets = Vec::new();
+    let chain = walk(client, profile, everyone, kind, None)?;
+    Ok(chain.into_iter().map(|(_, target)| target).collect())
+}
+
+/// Follows `kind`'s chain from the hook: each pointer (the hook's operand,
+/// then installed chain slots) with the target it holds, read until two
+/// answers agree, up to `until` or the first target no installed
+/// extension owns; at most one step per extension.
+fn walk<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    kind: HookKind,
+    until: Option<u16>,
+) -> Result<Vec<(u16, u16)>> {
+    let mut steps = Vec::new();
     let mut pointer = profile.hook_address(kind) + 1;
     for _ in 0..=everyone.len() {
         let Some(target) = read_word(client, pointer)? else {
             break;
         };
-        targets.push(target);
+        steps.push((pointer, target));
+        if Some(target) == until {
+            break;
+        }
         let next = everyone
             .iter()
             .flat_map(|other| other.hooks.iter())
@@ -398,7 +373,7 @@ pub fn chain_of<T: Transport>(
             None => break,
         }
     }
-    Ok(targets)
+    Ok(steps)
 }
 
 /// Sorted, merged extents of loaded areas.
