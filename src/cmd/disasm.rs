@@ -241,12 +241,17 @@ fn elf_blocks(name: &str, bytes: &[u8]) -> miette::Result<Parsed> {
             continue;
         };
         let end = u32::from(address) + section.size - 1;
+        let last = u16::try_from(end).unwrap_or(u16::MAX);
         blocks.push(Block {
             title: format!("{} ${address:04X}-${end:04X}", section.name),
             address,
             bytes: contents,
             code: section.exec,
-            labels: labels.clone(),
+            // The labels inside the section.
+            labels: labels
+                .range(address..=last)
+                .map(|(at, names)| (*at, names.clone()))
+                .collect(),
             notes: BTreeMap::new(),
         });
     }

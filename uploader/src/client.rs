@@ -366,6 +366,14 @@ impl<T: Transport> Client<T> {
         self.ask_with(command, self.config.question_attempts)
     }
 
+    /// How long `command` (encoded as `bytes`) and its answer take on the
+    /// line, with margin; `/1S` and extensions get the longest answer
+    /// there is.
+    fn answer_timeout(&self, command: &Command, bytes: &[u8]) -> Duration {
+        let answer_len = command.answer_len().unwrap_or(2 * 199 + 3);
+        self.chars(bytes.len() + answer_len) + self.config.margin * 2
+    }
+
     /// Sends a command that may or may not be answered (an extension's, in
     /// an expectation file) and waits as long as the longest answer takes:
     /// the answer if one came, `None` if the line stayed silent. Never
@@ -376,8 +384,7 @@ impl<T: Transport> Client<T> {
     /// printable text ending in a carriage return.
     pub fn listen(&mut self, command: &Command) -> Result<Option<Answer>> {
         let bytes = command.encode();
-        let answer_len = command.answer_len().unwrap_or(2 * 199 + 3);
-        let timeout = self.chars(bytes.len() + answer_len) + self.config.margin * 2;
+        let timeout = self.answer_timeout(command, &bytes);
         self.drain()?;
         self.transport.clear_input()?;
         self.send_raw(&bytes)?;
@@ -411,9 +418,7 @@ impl<T: Transport> Client<T> {
     fn ask_with(&mut self, command: &Command, attempts: u32) -> Result<Answer> {
         let attempts = attempts.max(1);
         let bytes = command.encode();
-        // `/1S` and extensions: allow the longest answer there is.
-        let answer_len = command.answer_len().unwrap_or(2 * 199 + 3);
-        let timeout = self.chars(bytes.len() + answer_len) + self.config.margin * 2;
+        let timeout = self.answer_timeout(command, &bytes);
         let mut heard = Vec::new();
         let mut last_error = None;
         for _ in 0..attempts {
