@@ -3,7 +3,9 @@
 //! - `scorpion-rom.elf` and `scorpion-rom.bin`, embedded by `romlib`;
 //! - `symbols.rs`: every exported ABI name as a Rust constant;
 //! - `scorpion.inc`: the same names for assembler sources, plus the hook
-//!   macros of `rom/hooks.inc`.
+//!   macros of `rom/hooks.inc`;
+//! - `hardware.inc`, which the ROM's sources include: the I/O page's names,
+//!   written from the `platform` crate.
 //!
 //! Each exported name's description is the comment on the source line that
 //! defines it, so the ROM source is the one place it is written; a name
@@ -88,12 +90,16 @@ fn main() {
         println!("cargo:rerun-if-changed=rom");
     }
 
+    // The I/O page's names come from the platform crate, as the emulator's
+    // wiring does; the sources include the generated file.
+    std::fs::write(out.join("hardware.inc"), platform::hardware_inc())
+        .expect("OUT_DIR is writable");
     let main_file = rom_dir.join("scorpion.s");
-    let assembly = match assembler::assemble(
-        &assembler::FsSource,
-        &main_file,
-        &assembler::Options::default(),
-    ) {
+    let options = assembler::Options {
+        include_dirs: vec![out.clone()],
+        ..assembler::Options::default()
+    };
+    let assembly = match assembler::assemble(&assembler::FsSource, &main_file, &options) {
         Ok(assembly) => assembly,
         Err(error) => {
             let details: Vec<String> = error

@@ -7,6 +7,7 @@
 //! - [`disasm`]: decoding and ca65-syntax disassembly.
 //! - [`elf`]: llvm-mos's ELF numbering (`EM_MOS`, `R_MOS_*`,
 //!   `SHF_MOS_ZEROPAGE`, `STO_MOS_ZEROPAGE`).
+//! - [`vectors`]: where the CPU reads its NMI, reset and IRQ/BRK vectors.
 //! - [`objfmt`]: our metadata sections (source map, deferred assertions, hook
 //!   records) and the one definition of the expression operators.
 //!
@@ -18,6 +19,16 @@ mod mnemonic;
 mod mode;
 pub mod objfmt;
 mod opcode;
+
+/// The addresses the 6502 reads its vectors from, low byte first.
+pub mod vectors {
+    /// The NMI vector, the first of the three.
+    pub const NMI: u16 = 0xFFFA;
+    /// The reset vector.
+    pub const RESET: u16 = 0xFFFC;
+    /// The IRQ/BRK vector.
+    pub const IRQ: u16 = 0xFFFE;
+}
 
 pub use disasm::{Disassembler, Instruction};
 pub use mnemonic::Mnemonic;

@@ -11,9 +11,10 @@
 //! 6551 at the line's baud rate and parses the answer.
 
 use emulator::Stop;
-use emulator::board::{CPU_HZ, Scorpion, map};
+use emulator::board::{CPU_HZ, Scorpion};
 use isa::objfmt::HookKind;
 use linker::Image;
+use platform::map;
 
 use crate::error::Error;
 use std::ops::RangeInclusive;
@@ -129,8 +130,8 @@ impl VirtualScorpion {
             name: name.to_owned(),
             reason,
         };
-        let mut bytes = Vec::with_capacity(0x1000);
-        for address in 0xF000..=0xFFFF_u32 {
+        let mut bytes = Vec::with_capacity(map::ROM_SIZE);
+        for address in u32::from(map::ROM_START)..=0xFFFF_u32 {
             let byte = rom
                 .byte_at(address)
                 .ok_or_else(|| bad(format!("it has no byte for ${address:04X}")))?;

@@ -222,7 +222,7 @@ fn elf_blocks(name: &str, bytes: &[u8]) -> miette::Result<Parsed> {
     // The built-in ROM's names for its own addresses and its RAM (the
     // hooks, the command buffer): never for the user's RAM or zero page.
     for rom in romlib::symbols::ALL {
-        let owned = (0x0200..0x0400).contains(&rom.value) || rom.value >= 0xF000;
+        let owned = (0x0200..0x0400).contains(&rom.value) || rom.value >= platform::map::ROM_START;
         if owned {
             operand_labels
                 .entry(rom.value)

@@ -54,8 +54,8 @@ impl Line {
     }
 }
 
-/// The default baud rate: the reference ROM's (docs/PROTOCOL.md section 3).
-pub(crate) const DEFAULT_BAUD: u32 = 9600;
+/// The default baud rate: the board's as shipped (docs/PROTOCOL.md section 3).
+pub(crate) const DEFAULT_BAUD: u32 = platform::line::DEFAULT_BAUD;
 
 /// The `--port` value that names the in-process virtual Scorpion.
 pub(crate) const EMU: &str = "emu";

@@ -112,6 +112,38 @@ fn scorpion_inc_is_built_in() {
     );
 }
 
+/// The board's `hardware.inc` is built in beside `scorpion.inc`, and a file
+/// of the same name on the search path comes first.
+#[test]
+fn hardware_inc_is_built_in_and_yields_to_the_users_own() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("card.s"),
+        "        .include \"hardware.inc\"\n        lda SWITCHES\n        and #ST_RDRF\n",
+    )
+    .expect("write the source");
+    let output = scorpion(dir.path(), &["asm", "card.s", "-l", "card.lst"]);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let listing = std::fs::read_to_string(dir.path().join("card.lst")).expect("the listing");
+    let switches = platform::map::SWITCHES.to_le_bytes();
+    let bytes = format!("AD {:02X} {:02X}", switches[0], switches[1]);
+    assert!(listing.contains(&bytes), "lda SWITCHES:\n{listing}");
+    assert!(listing.contains("29 08"), "and #ST_RDRF:\n{listing}");
+
+    std::fs::write(
+        dir.path().join("hardware.inc"),
+        "SWITCHES = $1234\nST_RDRF = 1\n",
+    )
+    .expect("write the user's include");
+    let output = scorpion(dir.path(), &["asm", "card.s", "-l", "card.lst"]);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let listing = std::fs::read_to_string(dir.path().join("card.lst")).expect("the listing");
+    assert!(
+        listing.contains("AD 34 12"),
+        "the user's file wins:\n{listing}"
+    );
+}
+
 /// `scorpion build --target flat --format bin` against ca65 + ld65.
 #[test]
 fn scorpion_build_flat_equals_ld65() {

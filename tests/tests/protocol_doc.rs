@@ -119,6 +119,50 @@ fn the_command_tables_are_the_roms_dispatch_table() {
     assert_eq!(pairs, rom, "the table of owned pairs against the ROM");
 }
 
+/// The host library's one table of commands is the ROM's dispatch table,
+/// entry by entry, and its forms are the forms docs/PROTOCOL.md shows.
+#[test]
+fn the_host_librarys_command_table_is_the_roms() {
+    let rom = linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("the ROM parses");
+    let table = rom.symbol("commands").expect("the ROM's dispatch table");
+    let mut dispatched = Vec::new();
+    for entry in 0.. {
+        let at = table + entry * 4;
+        let count = rom.byte_at(at).expect("in the ROM");
+        if count == 0 {
+            break;
+        }
+        dispatched.push((count, rom.byte_at(at + 1).expect("in the ROM")));
+    }
+    let listed: Vec<(u8, u8)> = romlib::protocol::COMMANDS
+        .iter()
+        .map(|spec| (spec.count, spec.letter))
+        .collect();
+    assert_eq!(listed, dispatched, "COMMANDS against the ROM's `commands`");
+
+    let text = doc();
+    let commands = section(&text, "## 2. The ROM's commands");
+    let forms: BTreeSet<String> = rows(commands)
+        .iter()
+        .flat_map(|row| {
+            row[0]
+                .split('`')
+                .skip(1)
+                .step_by(2)
+                .map(str::to_owned)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let ours: BTreeSet<String> = romlib::protocol::COMMANDS
+        .iter()
+        .map(|spec| spec.form.to_owned())
+        .collect();
+    assert_eq!(
+        forms, ours,
+        "the forms in docs/PROTOCOL.md against COMMANDS"
+    );
+}
+
 #[test]
 fn the_name_tables_are_the_roms_exported_symbols() {
     let text = doc();

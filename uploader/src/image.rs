@@ -7,8 +7,7 @@ use isa::objfmt::{HookKind, HookRecord};
 
 use crate::{Error, Result};
 
-/// The KIM-bus expansion space (docs/ARCHITECTURE.md's memory map).
-const KIM_BUS: RangeInclusive<u16> = 0x1000..=0xBFFF;
+use platform::map::KIM_BUS;
 
 /// Bytes to load at an address.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -23,9 +23,9 @@
 
 use std::time::Duration;
 
-use emulator::board::{acia, map};
 use isa::objfmt::HookKind;
 use linker::{Image, ImageSymbol};
+use platform::{acia, map};
 
 use crate::image::{Area, RomProfile, Services, UploadImage};
 use crate::transport::char_time;
@@ -62,8 +62,7 @@ const SLASH: u8 = b'/';
 /// `loader.s`): the key, two sums, the five header bytes.
 const ZERO_PAGE_LEN: u8 = 8;
 
-/// The 6551's control register on the reference board
-/// (`emulator/src/board/map.rs`; `ACIA_CTRL` in the ROM's `hardware.inc`).
+/// The 6551's control register (`ACIA_CTRL` in the ROM's `hardware.inc`).
 pub(crate) const ACIA_CONTROL: u16 = map::ACIA + acia::reg::CONTROL;
 
 /// What `rate` XORs the 6551's control register with: the baud codes of

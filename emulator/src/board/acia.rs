@@ -27,84 +27,7 @@ use super::device::Device;
 use super::serial::{Baud, FrameFormat, Parity};
 use super::wire::{Received, Sampler, Wire};
 
-/// Register offsets (RS1, RS0).
-pub mod reg {
-    /// Read: receive data register. Write: transmit data register.
-    pub const DATA: u16 = 0;
-    /// Read: status register. Write: programmed reset.
-    pub const STATUS: u16 = 1;
-    /// Command register.
-    pub const COMMAND: u16 = 2;
-    /// Control register.
-    pub const CONTROL: u16 = 3;
-}
-
-/// Status register bits.
-pub mod status {
-    /// Parity error.
-    pub const PARITY_ERROR: u8 = 0x01;
-    /// Framing error.
-    pub const FRAMING_ERROR: u8 = 0x02;
-    /// Overrun: a character arrived while the receive register was full.
-    pub const OVERRUN: u8 = 0x04;
-    /// Receive data register full.
-    pub const RDRF: u8 = 0x08;
-    /// Transmit data register empty.
-    pub const TDRE: u8 = 0x10;
-    /// /DCD is high (no carrier). Always 0 on the Scorpion.
-    pub const DCD: u8 = 0x20;
-    /// /DSR is high (not ready). Always 0 on the Scorpion.
-    pub const DSR: u8 = 0x40;
-    /// An interrupt occurred (cleared by reading the status register).
-    pub const IRQ: u8 = 0x80;
-}
-
-/// Command register bits.
-pub mod command {
-    /// DTR: enable the receiver and all interrupts.
-    pub const DTR: u8 = 0x01;
-    /// Receive interrupts disabled (IRD).
-    pub const IRD: u8 = 0x02;
-    /// Transmitter control (TIC), two bits: 00 off, 01 on with transmit
-    /// interrupts, 10 on, 11 on sending a break.
-    pub const TIC_MASK: u8 = 0x0C;
-    /// TIC = 01: transmitter on, transmit interrupt enabled.
-    pub const TIC_IRQ: u8 = 0x04;
-    /// TIC = 10: transmitter on, no transmit interrupt.
-    pub const TIC_ON: u8 = 0x08;
-    /// Receiver echo mode (with TIC = 00).
-    pub const ECHO: u8 = 0x10;
-}
-
-/// Control register bits.
-pub mod control {
-    /// Baud-rate select, four bits (0 = 16x external clock).
-    pub const BAUD_MASK: u8 = 0x0F;
-    /// Receiver clock: the baud-rate generator (1) or RxC (0).
-    pub const RCS: u8 = 0x10;
-    /// Word length, two bits: 00 = 8, 01 = 7, 10 = 6, 11 = 5.
-    pub const WORD_MASK: u8 = 0x60;
-    /// Two stop bits (one and a half with 5 bits and no parity, one with
-    /// 8 bits and parity).
-    pub const STOP2: u8 = 0x80;
-    /// The control code for 9600 baud, 8N1, internal receiver clock.
-    pub const B9600_8N1: u8 = 0x1E;
-}
-
-/// The divisor of crystal / 16 for each baud-select code (code 0 is the
-/// external clock).
-const DIVISORS: [u16; 16] = [
-    0, 2304, 1536, 1048, 856, 768, 384, 192, 96, 64, 48, 32, 24, 16, 12, 6,
-];
-
-/// The control-register baud code for a standard rate, if the 6551 has it.
-#[must_use]
-pub fn baud_code(bits_per_second: u32) -> Option<u8> {
-    (1u8..16).find(|&code| {
-        let rate = Baud::from_crystal_divisor(DIVISORS[usize::from(code)]);
-        rate.matches(Baud::new(bits_per_second)) && Baud::new(bits_per_second).matches(rate)
-    })
-}
+pub use platform::acia::{DIVISORS, baud_code, command, control, reg, status};
 
 /// The rate a baud code selects.
 #[must_use]
@@ -178,7 +101,7 @@ impl Acia {
             rx_sampler: Sampler::new(),
             tx_wire: Wire::new(),
             host_sampler: Sampler::new(),
-            host_baud: Baud::new(9600),
+            host_baud: Baud::new(platform::line::DEFAULT_BAUD),
             host_format: FrameFormat::EIGHT_N_ONE,
             overruns: 0,
         }

@@ -12,8 +12,9 @@
 //! - [`Via`] (6522) and [`Acia`] (6551): the chips, after their datasheets,
 //!   each usable on its own; [`Stepper`], [`Scene`]: what they drive and
 //!   read.
-//! - [`map`]: the register map of the I/O page and the pin wiring. In
-//!   short: VIA at `$C000`, ACIA at `$C010`, the `DRIVE` latch (eyes,
+//! - The register map of the I/O page and the pin wiring are the
+//!   `platform` crate's (`platform::map`), shared with the ROM's sources,
+//!   the linker and the uploader. In short: VIA at `$C000`, ACIA at `$C010`, the `DRIVE` latch (eyes,
 //!   lamps, stepper-driver enables, speaker amplifier) at `$C020`, the
 //!   ground-tracker phototransistors at `$C021`, the DIP switches at
 //!   `$C022`, the scanner's detector at `$C023`; bumpers on VIA port A and
@@ -26,7 +27,6 @@
 
 pub mod acia;
 mod device;
-pub mod map;
 mod motor;
 mod scene;
 mod scorpion;

@@ -13,7 +13,6 @@
 
 use super::acia::{self, Acia, HostByte};
 use super::device::Device;
-use super::map::{self, drive, port_b};
 use super::motor::Stepper;
 use super::scene::Scene;
 use super::serial::{Baud, CPU_HZ, FrameFormat};
@@ -21,6 +20,7 @@ use super::via::{self, Via};
 use crate::bus::{Bus, Interrupts, Line};
 use crate::cpu::Stop;
 use crate::machine::Machine;
+use platform::map::{self, drive, port_b};
 
 /// What a page of the address space is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,8 +103,14 @@ impl core::fmt::Debug for Memory {
         // 64 KiB of bytes helps nobody; the vectors identify the ROM.
         let word = |at: usize| u16::from_le_bytes([self.0[at], self.0[at + 1]]);
         f.debug_struct("Memory")
-            .field("reset_vector", &format_args!("${:04X}", word(0xFFFC)))
-            .field("irq_vector", &format_args!("${:04X}", word(0xFFFE)))
+            .field(
+                "reset_vector",
+                &format_args!("${:04X}", word(usize::from(crate::cpu::RESET_VECTOR))),
+            )
+            .field(
+                "irq_vector",
+                &format_args!("${:04X}", word(usize::from(crate::cpu::IRQ_VECTOR))),
+            )
             .finish_non_exhaustive()
     }
 }
@@ -172,7 +178,7 @@ pub struct Board {
 }
 
 fn is_ram_address(address: u16) -> bool {
-    address <= map::RAM_END || (map::KIM_START..=map::KIM_END).contains(&address)
+    address <= map::RAM_END || map::KIM_BUS.contains(&address)
 }
 
 impl Board {
@@ -639,12 +645,12 @@ impl Board {
     fn io_read(&mut self, address: u16, cycle: u64) -> u8 {
         self.catch_up(cycle);
         match address {
-            0xC000..=0xC00F => {
+            map::VIA..=map::VIA_END => {
                 let value = self.via.read(address - map::VIA, cycle);
                 self.refresh(cycle);
                 value
             }
-            0xC010..=0xC013 => {
+            map::ACIA..=map::ACIA_END => {
                 let value = self.acia_mut().read(address - map::ACIA, cycle);
                 self.refresh(cycle);
                 value
@@ -660,7 +666,7 @@ impl Board {
     fn io_write(&mut self, address: u16, value: u8, cycle: u64) {
         self.catch_up(cycle);
         match address {
-            0xC000..=0xC00F => {
+            map::VIA..=map::VIA_END => {
                 let register = address - map::VIA;
                 self.via.write(register, value, cycle);
                 if matches!(
@@ -671,7 +677,7 @@ impl Board {
                 }
                 self.refresh(cycle);
             }
-            0xC010..=0xC013 => {
+            map::ACIA..=map::ACIA_END => {
                 self.acia_mut().write(address - map::ACIA, value, cycle);
                 self.refresh(cycle);
             }
@@ -685,8 +691,8 @@ impl Board {
 
     fn io_peek(&self, address: u16) -> u8 {
         match address {
-            0xC000..=0xC00F => self.via.peek(address - map::VIA),
-            0xC010..=0xC013 => self.acia.peek(address - map::ACIA),
+            map::VIA..=map::VIA_END => self.via.peek(address - map::VIA),
+            map::ACIA..=map::ACIA_END => self.acia.peek(address - map::ACIA),
             map::DRIVE => self.drive,
             map::SENSE => self.sense,
             map::SWITCHES => self.switches,

@@ -7,12 +7,8 @@
 //! therefore keeps the cycle at which a burst started and the number of
 //! half-bits sent since, and rounds only the absolute times.
 
-/// The CPU clock of the Scorpion (docs/PROTOCOL.md section 3): 1 MHz.
-pub const CPU_HZ: u64 = 1_000_000;
-
-/// The 6551's crystal: every internal baud rate divides it by 16 and by a
-/// divisor.
-pub const ACIA_CRYSTAL_HZ: u64 = 1_843_200;
+use platform::acia::CRYSTAL_HZ as ACIA_CRYSTAL_HZ;
+pub use platform::line::CPU_HZ;
 
 /// A bit rate, kept as the exact fraction `numerator / denominator` bits per
 /// second so that the 6551's odd rates (109.92, 134.58 baud) stay exact.

@@ -49,12 +49,7 @@ pub mod flag {
     pub const N: u8 = 0x80;
 }
 
-/// The NMI vector's address.
-pub const NMI_VECTOR: u16 = 0xFFFA;
-/// The reset vector's address.
-pub const RESET_VECTOR: u16 = 0xFFFC;
-/// The IRQ/BRK vector's address.
-pub const IRQ_VECTOR: u16 = 0xFFFE;
+pub use isa::vectors::{IRQ as IRQ_VECTOR, NMI as NMI_VECTOR, RESET as RESET_VECTOR};
 
 /// An interrupt sequence the CPU went through.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

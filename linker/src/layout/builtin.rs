@@ -9,20 +9,19 @@ use crate::error::Error;
 /// Names `--target` accepts besides a `.toml` file.
 pub const BUILTIN_TARGETS: [&str; 4] = ["flat", "scorpion-ext", "scorpion-os", "scorpion-rom"];
 
-/// KIM-bus expansion space (docs/ARCHITECTURE.md, the memory map): a board
-/// property, not a ROM one.
-const KIM_START: u64 = 0x1000;
-const KIM_END: u64 = 0xBFFF;
-/// The ROM (docs/PROTOCOL.md section 3).
-const ROM_START: u64 = 0xF000;
-const ROM_SIZE: u64 = 0x1000;
-/// The ROM's own RAM starts after the stack page (ARCHITECTURE.md).
+/// The board's KIM-bus space and ROM (`platform::map`).
+const KIM_START: u64 = platform::map::KIM_START as u64;
+const KIM_END: u64 = platform::map::KIM_END as u64;
+const ROM_START: u64 = platform::map::ROM_START as u64;
+const ROM_SIZE: u64 = platform::map::ROM_SIZE as u64;
+const ROM_FILL: u8 = platform::map::ROM_FILL;
+/// The ROM's own RAM starts after the stack page (ARCHITECTURE.md): the
+/// `scorpion-rom` target's choice, which the ROM's hooks at `$0200` follow.
 const ROM_RAM_START: u64 = 0x0200;
-/// Where the optional service jump table and the vectors go.
+/// Where the ROM target puts the optional service jump table (the
+/// reference ROM's `JUMPTABLE` segment), and the CPU's vectors.
 const JUMPTABLE_START: u64 = 0xFF00;
-const VECTORS_START: u64 = 0xFFFA;
-/// An erased EPROM reads $FF.
-const ROM_FILL: u8 = 0xFF;
+const VECTORS_START: u64 = isa::vectors::NMI as u64;
 
 /// Absolute symbols the Scorpion layouts read their bounds from: the ROM's
 /// exports (from `--just-symbols`) or, when linking the ROM itself, its own.

@@ -8,6 +8,7 @@ use super::SLASH;
 use super::answer::{Answer, Pair};
 use super::cursor::{Cursor, Miss};
 use super::error::{ProtocolError, escape};
+use super::table::{self, CommandSpec, Reply};
 
 /// One of the two drive motors.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -180,18 +181,7 @@ impl Extension {
 
 /// Whether the ROM dispatches on this (count, letter) pair.
 fn is_rom_command(count: usize, letter: u8) -> bool {
-    matches!(
-        (count, letter),
-        (
-            1,
-            b'R' | b'B' | b'S' | b'E' | b'G' | b'T' | b'M' | b'X' | b'C' | b'D' | b'P'
-        ) | (2, b'E' | b'G')
-            | (3, b'Y' | b'Z' | b'K' | b'H' | b'V')
-            | (4, b'C' | b'D')
-            | (7, b'R' | b'W')
-            | (8, b'C' | b'D')
-            | (9, b'W')
-    )
+    table::find(count, letter).is_some()
 }
 
 /// A memory read `/7Raaaa##`: an address and 0 to 99 bytes that do not run
@@ -366,38 +356,32 @@ fn decimal(out: &mut Vec<u8>, value: u16, digits: u32) {
 }
 
 impl Command {
+    /// The ROM's entry for this command in [`table::COMMANDS`]; `None` for
+    /// an extension's.
+    #[must_use]
+    pub fn spec(&self) -> Option<&'static CommandSpec> {
+        if let Command::Extension(_) = self {
+            return None;
+        }
+        let encoded = self.encode();
+        table::find(usize::from(encoded[1] - b'0'), encoded[2])
+    }
+
     /// Whether the ROM answers this command (questions do, instructions do
     /// not). Extension commands may or may not; this says `false` for them,
     /// as the protocol cannot know.
     #[must_use]
     pub fn is_question(&self) -> bool {
-        matches!(
-            self,
-            Command::Bumpers
-                | Command::Scanner
-                | Command::Eyes
-                | Command::Lamps
-                | Command::Tracker
-                | Command::Moves
-                | Command::Busy
-                | Command::ReadMemory(_)
-                | Command::Remaining(_)
-                | Command::Everything
-        )
+        self.spec().is_some_and(CommandSpec::is_question)
     }
 
     /// The length of the answer in characters, carriage return included,
     /// when the question fixes it (all but `/1S` and extensions).
     #[must_use]
     pub fn answer_len(&self) -> Option<usize> {
-        match self {
-            Command::Bumpers | Command::Busy => Some(4),
-            Command::Eyes | Command::Lamps | Command::Tracker => Some(3),
-            Command::Moves => Some(12),
-            Command::Remaining(_) => Some(6),
-            Command::ReadMemory(span) => Some(2 + 2 * usize::from(span.count())),
-            // P + Bhh E# G# T# Ms####s#### Yhh Xhh C#### D#### + CR.
-            Command::Everything => Some(1 + 3 + 2 + 2 + 2 + 11 + 3 + 3 + 5 + 5 + 1),
+        match (self, self.spec()?.reply) {
+            (_, Reply::Fixed(len)) => Some(len),
+            (Command::ReadMemory(span), Reply::PerByte) => Some(2 + 2 * usize::from(span.count())),
             _ => None,
         }
     }

@@ -16,6 +16,10 @@
 //! A malformed answer is a [`ProtocolError`] naming what was expected and
 //! at which character.
 //!
+//! [`COMMANDS`] is the one table of the ROM's commands (count, letter, form,
+//! answer): whether a command is a question, how long its answer is and
+//! which (count, letter) pairs are left to extensions all come from it.
+//!
 //! Nothing else in the workspace formats a command string or parses an
 //! answer (docs/ARCHITECTURE.md).
 
@@ -23,6 +27,7 @@ mod answer;
 mod command;
 mod cursor;
 mod error;
+mod table;
 
 pub use answer::{Answer, Bumpers, BusyByte, MoveCount, MoveCounts, Pair, ScanAnswer, Status};
 pub use command::{
@@ -30,6 +35,7 @@ pub use command::{
     Speed, Steps, WordWrite,
 };
 pub use error::ProtocolError;
+pub use table::{COMMANDS, CommandSpec, Reply, find as find_command};
 
 /// The carriage return that ends every answer (docs/PROTOCOL.md section 2).
 pub const EOL: u8 = b'\r';

@@ -10,7 +10,7 @@
 use std::time::Duration;
 
 use emulator::Stop;
-use emulator::board::CPU_HZ;
+use platform::line::CPU_HZ;
 use romlib::VirtualScorpion;
 
 use super::Transport;
@@ -168,7 +168,7 @@ impl Transport for VirtualTransport {
     }
 
     fn set_baud(&mut self, baud: u32) -> Result<()> {
-        if emulator::board::acia::baud_code(baud).is_none() {
+        if platform::acia::baud_code(baud).is_none() {
             return Err(Error::BaudChange {
                 port: self.name(),
                 baud,

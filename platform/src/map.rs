@@ -1,10 +1,10 @@
 //! The Scorpion board's memory map and I/O register map.
 //!
-//! The memory map is fixed by docs/ARCHITECTURE.md; the I/O page's layout
-//! and the wiring of the chips' pins are this board's (docs/PROTOCOL.md section
-//! 3 leaves them to the developers) and are documented here, in
-//! `emulator/src/board/mod.rs` and in docs/ARCHITECTURE.md. The reference
-//! ROM's `hardware.inc` uses the same numbers; a romlib test compares them.
+//! The memory map is fixed by docs/PROTOCOL.md section 3; the I/O page's
+//! layout and the wiring of the chips' pins are this board's (the protocol
+//! leaves them to the developers) and are documented here and in
+//! docs/ARCHITECTURE.md. The reference ROM's `hardware.inc` is generated
+//! from these constants ([`crate::hardware_inc`]).
 //!
 //! | address | register |
 //! |---|---|
@@ -28,6 +28,8 @@
 //! The 6551's /IRQ and the 6522's /IRQ are wired-OR onto the CPU's IRQ
 //! input; NMI is not connected. DCD, DSR and CTS are tied active.
 
+use std::ops::RangeInclusive;
+
 /// First byte of the controller card's RAM.
 pub const RAM_START: u16 = 0x0000;
 /// Last byte of the controller card's RAM.
@@ -36,6 +38,9 @@ pub const RAM_END: u16 = 0x0FFF;
 pub const KIM_START: u16 = 0x1000;
 /// Last byte of the KIM-bus expansion space.
 pub const KIM_END: u16 = 0xBFFF;
+/// The KIM-bus expansion space: peripheral cards, or RAM on the virtual
+/// robot where no card is mapped.
+pub const KIM_BUS: RangeInclusive<u16> = KIM_START..=KIM_END;
 /// First byte of the I/O page.
 pub const IO_START: u16 = 0xC000;
 /// Last byte of the I/O page.
@@ -44,11 +49,17 @@ pub const IO_END: u16 = 0xC0FF;
 pub const ROM_START: u16 = 0xF000;
 /// The ROM's size in bytes.
 pub const ROM_SIZE: usize = 0x1000;
+/// What an erased EPROM reads: the fill of the ROM's unused bytes.
+pub const ROM_FILL: u8 = 0xFF;
 
 /// The 6522 VIA's base address (16 registers).
 pub const VIA: u16 = 0xC000;
+/// The VIA's last register.
+pub const VIA_END: u16 = VIA + 0x0F;
 /// The 6551 ACIA's base address (4 registers).
 pub const ACIA: u16 = 0xC010;
+/// The ACIA's last register.
+pub const ACIA_END: u16 = ACIA + 0x03;
 /// The drive latch: eyes, lamps, stepper-driver enables, speaker amplifier.
 pub const DRIVE: u16 = 0xC020;
 /// The ground-tracker phototransistors.
@@ -110,5 +121,6 @@ pub mod sense {
     pub const LEFT: u8 = 0x02;
 }
 
-/// The switch setting the board ships with: 9600 baud.
+/// The switch setting the board ships with: the 6551's code for
+/// [`crate::line::DEFAULT_BAUD`].
 pub const DEFAULT_SWITCHES: u8 = 0x0E;
