@@ -10,8 +10,6 @@
 //!   emulator CLI, the virtual Scorpion and the uploader.
 //! - [`output`]: the ELF executable, raw binary, Intel HEX, S-record and
 //!   KIM-1 tape writers; [`Linked::map`] and [`Linked::vice_labels`].
-//! - [`objbuild`]: writes relocatable objects from a description (tests,
-//!   and a model of other producers' objects).
 //!
 //! The library never prints; sources for diagnostics come through
 //! [`SourceProvider`].
@@ -25,7 +23,6 @@ pub mod layout;
 mod link;
 mod map;
 mod model;
-pub mod objbuild;
 pub mod output;
 mod place;
 mod relocate;

@@ -14,13 +14,13 @@ use emulator::Stop;
 use emulator::board::{CPU_HZ, Scorpion};
 use isa::objfmt::HookKind;
 use linker::Image;
-use platform::map;
+use platform::map::{self, KIM_BUS};
 
 use crate::error::Error;
 use std::ops::RangeInclusive;
 
 use crate::installed;
-use crate::protocol::{Answer, Command};
+use crate::protocol::{Answer, Command, EOL};
 use crate::symbols;
 
 /// Robot time the host waits for an answer by default: one second.
@@ -29,9 +29,6 @@ pub const ANSWER_TIMEOUT: u64 = CPU_HZ;
 /// Robot time the ROM needs to act on an instruction once its last byte
 /// arrived, with margin (the command loop, the dispatch, a handler).
 pub const INSTRUCTION_TIME: u64 = 5_000;
-
-/// The KIM-bus expansion space, where cards and extra RAM sit.
-const KIM_BUS: RangeInclusive<u16> = map::KIM_START..=map::KIM_END;
 
 /// Robot time [`VirtualScorpion::check_loop`] is given when the robot does
 /// not answer: 100 ms, a hundred times the longest the reference ROM's loop
@@ -454,7 +451,47 @@ impl VirtualScorpion {
     /// [`Error::Jam`] if the CPU jams.
     pub fn run_for(&mut self, cycles: u64) -> Result<(), Error> {
         let until = self.robot.now().saturating_add(cycles);
-        check(self.robot.run(until))
+        self.run_until(until)
+    }
+
+    /// Runs the robot until robot time `cycle` (since power-up).
+    ///
+    /// # Errors
+    /// [`Error::Jam`] if the CPU jams.
+    pub fn run_until(&mut self, cycle: u64) -> Result<(), Error> {
+        check(self.robot.run(cycle))
+    }
+
+    /// Whether everything the host sent has gone down the wire.
+    #[must_use]
+    pub fn line_idle(&self) -> bool {
+        self.robot.host_line_free_at() <= self.robot.now()
+    }
+
+    /// Sets the host's end of the line only (the robot keeps the rate its
+    /// switches gave the ROM): what a host does when the robot was told to
+    /// change its rate. See [`VirtualScorpion::set_baud`] for both ends.
+    pub fn set_host_baud(&mut self, bits_per_second: u32) {
+        self.robot.set_baud(bits_per_second);
+    }
+
+    /// The host's end of the line's rate, in whole bits per second.
+    #[must_use]
+    pub fn host_baud(&self) -> u32 {
+        let rate = self.robot.board().acia().host_baud().bits_per_second();
+        #[allow(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            reason = "a 6551 rate, 50 to 19200"
+        )]
+        let whole = rate.round() as u32;
+        whole
+    }
+
+    /// Closes the bumpers whose bits are set in `closed` (bit 0 the first
+    /// switch), opening the others, now.
+    pub fn set_bumpers(&mut self, closed: u8) {
+        self.robot.set_bumpers(closed);
     }
 
     /// Runs the robot until everything sent has arrived and the ROM had
@@ -463,7 +500,47 @@ impl VirtualScorpion {
     /// # Errors
     /// [`Error::Jam`] if the CPU jams.
     pub fn settle(&mut self) -> Result<(), Error> {
-        check(self.robot.settle(INSTRUCTION_TIME))
+        let until = self
+            .robot
+            .host_line_free_at()
+            .saturating_add(INSTRUCTION_TIME);
+        check(self.robot.run(until))
+    }
+
+    /// Runs the robot until the host has received an answer's carriage
+    /// return or `timeout` cycles passed, and returns what the host received
+    /// up to and including it; bytes after it stay for the next call.
+    ///
+    /// # Errors
+    /// [`Error::Jam`] if the CPU jams; [`Error::NoAnswer`] on timeout (or
+    /// [`Error::Stuck`] if the ROM's loop stopped coming round), with what
+    /// did arrive.
+    pub fn read_answer(&mut self, timeout: u64) -> Result<Vec<u8>, Error> {
+        self.read_answer_to(b"", timeout)
+    }
+
+    /// [`VirtualScorpion::read_answer`], naming `command` in the error.
+    fn read_answer_to(&mut self, command: &[u8], timeout: u64) -> Result<Vec<u8>, Error> {
+        let deadline = self.robot.now().saturating_add(timeout);
+        loop {
+            let now = self.robot.now();
+            if let Some(answer) = self.robot.receive_until(EOL) {
+                return Ok(answer);
+            }
+            if now >= deadline {
+                // No answer: a robot whose loop stopped says where.
+                let received = self.robot.receive();
+                self.check_loop(LOOP_WATCH)?;
+                return Err(Error::NoAnswer {
+                    command: escape(command),
+                    received: escape(&received),
+                    timeout_ms: timeout * 1000 / CPU_HZ,
+                });
+            }
+            // Slices of about one character time at 9600 baud.
+            let until = (now + 1000).min(deadline);
+            check(self.robot.run(until))?;
+        }
     }
 
     /// Sends `bytes` and waits up to `timeout` cycles for an answer (up to
@@ -471,25 +548,11 @@ impl VirtualScorpion {
     /// command are discarded first.
     ///
     /// # Errors
-    /// [`Error::NoAnswer`] on timeout, [`Error::Jam`] if the CPU jams.
+    /// As [`VirtualScorpion::read_answer`].
     pub fn transact(&mut self, bytes: &[u8], timeout: u64) -> Result<Vec<u8>, Error> {
         self.robot.receive();
         self.robot.send(bytes);
-        match self.robot.read_answer(timeout) {
-            Ok(answer) => Ok(answer),
-            Err(failure) => {
-                if let Some(Stop::Jam { pc, opcode }) = failure.stop {
-                    return Err(Error::Jam { pc, opcode });
-                }
-                // No answer: a robot whose loop stopped says where.
-                self.check_loop(LOOP_WATCH)?;
-                Err(Error::NoAnswer {
-                    command: escape(bytes),
-                    received: escape(&failure.received),
-                    timeout_ms: timeout * 1000 / CPU_HZ,
-                })
-            }
-        }
+        self.read_answer_to(bytes, timeout)
     }
 
     /// Sends a command; for a question, waits for its answer and parses

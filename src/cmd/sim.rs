@@ -114,7 +114,7 @@ pub(crate) fn robot(
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let mut robot = robot(args.baud, args.rom.as_ref(), &args.images)?;
     if let Some(mask) = args.bumpers {
-        robot.robot_mut().set_bumpers(mask);
+        robot.set_bumpers(mask);
     }
     if args.pty {
         serve_pty(&mut robot, args.baud)
@@ -264,7 +264,7 @@ fn serve_stdio(robot: &mut VirtualScorpion) -> miette::Result<ExitCode> {
             out.write_all(&text).into_diagnostic()?;
             out.flush().into_diagnostic()?;
         }
-        let line_idle = robot.robot().board().acia().host_line_free_at() <= robot.cycles();
+        let line_idle = robot.line_idle();
         if ended && line_idle && robot.cycles() >= quiet_since + QUIET_TIME {
             // The answers so far are out; a robot whose loop stopped (a
             // handler that never returns) fails the run, saying where.

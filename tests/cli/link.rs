@@ -1,11 +1,11 @@
-//! `scorpion link`: objects built with `linker::objbuild`, linked by the
+//! `scorpion link`: objects built with `isa::objfmt::ObjectBuilder`, linked by the
 //! binary, outputs read back.
 
 use std::path::Path;
 
 use isa::elf::{R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_PCREL_8};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 use linker::Image;
-use linker::objbuild::{ObjectBuilder, SymbolDef};
 
 use crate::{scorpion, transcript};
 

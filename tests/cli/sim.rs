@@ -20,12 +20,19 @@ fn sim(args: &[&str], input: &str) -> std::process::Output {
         .stderr(Stdio::piped())
         .spawn()
         .expect("the scorpion binary runs");
-    child
+    let written = child
         .stdin
         .take()
         .expect("stdin is piped")
-        .write_all(input.as_bytes())
-        .expect("the commands are written");
+        .write_all(input.as_bytes());
+    // A sim that refuses its images exits before reading its input.
+    if let Err(error) = written {
+        assert_eq!(
+            error.kind(),
+            std::io::ErrorKind::BrokenPipe,
+            "the commands are written"
+        );
+    }
     child
         .wait_with_output()
         .expect("scorpion sim ends at the end of stdin")

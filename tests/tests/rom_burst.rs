@@ -17,7 +17,7 @@ fn question_burst(command: &[u8], answer: &[u8], count: usize) -> bool {
     let burst: Vec<u8> = command.repeat(count);
     robot.send(&burst);
     let mut received = Vec::new();
-    while let Ok(line) = robot.robot_mut().read_answer(ANSWER_TIMEOUT) {
+    while let Ok(line) = robot.read_answer(ANSWER_TIMEOUT) {
         received.extend(line);
     }
     assert_eq!(

@@ -161,11 +161,12 @@ fn an_extension_answers_a_new_command_from_a_kim_bus_card() {
     // /1U are all executed.
     set_obstacle(&mut s, slot, Some(300));
     s.robot.send(b"/1U/2E3/2G1/1P");
-    let robot = s.robot.robot_mut();
-    let first = robot
+    let first = s
+        .robot
         .read_answer(romlib::sim::ANSWER_TIMEOUT)
         .expect("the range");
-    let second = robot
+    let second = s
+        .robot
         .read_answer(romlib::sim::ANSWER_TIMEOUT)
         .expect("the status");
     assert_eq!(String::from_utf8_lossy(&first), "U0300\r");
@@ -381,7 +382,6 @@ fn soak(extensions: bool) {
         for expected in &wanted {
             let raw = s
                 .robot
-                .robot_mut()
                 .read_answer(romlib::sim::ANSWER_TIMEOUT)
                 .unwrap_or_else(|error| panic!("`{text}`: no answer for `{expected}`: {error:?}"));
             got.push(String::from_utf8_lossy(&raw).trim_end().to_string());

@@ -87,16 +87,10 @@ impl UploadOptions {
     }
 }
 
-/// A hook the upload switched.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct InstalledHook {
-    /// Which hook.
-    pub kind: HookKind,
-    /// Where it points now.
-    pub handler: u16,
-    /// Where it pointed before: the extension's fallthrough.
-    pub previous: u16,
-}
+/// A hook the upload switched: the same record the virtual robot's
+/// loader gives (`previous` is the extension's fallthrough, in its chain
+/// slot).
+pub use romlib::InstalledHook;
 
 /// What the RAM loader did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -593,6 +587,7 @@ fn install_hooks<T: Transport>(
             kind: record.kind,
             handler: record.handler,
             previous: fallthrough,
+            chain: record.chain,
         });
     }
     let mut wanted = Vec::new();

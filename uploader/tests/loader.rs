@@ -73,7 +73,7 @@ fn a_good_frame_lands() {
     let mut stream = loader_frame(0x3000, &data[..40]);
     stream.extend_from_slice(b"/7R300040");
     robot.send(&stream);
-    let answer = robot.robot_mut().read_answer(1_000_000).expect("an answer");
+    let answer = robot.read_answer(1_000_000).expect("an answer");
     assert_eq!(
         Answer::parse(&answer).expect("parses"),
         Answer::Memory(data[..40].to_vec())

@@ -77,6 +77,7 @@ fn rom_only_upload_verifies_and_hooks_last() {
             kind: HookKind::Unknown,
             handler: 0x0403,
             previous: BAD_COMMAND,
+            chain: Some(0x0401),
         }]
     );
     // The hook is written once, after every write to the body.

@@ -38,6 +38,6 @@ pub use acia::{Acia, HostByte};
 pub use device::Device;
 pub use motor::Stepper;
 pub use scene::Scene;
-pub use scorpion::{AnswerTimeout, Board, DEFAULT_ANSWER_TIMEOUT, KimSlotId, Motor, Scorpion};
+pub use scorpion::{Board, KimSlotId, Motor, Scorpion};
 pub use serial::{Baud, CPU_HZ, FrameFormat, Parity};
 pub use via::Via;

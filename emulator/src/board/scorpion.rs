@@ -18,7 +18,6 @@ use super::scene::Scene;
 use super::serial::{Baud, CPU_HZ, FrameFormat};
 use super::via::{self, Via};
 use crate::bus::{Bus, Interrupts, Line};
-use crate::cpu::Stop;
 use crate::machine::Machine;
 use platform::map::{self, drive, port_b};
 
@@ -830,10 +829,6 @@ impl Bus for Board {
 /// side of the robot.
 pub type Scorpion = Machine<Board>;
 
-/// How long the host waits for an answer before giving up, by default: a
-/// second of emulated time.
-pub const DEFAULT_ANSWER_TIMEOUT: u64 = CPU_HZ;
-
 impl Machine<Board> {
     /// A powered-up Scorpion running `rom` (4 KiB, loaded at `$F000`).
     ///
@@ -899,48 +894,22 @@ impl Machine<Board> {
         self.bus.host_receive(now)
     }
 
-    /// Runs the robot until the host has received a carriage return (the
-    /// end of an answer) or `timeout` cycles passed. Returns what the host
-    /// received up to and including the carriage return; bytes after it
-    /// stay for the next call.
-    ///
-    /// # Errors
-    /// [`AnswerTimeout`] with the bytes received before the time ran out
-    /// (or the CPU jammed).
-    pub fn read_answer(&mut self, timeout: u64) -> Result<Vec<u8>, AnswerTimeout> {
-        let deadline = self.now().saturating_add(timeout);
-        loop {
-            let now = self.now();
-            if let Some(answer) = self.bus.host_receive_until(now, b'\r') {
-                return Ok(answer.iter().map(|b| b.byte).collect());
-            }
-            if now >= deadline {
-                return Err(AnswerTimeout {
-                    received: self.receive(),
-                    stop: None,
-                });
-            }
-            // Slices of about one character time at 9600 baud.
-            let until = (now + 1000).min(deadline);
-            if let stop @ Stop::Jam { .. } = self.run(until) {
-                return Err(AnswerTimeout {
-                    received: self.receive(),
-                    stop: Some(stop),
-                });
-            }
-        }
+    /// What the host has received up to and including the first `end`
+    /// byte, if one has arrived by now; bytes after it stay for the next
+    /// call. The wire knows no protocol: the host side (romlib's
+    /// `VirtualScorpion`) says which byte ends an answer.
+    pub fn receive_until(&mut self, end: u8) -> Option<Vec<u8>> {
+        let now = self.now();
+        self.bus
+            .host_receive_until(now, end)
+            .map(|bytes| bytes.iter().map(|b| b.byte).collect())
     }
 
-    /// Runs the robot until everything the host sent has arrived, plus
-    /// `then` more cycles for the ROM to act on it.
-    pub fn settle(&mut self, then: u64) -> Stop {
-        let until = self
-            .bus
-            .acia()
-            .host_line_free_at()
-            .max(self.now())
-            .saturating_add(then);
-        self.run(until)
+    /// The cycle the last byte the host sent ends on the wire (now or
+    /// earlier if the line is idle).
+    #[must_use]
+    pub fn host_line_free_at(&self) -> u64 {
+        self.bus.acia().host_line_free_at().max(self.now())
     }
 
     /// Maps a device into the KIM-bus space (see [`Board::map_kim`]).
@@ -964,15 +933,6 @@ impl Machine<Board> {
         self.bus.set_switches(switches);
         Some(code)
     }
-}
-
-/// No full answer arrived in time.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct AnswerTimeout {
-    /// What arrived before the time ran out.
-    pub received: Vec<u8>,
-    /// Set when the CPU stopped (a JAM) rather than the time running out.
-    pub stop: Option<Stop>,
 }
 
 #[cfg(test)]
@@ -1068,8 +1028,12 @@ mod tests {
             Scorpion::scorpion(&rom_with(&program, 0x800, &[0x40])).expect("a 4 KiB ROM");
         scorpion.run(50);
         scorpion.send(b"/1X\r");
-        let answer = scorpion.read_answer(DEFAULT_ANSWER_TIMEOUT);
-        assert_eq!(answer, Ok(b"/1X\r".to_vec()));
+        let mut answer = None;
+        while answer.is_none() && scorpion.now() < 1_000_000 {
+            scorpion.run(scorpion.now() + 100);
+            answer = scorpion.receive_until(b'\r');
+        }
+        assert_eq!(answer, Some(b"/1X\r".to_vec()));
         // Four characters at 9600 baud take about 4.2 ms; the echo ends
         // one character later.
         assert!(

@@ -10,18 +10,24 @@
 //! | [`FILL_SECTION`] | assembler | linker | reserved bytes (`.res`, `.align` without a fill value) that take the load area's fill value |
 //! | [`HOOKS_SECTION`] | linker | uploader, `scorpion sim` | which ROM hooks an image takes over, and where its fallthrough lives |
 //!
+//! [`RelObject`] is the one writer of relocatable objects (the assembler's
+//! and, through [`ObjectBuilder`], the tests').
+//!
 //! Every section starts with a four-byte magic and a version byte; all
 //! integers are little-endian. Decoders return [`FormatError`] for any
 //! malformed input and never panic: the linker reads other producers'
 //! objects too.
 
 mod assert;
+mod builder;
 mod codec;
 mod fill;
 mod hooks;
 mod srcmap;
+mod write;
 
 pub use assert::{AssertAction, Assertion, BinaryOp, EvalError, Expr, ExprOp, UnaryOp};
+pub use builder::{ObjectBuilder, SectionId, SymbolDef, SymbolId};
 pub use codec::FormatError;
 pub use fill::FillRun;
 pub use hooks::{
@@ -29,6 +35,9 @@ pub use hooks::{
     HookRecord, Hooks,
 };
 pub use srcmap::{SourceLoc, SrcMap, SrcMapEntry, SymbolLoc};
+pub use write::{
+    Binding, Definition, Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget,
+};
 
 /// Source locations of section bytes and symbols (assembler to linker).
 pub const SRCMAP_SECTION: &str = ".scorpion.srcmap";

@@ -2,7 +2,7 @@
 
 use isa::elf::*;
 use isa::objfmt::{AssertAction, Assertion, BinaryOp, Expr, ExprOp};
-use linker::objbuild::{ObjectBuilder, SymbolDef};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 use linker::{Error, Format, Image, Layout, MemorySources, SymbolFile, Target};
 
 use crate::support::{fake_rom, link_flat, link_with, render};

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use linker::objbuild::ObjectBuilder;
+use isa::objfmt::ObjectBuilder;
 use linker::{Format, Image, Layout, MemorySources, Target};
 
 use crate::round_trip::link_extension;
@@ -114,7 +114,7 @@ fn srecords_above_64k_use_wider_addresses() {
     }
 }
 
-/// binutils' readelf reads our images (and the objects objbuild writes)
+/// binutils' readelf reads our images (and the objects ObjectBuilder writes)
 /// without a warning, load/run split and hooks section included.
 #[test]
 fn readelf_reads_images_without_warnings() {

@@ -2,7 +2,7 @@
 //! a layout defines, and the map that shows it.
 
 use isa::elf::*;
-use linker::objbuild::{ObjectBuilder, SymbolDef};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 use linker::{Layout, MemorySources, SymbolFile, Target};
 
 use crate::round_trip::link_extension;

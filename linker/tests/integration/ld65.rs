@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::Command;
 
 use isa::elf::*;
-use linker::objbuild::{ObjectBuilder, SymbolDef};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 
 use crate::support::link_flat;
 

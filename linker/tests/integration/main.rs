@@ -1,4 +1,4 @@
-//! Linker integration tests: objects built with `linker::objbuild`, linked,
+//! Linker integration tests: objects built with `isa::objfmt::ObjectBuilder`, linked,
 //! written and read back. One test binary, one module per concern.
 
 mod support;

@@ -3,7 +3,7 @@
 //! holds, and the ELF image reads back unchanged.
 
 use isa::elf::R_MOS_ADDR16;
-use linker::objbuild::{ObjectBuilder, SymbolDef};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 use linker::{Format, Image, MemorySources, SymbolFile, Target};
 use proptest::prelude::*;
 

@@ -1,7 +1,7 @@
 //! Every supported relocation type, applied with lld's MOS semantics.
 
 use isa::elf::*;
-use linker::objbuild::{ObjectBuilder, SymbolDef};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 
 use crate::support::link_flat;
 

@@ -3,7 +3,7 @@
 
 use isa::elf::*;
 use isa::objfmt::{HookKind, HookRecord};
-use linker::objbuild::{ObjectBuilder, SymbolDef};
+use isa::objfmt::{ObjectBuilder, SymbolDef};
 use linker::{Format, Image, MemorySources, SymbolFile, Target};
 
 use crate::support::{fake_rom, link_with};

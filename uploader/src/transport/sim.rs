@@ -9,7 +9,6 @@
 
 use std::time::Duration;
 
-use emulator::Stop;
 use platform::line::CPU_HZ;
 use romlib::VirtualScorpion;
 
@@ -51,13 +50,7 @@ impl VirtualTransport {
     /// a fresh [`VirtualScorpion`]).
     #[must_use]
     pub fn new(robot: VirtualScorpion) -> Self {
-        let baud = robot
-            .robot()
-            .board()
-            .acia()
-            .host_baud()
-            .bits_per_second()
-            .round() as u32;
+        let baud = robot.host_baud();
         let opened = robot.cycles();
         VirtualTransport {
             robot,
@@ -81,20 +74,17 @@ impl VirtualTransport {
     }
 
     /// Runs the robot to `until`, doing the actions that fall due on the way.
-    fn run(&mut self, until: u64) -> Stop {
+    fn run(&mut self, until: u64) -> std::result::Result<(), romlib::Error> {
         loop {
             let due = self.actions.last().map(|(cycle, _)| *cycle);
             match due {
                 Some(cycle) if cycle <= until => {
-                    let stop = self.robot.robot_mut().run(cycle);
-                    if matches!(stop, Stop::Jam { .. }) {
-                        return stop;
-                    }
+                    self.robot.run_until(cycle)?;
                     if let Some((_, action)) = self.actions.pop() {
                         action(&mut self.robot);
                     }
                 }
-                _ => return self.robot.robot_mut().run(until),
+                _ => return self.robot.run_until(until),
             }
         }
     }
@@ -148,14 +138,18 @@ impl Transport for VirtualTransport {
             .saturating_add(duration_to_cycles(timeout));
         loop {
             let until = (self.robot.cycles() + self.slice()).min(deadline);
-            let stop = self.run(until);
+            let ran = self.run(until);
             let bytes = self.robot.receive();
             if !bytes.is_empty() {
                 into.extend_from_slice(&bytes);
                 return Ok(bytes.len());
             }
-            if let Stop::Jam { pc, opcode } = stop {
-                return Err(Error::RobotJammed { pc, opcode });
+            match ran {
+                Err(romlib::Error::Jam { pc, opcode }) => {
+                    return Err(Error::RobotJammed { pc, opcode });
+                }
+                Err(other) => return Err(Error::Robot(other)),
+                Ok(()) => {}
             }
             if self.robot.cycles() >= deadline {
                 return Ok(0);
@@ -175,7 +169,7 @@ impl Transport for VirtualTransport {
                 message: "the 6551 has no such rate".into(),
             });
         }
-        self.robot.robot_mut().set_baud(baud);
+        self.robot.set_host_baud(baud);
         self.baud = baud;
         Ok(())
     }
