@@ -9,6 +9,7 @@ use std::sync::Arc;
 use rustc_hash::FxHashMap;
 
 use crate::Options;
+use crate::cursor::Cursor;
 use crate::diag::{
     self, CtxId, CtxKind, CtxNode, Files, RawDiag, Reporter, Span, Text, count_chars,
 };
@@ -1076,7 +1077,8 @@ impl<'a> Asm<'a> {
             }),
             Dir::Else | Dir::Elseif | Dir::Endif => {
                 let toks = std::mem::take(&mut self.toks);
-                let _ = self.conditional(dir, &toks);
+                let mut c = self.cursor(&toks);
+                let _ = self.conditional(dir, &mut c);
                 self.toks = toks;
             }
             _ => {}
@@ -1190,11 +1192,24 @@ impl<'a> Asm<'a> {
 
     // ----- statements --------------------------------------------------
 
+    /// The cursor over a line's tokens, placing what is missing at the
+    /// line's end.
+    pub(crate) fn cursor<'t>(&self, toks: &'t [Token]) -> Cursor<'t> {
+        Cursor::new(
+            toks,
+            Span {
+                file: self.line.file,
+                start: self.line.end,
+                end: self.line.end,
+            },
+        )
+    }
+
     fn statement(&mut self, t: &[Token]) -> PResult<()> {
         if t.is_empty() {
             return Ok(());
         }
-        let mut p = 0;
+        let mut c = self.cursor(t);
         // Labels and assignments.
         if matches!(
             t.get(1).map(|t| t.kind),
@@ -1205,45 +1220,41 @@ impl<'a> Asm<'a> {
             self.reserved_name(&t[0], true)?;
         }
         match (t[0].kind, t.get(1).map(|t| t.kind)) {
-            (Tok::Ident | Tok::Local, Some(Tok::Eq)) => {
-                return self.assignment(t);
-            }
-            (Tok::Ident | Tok::Local, Some(Tok::Assign)) => {
-                return self.assignment(t);
+            (Tok::Ident | Tok::Local, Some(Tok::Eq | Tok::Assign)) => {
+                return self.assignment(&mut c);
             }
             (Tok::Ident, Some(Tok::Directive))
                 if self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set) =>
             {
-                return self.set_variable(t);
+                return self.set_variable(&mut c);
             }
             (Tok::Ident | Tok::Local, Some(Tok::Colon)) => {
                 // `name:` is a label even where a macro has the name.
                 self.define_label(&t[0])?;
-                p = 2;
+                c.advance_by(2);
             }
             (Tok::Colon, _) => {
                 self.define_label(&t[0])?;
-                p = 1;
+                c.advance();
             }
             _ => {}
         }
-        if p >= t.len() {
+        let Some(&head) = c.peek() else {
             return Ok(());
-        }
-        let head = t[p];
+        };
         match head.kind {
             Tok::Ident => {
                 let info = self.names.info[head.value as usize];
                 if let Some(mac) = info.macro_id {
-                    return self.invoke_macro(mac, t, p);
+                    return self.invoke_macro(mac, &mut c);
                 }
                 match info.keyword {
-                    Keyword::Mnemonic(mnemonic) => self.instruction(mnemonic, t, p),
+                    Keyword::Mnemonic(mnemonic) => self.instruction(mnemonic, &mut c),
                     _ => {
                         let name = self.names.name(head.name()).to_string();
                         // `name` alone, or before an instruction: a label
                         // missing its colon.
-                        let label_like = match t.get(p + 1) {
+                        let label_like = match c.peek_at(1) {
                             None => true,
                             Some(next) if next.kind == Tok::Directive => true,
                             Some(next) if next.kind == Tok::Ident => {
@@ -1290,7 +1301,7 @@ impl<'a> Asm<'a> {
                     }
                     return Err(self.report(diag));
                 };
-                self.directive(dir, t, p)
+                self.directive(dir, &mut c)
             }
             _ => Err(self.err(
                 "asm::syntax",
@@ -1323,13 +1334,14 @@ impl<'a> Asm<'a> {
     }
 
     /// `name = expr` and `name := expr`.
-    fn assignment(&mut self, t: &[Token]) -> PResult<()> {
-        let mut p = 2;
-        let expr = self.expression(t, &mut p)?;
-        self.expect_end(t, p)?;
-        let sym = match t[0].kind {
-            Tok::Local => self.cheap_sym(t[0].name()),
-            _ => self.sym_in(self.scope, t[0].name()),
+    fn assignment(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let name = c.current();
+        c.advance_by(2);
+        let expr = self.expression(c)?;
+        self.expect_end(c)?;
+        let sym = match name.kind {
+            Tok::Local => self.cheap_sym(name.name()),
+            _ => self.sym_in(self.scope, name.name()),
         };
         let def = match self.prog.eval(expr) {
             Ok(crate::expr::Value::Const(value)) => SymDef::Const(value),
@@ -1338,21 +1350,25 @@ impl<'a> Asm<'a> {
                 SymDef::Expr(expr)
             }
         };
-        self.define(sym, def, t[0].span)
+        self.define(sym, def, name.span)
     }
 
     /// `name .set expr`: a variable, taken by value where it is used.
-    fn set_variable(&mut self, t: &[Token]) -> PResult<()> {
-        let mut p = 2;
-        let expr = self.expression(t, &mut p)?;
-        self.expect_end(t, p)?;
-        let sym = self.sym_in(self.scope, t[0].name());
+    fn set_variable(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let name = c.current();
+        c.advance_by(2);
+        let start = c.pos();
+        let expr = self.expression(c)?;
+        self.expect_end(c)?;
+        let sym = self.sym_in(self.scope, name.name());
         let node = match self.prog.eval(expr) {
             Ok(crate::expr::Value::Const(value)) => {
                 self.prog.node(crate::model::Node::Const(value))
             }
             Ok(_) | Err(crate::expr::EvalErr::NotYet(_)) => expr,
-            Err(error) => return Err(self.eval_error(error, self.join(t[2].span, t[p - 1].span))),
+            Err(error) => {
+                return Err(self.eval_error(error, self.join(c.span_of(start), c.last_span())));
+            }
         };
         self.keep_nodes = true;
         self.new_cheap_region();
@@ -1362,26 +1378,26 @@ impl<'a> Asm<'a> {
             SymDef::Undefined | SymDef::Var(_) => {
                 s.def = SymDef::Var(node);
                 if s.def_loc.is_none() {
-                    let loc = self.loc(t[0].span);
+                    let loc = self.loc(name.span);
                     self.prog.syms[sym as usize].def_loc = Some(loc);
                 }
                 Ok(())
             }
             _ => {
-                let name = self.sym_name(sym);
+                let text = self.sym_name(sym);
                 Err(self.err(
                     "asm::duplicate",
-                    t[0].span,
-                    format!("`{name}` is a constant or label, not a `.set` variable"),
+                    name.span,
+                    format!("`{text}` is a constant or label, not a `.set` variable"),
                 ))
             }
         }
     }
 
     /// Reports unexpected tokens after a complete statement.
-    pub(crate) fn expect_end(&mut self, t: &[Token], p: usize) -> PResult<()> {
-        if let Some(extra) = t.get(p) {
-            let last = t[t.len() - 1].span;
+    pub(crate) fn expect_end(&mut self, c: &Cursor<'_>) -> PResult<()> {
+        if let Some(extra) = c.peek() {
+            let last = c.span_of(c.tokens().len() - 1);
             return Err(self.err(
                 "asm::syntax",
                 self.join(extra.span, last),
@@ -1393,17 +1409,17 @@ impl<'a> Asm<'a> {
 
     // ----- macros ------------------------------------------------------
 
-    fn invoke_macro(&mut self, mac: u32, t: &[Token], p: usize) -> PResult<()> {
-        let head = t[p];
+    fn invoke_macro(&mut self, mac: u32, c: &mut Cursor<'_>) -> PResult<()> {
+        let Some(head) = c.next_token() else {
+            return Ok(());
+        };
         self.frame_room(head.span)?;
         // Arguments: comma-separated token runs; `{...}` groups a run.
         let mut args: Vec<Vec<Token>> = Vec::new();
-        let mut i = p + 1;
-        if i < t.len() {
+        if !c.is_end() {
             let mut current = Vec::new();
             let mut depth = 0usize;
-            while i < t.len() {
-                let tok = t[i];
+            while let Some(tok) = c.next_token() {
                 match tok.kind {
                     Tok::LBrace => {
                         if depth > 0 {
@@ -1420,7 +1436,6 @@ impl<'a> Asm<'a> {
                     Tok::Comma if depth == 0 => args.push(std::mem::take(&mut current)),
                     _ => current.push(tok),
                 }
-                i += 1;
             }
             args.push(current);
         }
@@ -1432,7 +1447,7 @@ impl<'a> Asm<'a> {
             let count = macro_def.params.len();
             return Err(self.err(
                 "asm::macro-args",
-                self.join(head.span, t[t.len() - 1].span),
+                self.join(head.span, c.last_span()),
                 format!(
                     "macro `{name}` takes {count} parameter{}, {} given",
                     if count == 1 { "" } else { "s" },
@@ -1527,8 +1542,9 @@ impl<'a> Asm<'a> {
 
     // ----- conditionals ------------------------------------------------
 
-    pub(crate) fn conditional(&mut self, dir: Dir, t: &[Token]) -> PResult<()> {
-        let head = t[0];
+    /// `c` is at the directive.
+    pub(crate) fn conditional(&mut self, dir: Dir, c: &mut Cursor<'_>) -> PResult<()> {
+        let head = c.current();
         let base = self.frames.last().map_or(0, Frame::conds);
         match dir {
             Dir::Else | Dir::Elseif => {
@@ -1563,9 +1579,9 @@ impl<'a> Asm<'a> {
                 } else if !cond.parent_active || cond.taken {
                     next.active = false;
                 } else {
-                    let mut p = 1;
-                    let value = self.const_expr(t, &mut p, "`.elseif`")?;
-                    self.expect_end(t, p)?;
+                    c.advance();
+                    let value = self.const_expr(c, "`.elseif`")?;
+                    self.expect_end(c)?;
                     next.active = value != 0;
                     next.taken = next.active;
                 }
@@ -1579,10 +1595,11 @@ impl<'a> Asm<'a> {
                     return Err(self.err("asm::unbalanced", head.span, "`.endif` without `.if`"));
                 }
                 self.conds.pop();
-                self.expect_end(t, 1)
+                c.advance();
+                self.expect_end(c)
             }
             _ => {
-                let truth = self.condition(dir, t);
+                let truth = self.condition(dir, c);
                 let active = truth.unwrap_or(false);
                 self.conds.push(Cond {
                     span: head.span,
@@ -1598,12 +1615,12 @@ impl<'a> Asm<'a> {
         }
     }
 
-    fn condition(&mut self, dir: Dir, t: &[Token]) -> PResult<bool> {
-        let mut p = 1;
+    fn condition(&mut self, dir: Dir, c: &mut Cursor<'_>) -> PResult<bool> {
+        c.advance();
         let result = match dir {
-            Dir::If => self.const_expr(t, &mut p, "`.if`")? != 0,
+            Dir::If => self.const_expr(c, "`.if`")? != 0,
             Dir::Ifdef | Dir::Ifndef | Dir::Ifref | Dir::Ifnref => {
-                let sym = self.parse_symbol_name(t, &mut p)?;
+                let sym = self.parse_symbol_name(c)?;
                 let defined = sym.is_some_and(|s| {
                     if matches!(dir, Dir::Ifref | Dir::Ifnref) {
                         self.prog.syms[s as usize].ref_loc.is_some()
@@ -1614,18 +1631,18 @@ impl<'a> Asm<'a> {
                 defined == matches!(dir, Dir::Ifdef | Dir::Ifref)
             }
             Dir::Ifblank | Dir::Ifnblank => {
-                let blank = t.len() <= 1;
-                p = t.len();
+                let blank = c.is_end();
+                c.advance_by(c.rest().len());
                 blank == (dir == Dir::Ifblank)
             }
             Dir::Ifconst => {
-                let expr = self.expression(t, &mut p)?;
+                let expr = self.expression(c)?;
                 matches!(self.prog.eval(expr), Ok(crate::expr::Value::Const(_)))
             }
             Dir::Ifp02 => true,
             _ => false,
         };
-        self.expect_end(t, p)?;
+        self.expect_end(c)?;
         Ok(result)
     }
 }

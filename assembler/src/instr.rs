@@ -9,6 +9,7 @@ use isa::objfmt::{BinaryOp, UnaryOp};
 use isa::{AddressingMode as Mode, Mnemonic};
 
 use crate::asm::{Asm, PResult};
+use crate::cursor::Cursor;
 use crate::diag::{self, Span};
 use crate::expr::{Base, EvalErr, Value};
 use crate::intern::Keyword;
@@ -61,26 +62,29 @@ impl Asm<'_> {
     }
 
     /// The span of the tokens `from..to` (an expression's own tokens).
-    fn tokens_span(&self, t: &[Token], from: usize, to: usize) -> Span {
+    fn tokens_span(&self, c: &Cursor<'_>, from: usize, to: usize) -> Span {
+        let t = c.tokens();
         match (t.get(from), to.checked_sub(1).and_then(|last| t.get(last))) {
             (Some(first), Some(last)) if to > from => self.join(first.span, last.span),
-            _ => self.span_at(t, from),
+            _ => c.span_of(from),
         }
     }
 
-    /// The operand and the span of its expression.
-    fn operand(&mut self, mnemonic: Mnemonic, t: &[Token], p: usize) -> PResult<(Operand, Span)> {
-        let start = p;
-        let mut expr_start = p;
-        let operand = self.operand_inner(mnemonic, t, p, &mut expr_start)?;
+    /// The operand (from `c` to the end of the statement) and the span of
+    /// its expression.
+    fn operand(&mut self, mnemonic: Mnemonic, c: &mut Cursor<'_>) -> PResult<(Operand, Span)> {
+        let start = c.pos();
+        let mut expr_start = start;
+        let operand = self.operand_inner(mnemonic, c, &mut expr_start)?;
+        let n = c.tokens().len();
         let end = match operand.1 {
-            0 => t.len(),
+            0 => n,
             end => end,
         };
         let span = if expr_start < end {
-            self.tokens_span(t, expr_start, end)
+            self.tokens_span(c, expr_start, end)
         } else {
-            self.tokens_span(t, start, t.len())
+            self.tokens_span(c, start, n)
         };
         Ok((operand.0, span))
     }
@@ -90,62 +94,59 @@ impl Asm<'_> {
     fn operand_inner(
         &mut self,
         mnemonic: Mnemonic,
-        t: &[Token],
-        mut p: usize,
+        c: &mut Cursor<'_>,
         expr_start: &mut usize,
     ) -> PResult<(Operand, usize)> {
-        let n = t.len();
-        if p == n {
+        let Some(&first) = c.peek() else {
             return Ok((Operand::None, 0));
-        }
-        if p + 1 == n
-            && self.reg(t.get(p)) == Some(Keyword::RegA)
+        };
+        if c.rest().len() == 1
+            && self.reg(Some(&first)) == Some(Keyword::RegA)
             && isa::has_mode(mnemonic, Mode::Accumulator)
         {
             return Ok((Operand::Acc, 0));
         }
-        if t[p].kind == Tok::Hash {
-            p += 1;
-            *expr_start = p;
-            let expr = self.expression(t, &mut p)?;
-            self.expect_end(t, p)?;
-            return Ok((Operand::Imm(expr), p));
+        if c.eat(Tok::Hash) {
+            *expr_start = c.pos();
+            let expr = self.expression(c)?;
+            self.expect_end(c)?;
+            return Ok((Operand::Imm(expr), c.pos()));
         }
         let mut size = Size::Auto;
-        if t[p].kind == Tok::Ident && t.get(p + 1).map(|t| t.kind) == Some(Tok::Colon) {
-            size = match self.names.keyword(t[p].name()) {
+        if first.kind == Tok::Ident && c.peek_kind_at(1) == Some(Tok::Colon) {
+            size = match self.names.keyword(first.name()) {
                 Keyword::SizeZ => Size::Zp,
                 Keyword::RegA => Size::Abs,
                 Keyword::SizeF => {
                     return Err(self.err(
                         "asm::mode",
-                        t[p].span,
+                        first.span,
                         "`f:` (far, 24-bit) addressing does not exist on the 6502",
                     ));
                 }
                 _ => {
                     return Err(self.err(
                         "asm::syntax",
-                        self.join(t[p].span, t[p + 1].span),
+                        self.join(first.span, c.span_of(c.pos() + 1)),
                         "an address-size prefix is `z:` (zero page) or `a:` (absolute)",
                     ));
                 }
             };
-            p += 2;
+            c.advance_by(2);
         }
-        if t.get(p).map(|t| t.kind) == Some(Tok::LParen) {
-            return self.indirect_operand(t, p + 1, expr_start);
+        if c.eat(Tok::LParen) {
+            return self.indirect_operand(c, expr_start);
         }
-        *expr_start = p;
-        let expr = self.expression(t, &mut p)?;
-        let expr_end = p;
+        *expr_start = c.pos();
+        let expr = self.expression(c)?;
+        let expr_end = c.pos();
         let mut index = Index::None;
-        if t.get(p).map(|t| t.kind) == Some(Tok::Comma) {
-            index = match self.reg(t.get(p + 1)) {
+        if c.peek_kind() == Some(Tok::Comma) {
+            index = match self.reg(c.peek_at(1)) {
                 Some(Keyword::RegX) => Index::X,
                 Some(Keyword::RegY) => Index::Y,
                 _ => {
-                    let span = self.span_at(t, p + 1);
+                    let span = c.span_of(c.pos() + 1);
                     return Err(self.err(
                         "asm::syntax",
                         span,
@@ -153,52 +154,56 @@ impl Asm<'_> {
                     ));
                 }
             };
-            p += 2;
+            c.advance_by(2);
         }
-        self.expect_end(t, p)?;
+        self.expect_end(c)?;
         Ok((Operand::Direct(expr, index, size), expr_end))
     }
 
-    /// An operand that opens with `(`: `(zp,x)`, `(zp),y` or `(abs)`. As in
-    /// ca65, a leading parenthesis always means indirection, so a typo such
-    /// as `(zp),x` is an error rather than another instruction.
+    /// An operand that opens with `(` (read already): `(zp,x)`, `(zp),y` or
+    /// `(abs)`. As in ca65, a leading parenthesis always means indirection,
+    /// so a typo such as `(zp),x` is an error rather than another
+    /// instruction.
     fn indirect_operand(
         &mut self,
-        t: &[Token],
-        mut p: usize,
+        c: &mut Cursor<'_>,
         expr_start: &mut usize,
     ) -> PResult<(Operand, usize)> {
-        *expr_start = p;
-        let inner = self.expression(t, &mut p)?;
-        let inner_end = p;
-        let kind = |i: usize| t.get(i).map(|t| t.kind);
-        let (at, message, help) = match kind(p) {
-            Some(Tok::Comma) if self.reg(t.get(p + 1)) == Some(Keyword::RegX) => {
-                if kind(p + 2) == Some(Tok::RParen) {
-                    self.expect_end(t, p + 3)?;
+        *expr_start = c.pos();
+        let inner = self.expression(c)?;
+        let inner_end = c.pos();
+        // Offsets from the end of the inner expression.
+        let (ahead, message, help) = match c.peek_kind() {
+            Some(Tok::Comma) if self.reg(c.peek_at(1)) == Some(Keyword::RegX) => {
+                if c.peek_kind_at(2) == Some(Tok::RParen) {
+                    c.advance_by(3);
+                    self.expect_end(c)?;
                     return Ok((Operand::IndX(inner), inner_end));
                 }
-                (p + 2, "expected `)` to close `(zp,x)`", None)
+                (2, "expected `)` to close `(zp,x)`", None)
             }
             Some(Tok::Comma) => (
-                p + 1,
+                1,
                 "expected `x`: inside the parentheses the index is `x`, as in `(zp,x)`",
                 Some("`(zp,x)` indexes before the indirection, `(zp),y` after it"),
             ),
-            Some(Tok::RParen) if p + 1 == t.len() => return Ok((Operand::Ind(inner), inner_end)),
-            Some(Tok::RParen) if kind(p + 1) == Some(Tok::Comma) => {
-                if self.reg(t.get(p + 2)) == Some(Keyword::RegY) {
-                    self.expect_end(t, p + 3)?;
+            Some(Tok::RParen) if c.rest().len() == 1 => {
+                return Ok((Operand::Ind(inner), inner_end));
+            }
+            Some(Tok::RParen) if c.peek_kind_at(1) == Some(Tok::Comma) => {
+                if self.reg(c.peek_at(2)) == Some(Keyword::RegY) {
+                    c.advance_by(3);
+                    self.expect_end(c)?;
                     return Ok((Operand::IndY(inner), inner_end));
                 }
                 (
-                    p + 2,
+                    2,
                     "expected `y`: after the parentheses the index is `y`, as in `(zp),y`",
                     Some("the 6502 has `(zp),y` and `(zp,x)`; there is no `(zp),x`"),
                 )
             }
             Some(Tok::RParen) => (
-                p + 1,
+                1,
                 "unexpected text after an indirect operand",
                 Some(
                     "an operand that starts with `(` is indirect (as in ca65); \
@@ -206,12 +211,12 @@ impl Asm<'_> {
                 ),
             ),
             _ => (
-                p,
+                0,
                 "expected `,x)` or `)` to close the indirect operand",
                 None,
             ),
         };
-        let span = self.span_at(t, at);
+        let span = c.span_of(c.pos() + ahead);
         let mut diag = diag::error("asm::syntax", span, message);
         if let Some(help) = help {
             diag = diag.help(help);
@@ -219,16 +224,17 @@ impl Asm<'_> {
         Err(self.report(diag))
     }
 
-    /// Encodes one instruction.
-    pub(crate) fn instruction(&mut self, mnemonic: Mnemonic, t: &[Token], p: usize) -> PResult<()> {
-        let head = t[p];
-        let (operand, operand_span) = self.operand(mnemonic, t, p + 1)?;
+    /// Encodes one instruction; `c` is at its mnemonic.
+    pub(crate) fn instruction(&mut self, mnemonic: Mnemonic, c: &mut Cursor<'_>) -> PResult<()> {
+        let head = c.current();
+        c.advance();
         // The whole operand as written (`#3`, `table,x`, `($12),y`): where
         // a mode error points.
-        let whole = match t.get(p + 1) {
-            Some(first) => self.join(first.span, t[t.len() - 1].span),
+        let whole = match c.peek() {
+            Some(first) => self.join(first.span, c.span_of(c.tokens().len() - 1)),
             None => head.span,
         };
+        let (operand, operand_span) = self.operand(mnemonic, c)?;
         match operand {
             Operand::None => {
                 let mode = if isa::has_mode(mnemonic, Mode::Implied) {

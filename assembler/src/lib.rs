@@ -23,6 +23,7 @@
 //! deferred assertions exactly as the assembler would.
 
 mod asm;
+mod cursor;
 mod diag;
 mod directives;
 mod elf;

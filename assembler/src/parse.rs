@@ -17,6 +17,7 @@
 use isa::objfmt::{BinaryOp, UnaryOp};
 
 use crate::asm::{Asm, Frame, PResult, Reported};
+use crate::cursor::Cursor;
 use crate::diag::{self, Span};
 use crate::expr::{EvalErr, Value};
 use crate::intern::{Dir, Keyword};
@@ -26,25 +27,6 @@ use crate::model::{GLOBAL_SCOPE, Node, NodeId, ScopeId, SymDef, SymId};
 const MAX_NESTING: u32 = 256;
 
 impl Asm<'_> {
-    /// A zero-width span just after token `p - 1` (where something is missing).
-    pub(crate) fn span_at(&self, t: &[Token], p: usize) -> Span {
-        if let Some(tok) = t.get(p) {
-            return tok.span;
-        }
-        match t.last() {
-            Some(last) => Span {
-                file: last.span.file,
-                start: last.span.end,
-                end: last.span.end,
-            },
-            None => Span {
-                file: self.line.file,
-                start: self.line.end,
-                end: self.line.end,
-            },
-        }
-    }
-
     fn directive_of(&self, tok: &Token) -> Option<Dir> {
         if tok.kind != Tok::Directive {
             return None;
@@ -55,70 +37,67 @@ impl Asm<'_> {
         }
     }
 
-    /// Parses an expression starting at `*p`.
-    pub(crate) fn expression(&mut self, t: &[Token], p: &mut usize) -> PResult<NodeId> {
+    /// Parses an expression from the cursor on.
+    pub(crate) fn expression(&mut self, c: &mut Cursor<'_>) -> PResult<NodeId> {
         // Fast path for the commonest operand: a lone number or name.
-        if let Some(tok) = t.get(*p)
-            && matches!(
-                t.get(*p + 1).map(|t| t.kind),
-                None | Some(Tok::Comma | Tok::RParen)
-            )
+        if let Some(tok) = c.peek()
+            && matches!(c.peek_kind_at(1), None | Some(Tok::Comma | Tok::RParen))
         {
             match tok.kind {
                 Tok::Number => {
-                    *p += 1;
+                    c.advance();
                     return Ok(self.prog.node(Node::Const(tok.value as i64)));
                 }
                 Tok::Ident => {
-                    let sym = self.symbol_ref(t, p)?;
+                    let sym = self.symbol_ref(c)?;
                     return Ok(self.sym_node(sym));
                 }
                 _ => {}
             }
         }
-        self.level7(t, p, 0)
+        self.level7(c, 0)
     }
 
     /// Precedence climbing: parses operators of level `max_level` and
     /// tighter (2 is tightest among binary operators, 7 is `!`), left to
     /// right, in one loop rather than one recursive call per level.
-    fn level7(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
-        self.climb(t, p, 7, depth)
+    fn level7(&mut self, c: &mut Cursor<'_>, depth: u32) -> PResult<NodeId> {
+        self.climb(c, 7, depth)
     }
 
-    fn climb(&mut self, t: &[Token], p: &mut usize, max_level: u8, depth: u32) -> PResult<NodeId> {
+    fn climb(&mut self, c: &mut Cursor<'_>, max_level: u8, depth: u32) -> PResult<NodeId> {
         if depth > MAX_NESTING {
-            let span = self.span_at(t, *p);
+            let span = c.span();
             return Err(self.err("asm::too-deep", span, "expression nested too deeply"));
         }
-        let start = *p;
-        let mut left = match t.get(*p) {
+        let start = c.pos();
+        let mut left = match c.peek() {
             Some(tok)
                 if max_level == 7
                     && (tok.kind == Tok::Bang || self.directive_of(tok) == Some(Dir::Not)) =>
             {
-                *p += 1;
-                let inner = self.climb(t, p, 7, depth + 1)?;
+                c.advance();
+                let inner = self.climb(c, 7, depth + 1)?;
                 return Ok(self.unary_node(UnaryOp::LogNot, inner));
             }
-            _ => self.unary(t, p, depth + 1)?,
+            _ => self.unary(c, depth + 1)?,
         };
-        while let Some(tok) = t.get(*p) {
+        while let Some(tok) = c.peek() {
             let Some((op, level)) = self.binary_op(tok) else {
                 break;
             };
             if level > max_level {
                 break;
             }
-            *p += 1;
+            c.advance();
             // Left-associative: the right operand binds tighter.
-            let right = self.climb(t, p, level - 1, depth + 1)?;
+            let right = self.climb(c, level - 1, depth + 1)?;
             if matches!(op, BinaryOp::Div | BinaryOp::Mod)
                 && matches!(self.prog.nodes.get(right as usize), Some(Node::Const(0)))
             {
                 // Caught here, the caret goes under the division itself
                 // rather than the whole operand.
-                let span = self.join(self.span_at(t, start), t[*p - 1].span);
+                let span = self.join(c.span_of(start), c.last_span());
                 return Err(self.report(
                     diag::error("asm::div-zero", span, "division by zero")
                         .label("the divisor is 0"),
@@ -184,19 +163,19 @@ impl Asm<'_> {
         self.prog.node(Node::Unary(op, inner))
     }
 
-    fn unary(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
+    fn unary(&mut self, c: &mut Cursor<'_>, depth: u32) -> PResult<NodeId> {
         if depth > MAX_NESTING {
-            let span = self.span_at(t, *p);
+            let span = c.span();
             return Err(self.err("asm::too-deep", span, "expression nested too deeply"));
         }
-        let Some(tok) = t.get(*p).copied() else {
-            let span = self.span_at(t, *p);
+        let Some(tok) = c.peek().copied() else {
+            let span = c.span();
             return Err(self.err("asm::syntax", span, "expected an expression here"));
         };
         let op = match tok.kind {
             Tok::Plus => {
-                *p += 1;
-                return self.unary(t, p, depth + 1);
+                c.advance();
+                return self.unary(c, depth + 1);
             }
             Tok::Minus => Some(UnaryOp::Neg),
             Tok::Tilde => Some(UnaryOp::BitNot),
@@ -209,22 +188,22 @@ impl Asm<'_> {
             _ => None,
         };
         if let Some(op) = op {
-            *p += 1;
-            let inner = self.unary(t, p, depth + 1)?;
+            c.advance();
+            let inner = self.unary(c, depth + 1)?;
             return Ok(self.unary_node(op, inner));
         }
-        self.primary(t, p, depth)
+        self.primary(c, depth)
     }
 
-    fn primary(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
-        let tok = t[*p];
+    fn primary(&mut self, c: &mut Cursor<'_>, depth: u32) -> PResult<NodeId> {
+        let tok = c.current();
         match tok.kind {
             Tok::Number => {
-                *p += 1;
+                c.advance();
                 Ok(self.prog.node(Node::Const(tok.value as i64)))
             }
             Tok::Char => {
-                *p += 1;
+                c.advance();
                 match usize::try_from(tok.value)
                     .ok()
                     .and_then(|v| self.charmap.get(v))
@@ -238,7 +217,7 @@ impl Asm<'_> {
                 }
             }
             Tok::Str => {
-                *p += 1;
+                c.advance();
                 let text = self.string_bytes(&tok);
                 if text.len() == 1 {
                     let byte = self.charmap[usize::from(text[0])];
@@ -251,38 +230,38 @@ impl Asm<'_> {
                 ))
             }
             Tok::Star => {
-                *p += 1;
+                c.advance();
                 let (chunk, off) = self.here();
                 Ok(self.prog.node(Node::Pos { chunk, off }))
             }
             Tok::LParen => {
-                *p += 1;
-                let inner = self.level7(t, p, depth + 1)?;
-                if t.get(*p).map(|t| t.kind) != Some(Tok::RParen) {
-                    let span = self.span_at(t, *p);
+                c.advance();
+                let inner = self.level7(c, depth + 1)?;
+                if c.peek_kind() != Some(Tok::RParen) {
+                    let span = c.span();
                     let diag = diag::error("asm::syntax", span, "expected `)`")
                         .also(tok.span, "to close this `(`");
                     return Err(self.report(diag));
                 }
-                *p += 1;
+                c.advance();
                 Ok(inner)
             }
             Tok::Unnamed => {
-                *p += 1;
+                c.advance();
                 let sym = self.unnamed_ref(&tok)?;
                 Ok(self.prog.node(Node::Sym(sym)))
             }
             Tok::Local => {
-                *p += 1;
+                c.advance();
                 let sym = self.cheap_sym(tok.name());
                 self.note_ref(sym, tok.span);
                 Ok(self.sym_node(sym))
             }
             Tok::Ident | Tok::ColonColon => {
-                let sym = self.symbol_ref(t, p)?;
+                let sym = self.symbol_ref(c)?;
                 Ok(self.sym_node(sym))
             }
-            Tok::Directive => self.pseudo_function(t, p, depth),
+            Tok::Directive => self.pseudo_function(c, depth),
             _ => Err(self.err("asm::syntax", tok.span, "expected an expression here")),
         }
     }
@@ -326,22 +305,20 @@ impl Asm<'_> {
 
     /// `name`, `scope::name`, `::name`: a reference, creating the symbol
     /// when it does not exist yet.
-    pub(crate) fn symbol_ref(&mut self, t: &[Token], p: &mut usize) -> PResult<SymId> {
-        let start = t[*p].span;
+    pub(crate) fn symbol_ref(&mut self, c: &mut Cursor<'_>) -> PResult<SymId> {
+        let start = c.current().span;
         let mut scope: Option<ScopeId> = None;
-        if t[*p].kind == Tok::ColonColon {
+        if c.current().kind == Tok::ColonColon {
             scope = Some(GLOBAL_SCOPE);
-            *p += 1;
+            c.advance();
         }
-        let Some(first) = t.get(*p).filter(|t| t.kind == Tok::Ident).copied() else {
-            let span = self.span_at(t, *p);
+        let Some(first) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+            let span = c.span();
             return Err(self.err("asm::syntax", span, "expected a name after `::`"));
         };
-        *p += 1;
+        c.advance();
         let mut name = first;
-        while t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon)
-            && t.get(*p + 1).map(|t| t.kind) == Some(Tok::Ident)
-        {
+        while c.peek_kind() == Some(Tok::ColonColon) && c.peek_kind_at(1) == Some(Tok::Ident) {
             let outer = name.name();
             let next = match scope {
                 None => match self.lookup_scope(outer) {
@@ -353,8 +330,9 @@ impl Asm<'_> {
                 Some(s) => self.child_scope_or_new(s, outer, crate::model::ScopeKind::Scope),
             };
             scope = Some(next);
-            name = t[*p + 1];
-            *p += 2;
+            c.advance();
+            name = c.current();
+            c.advance();
         }
         let span = self.join(start, name.span);
         match scope {
@@ -368,35 +346,29 @@ impl Asm<'_> {
     }
 
     /// A symbol name for `.defined`, `.ifdef`...: found, never created.
-    pub(crate) fn parse_symbol_name(
-        &mut self,
-        t: &[Token],
-        p: &mut usize,
-    ) -> PResult<Option<SymId>> {
-        let Some(tok) = t.get(*p).copied() else {
-            let span = self.span_at(t, *p);
+    pub(crate) fn parse_symbol_name(&mut self, c: &mut Cursor<'_>) -> PResult<Option<SymId>> {
+        let Some(tok) = c.peek().copied() else {
+            let span = c.span();
             return Err(self.err("asm::syntax", span, "expected a symbol name"));
         };
         if tok.kind == Tok::Local {
-            *p += 1;
+            c.advance();
             let sym = self.cheap_sym(tok.name());
             return Ok(Some(sym));
         }
         let mut scope: Option<ScopeId> = None;
         if tok.kind == Tok::ColonColon {
             scope = Some(GLOBAL_SCOPE);
-            *p += 1;
+            c.advance();
         }
-        let Some(first) = t.get(*p).filter(|t| t.kind == Tok::Ident).copied() else {
-            let span = self.span_at(t, *p);
+        let Some(first) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+            let span = c.span();
             return Err(self.err("asm::syntax", span, "expected a symbol name"));
         };
-        *p += 1;
+        c.advance();
         let mut name = first.name();
         let mut missing_scope = false;
-        while t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon)
-            && t.get(*p + 1).map(|t| t.kind) == Some(Tok::Ident)
-        {
+        while c.peek_kind() == Some(Tok::ColonColon) && c.peek_kind_at(1) == Some(Tok::Ident) {
             let next = match scope {
                 None => self.lookup_scope(name),
                 Some(s) => self.child_scope(s, name),
@@ -405,8 +377,9 @@ impl Asm<'_> {
                 Some(s) => scope = Some(s),
                 None => missing_scope = true,
             }
-            name = t[*p + 1].name();
-            *p += 2;
+            c.advance();
+            name = c.current().name();
+            c.advance();
         }
         if missing_scope {
             return Ok(None);
@@ -428,17 +401,17 @@ impl Asm<'_> {
         })
     }
 
-    fn expect(&mut self, t: &[Token], p: &mut usize, kind: Tok, what: &str) -> PResult<()> {
-        if t.get(*p).map(|t| t.kind) == Some(kind) {
-            *p += 1;
+    fn expect(&mut self, c: &mut Cursor<'_>, kind: Tok, what: &str) -> PResult<()> {
+        if c.peek_kind() == Some(kind) {
+            c.advance();
             return Ok(());
         }
-        let span = self.span_at(t, *p);
+        let span = c.span();
         Err(self.err("asm::syntax", span, format!("expected {what}")))
     }
 
-    fn pseudo_function(&mut self, t: &[Token], p: &mut usize, depth: u32) -> PResult<NodeId> {
-        let head = t[*p];
+    fn pseudo_function(&mut self, c: &mut Cursor<'_>, depth: u32) -> PResult<NodeId> {
+        let head = c.current();
         let Some(dir) = self.directive_of(&head) else {
             let name = self.names.name(head.name()).to_string();
             return Err(self.err(
@@ -447,13 +420,13 @@ impl Asm<'_> {
                 format!("`{name}` is not a directive this assembler knows"),
             ));
         };
-        *p += 1;
+        c.advance();
         let bool_node = |asm: &mut Self, value: bool| asm.prog.node(Node::Const(i64::from(value)));
         match dir {
             Dir::Lobyte | Dir::Hibyte | Dir::Bankbyte | Dir::Loword | Dir::Hiword | Dir::Const => {
-                self.expect(t, p, Tok::LParen, "`(`")?;
-                let inner = self.level7(t, p, depth + 1)?;
-                self.expect(t, p, Tok::RParen, "`)`")?;
+                self.expect(c, Tok::LParen, "`(`")?;
+                let inner = self.level7(c, depth + 1)?;
+                self.expect(c, Tok::RParen, "`)`")?;
                 Ok(match dir {
                     Dir::Lobyte => self.unary_node(UnaryOp::LoByte, inner),
                     Dir::Hibyte => self.unary_node(UnaryOp::HiByte, inner),
@@ -475,9 +448,9 @@ impl Asm<'_> {
                 })
             }
             Dir::Defined | Dir::Referenced => {
-                self.expect(t, p, Tok::LParen, "`(`")?;
-                let sym = self.parse_symbol_name(t, p)?;
-                self.expect(t, p, Tok::RParen, "`)`")?;
+                self.expect(c, Tok::LParen, "`(`")?;
+                let sym = self.parse_symbol_name(c)?;
+                self.expect(c, Tok::RParen, "`)`")?;
                 let answer = sym.is_some_and(|s| {
                     let sym = &self.prog.syms[s as usize];
                     if dir == Dir::Defined {
@@ -489,24 +462,24 @@ impl Asm<'_> {
                 Ok(bool_node(self, answer))
             }
             Dir::Blank => {
-                self.expect(t, p, Tok::LParen, "`(`")?;
+                self.expect(c, Tok::LParen, "`(`")?;
                 let mut nesting = 0usize;
                 let mut count = 0usize;
-                while let Some(tok) = t.get(*p) {
+                while let Some(tok) = c.peek() {
                     match tok.kind {
                         Tok::LParen => nesting += 1,
                         Tok::RParen if nesting == 0 => break,
                         Tok::RParen => nesting -= 1,
                         Tok::LBrace | Tok::RBrace => {
-                            *p += 1;
+                            c.advance();
                             continue;
                         }
                         _ => {}
                     }
                     count += 1;
-                    *p += 1;
+                    c.advance();
                 }
-                self.expect(t, p, Tok::RParen, "`)`")?;
+                self.expect(c, Tok::RParen, "`)`")?;
                 Ok(bool_node(self, count == 0))
             }
             Dir::Paramcount => {
@@ -524,20 +497,20 @@ impl Asm<'_> {
                 }
             }
             Dir::Strlen => {
-                self.expect(t, p, Tok::LParen, "`(`")?;
-                let Some(tok) = t.get(*p).filter(|t| t.kind == Tok::Str).copied() else {
-                    let span = self.span_at(t, *p);
+                self.expect(c, Tok::LParen, "`(`")?;
+                let Some(tok) = c.peek().filter(|t| t.kind == Tok::Str).copied() else {
+                    let span = c.span();
                     return Err(self.err("asm::syntax", span, "expected a string"));
                 };
-                *p += 1;
-                self.expect(t, p, Tok::RParen, "`)`")?;
+                c.advance();
+                self.expect(c, Tok::RParen, "`)`")?;
                 let len = self.string_bytes(&tok).len();
                 Ok(self.prog.node(Node::Const(len as i64)))
             }
             Dir::Sizeof => {
-                self.expect(t, p, Tok::LParen, "`(`")?;
-                let node = self.sizeof(t, p)?;
-                self.expect(t, p, Tok::RParen, "`)`")?;
+                self.expect(c, Tok::LParen, "`(`")?;
+                let node = self.sizeof(c)?;
+                self.expect(c, Tok::RParen, "`)`")?;
                 Ok(node)
             }
             _ => {
@@ -552,20 +525,20 @@ impl Asm<'_> {
     }
 
     /// `.sizeof(name)`: the size of a struct, union, enum or scope.
-    fn sizeof(&mut self, t: &[Token], p: &mut usize) -> PResult<NodeId> {
-        let start = self.span_at(t, *p);
+    fn sizeof(&mut self, c: &mut Cursor<'_>) -> PResult<NodeId> {
+        let start = c.span();
         let mut scope: Option<ScopeId> = None;
         let mut absolute = false;
-        if t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon) {
+        if c.peek_kind() == Some(Tok::ColonColon) {
             absolute = true;
-            *p += 1;
+            c.advance();
         }
         loop {
-            let Some(tok) = t.get(*p).filter(|t| t.kind == Tok::Ident).copied() else {
-                let span = self.span_at(t, *p);
+            let Some(tok) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+                let span = c.span();
                 return Err(self.err("asm::syntax", span, "expected a struct or scope name"));
             };
-            *p += 1;
+            c.advance();
             let found = match (scope, absolute) {
                 (None, false) => self.lookup_scope(tok.name()),
                 (None, true) => self.child_scope(GLOBAL_SCOPE, tok.name()),
@@ -580,8 +553,8 @@ impl Asm<'_> {
                 ));
             };
             scope = Some(found);
-            if t.get(*p).map(|t| t.kind) == Some(Tok::ColonColon) {
-                *p += 1;
+            if c.peek_kind() == Some(Tok::ColonColon) {
+                c.advance();
                 continue;
             }
             break;
@@ -605,10 +578,10 @@ impl Asm<'_> {
     }
 
     /// An expression that must be a constant now (`.if`, `.res`, `.org`...).
-    pub(crate) fn const_expr(&mut self, t: &[Token], p: &mut usize, what: &str) -> PResult<i64> {
-        let start = *p;
-        let node = self.expression(t, p)?;
-        let span = self.join(self.span_at(t, start), self.span_at(t, p.saturating_sub(1)));
+    pub(crate) fn const_expr(&mut self, c: &mut Cursor<'_>, what: &str) -> PResult<i64> {
+        let start = c.pos();
+        let node = self.expression(c)?;
+        let span = self.join(c.span_of(start), c.last_span());
         match self.prog.eval(node) {
             Ok(Value::Const(value)) => Ok(value),
             Ok(_) => {
@@ -622,7 +595,7 @@ impl Asm<'_> {
             }
             Err(EvalErr::NotYet(Some(sym))) => {
                 let name = self.sym_name(sym);
-                let at = self.name_within(t, sym, span).unwrap_or(span);
+                let at = self.name_within(c.tokens(), sym, span).unwrap_or(span);
                 Err(self.err(
                     "asm::not-constant",
                     at,

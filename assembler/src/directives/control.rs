@@ -1,0 +1,103 @@
+//! Switches of the assembler itself: `.setcpu` and `.p02`, `.list`, and
+//! the directives accepted for compatibility that change nothing here
+//! (`.feature`, and those `Dir::NoEffect` groups).
+
+use crate::asm::{Asm, PResult};
+use crate::cursor::Cursor;
+use crate::diag;
+use crate::lexer::Tok;
+
+impl Asm<'_> {
+    pub(super) fn setcpu(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        let Some(cpu) = c.peek().filter(|t| t.kind == Tok::Str).copied() else {
+            let span = c.span();
+            return Err(self.err(
+                "asm::syntax",
+                span,
+                "expected a CPU name (`\"6502\"` or `\"6502X\"`)",
+            ));
+        };
+        c.advance();
+        self.expect_end(c)?;
+        let name = String::from_utf8_lossy(&self.string_bytes(&cpu)).to_ascii_uppercase();
+        match name.as_str() {
+            "6502" => self.cpu_x = false,
+            "6502X" => self.cpu_x = true,
+            _ => {
+                return Err(self.report(
+                    diag::error(
+                        "asm::cpu",
+                        cpu.span,
+                        format!("the Scorpion's CPU is an NMOS 6502; `{name}` is not supported"),
+                    )
+                    .help("use `.setcpu \"6502\"`, or `\"6502X\"` for the undocumented opcodes"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn p02(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        self.expect_end(c)?;
+        self.cpu_x = false;
+        Ok(())
+    }
+
+    /// The span from the directive at `c` to the end of the line.
+    fn whole_statement(&self, c: &Cursor<'_>) -> diag::Span {
+        self.join(c.current().span, c.span_of(c.tokens().len() - 1))
+    }
+
+    pub(super) fn no_effect(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let name = self.names.name(c.current().name()).to_string();
+        let span = self.whole_statement(c);
+        let diag = diag::warning(
+            "asm::no-effect",
+            span,
+            format!("`{name}` has no effect with this assembler; the line is ignored"),
+        );
+        self.report(diag);
+        Ok(())
+    }
+
+    pub(super) fn feature(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let span = self.whole_statement(c);
+        let diag = diag::warning(
+            "asm::feature",
+            span,
+            "`.feature` switches are not supported; this line is ignored",
+        );
+        self.report(diag);
+        Ok(())
+    }
+
+    pub(super) fn list(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        let on = match c.peek() {
+            Some(tok) if tok.kind == Tok::Plus => true,
+            Some(tok) if tok.kind == Tok::Minus => false,
+            Some(tok) if tok.kind == Tok::Ident => {
+                let word = self.names.name(tok.name()).to_ascii_lowercase();
+                match word.as_str() {
+                    "on" => true,
+                    "off" => false,
+                    _ => {
+                        return Err(self.err("asm::syntax", tok.span, "expected `on` or `off`"));
+                    }
+                }
+            }
+            _ => {
+                let span = c.span();
+                return Err(self.err("asm::syntax", span, "expected `on` or `off`"));
+            }
+        };
+        c.advance();
+        self.expect_end(c)?;
+        if let Some(listing) = self.listing.as_mut() {
+            listing.enabled = on;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,107 @@
+//! Linkage: `.import`/`.importzp` and `.export`/`.exportzp`/`.global`/
+//! `.globalzp`, with `name = expr` and `name := expr` in export lists.
+
+use crate::asm::{Asm, PResult};
+use crate::cursor::Cursor;
+use crate::diag;
+use crate::lexer::{Tok, Token};
+use crate::model::SymDef;
+
+/// A name in an `.import`/`.export` list, with `(label_like, expression
+/// start)` when it is `name = expr` or `name := expr`.
+type NameItem = (Token, Option<(bool, usize)>);
+
+impl Asm<'_> {
+    /// A comma-separated list of names after the directive at `c`.
+    fn name_list(&mut self, c: &mut Cursor<'_>) -> PResult<Vec<NameItem>> {
+        let mut names = Vec::new();
+        c.advance();
+        loop {
+            let Some(tok) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+                let span = c.span();
+                return Err(self.err("asm::syntax", span, "expected a symbol name"));
+            };
+            c.advance();
+            // `.export name = expr` / `name := expr`.
+            let mut assignment = None;
+            if let Some(kind @ (Tok::Eq | Tok::Assign)) = c.peek_kind() {
+                c.advance();
+                assignment = Some((kind == Tok::Assign, c.pos()));
+                let mut depth = 0;
+                while let Some(next) = c.peek() {
+                    match next.kind {
+                        Tok::LParen => depth += 1,
+                        Tok::RParen => depth -= 1,
+                        Tok::Comma if depth == 0 => break,
+                        _ => {}
+                    }
+                    c.advance();
+                }
+            }
+            names.push((tok, assignment));
+            match c.peek_kind() {
+                None => return Ok(names),
+                Some(Tok::Comma) => c.advance(),
+                _ => {
+                    let span = c.span();
+                    return Err(self.err("asm::syntax", span, "expected `,` and another name"));
+                }
+            }
+        }
+    }
+
+    pub(super) fn import(&mut self, c: &mut Cursor<'_>, zp: bool) -> PResult<()> {
+        for (tok, assignment) in self.name_list(c)? {
+            if assignment.is_some() {
+                return Err(self.err("asm::syntax", tok.span, "an import has no value here"));
+            }
+            self.reserved_name(&tok, false)?;
+            let sym = self.sym_in(self.scope, tok.name());
+            match self.prog.syms[sym as usize].def {
+                SymDef::Undefined => {
+                    self.define(sym, SymDef::Import { zp }, tok.span)?;
+                }
+                SymDef::Import { zp: was } if was == zp => {}
+                _ => {
+                    let name = self.sym_name(sym);
+                    let mut diag = diag::error(
+                        "asm::duplicate",
+                        tok.span,
+                        format!("`{name}` is defined in this file and cannot be imported"),
+                    );
+                    if let Some(loc) = self.prog.syms[sym as usize].def_loc {
+                        diag = diag.also(self.prog.locs[loc as usize].span, "defined here");
+                    }
+                    return Err(self.report(diag));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn export(&mut self, c: &mut Cursor<'_>, zp: bool, global: bool) -> PResult<()> {
+        for (tok, assignment) in self.name_list(c)? {
+            let sym = self.sym_in(self.scope, tok.name());
+            if let Some((_, start)) = assignment {
+                let mut value = c.at(start);
+                let expr = self.expression(&mut value)?;
+                let def = match self.prog.eval(expr) {
+                    Ok(crate::expr::Value::Const(value)) => SymDef::Const(value),
+                    _ => {
+                        self.keep_nodes = true;
+                        SymDef::Expr(expr)
+                    }
+                };
+                self.define(sym, def, tok.span)?;
+            }
+            let loc = self.loc(tok.span);
+            let s = &mut self.prog.syms[sym as usize];
+            s.export = Some(zp);
+            s.global |= global;
+            if s.export_loc.is_none() {
+                s.export_loc = Some(loc);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,100 @@
+//! Where bytes go: `.segment`, the named segments (`.code`, `.rodata`,
+//! `.data`, `.bss`, `.zeropage`), `.org` and `.reloc`.
+
+use crate::asm::{Asm, PResult};
+use crate::cursor::Cursor;
+use crate::intern::Dir;
+use crate::lexer::Tok;
+
+impl Asm<'_> {
+    pub(super) fn org(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        let start = c.pos();
+        let value = self.const_expr(c, "`.org`")?;
+        self.expect_end(c)?;
+        if !(0..=0xFF_FFFF).contains(&value) {
+            let span = self.join(c.span_of(start), c.last_span());
+            return Err(self.report(crate::layout::range_diag(
+                span,
+                "`.org` address",
+                value,
+                (0, 0xFF_FFFF),
+            )));
+        }
+        self.new_chunk(true, Some(value));
+        Ok(())
+    }
+
+    pub(super) fn reloc(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        self.expect_end(c)?;
+        self.new_chunk(false, None);
+        Ok(())
+    }
+
+    pub(super) fn named_segment(&mut self, dir: Dir, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        self.expect_end(c)?;
+        let (name, zp) = match dir {
+            Dir::Code => ("CODE", false),
+            Dir::Rodata => ("RODATA", false),
+            Dir::Data => ("DATA", false),
+            Dir::Bss => ("BSS", false),
+            _ => ("ZEROPAGE", true),
+        };
+        self.seg = self.segment(name, zp);
+        Ok(())
+    }
+
+    pub(super) fn segment_directive(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        let Some(name) = c.peek().filter(|t| t.kind == Tok::Str).copied() else {
+            let span = c.span();
+            return Err(self.err(
+                "asm::syntax",
+                span,
+                "expected a segment name in quotes: `.segment \"CODE\"`",
+            ));
+        };
+        c.advance();
+        let text = String::from_utf8_lossy(&self.string_bytes(&name)).into_owned();
+        if text.is_empty() || !text.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
+            return Err(self.err(
+                "asm::syntax",
+                name.span,
+                "a segment name is letters, digits and `_`",
+            ));
+        }
+        let mut zp = false;
+        if c.eat(Tok::Colon) {
+            let Some(kind) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+                let span = c.span();
+                return Err(self.err("asm::syntax", span, "expected `zeropage` or `absolute`"));
+            };
+            let word = self.names.name(kind.name()).to_ascii_lowercase();
+            zp = match word.as_str() {
+                "zeropage" | "zp" | "direct" => true,
+                "absolute" | "abs" => false,
+                _ => {
+                    return Err(self.err(
+                        "asm::syntax",
+                        kind.span,
+                        "expected `zeropage` or `absolute`",
+                    ));
+                }
+            };
+            c.advance();
+        }
+        self.expect_end(c)?;
+        let seg = self.segment(&text, zp);
+        if zp && !self.prog.segs[seg as usize].zp {
+            return Err(self.err(
+                "asm::segment",
+                name.span,
+                format!("segment `{text}` was first used as an absolute segment"),
+            ));
+        }
+        self.seg = seg;
+        Ok(())
+    }
+}
