@@ -12,7 +12,7 @@ use isa::objfmt::{
 use object::elf;
 
 use crate::diag::Files;
-use crate::layout::{OutSymKind, Output, Target, assert_ops};
+use crate::output::{OutSymKind, Output, Target, assert_ops};
 
 fn section_flags(name: &str, zp: bool) -> u64 {
     let mut flags = elf::SHF_ALLOC.0;

@@ -490,8 +490,8 @@ impl Asm<'_> {
     ) -> PResult<()> {
         match value {
             Ok(Value::Const(value)) => {
-                let bytes = crate::layout::const_bytes(kind, value).map_err(|(what, range)| {
-                    self.report(crate::layout::field_range_diag(
+                let bytes = crate::output::const_bytes(kind, value).map_err(|(what, range)| {
+                    self.report(crate::resolver::field_range_diag(
                         span, kind, value, what, range,
                     ))
                 });
@@ -568,7 +568,7 @@ impl Asm<'_> {
             Ok(Value::Const(distance)) => {
                 if !(-128..=127).contains(&distance) {
                     self.emit(&[0]);
-                    return Err(self.report(crate::layout::branch_diag(span, distance)));
+                    return Err(self.report(crate::resolver::branch_diag(span, distance)));
                 }
                 self.emit(&[distance as u8]);
                 Ok(())
@@ -627,7 +627,7 @@ impl Asm<'_> {
                     link_only: false,
                     message: message.to_string(),
                     loc,
-                    line: self.line.line,
+                    line: self.input.line.line,
                     column,
                 });
             }

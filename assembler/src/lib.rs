@@ -30,11 +30,12 @@ mod elf;
 mod expr;
 mod instr;
 mod intern;
-mod layout;
 mod lexer;
 mod listing;
 mod model;
+mod output;
 mod parse;
+mod resolver;
 mod source;
 
 use std::collections::BTreeMap;
@@ -270,7 +271,7 @@ fn define_symbols(asm: &mut asm::Asm<'_>, defines: &[(String, i64)]) {
         .files
         .add("<command line>".to_string(), Arc::new(text.into_bytes()));
     for (line, (name, value, start, end)) in spans.into_iter().enumerate() {
-        asm.line = lexer::LineInfo {
+        asm.input.line = lexer::LineInfo {
             file,
             line: line as u32 + 1,
             start,

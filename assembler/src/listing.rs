@@ -18,9 +18,9 @@ use std::fmt::Write as _;
 
 use crate::asm::Frame;
 use crate::diag::Files;
-use crate::layout::Output;
 use crate::lexer::LineInfo;
 use crate::model::{ChunkId, Program, SegId};
+use crate::output::Output;
 
 /// Two upper-case hex digits.
 fn hex_byte(byte: u8) -> [u8; 2] {

@@ -279,19 +279,19 @@ impl Asm<'_> {
         let count = tok.value as i64;
         let index = if count < 0 {
             let back = count.unsigned_abs() as usize;
-            if back > self.unnamed_count {
-                let message = match self.unnamed_count {
+            if back > self.symtab.unnamed_count {
+                let message = match self.symtab.unnamed_count {
                     0 => "there is no unnamed label `:` before this".to_string(),
                     1 => "there is only one unnamed label before this".to_string(),
                     n => format!("there are only {n} unnamed labels before this"),
                 };
                 return Err(self.err("asm::undefined", tok.span, message));
             }
-            self.unnamed_count - back
+            self.symtab.unnamed_count - back
         } else {
-            self.unnamed_count + count as usize - 1
+            self.symtab.unnamed_count + count as usize - 1
         };
-        if index > self.unnamed_count + 0x1_0000 {
+        if index > self.symtab.unnamed_count + 0x1_0000 {
             return Err(self.err(
                 "asm::undefined",
                 tok.span,
@@ -323,9 +323,11 @@ impl Asm<'_> {
             let next = match scope {
                 None => match self.lookup_scope(outer) {
                     Some(found) => found,
-                    None => {
-                        self.child_scope_or_new(self.scope, outer, crate::model::ScopeKind::Scope)
-                    }
+                    None => self.child_scope_or_new(
+                        self.symtab.scope,
+                        outer,
+                        crate::model::ScopeKind::Scope,
+                    ),
                 },
                 Some(s) => self.child_scope_or_new(s, outer, crate::model::ScopeKind::Scope),
             };
@@ -387,7 +389,7 @@ impl Asm<'_> {
         Ok(match scope {
             Some(s) => self.find_sym(s, name),
             None => {
-                let mut s = self.scope;
+                let mut s = self.symtab.scope;
                 loop {
                     if let Some(sym) = self.find_sym(s, name) {
                         break Some(sym);
@@ -483,10 +485,15 @@ impl Asm<'_> {
                 Ok(bool_node(self, count == 0))
             }
             Dir::Paramcount => {
-                let count = self.frames.iter().rev().find_map(|frame| match frame {
-                    Frame::Macro { args, .. } => Some(args.len()),
-                    _ => None,
-                });
+                let count = self
+                    .input
+                    .frames
+                    .iter()
+                    .rev()
+                    .find_map(|frame| match frame {
+                        Frame::Macro { args, .. } => Some(args.len()),
+                        _ => None,
+                    });
                 match count {
                     Some(count) => Ok(self.prog.node(Node::Const(count as i64))),
                     None => Err(self.err(
@@ -652,9 +659,9 @@ impl Asm<'_> {
     /// fault when the failure names one).
     pub(crate) fn eval_error(&mut self, error: EvalErr, span: Span) -> Reported {
         let span = match error {
-            EvalErr::NotYet(Some(sym)) | EvalErr::Circular(sym) => {
-                self.name_within(&self.toks, sym, span).unwrap_or(span)
-            }
+            EvalErr::NotYet(Some(sym)) | EvalErr::Circular(sym) => self
+                .name_within(&self.input.toks, sym, span)
+                .unwrap_or(span),
             _ => span,
         };
         let (code, message, help) = match error {

@@ -80,7 +80,7 @@ impl Asm<'_> {
     pub(super) fn reserve(&mut self, count: i64, fill: Option<u8>, span: Span) -> PResult<()> {
         if count < 0 || self.total_bytes.saturating_add(count as usize) > MAX_BYTES {
             let diag = if count < 0 {
-                crate::layout::range_diag(span, "reserved size", count, (0, MAX_BYTES as i64))
+                crate::resolver::range_diag(span, "reserved size", count, (0, MAX_BYTES as i64))
             } else {
                 diag::error(
                     "asm::too-big",
@@ -125,7 +125,7 @@ impl Asm<'_> {
         let value = self.const_expr(c, what)?;
         if !(0..=255).contains(&value) {
             let span = self.join(c.span_of(start), c.last_span());
-            return Err(self.report(crate::layout::range_diag(
+            return Err(self.report(crate::resolver::range_diag(
                 span,
                 "fill value",
                 value,
@@ -224,7 +224,7 @@ impl Asm<'_> {
         // The caret goes under the code that is out of range.
         for (value, span) in [(from, from_span), (to, to_span)] {
             if !(0..=255).contains(&value) {
-                return Err(self.report(crate::layout::range_diag(
+                return Err(self.report(crate::resolver::range_diag(
                     span,
                     "`.charmap` code",
                     value,

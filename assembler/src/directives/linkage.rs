@@ -56,7 +56,7 @@ impl Asm<'_> {
                 return Err(self.err("asm::syntax", tok.span, "an import has no value here"));
             }
             self.reserved_name(&tok, false)?;
-            let sym = self.sym_in(self.scope, tok.name());
+            let sym = self.sym_in(self.symtab.scope, tok.name());
             match self.prog.syms[sym as usize].def {
                 SymDef::Undefined => {
                     self.define(sym, SymDef::Import { zp }, tok.span)?;
@@ -81,7 +81,7 @@ impl Asm<'_> {
 
     pub(super) fn export(&mut self, c: &mut Cursor<'_>, zp: bool, global: bool) -> PResult<()> {
         for (tok, assignment) in self.name_list(c)? {
-            let sym = self.sym_in(self.scope, tok.name());
+            let sym = self.sym_in(self.symtab.scope, tok.name());
             if let Some((_, start)) = assignment {
                 let mut value = c.at(start);
                 let expr = self.expression(&mut value)?;

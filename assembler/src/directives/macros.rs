@@ -60,8 +60,8 @@ impl Asm<'_> {
                 format!("macro `{text}` is already defined"),
             ));
         }
-        let id = self.macros.len() as u32;
-        self.macros.push(crate::asm::Macro {
+        let id = self.input.macros.len() as u32;
+        self.input.macros.push(crate::asm::Macro {
             name: name.name(),
             params,
             body: std::rc::Rc::new(body),
@@ -76,6 +76,7 @@ impl Asm<'_> {
         let head = c.current();
         c.advance();
         let Some(index) = self
+            .input
             .frames
             .iter()
             .rposition(|frame| matches!(frame, Frame::Macro { .. }))
@@ -102,7 +103,7 @@ impl Asm<'_> {
                 (*name, self.names.intern(&text))
             })
             .collect();
-        if let Some(Frame::Macro { locals, .. }) = self.frames.get_mut(index) {
+        if let Some(Frame::Macro { locals, .. }) = self.input.frames.get_mut(index) {
             locals.extend(renamed);
         }
         Ok(())
@@ -113,18 +114,19 @@ impl Asm<'_> {
         c.advance();
         self.expect_end(c)?;
         let Some(index) = self
+            .input
             .frames
             .iter()
             .rposition(|frame| matches!(frame, Frame::Macro { .. }))
         else {
             return Err(self.err("asm::syntax", head.span, "`.exitmacro` outside a macro"));
         };
-        let conds = match &self.frames[index] {
+        let conds = match &self.input.frames[index] {
             Frame::Macro { conds, .. } => *conds,
-            _ => self.conds.len(),
+            _ => self.input.conds.len(),
         };
-        self.frames.truncate(index);
-        self.conds.truncate(conds);
+        self.input.frames.truncate(index);
+        self.input.conds.truncate(conds);
         Ok(())
     }
 
@@ -154,7 +156,7 @@ impl Asm<'_> {
             return Err(Reported);
         };
         if !(0..=MAX_REPEAT).contains(&count) {
-            return Err(self.report(crate::layout::range_diag(
+            return Err(self.report(crate::resolver::range_diag(
                 count_span,
                 "`.repeat` count",
                 count,
@@ -166,14 +168,14 @@ impl Asm<'_> {
         }
         self.frame_room(head.span)?;
         let ctx = self.new_ctx(CtxKind::Repeat, head.span);
-        self.frames.push(Frame::Repeat {
+        self.input.frames.push(Frame::Repeat {
             body: std::rc::Rc::new(body),
             line: 0,
             iter: 0,
             count: count as u32,
             var,
             ctx,
-            conds: self.conds.len(),
+            conds: self.input.conds.len(),
         });
         Ok(())
     }
@@ -214,8 +216,8 @@ impl Asm<'_> {
                 c.advance();
             }
         }
-        let id = self.defines.len() as u32;
-        self.defines.push(crate::asm::Define {
+        let id = self.input.defines.len() as u32;
+        self.input.defines.push(crate::asm::Define {
             params,
             has_params,
             tokens: c.rest().to_vec(),
@@ -223,7 +225,7 @@ impl Asm<'_> {
         if let Some(info) = self.names.info_mut(name.name()) {
             info.define_id = Some(id);
         }
-        self.any_define = true;
+        self.input.any_define = true;
         Ok(())
     }
 

@@ -58,7 +58,7 @@ impl Asm<'_> {
             link_only,
             message,
             loc,
-            line: self.line.line,
+            line: self.input.line.line,
             column,
         });
         Ok(())

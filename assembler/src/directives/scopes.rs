@@ -80,7 +80,7 @@ impl Asm<'_> {
         };
         let scope = match name {
             Some(name) => {
-                let scope = self.child_scope_or_new(self.scope, name.name(), kind);
+                let scope = self.child_scope_or_new(self.symtab.scope, name.name(), kind);
                 if self.prog.scopes[scope as usize].size.is_some() {
                     let text = self.names.name(name.name()).to_string();
                     self.err(
@@ -91,7 +91,7 @@ impl Asm<'_> {
                 }
                 scope
             }
-            None => self.scope,
+            None => self.symtab.scope,
         };
         let size = self.struct_members(scope, union, closer, head.span, 0)?;
         if name.is_some() {
@@ -117,10 +117,10 @@ impl Asm<'_> {
             let Some(_) = self.fetch_raw() else {
                 return Err(self.err("asm::unclosed", start, "this struct has no end directive"));
             };
-            let t = std::mem::take(&mut self.toks);
+            let t = std::mem::take(&mut self.input.toks);
             let mut c = self.cursor(&t);
             let result = self.struct_member(&mut c, scope, union, closer, offset, depth);
-            self.toks = t;
+            self.input.toks = t;
             match result {
                 Ok(Some(member_size)) => {
                     if union {
@@ -190,7 +190,7 @@ impl Asm<'_> {
                     1
                 };
                 if !(0..=0xFFFF).contains(&count) {
-                    return Err(self.report(crate::layout::range_diag(
+                    return Err(self.report(crate::resolver::range_diag(
                         dir_tok.span,
                         "member size",
                         count,
@@ -250,8 +250,8 @@ impl Asm<'_> {
         let head = c.current();
         let name = self.block_name(c)?;
         let scope = match name {
-            Some(name) => self.child_scope_or_new(self.scope, name.name(), ScopeKind::Enum),
-            None => self.scope,
+            Some(name) => self.child_scope_or_new(self.symtab.scope, name.name(), ScopeKind::Enum),
+            None => self.symtab.scope,
         };
         let mut next: i64 = 0;
         let mut count: i64 = 0;
@@ -259,10 +259,10 @@ impl Asm<'_> {
             let Some(_) = self.fetch_raw() else {
                 return Err(self.err("asm::unclosed", head.span, "`.enum` has no `.endenum`"));
             };
-            let t = std::mem::take(&mut self.toks);
+            let t = std::mem::take(&mut self.input.toks);
             let mut c = self.cursor(&t);
             let result = self.enum_member(&mut c, scope, next);
-            self.toks = t;
+            self.input.toks = t;
             match result {
                 Ok(Some(value)) => {
                     next = isa::objfmt::BinaryOp::Add.apply(value, 1).unwrap_or(value);
@@ -338,7 +338,7 @@ impl Asm<'_> {
         } else {
             ScopeKind::Scope
         };
-        let scope = self.child_scope_or_new(self.scope, name, kind);
+        let scope = self.child_scope_or_new(self.symtab.scope, name, kind);
         if self.prog.scopes[scope as usize].start.is_some() {
             let text = self.names.name(name).to_string();
             return Err(self.err(
@@ -352,8 +352,8 @@ impl Asm<'_> {
         info.start = Some(here);
         info.kind = kind;
         let loc = self.loc(head.span);
-        self.scope_stack.push((scope, loc));
-        self.scope = scope;
+        self.symtab.scope_stack.push((scope, loc));
+        self.symtab.scope = scope;
         Ok(())
     }
 
@@ -361,7 +361,7 @@ impl Asm<'_> {
         let head = c.current();
         c.advance();
         self.expect_end(c)?;
-        let Some(&(scope, _)) = self.scope_stack.last() else {
+        let Some(&(scope, _)) = self.symtab.scope_stack.last() else {
             return Err(self.err(
                 "asm::unbalanced",
                 head.span,
@@ -383,8 +383,8 @@ impl Asm<'_> {
         }
         let here = self.here();
         self.prog.scopes[scope as usize].end = Some(here);
-        self.scope_stack.pop();
-        self.scope = self.prog.scopes[scope as usize].parent;
+        self.symtab.scope_stack.pop();
+        self.symtab.scope = self.prog.scopes[scope as usize].parent;
         Ok(())
     }
 }

@@ -14,7 +14,7 @@ impl Asm<'_> {
         self.expect_end(c)?;
         if !(0..=0xFF_FFFF).contains(&value) {
             let span = self.join(c.span_of(start), c.last_span());
-            return Err(self.report(crate::layout::range_diag(
+            return Err(self.report(crate::resolver::range_diag(
                 span,
                 "`.org` address",
                 value,

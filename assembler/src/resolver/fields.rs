@@ -1,397 +1,22 @@
-//! After the front end: end-of-input checks, the layout fixpoint that
-//! settles zero-page versus absolute operands, and final resolution of
-//! every fixup into bytes or relocations.
-//!
-//! The fixpoint starts every undecided operand at zero page and only ever
-//! widens: a pass places the chunks, re-evaluates the undecided operands
-//! with the placed addresses, widens those that no longer fit, and stops
-//! when a pass widens nothing. Each operand widens at most once, so the
-//! loop ends.
+//! Final resolution: every fixup into bytes or a relocation, the output
+//! symbols and fills, branch distances and assertions.
 
 use isa::elf::{
     R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_ADDR16_HI, R_MOS_ADDR16_LO, R_MOS_ADDR24_BANK, R_MOS_IMM8,
     R_MOS_PCREL_8,
 };
-use isa::objfmt::{BinaryOp, ExprOp, FillRun, SourceLoc, SrcMapEntry, UnaryOp};
+use isa::objfmt::{BinaryOp, FillRun, SourceLoc, SrcMapEntry, UnaryOp};
 
+use super::{branch_diag, field_range_diag};
 use crate::asm::Asm;
-use crate::diag::{self, RawDiag, Span};
+use crate::diag::{self, RawDiag};
 use crate::expr::{Base, EvalErr, Sel, Value};
-use crate::model::{
-    ChunkId, FixKind, GLOBAL_SCOPE, LocId, Node, NodeId, ScopeKind, SegId, SymDef, SymId, SymKind,
-    VarKind,
+use crate::model::{ChunkId, FixKind, LocId, Node, NodeId, SegId, SymDef, SymId, SymKind, VarKind};
+use crate::output::{
+    AssertOp, OutAssert, OutReloc, OutSection, OutSym, OutSymKind, Output, Target, const_bytes,
 };
 
-/// What a relocation or a deferred assertion refers to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Target {
-    /// The section symbol of an output section (index in [`Output::sections`]).
-    Section(usize),
-    /// An output symbol (index in [`Output::symbols`]).
-    Symbol(usize),
-    /// No symbol (`S = 0`).
-    Absolute,
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct OutReloc {
-    pub(crate) offset: u32,
-    pub(crate) r_type: u32,
-    pub(crate) target: Target,
-    pub(crate) addend: i64,
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct OutSection {
-    pub(crate) name: String,
-    pub(crate) zp: bool,
-    pub(crate) nobits: bool,
-    pub(crate) data: Vec<u8>,
-    pub(crate) size: u32,
-    pub(crate) align: u32,
-    pub(crate) relocs: Vec<OutReloc>,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum OutSymKind {
-    Abs(i64),
-    Sec(usize, u32),
-    Undef { zp: bool },
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct OutSym {
-    pub(crate) name: String,
-    pub(crate) kind: OutSymKind,
-    pub(crate) global: bool,
-    /// (file, line, column) of the definition.
-    pub(crate) place: Option<(u32, u32, u32)>,
-    /// Where the outermost macro expansion that defined it was written
-    /// (file, line, column), if a macro defined it.
-    pub(crate) expanded_at: Option<(u32, u32, u32)>,
-}
-
-/// One bytecode step of a deferred assertion, before symbol numbering.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum AssertOp {
-    Const(i64),
-    Target(Target),
-    Unary(UnaryOp),
-    Binary(BinaryOp),
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct OutAssert {
-    pub(crate) error: bool,
-    pub(crate) file: u32,
-    pub(crate) line: u32,
-    pub(crate) column: u32,
-    pub(crate) message: String,
-    pub(crate) ops: Vec<AssertOp>,
-}
-
-/// Everything the object writer needs.
-#[derive(Debug, Default)]
-pub(crate) struct Output {
-    pub(crate) sections: Vec<OutSection>,
-    pub(crate) symbols: Vec<OutSym>,
-    /// Where every item came from; `section` is the index in
-    /// [`Output::sections`] until the object writer numbers the sections.
-    pub(crate) items: Vec<SrcMapEntry>,
-    pub(crate) asserts: Vec<OutAssert>,
-    /// Output section of each segment (`None` when the segment is empty).
-    pub(crate) seg_section: Vec<Option<usize>>,
-    /// Reserved bytes the linker fills; `section` as in [`Output::items`].
-    pub(crate) fills: Vec<FillRun>,
-}
-
-/// The bytes of a constant stored as `kind`, or what and which range.
-pub(crate) fn const_bytes(
-    kind: FixKind,
-    value: i64,
-) -> Result<[u8; 4], (&'static str, (i64, i64))> {
-    let (what, range) = match kind {
-        FixKind::Imm8 => ("immediate value", (0, 0xFF)),
-        FixKind::Byte => ("byte value", (0, 0xFF)),
-        FixKind::Zp => ("zero-page address", (0, 0xFF)),
-        FixKind::Abs => ("address", (0, 0xFFFF)),
-        FixKind::Word => ("word value", (0, 0xFFFF)),
-        FixKind::Dbyt => ("word value", (0, 0xFFFF)),
-        FixKind::Dword => ("dword value", (0, i64::from(u32::MAX))),
-        FixKind::Branch => ("branch distance", (-128, 127)),
-    };
-    if value < range.0 || value > range.1 {
-        return Err((what, range));
-    }
-    let v = value as u32;
-    Ok(match kind {
-        FixKind::Dbyt => [(v >> 8) as u8, v as u8, 0, 0],
-        _ => v.to_le_bytes(),
-    })
-}
-
-fn show(value: i64) -> String {
-    if (0..10).contains(&value) {
-        value.to_string()
-    } else if value < 0 {
-        format!("{value}")
-    } else {
-        format!("{value} (${value:X})")
-    }
-}
-
-/// A range error naming the value and the allowed range.
-pub(crate) fn range_diag(span: Span, what: &str, value: i64, range: (i64, i64)) -> RawDiag {
-    let bounds = if range.0 >= 0 && range.1 >= 16 {
-        format!("{} to {} (${:X})", range.0, range.1, range.1)
-    } else {
-        format!("{} to {}", range.0, range.1)
-    };
-    diag::error(
-        "asm::range",
-        span,
-        format!("{what} {} is outside {bounds}", show(value)),
-    )
-    .label(format!("this is {}", show(value)))
-}
-
-/// A range error for a value stored as `kind`, with advice where the
-/// usual mistake is clear.
-pub(crate) fn field_range_diag(
-    span: Span,
-    kind: FixKind,
-    value: i64,
-    what: &str,
-    range: (i64, i64),
-) -> RawDiag {
-    let diag = range_diag(span, what, value, range);
-    match kind {
-        FixKind::Imm8 | FixKind::Byte if value > 0xFF => diag.help(
-            "to take one byte of a 16-bit value, write `<value` (low byte) or `>value` (high byte)",
-        ),
-        _ => diag,
-    }
-}
-
-/// A branch that does not reach.
-pub(crate) fn branch_diag(span: Span, distance: i64) -> RawDiag {
-    diag::error(
-        "asm::branch-range",
-        span,
-        format!("branch target is {distance:+} bytes away; a branch reaches -128 to +127"),
-    )
-    .label(format!("{distance:+} bytes from the next instruction"))
-    .help("branch the other way over a `jmp` to the target")
-}
-
 impl Asm<'_> {
-    fn report_at(&mut self, loc: LocId, mut diag: RawDiag) {
-        if let Some(l) = self.prog.locs.get(loc as usize) {
-            diag.ctx = l.ctx;
-        }
-        self.rep.push(diag);
-    }
-
-    fn loc_span(&self, loc: LocId) -> Span {
-        self.prog
-            .locs
-            .get(loc as usize)
-            .map(|l| l.span)
-            .unwrap_or_default()
-    }
-
-    /// End-of-input checks: open scopes, outer-scope binding of names
-    /// used inside scopes, `.global`, undefined names.
-    pub(crate) fn finish_front(&mut self) {
-        while let Some((scope, loc)) = self.scope_stack.pop() {
-            let kind = self.prog.scopes[scope as usize].kind;
-            let what = if kind == ScopeKind::Proc {
-                "`.proc` has no `.endproc`"
-            } else {
-                "`.scope` has no `.endscope`"
-            };
-            let span = self.loc_span(loc);
-            self.report_at(loc, diag::error("asm::unclosed", span, what));
-        }
-        for sym in 0..self.prog.syms.len() {
-            let s = &self.prog.syms[sym];
-            if s.def != SymDef::Undefined || s.kind != SymKind::Normal || s.scope == GLOBAL_SCOPE {
-                continue;
-            }
-            let (name, mut scope) = (s.name, s.scope);
-            while scope != GLOBAL_SCOPE {
-                scope = self.prog.scopes[scope as usize].parent;
-                if let Some(outer) = self.find_sym(scope, name)
-                    && self.prog.syms[outer as usize].is_defined()
-                {
-                    self.prog.syms[sym].def = SymDef::Alias(outer);
-                    break;
-                }
-            }
-        }
-        for sym in 0..self.prog.syms.len() {
-            let s = &self.prog.syms[sym];
-            if s.def == SymDef::Undefined && s.global {
-                let zp = s.export.unwrap_or(false);
-                let s = &mut self.prog.syms[sym];
-                s.def = SymDef::Import { zp };
-                s.export = None;
-                s.def_loc = s.export_loc;
-            }
-        }
-        // Built only if a name is undefined: the defined names, for "did
-        // you mean".
-        let mut known: Option<Vec<String>> = None;
-        for sym in 0..self.prog.syms.len() {
-            let s = &self.prog.syms[sym];
-            if s.def != SymDef::Undefined {
-                continue;
-            }
-            let Some(loc) = s.ref_loc.or(s.export_loc) else {
-                continue;
-            };
-            let name = self.sym_name(sym as SymId);
-            let span = self.loc_span(loc);
-            let diag = match s.kind {
-                SymKind::Unnamed => diag::error(
-                    "asm::undefined",
-                    span,
-                    "there is no unnamed label `:` after this",
-                ),
-                SymKind::Cheap => diag::error(
-                    "asm::undefined",
-                    span,
-                    format!("cheap local `{name}` is not defined before the next normal label"),
-                ),
-                SymKind::Normal => {
-                    let exported = s.ref_loc.is_none();
-                    let message = if exported {
-                        format!("`{name}` is exported but never defined")
-                    } else {
-                        format!("`{name}` is not defined")
-                    };
-                    let short = self.names.name(s.name).to_string();
-                    let known = known.get_or_insert_with(|| self.defined_names());
-                    let help = match diag::did_you_mean(&name, known.iter().map(String::as_str)) {
-                        Some(similar) => format!("did you mean `{similar}`?"),
-                        None => format!(
-                            "define it, or import it with `.import {short}` if another file defines it"
-                        ),
-                    };
-                    diag::error("asm::undefined", span, message).help(help)
-                }
-            };
-            self.report_at(loc, diag);
-        }
-    }
-
-    /// The place (file, line, column) of the outermost macro call in the
-    /// expansion context `ctx`: the user's line that made the definition.
-    fn outermost_expansion(&self, mut ctx: u32) -> Option<(u32, u32, u32)> {
-        let mut outermost = None;
-        let mut guard = 0;
-        while ctx != 0 && guard < 256 {
-            let node = self.ctx.get(ctx as usize)?;
-            if matches!(node.kind, crate::diag::CtxKind::Macro(_)) {
-                outermost = Some(node.span);
-            }
-            ctx = node.parent;
-            guard += 1;
-        }
-        outermost.map(|span| {
-            let (line, column) = self.files.line_col(span.file, span.start);
-            (span.file, line, column)
-        })
-    }
-
-    /// The full names of the defined ordinary symbols.
-    fn defined_names(&self) -> Vec<String> {
-        (0..self.prog.syms.len())
-            .filter(|&sym| {
-                let s = &self.prog.syms[sym];
-                s.kind == SymKind::Normal && s.is_defined()
-            })
-            .map(|sym| self.sym_name(sym as SymId))
-            .collect()
-    }
-
-    /// Places every chunk with the current sizes.
-    fn place(&mut self) {
-        let prog = &mut self.prog;
-        for seg in &mut prog.segs {
-            let mut offset: u32 = 0;
-            let mut abs: i64 = 0;
-            for &c in &seg.chunks {
-                let chunk = &mut prog.chunks[c as usize];
-                chunk.start = offset;
-                if chunk.org {
-                    chunk.abs = chunk.org_base.unwrap_or(abs);
-                }
-                let end = offset.saturating_add(chunk.len);
-                let var_size = match chunk.var.and_then(|v| prog.vars.get_mut(v as usize)) {
-                    None => 0,
-                    Some(var) => {
-                        let size = match var.kind {
-                            VarKind::Instr { is_wide, .. } => 2 + u32::from(is_wide),
-                            VarKind::Align { align, .. } => {
-                                let position = if chunk.org {
-                                    chunk.abs + i64::from(chunk.len)
-                                } else {
-                                    i64::from(end)
-                                };
-                                let align = i64::from(align);
-                                ((align - position.rem_euclid(align)) % align) as u32
-                            }
-                        };
-                        var.size = size;
-                        size
-                    }
-                };
-                offset = end.saturating_add(var_size);
-                abs = chunk.abs + i64::from(chunk.len) + i64::from(var_size);
-            }
-            seg.size = offset;
-        }
-    }
-
-    /// Iterates layout passes until no undecided operand widens.
-    pub(crate) fn layout(&mut self) {
-        self.prog.placed = true;
-        loop {
-            self.place();
-            self.prog.stamp += 1;
-            let mut changed = false;
-            for v in 0..self.prog.vars.len() {
-                let VarKind::Instr {
-                    expr,
-                    is_wide: false,
-                    ..
-                } = self.prog.vars[v].kind
-                else {
-                    continue;
-                };
-                let fits = match self.prog.eval(expr) {
-                    Ok(value) => self.value_fit(value).unwrap_or(false),
-                    // Errors are reported in the final pass; stay narrow.
-                    Err(_) => true,
-                };
-                if !fits && let VarKind::Instr { is_wide, .. } = &mut self.prog.vars[v].kind {
-                    *is_wide = true;
-                    changed = true;
-                }
-            }
-            if !changed {
-                break;
-            }
-        }
-        self.prog.stamp += 1;
-    }
-
-    fn chunk_pos(&self, chunk: ChunkId, off: u32) -> (SegId, u32) {
-        let c = &self.prog.chunks[chunk as usize];
-        (c.seg, c.start + off)
-    }
-
     /// Builds the output: section bytes, relocations, symbols, asserts.
     pub(crate) fn resolve(&mut self) -> Output {
         let mut out = Output::default();
@@ -730,10 +355,10 @@ impl Asm<'_> {
         let value = match value {
             Ok(value) => value,
             Err(error) => {
-                let saved = self.line_ctx;
-                self.line_ctx = self.prog.locs.get(loc as usize).map_or(0, |l| l.ctx);
+                let saved = self.input.line_ctx;
+                self.input.line_ctx = self.prog.locs.get(loc as usize).map_or(0, |l| l.ctx);
                 self.eval_error(error, span);
-                self.line_ctx = saved;
+                self.input.line_ctx = saved;
                 return;
             }
         };
@@ -899,17 +524,17 @@ impl Asm<'_> {
                             ops,
                         });
                     } else {
-                        let saved = self.line_ctx;
-                        self.line_ctx = self.prog.locs[a.loc as usize].ctx;
+                        let saved = self.input.line_ctx;
+                        self.input.line_ctx = self.prog.locs[a.loc as usize].ctx;
                         self.eval_error(EvalErr::NotRelocatable, span);
-                        self.line_ctx = saved;
+                        self.input.line_ctx = saved;
                     }
                 }
                 Err(error) => {
-                    let saved = self.line_ctx;
-                    self.line_ctx = self.prog.locs[a.loc as usize].ctx;
+                    let saved = self.input.line_ctx;
+                    self.input.line_ctx = self.prog.locs[a.loc as usize].ctx;
                     self.eval_error(error, span);
-                    self.line_ctx = saved;
+                    self.input.line_ctx = saved;
                 }
             }
         }
@@ -984,22 +609,4 @@ impl Asm<'_> {
         }
         Some(())
     }
-}
-
-/// Converts assertion ops into `isa::objfmt` bytecode, given symbol indices.
-pub(crate) fn assert_ops(
-    ops: &[AssertOp],
-    target_index: impl Fn(Target) -> Option<u32>,
-) -> Option<Vec<ExprOp>> {
-    ops.iter()
-        .map(|op| {
-            Some(match *op {
-                AssertOp::Const(v) => ExprOp::Const(v),
-                AssertOp::Target(Target::Absolute) => ExprOp::Const(0),
-                AssertOp::Target(target) => ExprOp::Symbol(target_index(target)?),
-                AssertOp::Unary(op) => ExprOp::Unary(op),
-                AssertOp::Binary(op) => ExprOp::Binary(op),
-            })
-        })
-        .collect()
 }

@@ -1,0 +1,222 @@
+//! One statement: labels, assignments, then an instruction, a directive
+//! or a macro call.
+
+use super::*;
+
+impl<'a> Asm<'a> {
+    /// The cursor over a line's tokens, placing what is missing at the
+    /// line's end.
+    pub(crate) fn cursor<'t>(&self, toks: &'t [Token]) -> Cursor<'t> {
+        Cursor::new(
+            toks,
+            Span {
+                file: self.input.line.file,
+                start: self.input.line.end,
+                end: self.input.line.end,
+            },
+        )
+    }
+
+    pub(super) fn statement(&mut self, t: &[Token]) -> PResult<()> {
+        if t.is_empty() {
+            return Ok(());
+        }
+        let mut c = self.cursor(t);
+        // Labels and assignments.
+        if matches!(
+            t.get(1).map(|t| t.kind),
+            Some(Tok::Eq | Tok::Assign | Tok::Colon | Tok::Directive)
+        ) && (t[1].kind != Tok::Directive
+            || self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set))
+        {
+            self.reserved_name(&t[0], true)?;
+        }
+        match (t[0].kind, t.get(1).map(|t| t.kind)) {
+            (Tok::Ident | Tok::Local, Some(Tok::Eq | Tok::Assign)) => {
+                return self.assignment(&mut c);
+            }
+            (Tok::Ident, Some(Tok::Directive))
+                if self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set) =>
+            {
+                return self.set_variable(&mut c);
+            }
+            (Tok::Ident | Tok::Local, Some(Tok::Colon)) => {
+                // `name:` is a label even where a macro has the name.
+                self.define_label(&t[0])?;
+                c.advance_by(2);
+            }
+            (Tok::Colon, _) => {
+                self.define_label(&t[0])?;
+                c.advance();
+            }
+            _ => {}
+        }
+        let Some(&head) = c.peek() else {
+            return Ok(());
+        };
+        match head.kind {
+            Tok::Ident => {
+                let info = self.names.info[head.value as usize];
+                if let Some(mac) = info.macro_id {
+                    return self.invoke_macro(mac, &mut c);
+                }
+                match info.keyword {
+                    Keyword::Mnemonic(mnemonic) => self.instruction(mnemonic, &mut c),
+                    _ => {
+                        let name = self.names.name(head.name()).to_string();
+                        // `name` alone, or before an instruction: a label
+                        // missing its colon.
+                        let label_like = match c.peek_at(1) {
+                            None => true,
+                            Some(next) if next.kind == Tok::Directive => true,
+                            Some(next) if next.kind == Tok::Ident => {
+                                let info = self.names.info[next.value as usize];
+                                matches!(info.keyword, Keyword::Mnemonic(_))
+                                    || info.macro_id.is_some()
+                            }
+                            _ => false,
+                        };
+                        let suggestion = self.similar_statement_head(&name);
+                        let help = match suggestion {
+                            Some(similar) if label_like => Some(format!(
+                                "did you mean `{similar}`? (a label needs a colon: `{name}:`)"
+                            )),
+                            Some(similar) => Some(format!("did you mean `{similar}`?")),
+                            None => label_like.then(|| format!("a label needs a colon: `{name}:`")),
+                        };
+                        let mut diag = diag::error(
+                            "asm::unknown",
+                            head.span,
+                            format!("`{name}` is not an instruction, directive or macro"),
+                        );
+                        if let Some(help) = help {
+                            diag = diag.help(help);
+                        }
+                        Err(self.report(diag))
+                    }
+                }
+            }
+            Tok::Directive => {
+                let Keyword::Directive(dir) = self.names.keyword(head.name()) else {
+                    let name = self.names.name(head.name()).to_string();
+                    let mut diag = diag::error(
+                        "asm::unknown-directive",
+                        head.span,
+                        format!("`{name}` is not a directive this assembler knows"),
+                    );
+                    let written = name.trim_start_matches('.');
+                    if let Some(similar) = diag::did_you_mean(
+                        &written.to_ascii_lowercase(),
+                        crate::intern::DIRECTIVE_NAMES.iter().copied(),
+                    ) {
+                        diag = diag.help(format!("did you mean `.{similar}`?"));
+                    }
+                    return Err(self.report(diag));
+                };
+                self.directive(dir, &mut c)
+            }
+            _ => Err(self.err(
+                "asm::syntax",
+                head.span,
+                "expected a label, an instruction, a directive or a macro here",
+            )),
+        }
+    }
+
+    /// An instruction or macro whose name is near `name`, for the error on
+    /// a statement that starts with an unknown name.
+    fn similar_statement_head(&self, name: &str) -> Option<String> {
+        let lower = name.to_ascii_lowercase();
+        let mnemonics = isa::Mnemonic::ALL
+            .iter()
+            .filter(|m| m.is_documented() || self.cpu_x)
+            .map(|m| m.name().to_ascii_lowercase());
+        let macros = self
+            .input
+            .macros
+            .iter()
+            .map(|m| self.names.name(m.name).to_string());
+        let candidates: Vec<String> = mnemonics.chain(macros).collect();
+        diag::did_you_mean(&lower, candidates.iter().map(String::as_str)).map(|similar| {
+            if similar.len() == 3 && name.chars().all(|c| c.is_ascii_uppercase()) {
+                similar.to_ascii_uppercase()
+            } else {
+                similar.to_string()
+            }
+        })
+    }
+
+    /// `name = expr` and `name := expr`.
+    fn assignment(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let name = c.current();
+        c.advance_by(2);
+        let expr = self.expression(c)?;
+        self.expect_end(c)?;
+        let sym = match name.kind {
+            Tok::Local => self.cheap_sym(name.name()),
+            _ => self.sym_in(self.symtab.scope, name.name()),
+        };
+        let def = match self.prog.eval(expr) {
+            Ok(crate::expr::Value::Const(value)) => SymDef::Const(value),
+            _ => {
+                self.keep_nodes = true;
+                SymDef::Expr(expr)
+            }
+        };
+        self.define(sym, def, name.span)
+    }
+
+    /// `name .set expr`: a variable, taken by value where it is used.
+    fn set_variable(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let name = c.current();
+        c.advance_by(2);
+        let start = c.pos();
+        let expr = self.expression(c)?;
+        self.expect_end(c)?;
+        let sym = self.sym_in(self.symtab.scope, name.name());
+        let node = match self.prog.eval(expr) {
+            Ok(crate::expr::Value::Const(value)) => {
+                self.prog.node(crate::model::Node::Const(value))
+            }
+            Ok(_) | Err(crate::expr::EvalErr::NotYet(_)) => expr,
+            Err(error) => {
+                return Err(self.eval_error(error, self.join(c.span_of(start), c.last_span())));
+            }
+        };
+        self.keep_nodes = true;
+        self.new_cheap_region();
+        self.prog.defs = self.prog.defs.wrapping_add(1);
+        let s = &mut self.prog.syms[sym as usize];
+        match s.def {
+            SymDef::Undefined | SymDef::Var(_) => {
+                s.def = SymDef::Var(node);
+                if s.def_loc.is_none() {
+                    let loc = self.loc(name.span);
+                    self.prog.syms[sym as usize].def_loc = Some(loc);
+                }
+                Ok(())
+            }
+            _ => {
+                let text = self.sym_name(sym);
+                Err(self.err(
+                    "asm::duplicate",
+                    name.span,
+                    format!("`{text}` is a constant or label, not a `.set` variable"),
+                ))
+            }
+        }
+    }
+
+    /// Reports unexpected tokens after a complete statement.
+    pub(crate) fn expect_end(&mut self, c: &Cursor<'_>) -> PResult<()> {
+        if let Some(extra) = c.peek() {
+            let last = c.span_of(c.tokens().len() - 1);
+            return Err(self.err(
+                "asm::syntax",
+                self.join(extra.span, last),
+                "unexpected text at the end of this statement",
+            ));
+        }
+        Ok(())
+    }
+}

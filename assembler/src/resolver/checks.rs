@@ -1,0 +1,123 @@
+//! End-of-input checks: open scopes, names bound to outer scopes,
+//! `.global`, undefined names.
+
+use crate::asm::Asm;
+use crate::diag;
+use crate::model::{GLOBAL_SCOPE, ScopeKind, SymDef, SymId, SymKind};
+
+impl Asm<'_> {
+    /// End-of-input checks: open scopes, outer-scope binding of names
+    /// used inside scopes, `.global`, undefined names.
+    pub(crate) fn finish_front(&mut self) {
+        while let Some((scope, loc)) = self.symtab.scope_stack.pop() {
+            let kind = self.prog.scopes[scope as usize].kind;
+            let what = if kind == ScopeKind::Proc {
+                "`.proc` has no `.endproc`"
+            } else {
+                "`.scope` has no `.endscope`"
+            };
+            let span = self.loc_span(loc);
+            self.report_at(loc, diag::error("asm::unclosed", span, what));
+        }
+        for sym in 0..self.prog.syms.len() {
+            let s = &self.prog.syms[sym];
+            if s.def != SymDef::Undefined || s.kind != SymKind::Normal || s.scope == GLOBAL_SCOPE {
+                continue;
+            }
+            let (name, mut scope) = (s.name, s.scope);
+            while scope != GLOBAL_SCOPE {
+                scope = self.prog.scopes[scope as usize].parent;
+                if let Some(outer) = self.find_sym(scope, name)
+                    && self.prog.syms[outer as usize].is_defined()
+                {
+                    self.prog.syms[sym].def = SymDef::Alias(outer);
+                    break;
+                }
+            }
+        }
+        for sym in 0..self.prog.syms.len() {
+            let s = &self.prog.syms[sym];
+            if s.def == SymDef::Undefined && s.global {
+                let zp = s.export.unwrap_or(false);
+                let s = &mut self.prog.syms[sym];
+                s.def = SymDef::Import { zp };
+                s.export = None;
+                s.def_loc = s.export_loc;
+            }
+        }
+        // Built only if a name is undefined: the defined names, for "did
+        // you mean".
+        let mut known: Option<Vec<String>> = None;
+        for sym in 0..self.prog.syms.len() {
+            let s = &self.prog.syms[sym];
+            if s.def != SymDef::Undefined {
+                continue;
+            }
+            let Some(loc) = s.ref_loc.or(s.export_loc) else {
+                continue;
+            };
+            let name = self.sym_name(sym as SymId);
+            let span = self.loc_span(loc);
+            let diag = match s.kind {
+                SymKind::Unnamed => diag::error(
+                    "asm::undefined",
+                    span,
+                    "there is no unnamed label `:` after this",
+                ),
+                SymKind::Cheap => diag::error(
+                    "asm::undefined",
+                    span,
+                    format!("cheap local `{name}` is not defined before the next normal label"),
+                ),
+                SymKind::Normal => {
+                    let exported = s.ref_loc.is_none();
+                    let message = if exported {
+                        format!("`{name}` is exported but never defined")
+                    } else {
+                        format!("`{name}` is not defined")
+                    };
+                    let short = self.names.name(s.name).to_string();
+                    let known = known.get_or_insert_with(|| self.defined_names());
+                    let help = match diag::did_you_mean(&name, known.iter().map(String::as_str)) {
+                        Some(similar) => format!("did you mean `{similar}`?"),
+                        None => format!(
+                            "define it, or import it with `.import {short}` if another file defines it"
+                        ),
+                    };
+                    diag::error("asm::undefined", span, message).help(help)
+                }
+            };
+            self.report_at(loc, diag);
+        }
+    }
+
+    /// The place (file, line, column) of the outermost macro call in the
+    /// expansion context `ctx`: the user's line that made the definition.
+    pub(super) fn outermost_expansion(&self, mut ctx: u32) -> Option<(u32, u32, u32)> {
+        let mut outermost = None;
+        let mut guard = 0;
+        while ctx != 0 && guard < 256 {
+            let node = self.ctx.get(ctx as usize)?;
+            if matches!(node.kind, crate::diag::CtxKind::Macro(_)) {
+                outermost = Some(node.span);
+            }
+            ctx = node.parent;
+            guard += 1;
+        }
+        outermost.map(|span| {
+            let (line, column) = self.files.line_col(span.file, span.start);
+            (span.file, line, column)
+        })
+    }
+
+    /// The full names of the defined ordinary symbols.
+    pub(super) fn defined_names(&self) -> Vec<String> {
+        (0..self.prog.syms.len())
+            .filter(|&sym| {
+                let s = &self.prog.syms[sym];
+                s.kind == SymKind::Normal && s.is_defined()
+            })
+            .map(|sym| self.sym_name(sym as SymId))
+            .collect()
+    }
+}
