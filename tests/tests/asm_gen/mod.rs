@@ -18,27 +18,27 @@
 use std::fmt::Write as _;
 
 use isa::{AddressingMode as Mode, OPCODES, OpcodeKind};
+use rand::rngs::StdRng;
+use rand::{Rng as _, RngExt as _, SeedableRng as _};
 
-/// SplitMix64: small, seeded, stable across platforms and crate versions.
-#[derive(Debug, Clone)]
-pub(crate) struct Rng(u64);
+/// The generator's randomness: rand's seeded `StdRng`, so a seed names
+/// one program on every platform (the lock file pins rand's version, which
+/// fixes the stream).
+#[derive(Debug)]
+pub(crate) struct Rng(StdRng);
 
 impl Rng {
     pub(crate) fn new(seed: u64) -> Rng {
-        Rng(seed ^ 0x5DEE_CE66_D1CE_4E5B)
+        Rng(StdRng::seed_from_u64(seed))
     }
 
     pub(crate) fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// A number in `0..n` (`n > 0`).
     pub(crate) fn below(&mut self, n: u64) -> u64 {
-        self.next() % n.max(1)
+        self.0.random_range(0..n.max(1))
     }
 
     /// True with probability `percent`/100.
