@@ -269,9 +269,12 @@ const KNOWN_DIFFERENCES: [(&str, &str); 11] = [
     ),
 ];
 
+/// A case's directory: every file's name and bytes.
+type CaseFiles = Vec<(String, Vec<u8>)>;
+
 /// The assembler's `ok_*.s` cases, each with the other files of its
 /// directory (includes, binaries).
-fn cases() -> Vec<(String, Vec<(String, Vec<u8>)>)> {
+fn cases() -> Vec<(String, CaseFiles)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assembler/tests/cases");
     let mut found = Vec::new();
     let mut dirs: Vec<_> = std::fs::read_dir(&root)
@@ -281,7 +284,7 @@ fn cases() -> Vec<(String, Vec<(String, Vec<u8>)>)> {
         .collect();
     dirs.sort();
     for dir in dirs {
-        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(&dir)
+        let mut files: CaseFiles = std::fs::read_dir(&dir)
             .expect("a case directory")
             .map(|entry| entry.expect("a directory entry").path())
             .filter(|path| path.is_file())
@@ -323,7 +326,7 @@ fn the_assemblers_cases_match_ld65() {
         let mut differs = false;
         for fill in [0x00, 0xFF] {
             let label = format!("{what} (fill ${fill:02X})");
-            match compare(&label, &files, &[main.clone()], tools, fill) {
+            match compare(&label, &files, std::slice::from_ref(&main), tools, fill) {
                 Err(failure) if known.is_none() => failures.push(failure),
                 Err(_) => differs = true,
                 Ok(()) => {}
