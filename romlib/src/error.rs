@@ -169,4 +169,30 @@ pub enum Error {
         /// The JAM opcode.
         opcode: u8,
     },
+
+    /// A KIM-bus card failed on its own (a card script's runtime error):
+    /// the robot stops, since what it read from the card is not what the
+    /// card meant.
+    #[error("the card at ${base:04X} failed")]
+    #[diagnostic(code(romlib::card))]
+    Card {
+        /// The base address of the card's window.
+        base: u16,
+        /// The failure, in one line.
+        message: String,
+        /// The failure, located in the card's script.
+        #[diagnostic_source]
+        fault: Box<dyn miette::Diagnostic + Send + Sync>,
+    },
+
+    /// The script of the robot's surroundings failed.
+    #[error("the surroundings failed")]
+    #[diagnostic(code(romlib::surroundings))]
+    Surroundings {
+        /// The failure, in one line.
+        message: String,
+        /// The failure, located in the script.
+        #[diagnostic_source]
+        fault: Box<dyn miette::Diagnostic + Send + Sync>,
+    },
 }

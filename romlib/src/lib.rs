@@ -21,7 +21,7 @@ pub mod sim;
 pub mod symbols;
 
 pub use error::Error;
-pub use sim::{InstalledHook, VirtualScorpion};
+pub use sim::{InstalledHook, Surroundings, VirtualScorpion};
 
 /// The reference ROM image, `$F000-$FFFF`.
 pub const ROM: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/scorpion-rom.bin"));

@@ -81,6 +81,27 @@ pub struct VirtualScorpion {
     /// Labels of the ROM and of every image loaded, for naming the place
     /// a robot that stopped answering is stuck in.
     labels: Vec<(u16, String)>,
+    /// What changes the robot's inputs over time, if anything.
+    world: Option<Box<dyn Surroundings>>,
+}
+
+/// The robot's surroundings: what closes its bumpers, lights its
+/// phototransistors, over robot time and in answer to its motion. The
+/// session wakes them at the robot time they ask for.
+pub trait Surroundings: std::fmt::Debug + Send {
+    /// The robot time (cycles since power-up) to be woken at next, if any.
+    fn next_wake(&self) -> Option<u64>;
+
+    /// Woken at robot time `now`: change the robot's inputs, read its
+    /// motors.
+    ///
+    /// # Errors
+    /// The surroundings' own failure, located in their script.
+    fn wake(
+        &mut self,
+        now: u64,
+        robot: &mut Scorpion,
+    ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>>;
 }
 
 impl Default for VirtualScorpion {
@@ -108,6 +129,7 @@ impl VirtualScorpion {
                 KIM_BUS,
             ],
             labels: Vec::new(),
+            world: None,
         };
         if let Ok(rom) = Image::parse("scorpion-rom.elf", crate::ROM_ELF) {
             scorpion.add_labels(&rom);
@@ -167,6 +189,7 @@ impl VirtualScorpion {
             table,
             user,
             labels: Vec::new(),
+            world: None,
         };
         scorpion.add_labels(rom);
         scorpion.boot();
@@ -176,6 +199,67 @@ impl VirtualScorpion {
     fn boot(&mut self) {
         let until = self.robot.now() + BOOT_TIME;
         self.robot.run(until);
+    }
+
+    /// Runs the robot to robot time `until`: the surroundings woken when
+    /// they asked to be, then a jammed CPU or a failed card reported.
+    fn advance(&mut self, until: u64) -> Result<(), Error> {
+        loop {
+            let wake = self
+                .world
+                .as_ref()
+                .and_then(|world| world.next_wake())
+                .filter(|&at| at <= until);
+            let Some(at) = wake else {
+                break;
+            };
+            if at > self.robot.now() {
+                let stop = self.robot.run(at);
+                self.after_run(stop)?;
+            }
+            if let Some(world) = self.world.as_mut() {
+                let now = self.robot.now();
+                world
+                    .wake(now, &mut self.robot)
+                    .map_err(|fault| Error::Surroundings {
+                        message: fault.to_string(),
+                        fault,
+                    })?;
+            }
+        }
+        let stop = self.robot.run(until);
+        self.after_run(stop)
+    }
+
+    fn after_run(&mut self, stop: Stop) -> Result<(), Error> {
+        if let Some((base, fault)) = self.robot.board_mut().take_device_fault() {
+            return Err(Error::Card {
+                base,
+                message: fault.to_string(),
+                fault,
+            });
+        }
+        check(stop)
+    }
+
+    /// Gives the robot surroundings that change its inputs over robot
+    /// time (bumpers, phototransistors), replacing any it had.
+    pub fn set_surroundings(&mut self, world: Box<dyn Surroundings>) {
+        self.world = Some(world);
+    }
+
+    /// Maps a card into the KIM-bus space at `start..=end`.
+    ///
+    /// # Errors
+    /// [`Error::Emulator`] if the window leaves the KIM bus or overlaps
+    /// another card.
+    pub fn map_card(
+        &mut self,
+        start: u16,
+        end: u16,
+        card: Box<dyn emulator::board::Device>,
+    ) -> Result<emulator::board::KimSlotId, Error> {
+        Ok(self.robot.map_kim(start, end, card)?)
     }
 
     /// Keeps `image`'s labels (symbols in its sections) for
@@ -459,7 +543,7 @@ impl VirtualScorpion {
     /// # Errors
     /// [`Error::Jam`] if the CPU jams.
     pub fn run_until(&mut self, cycle: u64) -> Result<(), Error> {
-        check(self.robot.run(cycle))
+        self.advance(cycle)
     }
 
     /// Whether everything the host sent has gone down the wire.
@@ -504,7 +588,7 @@ impl VirtualScorpion {
             .robot
             .host_line_free_at()
             .saturating_add(INSTRUCTION_TIME);
-        check(self.robot.run(until))
+        self.advance(until)
     }
 
     /// Runs the robot until the host has received an answer's carriage
@@ -539,7 +623,7 @@ impl VirtualScorpion {
             }
             // Slices of about one character time at 9600 baud.
             let until = (now + 1000).min(deadline);
-            check(self.robot.run(until))?;
+            self.advance(until)?;
         }
     }
 

@@ -94,7 +94,12 @@ impl Robot {
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let mut robot = if args.line.is_emulated() {
-        Robot::Virtual(Box::new(sim::robot(args.line.baud, None, &args.images)?))
+        Robot::Virtual(Box::new(sim::robot(
+            args.line.baud,
+            None,
+            &args.line.rig,
+            &args.images,
+        )?))
     } else {
         if !args.images.is_empty() {
             miette::bail!(

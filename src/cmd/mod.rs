@@ -9,5 +9,6 @@ pub(crate) mod installed;
 pub(crate) mod link;
 pub(crate) mod ports;
 pub(crate) mod read;
+pub(crate) mod rig;
 pub(crate) mod sim;
 pub(crate) mod upload;

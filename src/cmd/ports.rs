@@ -40,6 +40,10 @@ pub(crate) struct Line {
     /// The line's baud rate (the robot's).
     #[arg(long, default_value_t = DEFAULT_BAUD)]
     pub(crate) baud: u32,
+    /// The virtual Scorpion's cards and surroundings (with `--port emu`,
+    /// and for `upload`'s rehearsal).
+    #[command(flatten)]
+    pub(crate) rig: crate::cmd::rig::Rig,
 }
 
 impl Line {
@@ -50,7 +54,7 @@ impl Line {
 
     /// Opens the line: see [`open`].
     pub(crate) fn open(&self) -> miette::Result<Box<dyn Transport>> {
-        open(&self.port, self.baud)
+        open(&self.port, self.baud, &self.rig)
     }
 }
 
@@ -60,8 +64,12 @@ pub(crate) const DEFAULT_BAUD: u32 = platform::line::DEFAULT_BAUD;
 /// The `--port` value that names the in-process virtual Scorpion.
 pub(crate) const EMU: &str = "emu";
 
-/// A fresh virtual Scorpion whose DIP switches and host line are at `baud`.
-pub(crate) fn virtual_robot(baud: u32) -> miette::Result<VirtualScorpion> {
+/// A fresh virtual Scorpion whose DIP switches and host line are at `baud`,
+/// with the cards and surroundings of `rig`.
+pub(crate) fn virtual_robot(
+    baud: u32,
+    rig: &crate::cmd::rig::Rig,
+) -> miette::Result<VirtualScorpion> {
     let mut robot = VirtualScorpion::new();
     if !robot.set_baud(baud) {
         miette::bail!(
@@ -69,15 +77,26 @@ pub(crate) fn virtual_robot(baud: u32) -> miette::Result<VirtualScorpion> {
             "the Scorpion's 6551 has no {baud} baud rate"
         );
     }
+    rig.apply(&mut robot)?;
     Ok(robot)
 }
 
 /// Opens `--port`: a serial device path, or `emu` for a fresh virtual
 /// Scorpion in this process (the transport's clock is then its emulated
-/// time).
-pub(crate) fn open(port: &str, baud: u32) -> miette::Result<Box<dyn Transport>> {
+/// time) with the cards and surroundings of `rig`.
+pub(crate) fn open(
+    port: &str,
+    baud: u32,
+    rig: &crate::cmd::rig::Rig,
+) -> miette::Result<Box<dyn Transport>> {
     if port == EMU {
-        return Ok(Box::new(VirtualTransport::new(virtual_robot(baud)?)));
+        return Ok(Box::new(VirtualTransport::new(virtual_robot(baud, rig)?)));
+    }
+    if !rig.is_empty() {
+        miette::bail!(
+            help = "cards and surroundings are scripts the virtual Scorpion runs: use them with `--port emu`, or with `upload`, whose rehearsal on the virtual Scorpion comes first",
+            "--card and --world do not apply to the robot on {port}"
+        );
     }
     Ok(Box::new(SerialTransport::open(port, baud)?))
 }

@@ -39,6 +39,9 @@ pub(crate) struct Args {
     /// reference ROM.
     #[arg(long, value_name = "ELF")]
     rom: Option<PathBuf>,
+    /// Cards on the KIM bus and the robot's surroundings.
+    #[command(flatten)]
+    rig: crate::cmd::rig::Rig,
 }
 
 /// A bumper mask in hex: `05`, `$05` or `0x05`.
@@ -56,6 +59,7 @@ fn bumper_mask(text: &str) -> Result<u8, String> {
 pub(crate) fn robot(
     baud: u32,
     rom: Option<&PathBuf>,
+    rig: &crate::cmd::rig::Rig,
     images: &[PathBuf],
 ) -> miette::Result<VirtualScorpion> {
     let mut robot = match rom {
@@ -78,6 +82,8 @@ pub(crate) fn robot(
             "the Scorpion's 6551 cannot run at {baud} baud"
         );
     }
+    // Cards first: an image cannot be loaded over a card's registers.
+    rig.apply(&mut robot)?;
     for path in images {
         let bytes = std::fs::read(path)
             .into_diagnostic()
@@ -112,7 +118,7 @@ pub(crate) fn robot(
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let mut robot = robot(args.baud, args.rom.as_ref(), &args.images)?;
+    let mut robot = robot(args.baud, args.rom.as_ref(), &args.rig, &args.images)?;
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }

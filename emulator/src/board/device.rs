@@ -46,6 +46,13 @@ pub trait Device: Any + std::fmt::Debug + Send {
         false
     }
 
+    /// A failure of the device's own, taken once: a card script's runtime
+    /// error, say. The device answers `$FF` meanwhile; the robot's host
+    /// (romlib's session) asks after every run and stops with it.
+    fn take_fault(&mut self) -> Option<Box<dyn miette::Diagnostic + Send + Sync>> {
+        None
+    }
+
     /// The device as [`Any`], so that its owner can get its concrete type
     /// back (`board.kim_device::<MyCard>()`).
     fn as_any(&self) -> &dyn Any;

@@ -366,6 +366,16 @@ impl Board {
         self.refresh(cycle);
     }
 
+    /// The first failure a KIM-bus device reported since the last call,
+    /// with the base address of its slot.
+    pub fn take_device_fault(
+        &mut self,
+    ) -> Option<(u16, Box<dyn miette::Diagnostic + Send + Sync>)> {
+        self.kim
+            .iter_mut()
+            .find_map(|slot| slot.device.take_fault().map(|fault| (slot.start, fault)))
+    }
+
     /// The 6522.
     #[must_use]
     pub fn via(&self) -> &Via {

@@ -1,0 +1,357 @@
+//! A KIM-bus card whose registers are a script's: the emulator's
+//! [`Device`] over a [`Script`].
+//!
+//! The script declares its window with top-level constants (`SIZE`, the
+//! number of registers; `BASE`, the default address) and its behaviour
+//! with functions: `read(reg, now)` returns a register's value, `write(reg,
+//! value, now)` takes one, `wake(now)` runs at the robot time it asked for
+//! with `wake_at(cycle)`, `init()` once at power-up. State lives in `this`.
+//! Registers listed in `PLAIN` (all of them when there is no `read`) are
+//! read from the card's register table without calling the script; the
+//! script fills the table with `set(reg, value)`, so a program that polls a
+//! status bit costs a table look-up per read. `irq(true)` pulls the bus's
+//! /IRQ line low until `irq(false)`.
+
+use std::sync::{Arc, Mutex};
+
+use emulator::board::Device;
+
+use crate::error::ScriptError;
+use crate::script::{Script, engine};
+
+/// What the script changes through the host's functions.
+#[derive(Debug, Default)]
+struct Shared {
+    /// The register table (`set`, `get`; plain reads come from here).
+    table: Vec<u8>,
+    /// The card's /IRQ output.
+    irq: bool,
+    /// When the script asked to be woken.
+    wake: Option<u64>,
+}
+
+/// A card run by a script.
+#[derive(Debug)]
+pub struct ScriptCard {
+    script: Script,
+    shared: Arc<Mutex<Shared>>,
+    /// Registers read from the table without calling `read`.
+    plain: Vec<bool>,
+    has_write: bool,
+    has_wake: bool,
+    base: u16,
+    size: u16,
+    /// The robot time the card caught up to.
+    now: u64,
+    /// The first failure, until the robot's host takes it.
+    fault: Option<ScriptError>,
+    /// Once failed, the card answers `$FF` and runs no more script.
+    failed: bool,
+}
+
+impl ScriptCard {
+    /// Loads the card script `text` (named `name` in errors), at `base`
+    /// or the script's own `BASE`.
+    ///
+    /// # Errors
+    /// [`ScriptError::Script`] for a syntax error or a failing top level or
+    /// `init`; [`ScriptError::Window`] for a missing or bad `SIZE`/`BASE`
+    /// or a window outside the KIM bus.
+    pub fn load(name: &str, text: &str, base: Option<u16>) -> Result<ScriptCard, ScriptError> {
+        let printed = Arc::new(Mutex::new(Vec::new()));
+        let shared = Arc::new(Mutex::new(Shared::default()));
+        let mut engine = engine(&printed);
+        register(&mut engine, &shared);
+        let script = Script::load(engine, name, text, printed)?;
+        let window = |message: String, help: &str| ScriptError::Window {
+            file: name.to_owned(),
+            message,
+            help: Some(help.to_owned()),
+        };
+        let size = script
+            .constant("SIZE")
+            .and_then(|v| v.as_int().ok())
+            .ok_or_else(|| {
+                window(
+                    "the card declares no `SIZE`".into(),
+                    "start the script with `const SIZE = 4;`: how many registers the card has",
+                )
+            })?;
+        let base = match base {
+            Some(base) => i64::from(base),
+            None => script
+                .constant("BASE")
+                .and_then(|v| v.as_int().ok())
+                .ok_or_else(|| {
+                    window(
+                        "the card declares no `BASE` and none was given".into(),
+                        "declare `const BASE = 0x9000;` or give the address: `--card card.rhai@9000`",
+                    )
+                })?,
+        };
+        let (kim_start, kim_end) = (
+            i64::from(platform::map::KIM_START),
+            i64::from(platform::map::KIM_END),
+        );
+        if !(1..=0x1000).contains(&size) {
+            return Err(window(
+                format!("SIZE = {size}: a card has 1 to 4096 registers"),
+                "SIZE is the number of registers (bytes) the card decodes",
+            ));
+        }
+        if base < kim_start || base + size - 1 > kim_end {
+            return Err(window(
+                format!(
+                    "the window ${base:04X}-${:04X} is not inside the KIM bus (${kim_start:04X}-${kim_end:04X})",
+                    base + size - 1
+                ),
+                "cards sit on the KIM bus; move the card with `--card FILE@ADDR`",
+            ));
+        }
+        let size = u16::try_from(size).unwrap_or(1);
+        let base = u16::try_from(base).unwrap_or(platform::map::KIM_START);
+        let has_read = script.has_fn("read", 2);
+        let mut plain = vec![!has_read; usize::from(size)];
+        if let Some(list) = script.constant("PLAIN") {
+            let registers = list.into_array().map_err(|_| {
+                window(
+                    "`PLAIN` is not a list of registers".into(),
+                    "write `const PLAIN = [1, 2];`: the registers read from the table",
+                )
+            })?;
+            for register in registers {
+                let index = register
+                    .as_int()
+                    .ok()
+                    .and_then(|r| usize::try_from(r).ok())
+                    .filter(|&r| r < usize::from(size))
+                    .ok_or_else(|| {
+                        window(
+                            format!(
+                                "`PLAIN` lists {register}, not a register of 0 to {}",
+                                size - 1
+                            ),
+                            "registers are numbered from 0 to SIZE - 1",
+                        )
+                    })?;
+                plain[index] = true;
+            }
+        }
+        if let Ok(mut shared) = shared.lock() {
+            shared.table = vec![0; usize::from(size)];
+        }
+        let mut card = ScriptCard {
+            has_write: script.has_fn("write", 3),
+            has_wake: script.has_fn("wake", 1),
+            script,
+            shared,
+            plain,
+            base,
+            size,
+            now: 0,
+            fault: None,
+            failed: false,
+        };
+        if card.script.has_fn("init", 0) {
+            let _ = card.script.call("init", ())?;
+        }
+        Ok(card)
+    }
+
+    /// The window: first and last address.
+    #[must_use]
+    pub fn window(&self) -> (u16, u16) {
+        (self.base, self.base + (self.size - 1))
+    }
+
+    /// What the script printed since the last call.
+    #[must_use]
+    pub fn take_printed(&self) -> Vec<String> {
+        self.script.take_printed()
+    }
+
+    /// A register of the table (what a plain read returns).
+    #[must_use]
+    pub fn table(&self, register: u16) -> u8 {
+        self.shared
+            .lock()
+            .ok()
+            .and_then(|shared| shared.table.get(usize::from(register)).copied())
+            .unwrap_or(0xFF)
+    }
+
+    fn fail(&mut self, error: ScriptError) {
+        if !self.failed {
+            self.failed = true;
+            self.fault = Some(error);
+        }
+        if let Ok(mut shared) = self.shared.lock() {
+            shared.wake = None;
+            shared.irq = false;
+        }
+    }
+
+    /// Runs the wake-ups due by `cycle`.
+    fn catch_up(&mut self, cycle: u64) {
+        self.now = self.now.max(cycle);
+        while !self.failed {
+            let due = {
+                let Ok(mut shared) = self.shared.lock() else {
+                    return;
+                };
+                match shared.wake {
+                    Some(at) if at <= cycle => {
+                        shared.wake = None;
+                        at
+                    }
+                    _ => return,
+                }
+            };
+            if !self.has_wake {
+                continue;
+            }
+            if let Err(error) = self.script.call("wake", (as_int(due),)) {
+                self.fail(error);
+            }
+        }
+    }
+}
+
+fn as_int(cycle: u64) -> i64 {
+    i64::try_from(cycle).unwrap_or(i64::MAX)
+}
+
+/// The host's functions a card script calls.
+fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
+    let state = Arc::clone(shared);
+    engine.register_fn("set", move |register: i64, value: i64| {
+        if let Ok(mut shared) = state.lock()
+            && let Some(slot) = usize::try_from(register)
+                .ok()
+                .and_then(|r| shared.table.get_mut(r))
+        {
+            *slot = (value & 0xFF) as u8;
+        }
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("get", move |register: i64| -> i64 {
+        state
+            .lock()
+            .ok()
+            .and_then(|shared| {
+                usize::try_from(register)
+                    .ok()
+                    .and_then(|r| shared.table.get(r).copied())
+            })
+            .map_or(0xFF, i64::from)
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("irq", move |on: bool| {
+        if let Ok(mut shared) = state.lock() {
+            shared.irq = on;
+        }
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("wake_at", move |cycle: i64| {
+        if let Ok(mut shared) = state.lock() {
+            let at = u64::try_from(cycle).unwrap_or(0);
+            shared.wake = Some(shared.wake.map_or(at, |old| old.min(at)));
+        }
+    });
+}
+
+impl Device for ScriptCard {
+    fn read(&mut self, offset: u16, cycle: u64) -> u8 {
+        self.catch_up(cycle);
+        if self.failed {
+            return 0xFF;
+        }
+        let register = offset % self.size;
+        if self.plain[usize::from(register)] {
+            return self.table(register);
+        }
+        let value = self
+            .script
+            .call("read", (i64::from(register), as_int(cycle)));
+        match value.map(|v| v.as_int()) {
+            Ok(Ok(value)) if (0..=0xFF).contains(&value) => value as u8,
+            Ok(Ok(value)) => {
+                let error = self.script.error_at_fn(
+                    "read",
+                    format!(
+                        "`read` returned {value} for register {register}, not a byte (0 to 255)"
+                    ),
+                );
+                self.fail(error);
+                0xFF
+            }
+            Ok(Err(kind)) => {
+                let error = self.script.error_at_fn(
+                    "read",
+                    format!("`read` returned a {kind} for register {register}, not a byte"),
+                );
+                self.fail(error);
+                0xFF
+            }
+            Err(error) => {
+                self.fail(error);
+                0xFF
+            }
+        }
+    }
+
+    fn write(&mut self, offset: u16, value: u8, cycle: u64) {
+        self.catch_up(cycle);
+        if self.failed {
+            return;
+        }
+        let register = offset % self.size;
+        if !self.has_write {
+            if let Ok(mut shared) = self.shared.lock()
+                && let Some(slot) = shared.table.get_mut(usize::from(register))
+            {
+                *slot = value;
+            }
+            return;
+        }
+        if let Err(error) = self.script.call(
+            "write",
+            (i64::from(register), i64::from(value), as_int(cycle)),
+        ) {
+            self.fail(error);
+        }
+    }
+
+    fn peek(&self, offset: u16) -> u8 {
+        self.table(offset % self.size)
+    }
+
+    fn sync(&mut self, cycle: u64) {
+        self.catch_up(cycle);
+    }
+
+    fn next_event(&self) -> Option<u64> {
+        if self.failed {
+            return None;
+        }
+        self.shared.lock().ok().and_then(|shared| shared.wake)
+    }
+
+    fn irq(&self) -> bool {
+        self.shared.lock().is_ok_and(|shared| shared.irq)
+    }
+
+    fn take_fault(&mut self) -> Option<Box<dyn miette::Diagnostic + Send + Sync>> {
+        self.fault
+            .take()
+            .map(|fault| Box::new(fault) as Box<dyn miette::Diagnostic + Send + Sync>)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
+}

@@ -1,0 +1,65 @@
+//! Peripheral cards on the KIM bus and the robot's surroundings, as
+//! scripts the virtual Scorpion runs: a card owner rehearses an extension
+//! against the card before it goes near the robot, without writing Rust.
+//!
+//! - [`ScriptCard`]: a card whose registers a Rhai script serves (an
+//!   emulator [`Device`](emulator::board::Device), mapped with
+//!   `VirtualScorpion::map_card`). See `docs/CARDS.md` for the script's
+//!   interface.
+//! - [`ScriptWorld`]: surroundings that change the robot's inputs over
+//!   robot time (a [`romlib::Surroundings`]).
+//! - [`CardArg`]: the `--card FILE[@ADDR]` argument.
+//!
+//! Scripts are untrusted input: they reach no file, network or process,
+//! each call into one has an operation budget ([`OPERATION_BUDGET`]), and
+//! every failure is a [`ScriptError`] located in the script. Cards in Rust
+//! implement the same `Device` trait (`examples/adc_in_rust.rs`).
+
+mod card;
+mod error;
+mod script;
+mod world;
+
+pub use card::ScriptCard;
+pub use error::{Located, ScriptError};
+pub use script::OPERATION_BUDGET;
+pub use world::ScriptWorld;
+
+/// `--card FILE[@ADDR]`: a card script and where to put it (hex, `$` or
+/// `0x` allowed), if not at the script's own `BASE`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CardArg {
+    /// The script's path.
+    pub path: std::path::PathBuf,
+    /// The base address, if given.
+    pub base: Option<u16>,
+}
+
+impl std::str::FromStr for CardArg {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<CardArg, String> {
+        let (path, base) = match text.rsplit_once('@') {
+            Some((path, address)) => {
+                let digits = address
+                    .trim_start_matches('$')
+                    .trim_start_matches("0x")
+                    .trim_start_matches("0X");
+                let base = u16::from_str_radix(digits, 16).map_err(|_| {
+                    format!("`{address}` is not an address (write FILE@9000 or FILE@$9000)")
+                })?;
+                (path, Some(base))
+            }
+            None => (text, None),
+        };
+        if path.is_empty() {
+            return Err("no script file before `@`".into());
+        }
+        Ok(CardArg {
+            path: path.into(),
+            base,
+        })
+    }
+}
+#[cfg(test)]
+mod tests;

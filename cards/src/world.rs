@@ -1,0 +1,168 @@
+//! The robot's surroundings as a script: what closes its bumpers, lights
+//! its ground-tracker phototransistors and fills the scanner's scene, over
+//! robot time and in answer to its motion.
+//!
+//! The script asks to be woken with `wake_at(cycle)` (from `init()` or a
+//! previous `wake`), and `wake(now)` then sets the inputs: `bumpers(mask)`
+//! (a bit per microswitch, 1 = closed), `tracker(left_lit, right_lit)`,
+//! `scene(value)` (every scanner position reads `value`) and `scene_at(h, v,
+//! value)`. It reads the drive motors' positions in steps with
+//! `left_position()` and `right_position()` (forward counts up).
+
+use std::sync::{Arc, Mutex};
+
+use emulator::board::{Motor, Scorpion};
+use romlib::Surroundings;
+
+use crate::error::ScriptError;
+use crate::script::{Script, engine};
+
+/// One change to the robot's inputs a script asked for.
+#[derive(Debug, Clone, Copy)]
+enum Change {
+    Bumpers(u8),
+    Tracker { left: bool, right: bool },
+    Scene(u8),
+    SceneAt(i64, i64, u8),
+}
+
+#[derive(Debug, Default)]
+struct Shared {
+    wake: Option<u64>,
+    changes: Vec<Change>,
+    positions: (i64, i64),
+}
+
+/// Surroundings run by a script.
+#[derive(Debug)]
+pub struct ScriptWorld {
+    script: Script,
+    shared: Arc<Mutex<Shared>>,
+    has_wake: bool,
+    /// Changes `init` asked for, applied at the first wake-up.
+    pending: bool,
+}
+
+impl ScriptWorld {
+    /// Loads the surroundings script `text` (named `name` in errors) and
+    /// runs its `init()`.
+    ///
+    /// # Errors
+    /// [`ScriptError::Script`] for a syntax error or a failing top level or
+    /// `init`.
+    pub fn load(name: &str, text: &str) -> Result<ScriptWorld, ScriptError> {
+        let printed = Arc::new(Mutex::new(Vec::new()));
+        let shared = Arc::new(Mutex::new(Shared::default()));
+        let mut engine = engine(&printed);
+        register(&mut engine, &shared);
+        let mut script = Script::load(engine, name, text, printed)?;
+        if script.has_fn("init", 0) {
+            let _ = script.call("init", ())?;
+        }
+        // What `init` set applies at once, at the first wake-up.
+        let pending = shared.lock().is_ok_and(|s| !s.changes.is_empty());
+        Ok(ScriptWorld {
+            has_wake: script.has_fn("wake", 1),
+            script,
+            shared,
+            pending,
+        })
+    }
+
+    /// What the script printed since the last call.
+    #[must_use]
+    pub fn take_printed(&self) -> Vec<String> {
+        self.script.take_printed()
+    }
+}
+
+fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
+    let push = |shared: &Arc<Mutex<Shared>>, change: Change| {
+        if let Ok(mut s) = shared.lock() {
+            s.changes.push(change);
+        }
+    };
+    let state = Arc::clone(shared);
+    engine.register_fn("bumpers", move |mask: i64| {
+        push(&state, Change::Bumpers((mask & 0xFF) as u8));
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("tracker", move |left: bool, right: bool| {
+        push(&state, Change::Tracker { left, right });
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("scene", move |value: i64| {
+        push(&state, Change::Scene((value & 0xFF) as u8));
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("scene_at", move |h: i64, v: i64, value: i64| {
+        push(&state, Change::SceneAt(h, v, (value & 0xFF) as u8));
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("wake_at", move |cycle: i64| {
+        if let Ok(mut s) = state.lock() {
+            let at = u64::try_from(cycle).unwrap_or(0);
+            s.wake = Some(s.wake.map_or(at, |old| old.min(at)));
+        }
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("left_position", move || -> i64 {
+        state.lock().map_or(0, |s| s.positions.0)
+    });
+    let state = Arc::clone(shared);
+    engine.register_fn("right_position", move || -> i64 {
+        state.lock().map_or(0, |s| s.positions.1)
+    });
+}
+
+impl Surroundings for ScriptWorld {
+    fn next_wake(&self) -> Option<u64> {
+        if self.pending {
+            return Some(0);
+        }
+        self.shared.lock().ok().and_then(|s| s.wake)
+    }
+
+    fn wake(
+        &mut self,
+        now: u64,
+        robot: &mut Scorpion,
+    ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>> {
+        if let Ok(mut s) = self.shared.lock() {
+            if !self.pending {
+                s.wake = None;
+            }
+            s.positions = (
+                robot.board().motor(Motor::Left).position(),
+                robot.board().motor(Motor::Right).position(),
+            );
+        }
+        if self.pending {
+            self.pending = false;
+        } else if self.has_wake {
+            let now = i64::try_from(now).unwrap_or(i64::MAX);
+            let _ = self
+                .script
+                .call("wake", (now,))
+                .map_err(|error| Box::new(error) as Box<dyn miette::Diagnostic + Send + Sync>)?;
+        }
+        let changes = self
+            .shared
+            .lock()
+            .map(|mut s| std::mem::take(&mut s.changes))
+            .unwrap_or_default();
+        for change in changes {
+            match change {
+                Change::Bumpers(mask) => robot.set_bumpers(mask),
+                Change::Tracker { left, right } => robot
+                    .board_mut()
+                    .set_phototransistors(u8::from(right) | (u8::from(left) << 1)),
+                Change::Scene(value) => robot
+                    .board_mut()
+                    .set_scene(emulator::board::Scene::uniform(value)),
+                Change::SceneAt(h, v, value) => robot.board_mut().scene_mut().set(h, v, value),
+            }
+        }
+        Ok(())
+    }
+}

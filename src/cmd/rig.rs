@@ -1,0 +1,59 @@
+//! `--card FILE[@ADDR]` and `--world FILE`: what the virtual Scorpion has
+//! around it besides the ROM and the images (KIM-bus cards and the
+//! surroundings, as scripts), for every command that runs it.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use cards::{CardArg, ScriptCard, ScriptWorld};
+use miette::{Context, IntoDiagnostic};
+use romlib::VirtualScorpion;
+
+/// Cards and surroundings of the virtual Scorpion.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub(crate) struct Rig {
+    /// A KIM-bus card, a Rhai script (docs/CARDS.md), at the script's
+    /// `BASE` or at ADDR (hex); repeat for more cards.
+    #[arg(long = "card", value_name = "FILE[@ADDR]")]
+    pub(crate) cards: Vec<CardArg>,
+    /// The robot's surroundings, a Rhai script that closes bumpers and
+    /// lights the phototransistors over robot time (docs/CARDS.md).
+    #[arg(long = "world", value_name = "FILE")]
+    pub(crate) world: Option<PathBuf>,
+}
+
+fn read(path: &Path) -> miette::Result<String> {
+    std::fs::read_to_string(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read the script {}", path.display()))
+}
+
+impl Rig {
+    /// Whether anything is asked for.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.cards.is_empty() && self.world.is_none()
+    }
+
+    /// Maps the cards into `robot`'s KIM bus and gives it the
+    /// surroundings, saying on stderr where each card went.
+    pub(crate) fn apply(&self, robot: &mut VirtualScorpion) -> miette::Result<()> {
+        for card in &self.cards {
+            let name = card.path.display().to_string();
+            let text = read(&card.path)?;
+            let script = ScriptCard::load(&name, &text, card.base)?;
+            let (start, end) = script.window();
+            robot
+                .map_card(start, end, Box::new(script))
+                .wrap_err_with(|| {
+                    format!("cannot put the card {name} at ${start:04X}-${end:04X}")
+                })?;
+            let _ = writeln!(std::io::stderr(), "card {name}: ${start:04X}-${end:04X}");
+        }
+        if let Some(path) = &self.world {
+            let name = path.display().to_string();
+            let text = read(path)?;
+            robot.set_surroundings(Box::new(ScriptWorld::load(&name, &text)?));
+        }
+        Ok(())
+    }
+}
