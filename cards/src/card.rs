@@ -164,10 +164,10 @@ impl ScriptCard {
         (self.base, self.base + (self.size - 1))
     }
 
-    /// What the script printed since the last call.
+    /// What the script prints, to show as the robot runs.
     #[must_use]
-    pub fn take_printed(&self) -> Vec<String> {
-        self.script.take_printed()
+    pub fn printed(&self) -> crate::Printed {
+        self.script.printed()
     }
 
     /// A register of the table (what a plain read returns).

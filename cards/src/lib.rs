@@ -22,7 +22,7 @@ mod world;
 
 pub use card::ScriptCard;
 pub use error::{Located, ScriptError};
-pub use script::OPERATION_BUDGET;
+pub use script::{OPERATION_BUDGET, Printed};
 pub use world::ScriptWorld;
 
 /// `--card FILE[@ADDR]`: a card script and where to put it (hex, `$` or

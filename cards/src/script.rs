@@ -37,6 +37,22 @@ impl std::fmt::Debug for Script {
     }
 }
 
+/// What a script prints (`print`, `debug`), kept for the host to show: a
+/// handle that stays valid after the card is mapped into the board.
+#[derive(Debug, Clone, Default)]
+pub struct Printed(pub(crate) Arc<Mutex<Vec<String>>>);
+
+impl Printed {
+    /// The lines printed since the last call.
+    #[must_use]
+    pub fn take(&self) -> Vec<String> {
+        self.0
+            .lock()
+            .map(|mut lines| std::mem::take(&mut *lines))
+            .unwrap_or_default()
+    }
+}
+
 /// An engine with the sandbox's limits; `register` adds the host's
 /// functions for the kind of script.
 pub(crate) fn engine(printed: &Arc<Mutex<Vec<String>>>) -> Engine {
@@ -132,12 +148,9 @@ impl Script {
         result.map_err(|error| self.runtime_error_in(&error, Some(function)))
     }
 
-    /// What the script printed since the last call.
-    pub(crate) fn take_printed(&self) -> Vec<String> {
-        self.printed
-            .lock()
-            .map(|mut lines| std::mem::take(&mut *lines))
-            .unwrap_or_default()
+    /// The handle to what the script prints.
+    pub(crate) fn printed(&self) -> Printed {
+        Printed(Arc::clone(&self.printed))
     }
 
     /// A located error for a runtime failure in a call of `function`: the

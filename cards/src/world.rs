@@ -69,10 +69,10 @@ impl ScriptWorld {
         })
     }
 
-    /// What the script printed since the last call.
+    /// What the script prints, to show as the robot runs.
     #[must_use]
-    pub fn take_printed(&self) -> Vec<String> {
-        self.script.take_printed()
+    pub fn printed(&self) -> crate::Printed {
+        self.script.printed()
     }
 }
 

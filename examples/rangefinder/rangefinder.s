@@ -12,11 +12,11 @@
 ; when nothing is in range. The ROM does not know /1U, so it reaches this
 ; handler through HOOK_UNKNOWN; any other command goes on down the chain.
 ;
-; Build and try it on the virtual Scorpion (tests/tests/rom_examples.rs
-; maps a model of the card at $8000):
+; Build and try it on the virtual Scorpion, with the card's model
+; (rangefinder.rhai, a script: its obstacle is 123 cm away):
 ;
 ;   scorpion build examples/rangefinder/rangefinder.s -o rangefinder.elf --target scorpion-ext
-;   scorpion upload rangefinder.elf --port emu
+;   echo /1U | scorpion sim --image rangefinder.elf --card examples/rangefinder/rangefinder.rhai
 ;
 ; Everything comes from scorpion.inc: the hook macros, PUTCH and friends,
 ; CMD_DONE. The image needs no start-up code: the loader writes it into

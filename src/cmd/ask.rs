@@ -94,7 +94,7 @@ impl Robot {
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let mut robot = if args.line.is_emulated() {
-        Robot::Virtual(Box::new(sim::robot(
+        Robot::Virtual(Box::new(sim::robot_only(
             args.line.baud,
             None,
             &args.line.rig,

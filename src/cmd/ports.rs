@@ -77,7 +77,8 @@ pub(crate) fn virtual_robot(
             "the Scorpion's 6551 has no {baud} baud rate"
         );
     }
-    rig.apply(&mut robot)?;
+    // What their scripts print is shown by `scorpion sim` only.
+    let _printed = rig.apply(&mut robot)?;
     Ok(robot)
 }
 

@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use cards::{CardArg, ScriptCard, ScriptWorld};
+use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 
@@ -35,13 +35,19 @@ impl Rig {
     }
 
     /// Maps the cards into `robot`'s KIM bus and gives it the
-    /// surroundings, saying on stderr where each card went.
-    pub(crate) fn apply(&self, robot: &mut VirtualScorpion) -> miette::Result<()> {
+    /// surroundings, saying on stderr where each card went. Returns each
+    /// script's name and what it prints.
+    pub(crate) fn apply(
+        &self,
+        robot: &mut VirtualScorpion,
+    ) -> miette::Result<Vec<(String, Printed)>> {
+        let mut printed = Vec::new();
         for card in &self.cards {
             let name = card.path.display().to_string();
             let text = read(&card.path)?;
             let script = ScriptCard::load(&name, &text, card.base)?;
             let (start, end) = script.window();
+            printed.push((name.clone(), script.printed()));
             robot
                 .map_card(start, end, Box::new(script))
                 .wrap_err_with(|| {
@@ -52,8 +58,21 @@ impl Rig {
         if let Some(path) = &self.world {
             let name = path.display().to_string();
             let text = read(path)?;
-            robot.set_surroundings(Box::new(ScriptWorld::load(&name, &text)?));
+            let world = ScriptWorld::load(&name, &text)?;
+            printed.push((name, world.printed()));
+            robot.set_surroundings(Box::new(world));
         }
-        Ok(())
+        Ok(printed)
+    }
+}
+
+/// Shows on stderr what the scripts printed, a line each, after the
+/// script's name.
+pub(crate) fn show_printed(printed: &[(String, Printed)]) {
+    let mut err = std::io::stderr().lock();
+    for (name, lines) in printed {
+        for line in lines.take() {
+            let _ = writeln!(err, "{name}: {line}");
+        }
     }
 }

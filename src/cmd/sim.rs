@@ -55,13 +55,25 @@ fn bumper_mask(text: &str) -> Result<u8, String> {
         .map_err(|_| format!("`{text}` is not a hex byte (write 05 or $80: a bit per bumper)"))
 }
 
-/// The virtual robot as the options describe it, powered up.
-pub(crate) fn robot(
+/// The virtual robot as the options describe it, powered up, without the
+/// handles to what its scripts print.
+pub(crate) fn robot_only(
     baud: u32,
     rom: Option<&PathBuf>,
     rig: &crate::cmd::rig::Rig,
     images: &[PathBuf],
 ) -> miette::Result<VirtualScorpion> {
+    robot(baud, rom, rig, images).map(|(robot, _)| robot)
+}
+
+/// The virtual robot as the options describe it, powered up, and what
+/// each of its scripts prints.
+pub(crate) fn robot(
+    baud: u32,
+    rom: Option<&PathBuf>,
+    rig: &crate::cmd::rig::Rig,
+    images: &[PathBuf],
+) -> miette::Result<(VirtualScorpion, Vec<(String, cards::Printed)>)> {
     let mut robot = match rom {
         Some(path) => {
             let bytes = std::fs::read(path)
@@ -83,7 +95,7 @@ pub(crate) fn robot(
         );
     }
     // Cards first: an image cannot be loaded over a card's registers.
-    rig.apply(&mut robot)?;
+    let printed = rig.apply(&mut robot)?;
     for path in images {
         let bytes = std::fs::read(path)
             .into_diagnostic()
@@ -114,18 +126,18 @@ pub(crate) fn robot(
             .into_diagnostic()?;
         }
     }
-    Ok(robot)
+    Ok((robot, printed))
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let mut robot = robot(args.baud, args.rom.as_ref(), &args.rig, &args.images)?;
+    let (mut robot, printed) = robot(args.baud, args.rom.as_ref(), &args.rig, &args.images)?;
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }
     if args.pty {
-        serve_pty(&mut robot, args.baud)
+        serve_pty(&mut robot, args.baud, &printed)
     } else {
-        serve_stdio(&mut robot)
+        serve_stdio(&mut robot, &printed)
     }
 }
 
@@ -157,7 +169,11 @@ impl Pace {
 }
 
 #[cfg(unix)]
-fn serve_pty(robot: &mut VirtualScorpion, baud: u32) -> miette::Result<ExitCode> {
+fn serve_pty(
+    robot: &mut VirtualScorpion,
+    baud: u32,
+    printed: &[(String, cards::Printed)],
+) -> miette::Result<ExitCode> {
     use std::io::Read;
 
     use serialport::{SerialPort, TTYPort};
@@ -198,6 +214,7 @@ fn serve_pty(robot: &mut VirtualScorpion, baud: u32) -> miette::Result<ExitCode>
             }
         }
         pace.catch_up(robot)?;
+        crate::cmd::rig::show_printed(printed);
         let answer = robot.receive();
         if !answer.is_empty() {
             master
@@ -209,7 +226,11 @@ fn serve_pty(robot: &mut VirtualScorpion, baud: u32) -> miette::Result<ExitCode>
 }
 
 #[cfg(not(unix))]
-fn serve_pty(_robot: &mut VirtualScorpion, _baud: u32) -> miette::Result<ExitCode> {
+fn serve_pty(
+    _robot: &mut VirtualScorpion,
+    _baud: u32,
+    _printed: &[(String, cards::Printed)],
+) -> miette::Result<ExitCode> {
     miette::bail!(
         help = "run `scorpion sim` without --pty and type commands, or use --port emu",
         "pseudo-terminals are a Unix feature"
@@ -221,7 +242,10 @@ const QUIET_TIME: u64 = CPU_HZ / 5;
 
 /// Commands from stdin (line ends and all: the ROM ignores bytes outside
 /// commands), answers to stdout with their carriage returns as line ends.
-fn serve_stdio(robot: &mut VirtualScorpion) -> miette::Result<ExitCode> {
+fn serve_stdio(
+    robot: &mut VirtualScorpion,
+    printed: &[(String, cards::Printed)],
+) -> miette::Result<ExitCode> {
     let (sender, lines) = mpsc::channel::<Option<Vec<u8>>>();
     std::thread::spawn(move || {
         let stdin = std::io::stdin();
@@ -260,6 +284,7 @@ fn serve_stdio(robot: &mut VirtualScorpion) -> miette::Result<ExitCode> {
         } else {
             pace.catch_up(robot)?;
         }
+        crate::cmd::rig::show_printed(printed);
         let answer = robot.receive();
         if !answer.is_empty() {
             quiet_since = robot.cycles();

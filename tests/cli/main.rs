@@ -4,6 +4,7 @@
 mod ask;
 mod asm;
 mod build;
+mod cards;
 mod disasm;
 mod emu;
 mod link;

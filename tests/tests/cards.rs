@@ -154,3 +154,33 @@ fn a_bumper_the_surroundings_close_at_half_a_second_makes_patrol_back_away() {
     let backing = s.position(Motor::Left);
     assert!(backing < hit, "patrol backs away: {hit} then {backing}");
 }
+
+/// The surroundings example of docs/CARDS.md, run as written: a wall 500
+/// steps ahead of patrol's cruise.
+#[test]
+fn the_docs_wall_closes_the_bumper_where_the_robot_meets_it() {
+    let docs =
+        std::fs::read_to_string(examples_dir().join("../docs/CARDS.md")).expect("docs/CARDS.md");
+    let start = docs.find("```rhai\n").expect("the example") + 8;
+    let end = start + docs[start..].find("```").expect("its end");
+    let world = ScriptWorld::load("wall.rhai", &docs[start..end]).expect("the example loads");
+    let mut s = Session::new();
+    s.robot.set_surroundings(Box::new(world));
+    let patrol = build(&[examples_dir().join("patrol/patrol.s")], "scorpion-os");
+    s.robot.load_image(&patrol).expect("patrol loads");
+    s.send("/2A1");
+    let io = |s: &Session| s.robot.robot().board().memory()[usize::from(IOBYTE)];
+    let mut met = None;
+    for _ in 0..400 {
+        s.robot.run_for(10_000).expect("runs");
+        if io(&s) & 0x80 != 0 {
+            met = Some(s.position(Motor::Left));
+            break;
+        }
+    }
+    let met = met.expect("the robot met the wall within 4 s");
+    assert!(
+        (500..520).contains(&met),
+        "the bumper closed at {met} steps"
+    );
+}

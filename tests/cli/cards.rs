@@ -1,0 +1,262 @@
+//! `--card FILE[@ADDR]` and `--world FILE` as a user gives them: the
+//! examples' cards answering through their extensions in `scorpion sim`
+//! and `scorpion ask --port emu`, and scripts that loop, do not parse or do
+//! not fit stopping the run with a located error and a non-zero exit.
+
+use std::path::Path;
+
+use crate::{build_example, scorpion, transcript};
+
+fn example(path: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(path)
+        .display()
+        .to_string()
+}
+
+/// `scorpion sim ARGS` in `dir` with `input` on stdin; the transcript with
+/// the paths made stable.
+fn sim_in(dir: &Path, args: &[&str], input: &str) -> (i32, String) {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .current_dir(dir)
+        .arg("sim")
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .env("NO_COLOR", "1")
+        .env("COLUMNS", "100")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the scorpion binary runs");
+    let written = child
+        .stdin
+        .take()
+        .expect("stdin is piped")
+        .write_all(input.as_bytes());
+    if let Err(error) = written {
+        assert_eq!(error.kind(), std::io::ErrorKind::BrokenPipe);
+    }
+    let output = child.wait_with_output().expect("sim ends");
+    let text = transcript(&output)
+        .replace(&example(""), "[EXAMPLES]/")
+        .replace(dir.to_str().expect("UTF-8"), "[TMP]");
+    (output.status.code().unwrap_or(-1), text)
+}
+
+#[test]
+fn the_rangefinder_card_script_gives_real_distances_in_sim() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    build_example(
+        dir.path(),
+        "rangefinder/rangefinder.s",
+        "rangefinder.elf",
+        &["--target", "scorpion-ext"],
+    );
+    let card = example("rangefinder/rangefinder.rhai");
+    let (code, text) = sim_in(
+        dir.path(),
+        &["--image", "rangefinder.elf", "--card", &card],
+        "/1U\n/1U\n",
+    );
+    assert_eq!(code, 0, "{text}");
+    insta::assert_snapshot!(text);
+    // Without its card the extension reads plain RAM: 0 cm.
+    let (_, text) = sim_in(dir.path(), &["--image", "rangefinder.elf"], "/1U\n");
+    assert!(text.contains("U0000"), "{text}");
+}
+
+#[test]
+fn ask_on_the_virtual_scorpion_takes_cards_too() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    build_example(
+        dir.path(),
+        "adc/adc.s",
+        "adc.elf",
+        &["--target", "scorpion-ext"],
+    );
+    let card = format!("{}@A000", example("adc/adc.rhai"));
+    // The extension reads $9000; the card moved to $A000 is not there.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "ask",
+            "--port",
+            "emu",
+            "--image",
+            "adc.elf",
+            "--card",
+            &card,
+            "--timeout",
+            "50",
+            "/2A0",
+        ],
+    );
+    assert_ne!(output.status.code(), Some(0), "{}", transcript(&output));
+    let card = example("adc/adc.rhai");
+    let output = scorpion(
+        dir.path(),
+        &[
+            "ask", "--port", "emu", "--image", "adc.elf", "--card", &card, "/2A0", "/2A1",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    assert_eq!(String::from_utf8_lossy(&output.stdout), "AC0\nA57\n");
+}
+
+#[test]
+fn a_card_script_that_loops_stops_the_sim_with_its_line() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    build_example(
+        dir.path(),
+        "rangefinder/rangefinder.s",
+        "rangefinder.elf",
+        &["--target", "scorpion-ext"],
+    );
+    std::fs::write(
+        dir.path().join("stuck.rhai"),
+        "const SIZE = 4;\nconst BASE = 0x8000;\n\n// Waits for an echo that the script itself would have to make.\nfn write(reg, value, now) {\n    while get(1) != 0 { }\n}\nfn init() { set(1, 0x80); }\n",
+    )
+    .expect("write the script");
+    let (code, text) = sim_in(
+        dir.path(),
+        &["--image", "rangefinder.elf", "--card", "stuck.rhai"],
+        "/1U\n",
+    );
+    assert_eq!(code, 1, "{text}");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn a_card_script_with_a_syntax_error_is_refused_with_its_place() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("typo.rhai"),
+        "const SIZE = 4;\nconst BASE = 0x8000;\nfn read(reg, now) {\n    if reg == 1 { 0x80 } els { 0 }\n}\n",
+    )
+    .expect("write the script");
+    let (code, text) = sim_in(dir.path(), &["--card", "typo.rhai"], "/1X\n");
+    assert_eq!(code, 1, "{text}");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn cards_must_fit_the_kim_bus_and_not_each_other() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let card = example("adc/adc.rhai");
+    let low = format!("{card}@0400");
+    let (code, text) = sim_in(dir.path(), &["--card", &low], "");
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("is not inside the"), "{text}");
+    let (code, text) = sim_in(dir.path(), &["--card", &card, "--card", &card], "");
+    assert_eq!(code, 1, "{text}");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn cards_and_surroundings_are_for_the_virtual_scorpion_only() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let card = example("adc/adc.rhai");
+    let output = scorpion(
+        dir.path(),
+        &["ask", "--port", "/dev/null", "--card", &card, "/1X"],
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("do not apply to the robot on /dev/null"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+#[test]
+fn the_world_script_sets_the_bumpers_in_sim() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("wall.rhai"),
+        "// Against a wall from power-up; the robot is moved away after 2 s.\nfn init() { bumpers(0x04); wake_at(ms(2000)); }\nfn wake(now) { bumpers(0); }\n",
+    )
+    .expect("write the script");
+    let (code, text) = sim_in(dir.path(), &["--world", "wall.rhai"], "/1B\n");
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("B04"), "{text}");
+}
+
+/// The fenced block of `kind` that follows `heading` in README.md.
+fn readme_block(heading: &str, kind: &str) -> String {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
+        .expect("README.md");
+    let section = &readme[readme.find(heading).expect("the section")..];
+    let fence = format!("```{kind}\n");
+    let start = section.find(&fence).expect("the block") + fence.len();
+    let end = start + section[start..].find("```").expect("the block's end");
+    section[start..end].to_string()
+}
+
+#[test]
+fn the_readmes_own_card_section_runs_as_written() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::os::unix::fs::symlink(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples"),
+        dir.path().join("examples"),
+    )
+    .expect("link the examples");
+    let bin = Path::new(env!("CARGO_BIN_EXE_scorpion"))
+        .parent()
+        .expect("the binary's directory")
+        .to_path_buf();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let mut printed = String::new();
+    for line in readme_block("## Your own card", "sh").lines() {
+        let output = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!("{line} 2>&1"))
+            .current_dir(dir.path())
+            .env("PATH", &path)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("sh runs");
+        assert!(
+            output.status.success(),
+            "`{line}`:\n{}",
+            transcript(&output)
+        );
+        printed.push_str(&String::from_utf8_lossy(&output.stdout));
+    }
+    assert_eq!(
+        printed,
+        readme_block("## Your own card", "text"),
+        "README.md's card section is stale"
+    );
+}
+
+#[test]
+fn the_examples_readme_shows_the_same_card_commands() {
+    let examples =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/README.md"))
+            .expect("examples/README.md");
+    let section = &examples[examples.find("## Your own card").expect("the section")..];
+    let start = section.find("```sh\n").expect("the block") + 6;
+    let end = start + section[start..].find("```").expect("its end");
+    assert_eq!(&section[start..end], readme_block("## Your own card", "sh"));
+}
+
+#[test]
+fn what_a_card_script_prints_shows_on_stderr_in_sim() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("chatty.rhai"),
+        "const SIZE = 1;\nconst BASE = 0x9000;\nfn write(reg, value, now) { print(`written ${value} at ${now}`); }\n",
+    )
+    .expect("write the script");
+    let (code, text) = sim_in(dir.path(), &["--card", "chatty.rhai"], "/7W900042\n/1X\n");
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("chatty.rhai: written 66 at "), "{text}");
+}
