@@ -7,6 +7,7 @@
 
 mod args;
 mod cmd;
+mod project;
 
 use std::process::ExitCode;
 
@@ -45,6 +46,10 @@ enum Command {
     Sim(cmd::sim::Args),
     /// Send commands to a robot and print the answers.
     Ask(cmd::ask::Args),
+    /// Start a project: a project file, a source, a transcript test.
+    New(cmd::new::Args),
+    /// Run a project's tests: snapshots and transcripts.
+    Test(cmd::test::Args),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +66,8 @@ fn main() -> ExitCode {
         Command::Installed(args) => cmd::installed::run(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Ask(args) => cmd::ask::run(&args),
+        Command::New(args) => cmd::new::run(&args),
+        Command::Test(args) => cmd::test::run(&args),
     };
     match result {
         Ok(code) => code,

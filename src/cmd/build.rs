@@ -12,8 +12,9 @@ use crate::cmd::link::{DiskSources, LinkArgs, link_and_write};
 /// Assemble ca65-syntax sources and link them into a Scorpion image.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// The sources, in link order.
-    #[arg(required = true, value_name = "SRC")]
+    /// The sources, in link order; none: the images of the project
+    /// (`Scorpion.toml` here or above) into `target/scorpion/`.
+    #[arg(value_name = "SRC")]
     sources: Vec<PathBuf>,
     #[command(flatten)]
     assembler: AsmOptions,
@@ -24,7 +25,49 @@ pub(crate) struct Args {
     link: LinkArgs,
 }
 
+/// Builds every image of the project found from here: `NAME.elf`,
+/// `NAME.lst` and `NAME.map` in `target/scorpion/`.
+fn project() -> miette::Result<ExitCode> {
+    let project = crate::project::Project::here()?;
+    let dir = project.target_dir();
+    std::fs::create_dir_all(&dir)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot create {}", dir.display()))?;
+    for spec in &project.file.images {
+        let built = crate::project::build::build(&project, spec)?;
+        for warning in &built.warnings {
+            #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
+            {
+                eprintln!("{warning:?}");
+            }
+        }
+        let elf = linker::Format::Elf.write(&built.linked.image)?;
+        for (ext, bytes) in [
+            ("elf", elf),
+            ("lst", built.listing.clone().into_bytes()),
+            ("map", built.linked.map().into_bytes()),
+        ] {
+            let path = dir.join(format!("{}.{ext}", built.name));
+            std::fs::write(&path, bytes)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+        }
+        let bytes: usize = built.linked.image.areas.iter().map(|a| a.bytes.len()).sum();
+        #[allow(clippy::print_stdout, reason = "the CLI reports what it wrote")]
+        {
+            println!(
+                "{}: target/scorpion/{}.elf ({bytes} bytes, target {}), .lst, .map",
+                project.file.project.name, built.name, spec.target
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    if args.sources.is_empty() {
+        return project();
+    }
     let options = args.assembler.options(args.listing.is_some());
     let mut objects = Vec::with_capacity(args.sources.len());
     let mut listings = String::new();

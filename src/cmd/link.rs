@@ -14,9 +14,10 @@ use crate::args;
 /// Where the image goes and what the linker needs besides the objects.
 #[derive(Debug, clap::Args)]
 pub(crate) struct LinkArgs {
-    /// The image to write.
+    /// The image to write (required but for `scorpion build` in a
+    /// project, which writes into `target/scorpion/`).
     #[arg(short, long, value_name = "OUT")]
-    pub(crate) output: PathBuf,
+    pub(crate) output: Option<PathBuf>,
     /// Where things go: flat, scorpion-ext, scorpion-os, scorpion-rom, or a
     /// layout file (FILE.toml).
     #[arg(long, value_name = "NAME|FILE.toml", default_value = "scorpion-ext")]
@@ -98,6 +99,12 @@ pub(crate) fn link_and_write(
     args: &LinkArgs,
     sources: &dyn SourceProvider,
 ) -> miette::Result<ExitCode> {
+    let Some(output) = &args.output else {
+        miette::bail!(
+            help = "name the image to write: `-o ext.elf`",
+            "no output file (-o OUT)"
+        );
+    };
     let target = target(args)?;
     let mut symbol_images = Vec::with_capacity(args.just_symbols.len());
     for path in &args.just_symbols {
@@ -130,14 +137,14 @@ pub(crate) fn link_and_write(
     )?;
     report_warnings(&mut linked);
     let bytes = args.format.write(&linked.image)?;
-    write(&args.output, &bytes)?;
+    write(output, &bytes)?;
     if let Some(path) = &args.map {
         write(path, linked.map().as_bytes())?;
     }
     if let Some(path) = &args.labels {
         write(path, linked.vice_labels().as_bytes())?;
     }
-    summary(&linked, args);
+    summary(&linked, args, output);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -156,7 +163,7 @@ fn report_warnings(linked: &mut Linked) {
     }
 }
 
-fn summary(linked: &Linked, args: &LinkArgs) {
+fn summary(linked: &Linked, args: &LinkArgs, output: &Path) {
     let image = &linked.image;
     let ranges: Vec<String> = image
         .areas
@@ -168,7 +175,7 @@ fn summary(linked: &Linked, args: &LinkArgs) {
     {
         println!(
             "{} ({}, target {}): {} byte{} at {}, entry ${:04X}",
-            args.output.display(),
+            output.display(),
             args.format,
             linked.layout.name,
             bytes,

@@ -20,10 +20,15 @@ pub(crate) struct Rig {
     /// lights the phototransistors over robot time (docs/CARDS.md).
     #[arg(long = "world", value_name = "FILE")]
     pub(crate) world: Option<PathBuf>,
+    /// The directory relative paths are read from (a project's root); the
+    /// paths are shown as given.
+    #[arg(skip)]
+    pub(crate) root: Option<PathBuf>,
 }
 
-fn read(path: &Path) -> miette::Result<String> {
-    std::fs::read_to_string(path)
+fn read(root: Option<&Path>, path: &Path) -> miette::Result<String> {
+    let full = root.map_or_else(|| path.to_path_buf(), |root| root.join(path));
+    std::fs::read_to_string(full)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot read the script {}", path.display()))
 }
@@ -44,7 +49,7 @@ impl Rig {
         let mut printed = Vec::new();
         for card in &self.cards {
             let name = card.path.display().to_string();
-            let text = read(&card.path)?;
+            let text = read(self.root.as_deref(), &card.path)?;
             let script = ScriptCard::load(&name, &text, card.base)?;
             let (start, end) = script.window();
             printed.push((name.clone(), script.printed()));
@@ -57,7 +62,7 @@ impl Rig {
         }
         if let Some(path) = &self.world {
             let name = path.display().to_string();
-            let text = read(path)?;
+            let text = read(self.root.as_deref(), path)?;
             let world = ScriptWorld::load(&name, &text)?;
             printed.push((name, world.printed()));
             robot.set_surroundings(Box::new(world));

@@ -8,6 +8,7 @@ mod cards;
 mod disasm;
 mod emu;
 mod link;
+mod project;
 mod read;
 mod search_order;
 mod sim;

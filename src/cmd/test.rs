@@ -1,0 +1,278 @@
+//! `scorpion test`: a project's tests. For every image, snapshots of the
+//! assembled output (listing, map, symbols, bytes: nothing of the machine,
+//! no times); then every transcript (`tests/*.expect`) on the virtual
+//! Scorpion with the images loaded as an upload leaves them and the
+//! project's cards and surroundings; with `--port`, the transcripts on a
+//! real robot after uploading the images, and no snapshots.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use miette::{Context, IntoDiagnostic};
+use uploader::transport::VirtualTransport;
+use uploader::{
+    Client, ClientConfig, Expectations, NoProgress, RomProfile, Transport, UploadImage,
+};
+
+use crate::cmd::ports;
+use crate::project::build::{Built, build};
+use crate::project::snapshot::{self, Outcome};
+use crate::project::{FILE, Project};
+
+/// Run the project's tests: snapshots of the assembled output and
+/// transcripts on the virtual Scorpion.
+///
+/// Prints a line per test and `N passed, N failed`; exits 1 if any failed.
+/// A new or changed snapshot fails with its diff until `--accept` takes it.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// Take new and changed snapshots as they are now.
+    #[arg(long)]
+    accept: bool,
+    /// Run the transcripts on the robot on PORT after uploading the
+    /// images (no snapshots); `SCORPION_PORT` or the project's [robot]
+    /// port when given without a value.
+    #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
+    port: Option<String>,
+}
+
+/// The results, printed as they come.
+struct Tally {
+    passed: usize,
+    failed: usize,
+    out: std::io::StdoutLock<'static>,
+}
+
+impl Tally {
+    fn record(&mut self, name: &str, result: Result<&str, String>) {
+        match result {
+            Ok(how) => {
+                self.passed += 1;
+                let _ = writeln!(self.out, "test {name} ... {how}");
+            }
+            Err(why) => {
+                self.failed += 1;
+                let _ = writeln!(self.out, "test {name} ... FAILED\n{why}");
+            }
+        }
+    }
+}
+
+fn snapshot_path(project: &Project, image: &str, kind: &str) -> PathBuf {
+    project
+        .root
+        .join("tests")
+        .join("snapshots")
+        .join(format!("{image}__{kind}.snap"))
+}
+
+fn check_snapshots(
+    project: &Project,
+    built: &Built,
+    accept: bool,
+    tally: &mut Tally,
+) -> miette::Result<()> {
+    let texts = [
+        ("listing", built.listing.clone()),
+        ("map", built.linked.map()),
+        ("symbols", built.symbols()),
+        ("bytes", built.bytes()),
+    ];
+    for (kind, content) in texts {
+        let path = snapshot_path(project, &built.name, kind);
+        let name = format!("{}/{kind}", built.name);
+        let outcome = snapshot::compare(&path, &content);
+        if outcome == Outcome::Same {
+            tally.record(&name, Ok("ok"));
+            continue;
+        }
+        if accept {
+            if let Some(dir) = path.parent() {
+                std::fs::create_dir_all(dir).into_diagnostic()?;
+            }
+            std::fs::write(&path, snapshot::render(FILE, &name, &content))
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+            tally.record(&name, Ok("accepted"));
+            continue;
+        }
+        let shown = relative(project, &path);
+        let why = match outcome {
+            Outcome::New => format!(
+                "  no snapshot {shown} yet; `scorpion test --accept` takes this one:\n{}",
+                indent(&content)
+            ),
+            Outcome::Changed(diff) => format!(
+                "  {shown} differs (- snapshot, + now); `scorpion test --accept` takes the new one:\n{}",
+                indent(&diff)
+            ),
+            Outcome::Same => String::new(),
+        };
+        tally.record(&name, Err(why));
+    }
+    Ok(())
+}
+
+fn indent(text: &str) -> String {
+    text.lines().fold(String::new(), |mut out, line| {
+        let _ = writeln!(out, "    {line}");
+        out
+    })
+}
+
+fn relative(project: &Project, path: &Path) -> String {
+    path.strip_prefix(&project.root)
+        .unwrap_or(path)
+        .display()
+        .to_string()
+}
+
+fn read_transcript(path: &Path) -> miette::Result<Expectations> {
+    let text = std::fs::read_to_string(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
+    Expectations::parse(&text).wrap_err_with(|| format!("in {}", path.display()))
+}
+
+/// Runs `expectations`, a difference said as a test's failure (not as an
+/// upload's rehearsal).
+fn check<T: Transport>(expectations: &Expectations, client: &mut Client<T>) -> miette::Result<()> {
+    match expectations.check(client) {
+        Ok(_) => Ok(()),
+        Err(uploader::Error::RehearsalFailed {
+            command,
+            expected,
+            found,
+        }) => Err(miette::miette!(
+            "`{command}` answered `{found}`, expected `{expected}`"
+        )),
+        Err(other) => Err(other.into()),
+    }
+}
+
+fn client<T: Transport>(transport: T) -> Client<T> {
+    Client::new(
+        transport,
+        ClientConfig {
+            window: RomProfile::reference().window(),
+            ..ClientConfig::default()
+        },
+    )
+}
+
+/// Every transcript on a fresh virtual Scorpion with the images loaded.
+fn virtual_transcripts(
+    project: &Project,
+    built: &[Built],
+    tally: &mut Tally,
+) -> miette::Result<()> {
+    let rig = project.rig()?;
+    for path in project.transcripts() {
+        let name = format!("transcript {}", relative(project, &path));
+        let result = (|| -> miette::Result<()> {
+            let expectations = read_transcript(&path)?;
+            let mut robot = ports::virtual_robot(project.baud()?, &rig)?;
+            for image in built {
+                robot
+                    .load_image(&image.linked.image)
+                    .wrap_err_with(|| format!("cannot load {}", image.name))?;
+            }
+            let mut client = client(VirtualTransport::new(robot));
+            check(&expectations, &mut client)
+        })();
+        tally.record(
+            &name,
+            result.map(|()| "ok").map_err(|e| indent(&format!("{e:?}"))),
+        );
+    }
+    Ok(())
+}
+
+/// Uploads the images to the robot on `port`, then runs the transcripts.
+fn robot_transcripts(
+    project: &Project,
+    built: &[Built],
+    port: &str,
+    tally: &mut Tally,
+) -> miette::Result<()> {
+    let transport = ports::open(port, project.baud()?, &crate::cmd::rig::Rig::default())?;
+    let mut client = client(transport);
+    for image in built {
+        let upload = UploadImage::try_from(&image.linked.image)?;
+        uploader::upload(
+            &mut client,
+            &upload,
+            &uploader::UploadOptions::default(),
+            &mut NoProgress,
+        )
+        .wrap_err_with(|| format!("cannot upload {}", image.name))?;
+        tally.record(&format!("upload {}", image.name), Ok("ok"));
+    }
+    for path in project.transcripts() {
+        let name = format!("transcript {}", relative(project, &path));
+        let result = read_transcript(&path).and_then(|e| Ok(e.check(&mut client)?));
+        tally.record(
+            &name,
+            result.map(|_| "ok").map_err(|e| indent(&format!("{e:?}"))),
+        );
+    }
+    Ok(())
+}
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let project = Project::here()?;
+    let mut tally = Tally {
+        passed: 0,
+        failed: 0,
+        out: std::io::stdout().lock(),
+    };
+    let mut built = Vec::new();
+    for spec in &project.file.images {
+        match build(&project, spec) {
+            Ok(image) => {
+                for warning in &image.warnings {
+                    let _ = writeln!(std::io::stderr(), "{warning:?}");
+                }
+                built.push(image);
+            }
+            Err(error) => tally.record(&format!("build {}", spec.name), Err(format!("{error:?}"))),
+        }
+    }
+    match &args.port {
+        Some(port) => {
+            let port = if port.is_empty() {
+                project.port().ok_or_else(|| {
+                    miette::miette!(
+                        help = "give it (`--port /dev/ttyUSB0`), set SCORPION_PORT, or add `port` to [robot] in Scorpion.toml",
+                        "no port for the robot"
+                    )
+                })?
+            } else {
+                port.clone()
+            };
+            if tally.failed == 0 {
+                robot_transcripts(&project, &built, &port, &mut tally)?;
+            }
+        }
+        None => {
+            for image in &built {
+                check_snapshots(&project, image, args.accept, &mut tally)?;
+            }
+            if tally.failed == 0 || built.len() == project.file.images.len() {
+                virtual_transcripts(&project, &built, &mut tally)?;
+            }
+        }
+    }
+    let _ = writeln!(
+        tally.out,
+        "{} passed, {} failed",
+        tally.passed, tally.failed
+    );
+    Ok(if tally.failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}

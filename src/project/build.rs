@@ -1,0 +1,164 @@
+//! An image of the project built in memory: assembled with paths relative
+//! to the project (so listings and maps name no directory of the machine),
+//! linked against the reference ROM, with the texts its snapshots are made
+//! of.
+
+use std::fmt::Write as _;
+use std::io;
+use std::path::{Path, PathBuf};
+
+use linker::{Image, Input, LinkOptions, Linked, SourceProvider, SymbolFile, Target};
+
+use super::Project;
+use super::config::ImageSpec;
+
+/// Files read relative to the project's root.
+struct Rooted<'a>(&'a Path);
+
+impl Rooted<'_> {
+    fn full(&self, path: &Path) -> PathBuf {
+        if path.is_absolute() {
+            path.to_path_buf()
+        } else {
+            self.0.join(path)
+        }
+    }
+}
+
+impl assembler::FileSource for Rooted<'_> {
+    fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
+        std::fs::read(self.full(path))
+    }
+}
+
+impl SourceProvider for Rooted<'_> {
+    fn source(&self, path: &str) -> Option<String> {
+        std::fs::read_to_string(self.full(Path::new(path))).ok()
+    }
+}
+
+/// A built image and what it is made of.
+#[derive(Debug)]
+pub(crate) struct Built {
+    /// The image's name in the project.
+    pub(crate) name: String,
+    /// The link's result.
+    pub(crate) linked: Linked,
+    /// The listings of its sources, one after the other.
+    pub(crate) listing: String,
+    /// Warnings of the assembler and the linker, rendered.
+    pub(crate) warnings: Vec<miette::Report>,
+}
+
+/// Assembles and links `spec`.
+pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built> {
+    let source = Rooted(&project.root);
+    let options = assembler::Options {
+        include_dirs: spec.include.iter().map(PathBuf::from).collect(),
+        defines: spec
+            .defines
+            .iter()
+            .map(|(name, value)| (name.clone(), *value))
+            .collect(),
+        listing: true,
+        builtin_includes: crate::cmd::asm::builtin_includes(),
+        ..assembler::Options::default()
+    };
+    let mut objects = Vec::new();
+    let mut listing = String::new();
+    let mut warnings = Vec::new();
+    for path in &spec.sources {
+        let assembly = assembler::assemble(&source, Path::new(path), &options)?;
+        for warning in assembly.warnings {
+            warnings.push(miette::Report::new(warning));
+        }
+        if let Some(text) = assembly.listing {
+            listing.push_str(&text);
+        }
+        objects.push((path.clone(), assembly.object));
+    }
+    let target = if spec.target.ends_with(".toml") {
+        let text = std::fs::read_to_string(project.path(&spec.target)).map_err(|e| {
+            miette::miette!(
+                "image {}: cannot read the layout {}: {e}",
+                spec.name,
+                spec.target
+            )
+        })?;
+        Target::Custom(linker::Layout::from_toml(&spec.target, &text)?)
+    } else {
+        Target::builtin(&spec.target, None)?
+    };
+    let rom = Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?;
+    let inputs: Vec<Input<'_>> = objects
+        .iter()
+        .map(|(name, bytes)| Input { name, bytes })
+        .collect();
+    let mut linked = linker::link(
+        &inputs,
+        &LinkOptions {
+            target: &target,
+            just_symbols: &[SymbolFile {
+                name: "scorpion-rom.elf",
+                image: &rom,
+            }],
+            sources: &source,
+        },
+    )?;
+    for warning in std::mem::take(&mut linked.warnings) {
+        warnings.push(miette::Report::new(warning));
+    }
+    Ok(Built {
+        name: spec.name.clone(),
+        linked,
+        listing,
+        warnings,
+    })
+}
+
+impl Built {
+    /// The image's own symbols (not the ROM's it linked against), a line
+    /// each, by address then name.
+    pub(crate) fn symbols(&self) -> String {
+        let rom = |name: &str, value: u32| {
+            romlib::symbols::find(name).is_some_and(|s| u32::from(s.value) == value)
+        };
+        let mut symbols: Vec<_> = self
+            .linked
+            .image
+            .symbols
+            .iter()
+            .filter(|s| !rom(&s.name, s.value))
+            .collect();
+        symbols.sort_by(|a, b| (a.value, &a.name).cmp(&(b.value, &b.name)));
+        let mut text = String::new();
+        for symbol in symbols {
+            let _ = writeln!(
+                text,
+                "${:04X}  {}{}",
+                symbol.value,
+                symbol.name,
+                if symbol.global { "  (global)" } else { "" }
+            );
+        }
+        text
+    }
+
+    /// The loaded bytes as a hex dump, 16 a line, each line at its address.
+    pub(crate) fn bytes(&self) -> String {
+        let mut text = String::new();
+        for area in &self.linked.image.areas {
+            for (index, chunk) in area.bytes.chunks(16).enumerate() {
+                let hex: Vec<String> = chunk.iter().map(|b| format!("{b:02X}")).collect();
+                let _ = writeln!(
+                    text,
+                    "${:04X}  {}",
+                    area.load as usize + index * 16,
+                    hex.join(" ")
+                );
+            }
+        }
+        let _ = writeln!(text, "entry ${:04X}", self.linked.image.entry);
+        text
+    }
+}

@@ -1,0 +1,247 @@
+//! `Scorpion.toml`, read with serde and toml; an error names the file, the
+//! line and column, and shows the key.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use miette::{NamedSource, SourceSpan};
+use serde::Deserialize;
+
+/// The whole file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ProjectFile {
+    /// `[project]`.
+    pub(crate) project: Meta,
+    /// `[[image]]`, one per image.
+    #[serde(rename = "image", default)]
+    pub(crate) images: Vec<ImageSpec>,
+    /// `[robot]`.
+    #[serde(default)]
+    pub(crate) robot: RobotSpec,
+    /// `[tests]`.
+    #[serde(default)]
+    pub(crate) tests: TestsSpec,
+}
+
+/// `[project]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Meta {
+    /// The project's name.
+    pub(crate) name: String,
+}
+
+/// One image: its sources and how to link them.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ImageSpec {
+    /// The image's name: `target/scorpion/NAME.elf`, the snapshots' prefix.
+    pub(crate) name: String,
+    /// The sources, in link order, relative to the project.
+    pub(crate) sources: Vec<String>,
+    /// A built-in target (`scorpion-ext`, `scorpion-os`) or a layout file.
+    #[serde(default = "default_target")]
+    pub(crate) target: String,
+    /// Include directories, relative to the project.
+    #[serde(default)]
+    pub(crate) include: Vec<String>,
+    /// `-D` definitions.
+    #[serde(default)]
+    pub(crate) defines: BTreeMap<String, i64>,
+}
+
+fn default_target() -> String {
+    "scorpion-ext".to_owned()
+}
+
+/// `[robot]`: the virtual robot's set-up and the real one's line.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RobotSpec {
+    /// The serial port (`SCORPION_PORT` overrides it, so a shared project
+    /// need not carry one person's device).
+    pub(crate) port: Option<String>,
+    /// The baud rate (`SCORPION_BAUD` overrides it).
+    pub(crate) baud: Option<u32>,
+    /// Card scripts, `FILE[@ADDR]`, relative to the project.
+    #[serde(default)]
+    pub(crate) cards: Vec<String>,
+    /// The surroundings script.
+    pub(crate) world: Option<String>,
+}
+
+/// `[tests]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TestsSpec {
+    /// Transcript files (`.expect`), relative to the project; default:
+    /// every `tests/*.expect`.
+    #[serde(default)]
+    pub(crate) transcripts: Vec<String>,
+}
+
+/// An error in the project file, at its place.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[error("{file}:{line}:{column}: {message}")]
+#[diagnostic(code(scorpion::project))]
+pub(crate) struct ProjectError {
+    file: String,
+    line: usize,
+    column: usize,
+    message: String,
+    #[source_code]
+    source_code: NamedSource<String>,
+    #[label("here")]
+    at: SourceSpan,
+    #[help]
+    help: Option<String>,
+}
+
+/// A project: its root directory and its file.
+#[derive(Debug, Clone)]
+pub(crate) struct Project {
+    /// The directory that holds `Scorpion.toml`.
+    pub(crate) root: PathBuf,
+    /// What the file says.
+    pub(crate) file: ProjectFile,
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+impl Project {
+    /// The project whose `Scorpion.toml` is in `dir` or the nearest
+    /// directory above it; `None` if there is none.
+    pub(crate) fn find(dir: &Path) -> Option<PathBuf> {
+        dir.ancestors()
+            .find(|d| d.join(super::FILE).is_file())
+            .map(Path::to_path_buf)
+    }
+
+    /// Reads the project in `root`.
+    pub(crate) fn load(root: &Path) -> miette::Result<Project> {
+        let path = root.join(super::FILE);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
+        // Named as the user knows it: relative to where they are.
+        let name = std::env::current_dir()
+            .ok()
+            .and_then(|cwd| path.strip_prefix(cwd).ok().map(Path::to_path_buf))
+            .unwrap_or_else(|| path.clone())
+            .display()
+            .to_string();
+        let file: ProjectFile = toml::from_str(&text).map_err(|error| {
+            let span = error.span().unwrap_or(0..0);
+            let (line, column) = line_col(&text, span.start);
+            ProjectError {
+                file: name.clone(),
+                line,
+                column,
+                message: error.message().to_owned(),
+                source_code: NamedSource::new(&name, text.clone()),
+                at: SourceSpan::from((span.start, span.len())),
+                help: Some(
+                    "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world; [tests] transcripts"
+                        .into(),
+                ),
+            }
+        })?;
+        if file.images.is_empty() {
+            miette::bail!(
+                help = "add an image:\n[[image]]\nname = \"myext\"\nsources = [\"src/myext.s\"]",
+                "{name} has no [[image]]"
+            );
+        }
+        Ok(Project {
+            root: root.to_path_buf(),
+            file,
+        })
+    }
+
+    /// The project found from the current directory up, or an error that
+    /// says what was looked for.
+    pub(crate) fn here() -> miette::Result<Project> {
+        let cwd = std::env::current_dir()
+            .map_err(|e| miette::miette!("cannot read the current directory: {e}"))?;
+        let Some(root) = Project::find(&cwd) else {
+            miette::bail!(
+                help = "give the files on the command line, or start a project with `scorpion new NAME`",
+                "no {} in {} or any directory above it",
+                super::FILE,
+                cwd.display()
+            );
+        };
+        Project::load(&root)
+    }
+
+    /// A path of the project, relative to its root.
+    pub(crate) fn path(&self, relative: &str) -> PathBuf {
+        self.root.join(relative)
+    }
+
+    /// Where built images go.
+    pub(crate) fn target_dir(&self) -> PathBuf {
+        self.root.join("target").join("scorpion")
+    }
+
+    /// The robot's port: `SCORPION_PORT`, else the project's.
+    pub(crate) fn port(&self) -> Option<String> {
+        std::env::var("SCORPION_PORT")
+            .ok()
+            .filter(|p| !p.is_empty())
+            .or_else(|| self.file.robot.port.clone())
+    }
+
+    /// The baud rate: `SCORPION_BAUD`, else the project's, else 9600.
+    pub(crate) fn baud(&self) -> miette::Result<u32> {
+        match std::env::var("SCORPION_BAUD") {
+            Ok(text) if !text.is_empty() => text
+                .parse()
+                .map_err(|_| miette::miette!("SCORPION_BAUD={text} is not a baud rate")),
+            _ => Ok(self.file.robot.baud.unwrap_or(platform::line::DEFAULT_BAUD)),
+        }
+    }
+
+    /// The virtual robot's cards and surroundings, paths made absolute.
+    pub(crate) fn rig(&self) -> miette::Result<crate::cmd::rig::Rig> {
+        let mut cards = Vec::new();
+        for card in &self.file.robot.cards {
+            let arg: cards::CardArg = card
+                .parse()
+                .map_err(|e: String| miette::miette!("{}: [robot] cards: {e}", super::FILE))?;
+            cards.push(arg);
+        }
+        Ok(crate::cmd::rig::Rig {
+            cards,
+            world: self.file.robot.world.as_ref().map(PathBuf::from),
+            root: Some(self.root.clone()),
+        })
+    }
+
+    /// The transcript files.
+    pub(crate) fn transcripts(&self) -> Vec<PathBuf> {
+        if !self.file.tests.transcripts.is_empty() {
+            return self
+                .file
+                .tests
+                .transcripts
+                .iter()
+                .map(|t| self.root.join(t))
+                .collect();
+        }
+        let mut found: Vec<PathBuf> = std::fs::read_dir(self.root.join("tests"))
+            .into_iter()
+            .flatten()
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "expect"))
+            .collect();
+        found.sort();
+        found
+    }
+}

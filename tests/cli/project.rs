@@ -1,0 +1,118 @@
+//! A project's loop as a user runs it: `scorpion new`, `scorpion test`, a
+//! change to the source that alters the bytes failing with a diff,
+//! `scorpion test --accept`, passing again; `scorpion build` in the
+//! project; errors in `Scorpion.toml` at their line; the examples'
+//! projects passing their own tests.
+
+use std::path::Path;
+
+use crate::{scorpion, transcript};
+
+fn stdout(output: &std::process::Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+#[test]
+fn new_test_change_fail_accept_pass() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "probe"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("probe");
+    for file in [
+        "Scorpion.toml",
+        "src/probe.s",
+        "tests/probe.expect",
+        ".gitignore",
+        "README.md",
+    ] {
+        assert!(project.join(file).is_file(), "{file}");
+    }
+
+    let first = scorpion(&project, &["test"]);
+    assert_eq!(first.status.code(), Some(0), "{}", transcript(&first));
+    insta::assert_snapshot!("project_passes_at_once", stdout(&first));
+
+    // From a subdirectory too, as cargo finds its manifest.
+    let below = scorpion(&project.join("src"), &["test"]);
+    assert_eq!(below.status.code(), Some(0), "{}", transcript(&below));
+
+    let source = project.join("src/probe.s");
+    let text = std::fs::read_to_string(&source).expect("the source");
+    std::fs::write(&source, text.replace("VERSION = $01", "VERSION = $02")).expect("edit");
+    let changed = scorpion(&project, &["test"]);
+    assert_eq!(changed.status.code(), Some(1), "{}", transcript(&changed));
+    insta::assert_snapshot!("project_change_fails_with_a_diff", stdout(&changed));
+
+    // The transcript says V01: accepting the snapshots leaves it failing,
+    // until it says what the robot now answers.
+    let accepted = scorpion(&project, &["test", "--accept"]);
+    assert!(
+        stdout(&accepted).contains("test probe/bytes ... accepted"),
+        "{}",
+        transcript(&accepted)
+    );
+    let transcript_file = project.join("tests/probe.expect");
+    let text = std::fs::read_to_string(&transcript_file).expect("the transcript");
+    std::fs::write(&transcript_file, text.replace("V01", "V02")).expect("edit");
+    let again = scorpion(&project, &["test"]);
+    assert_eq!(again.status.code(), Some(0), "{}", transcript(&again));
+    assert!(
+        stdout(&again).ends_with("5 passed, 0 failed\n"),
+        "{}",
+        transcript(&again)
+    );
+
+    let built = scorpion(&project, &["build"]);
+    assert_eq!(built.status.code(), Some(0), "{}", transcript(&built));
+    assert!(project.join("target/scorpion/probe.elf").is_file());
+}
+
+#[test]
+fn an_operating_system_project_passes_at_once() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "os", "--os"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let tested = scorpion(&dir.path().join("os"), &["test"]);
+    assert_eq!(tested.status.code(), Some(0), "{}", transcript(&tested));
+}
+
+#[test]
+fn errors_in_the_project_file_name_its_line() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("Scorpion.toml"),
+        "[project]\nname = \"bad\"\n\n[[image]]\nname = \"bad\"\nsourcse = [\"bad.s\"]\n",
+    )
+    .expect("write the project");
+    let output = scorpion(dir.path(), &["test"]);
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let text = transcript(&output).replace(dir.path().to_str().expect("UTF-8"), "[TMP]");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn outside_a_project_test_says_what_it_looked_for() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let output = scorpion(dir.path(), &["test"]);
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("no Scorpion.toml in"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+#[test]
+fn the_examples_are_projects_that_pass_their_tests() {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    for example in ["rangefinder", "adc", "checksum", "patrol"] {
+        let output = scorpion(&examples.join(example), &["test"]);
+        assert_eq!(
+            output.status.code(),
+            Some(0),
+            "{example}: {}",
+            transcript(&output)
+        );
+        assert!(stdout(&output).contains(" passed, 0 failed"), "{example}");
+    }
+}
