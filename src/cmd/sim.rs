@@ -73,7 +73,7 @@ pub(crate) fn robot(
     rom: Option<&PathBuf>,
     rig: &crate::cmd::rig::Rig,
     images: &[PathBuf],
-) -> miette::Result<(VirtualScorpion, Vec<(String, cards::Printed)>)> {
+) -> miette::Result<Rigged> {
     let mut robot = match rom {
         Some(path) => {
             let bytes = std::fs::read(path)
@@ -129,8 +129,43 @@ pub(crate) fn robot(
     Ok((robot, printed))
 }
 
+/// The virtual robot and what each of its scripts prints.
+type Rigged = (VirtualScorpion, Vec<(String, cards::Printed)>);
+
+/// In a project, with no images, cards or ROM on the command line: the
+/// project's images built and loaded, its cards and surroundings.
+fn project_robot(args: &Args) -> miette::Result<Option<Rigged>> {
+    if !args.images.is_empty() || !args.rig.is_empty() || args.rom.is_some() {
+        return Ok(None);
+    }
+    let Some(root) = std::env::current_dir()
+        .ok()
+        .and_then(|cwd| crate::project::Project::find(&cwd))
+    else {
+        return Ok(None);
+    };
+    let project = crate::project::Project::load(&root)?;
+    let (mut robot, printed) = robot(args.baud, None, &project.rig()?, &[])?;
+    for spec in &project.file.images {
+        let built = crate::project::build::build(&project, spec)?;
+        robot
+            .load_image(&built.linked.image)
+            .wrap_err_with(|| format!("cannot load {}", built.name))?;
+        let _ = writeln!(
+            std::io::stderr(),
+            "loaded {} from {}",
+            built.name,
+            crate::project::FILE
+        );
+    }
+    Ok(Some((robot, printed)))
+}
+
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let (mut robot, printed) = robot(args.baud, args.rom.as_ref(), &args.rig, &args.images)?;
+    let (mut robot, printed) = match project_robot(args)? {
+        Some(found) => found,
+        None => robot(args.baud, args.rom.as_ref(), &args.rig, &args.images)?,
+    };
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }

@@ -42,6 +42,8 @@ pub(crate) struct Args {
 struct Tally {
     passed: usize,
     failed: usize,
+    /// Robot time the virtual transcripts took, all told.
+    robot_time: std::time::Duration,
     out: std::io::StdoutLock<'static>,
 }
 
@@ -169,6 +171,7 @@ fn virtual_transcripts(
     tally: &mut Tally,
 ) -> miette::Result<()> {
     let rig = project.rig()?;
+    let mut robot_time = std::time::Duration::ZERO;
     for path in project.transcripts() {
         let name = format!("transcript {}", relative(project, &path));
         let result = (|| -> miette::Result<()> {
@@ -180,13 +183,16 @@ fn virtual_transcripts(
                     .wrap_err_with(|| format!("cannot load {}", image.name))?;
             }
             let mut client = client(VirtualTransport::new(robot));
-            check(&expectations, &mut client)
+            let result = check(&expectations, &mut client);
+            robot_time += client.transport().now();
+            result
         })();
         tally.record(
             &name,
             result.map(|()| "ok").map_err(|e| indent(&format!("{e:?}"))),
         );
     }
+    tally.robot_time += robot_time;
     Ok(())
 }
 
@@ -223,9 +229,11 @@ fn robot_transcripts(
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let project = Project::here()?;
+    let started = std::time::Instant::now();
     let mut tally = Tally {
         passed: 0,
         failed: 0,
+        robot_time: std::time::Duration::ZERO,
         out: std::io::stdout().lock(),
     };
     let mut built = Vec::new();
@@ -243,9 +251,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     match &args.port {
         Some(port) => {
             let port = if port.is_empty() {
-                project.port().ok_or_else(|| {
+                project.port()?.ok_or_else(|| {
                     miette::miette!(
-                        help = "give it (`--port /dev/ttyUSB0`), set SCORPION_PORT, or add `port` to [robot] in Scorpion.toml",
+                        help = "give it (`--port /dev/ttyUSB0`), set SCORPION_PORT, or add `port` to [robot] in ~/.config/scorpion/config.toml (yours) or Scorpion.toml (the project's)",
                         "no port for the robot"
                     )
                 })?
@@ -264,6 +272,14 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 virtual_transcripts(&project, &built, &mut tally)?;
             }
         }
+    }
+    if !tally.robot_time.is_zero() {
+        let _ = writeln!(
+            tally.out,
+            "transcripts: {:.3} s of robot time in {:.3} s",
+            tally.robot_time.as_secs_f64(),
+            started.elapsed().as_secs_f64()
+        );
     }
     let _ = writeln!(
         tally.out,

@@ -81,6 +81,68 @@ pub(crate) struct TestsSpec {
     pub(crate) transcripts: Vec<String>,
 }
 
+/// The per-user file (`$XDG_CONFIG_HOME/scorpion/config.toml`, else
+/// `~/.config/scorpion/config.toml`): this person's robot, for every
+/// project.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UserSettings {
+    #[serde(default)]
+    robot: UserRobot,
+}
+
+/// `[robot]` of the per-user file.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UserRobot {
+    port: Option<String>,
+    baud: Option<u32>,
+}
+
+/// The per-user file's path.
+pub(crate) fn user_file() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_CONFIG_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|home| PathBuf::from(home).join(".config")))?;
+    Some(base.join("scorpion").join("config.toml"))
+}
+
+/// The per-user settings, if the file exists; an error in it at its
+/// line.
+fn user_settings() -> miette::Result<Option<UserSettings>> {
+    let Some(path) = user_file() else {
+        return Ok(None);
+    };
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return Ok(None);
+    };
+    let name = path.display().to_string();
+    toml::from_str(&text).map(Some).map_err(|error| {
+        located(
+            &name,
+            &text,
+            &error,
+            "the per-user file holds [robot] port and baud",
+        )
+        .into()
+    })
+}
+
+fn located(name: &str, text: &str, error: &toml::de::Error, help: &str) -> ProjectError {
+    let span = error.span().unwrap_or(0..0);
+    let (line, column) = line_col(text, span.start);
+    ProjectError {
+        file: name.to_owned(),
+        line,
+        column,
+        message: error.message().to_owned(),
+        source_code: NamedSource::new(name, text.to_owned()),
+        at: SourceSpan::from((span.start, span.len())),
+        help: Some(help.to_owned()),
+    }
+}
+
 /// An error in the project file, at its place.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[error("{file}:{line}:{column}: {message}")]
@@ -136,20 +198,12 @@ impl Project {
             .display()
             .to_string();
         let file: ProjectFile = toml::from_str(&text).map_err(|error| {
-            let span = error.span().unwrap_or(0..0);
-            let (line, column) = line_col(&text, span.start);
-            ProjectError {
-                file: name.clone(),
-                line,
-                column,
-                message: error.message().to_owned(),
-                source_code: NamedSource::new(&name, text.clone()),
-                at: SourceSpan::from((span.start, span.len())),
-                help: Some(
-                    "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world; [tests] transcripts"
-                        .into(),
-                ),
-            }
+            located(
+                &name,
+                &text,
+                &error,
+                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world; [tests] transcripts",
+            )
         })?;
         if file.images.is_empty() {
             miette::bail!(
@@ -189,21 +243,31 @@ impl Project {
         self.root.join("target").join("scorpion")
     }
 
-    /// The robot's port: `SCORPION_PORT`, else the project's.
-    pub(crate) fn port(&self) -> Option<String> {
-        std::env::var("SCORPION_PORT")
+    /// The robot's port: `SCORPION_PORT`, else the user's file, else the
+    /// project's.
+    pub(crate) fn port(&self) -> miette::Result<Option<String>> {
+        if let Some(port) = std::env::var("SCORPION_PORT")
             .ok()
             .filter(|p| !p.is_empty())
-            .or_else(|| self.file.robot.port.clone())
+        {
+            return Ok(Some(port));
+        }
+        Ok(user_settings()?
+            .and_then(|u| u.robot.port)
+            .or_else(|| self.file.robot.port.clone()))
     }
 
-    /// The baud rate: `SCORPION_BAUD`, else the project's, else 9600.
+    /// The baud rate: `SCORPION_BAUD`, else the user's file, else the
+    /// project's, else 9600.
     pub(crate) fn baud(&self) -> miette::Result<u32> {
         match std::env::var("SCORPION_BAUD") {
             Ok(text) if !text.is_empty() => text
                 .parse()
                 .map_err(|_| miette::miette!("SCORPION_BAUD={text} is not a baud rate")),
-            _ => Ok(self.file.robot.baud.unwrap_or(platform::line::DEFAULT_BAUD)),
+            _ => Ok(user_settings()?
+                .and_then(|u| u.robot.baud)
+                .or(self.file.robot.baud)
+                .unwrap_or(platform::line::DEFAULT_BAUD)),
         }
     }
 

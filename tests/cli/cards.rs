@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::{build_example, scorpion, transcript};
+use crate::{build_example, readme_block, scorpion, transcript};
 
 fn example(path: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -183,17 +183,6 @@ fn the_world_script_sets_the_bumpers_in_sim() {
     let (code, text) = sim_in(dir.path(), &["--world", "wall.rhai"], "/1B\n");
     assert_eq!(code, 0, "{text}");
     assert!(text.contains("B04"), "{text}");
-}
-
-/// The fenced block of `kind` that follows `heading` in README.md.
-fn readme_block(heading: &str, kind: &str) -> String {
-    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
-        .expect("README.md");
-    let section = &readme[readme.find(heading).expect("the section")..];
-    let fence = format!("```{kind}\n");
-    let start = section.find(&fence).expect("the block") + fence.len();
-    let end = start + section[start..].find("```").expect("the block's end");
-    section[start..end].to_string()
 }
 
 #[test]

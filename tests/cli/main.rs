@@ -50,3 +50,15 @@ pub(crate) fn transcript(output: &Output) -> String {
         String::from_utf8_lossy(&output.stderr)
     )
 }
+
+/// The fenced block of `kind` that follows `heading` in README.md.
+pub(crate) fn readme_block(heading: &str, kind: &str) -> String {
+    let readme =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
+            .expect("README.md");
+    let section = &readme[readme.find(heading).expect("the section")..];
+    let fence = format!("```{kind}\n");
+    let start = section.find(&fence).expect("the block") + fence.len();
+    let end = start + section[start..].find("```").expect("the block's end");
+    section[start..end].to_string()
+}

@@ -116,3 +116,120 @@ fn the_examples_are_projects_that_pass_their_tests() {
         assert!(stdout(&output).contains(" passed, 0 failed"), "{example}");
     }
 }
+
+#[test]
+fn a_transcript_line_can_bound_the_answers_robot_time() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "timed"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("timed");
+    let file = project.join("tests/timed.expect");
+    // /1V and V01 are 3 + 4 characters at 9600 baud: about 7.3 ms of line.
+    std::fs::write(&file, "/1V => V01 within 10ms\n").expect("write");
+    let fast = scorpion(&project, &["test"]);
+    assert_eq!(fast.status.code(), Some(0), "{}", transcript(&fast));
+    std::fs::write(&file, "/1V => V01 within 2ms\n").expect("write");
+    let slow = scorpion(&project, &["test"]);
+    assert_eq!(slow.status.code(), Some(1), "{}", transcript(&slow));
+    let text = stdout(&slow);
+    assert!(
+        text.contains("expected `an answer within 2000 us`"),
+        "{text}"
+    );
+    std::fs::write(&file, "/1V => V01 within soon\n").expect("write");
+    let bad = scorpion(&project, &["test"]);
+    assert!(
+        stdout(&bad).contains("is not a time"),
+        "{}",
+        transcript(&bad)
+    );
+}
+
+#[test]
+fn the_readmes_project_section_runs_as_written() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let bin = Path::new(env!("CARGO_BIN_EXE_scorpion"))
+        .parent()
+        .expect("the binary's directory")
+        .to_path_buf();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let script = crate::readme_block("## A project", "sh");
+    let output = std::process::Command::new("sh")
+        .arg("-e")
+        .arg("-c")
+        .arg(format!("exec 2>&1\n{script}"))
+        .current_dir(dir.path())
+        .env("PATH", &path)
+        .env("NO_COLOR", "1")
+        .env_remove("SCORPION_PORT")
+        .env_remove("SCORPION_BAUD")
+        .output()
+        .expect("sh runs");
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        String::from_utf8_lossy(&output.stdout),
+        crate::readme_block("## A project", "text"),
+        "README.md's project section is stale"
+    );
+}
+
+/// `scorpion test --port` uploads and runs the transcripts only; the port
+/// comes from the user's file when the project does not name one, and
+/// `SCORPION_PORT` overrides both.
+#[test]
+fn test_on_a_robot_takes_the_port_from_the_user_or_the_environment() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "robo"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("robo");
+    let config = dir.path().join("config");
+    std::fs::create_dir_all(config.join("scorpion")).expect("mkdir");
+    let run = |extra: &[(&str, &str)]| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_scorpion"));
+        command
+            .args(["test", "--port"])
+            .current_dir(&project)
+            .env("NO_COLOR", "1")
+            .env("XDG_CONFIG_HOME", &config)
+            .env_remove("SCORPION_PORT");
+        for (key, value) in extra {
+            command.env(key, value);
+        }
+        command.output().expect("runs")
+    };
+    let none = run(&[]);
+    assert_eq!(none.status.code(), Some(1), "{}", transcript(&none));
+    assert!(String::from_utf8_lossy(&none.stderr).contains("no port for the robot"));
+
+    std::fs::write(
+        config.join("scorpion/config.toml"),
+        "[robot]\nport = \"emu\"\n",
+    )
+    .expect("write");
+    let mine = run(&[]);
+    assert_eq!(mine.status.code(), Some(0), "{}", transcript(&mine));
+    let text = stdout(&mine);
+    assert!(text.contains("test upload robo ... ok"), "{text}");
+    assert!(!text.contains("listing"), "no snapshots on a robot: {text}");
+
+    std::fs::write(
+        config.join("scorpion/config.toml"),
+        "[robot]\nport = \"/dev/null/none\"\n",
+    )
+    .expect("write");
+    let env = run(&[("SCORPION_PORT", "emu")]);
+    assert_eq!(env.status.code(), Some(0), "{}", transcript(&env));
+
+    std::fs::write(config.join("scorpion/config.toml"), "[robot]\nprot = 1\n").expect("write");
+    let broken = run(&[]);
+    assert_eq!(broken.status.code(), Some(1), "{}", transcript(&broken));
+    assert!(
+        String::from_utf8_lossy(&broken.stderr).contains("config.toml:2:1"),
+        "{}",
+        transcript(&broken)
+    );
+}

@@ -49,6 +49,21 @@ pub struct Expectation {
     pub command: Command,
     /// What must come back.
     pub required: Required,
+    /// `within 2ms`: the longest the answer may take, from sending the
+    /// command to its carriage return (the line's own time included).
+    pub within: Option<std::time::Duration>,
+}
+
+/// `within N` with `cycles` (of the 1 MHz CPU), `us` or `ms`.
+fn budget(text: &str) -> Option<std::time::Duration> {
+    let text = text.trim();
+    let (number, unit) = text.split_at(text.find(|c: char| !c.is_ascii_digit())?);
+    let n: u64 = number.parse().ok()?;
+    match unit.trim() {
+        "cycles" | "us" => Some(std::time::Duration::from_micros(n)),
+        "ms" => Some(std::time::Duration::from_millis(n)),
+        _ => None,
+    }
 }
 
 /// A parsed expectation file.
@@ -74,6 +89,19 @@ impl Expectations {
             let (command, answer) = match content.split_once("=>") {
                 Some((command, answer)) => (command.trim(), Some(answer.trim())),
                 None => (content, None),
+            };
+            let (answer, within) = match answer.and_then(|a| a.rsplit_once(" within ")) {
+                Some((answer, limit)) => {
+                    let within = budget(limit).ok_or_else(|| Error::BadExpectations {
+                        line,
+                        reason: format!(
+                            "`within {}` is not a time: write `within 2ms`, `within 500us` or `within 3000 cycles`",
+                            limit.trim()
+                        ),
+                    })?;
+                    (Some(answer.trim()), Some(within))
+                }
+                None => (answer, None),
             };
             let command: Command = command.parse().map_err(|error| Error::BadExpectations {
                 line,
@@ -105,10 +133,17 @@ impl Expectations {
                     Required::Exactly(text.to_owned())
                 }
             };
+            if within.is_some() && !matches!(required, Required::Any | Required::Exactly(_)) {
+                return Err(Error::BadExpectations {
+                    line,
+                    reason: "`within` needs an answer to time: write `=> ANSWER within 2ms` or `=> * within 2ms`".into(),
+                });
+            }
             lines.push(Expectation {
                 line,
                 command,
                 required,
+                within,
             });
         }
         if lines.is_empty() {
@@ -148,6 +183,7 @@ impl Expectations {
                     heard
                 }
                 Required::Any | Required::Exactly(_) => {
+                    let sent_at = client.transport().now();
                     let answer = match client.ask(command) {
                         Ok(answer) => answer,
                         Err(error) => {
@@ -172,6 +208,20 @@ impl Expectations {
                                 found,
                             });
                         }
+                    }
+                    let took = client.transport().now().saturating_sub(sent_at);
+                    if let Some(within) = expectation.within
+                        && took > within
+                    {
+                        return Err(Error::RehearsalFailed {
+                            command: command.to_string(),
+                            expected: format!("an answer within {} us", within.as_micros()),
+                            found: format!(
+                                "{} after {} us",
+                                answer_text(&answer),
+                                took.as_micros()
+                            ),
+                        });
                     }
                     Some(answer)
                 }
