@@ -32,7 +32,7 @@ fn main() {
         for (index, project) in projects.iter().enumerate() {
             let start = Instant::now();
             let output = Command::new(env!("CARGO_BIN_EXE_scorpion"))
-                .arg("test")
+                .args(["test", "--timing"])
                 .current_dir(examples.join(project))
                 .env_remove("SCORPION_PORT")
                 .output()

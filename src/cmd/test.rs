@@ -36,6 +36,11 @@ pub(crate) struct Args {
     /// port when given without a value.
     #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
     port: Option<String>,
+    /// Also print the robot time the transcripts stood for and the wall
+    /// time they took (left out otherwise: the output stays the same from
+    /// run to run).
+    #[arg(long)]
+    timing: bool,
 }
 
 /// The results, printed as they come.
@@ -273,7 +278,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             }
         }
     }
-    if !tally.robot_time.is_zero() {
+    if args.timing {
         let _ = writeln!(
             tally.out,
             "transcripts: {:.3} s of robot time in {:.3} s",

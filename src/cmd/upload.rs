@@ -31,8 +31,9 @@ use crate::cmd::ports;
 /// eleven, at 19200 baud when the line allows.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// The linked ELF image.
-    image: PathBuf,
+    /// The linked ELF image; none: the images of the project
+    /// (`Scorpion.toml` here or above), built first.
+    image: Option<PathBuf>,
     #[command(flatten)]
     line: ports::Line,
     /// Commands and the answers they must produce (`/1Q => QHELLO`, one a
@@ -242,7 +243,44 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let (linked, image) = read_image(&args.image)?;
+    match &args.image {
+        Some(path) => upload_file(args, path, &args.line.rig),
+        None => {
+            let project = crate::project::Project::here()?;
+            // The project's cards rehearse the upload, unless the command
+            // line names others.
+            let rig = if args.line.rig.is_empty() {
+                project.rig()?
+            } else {
+                args.line.rig.clone()
+            };
+            let dir = project.target_dir();
+            std::fs::create_dir_all(&dir)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot create {}", dir.display()))?;
+            for spec in &project.file.images {
+                let built = crate::project::build::build(&project, spec)?;
+                let path = dir.join(format!("{}.elf", built.name));
+                std::fs::write(&path, linker::Format::Elf.write(&built.linked.image)?)
+                    .into_diagnostic()
+                    .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+                let code = upload_file(args, &path, &rig)?;
+                if code != ExitCode::SUCCESS {
+                    return Ok(code);
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+/// Uploads the linked image at `path`.
+fn upload_file(
+    args: &Args,
+    path: &PathBuf,
+    rig: &crate::cmd::rig::Rig,
+) -> miette::Result<ExitCode> {
+    let (linked, image) = read_image(path)?;
     let expectations = args.expect.as_ref().map(read_expectations).transpose()?;
     let options = args.options();
     let profile = &options.profile;
@@ -254,7 +292,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let mut robot = ports::virtual_robot(args.line.baud, &args.line.rig)?;
+        let mut robot = ports::virtual_robot(args.line.baud, rig)?;
         // A handler that hangs in the rehearsal is named by its label.
         robot.add_labels(&linked);
         let mut client = args.client(VirtualTransport::new(robot), profile);
@@ -286,7 +324,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         out.clear();
     }
 
-    let transport = args.line.open()?;
+    let transport = ports::open(&args.line.port, args.line.baud, rig)?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
     let result = uploader::upload(&mut client, &image, &options, &mut bar);

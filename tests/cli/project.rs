@@ -233,3 +233,20 @@ fn test_on_a_robot_takes_the_port_from_the_user_or_the_environment() {
         transcript(&broken)
     );
 }
+
+#[test]
+fn upload_in_a_project_builds_and_rehearses_with_its_cards() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "up"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("up");
+    let output = scorpion(
+        &project,
+        &["upload", "--port", "emu", "--expect", "tests/up.expect"],
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = stdout(&output);
+    assert!(text.contains("rehearsed on the virtual Scorpion"), "{text}");
+    assert!(text.contains("< V01"), "{text}");
+    assert!(project.join("target/scorpion/up.elf").is_file());
+}
