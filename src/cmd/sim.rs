@@ -145,7 +145,13 @@ fn project_robot(args: &Args) -> miette::Result<Option<Rigged>> {
         return Ok(None);
     };
     let project = crate::project::Project::load(&root)?;
-    let (mut robot, printed) = robot(args.baud, None, &project.rig()?, &[])?;
+    let rom = project
+        .file
+        .robot
+        .rom
+        .as_ref()
+        .map(|rom| project.root.join(rom));
+    let (mut robot, printed) = robot(args.baud, rom.as_ref(), &project.rig()?, &[])?;
     for spec in &project.file.images {
         let built = crate::project::build::build(&project, spec)?;
         robot

@@ -181,7 +181,18 @@ fn virtual_transcripts(
         let name = format!("transcript {}", relative(project, &path));
         let result = (|| -> miette::Result<()> {
             let expectations = read_transcript(&path)?;
-            let mut robot = ports::virtual_robot(project.baud()?, &rig)?;
+            let mut robot = match project.rom()? {
+                Some((name, rom)) => {
+                    let mut robot = romlib::VirtualScorpion::with_rom(&name, &rom)?;
+                    let baud = project.baud()?;
+                    if !robot.set_baud(baud) {
+                        miette::bail!("the Scorpion's 6551 has no {baud} baud rate");
+                    }
+                    rig.apply(&mut robot)?;
+                    robot
+                }
+                None => ports::virtual_robot(project.baud()?, &rig)?,
+            };
             for image in built {
                 robot
                     .load_image(&image.linked.image)

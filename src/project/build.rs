@@ -89,7 +89,13 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
     } else {
         Target::builtin(&spec.target, None)?
     };
-    let rom = Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?;
+    let (rom_name, rom) = match project.rom()? {
+        Some(profile) => profile,
+        None => (
+            "scorpion-rom.elf".to_owned(),
+            Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?,
+        ),
+    };
     let inputs: Vec<Input<'_>> = objects
         .iter()
         .map(|(name, bytes)| Input { name, bytes })
@@ -99,7 +105,7 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
         &LinkOptions {
             target: &target,
             just_symbols: &[SymbolFile {
-                name: "scorpion-rom.elf",
+                name: &rom_name,
                 image: &rom,
             }],
             sources: &source,

@@ -69,6 +69,9 @@ pub(crate) struct RobotSpec {
     pub(crate) cards: Vec<String>,
     /// The surroundings script.
     pub(crate) world: Option<String>,
+    /// A ROM profile (the ROM's linked ELF) the images link against and
+    /// the virtual robot runs, instead of the reference ROM.
+    pub(crate) rom: Option<String>,
 }
 
 /// `[tests]`.
@@ -202,7 +205,7 @@ impl Project {
                 &name,
                 &text,
                 &error,
-                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world; [tests] transcripts",
+                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts",
             )
         })?;
         if file.images.is_empty() {
@@ -285,6 +288,16 @@ impl Project {
             world: self.file.robot.world.as_ref().map(PathBuf::from),
             root: Some(self.root.clone()),
         })
+    }
+
+    /// The ROM profile's path and linked image, if the project names one.
+    pub(crate) fn rom(&self) -> miette::Result<Option<(String, linker::Image)>> {
+        let Some(rom) = &self.file.robot.rom else {
+            return Ok(None);
+        };
+        let bytes = std::fs::read(self.root.join(rom))
+            .map_err(|e| miette::miette!("{}: [robot] rom = \"{rom}\": {e}", super::FILE))?;
+        Ok(Some((rom.clone(), linker::Image::parse(rom, &bytes)?)))
     }
 
     /// The transcript files.

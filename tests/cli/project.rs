@@ -250,3 +250,25 @@ fn upload_in_a_project_builds_and_rehearses_with_its_cards() {
     assert!(text.contains("< V01"), "{text}");
     assert!(project.join("target/scorpion/up.elf").is_file());
 }
+
+#[test]
+fn a_project_can_name_its_rom_profile() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "withrom"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("withrom");
+    std::fs::write(project.join("rom.elf"), romlib::ROM_ELF).expect("write the profile");
+    let file = project.join("Scorpion.toml");
+    let text = std::fs::read_to_string(&file).expect("the project");
+    std::fs::write(&file, format!("{text}rom = \"rom.elf\"\n")).expect("edit");
+    let tested = scorpion(&project, &["test"]);
+    assert_eq!(tested.status.code(), Some(0), "{}", transcript(&tested));
+    std::fs::write(&file, format!("{text}rom = \"missing.elf\"\n")).expect("edit");
+    let missing = scorpion(&project, &["test"]);
+    assert_eq!(missing.status.code(), Some(1), "{}", transcript(&missing));
+    assert!(
+        transcript(&missing).contains("missing.elf"),
+        "{}",
+        transcript(&missing)
+    );
+}
