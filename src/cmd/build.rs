@@ -29,28 +29,13 @@ pub(crate) struct Args {
 /// `NAME.lst` and `NAME.map` in `target/scorpion/`.
 fn project() -> miette::Result<ExitCode> {
     let project = crate::project::Project::here()?;
-    let dir = project.target_dir();
-    std::fs::create_dir_all(&dir)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot create {}", dir.display()))?;
     for spec in &project.file.images {
-        let built = crate::project::build::build(&project, spec)?;
+        let (built, _) = crate::project::build::build_to_target(&project, spec)?;
         for warning in &built.warnings {
             #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
             {
                 eprintln!("{warning:?}");
             }
-        }
-        let elf = linker::Format::Elf.write(&built.linked.image)?;
-        for (ext, bytes) in [
-            ("elf", elf),
-            ("lst", built.listing.clone().into_bytes()),
-            ("map", built.linked.map().into_bytes()),
-        ] {
-            let path = dir.join(format!("{}.{ext}", built.name));
-            std::fs::write(&path, bytes)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot write {}", path.display()))?;
         }
         let bytes: usize = built.linked.image.areas.iter().map(|a| a.bytes.len()).sum();
         #[allow(clippy::print_stdout, reason = "the CLI reports what it wrote")]

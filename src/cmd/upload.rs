@@ -254,16 +254,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             } else {
                 args.line.rig.clone()
             };
-            let dir = project.target_dir();
-            std::fs::create_dir_all(&dir)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot create {}", dir.display()))?;
             for spec in &project.file.images {
-                let built = crate::project::build::build(&project, spec)?;
-                let path = dir.join(format!("{}.elf", built.name));
-                std::fs::write(&path, linker::Format::Elf.write(&built.linked.image)?)
-                    .into_diagnostic()
-                    .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+                let (_, path) = crate::project::build::build_to_target(&project, spec)?;
                 let code = upload_file(args, &path, &rig)?;
                 if code != ExitCode::SUCCESS {
                     return Ok(code);

@@ -122,6 +122,31 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
     })
 }
 
+/// Builds `spec` and writes `NAME.elf`, `NAME.lst` and `NAME.map` into
+/// the project's `target/scorpion/`; returns the build and the image's
+/// path.
+pub(crate) fn build_to_target(
+    project: &Project,
+    spec: &ImageSpec,
+) -> miette::Result<(Built, PathBuf)> {
+    let built = build(project, spec)?;
+    let dir = project.target_dir();
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| miette::miette!("cannot create {}: {e}", dir.display()))?;
+    let elf = linker::Format::Elf.write(&built.linked.image)?;
+    for (ext, bytes) in [
+        ("elf", elf),
+        ("lst", built.listing.clone().into_bytes()),
+        ("map", built.linked.map().into_bytes()),
+    ] {
+        let path = dir.join(format!("{}.{ext}", built.name));
+        std::fs::write(&path, bytes)
+            .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
+    }
+    let path = dir.join(format!("{}.elf", built.name));
+    Ok((built, path))
+}
+
 impl Built {
     /// The image's own symbols (not the ROM's it linked against), a line
     /// each, by address then name.

@@ -15,32 +15,12 @@ fn example(path: &str) -> String {
         .to_string()
 }
 
-/// `scorpion sim ARGS` in `dir` with `input` on stdin; the transcript with
-/// the paths made stable.
+/// `scorpion sim ARGS` in `dir` with `input` on stdin; the exit code and
+/// the transcript with the paths made stable.
 fn sim_in(dir: &Path, args: &[&str], input: &str) -> (i32, String) {
-    use std::io::Write;
-    use std::process::{Command, Stdio};
-    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
-        .current_dir(dir)
-        .arg("sim")
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .env("NO_COLOR", "1")
-        .env("COLUMNS", "100")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the scorpion binary runs");
-    let written = child
-        .stdin
-        .take()
-        .expect("stdin is piped")
-        .write_all(input.as_bytes());
-    if let Err(error) = written {
-        assert_eq!(error.kind(), std::io::ErrorKind::BrokenPipe);
-    }
-    let output = child.wait_with_output().expect("sim ends");
+    let mut all = vec!["sim"];
+    all.extend(args);
+    let output = crate::scorpion_with_input(Some(dir), &all, input);
     let text = transcript(&output)
         .replace(&example(""), "[EXAMPLES]/")
         .replace(dir.to_str().expect("UTF-8"), "[TMP]");
@@ -193,15 +173,7 @@ fn the_readmes_own_card_section_runs_as_written() {
         dir.path().join("examples"),
     )
     .expect("link the examples");
-    let bin = Path::new(env!("CARGO_BIN_EXE_scorpion"))
-        .parent()
-        .expect("the binary's directory")
-        .to_path_buf();
-    let path = format!(
-        "{}:{}",
-        bin.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
+    let path = crate::path_with_scorpion();
     let mut printed = String::new();
     for line in readme_block("## Your own card", "sh").lines() {
         let output = std::process::Command::new("sh")

@@ -62,3 +62,58 @@ pub(crate) fn readme_block(heading: &str, kind: &str) -> String {
     let end = start + section[start..].find("```").expect("the block's end");
     section[start..end].to_string()
 }
+
+/// Runs `scorpion ARGS` (in `dir`, else the package's directory) with
+/// `input` on stdin. A command that exits before reading its input (a sim
+/// that refuses its images) is not an error here.
+pub(crate) fn scorpion_with_input(
+    dir: Option<&std::path::Path>,
+    args: &[&str],
+    input: &str,
+) -> Output {
+    use std::io::Write as _;
+    use std::process::Stdio;
+    let mut command = Command::new(env!("CARGO_BIN_EXE_scorpion"));
+    if let Some(dir) = dir {
+        command.current_dir(dir);
+    }
+    let mut child = command
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .env("NO_COLOR", "1")
+        .env("COLUMNS", "100")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the scorpion binary runs");
+    let written = child
+        .stdin
+        .take()
+        .expect("stdin is piped")
+        .write_all(input.as_bytes());
+    if let Err(error) = written {
+        assert_eq!(
+            error.kind(),
+            std::io::ErrorKind::BrokenPipe,
+            "the input is written"
+        );
+    }
+    child
+        .wait_with_output()
+        .expect("scorpion ends at the end of its input")
+}
+
+/// `PATH` with the `scorpion` binary's directory first: how a README's
+/// commands find it.
+pub(crate) fn path_with_scorpion() -> String {
+    let bin = std::path::Path::new(env!("CARGO_BIN_EXE_scorpion"))
+        .parent()
+        .expect("the binary's directory")
+        .to_path_buf();
+    format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    )
+}

@@ -148,15 +148,7 @@ fn a_transcript_line_can_bound_the_answers_robot_time() {
 #[test]
 fn the_readmes_project_section_runs_as_written() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let bin = Path::new(env!("CARGO_BIN_EXE_scorpion"))
-        .parent()
-        .expect("the binary's directory")
-        .to_path_buf();
-    let path = format!(
-        "{}:{}",
-        bin.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
+    let path = crate::path_with_scorpion();
     let script = crate::readme_block("## A project", "sh");
     let output = std::process::Command::new("sh")
         .arg("-e")

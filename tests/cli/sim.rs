@@ -9,33 +9,9 @@ use crate::{build_example, scorpion, transcript};
 
 /// Runs `scorpion sim ARGS` with `input` on stdin.
 fn sim(args: &[&str], input: &str) -> std::process::Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
-        .arg("sim")
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .env("NO_COLOR", "1")
-        .env("COLUMNS", "100")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the scorpion binary runs");
-    let written = child
-        .stdin
-        .take()
-        .expect("stdin is piped")
-        .write_all(input.as_bytes());
-    // A sim that refuses its images exits before reading its input.
-    if let Err(error) = written {
-        assert_eq!(
-            error.kind(),
-            std::io::ErrorKind::BrokenPipe,
-            "the commands are written"
-        );
-    }
-    child
-        .wait_with_output()
-        .expect("scorpion sim ends at the end of stdin")
+    let mut all = vec!["sim"];
+    all.extend(args);
+    crate::scorpion_with_input(None, &all, input)
 }
 
 /// `scorpion sim` with `images` (in `dir`) and `input`; its output, and
