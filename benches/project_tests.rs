@@ -13,14 +13,17 @@ use std::time::Instant;
 
 const ROUNDS: usize = 5;
 
-/// Robot seconds the run's `transcripts:` line reports.
-fn robot_seconds(stdout: &str) -> f64 {
-    stdout
+/// Robot seconds and the runner's wall seconds that the run's
+/// `transcripts:` line reports.
+fn transcript_seconds(stdout: &str) -> (f64, f64) {
+    let words: Vec<&str> = stdout
         .lines()
         .find_map(|line| line.strip_prefix("transcripts: "))
-        .and_then(|rest| rest.split_whitespace().next())
-        .and_then(|number| number.parse().ok())
-        .unwrap_or(0.0)
+        .map(|rest| rest.split_whitespace().collect())
+        .unwrap_or_default();
+    let number = |index: usize| words.get(index).and_then(|w| w.parse().ok()).unwrap_or(0.0);
+    // "R s of robot time in W s (...)"
+    (number(0), number(6))
 }
 
 fn main() {
@@ -28,6 +31,7 @@ fn main() {
     let projects = ["rangefinder", "adc", "checksum", "patrol"];
     let mut best = vec![f64::MAX; projects.len()];
     let mut robot = vec![0.0; projects.len()];
+    let mut runner = vec![f64::MAX; projects.len()];
     for _ in 0..ROUNDS {
         for (index, project) in projects.iter().enumerate() {
             let start = Instant::now();
@@ -41,29 +45,42 @@ fn main() {
             let stdout = String::from_utf8_lossy(&output.stdout);
             assert!(output.status.success(), "{project}: {stdout}");
             best[index] = best[index].min(wall);
-            robot[index] = robot_seconds(&stdout);
+            let (robot_time, transcripts) = transcript_seconds(&stdout);
+            robot[index] = robot_time;
+            runner[index] = runner[index].min(transcripts);
         }
     }
     println!("scorpion test on the example projects (best of {ROUNDS}, a fresh process each)");
     println!(
-        "  {:<12} {:>12} {:>10} {:>10}",
-        "project", "robot time", "wall", "x robot"
+        "  {:<12} {:>12} {:>14} {:>9} {:>11} {:>9}",
+        "project", "robot time", "transcripts", "x robot", "whole run", "x robot"
     );
-    for ((project, wall), robot) in projects.iter().zip(&best).zip(&robot) {
+    for (((project, wall), robot), runner) in projects.iter().zip(&best).zip(&robot).zip(&runner) {
         println!(
-            "  {project:<12} {robot:>10.3} s {wall:>8.3} s {:>10.0}",
+            "  {project:<12} {robot:>10.3} s {runner:>12.6} s {:>9.0} {wall:>9.4} s {:>9.0}",
+            robot / runner,
             robot / wall
         );
     }
     let wall: f64 = best.iter().sum();
+    let runner: f64 = runner.iter().sum();
     let robot: f64 = robot.iter().sum();
     let ratio = robot / wall;
+    let runner_ratio = robot / runner;
     println!(
-        "  {:<12} {robot:>10.3} s {wall:>8.3} s {ratio:>10.0}",
+        "  {:<12} {robot:>10.3} s {runner:>12.6} s {runner_ratio:>9.0} {wall:>9.4} s {ratio:>9.0}",
         "suite"
     );
     println!(
-        "  goals: 1000x the robot ({ratio:.0}x: {}), under a second ({wall:.3} s: {})",
+        "  (transcripts: the runner's own time for them, robots set up and images loaded; whole run: a process per project: start, build, snapshots, transcripts)"
+    );
+    println!(
+        "  goals: 1000x the robot (transcripts {runner_ratio:.0}x: {}; whole runs {ratio:.0}x: {}), under a second ({wall:.3} s: {})",
+        if runner_ratio >= 1000.0 {
+            "met"
+        } else {
+            "MISSED"
+        },
         if ratio >= 1000.0 { "met" } else { "MISSED" },
         if wall < 1.0 { "met" } else { "MISSED" }
     );

@@ -85,6 +85,27 @@ pub struct VirtualScorpion {
     world: Option<Box<dyn Surroundings>>,
 }
 
+/// The reference ROM's labels, read from its ELF once per process (every
+/// virtual robot starts with them).
+fn reference_labels() -> &'static [(u16, String)] {
+    static LABELS: std::sync::OnceLock<Vec<(u16, String)>> = std::sync::OnceLock::new();
+    LABELS.get_or_init(|| {
+        let mut labels: Vec<(u16, String)> = Image::parse("scorpion-rom.elf", crate::ROM_ELF)
+            .map(|rom| {
+                rom.symbols
+                    .iter()
+                    .filter_map(|symbol| {
+                        symbol.section?;
+                        Some((u16::try_from(symbol.value).ok()?, symbol.name.clone()))
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        labels.sort();
+        labels
+    })
+}
+
 /// The robot's surroundings: what closes its bumpers, lights its
 /// phototransistors, over robot time and in answer to its motion. The
 /// session wakes them at the robot time they ask for.
@@ -131,9 +152,7 @@ impl VirtualScorpion {
             labels: Vec::new(),
             world: None,
         };
-        if let Ok(rom) = Image::parse("scorpion-rom.elf", crate::ROM_ELF) {
-            scorpion.add_labels(&rom);
-        }
+        scorpion.labels = reference_labels().to_vec();
         scorpion.boot();
         scorpion
     }
