@@ -124,6 +124,47 @@ fn check_snapshots(
     Ok(())
 }
 
+/// Snapshot files no image and kind of the project makes (an image renamed
+/// or removed): a failure, or deleted with `--accept`.
+fn stale_snapshots(project: &Project, accept: bool, tally: &mut Tally) -> miette::Result<()> {
+    let dir = project.root.join("tests").join("snapshots");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return Ok(());
+    };
+    let wanted: Vec<PathBuf> = project
+        .file
+        .images
+        .iter()
+        .flat_map(|image| {
+            ["listing", "map", "symbols", "bytes"]
+                .map(|kind| snapshot_path(project, &image.name, kind))
+        })
+        .collect();
+    let mut stale: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|entry| entry.path())
+        .filter(|path| path.extension().is_some_and(|ext| ext == "snap") && !wanted.contains(path))
+        .collect();
+    stale.sort();
+    for path in stale {
+        let shown = relative(project, &path);
+        if accept {
+            std::fs::remove_file(&path)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot delete {shown}"))?;
+            tally.record(&format!("stale {shown}"), Ok("deleted"));
+        } else {
+            tally.record(
+                &format!("stale {shown}"),
+                Err(format!(
+                    "  no image of {FILE} makes {shown}; `scorpion test --accept` deletes it"
+                )),
+            );
+        }
+    }
+    Ok(())
+}
+
 fn indent(text: &str) -> String {
     text.lines().fold(String::new(), |mut out, line| {
         let _ = writeln!(out, "    {line}");
@@ -288,6 +329,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         None => {
             for image in &built {
                 check_snapshots(&project, image, args.accept, &mut tally)?;
+            }
+            if built.len() == project.file.images.len() {
+                stale_snapshots(&project, args.accept, &mut tally)?;
             }
             if tally.failed == 0 || built.len() == project.file.images.len() {
                 virtual_transcripts(&project, &built, &mut tally)?;

@@ -62,6 +62,20 @@ fn new_test_change_fail_accept_pass() {
         transcript(&again)
     );
 
+    // A snapshot no image makes any more fails, and --accept deletes it.
+    let stale = project.join("tests/snapshots/gone__bytes.snap");
+    std::fs::write(
+        &stale,
+        "---\nsource: Scorpion.toml\nexpression: gone/bytes\n---\n",
+    )
+    .expect("write");
+    let failed = scorpion(&project, &["test"]);
+    assert_eq!(failed.status.code(), Some(1), "{}", transcript(&failed));
+    assert!(stdout(&failed).contains("test stale tests/snapshots/gone__bytes.snap ... FAILED"));
+    let cleaned = scorpion(&project, &["test", "--accept"]);
+    assert_eq!(cleaned.status.code(), Some(0), "{}", transcript(&cleaned));
+    assert!(!stale.exists());
+
     let built = scorpion(&project, &["build"]);
     assert_eq!(built.status.code(), Some(0), "{}", transcript(&built));
     assert!(project.join("target/scorpion/probe.elf").is_file());
