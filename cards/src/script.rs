@@ -56,7 +56,16 @@ impl Printed {
 /// An engine with the sandbox's limits; `register` adds the host's
 /// functions for the kind of script.
 pub(crate) fn engine(printed: &Arc<Mutex<Vec<String>>>) -> Engine {
-    let mut engine = Engine::new();
+    // Rhai's standard library, built once and shared by every script's
+    // engine: a robot with cards is set up per transcript test.
+    static STANDARD: std::sync::OnceLock<rhai::Shared<rhai::Module>> = std::sync::OnceLock::new();
+    let standard = STANDARD.get_or_init(|| {
+        use rhai::packages::Package as _;
+        rhai::packages::StandardPackage::new().as_shared_module()
+    });
+    let mut engine = Engine::new_raw();
+    engine.register_global_module(standard.clone());
+    engine.set_max_strings_interned(256);
     engine.set_max_operations(OPERATION_BUDGET);
     engine.set_max_call_levels(MAX_CALL_LEVELS);
     engine.set_max_expr_depths(64, 32);
