@@ -212,6 +212,78 @@ fn client<T: Transport>(transport: T) -> Client<T> {
     )
 }
 
+/// A virtual Scorpion with the project's ROM, cards and surroundings, the
+/// images loaded as an upload leaves them.
+fn fresh_robot(
+    project: &Project,
+    built: &[Built],
+    rig: &crate::cmd::rig::Rig,
+) -> miette::Result<romlib::VirtualScorpion> {
+    let mut robot = match project.rom()? {
+        Some((name, rom)) => {
+            let mut robot = romlib::VirtualScorpion::with_rom(&name, &rom)?;
+            let baud = project.baud()?;
+            if !robot.set_baud(baud) {
+                miette::bail!("the Scorpion's 6551 has no {baud} baud rate");
+            }
+            rig.apply(&mut robot)?;
+            robot
+        }
+        None => ports::virtual_robot(project.baud()?, rig)?,
+    };
+    for image in built {
+        robot
+            .load_image(&image.linked.image)
+            .wrap_err_with(|| format!("cannot load {}", image.name))?;
+    }
+    Ok(robot)
+}
+
+/// Every `tests/*.calls` file: each call on a fresh virtual Scorpion.
+fn routine_calls(project: &Project, built: &[Built], tally: &mut Tally) -> miette::Result<()> {
+    let rig = project.rig()?;
+    let mut symbols = std::collections::HashMap::new();
+    for image in built {
+        for symbol in &image.linked.image.symbols {
+            if let Ok(value) = u16::try_from(symbol.value) {
+                symbols.entry(symbol.name.clone()).or_insert(value);
+            }
+        }
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(project.root.join("tests"))
+        .into_iter()
+        .flatten()
+        .filter_map(Result::ok)
+        .map(|entry| entry.path())
+        .filter(|path| path.extension().is_some_and(|ext| ext == "calls"))
+        .collect();
+    files.sort();
+    for path in files {
+        let shown = relative(project, &path);
+        let text = std::fs::read_to_string(&path)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot read {shown}"))?;
+        let calls = match crate::project::calls::parse(&text, &symbols) {
+            Ok(calls) => calls,
+            Err(why) => {
+                tally.record(&format!("calls {shown}"), Err(format!("  {shown}: {why}")));
+                continue;
+            }
+        };
+        for call in calls {
+            let name = format!("call {shown}:{} {}", call.line, call.routine);
+            let result = fresh_robot(project, built, &rig)
+                .map_err(|e| format!("{e:?}"))
+                .and_then(|mut robot| crate::project::calls::run(&call, &mut robot));
+            tally.record(
+                &name,
+                result.map(|()| "ok").map_err(|why| format!("  {why}")),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Every transcript on a fresh virtual Scorpion with the images loaded.
 fn virtual_transcripts(
     project: &Project,
@@ -225,23 +297,7 @@ fn virtual_transcripts(
         let name = format!("transcript {}", relative(project, &path));
         let result = (|| -> miette::Result<()> {
             let expectations = read_transcript(&path)?;
-            let mut robot = match project.rom()? {
-                Some((name, rom)) => {
-                    let mut robot = romlib::VirtualScorpion::with_rom(&name, &rom)?;
-                    let baud = project.baud()?;
-                    if !robot.set_baud(baud) {
-                        miette::bail!("the Scorpion's 6551 has no {baud} baud rate");
-                    }
-                    rig.apply(&mut robot)?;
-                    robot
-                }
-                None => ports::virtual_robot(project.baud()?, &rig)?,
-            };
-            for image in built {
-                robot
-                    .load_image(&image.linked.image)
-                    .wrap_err_with(|| format!("cannot load {}", image.name))?;
-            }
+            let robot = fresh_robot(project, built, &rig)?;
             let mut client = client(VirtualTransport::new(robot));
             let result = check(&expectations, &mut client);
             robot_time += client.transport().now();
@@ -335,6 +391,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             }
             if tally.failed == 0 || built.len() == project.file.images.len() {
                 virtual_transcripts(&project, &built, &mut tally)?;
+                routine_calls(&project, &built, &mut tally)?;
             }
         }
     }

@@ -8,10 +8,12 @@
 //! - [`build`]: an image built in memory, with its listing, map, symbols
 //!   and bytes.
 //! - [`snapshot`]: insta-format snapshot files and their diffs.
+//! - [`calls`]: routine-level tests (`tests/*.calls`).
 //!
 //! Nothing here prints: `scorpion build`, `test` and `new` do.
 
 pub(crate) mod build;
+pub(crate) mod calls;
 pub(crate) mod config;
 pub(crate) mod snapshot;
 

@@ -278,3 +278,61 @@ fn a_project_can_name_its_rom_profile() {
         transcript(&missing)
     );
 }
+
+#[test]
+fn routine_calls_check_registers_memory_and_cycles() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "calls"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("calls");
+    let source = project.join("src/calls.s");
+    let mut text = std::fs::read_to_string(&source).expect("the source");
+    text.push_str(
+        "\n; Routines for tests/calls.calls.\ndouble: asl a\n        rts\nclear:  lda #0\n        sta buffer\n        sta buffer+1\n        rts\n        .bss\nbuffer: .res 2\n",
+    );
+    std::fs::write(&source, text).expect("edit");
+    std::fs::write(
+        project.join("tests/calls.calls"),
+        "# routine-level tests\ncall double A=$21 => A=$42 C=0 within 20 cycles\ncall clear buffer=FF FF => buffer=00 00\n",
+    )
+    .expect("write");
+    let passed = scorpion(&project, &["test", "--accept"]);
+    assert_eq!(passed.status.code(), Some(0), "{}", transcript(&passed));
+    let text = stdout(&passed);
+    assert!(
+        text.contains("test call tests/calls.calls:2 double ... ok"),
+        "{text}"
+    );
+    assert!(
+        text.contains("test call tests/calls.calls:3 clear ... ok"),
+        "{text}"
+    );
+
+    std::fs::write(
+        project.join("tests/calls.calls"),
+        "call double A=$81 => A=$02 C=0\n",
+    )
+    .expect("write");
+    let failed = scorpion(&project, &["test"]);
+    assert_eq!(failed.status.code(), Some(1), "{}", transcript(&failed));
+    let text = stdout(&failed);
+    assert!(text.contains("C=$01, expected $00"), "{text}");
+    std::fs::write(project.join("tests/calls.calls"), "call nowhere => A=0\n").expect("write");
+    let unknown = scorpion(&project, &["test"]);
+    assert!(
+        stdout(&unknown).contains("line 1: `nowhere` is neither an address nor a symbol"),
+        "{}",
+        transcript(&unknown)
+    );
+    std::fs::write(
+        project.join("tests/calls.calls"),
+        "call double A=$01 => A=$02 within 5 cycles\n",
+    )
+    .expect("write");
+    let slow = scorpion(&project, &["test"]);
+    assert!(
+        stdout(&slow).contains("did not return within 5 cycles"),
+        "{}",
+        transcript(&slow)
+    );
+}
