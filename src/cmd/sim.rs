@@ -132,12 +132,10 @@ pub(crate) fn robot(
 /// The virtual robot and what each of its scripts prints.
 type Rigged = (VirtualScorpion, Vec<(String, cards::Printed)>);
 
-/// In a project, with no images, cards or ROM on the command line: the
-/// project's images built and loaded, its cards and surroundings.
+/// In a project: its ROM profile, cards and surroundings, and its images
+/// built and loaded; each given on the command line (`--rom`, `--card` or
+/// `--world`, `--image`) instead overrides that part.
 fn project_robot(args: &Args) -> miette::Result<Option<Rigged>> {
-    if !args.images.is_empty() || !args.rig.is_empty() || args.rom.is_some() {
-        return Ok(None);
-    }
     let Some(root) = std::env::current_dir()
         .ok()
         .and_then(|cwd| crate::project::Project::find(&cwd))
@@ -145,13 +143,23 @@ fn project_robot(args: &Args) -> miette::Result<Option<Rigged>> {
         return Ok(None);
     };
     let project = crate::project::Project::load(&root)?;
-    let rom = project
-        .file
-        .robot
-        .rom
-        .as_ref()
-        .map(|rom| project.root.join(rom));
-    let (mut robot, printed) = robot(args.baud, rom.as_ref(), &project.rig()?, &[])?;
+    let rom = args.rom.clone().or_else(|| {
+        project
+            .file
+            .robot
+            .rom
+            .as_ref()
+            .map(|rom| project.root.join(rom))
+    });
+    let rig = if args.rig.is_empty() {
+        project.rig()?
+    } else {
+        args.rig.clone()
+    };
+    let (mut robot, printed) = robot(args.baud, rom.as_ref(), &rig, &args.images)?;
+    if !args.images.is_empty() {
+        return Ok(Some((robot, printed)));
+    }
     for spec in &project.file.images {
         let built = crate::project::build::build(&project, spec)?;
         robot

@@ -336,3 +336,32 @@ fn routine_calls_check_registers_memory_and_cycles() {
         transcript(&slow)
     );
 }
+
+#[test]
+fn sim_in_a_project_takes_overrides_part_by_part() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "over"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("over");
+    std::fs::write(project.join("wall.rhai"), "fn init() { bumpers(0x04); }\n").expect("write");
+    // --world replaces the surroundings only: the project's image is there.
+    let output = crate::scorpion_with_input(
+        Some(&project),
+        &["sim", "--world", "wall.rhai"],
+        "/1V\n/1B\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    assert_eq!(stdout(&output), "V01\nB04\n", "{}", transcript(&output));
+    // --image replaces the images: /1V is nobody's then.
+    let other = scorpion(&project, &["build"]);
+    assert_eq!(other.status.code(), Some(0), "{}", transcript(&other));
+    std::fs::copy(
+        project.join("target/scorpion/over.elf"),
+        project.join("copy.elf"),
+    )
+    .expect("copy");
+    let output =
+        crate::scorpion_with_input(Some(&project), &["sim", "--image", "copy.elf"], "/1V\n");
+    assert_eq!(stdout(&output), "V01\n", "{}", transcript(&output));
+    assert!(!String::from_utf8_lossy(&output.stderr).contains("from Scorpion.toml"));
+}
