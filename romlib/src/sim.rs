@@ -85,21 +85,21 @@ pub struct VirtualScorpion {
     world: Option<Box<dyn Surroundings>>,
 }
 
+/// An image's labels: its symbols that lie in a section (not constants).
+fn labels_of(image: &Image) -> impl Iterator<Item = (u16, String)> + '_ {
+    image.symbols.iter().filter_map(|symbol| {
+        symbol.section?;
+        Some((u16::try_from(symbol.value).ok()?, symbol.name.clone()))
+    })
+}
+
 /// The reference ROM's labels, read from its ELF once per process (every
 /// virtual robot starts with them).
 fn reference_labels() -> &'static [(u16, String)] {
     static LABELS: std::sync::OnceLock<Vec<(u16, String)>> = std::sync::OnceLock::new();
     LABELS.get_or_init(|| {
         let mut labels: Vec<(u16, String)> = Image::parse("scorpion-rom.elf", crate::ROM_ELF)
-            .map(|rom| {
-                rom.symbols
-                    .iter()
-                    .filter_map(|symbol| {
-                        symbol.section?;
-                        Some((u16::try_from(symbol.value).ok()?, symbol.name.clone()))
-                    })
-                    .collect()
-            })
+            .map(|rom| labels_of(&rom).collect())
             .unwrap_or_default();
         labels.sort();
         labels
@@ -284,11 +284,7 @@ impl VirtualScorpion {
     /// Keeps `image`'s labels (symbols in its sections) for
     /// [`Error::Stuck`] reports (loading an image keeps its own).
     pub fn add_labels(&mut self, image: &Image) {
-        self.labels
-            .extend(image.symbols.iter().filter_map(|symbol| {
-                symbol.section?;
-                Some((u16::try_from(symbol.value).ok()?, symbol.name.clone()))
-            }));
+        self.labels.extend(labels_of(image));
         self.labels.sort();
     }
 

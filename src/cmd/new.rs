@@ -189,18 +189,10 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let project = Project::load(&root)?;
     for spec in &project.file.images {
         let built = build(&project, spec)?;
-        for (kind, content) in [
-            ("listing", built.listing.clone()),
-            ("map", built.linked.map()),
-            ("symbols", built.symbols()),
-            ("bytes", built.bytes()),
-        ] {
+        for (kind, content) in built.snapshots() {
             let label = format!("{}/{kind}", built.name);
             write(
-                &root
-                    .join("tests")
-                    .join("snapshots")
-                    .join(format!("{}__{kind}.snap", built.name)),
+                &project.snapshot_path(&built.name, kind),
                 &snapshot::render(FILE, &label, &content),
             )?;
         }

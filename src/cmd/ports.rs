@@ -65,12 +65,17 @@ pub(crate) const DEFAULT_BAUD: u32 = platform::line::DEFAULT_BAUD;
 pub(crate) const EMU: &str = "emu";
 
 /// A fresh virtual Scorpion whose DIP switches and host line are at `baud`,
-/// with the cards and surroundings of `rig`.
+/// with the cards and surroundings of `rig`, running the ROM profile `rom`
+/// (its name and linked image) or the reference ROM.
 pub(crate) fn virtual_robot(
     baud: u32,
+    rom: Option<&(String, linker::Image)>,
     rig: &crate::cmd::rig::Rig,
 ) -> miette::Result<VirtualScorpion> {
-    let mut robot = VirtualScorpion::new();
+    let mut robot = match rom {
+        Some((name, image)) => VirtualScorpion::with_rom(name, image)?,
+        None => VirtualScorpion::new(),
+    };
     if !robot.set_baud(baud) {
         miette::bail!(
             help = "the 6551 runs at 50 to 19200 baud; the reference ROM's rate is 9600",
@@ -91,7 +96,9 @@ pub(crate) fn open(
     rig: &crate::cmd::rig::Rig,
 ) -> miette::Result<Box<dyn Transport>> {
     if port == EMU {
-        return Ok(Box::new(VirtualTransport::new(virtual_robot(baud, rig)?)));
+        return Ok(Box::new(VirtualTransport::new(virtual_robot(
+            baud, None, rig,
+        )?)));
     }
     if !rig.is_empty() {
         miette::bail!(

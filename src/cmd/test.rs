@@ -17,7 +17,7 @@ use uploader::{
 };
 
 use crate::cmd::ports;
-use crate::project::build::{Built, build};
+use crate::project::build::{Built, SNAPSHOT_KINDS, build};
 use crate::project::snapshot::{self, Outcome};
 use crate::project::{FILE, Project};
 
@@ -69,28 +69,14 @@ impl Tally {
     }
 }
 
-fn snapshot_path(project: &Project, image: &str, kind: &str) -> PathBuf {
-    project
-        .root
-        .join("tests")
-        .join("snapshots")
-        .join(format!("{image}__{kind}.snap"))
-}
-
 fn check_snapshots(
     project: &Project,
     built: &Built,
     accept: bool,
     tally: &mut Tally,
 ) -> miette::Result<()> {
-    let texts = [
-        ("listing", built.listing.clone()),
-        ("map", built.linked.map()),
-        ("symbols", built.symbols()),
-        ("bytes", built.bytes()),
-    ];
-    for (kind, content) in texts {
-        let path = snapshot_path(project, &built.name, kind);
+    for (kind, content) in built.snapshots() {
+        let path = project.snapshot_path(&built.name, kind);
         let name = format!("{}/{kind}", built.name);
         let outcome = snapshot::compare(&path, &content);
         if outcome == Outcome::Same {
@@ -135,10 +121,7 @@ fn stale_snapshots(project: &Project, accept: bool, tally: &mut Tally) -> miette
         .file
         .images
         .iter()
-        .flat_map(|image| {
-            ["listing", "map", "symbols", "bytes"]
-                .map(|kind| snapshot_path(project, &image.name, kind))
-        })
+        .flat_map(|image| SNAPSHOT_KINDS.map(|kind| project.snapshot_path(&image.name, kind)))
         .collect();
     let mut stale: Vec<PathBuf> = entries
         .filter_map(Result::ok)
@@ -212,36 +195,42 @@ fn client<T: Transport>(transport: T) -> Client<T> {
     )
 }
 
-/// A virtual Scorpion with the project's ROM, cards and surroundings, the
-/// images loaded as an upload leaves them.
-fn fresh_robot(
-    project: &Project,
-    built: &[Built],
-    rig: &crate::cmd::rig::Rig,
-) -> miette::Result<romlib::VirtualScorpion> {
-    let mut robot = match project.rom()? {
-        Some((name, rom)) => {
-            let mut robot = romlib::VirtualScorpion::with_rom(&name, &rom)?;
-            let baud = project.baud()?;
-            if !robot.set_baud(baud) {
-                miette::bail!("the Scorpion's 6551 has no {baud} baud rate");
-            }
-            rig.apply(&mut robot)?;
-            robot
-        }
-        None => ports::virtual_robot(project.baud()?, rig)?,
-    };
-    for image in built {
-        robot
-            .load_image(&image.linked.image)
-            .wrap_err_with(|| format!("cannot load {}", image.name))?;
+/// What every virtual robot of a run is made of, read once: the line's
+/// rate, the project's ROM profile, its cards and surroundings.
+struct Setup {
+    baud: u32,
+    rom: Option<(String, linker::Image)>,
+    rig: crate::cmd::rig::Rig,
+}
+
+impl Setup {
+    fn of(project: &Project) -> miette::Result<Setup> {
+        Ok(Setup {
+            baud: project.baud()?,
+            rom: project.rom()?,
+            rig: project.rig()?,
+        })
     }
-    Ok(robot)
+
+    /// A fresh robot with the images loaded as an upload leaves them.
+    fn robot(&self, built: &[Built]) -> miette::Result<romlib::VirtualScorpion> {
+        let mut robot = ports::virtual_robot(self.baud, self.rom.as_ref(), &self.rig)?;
+        for image in built {
+            robot
+                .load_image(&image.linked.image)
+                .wrap_err_with(|| format!("cannot load {}", image.name))?;
+        }
+        Ok(robot)
+    }
 }
 
 /// Every `tests/*.calls` file: each call on a fresh virtual Scorpion.
-fn routine_calls(project: &Project, built: &[Built], tally: &mut Tally) -> miette::Result<()> {
-    let rig = project.rig()?;
+fn routine_calls(
+    project: &Project,
+    setup: &Setup,
+    built: &[Built],
+    tally: &mut Tally,
+) -> miette::Result<()> {
     let mut symbols = std::collections::HashMap::new();
     for image in built {
         for symbol in &image.linked.image.symbols {
@@ -250,15 +239,7 @@ fn routine_calls(project: &Project, built: &[Built], tally: &mut Tally) -> miett
             }
         }
     }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(project.root.join("tests"))
-        .into_iter()
-        .flatten()
-        .filter_map(Result::ok)
-        .map(|entry| entry.path())
-        .filter(|path| path.extension().is_some_and(|ext| ext == "calls"))
-        .collect();
-    files.sort();
-    for path in files {
+    for path in project.test_files("calls") {
         let shown = relative(project, &path);
         let text = std::fs::read_to_string(&path)
             .into_diagnostic()
@@ -272,7 +253,8 @@ fn routine_calls(project: &Project, built: &[Built], tally: &mut Tally) -> miett
         };
         for call in calls {
             let name = format!("call {shown}:{} {}", call.line, call.routine);
-            let result = fresh_robot(project, built, &rig)
+            let result = setup
+                .robot(built)
                 .map_err(|e| format!("{e:?}"))
                 .and_then(|mut robot| crate::project::calls::run(&call, &mut robot));
             tally.record(
@@ -287,17 +269,17 @@ fn routine_calls(project: &Project, built: &[Built], tally: &mut Tally) -> miett
 /// Every transcript on a fresh virtual Scorpion with the images loaded.
 fn virtual_transcripts(
     project: &Project,
+    setup: &Setup,
     built: &[Built],
     tally: &mut Tally,
 ) -> miette::Result<()> {
-    let rig = project.rig()?;
     let mut robot_time = std::time::Duration::ZERO;
     let started = std::time::Instant::now();
     for path in project.transcripts() {
         let name = format!("transcript {}", relative(project, &path));
         let result = (|| -> miette::Result<()> {
             let expectations = read_transcript(&path)?;
-            let robot = fresh_robot(project, built, &rig)?;
+            let robot = setup.robot(built)?;
             let mut client = client(VirtualTransport::new(robot));
             let result = check(&expectations, &mut client);
             robot_time += client.transport().now();
@@ -390,8 +372,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 stale_snapshots(&project, args.accept, &mut tally)?;
             }
             if tally.failed == 0 || built.len() == project.file.images.len() {
-                virtual_transcripts(&project, &built, &mut tally)?;
-                routine_calls(&project, &built, &mut tally)?;
+                let setup = Setup::of(&project)?;
+                virtual_transcripts(&project, &setup, &built, &mut tally)?;
+                routine_calls(&project, &setup, &built, &mut tally)?;
             }
         }
     }

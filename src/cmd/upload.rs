@@ -284,7 +284,7 @@ fn upload_file(
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let mut robot = ports::virtual_robot(args.line.baud, rig)?;
+        let mut robot = ports::virtual_robot(args.line.baud, None, rig)?;
         // A handler that hangs in the rehearsal is named by its label.
         robot.add_labels(&linked);
         let mut client = args.client(VirtualTransport::new(robot), profile);

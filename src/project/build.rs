@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::io;
 use std::path::{Path, PathBuf};
 
-use linker::{Image, Input, LinkOptions, Linked, SourceProvider, SymbolFile, Target};
+use linker::{Image, Linked, SourceProvider, Target};
 
 use super::Project;
 use super::config::ImageSpec;
@@ -36,6 +36,9 @@ impl SourceProvider for Rooted<'_> {
         std::fs::read_to_string(self.full(Path::new(path))).ok()
     }
 }
+
+/// What `scorpion test` snapshots of every image.
+pub(crate) const SNAPSHOT_KINDS: [&str; 4] = ["listing", "map", "symbols", "bytes"];
 
 /// A built image and what it is made of.
 #[derive(Debug)]
@@ -89,28 +92,14 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
     } else {
         Target::builtin(&spec.target, None)?
     };
-    let (rom_name, rom) = match project.rom()? {
+    let rom = match project.rom()? {
         Some(profile) => profile,
         None => (
             "scorpion-rom.elf".to_owned(),
             Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?,
         ),
     };
-    let inputs: Vec<Input<'_>> = objects
-        .iter()
-        .map(|(name, bytes)| Input { name, bytes })
-        .collect();
-    let mut linked = linker::link(
-        &inputs,
-        &LinkOptions {
-            target: &target,
-            just_symbols: &[SymbolFile {
-                name: &rom_name,
-                image: &rom,
-            }],
-            sources: &source,
-        },
-    )?;
+    let mut linked = crate::cmd::link::link_objects(&objects, &target, &[rom], &source)?;
     for warning in std::mem::take(&mut linked.warnings) {
         warnings.push(miette::Report::new(warning));
     }
@@ -148,6 +137,16 @@ pub(crate) fn build_to_target(
 }
 
 impl Built {
+    /// The texts its snapshots hold, by kind ([`SNAPSHOT_KINDS`]).
+    pub(crate) fn snapshots(&self) -> [(&'static str, String); 4] {
+        [
+            (SNAPSHOT_KINDS[0], self.listing.clone()),
+            (SNAPSHOT_KINDS[1], self.linked.map()),
+            (SNAPSHOT_KINDS[2], self.symbols()),
+            (SNAPSHOT_KINDS[3], self.bytes()),
+        ]
+    }
+
     /// The image's own symbols (not the ROM's it linked against), a line
     /// each, by address then name.
     pub(crate) fn symbols(&self) -> String {

@@ -311,14 +311,27 @@ impl Project {
                 .map(|t| self.root.join(t))
                 .collect();
         }
+        self.test_files("expect")
+    }
+
+    /// The files `tests/*.EXT`, in name order.
+    pub(crate) fn test_files(&self, ext: &str) -> Vec<PathBuf> {
         let mut found: Vec<PathBuf> = std::fs::read_dir(self.root.join("tests"))
             .into_iter()
             .flatten()
             .filter_map(Result::ok)
             .map(|e| e.path())
-            .filter(|p| p.extension().is_some_and(|x| x == "expect"))
+            .filter(|p| p.extension().is_some_and(|x| x == ext))
             .collect();
         found.sort();
         found
+    }
+
+    /// Where image `image`'s snapshot of `kind` lives.
+    pub(crate) fn snapshot_path(&self, image: &str, kind: &str) -> PathBuf {
+        self.root
+            .join("tests")
+            .join("snapshots")
+            .join(format!("{image}__{kind}.snap"))
     }
 }
