@@ -170,6 +170,18 @@ pub trait Bus {
         let _ = address;
         false
     }
+
+    /// True if a write to `address` has no effect but to store the value
+    /// where [`Bus::is_plain_memory`] reads it back (RAM: not the ROM, whose
+    /// writes a board may count, and no device). A loop whose only writes
+    /// store what is already there (a JSR pushing the same return address
+    /// every time) changes nothing, so it may be skipped like one that
+    /// only reads. The default, false for every address, never allows it.
+    #[inline(always)]
+    fn is_plain_store(&self, address: u16) -> bool {
+        let _ = address;
+        false
+    }
 }
 
 impl<B: Bus + ?Sized> Bus for &mut B {
@@ -216,6 +228,11 @@ impl<B: Bus + ?Sized> Bus for &mut B {
     #[inline(always)]
     fn is_plain_memory(&self, address: u16) -> bool {
         (**self).is_plain_memory(address)
+    }
+
+    #[inline(always)]
+    fn is_plain_store(&self, address: u16) -> bool {
+        (**self).is_plain_store(address)
     }
 }
 
@@ -370,6 +387,11 @@ impl Bus for Ram {
 
     #[inline(always)]
     fn is_plain_memory(&self, _address: u16) -> bool {
+        true
+    }
+
+    #[inline(always)]
+    fn is_plain_store(&self, _address: u16) -> bool {
         true
     }
 }

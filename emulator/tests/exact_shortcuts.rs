@@ -234,6 +234,54 @@ fn a_loop_on_plain_ram_is_skipped_to_the_limit_and_counted_exactly() {
 }
 
 #[test]
+fn a_loop_that_stores_what_is_there_is_skipped_exactly() {
+    // $0400: JSR $0410 / LDA $10 / STA $11 / JMP $0400, $0410: RTS - the
+    // JSR pushes the same return address every lap and the STA stores the
+    // zero already at $11: writes, but nothing changes.
+    let mut program = vec![0x20, 0x10, 0x04, 0xA5, 0x10, 0x85, 0x11, 0x4C, 0x00, 0x04];
+    program.resize(0x10, 0xEA);
+    program.push(0x60);
+    let machines = [true, false].map(|skip| {
+        let mut ram = Ram::new();
+        ram.load(0x0400, &program).expect("fits");
+        let mut machine = Machine::new(ram);
+        machine.cpu.pc = 0x0400;
+        machine.cpu.set_idle_skip(skip);
+        let stop = machine.run_with(500_001, &mut NoHooks);
+        assert_eq!(stop, Stop::Limit);
+        machine
+    });
+    let [skipped, run] = machines;
+    assert_eq!(skipped.cpu, run.cpu);
+    assert_eq!(skipped.bus.bytes(), run.bus.bytes());
+    assert!(skipped.cpu.skipped_cycles() > 490_000);
+}
+
+#[test]
+fn loops_that_change_memory_or_write_the_rom_are_run() {
+    // $0400: JSR $0410 / INC $11 / JMP $0400: the stores of the JSR change
+    // nothing after the first lap, the INC changes $11 every lap.
+    let mut program = vec![0x20, 0x10, 0x04, 0xE6, 0x11, 0x4C, 0x00, 0x04];
+    program.resize(0x10, 0xEA);
+    program.push(0x60);
+    let mut ram = Ram::new();
+    ram.load(0x0400, &program).expect("fits");
+    let mut machine = Machine::new(ram);
+    machine.cpu.pc = 0x0400;
+    machine.run_with(200_000, &mut NoHooks);
+    assert_eq!(machine.cpu.skipped_cycles(), 0, "a changing counter");
+    // $F000: LDA $F000 / STA $F000 / JMP $F000 stores the ROM's own byte
+    // back: the board counts every ROM write, so that is not nothing.
+    let mut rom = vec![0xEA; 4096];
+    rom[..9].copy_from_slice(&[0xAD, 0x00, 0xF0, 0x8D, 0x00, 0xF0, 0x4C, 0x00, 0xF0]);
+    rom[0xFFC..].copy_from_slice(&0xF000u16.to_le_bytes().repeat(2));
+    let mut robot = Scorpion::scorpion(&rom).expect("4 KiB");
+    robot.run(200_000);
+    assert_eq!(robot.cpu.skipped_cycles(), 0, "ROM writes");
+    assert!(robot.board().rom_writes() > 10_000);
+}
+
+#[test]
 fn loops_that_write_or_touch_io_are_run() {
     // $F000: INC $0300 / JMP $F000 writes every lap; $F006: LDA $C011 /
     // JMP $F006 reads the 6551's status (an I/O read) every lap.

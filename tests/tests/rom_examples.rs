@@ -232,7 +232,32 @@ fn drives_idle(s: &mut Session) -> (i64, i64) {
 
 #[test]
 fn an_operating_system_takes_the_control_loop() {
+    let s = patrol_session(true);
+    insta::assert_snapshot!(s.transcript);
+}
+
+/// The patrol session again with idle-loop skipping off: the OS's loop
+/// (a JSR to PENDING every pass, so it writes the stack) is skipped between
+/// the motors' ticks, and the robot ends exactly as running every cycle
+/// leaves it.
+#[test]
+fn skipping_an_operating_systems_loop_changes_nothing() {
+    let skipped = patrol_session(true);
+    let run = patrol_session(false);
+    assert_eq!(skipped.transcript, run.transcript);
+    let (a, b) = (skipped.robot.robot(), run.robot.robot());
+    assert_eq!(a.cpu, b.cpu, "registers, flags and counters");
+    assert_eq!(a.board().memory(), b.board().memory());
+    assert_eq!(format!("{:?}", a.board()), format!("{:?}", b.board()));
+    // Both booted with skipping on; only one went on with it.
+    let share = (a.cpu.skipped_cycles() - b.cpu.skipped_cycles()) * 100 / a.cpu.cycles();
+    assert!(share >= 20, "only {share}% of the cycles were skipped");
+}
+
+/// Installs the patrol OS, patrols, bumps into something, stops.
+fn patrol_session(skip: bool) -> Session {
     let mut s = Session::new();
+    s.robot.robot_mut().cpu.set_idle_skip(skip);
     let image = patrol();
     assert!(
         image
@@ -289,7 +314,7 @@ fn an_operating_system_takes_the_control_loop() {
     s.wait_ms(200);
     assert_eq!(s.position(Motor::Left), stopped);
     assert_eq!(s.ask("/1X"), "X00\r");
-    insta::assert_snapshot!(s.transcript);
+    s
 }
 
 /// The soak of issue 11: an operating system that injects a command on

@@ -833,6 +833,12 @@ impl Bus for Board {
         // space or a KIM-bus device's page.
         self.is_plain_read(address)
     }
+
+    #[inline(always)]
+    fn is_plain_store(&self, address: u16) -> bool {
+        // RAM and KIM-bus RAM below the I/O page.
+        self.is_plain_write(address)
+    }
 }
 
 /// The virtual Scorpion: the controller card with its CPU, and the host's

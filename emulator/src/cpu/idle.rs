@@ -6,22 +6,25 @@
 //!
 //! A probe runs real instructions (nothing is executed twice or undone)
 //! through [`ProbeBus`], which passes every call on and notes whether any of
-//! them was a write or a read of something other than plain memory
-//! ([`Bus::is_plain_memory`]: no side effect, and a value only the CPU's own
-//! writes change). When the PC comes back to where the probe started, with
-//! every register and flag byte-for-byte as it was and nothing but plain
-//! reads in between, the next iteration would start from the same state and
-//! read the same memory, which nothing can have changed, so it would take
-//! the same path, the same accesses and the same `C` cycles and `I`
-//! instructions; and so would every iteration after it, as long as none of
-//! their interrupt polls could find anything. The polls are the only way the
-//! outside world reaches the CPU, so the skip is bounded by
-//! [`Bus::quiet_until`] (every instruction of the skipped iterations ends at
-//! or before it, so each of their polls would have been skipped too) and by
-//! the run's limit (every instruction of them ends before it, so the run
-//! would not have stopped among them). The state after `k` skipped
-//! iterations is then the state now with `k * C` more cycles and `k * I`
-//! more instructions, which is what the skip produces.
+//! them could have changed anything: a read of something other than plain
+//! memory ([`Bus::is_plain_memory`]: no side effect, and a value only the
+//! CPU's own writes change), or a write that is not a plain store
+//! ([`Bus::is_plain_store`]) of the value already there. When the PC comes
+//! back to where the probe started, with every register and flag
+//! byte-for-byte as it was and nothing but plain reads and such stores in
+//! between (a JSR's return address pushed where the last lap pushed it),
+//! memory is as it was when the lap began, so the next iteration would
+//! start from the same state and read the same memory, which nothing can
+//! have changed; it would take the same path, the same accesses and the
+//! same `C` cycles and `I` instructions; and so would every iteration after
+//! it, as long as none of their interrupt polls could find anything. The
+//! polls are the only way the outside world reaches the CPU, so the skip is
+//! bounded by [`Bus::quiet_until`] (every instruction of the skipped
+//! iterations ends at or before it, so each of their polls would have been
+//! skipped too) and by the run's limit (every instruction of them ends
+//! before it, so the run would not have stopped among them). The state
+//! after `k` skipped iterations is then the state now with `k * C` more
+//! cycles and `k * I` more instructions, which is what the skip produces.
 //!
 //! Skipping is off with any hook that is not [`Hooks::PASSIVE`](crate::Hooks)
 //! (tracing and breakpoints see every instruction), off in [`Cpu::step`],
@@ -31,8 +34,8 @@
 //!
 //! # Cost
 //!
-//! A probe gives up at the first write or device read (the program is at
-//! work) or after [`BUDGET`] instructions; probes come [`MIN_GAP`] cycles
+//! A probe gives up at the first write that changes memory or device read
+//! (the program is at work) or after [`BUDGET`] instructions; probes come [`MIN_GAP`] cycles
 //! after a success and back off to every 64K cycles while the program is
 //! busy, so code that never idles pays almost nothing. An RTI that goes
 //! back into the loop last found (an interrupt-driven program returning to
@@ -49,7 +52,7 @@ const MIN_GAP: u64 = 128;
 /// The longest wait between probes while nothing is found.
 const MAX_GAP: u64 = 1 << 16;
 /// The longest loop a probe recognises, in instructions.
-const MAX_LOOP: usize = 16;
+const MAX_LOOP: usize = 32;
 /// Instructions one probe may run before giving up.
 const BUDGET: usize = 2 * MAX_LOOP;
 /// No skip carries the cycle counter past this: a host that runs "forever"
@@ -133,6 +136,15 @@ struct ProbeBus<'a, B> {
     clean: bool,
 }
 
+impl<B: Bus> ProbeBus<'_, B> {
+    /// A write that leaves memory as it was: plain RAM that holds `value`
+    /// already.
+    #[inline(always)]
+    fn stores_nothing_new(&self, address: u16, value: u8) -> bool {
+        self.bus.is_plain_store(address) && self.bus.peek(address) == value
+    }
+}
+
 impl<B: Bus> Bus for ProbeBus<'_, B> {
     #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
@@ -142,8 +154,14 @@ impl<B: Bus> Bus for ProbeBus<'_, B> {
 
     #[inline(always)]
     fn write(&mut self, address: u16, value: u8, cycle: u64) {
-        self.clean = false;
+        self.clean &= self.stores_nothing_new(address, value);
         self.bus.write(address, value, cycle);
+    }
+
+    #[inline(always)]
+    fn write_zp_stack(&mut self, address: u16, value: u8, cycle: u64) {
+        self.clean &= self.stores_nothing_new(address, value);
+        self.bus.write_zp_stack(address, value, cycle);
     }
 
     #[inline(always)]
@@ -170,6 +188,11 @@ impl<B: Bus> Bus for ProbeBus<'_, B> {
     #[inline(always)]
     fn is_plain_memory(&self, address: u16) -> bool {
         self.bus.is_plain_memory(address)
+    }
+
+    #[inline(always)]
+    fn is_plain_store(&self, address: u16) -> bool {
+        self.bus.is_plain_store(address)
     }
 }
 
@@ -231,7 +254,7 @@ impl Cpu {
                 break;
             }
             if !probe.clean {
-                // A write or a device read: the program is at work, not
+                // A change to memory or a device read: the program is at work, not
                 // idling. Cheap to find out, so the next probe comes soon.
                 break;
             }

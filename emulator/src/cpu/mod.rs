@@ -262,8 +262,9 @@ impl Cpu {
     }
 
     /// Allows or forbids idle-loop skipping in [`Cpu::run`] (allowed by
-    /// default). When the program goes round a loop that makes no write and
-    /// reads only plain memory, with every register back as it was, the
+    /// default). When the program goes round a loop that changes no memory
+    /// (its writes, if any, store what is there already) and reads only
+    /// plain memory, with every register back as it was, the
     /// run advances whole iterations up to the next moment a device could
     /// act (the bus's [`Bus::quiet_until`]) or the run's limit, counting
     /// their cycles and instructions as if it had run them: the state
