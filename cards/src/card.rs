@@ -20,7 +20,7 @@ use crate::error::ScriptError;
 use crate::script::{Script, engine};
 
 /// What the script changes through the host's functions.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct Shared {
     /// The register table (`set`, `get`; plain reads come from here).
     table: Vec<u8>,
@@ -35,6 +35,10 @@ struct Shared {
 pub struct ScriptCard {
     script: Script,
     shared: Arc<Mutex<Shared>>,
+    /// `shared` as the script last left it: only a script call changes
+    /// it, and the board asks for the card's IRQ output and next event
+    /// after every access, so those (and plain reads) need no lock.
+    view: Shared,
     /// Registers read from the table without calling `read`.
     plain: Vec<bool>,
     has_write: bool,
@@ -141,6 +145,7 @@ impl ScriptCard {
             shared.table = vec![0; usize::from(size)];
         }
         let mut card = ScriptCard {
+            view: Shared::default(),
             has_write: script.has_fn("write", 3),
             has_wake: script.has_fn("wake", 1),
             script,
@@ -153,7 +158,9 @@ impl ScriptCard {
             failed: false,
         };
         if card.script.has_fn("init", 0) {
-            let _ = card.script.call("init", ())?;
+            let _ = card.call("init", ())?;
+        } else {
+            card.look();
         }
         Ok(card)
     }
@@ -173,11 +180,29 @@ impl ScriptCard {
     /// A register of the table (what a plain read returns).
     #[must_use]
     pub fn table(&self, register: u16) -> u8 {
-        self.shared
-            .lock()
-            .ok()
-            .and_then(|shared| shared.table.get(usize::from(register)).copied())
+        self.view
+            .table
+            .get(usize::from(register))
+            .copied()
             .unwrap_or(0xFF)
+    }
+
+    /// Calls the script's `function`, then looks at what it changed.
+    fn call(
+        &mut self,
+        function: &str,
+        args: impl rhai::FuncArgs,
+    ) -> Result<rhai::Dynamic, ScriptError> {
+        let result = self.script.call(function, args);
+        self.look();
+        result
+    }
+
+    /// Copies what the script left in `shared` into `view`.
+    fn look(&mut self) {
+        if let Ok(shared) = self.shared.lock() {
+            self.view.clone_from(&shared);
+        }
     }
 
     fn fail(&mut self, error: ScriptError) {
@@ -189,28 +214,25 @@ impl ScriptCard {
             shared.wake = None;
             shared.irq = false;
         }
+        self.look();
     }
 
     /// Runs the wake-ups due by `cycle`.
     fn catch_up(&mut self, cycle: u64) {
         self.now = self.now.max(cycle);
         while !self.failed {
-            let due = {
-                let Ok(mut shared) = self.shared.lock() else {
-                    return;
-                };
-                match shared.wake {
-                    Some(at) if at <= cycle => {
-                        shared.wake = None;
-                        at
-                    }
-                    _ => return,
-                }
+            let due = match self.view.wake {
+                Some(at) if at <= cycle => at,
+                _ => return,
             };
+            self.view.wake = None;
+            if let Ok(mut shared) = self.shared.lock() {
+                shared.wake = None;
+            }
             if !self.has_wake {
                 continue;
             }
-            if let Err(error) = self.script.call("wake", (as_int(due),)) {
+            if let Err(error) = self.call("wake", (as_int(due),)) {
                 self.fail(error);
             }
         }
@@ -270,9 +292,7 @@ impl Device for ScriptCard {
         if self.plain[usize::from(register)] {
             return self.table(register);
         }
-        let value = self
-            .script
-            .call("read", (i64::from(register), as_int(cycle)));
+        let value = self.call("read", (i64::from(register), as_int(cycle)));
         match value.map(|v| v.as_int()) {
             Ok(Ok(value)) if (0..=0xFF).contains(&value) => value as u8,
             Ok(Ok(value)) => {
@@ -312,9 +332,10 @@ impl Device for ScriptCard {
             {
                 *slot = value;
             }
+            self.look();
             return;
         }
-        if let Err(error) = self.script.call(
+        if let Err(error) = self.call(
             "write",
             (i64::from(register), i64::from(value), as_int(cycle)),
         ) {
@@ -326,6 +347,12 @@ impl Device for ScriptCard {
         self.table(offset % self.size)
     }
 
+    fn is_stable(&self, offset: u16) -> bool {
+        // A plain register is the table, which only the script changes:
+        // at a wake-up (the card's next event) or a write.
+        self.failed || self.plain[usize::from(offset % self.size)]
+    }
+
     fn sync(&mut self, cycle: u64) {
         self.catch_up(cycle);
     }
@@ -334,11 +361,11 @@ impl Device for ScriptCard {
         if self.failed {
             return None;
         }
-        self.shared.lock().ok().and_then(|shared| shared.wake)
+        self.view.wake
     }
 
     fn irq(&self) -> bool {
-        self.shared.lock().is_ok_and(|shared| shared.irq)
+        self.view.irq
     }
 
     fn take_fault(&mut self) -> Option<Box<dyn miette::Diagnostic + Send + Sync>> {

@@ -182,6 +182,17 @@ pub trait Bus {
         let _ = address;
         false
     }
+
+    /// True if the run should end at this instruction's end: read only
+    /// after a [`Bus::poll`], so a bus raises it in `poll` and keeps
+    /// [`Bus::quiet_until`] no later than the poll that is to see it. The
+    /// board raises it when a byte reaches a host that watches its line,
+    /// so the host looks at the byte the moment it arrives. The default:
+    /// never.
+    #[inline(always)]
+    fn stop_requested(&self) -> bool {
+        false
+    }
 }
 
 impl<B: Bus + ?Sized> Bus for &mut B {
@@ -233,6 +244,11 @@ impl<B: Bus + ?Sized> Bus for &mut B {
     #[inline(always)]
     fn is_plain_store(&self, address: u16) -> bool {
         (**self).is_plain_store(address)
+    }
+
+    #[inline(always)]
+    fn stop_requested(&self) -> bool {
+        (**self).stop_requested()
     }
 }
 

@@ -78,9 +78,12 @@ pub struct VirtualScorpion {
     /// The memory a loaded image may use: the user zero page and RAM the
     /// ROM exports, and the KIM bus (empty: the ROM does not say).
     user: Vec<RangeInclusive<u16>>,
-    /// Labels of the ROM and of every image loaded, for naming the place
-    /// a robot that stopped answering is stuck in.
+    /// Labels of a ROM profile and of every image loaded, sorted, for
+    /// naming the place a robot that stopped answering is stuck in.
     labels: Vec<(u16, String)>,
+    /// The reference ROM's labels count too (read from its ELF only when a
+    /// place is to be named: a robot that answers never needs them).
+    reference_rom: bool,
     /// What changes the robot's inputs over time, if anything.
     world: Option<Box<dyn Surroundings>>,
 }
@@ -150,9 +153,9 @@ impl VirtualScorpion {
                 KIM_BUS,
             ],
             labels: Vec::new(),
+            reference_rom: true,
             world: None,
         };
-        scorpion.labels = reference_labels().to_vec();
         scorpion.boot();
         scorpion
     }
@@ -208,6 +211,7 @@ impl VirtualScorpion {
             table,
             user,
             labels: Vec::new(),
+            reference_rom: false,
             world: None,
         };
         scorpion.add_labels(rom);
@@ -220,8 +224,9 @@ impl VirtualScorpion {
         self.robot.run(until);
     }
 
-    /// Runs the robot to robot time `until`: the surroundings woken when
-    /// they asked to be, then a jammed CPU or a failed card reported.
+    /// Runs the robot to robot time `until` (or, while the host watches its
+    /// line, until a byte reaches it): the surroundings woken when they
+    /// asked to be, then a jammed CPU or a failed card reported.
     fn advance(&mut self, until: u64) -> Result<(), Error> {
         loop {
             let wake = self
@@ -229,25 +234,24 @@ impl VirtualScorpion {
                 .as_ref()
                 .and_then(|world| world.next_wake())
                 .filter(|&at| at <= until);
-            let Some(at) = wake else {
-                break;
-            };
-            if at > self.robot.now() {
-                let stop = self.robot.run(at);
+            if wake.unwrap_or(until) > self.robot.now() {
+                let stop = self.robot.run(wake.unwrap_or(until));
                 self.after_run(stop)?;
+                if stop == Stop::Bus {
+                    return Ok(());
+                }
             }
-            if let Some(world) = self.world.as_mut() {
-                let now = self.robot.now();
-                world
-                    .wake(now, &mut self.robot)
-                    .map_err(|fault| Error::Surroundings {
-                        message: fault.to_string(),
-                        fault,
-                    })?;
-            }
+            let (Some(_), Some(world)) = (wake, self.world.as_mut()) else {
+                return Ok(());
+            };
+            let now = self.robot.now();
+            world
+                .wake(now, &mut self.robot)
+                .map_err(|fault| Error::Surroundings {
+                    message: fault.to_string(),
+                    fault,
+                })?;
         }
-        let stop = self.robot.run(until);
-        self.after_run(stop)
     }
 
     fn after_run(&mut self, stop: Stop) -> Result<(), Error> {
@@ -285,14 +289,27 @@ impl VirtualScorpion {
     /// [`Error::Stuck`] reports (loading an image keeps its own).
     pub fn add_labels(&mut self, image: &Image) {
         self.labels.extend(labels_of(image));
-        self.labels.sort();
+    }
+
+    /// Every label, the reference ROM's (if it runs) and the others', in
+    /// address order.
+    fn all_labels(&self) -> Vec<&(u16, String)> {
+        let rom = if self.reference_rom {
+            reference_labels()
+        } else {
+            &[]
+        };
+        let mut labels: Vec<_> = rom.iter().chain(&self.labels).collect();
+        labels.sort();
+        labels
     }
 
     /// The label at or below `pc` (within a page), as `name+$offset`.
     #[must_use]
     pub fn place_of(&self, pc: u16) -> Option<String> {
-        let index = self.labels.partition_point(|(at, _)| *at <= pc);
-        let (at, name) = self.labels.get(index.checked_sub(1)?)?;
+        let labels = self.all_labels();
+        let index = labels.partition_point(|(at, _)| *at <= pc);
+        let (at, name) = labels.get(index.checked_sub(1)?)?;
         let offset = pc - at;
         (offset < 0x100).then(|| match offset {
             0 => name.clone(),
@@ -304,17 +321,12 @@ impl VirtualScorpion {
     /// label after `chkch`): a handler waiting there for the host's next
     /// byte is waiting, not stuck.
     fn waiting_for_input(&self, pc: u16) -> bool {
-        let find = |name: &str| {
-            self.labels
-                .iter()
-                .find(|(_, n)| n == name)
-                .map(|(at, _)| *at)
-        };
+        let labels = self.all_labels();
+        let find = |name: &str| labels.iter().find(|(_, n)| n == name).map(|(at, _)| *at);
         let (Some(getch), Some(chkch)) = (find("getch"), find("chkch")) else {
             return false;
         };
-        let end = self
-            .labels
+        let end = labels
             .iter()
             .map(|(at, _)| *at)
             .find(|&at| at > chkch)
@@ -561,6 +573,20 @@ impl VirtualScorpion {
         self.advance(cycle)
     }
 
+    /// Runs the robot until robot time `cycle`, or until a byte reaches
+    /// the host if one does before: the end of the instruction during
+    /// which it arrived, as a host that waits for an answer sees it. What
+    /// the robot does is the same either way; only the host looks sooner.
+    ///
+    /// # Errors
+    /// [`Error::Jam`] if the CPU jams.
+    pub fn run_until_received(&mut self, cycle: u64) -> Result<(), Error> {
+        self.robot.board_mut().watch_host(true);
+        let result = self.advance(cycle);
+        self.robot.board_mut().watch_host(false);
+        result
+    }
+
     /// Whether everything the host sent has gone down the wire.
     #[must_use]
     pub fn line_idle(&self) -> bool {
@@ -636,9 +662,7 @@ impl VirtualScorpion {
                     timeout_ms: timeout * 1000 / CPU_HZ,
                 });
             }
-            // Slices of about one character time at 9600 baud.
-            let until = (now + 1000).min(deadline);
-            self.advance(until)?;
+            self.run_until_received(deadline)?;
         }
     }
 

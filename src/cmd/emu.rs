@@ -150,8 +150,8 @@ fn report(args: &RunArgs, machine: &RamMachine, stop: Stop, seconds: f64) -> mie
         let stop_name = match stop {
             Stop::Trap { .. } => "trap",
             Stop::Jam { .. } => "jam",
-            // Hooks here never stop the run by themselves.
-            Stop::Limit | Stop::Hook { .. } => "cycle_limit",
+            // Hooks here never stop the run by themselves, nor does RAM.
+            Stop::Limit | Stop::Hook { .. } | Stop::Bus => "cycle_limit",
         };
         // Written by hand to keep the keys in the documented order; every
         // value but `stop` is a JSON number.
@@ -175,7 +175,7 @@ fn report(args: &RunArgs, machine: &RamMachine, stop: Stop, seconds: f64) -> mie
         Stop::Jam { pc, opcode } => {
             format!("JAM: opcode ${opcode:02X} at ${pc:04X} halted the processor")
         }
-        Stop::Limit | Stop::Hook { .. } => {
+        Stop::Limit | Stop::Hook { .. } | Stop::Bus => {
             let limit = args.max_cycles.unwrap_or(if args.trace.is_some() {
                 MAX_CYCLES_TRACED
             } else {

@@ -76,7 +76,8 @@ pub(crate) fn virtual_robot(
         Some((name, image)) => VirtualScorpion::with_rom(name, image)?,
         None => VirtualScorpion::new(),
     };
-    if !robot.set_baud(baud) {
+    // A fresh robot runs at the reference rate already: no second boot.
+    if robot.host_baud() != baud && !robot.set_baud(baud) {
         miette::bail!(
             help = "the 6551 runs at 50 to 19200 baud; the reference ROM's rate is 9600",
             "the Scorpion's 6551 has no {baud} baud rate"

@@ -165,6 +165,22 @@ impl Acia {
         out
     }
 
+    /// When to look next for a byte reaching the host: the cycle the host
+    /// receives the next byte it has not taken, or, while the only byte
+    /// to come waits in the transmit register, the cycle it goes on the
+    /// wire (a look then finds when it arrives). `None`: nothing is on its
+    /// way.
+    #[must_use]
+    pub fn host_byte_due(&self) -> Option<u64> {
+        if let Some(next) = self
+            .host_sampler
+            .peek(&self.tx_wire, self.host_baud, self.host_format)
+        {
+            return Some(next.at);
+        }
+        (self.tdr.is_some() && self.transmitter_enabled()).then_some(self.shift_free_at)
+    }
+
     /// The cycle the 6551's last character ends on the wire (the host has
     /// everything sent so far once this cycle has passed).
     #[must_use]

@@ -28,6 +28,19 @@ pub trait Device: Any + std::fmt::Debug + Send {
         0xFF
     }
 
+    /// True if a read of `offset` has no side effect and returns the same
+    /// value until the device's next event ([`Device::next_event`]) or a
+    /// write to the device: a register that only the device's own events
+    /// and the CPU change. A loop that only polls such registers (and plain
+    /// memory) may be skipped up to the next event, exactly (see
+    /// [`crate::Bus::is_plain_memory`]). A register that changes by itself
+    /// between events (a free-running counter) is not stable. The default:
+    /// none is.
+    fn is_stable(&self, offset: u16) -> bool {
+        let _ = offset;
+        false
+    }
+
     /// Catches up to `cycle` (time never goes backwards: a smaller cycle
     /// is ignored).
     fn sync(&mut self, cycle: u64) {

@@ -139,6 +139,8 @@ pub struct Board {
     /// since: its receiver decodes the line to answer, which every access
     /// to any chip would otherwise pay for.
     acia_next: Option<u64>,
+    /// [`Acia::host_byte_due`], as `acia_next`.
+    acia_host_due: Option<u64>,
     acia_stale: bool,
     drive: u8,
     sense: u8,
@@ -164,6 +166,14 @@ pub struct Board {
     attention: u64,
     /// The cycle the IRQ line last changed.
     irq_changed_at: u64,
+    /// The host watches its line: a byte reaching it ends the CPU's run
+    /// ([`Board::watch_host`]).
+    host_watch: bool,
+    /// While watching, the next cycle to look for a byte reaching the host
+    /// ([`Acia::host_byte_due`]); `u64::MAX` otherwise.
+    host_due: u64,
+    /// A byte reached the watching host and it has not taken it yet.
+    host_arrived: bool,
     /// The cycle of the last poll.
     last_poll: u64,
     /// Addresses from here up to the ROM take the slow path (the I/O page,
@@ -212,6 +222,7 @@ impl Board {
             via: Via::new(),
             acia: Acia::new(),
             acia_next: None,
+            acia_host_due: None,
             acia_stale: true,
             drive: 0,
             sense: 0,
@@ -228,6 +239,9 @@ impl Board {
             next_event: u64::MAX,
             attention: 0,
             irq_changed_at: 0,
+            host_watch: false,
+            host_due: u64::MAX,
+            host_arrived: false,
             last_poll: 0,
             slow_start: map::IO_START,
             slow_span: map::ROM_START - map::IO_START,
@@ -526,7 +540,20 @@ impl Board {
         self.catch_up(cycle);
         let received = self.acia_mut().host_receive(cycle);
         self.inbox.extend(received);
+        self.host_arrived = false;
         self.refresh(cycle);
+    }
+
+    /// The host watches its line (`true`) or not: while it does, a byte
+    /// reaching it ends the CPU's run at the end of the instruction during
+    /// which it arrived ([`crate::Stop::Bus`]), so the host can answer it
+    /// as promptly as it likes instead of looking every so often; once
+    /// the host has taken what arrived ([`Board::host_receive`]), runs go
+    /// on. Ending a run changes nothing in what the robot does.
+    pub fn watch_host(&mut self, watch: bool) {
+        self.host_watch = watch;
+        self.host_arrived = false;
+        self.refresh_next_event();
     }
 
     /// Attempted writes to the ROM since power-up (they change nothing).
@@ -559,11 +586,22 @@ impl Board {
     /// [`Device::next_event`] of the 6551, computed again only after it
     /// changed (it depends on nothing else).
     fn acia_next_event(&mut self) -> Option<u64> {
+        self.refresh_acia();
+        self.acia_next
+    }
+
+    /// [`Acia::host_byte_due`], kept like its next event.
+    fn acia_host_byte_due(&mut self) -> Option<u64> {
+        self.refresh_acia();
+        self.acia_host_due
+    }
+
+    fn refresh_acia(&mut self) {
         if self.acia_stale {
             self.acia_next = self.acia.next_event();
+            self.acia_host_due = self.acia.host_byte_due();
             self.acia_stale = false;
         }
-        self.acia_next
     }
 
     /// Processes every device event up to `cycle`, each at its own cycle.
@@ -609,6 +647,11 @@ impl Board {
             next = next.min(slot.device.next_event().unwrap_or(u64::MAX));
         }
         self.next_event = next;
+        self.host_due = if self.host_watch {
+            self.acia_host_byte_due().unwrap_or(u64::MAX)
+        } else {
+            u64::MAX
+        };
         self.set_attention();
     }
 
@@ -619,7 +662,7 @@ impl Board {
         self.attention = if self.irq.is_asserted() || self.irq_changed_at > self.last_poll {
             0
         } else {
-            self.next_event
+            self.next_event.min(self.host_due)
         };
     }
 
@@ -628,6 +671,12 @@ impl Board {
     fn poll_slow(&mut self, cycle: u64) -> Interrupts {
         if cycle >= self.next_event {
             self.catch_up(cycle);
+        }
+        if cycle >= self.host_due {
+            // A byte on its way to the watching host: has it arrived?
+            self.acia_mut().sync(cycle);
+            self.refresh_next_event();
+            self.host_arrived |= self.host_due <= cycle;
         }
         self.last_poll = cycle;
         let irq = self.irq.at(cycle);
@@ -708,6 +757,16 @@ impl Board {
             map::SCANNER => self.scanner_reading(),
             _ => map::OPEN_BUS,
         }
+    }
+
+    /// Whether `address` is a KIM-bus device's stable register
+    /// ([`Device::is_stable`]).
+    fn is_stable_device_read(&self, address: u16) -> bool {
+        self.pages[usize::from(address >> 8)] == Page::Kim
+            && self.kim_slot(address).is_some_and(|index| {
+                let slot = &self.kim[index];
+                slot.device.is_stable(address - slot.start)
+            })
     }
 
     fn kim_slot(&self, address: u16) -> Option<usize> {
@@ -828,10 +887,17 @@ impl Bus for Board {
     }
 
     #[inline(always)]
+    fn stop_requested(&self) -> bool {
+        self.host_arrived
+    }
+
+    #[inline(always)]
     fn is_plain_memory(&self, address: u16) -> bool {
-        // RAM, KIM-bus RAM and the ROM; not the I/O page, unconnected
-        // space or a KIM-bus device's page.
-        self.is_plain_read(address)
+        // RAM, KIM-bus RAM and the ROM, and a KIM-bus device's stable
+        // registers (their values change only at the device's events,
+        // which bound a skip like every event); not the I/O page or
+        // unconnected space.
+        self.is_plain_read(address) || self.is_stable_device_read(address)
     }
 
     #[inline(always)]

@@ -79,6 +79,14 @@ impl Baud {
         u64::try_from(bits).unwrap_or(u64::MAX)
     }
 
+    /// Whether two rates are the same fraction (`Baud::new(9600)` and the
+    /// 6551's crystal / 16 / 12 are).
+    #[must_use]
+    pub fn same_rate(self, other: Baud) -> bool {
+        u128::from(self.numerator) * u128::from(other.denominator)
+            == u128::from(other.numerator) * u128::from(self.denominator)
+    }
+
     /// Whether two rates are close enough for a UART to receive what the
     /// other sends: within 2%, the usual tolerance of a 16x-sampling
     /// receiver over a 10-bit character.

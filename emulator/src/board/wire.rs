@@ -24,6 +24,8 @@ pub struct Character {
     pub data: u8,
     baud: Baud,
     format: FrameFormat,
+    /// The cycle its first stop bit begins: no falling edge from then on.
+    stop_start: u64,
 }
 
 impl Character {
@@ -59,14 +61,18 @@ impl Character {
     }
 }
 
-/// The parity bit for `data` in `format`, or `None` without parity.
-fn parity_bit(data: u8, format: FrameFormat) -> Option<bool> {
-    let mask = if format.data_bits >= 8 {
+/// The bits of a byte that `format` carries.
+fn data_mask(format: FrameFormat) -> u8 {
+    if format.data_bits >= 8 {
         0xFF
     } else {
         (1u8 << format.data_bits) - 1
-    };
-    let ones = (data & mask).count_ones();
+    }
+}
+
+/// The parity bit for `data` in `format`, or `None` without parity.
+fn parity_bit(data: u8, format: FrameFormat) -> Option<bool> {
+    let ones = (data & data_mask(format)).count_ones();
     match format.parity {
         Parity::None => None,
         Parity::Odd => Some(ones % 2 == 0),
@@ -94,13 +100,15 @@ impl Wire {
     /// the character before it ends.
     pub fn send(&mut self, data: u8, now: u64, baud: Baud, format: FrameFormat) -> Character {
         let (start, end) = self.clock.schedule(now, format.half_bits(), baud);
-        let character = Character {
+        let mut character = Character {
             start,
             end,
             data,
             baud,
             format,
+            stop_start: end,
         };
+        character.stop_start = character.bit_start(character.leading_bits());
         self.chars.push_back(character);
         character
     }
@@ -126,15 +134,19 @@ impl Wire {
             .is_none_or(|c| c.level_at(cycle))
     }
 
-    /// The first high-to-low transition at or after `from`.
-    fn next_falling_edge(&self, from: u64) -> Option<u64> {
-        for character in self.chars.iter().filter(|c| c.end > from) {
+    /// The first high-to-low transition at or after `from`, and the
+    /// character it is in.
+    fn next_falling_edge(&self, from: u64) -> Option<(u64, &Character)> {
+        // A character whose edges all lie before `from` (the last one a
+        // receiver took stays on the wire until its stop bit ends) is
+        // passed over without looking at its bits.
+        for character in self.chars.iter().filter(|c| c.stop_start > from) {
             for k in 0..character.leading_bits() {
                 let before = k == 0 || character.bit(k - 1);
                 if before && !character.bit(k) {
                     let at = character.bit_start(k);
                     if at >= from {
-                        return Some(at);
+                        return Some((at, character));
                     }
                 }
             }
@@ -181,9 +193,27 @@ impl Sampler {
     /// wire now, at `baud` in `format` (its `at` may be in the future).
     #[must_use]
     pub fn peek(&self, wire: &Wire, baud: Baud, format: FrameFormat) -> Option<Received> {
+        let (edge, character) = wire.next_falling_edge(self.hunt_from)?;
+        if edge == character.start && character.baud.same_rate(baud) && character.format == format {
+            // Sent at this receiver's own rate and format, and found by its
+            // start bit: every sample falls in the middle of the bit it is
+            // meant for, so the character reads back exactly as sent (what
+            // sampling it bit by bit would find, as a test checks).
+            return Some(Received {
+                data: character.data & data_mask(format),
+                framing_error: false,
+                parity_error: false,
+                at: edge + baud.cycles_for_half_bits(2 * character.leading_bits() + 1),
+            });
+        }
+        self.sample(wire, baud, format)
+    }
+
+    /// [`Sampler::peek`] the long way: every bit sampled on the wire.
+    fn sample(&self, wire: &Wire, baud: Baud, format: FrameFormat) -> Option<Received> {
         let mut from = self.hunt_from;
         loop {
-            let edge = wire.next_falling_edge(from)?;
+            let (edge, _) = wire.next_falling_edge(from)?;
             let sample = |half_bits: u64| edge + baud.cycles_for_half_bits(half_bits);
             let start = sample(1);
             if wire.level(start) {
@@ -249,6 +279,57 @@ mod tests {
             out.push(r);
         }
         out
+    }
+
+    /// The shortcut for characters sent at the receiver's own rate gives
+    /// what sampling every bit gives, for every byte, format and rate,
+    /// including the 6551's crystal rates against the host's round ones.
+    #[test]
+    fn the_matching_rate_shortcut_reads_what_sampling_reads() {
+        let formats = [
+            FrameFormat::EIGHT_N_ONE,
+            FrameFormat {
+                data_bits: 7,
+                parity: Parity::Even,
+                stop_half_bits: 2,
+            },
+            FrameFormat {
+                data_bits: 5,
+                parity: Parity::Odd,
+                stop_half_bits: 3,
+            },
+            FrameFormat {
+                data_bits: 8,
+                parity: Parity::Mark,
+                stop_half_bits: 4,
+            },
+        ];
+        let rates = [
+            (Baud::new(9600), Baud::from_crystal_divisor(12)),
+            (Baud::new(19200), Baud::new(19200)),
+            (
+                Baud::from_crystal_divisor(1047),
+                Baud::from_crystal_divisor(1047),
+            ),
+        ];
+        for format in formats {
+            for (sent, heard) in rates {
+                assert!(sent.same_rate(heard));
+                let mut wire = Wire::new();
+                for byte in 0..=255u8 {
+                    wire.send(byte, u64::from(byte) * 7, sent, format);
+                }
+                let mut sampler = Sampler::new();
+                for byte in 0..=255u8 {
+                    let quick = sampler.peek(&wire, heard, format);
+                    let slow = sampler.sample(&wire, heard, format);
+                    assert_eq!(quick, slow, "{byte} in {format:?} at {sent:?}");
+                    let quick = quick.expect("a character");
+                    assert_eq!(quick.data, byte & data_mask(format));
+                    sampler.receive(&mut wire, quick.at, heard, format);
+                }
+            }
+        }
     }
 
     #[test]

@@ -194,6 +194,11 @@ impl<B: Bus> Bus for ProbeBus<'_, B> {
     fn is_plain_store(&self, address: u16) -> bool {
         self.bus.is_plain_store(address)
     }
+
+    #[inline(always)]
+    fn stop_requested(&self) -> bool {
+        self.bus.stop_requested()
+    }
 }
 
 impl Cpu {
@@ -250,7 +255,9 @@ impl Cpu {
             if flow & JAM != 0 {
                 break;
             }
-            if flow & POLLED != 0 && (self.nmi_pending || self.irq_pending) {
+            if flow & POLLED != 0
+                && (self.nmi_pending || self.irq_pending || probe.bus.stop_requested())
+            {
                 break;
             }
             if !probe.clean {

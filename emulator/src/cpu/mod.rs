@@ -85,6 +85,10 @@ pub enum Stop {
         /// The address of the instruction not yet executed.
         pc: u16,
     },
+    /// The bus asked the run to end ([`Bus::stop_requested`], seen at an
+    /// interrupt poll): on the board, a byte reached a host that watches
+    /// its line. Running again goes on exactly as if the run had not ended.
+    Bus,
 }
 
 /// What one [`Cpu::step`] did.
@@ -440,6 +444,11 @@ impl Cpu {
             if self.cycles >= until {
                 return Stop::Limit;
             }
+            // Only a poll can have raised it: the inner loop and the probe
+            // come out at a poll that finds it.
+            if bus.stop_requested() {
+                return Stop::Bus;
+            }
             if self.nmi_pending || self.irq_pending {
                 let kind = self.interrupt_sequence(bus);
                 hooks.interrupt(self, &*bus, kind);
@@ -502,7 +511,8 @@ impl Cpu {
                     if flow & RETURNED != 0 {
                         if self.cycles > bus.quiet_until() {
                             self.poll_after(bus, flow);
-                            interrupted = self.nmi_pending || self.irq_pending;
+                            interrupted =
+                                self.nmi_pending || self.irq_pending || bus.stop_requested();
                         }
                         if H::PASSIVE {
                             // Maybe back into the idle loop last found:
@@ -516,7 +526,7 @@ impl Cpu {
                     // `instruction`).
                     if self.cycles > bus.quiet_until() {
                         self.poll_after(bus, flow);
-                        interrupted = self.nmi_pending || self.irq_pending;
+                        interrupted = self.nmi_pending || self.irq_pending || bus.stop_requested();
                     }
                 }
                 if flow & TRAP != 0 {

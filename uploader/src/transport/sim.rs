@@ -73,18 +73,23 @@ impl VirtualTransport {
             .sort_by_key(|(cycle, _)| std::cmp::Reverse(*cycle));
     }
 
-    /// Runs the robot to `until`, doing the actions that fall due on the way.
+    /// Runs the robot to `until` or until a byte reaches the host, doing
+    /// the actions that fall due on the way.
     fn run(&mut self, until: u64) -> std::result::Result<(), romlib::Error> {
         loop {
             let due = self.actions.last().map(|(cycle, _)| *cycle);
             match due {
                 Some(cycle) if cycle <= until => {
-                    self.robot.run_until(cycle)?;
+                    self.robot.run_until_received(cycle)?;
+                    if self.robot.cycles() < cycle {
+                        // A byte arrived first.
+                        return Ok(());
+                    }
                     if let Some((_, action)) = self.actions.pop() {
                         action(&mut self.robot);
                     }
                 }
-                _ => return self.robot.run_until(until),
+                _ => return self.robot.run_until_received(until),
             }
         }
     }
@@ -104,12 +109,6 @@ impl VirtualTransport {
     #[must_use]
     pub fn into_robot(self) -> VirtualScorpion {
         self.robot
-    }
-
-    /// One character time at the current rate, in cycles: the slice the
-    /// robot runs for between looks at the line.
-    fn slice(&self) -> u64 {
-        (10 * CPU_HZ / u64::from(self.baud.max(1))).max(1)
     }
 }
 
@@ -137,8 +136,9 @@ impl Transport for VirtualTransport {
             .cycles()
             .saturating_add(duration_to_cycles(timeout));
         loop {
-            let until = (self.robot.cycles() + self.slice()).min(deadline);
-            let ran = self.run(until);
+            // The robot runs until the first byte reaches the host, which
+            // looks at it at once: no slicing, so no slice to wait out.
+            let ran = self.run(deadline);
             let bytes = self.robot.receive();
             if !bytes.is_empty() {
                 into.extend_from_slice(&bytes);
