@@ -42,6 +42,9 @@ enum Mode {
     Skipping,
     Running,
     GenericBus,
+    /// Skipping, with the host watching its line: every byte that reaches
+    /// it ends the run.
+    Watching,
 }
 
 /// A KIM-bus card with a clock: it catches up every 10,000 cycles (device
@@ -137,11 +140,15 @@ const END_MS: u64 = 5_000;
 /// Runs the session; returns the robot and everything the host received.
 fn session(mode: Mode) -> (Scorpion, Vec<HostByte>) {
     let mut robot = Scorpion::scorpion(romlib::ROM).expect("the reference ROM is 4 KiB");
-    robot.cpu.set_idle_skip(mode == Mode::Skipping);
+    robot
+        .cpu
+        .set_idle_skip(matches!(mode, Mode::Skipping | Mode::Watching));
+    robot.board_mut().watch_host(mode == Mode::Watching);
     robot
         .map_kim(0x8000, 0x8001, Box::new(ClockCard::default()))
         .expect("free KIM-bus space");
     let mut received = Vec::new();
+    let mut stops = 0;
     let mut script = SCRIPT.iter().peekable();
     // Slices of odd lengths, so that runs end in every phase of the loops.
     let mut slice = 0u64;
@@ -156,16 +163,46 @@ fn session(mode: Mode) -> (Scorpion, Vec<HostByte>) {
         }
         slice = (slice * 7 + 613) % 5_000 + 1;
         let until = robot.now() + slice;
-        let stop = if mode == Mode::GenericBus {
-            robot
-                .cpu
-                .run(&mut Generic(&mut robot.bus), until, &mut NoHooks)
-        } else {
-            robot.run(until)
-        };
-        assert_eq!(stop, Stop::Limit, "the ROM runs on");
-        received.extend(robot.receive_detailed());
+        // A watching host's runs also end at every byte that reaches it;
+        // it takes the byte and runs on to the slice's end, so the host
+        // acts at the same cycles in every mode.
+        loop {
+            let stop = if mode == Mode::GenericBus {
+                robot
+                    .cpu
+                    .run(&mut Generic(&mut robot.bus), until, &mut NoHooks)
+            } else {
+                robot.run(until)
+            };
+            let arrived = robot.receive_detailed();
+            let watched = stop == Stop::Bus;
+            if watched {
+                // Ended by a byte's arrival, at the end of the instruction
+                // it arrived in: no later than the longest one after it.
+                let last = arrived.last().expect("a byte ended the run");
+                assert!(
+                    last.at <= robot.now() && robot.now() - last.at <= 8,
+                    "a byte at {} seen at {}",
+                    last.at,
+                    robot.now()
+                );
+                stops += 1;
+            } else {
+                assert_eq!(stop, Stop::Limit, "the ROM runs on");
+            }
+            received.extend(arrived);
+            if !watched {
+                break;
+            }
+        }
     }
+    if mode == Mode::Watching {
+        assert!(stops >= 100, "every byte ended a run: {stops} did");
+    }
+    // Every mode ends at the same cycle, whatever its last slices were.
+    robot.board_mut().watch_host(false);
+    assert_eq!(robot.run(END_MS * 1000 + 6_000), Stop::Limit);
+    received.extend(robot.receive_detailed());
     (robot, received)
 }
 
@@ -186,7 +223,9 @@ fn skipping_idle_loops_and_the_board_shortcuts_leave_the_board_exactly_as_runnin
     let skipped = session(Mode::Skipping);
     let run = session(Mode::Running);
     let generic = session(Mode::GenericBus);
+    let watched = session(Mode::Watching);
     assert_same(&skipped, &run, "skipping against running");
+    assert_same(&watched, &run, "a watching host against running");
     assert_same(
         &run,
         &generic,
@@ -207,6 +246,77 @@ fn skipping_idle_loops_and_the_board_shortcuts_leave_the_board_exactly_as_runnin
     assert_eq!(generic.0.cpu.skipped_cycles(), 0);
     let share = skipped.0.cpu.skipped_cycles() * 100 / skipped.0.cpu.cycles();
     assert!(share >= 50, "only {share}% of the cycles were skipped");
+}
+
+/// A KIM-bus card whose one register counts its ticks: it changes only at
+/// the card's events and reading it has no side effect, so it is stable.
+#[derive(Debug, Default)]
+struct TickCard {
+    now: u64,
+}
+
+impl Device for TickCard {
+    fn read(&mut self, _offset: u16, cycle: u64) -> u8 {
+        self.sync(cycle);
+        self.peek(0)
+    }
+
+    fn write(&mut self, _offset: u16, _value: u8, cycle: u64) {
+        self.sync(cycle);
+    }
+
+    fn peek(&self, _offset: u16) -> u8 {
+        (self.now / TICK).to_le_bytes()[0]
+    }
+
+    fn is_stable(&self, _offset: u16) -> bool {
+        true
+    }
+
+    fn sync(&mut self, cycle: u64) {
+        self.now = self.now.max(cycle);
+    }
+
+    fn next_event(&self) -> Option<u64> {
+        Some((self.now / TICK + 1) * TICK)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+#[test]
+fn a_loop_polling_a_stable_card_register_is_skipped_to_the_cards_events() {
+    // $F000: LDA $8000 / CMP #5 / BNE $F000 / STA $0300 / JMP $F00A - waits
+    // for the card's fifth tick, then writes it down.
+    let mut rom = vec![0xEA; 4096];
+    rom[..13].copy_from_slice(&[
+        0xAD, 0x00, 0x80, 0xC9, 0x05, 0xD0, 0xF9, 0x8D, 0x00, 0x03, 0x4C, 0x0A, 0xF0,
+    ]);
+    rom[0xFFC..].copy_from_slice(&0xF000u16.to_le_bytes().repeat(2));
+    let robots = [true, false].map(|skip| {
+        let mut robot = Scorpion::scorpion(&rom).expect("4 KiB");
+        robot.cpu.set_idle_skip(skip);
+        robot
+            .map_kim(0x8000, 0x8000, Box::new(TickCard::default()))
+            .expect("free KIM-bus space");
+        assert_eq!(robot.run(80_000), Stop::Limit);
+        robot
+    });
+    let [skipped, run] = robots;
+    assert_eq!(skipped.cpu, run.cpu);
+    assert_eq!(skipped.board().memory(), run.board().memory());
+    assert_eq!(
+        run.board().memory()[0x0300],
+        5,
+        "the loop saw the fifth tick"
+    );
+    assert!(skipped.cpu.skipped_cycles() > 40_000);
 }
 
 #[test]
