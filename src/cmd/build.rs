@@ -25,12 +25,26 @@ pub(crate) struct Args {
     link: LinkArgs,
 }
 
-/// Builds every image of the project found from here: `NAME.elf`,
-/// `NAME.lst` and `NAME.map` in `target/scorpion/`.
+/// Builds every image of the project found from here (of every member,
+/// in a workspace): `NAME.elf`, `NAME.lst` and `NAME.map` in each
+/// project's `target/scorpion/`.
 fn project() -> miette::Result<ExitCode> {
-    let project = crate::project::Project::here()?;
+    match crate::project::config::Found::here()? {
+        crate::project::config::Found::Project(project) => build_project(&project, ""),
+        crate::project::config::Found::Workspace(workspace) => {
+            for (name, project) in workspace.projects()? {
+                build_project(&project, &format!("{name}/"))?;
+            }
+            Ok(())
+        }
+    }?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Builds `project`'s images; `at` is its directory as printed.
+fn build_project(project: &crate::project::Project, at: &str) -> miette::Result<()> {
     for spec in &project.file.images {
-        let (built, _) = crate::project::build::build_to_target(&project, spec)?;
+        let (built, _) = crate::project::build::build_to_target(project, spec)?;
         for warning in &built.warnings {
             #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
             {
@@ -41,12 +55,12 @@ fn project() -> miette::Result<ExitCode> {
         #[allow(clippy::print_stdout, reason = "the CLI reports what it wrote")]
         {
             println!(
-                "{}: target/scorpion/{}.elf ({bytes} bytes, target {}), .lst, .map",
+                "{}: {at}target/scorpion/{}.elf ({bytes} bytes, target {}), .lst, .map",
                 project.file.project.name, built.name, spec.target
             );
         }
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {

@@ -142,7 +142,12 @@ fn project_robot(args: &Args) -> miette::Result<Option<Rigged>> {
     else {
         return Ok(None);
     };
-    let project = crate::project::Project::load(&root)?;
+    // A workspace holds no robot of its own: the options alone apply.
+    let crate::project::config::Found::Project(project) =
+        crate::project::config::Found::load(&root)?
+    else {
+        return Ok(None);
+    };
     let rom = args.rom.clone().or_else(|| {
         project
             .file

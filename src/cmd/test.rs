@@ -18,6 +18,7 @@ use uploader::{
 
 use crate::cmd::ports;
 use crate::project::build::{Built, SNAPSHOT_KINDS, build};
+use crate::project::config::Found;
 use crate::project::snapshot::{self, Outcome};
 use crate::project::{FILE, Project};
 
@@ -327,7 +328,7 @@ fn robot_transcripts(
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let project = Project::here()?;
+    let found = Found::here()?;
     let started = std::time::Instant::now();
     let mut tally = Tally {
         passed: 0,
@@ -336,45 +337,29 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         wall_time: std::time::Duration::ZERO,
         out: std::io::stdout().lock(),
     };
-    let mut built = Vec::new();
-    for spec in &project.file.images {
-        match build(&project, spec) {
-            Ok(image) => {
-                for warning in &image.warnings {
-                    let _ = writeln!(std::io::stderr(), "{warning:?}");
+    match found {
+        Found::Project(project) => test_project(&project, args, &mut tally)?,
+        Found::Workspace(workspace) => {
+            if args.port.is_some() {
+                miette::bail!(
+                    help = "a workspace's members may not fit on one robot together: run `scorpion test --port` in each member's directory",
+                    "--port tests one project on the robot, and {FILE} here is a workspace"
+                );
+            }
+            // One process for every member: what is set up once (the
+            // scripting engine's library, the ROM's symbols) serves all.
+            for (name, project) in workspace.projects()? {
+                let _ = writeln!(tally.out, "== {name}");
+                let (passed, failed) = (tally.passed, tally.failed);
+                if let Err(error) = test_project(&project, args, &mut tally) {
+                    tally.record(&format!("project {name}"), Err(format!("{error:?}")));
                 }
-                built.push(image);
-            }
-            Err(error) => tally.record(&format!("build {}", spec.name), Err(format!("{error:?}"))),
-        }
-    }
-    match &args.port {
-        Some(port) => {
-            let port = if port.is_empty() {
-                project.port()?.ok_or_else(|| {
-                    miette::miette!(
-                        help = "give it (`--port /dev/ttyUSB0`), set SCORPION_PORT, or add `port` to [robot] in ~/.config/scorpion/config.toml (yours) or Scorpion.toml (the project's)",
-                        "no port for the robot"
-                    )
-                })?
-            } else {
-                port.clone()
-            };
-            if tally.failed == 0 {
-                robot_transcripts(&project, &built, &port, &mut tally)?;
-            }
-        }
-        None => {
-            for image in &built {
-                check_snapshots(&project, image, args.accept, &mut tally)?;
-            }
-            if built.len() == project.file.images.len() {
-                stale_snapshots(&project, args.accept, &mut tally)?;
-            }
-            if tally.failed == 0 || built.len() == project.file.images.len() {
-                let setup = Setup::of(&project)?;
-                virtual_transcripts(&project, &setup, &built, &mut tally)?;
-                routine_calls(&project, &setup, &built, &mut tally)?;
+                let _ = writeln!(
+                    tally.out,
+                    "{name}: {} passed, {} failed",
+                    tally.passed - passed,
+                    tally.failed - failed
+                );
             }
         }
     }
@@ -397,4 +382,53 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// One project's tests, recorded in `tally`.
+fn test_project(project: &Project, args: &Args, tally: &mut Tally) -> miette::Result<()> {
+    // Failures of this project only (a workspace runs several).
+    let failed_before = tally.failed;
+    let mut built = Vec::new();
+    for spec in &project.file.images {
+        match build(project, spec) {
+            Ok(image) => {
+                for warning in &image.warnings {
+                    let _ = writeln!(std::io::stderr(), "{warning:?}");
+                }
+                built.push(image);
+            }
+            Err(error) => tally.record(&format!("build {}", spec.name), Err(format!("{error:?}"))),
+        }
+    }
+    match &args.port {
+        Some(port) => {
+            let port = if port.is_empty() {
+                project.port()?.ok_or_else(|| {
+                    miette::miette!(
+                        help = "give it (`--port /dev/ttyUSB0`), set SCORPION_PORT, or add `port` to [robot] in ~/.config/scorpion/config.toml (yours) or Scorpion.toml (the project's)",
+                        "no port for the robot"
+                    )
+                })?
+            } else {
+                port.clone()
+            };
+            if tally.failed == failed_before {
+                robot_transcripts(project, &built, &port, tally)?;
+            }
+        }
+        None => {
+            for image in &built {
+                check_snapshots(project, image, args.accept, tally)?;
+            }
+            if built.len() == project.file.images.len() {
+                stale_snapshots(project, args.accept, tally)?;
+            }
+            if tally.failed == failed_before || built.len() == project.file.images.len() {
+                let setup = Setup::of(project)?;
+                virtual_transcripts(project, &setup, &built, tally)?;
+                routine_calls(project, &setup, &built, tally)?;
+            }
+        }
+    }
+    Ok(())
 }

@@ -24,6 +24,23 @@ pub(crate) struct ProjectFile {
     pub(crate) tests: TestsSpec,
 }
 
+/// A workspace's file: `[workspace]` only.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WorkspaceFile {
+    workspace: WorkspaceSpec,
+}
+
+/// `[workspace]`: projects that `scorpion test` and `build` run together,
+/// in one process (as cargo's workspaces).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WorkspaceSpec {
+    /// The members' directories, relative to the workspace, in the order
+    /// they run.
+    members: Vec<String>,
+}
+
 /// `[project]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -188,24 +205,27 @@ impl Project {
             .map(Path::to_path_buf)
     }
 
-    /// Reads the project in `root`.
+    /// Reads the project in `root`; a workspace there is an error that
+    /// says what to do instead.
     pub(crate) fn load(root: &Path) -> miette::Result<Project> {
-        let path = root.join(super::FILE);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
-        // Named as the user knows it: relative to where they are.
-        let name = std::env::current_dir()
-            .ok()
-            .and_then(|cwd| path.strip_prefix(cwd).ok().map(Path::to_path_buf))
-            .unwrap_or_else(|| path.clone())
-            .display()
-            .to_string();
-        let file: ProjectFile = toml::from_str(&text).map_err(|error| {
+        match Found::load(root)? {
+            Found::Project(project) => Ok(project),
+            Found::Workspace(workspace) => miette::bail!(
+                help = "`scorpion test` and `scorpion build` run every member from here; run the other commands in a member's directory",
+                "{} is a workspace of {}, not a project",
+                shown(&root.join(super::FILE)),
+                workspace.member_names().join(", ")
+            ),
+        }
+    }
+
+    fn parse(root: &Path, name: &str, text: &str) -> miette::Result<Project> {
+        let file: ProjectFile = toml::from_str(text).map_err(|error| {
             located(
-                &name,
-                &text,
+                name,
+                text,
                 &error,
-                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts",
+                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts (or, for a workspace, [workspace] members alone)",
             )
         })?;
         if file.images.is_empty() {
@@ -223,17 +243,7 @@ impl Project {
     /// The project found from the current directory up, or an error that
     /// says what was looked for.
     pub(crate) fn here() -> miette::Result<Project> {
-        let cwd = std::env::current_dir()
-            .map_err(|e| miette::miette!("cannot read the current directory: {e}"))?;
-        let Some(root) = Project::find(&cwd) else {
-            miette::bail!(
-                help = "give the files on the command line, or start a project with `scorpion new NAME`",
-                "no {} in {} or any directory above it",
-                super::FILE,
-                cwd.display()
-            );
-        };
-        Project::load(&root)
+        Project::load(&here_root()?)
     }
 
     /// A path of the project, relative to its root.
@@ -333,5 +343,117 @@ impl Project {
             .join("tests")
             .join("snapshots")
             .join(format!("{image}__{kind}.snap"))
+    }
+}
+
+/// A file's path as the user knows it: relative to where they are.
+fn shown(path: &Path) -> String {
+    std::env::current_dir()
+        .ok()
+        .and_then(|cwd| path.strip_prefix(cwd).ok().map(Path::to_path_buf))
+        .unwrap_or_else(|| path.to_path_buf())
+        .display()
+        .to_string()
+}
+
+/// The directory of the `Scorpion.toml` found from the current directory
+/// up, or an error that says what was looked for.
+fn here_root() -> miette::Result<PathBuf> {
+    let cwd = std::env::current_dir()
+        .map_err(|e| miette::miette!("cannot read the current directory: {e}"))?;
+    Project::find(&cwd).ok_or_else(|| {
+        miette::miette!(
+            help =
+                "give the files on the command line, or start a project with `scorpion new NAME`",
+            "no {} in {} or any directory above it",
+            super::FILE,
+            cwd.display()
+        )
+    })
+}
+
+/// Projects run together: a `Scorpion.toml` with `[workspace] members`.
+#[derive(Debug, Clone)]
+pub(crate) struct Workspace {
+    /// The directory that holds the workspace's file.
+    pub(crate) root: PathBuf,
+    /// The members' directories, as the file lists them.
+    members: Vec<String>,
+}
+
+impl Workspace {
+    /// The members' names, as the file gives them.
+    pub(crate) fn member_names(&self) -> Vec<String> {
+        self.members.clone()
+    }
+
+    /// Every member, read in order: (its name, the project).
+    pub(crate) fn projects(&self) -> miette::Result<Vec<(String, Project)>> {
+        self.members
+            .iter()
+            .map(|member| {
+                let root = self.root.join(member);
+                match Found::load(&root) {
+                    Ok(Found::Project(project)) => Ok((member.clone(), project)),
+                    Ok(Found::Workspace(_)) => miette::bail!(
+                        "{}: member `{member}` is a workspace itself; list its members instead",
+                        shown(&self.root.join(super::FILE))
+                    ),
+                    Err(error) if !root.join(super::FILE).is_file() => miette::bail!(
+                        help = "a member is a directory with its own Scorpion.toml (`scorpion new NAME` makes one)",
+                        "{}: member `{member}` has no {}: {error}",
+                        shown(&self.root.join(super::FILE)),
+                        super::FILE
+                    ),
+                    Err(error) => Err(error),
+                }
+            })
+            .collect()
+    }
+}
+
+/// What a `Scorpion.toml` holds: a project, or a workspace of them.
+#[derive(Debug, Clone)]
+pub(crate) enum Found {
+    Project(Project),
+    Workspace(Workspace),
+}
+
+impl Found {
+    /// The file found from the current directory up.
+    pub(crate) fn here() -> miette::Result<Found> {
+        Found::load(&here_root()?)
+    }
+
+    /// The file in `root`.
+    pub(crate) fn load(root: &Path) -> miette::Result<Found> {
+        let path = root.join(super::FILE);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
+        let name = shown(&path);
+        let is_workspace = text
+            .parse::<toml::Table>()
+            .is_ok_and(|table| table.contains_key("workspace"));
+        if !is_workspace {
+            return Project::parse(root, &name, &text).map(Found::Project);
+        }
+        let file: WorkspaceFile = toml::from_str(&text).map_err(|error| {
+            located(
+                &name,
+                &text,
+                &error,
+                "a workspace's file holds [workspace] members = [\"dir\", ...] and nothing else",
+            )
+        })?;
+        if file.workspace.members.is_empty() {
+            miette::bail!(
+                help = "list the projects' directories: members = [\"myext\", \"myos\"]",
+                "{name}: the workspace has no members"
+            );
+        }
+        Ok(Found::Workspace(Workspace {
+            root: root.to_path_buf(),
+            members: file.workspace.members,
+        }))
     }
 }

@@ -117,18 +117,81 @@ fn outside_a_project_test_says_what_it_looked_for() {
 }
 
 #[test]
-fn the_examples_are_projects_that_pass_their_tests() {
+fn the_examples_are_a_workspace_whose_members_pass_their_tests() {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
-    for example in ["rangefinder", "adc", "checksum", "patrol"] {
-        let output = scorpion(&examples.join(example), &["test"]);
-        assert_eq!(
-            output.status.code(),
-            Some(0),
-            "{example}: {}",
-            transcript(&output)
-        );
-        assert!(stdout(&output).contains(" passed, 0 failed"), "{example}");
+    let suite = scorpion(&examples, &["test"]);
+    assert_eq!(suite.status.code(), Some(0), "{}", transcript(&suite));
+    insta::assert_snapshot!("examples_workspace_test", stdout(&suite));
+    // Each member is a project of its own as well.
+    let alone = scorpion(&examples.join("adc"), &["test"]);
+    assert_eq!(alone.status.code(), Some(0), "{}", transcript(&alone));
+    assert!(stdout(&alone).ends_with("5 passed, 0 failed\n"));
+}
+
+/// A workspace of two fresh projects: `build` and `test` run both; a
+/// failing member fails the run and the others still run; `upload` and
+/// `test --port` say to go into a member.
+#[test]
+fn a_workspace_builds_and_tests_its_members() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for name in ["one", "two"] {
+        let made = scorpion(dir.path(), &["new", name]);
+        assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
     }
+    let file = dir.path().join("Scorpion.toml");
+    std::fs::write(&file, "[workspace]\nmembers = [\"one\", \"two\"]\n").expect("write");
+    let built = scorpion(dir.path(), &["build"]);
+    assert_eq!(built.status.code(), Some(0), "{}", transcript(&built));
+    assert!(dir.path().join("two/target/scorpion/two.elf").is_file());
+    let tested = scorpion(dir.path(), &["test"]);
+    assert_eq!(tested.status.code(), Some(0), "{}", transcript(&tested));
+    let text = stdout(&tested);
+    assert!(
+        text.contains("== one\n") && text.contains("two: 5 passed, 0 failed\n"),
+        "{text}"
+    );
+    assert!(text.ends_with("10 passed, 0 failed\n"), "{text}");
+
+    // The first member's transcript now expects another answer.
+    std::fs::write(dir.path().join("one/tests/one.expect"), "/1V => V09\n").expect("write");
+    let failing = scorpion(dir.path(), &["test"]);
+    assert_eq!(failing.status.code(), Some(1), "{}", transcript(&failing));
+    let text = stdout(&failing);
+    assert!(text.contains("one: 4 passed, 1 failed\n"), "{text}");
+    assert!(text.contains("two: 5 passed, 0 failed\n"), "{text}");
+    assert!(text.ends_with("9 passed, 1 failed\n"), "{text}");
+
+    for args in [&["upload", "--port", "emu"][..], &["test", "--port", "emu"]] {
+        let refused = scorpion(dir.path(), args);
+        assert_eq!(refused.status.code(), Some(1), "{}", transcript(&refused));
+        assert!(
+            transcript(&refused).contains("workspace"),
+            "{args:?}: {}",
+            transcript(&refused)
+        );
+    }
+}
+
+#[test]
+fn workspace_errors_name_the_file_and_the_member() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let file = dir.path().join("Scorpion.toml");
+    std::fs::write(&file, "[workspace]\nmembers = [\"gone\"]\n").expect("write");
+    let missing = scorpion(dir.path(), &["test"]);
+    assert_eq!(missing.status.code(), Some(1), "{}", transcript(&missing));
+    assert!(
+        transcript(&missing).contains("member `gone` has no Scorpion.toml"),
+        "{}",
+        transcript(&missing)
+    );
+    std::fs::write(&file, "[workspace]\nmembers = [\"a\"]\nname = \"x\"\n").expect("write");
+    let extra = scorpion(dir.path(), &["test"]);
+    assert_eq!(extra.status.code(), Some(1), "{}", transcript(&extra));
+    assert!(
+        transcript(&extra).contains("Scorpion.toml:3:1"),
+        "{}",
+        transcript(&extra)
+    );
 }
 
 #[test]
