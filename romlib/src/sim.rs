@@ -228,21 +228,35 @@ impl VirtualScorpion {
     /// line, until a byte reaches it): the surroundings woken when they
     /// asked to be, then a jammed CPU or a failed card reported.
     fn advance(&mut self, until: u64) -> Result<(), Error> {
+        self.advance_with(until, |robot, to| robot.run(to))
+            .map(|_| ())
+    }
+
+    /// [`VirtualScorpion::advance`] with the caller's own run of the CPU
+    /// (`run(robot, to)` runs to `to` or stops earlier, as
+    /// [`emulator::Cpu::run`] does): the surroundings are woken between
+    /// runs, and a stop before `to` (a hook's, a watching host's) ends it.
+    fn advance_with(
+        &mut self,
+        until: u64,
+        mut run: impl FnMut(&mut Scorpion, u64) -> Stop,
+    ) -> Result<Stop, Error> {
         loop {
             let wake = self
                 .world
                 .as_ref()
                 .and_then(|world| world.next_wake())
                 .filter(|&at| at <= until);
-            if wake.unwrap_or(until) > self.robot.now() {
-                let stop = self.robot.run(wake.unwrap_or(until));
+            let to = wake.unwrap_or(until);
+            if to > self.robot.now() {
+                let stop = run(&mut self.robot, to);
                 self.after_run(stop)?;
-                if stop == Stop::Bus {
-                    return Ok(());
+                if self.robot.now() < to || matches!(stop, Stop::Bus | Stop::Hook { .. }) {
+                    return Ok(stop);
                 }
             }
             let (Some(_), Some(world)) = (wake, self.world.as_mut()) else {
-                return Ok(());
+                return Ok(Stop::Limit);
             };
             let now = self.robot.now();
             world
@@ -252,6 +266,35 @@ impl VirtualScorpion {
                     fault,
                 })?;
         }
+    }
+
+    /// Runs the robot to robot time `until` with the caller's own run of
+    /// the CPU (hooks, a bus that watches memory: a debugger's), the
+    /// surroundings woken as in [`VirtualScorpion::run_until`]. Returns
+    /// the stop that ended it: [`Stop::Limit`] at `until`, or the caller's
+    /// run's earlier stop.
+    ///
+    /// # Errors
+    /// [`Error::Jam`], a card's or the surroundings' failure.
+    pub fn run_until_with(
+        &mut self,
+        until: u64,
+        run: impl FnMut(&mut Scorpion, u64) -> Stop,
+    ) -> Result<Stop, Error> {
+        self.advance_with(until, run)
+    }
+
+    /// Every label the robot knows (the ROM's, a ROM profile's, every
+    /// loaded image's), in address order.
+    #[must_use]
+    pub fn labels(&self) -> Vec<(u16, String)> {
+        self.all_labels().into_iter().cloned().collect()
+    }
+
+    /// The address of `kind`'s hook (the `JMP` in RAM the ROM goes through).
+    #[must_use]
+    pub fn hook_address(&self, kind: HookKind) -> u16 {
+        self.hooks.address(kind)
     }
 
     fn after_run(&mut self, stop: Stop) -> Result<(), Error> {

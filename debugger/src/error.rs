@@ -1,0 +1,47 @@
+//! What can go wrong while debugging.
+
+/// A debugger error.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+pub enum Error {
+    /// The robot failed (a JAM, a card's or the surroundings' fault).
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Robot(#[from] romlib::Error),
+    /// An address expression that does not evaluate.
+    #[error("`{text}`: {reason}")]
+    #[diagnostic(
+        code(debugger::address),
+        help(
+            "an address is a number ($C000, 49152, %1100...), a label, or a sum of them: CMDBUF+1"
+        )
+    )]
+    Address {
+        /// The expression as given.
+        text: String,
+        /// Why it does not evaluate.
+        reason: String,
+    },
+    /// A step back further than the robot has run.
+    #[error("cannot go back {asked} instructions: only {ran} have run since power-up")]
+    #[diagnostic(code(debugger::history))]
+    BeforePowerUp {
+        /// Instructions asked for.
+        asked: u64,
+        /// Instructions run so far.
+        ran: u64,
+    },
+    /// Re-running from power-up did not come back to the same state: a
+    /// card or the surroundings behave differently the second time.
+    #[error(
+        "re-running from power-up reached instruction {instruction} at cycle {found}, not {expected}: the robot's set-up is not deterministic"
+    )]
+    #[diagnostic(code(debugger::replay))]
+    Diverged {
+        /// The instruction count compared at.
+        instruction: u64,
+        /// The cycle the first run had there.
+        expected: u64,
+        /// The cycle the re-run had.
+        found: u64,
+    },
+}

@@ -1,0 +1,656 @@
+//! The debugging session: the robot, the host's actions on it, and the
+//! ways to run it.
+
+use std::cell::Cell;
+use std::collections::VecDeque;
+use std::io::Write;
+
+use emulator::{Cpu, Tracer};
+use isa::objfmt::HookKind;
+use romlib::VirtualScorpion;
+
+use crate::Error;
+use crate::hooks::{Access, Found, Look, WatchBus};
+use crate::points::{Breakpoint, Watch};
+use crate::symbols::Symbols;
+
+/// Builds the robot as it is at power-up with everything loaded: called
+/// once, and again for every step back.
+pub type MakeRobot = Box<dyn Fn() -> Result<VirtualScorpion, romlib::Error> + Send>;
+
+/// Something the host did to the robot, kept to be done again.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Event {
+    /// Bytes sent down the serial line.
+    Send(Vec<u8>),
+    /// The bumpers set (a bit per closed bumper).
+    Bumpers(u8),
+}
+
+/// An event and where in the run it happened.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Done {
+    /// Instructions run before it.
+    instructions: u64,
+    /// The robot's cycle then (checked on every re-run).
+    cycle: u64,
+    event: Event,
+}
+
+/// Why the robot stopped.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Why {
+    /// Breakpoint number `id` (from 1).
+    Breakpoint {
+        /// Its number.
+        id: usize,
+        /// What it is.
+        point: Breakpoint,
+    },
+    /// Watchpoint number `id` saw an access, made by the instruction at
+    /// `pc`.
+    Watch {
+        /// Its number.
+        id: usize,
+        /// The access.
+        access: Access,
+        /// The instruction that made it.
+        pc: u16,
+    },
+    /// The steps asked for were done.
+    Stepped,
+    /// `finish`: the routine returned.
+    Finished,
+    /// The robot time given to the run ran out.
+    Budget,
+    /// Back in time, at the instruction asked for.
+    Back,
+}
+
+/// Where a run ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Stopped {
+    /// Why.
+    pub why: Why,
+    /// The PC (the next instruction to run).
+    pub pc: u16,
+    /// Robot cycles since the last stop.
+    pub cycles: u64,
+    /// Instructions since the last stop (negative after a step back).
+    pub instructions: i64,
+    /// What the robot sent the host meanwhile.
+    pub received: Vec<u8>,
+}
+
+/// The debugger: the robot, the host's history, the points to stop at.
+pub struct Debugger {
+    make: MakeRobot,
+    robot: VirtualScorpion,
+    symbols: Symbols,
+    breakpoints: Vec<Option<Breakpoint>>,
+    watches: Vec<Option<Watch>>,
+    /// What the host did, in order, up to now.
+    done: Vec<Done>,
+    /// After a step back: what the host had done further on, done again
+    /// when the run gets there (until the host does something new).
+    ahead: VecDeque<Done>,
+    /// Where the last stop was: (cycle, instructions).
+    last_stop: (u64, u64),
+    /// Instructions run when the robot was handed over (no going back
+    /// before them).
+    power_up: u64,
+    trace: Option<Tracer<Box<dyn Write + Send>>>,
+}
+
+impl std::fmt::Debug for Debugger {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Debugger")
+            .field("robot", &self.robot)
+            .field("breakpoints", &self.breakpoints)
+            .field("watches", &self.watches)
+            .field("done", &self.done.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// A line of disassembly.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Line {
+    /// Where the instruction is.
+    pub address: u16,
+    /// Its bytes.
+    pub bytes: Vec<u8>,
+    /// The label at its address, if any.
+    pub label: Option<String>,
+    /// The instruction, its operand named by a label where one fits.
+    pub text: String,
+}
+
+impl Debugger {
+    /// A session on the robot `make` builds; `images` are the loaded
+    /// images (for their symbols).
+    ///
+    /// # Errors
+    /// The robot's own failure to build.
+    pub fn new(make: MakeRobot, images: &[linker::Image]) -> Result<Debugger, Error> {
+        let robot = make()?;
+        let symbols = Symbols::new(&robot, images);
+        let last_stop = (robot.cycles(), robot.robot().cpu.instructions());
+        Ok(Debugger {
+            make,
+            robot,
+            symbols,
+            breakpoints: Vec::new(),
+            watches: Vec::new(),
+            done: Vec::new(),
+            ahead: VecDeque::new(),
+            last_stop,
+            power_up: last_stop.1,
+            trace: None,
+        })
+    }
+
+    /// The robot.
+    #[must_use]
+    pub fn robot(&self) -> &VirtualScorpion {
+        &self.robot
+    }
+
+    /// The CPU.
+    #[must_use]
+    pub fn cpu(&self) -> &Cpu {
+        &self.robot.robot().cpu
+    }
+
+    /// The names known.
+    #[must_use]
+    pub fn symbols(&self) -> &Symbols {
+        &self.symbols
+    }
+
+    /// Traces every instruction run from now on into `out` (`None`: stop).
+    pub fn trace(&mut self, out: Option<Box<dyn Write + Send>>) {
+        self.trace = out.map(Tracer::new);
+    }
+
+    /// Adds a breakpoint; returns its number.
+    pub fn add_breakpoint(&mut self, point: Breakpoint) -> usize {
+        self.breakpoints.push(Some(point));
+        self.breakpoints.len()
+    }
+
+    /// Adds a watchpoint; returns its number.
+    pub fn add_watch(&mut self, watch: Watch) -> usize {
+        self.watches.push(Some(watch));
+        self.watches.len()
+    }
+
+    /// Deletes breakpoint `id`; false if there was none.
+    pub fn delete_breakpoint(&mut self, id: usize) -> bool {
+        id.checked_sub(1)
+            .and_then(|i| self.breakpoints.get_mut(i))
+            .and_then(Option::take)
+            .is_some()
+    }
+
+    /// Deletes watchpoint `id`; false if there was none.
+    pub fn delete_watch(&mut self, id: usize) -> bool {
+        id.checked_sub(1)
+            .and_then(|i| self.watches.get_mut(i))
+            .and_then(Option::take)
+            .is_some()
+    }
+
+    /// The breakpoints, with their numbers.
+    #[must_use]
+    pub fn breakpoints(&self) -> Vec<(usize, Breakpoint)> {
+        numbered(&self.breakpoints)
+    }
+
+    /// The watchpoints, with their numbers.
+    #[must_use]
+    pub fn watches(&self) -> Vec<(usize, Watch)> {
+        numbered(&self.watches)
+    }
+
+    /// The host sends `bytes` down the line (now, at the robot's time).
+    pub fn send(&mut self, bytes: &[u8]) {
+        self.act(Event::Send(bytes.to_vec()));
+    }
+
+    /// The host closes the bumpers whose bits are set in `closed`.
+    pub fn set_bumpers(&mut self, closed: u8) {
+        self.act(Event::Bumpers(closed));
+    }
+
+    fn act(&mut self, event: Event) {
+        // Something new: what the host had done further on is not redone.
+        self.ahead.clear();
+        let done = Done {
+            instructions: self.cpu().instructions(),
+            cycle: self.robot.cycles(),
+            event,
+        };
+        apply(&mut self.robot, &done.event);
+        self.done.push(done);
+    }
+
+    /// Runs until a breakpoint or watchpoint, or for `budget` cycles.
+    ///
+    /// # Errors
+    /// The robot's failure (a JAM, a card's fault).
+    pub fn run(&mut self, budget: u64) -> Result<Stopped, Error> {
+        let until = self.robot.cycles().saturating_add(budget);
+        self.go(until, Goal::default())
+    }
+
+    /// Runs `count` instructions (stopping earlier at a breakpoint or
+    /// watchpoint).
+    ///
+    /// # Errors
+    /// As [`Debugger::run`].
+    pub fn step(&mut self, count: u64) -> Result<Stopped, Error> {
+        let target = self.cpu().instructions().saturating_add(count.max(1));
+        self.go(
+            u64::MAX,
+            Goal {
+                at_count: Some(target),
+                ..Goal::default()
+            },
+        )
+    }
+
+    /// One instruction, a `JSR` with the whole subroutine it calls.
+    ///
+    /// # Errors
+    /// As [`Debugger::run`].
+    pub fn next(&mut self, budget: u64) -> Result<Stopped, Error> {
+        let cpu = self.cpu();
+        let pc = cpu.pc;
+        let is_jsr = emulator::Bus::peek(&self.robot.robot().bus, pc) == 0x20;
+        if !is_jsr {
+            return self.step(1);
+        }
+        let goal = Goal {
+            returning_to: Some((pc.wrapping_add(3), cpu.s)),
+            ..Goal::default()
+        };
+        let until = self.robot.cycles().saturating_add(budget);
+        self.go(until, goal)
+    }
+
+    /// Runs until the current subroutine returns (its `RTS` pops the
+    /// return address it was called with).
+    ///
+    /// # Errors
+    /// As [`Debugger::run`].
+    pub fn finish(&mut self, budget: u64) -> Result<Stopped, Error> {
+        let goal = Goal {
+            finish_at: self.cpu().s.checked_add(2),
+            ..Goal::default()
+        };
+        let until = self.robot.cycles().saturating_add(budget);
+        self.go(until, goal)
+    }
+
+    fn go(&mut self, until: u64, goal: Goal) -> Result<Stopped, Error> {
+        let mut received = Vec::new();
+        loop {
+            // After a step back, the host's recorded actions are done
+            // again when the run gets to them.
+            while let Some(done) = self.ahead.front() {
+                if self.robot.cycles() < done.cycle {
+                    break;
+                }
+                check_place(&self.robot, done)?;
+                apply(&mut self.robot, &done.event);
+                if let Some(done) = self.ahead.pop_front() {
+                    self.done.push(done);
+                }
+            }
+            let to = until.min(self.ahead.front().map_or(u64::MAX, |d| d.cycle));
+            let arrival = self.arrival();
+            let found = run_hooked(
+                &mut self.robot,
+                self.trace.as_mut(),
+                Points {
+                    breakpoints: &self.breakpoints,
+                    watches: &self.watches,
+                    arrival,
+                },
+                to,
+                goal,
+            )?;
+            received.extend(self.robot.receive());
+            if found.is_none() && self.robot.cycles() < until {
+                continue;
+            }
+            let why = match found {
+                Some(Found::Breakpoint(index)) => Why::Breakpoint {
+                    id: index + 1,
+                    point: self.breakpoints[index]
+                        .clone()
+                        .unwrap_or(Breakpoint::UnknownHook),
+                },
+                Some(Found::Watch { access, pc }) => Why::Watch {
+                    id: access.watch + 1,
+                    access,
+                    pc,
+                },
+                Some(Found::Count | Found::Returned) => Why::Stepped,
+                Some(Found::Finished) => Why::Finished,
+                None => Why::Budget,
+            };
+            return Ok(self.stopped(why, received));
+        }
+    }
+
+    fn stopped(&mut self, why: Why, received: Vec<u8>) -> Stopped {
+        let now = (self.robot.cycles(), self.cpu().instructions());
+        let (cycle, instructions) = std::mem::replace(&mut self.last_stop, now);
+        Stopped {
+            why,
+            pc: self.cpu().pc,
+            cycles: now.0.abs_diff(cycle),
+            instructions: signed(now.1) - signed(instructions),
+            received,
+        }
+    }
+
+    /// Where a command breakpoint looks: the ROM's `dispatch` and the
+    /// unknown-command hook.
+    fn arrival(&self) -> Arrival {
+        Arrival {
+            dispatch: self.symbols.get("dispatch"),
+            unknown: self.robot.hook_address(HookKind::Unknown),
+        }
+    }
+
+    /// Goes back `count` instructions: the robot built again and run,
+    /// with the host's actions replayed, to that point.
+    ///
+    /// # Errors
+    /// [`Error::BeforePowerUp`] for more instructions than have run;
+    /// [`Error::Diverged`] if the re-run does not retrace the run.
+    pub fn back(&mut self, count: u64) -> Result<Stopped, Error> {
+        let now = self.cpu().instructions();
+        let target = now
+            .checked_sub(count)
+            .filter(|&t| t >= self.power_up)
+            .ok_or(Error::BeforePowerUp {
+                asked: count,
+                ran: now - self.power_up,
+            })?;
+        self.rerun_to(target)?;
+        Ok(self.stopped(Why::Back, Vec::new()))
+    }
+
+    /// Goes back to the last breakpoint or watchpoint hit before now.
+    /// `None` (and nothing changed) if there was none.
+    ///
+    /// # Errors
+    /// As [`Debugger::back`].
+    pub fn reverse_continue(&mut self) -> Result<Option<Stopped>, Error> {
+        let now = self.cpu().instructions();
+        let arrival = self.arrival();
+        let points = Points {
+            breakpoints: &self.breakpoints,
+            watches: &self.watches,
+            arrival,
+        };
+        let mut scout = self.replayer()?;
+        let mut last = None;
+        // Short of now: a hit at now is the stop the robot is at.
+        while let Some(hit) = scout.run_to(now, points)? {
+            if hit.0 < now {
+                last = Some(hit);
+            }
+        }
+        let Some((count, found)) = last else {
+            return Ok(None);
+        };
+        self.rerun_to(count)?;
+        let why = match found {
+            Found::Breakpoint(index) => Why::Breakpoint {
+                id: index + 1,
+                point: self.breakpoints[index]
+                    .clone()
+                    .unwrap_or(Breakpoint::UnknownHook),
+            },
+            Found::Watch { access, pc } => Why::Watch {
+                id: access.watch + 1,
+                access,
+                pc,
+            },
+            _ => Why::Back,
+        };
+        Ok(Some(self.stopped(why, Vec::new())))
+    }
+
+    /// The last write to `address` before now: the writing instruction's
+    /// count (instructions run before it), its PC and the byte written.
+    /// `None` if nothing has written it since power-up.
+    ///
+    /// # Errors
+    /// As [`Debugger::back`].
+    pub fn who_wrote(&mut self, address: u16) -> Result<Option<LastWrite>, Error> {
+        let now = self.cpu().instructions();
+        let watches = [Some(Watch {
+            start: address,
+            end: address,
+            kind: crate::WatchKind::Write,
+        })];
+        let points = Points {
+            breakpoints: &[],
+            watches: &watches,
+            arrival: self.arrival(),
+        };
+        let mut scout = self.replayer()?;
+        let mut last = None;
+        while let Some((count, found)) = scout.run_to(now, points)? {
+            if let Found::Watch { access, pc } = found {
+                last = Some(LastWrite {
+                    instruction: count - 1,
+                    pc,
+                    value: access.value,
+                    cycle: scout.robot.cycles(),
+                });
+            }
+        }
+        Ok(last)
+    }
+
+    fn replayer(&self) -> Result<Replayer, Error> {
+        Ok(Replayer {
+            robot: (self.make)()?,
+            events: self.done.iter().chain(self.ahead.iter()).cloned().collect(),
+            next: 0,
+        })
+    }
+
+    /// Builds the robot again and runs it to `target` instructions.
+    fn rerun_to(&mut self, target: u64) -> Result<(), Error> {
+        let mut replay = self.replayer()?;
+        let points = Points {
+            breakpoints: &[],
+            watches: &[],
+            arrival: self.arrival(),
+        };
+        while replay.run_to(target, points)?.is_some() {}
+        replay.robot.receive();
+        let mut events = replay.events;
+        self.ahead = events.split_off(replay.next).into();
+        self.done = events;
+        self.robot = replay.robot;
+        Ok(())
+    }
+}
+
+/// A write found by [`Debugger::who_wrote`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LastWrite {
+    /// Instructions run before the writing one.
+    pub instruction: u64,
+    /// The writing instruction's address.
+    pub pc: u16,
+    /// The byte written.
+    pub value: u8,
+    /// The robot's cycle after it.
+    pub cycle: u64,
+}
+
+/// The robot built again, and the host's actions to do again on it.
+struct Replayer {
+    robot: VirtualScorpion,
+    events: Vec<Done>,
+    /// The next event to do.
+    next: usize,
+}
+
+impl Replayer {
+    /// Runs to `target` instructions, doing the host's actions at their
+    /// cycles; `Some` at a breakpoint or watchpoint on the way (call again
+    /// to go on), `None` at the target.
+    fn run_to(&mut self, target: u64, points: Points<'_>) -> Result<Option<(u64, Found)>, Error> {
+        loop {
+            while let Some(done) = self.events.get(self.next) {
+                if self.robot.cycles() < done.cycle || done.instructions > target {
+                    break;
+                }
+                check_place(&self.robot, done)?;
+                apply(&mut self.robot, &done.event);
+                self.next += 1;
+            }
+            if self.robot.robot().cpu.instructions() >= target {
+                return Ok(None);
+            }
+            let until = self
+                .events
+                .get(self.next)
+                .filter(|d| d.instructions <= target)
+                .map_or(u64::MAX, |d| d.cycle);
+            let goal = Goal {
+                at_count: Some(target),
+                ..Goal::default()
+            };
+            match run_hooked(&mut self.robot, None, points, until, goal)? {
+                None | Some(Found::Count) => {}
+                Some(found) => return Ok(Some((self.robot.robot().cpu.instructions(), found))),
+            }
+        }
+    }
+}
+
+/// Checks that a re-run reached a recorded action where the run did.
+fn check_place(robot: &VirtualScorpion, done: &Done) -> Result<(), Error> {
+    let (cycle, count) = (robot.cycles(), robot.robot().cpu.instructions());
+    if cycle != done.cycle || count != done.instructions {
+        return Err(Error::Diverged {
+            instruction: done.instructions,
+            expected: done.cycle,
+            found: cycle,
+        });
+    }
+    Ok(())
+}
+
+/// What the hooks stop at.
+#[derive(Clone, Copy)]
+struct Points<'a> {
+    breakpoints: &'a [Option<Breakpoint>],
+    watches: &'a [Option<Watch>],
+    arrival: Arrival,
+}
+
+/// One run under the hooks, to `until` (a cycle) or a stop.
+fn run_hooked(
+    robot: &mut VirtualScorpion,
+    trace: Option<&mut Tracer<Box<dyn Write + Send>>>,
+    points: Points<'_>,
+    until: u64,
+    goal: Goal,
+) -> Result<Option<Found>, Error> {
+    let hit = Cell::new(None);
+    let matches = |cpu: &Cpu, peek: &dyn Fn(u16) -> u8| {
+        points.breakpoints.iter().position(|point| {
+            point
+                .as_ref()
+                .is_some_and(|point| breakpoint_hits(point, cpu.pc, &points.arrival, peek))
+        })
+    };
+    let mut look = Look {
+        breakpoint: matches,
+        at_count: goal.at_count,
+        returning_to: goal.returning_to,
+        finish_at: goal.finish_at,
+        hit: &hit,
+        first: true,
+        last_pc: 0,
+        found: None,
+    };
+    let mut trace = trace;
+    robot.run_until_with(until, |robot, to| {
+        let mut bus = WatchBus {
+            board: &mut robot.bus,
+            watches: points.watches,
+            hit: &hit,
+        };
+        match trace.as_deref_mut() {
+            Some(tracer) => robot.cpu.run(&mut bus, to, &mut (&mut look, tracer)),
+            None => robot.cpu.run(&mut bus, to, &mut look),
+        }
+    })?;
+    Ok(look.found)
+}
+
+fn signed(count: u64) -> i64 {
+    i64::try_from(count).unwrap_or(i64::MAX)
+}
+
+/// What a run aims for besides breakpoints and watchpoints.
+#[derive(Debug, Clone, Copy, Default)]
+struct Goal {
+    at_count: Option<u64>,
+    returning_to: Option<(u16, u8)>,
+    finish_at: Option<u8>,
+}
+
+/// Where a command arrives.
+#[derive(Debug, Clone, Copy)]
+struct Arrival {
+    dispatch: Option<u16>,
+    unknown: u16,
+}
+
+fn breakpoint_hits(
+    point: &Breakpoint,
+    pc: u16,
+    arrival: &Arrival,
+    peek: &dyn Fn(u16) -> u8,
+) -> bool {
+    match point {
+        Breakpoint::At(address) => pc == *address,
+        Breakpoint::UnknownHook => pc == arrival.unknown,
+        Breakpoint::Command { count, letter } => {
+            let at = arrival.dispatch.unwrap_or(arrival.unknown);
+            pc == at
+                && peek(romlib::symbols::CMDLEN) == *count
+                && peek(romlib::symbols::CMDBUF) == *letter
+        }
+    }
+}
+
+fn apply(robot: &mut VirtualScorpion, event: &Event) {
+    match event {
+        Event::Send(bytes) => robot.send(bytes),
+        Event::Bumpers(closed) => robot.set_bumpers(*closed),
+    }
+}
+
+fn numbered<T: Clone>(items: &[Option<T>]) -> Vec<(usize, T)> {
+    items
+        .iter()
+        .enumerate()
+        .filter_map(|(i, item)| Some((i + 1, item.clone()?)))
+        .collect()
+}

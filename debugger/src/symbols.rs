@@ -1,0 +1,165 @@
+//! Names for addresses and addresses for names: the ROM's labels and
+//! exported names, and every loaded image's symbols.
+
+use std::collections::HashMap;
+
+use crate::Error;
+
+/// The names the debugger knows.
+#[derive(Debug, Clone, Default)]
+pub struct Symbols {
+    /// Every name and its value (labels and constants).
+    by_name: HashMap<String, u16>,
+    /// Labels (names of places in code or data), by address.
+    labels: Vec<(u16, String)>,
+}
+
+impl Symbols {
+    /// The robot's labels, the ROM's exported names, and `images`'
+    /// symbols (constants too, for expressions).
+    #[must_use]
+    pub fn new(robot: &romlib::VirtualScorpion, images: &[linker::Image]) -> Symbols {
+        let mut symbols = Symbols::default();
+        for symbol in romlib::symbols::ALL {
+            symbols.by_name.insert(symbol.name.to_owned(), symbol.value);
+        }
+        for image in images {
+            for symbol in &image.symbols {
+                if let Ok(value) = u16::try_from(symbol.value) {
+                    let entry = symbols.by_name.entry(symbol.name.clone());
+                    if symbol.global {
+                        *entry.or_default() = value;
+                    } else {
+                        entry.or_insert(value);
+                    }
+                }
+            }
+        }
+        symbols.labels = robot.labels();
+        for (at, name) in &symbols.labels {
+            symbols.by_name.entry(name.clone()).or_insert(*at);
+        }
+        // One label per address: the user's own before the toolchain's
+        // `__scorpion_...` names.
+        symbols
+            .labels
+            .sort_by_key(|(at, name)| (*at, name.starts_with("__"), name.clone()));
+        symbols.labels.dedup_by_key(|(at, _)| *at);
+        symbols
+    }
+
+    /// The value of `name`.
+    #[must_use]
+    pub fn get(&self, name: &str) -> Option<u16> {
+        self.by_name.get(name).copied()
+    }
+
+    /// The label at `address` exactly.
+    #[must_use]
+    pub fn label(&self, address: u16) -> Option<&str> {
+        let index = self
+            .labels
+            .binary_search_by_key(&address, |(at, _)| *at)
+            .ok()?;
+        Some(&self.labels[index].1)
+    }
+
+    /// `address` as `label` or `label+$offset` (a label within a page
+    /// below it), if there is one.
+    #[must_use]
+    pub fn place(&self, address: u16) -> Option<String> {
+        let index = self.labels.partition_point(|(at, _)| *at <= address);
+        let (at, name) = self.labels.get(index.checked_sub(1)?)?;
+        match address - at {
+            0 => Some(name.clone()),
+            offset if offset < 0x100 => Some(format!("{name}+${offset:X}")),
+            _ => None,
+        }
+    }
+
+    /// Evaluates an address expression: numbers (`$C000`, `0xC000`,
+    /// `%1010`, `49152`) and names joined by `+` and `-`.
+    ///
+    /// # Errors
+    /// [`Error::Address`] for an unknown name, a malformed number, or a
+    /// value outside `$0000-$FFFF`.
+    pub fn address(&self, text: &str) -> Result<u16, Error> {
+        let bad = |reason: String| Error::Address {
+            text: text.to_owned(),
+            reason,
+        };
+        let mut total: i64 = 0;
+        let mut sign = 1;
+        let mut rest = text.trim();
+        if rest.is_empty() {
+            return Err(bad("no address given".into()));
+        }
+        loop {
+            let end = rest.find(['+', '-']).unwrap_or(rest.len());
+            let term = rest[..end].trim();
+            if term.is_empty() {
+                return Err(bad("a `+` or `-` with nothing beside it".into()));
+            }
+            total += sign * self.term(term).map_err(bad)?;
+            if end == rest.len() {
+                break;
+            }
+            sign = if rest.as_bytes()[end] == b'+' { 1 } else { -1 };
+            rest = &rest[end + 1..];
+        }
+        u16::try_from(total).map_err(|_| bad(format!("{total} is not an address ($0000-$FFFF)")))
+    }
+
+    fn term(&self, term: &str) -> Result<i64, String> {
+        let number = |digits: &str, radix| {
+            i64::from_str_radix(&digits.replace('_', ""), radix)
+                .map_err(|_| format!("`{term}` is not a number"))
+        };
+        if let Some(hex) = term.strip_prefix('$').or_else(|| term.strip_prefix("0x")) {
+            return number(hex, 16);
+        }
+        if let Some(binary) = term.strip_prefix('%') {
+            return number(binary, 2);
+        }
+        if term.starts_with(|c: char| c.is_ascii_digit()) {
+            return number(term, 10);
+        }
+        self.get(term).map(i64::from).ok_or_else(|| {
+            let near: Vec<&str> = self
+                .by_name
+                .keys()
+                .filter(|name| name.eq_ignore_ascii_case(term))
+                .map(String::as_str)
+                .collect();
+            match near.first() {
+                Some(name) => format!("no label `{term}` (did you mean `{name}`?)"),
+                None => format!("no label `{term}`"),
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn expressions_of_numbers_and_names() {
+        let robot = romlib::VirtualScorpion::new();
+        let symbols = Symbols::new(&robot, &[]);
+        let cmdbuf = romlib::symbols::CMDBUF;
+        assert_eq!(symbols.address("$C011").ok(), Some(0xC011));
+        assert_eq!(symbols.address("0x10 + %11 - 1").ok(), Some(0x12));
+        assert_eq!(symbols.address("CMDBUF+1").ok(), Some(cmdbuf + 1));
+        assert!(
+            symbols
+                .address("cmdbuf")
+                .is_err_and(|e| e.to_string().contains("did you mean `CMDBUF`"))
+        );
+        assert!(symbols.address("$10000").is_err());
+        assert!(symbols.address("1+").is_err());
+        let dispatch = symbols.get("dispatch").expect("the ROM's dispatch label");
+        assert_eq!(symbols.place(dispatch).as_deref(), Some("dispatch"));
+        assert_eq!(symbols.place(dispatch + 2), Some("dispatch+$2".into()));
+    }
+}
