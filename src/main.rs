@@ -50,6 +50,9 @@ enum Command {
     New(cmd::new::Args),
     /// Run a project's tests: snapshots and transcripts.
     Test(cmd::test::Args),
+    /// Debug a program on the virtual Scorpion: breakpoints, stepping,
+    /// back in time.
+    Debug(cmd::debug::Args),
 }
 
 fn main() -> ExitCode {
@@ -68,6 +71,7 @@ fn main() -> ExitCode {
         Command::Ask(args) => cmd::ask::run(&args),
         Command::New(args) => cmd::new::run(&args),
         Command::Test(args) => cmd::test::run(&args),
+        Command::Debug(args) => cmd::debug::run(&args),
     };
     match result {
         Ok(code) => code,

@@ -7,6 +7,14 @@ pub enum Error {
     #[error(transparent)]
     #[diagnostic(transparent)]
     Robot(#[from] romlib::Error),
+    /// Building the robot again (for a step back) failed: its files
+    /// changed or went since the session began.
+    #[error("cannot build the robot again: {message}")]
+    #[diagnostic(code(debugger::setup))]
+    Setup {
+        /// What went wrong.
+        message: String,
+    },
     /// An address expression that does not evaluate.
     #[error("`{text}`: {reason}")]
     #[diagnostic(

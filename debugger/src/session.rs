@@ -16,7 +16,7 @@ use crate::symbols::Symbols;
 
 /// Builds the robot as it is at power-up with everything loaded: called
 /// once, and again for every step back.
-pub type MakeRobot = Box<dyn Fn() -> Result<VirtualScorpion, romlib::Error> + Send>;
+pub type MakeRobot = Box<dyn Fn() -> Result<VirtualScorpion, Error> + Send>;
 
 /// Something the host did to the robot, kept to be done again.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -166,6 +166,32 @@ impl Debugger {
     #[must_use]
     pub fn symbols(&self) -> &Symbols {
         &self.symbols
+    }
+
+    /// `count` instructions from `address`, decoded from memory as the CPU
+    /// sees it, labels beside them and jump targets named.
+    #[must_use]
+    pub fn disassemble(&self, address: u16, count: usize) -> Vec<Line> {
+        let bus = &self.robot.robot().bus;
+        let peek = |at: u16| emulator::Bus::peek(bus, at);
+        let mut lines = Vec::with_capacity(count);
+        let mut at = address;
+        for _ in 0..count {
+            let instruction = isa::Instruction::decode_with(at, peek);
+            let len = u16::from(instruction.len());
+            let mut text = instruction.to_string();
+            if let Some(name) = instruction.target().and_then(|t| self.symbols.label(t)) {
+                text = format!("{text:<14} ; {name}");
+            }
+            lines.push(Line {
+                address: at,
+                bytes: (0..len).map(|i| peek(at.wrapping_add(i))).collect(),
+                label: self.symbols.label(at).map(str::to_owned),
+                text,
+            });
+            at = at.wrapping_add(len);
+        }
+        lines
     }
 
     /// Traces every instruction run from now on into `out` (`None`: stop).

@@ -125,14 +125,22 @@ impl Symbols {
             return number(term, 10);
         }
         self.get(term).map(i64::from).ok_or_else(|| {
-            let near: Vec<&str> = self
+            // The nearest name, a letter or two away (or only in case).
+            let near = self
                 .by_name
                 .keys()
-                .filter(|name| name.eq_ignore_ascii_case(term))
-                .map(String::as_str)
-                .collect();
-            match near.first() {
-                Some(name) => format!("no label `{term}` (did you mean `{name}`?)"),
+                .map(|name| {
+                    let distance = if name.eq_ignore_ascii_case(term) {
+                        0
+                    } else {
+                        strsim::levenshtein(name, term)
+                    };
+                    (distance, name)
+                })
+                .filter(|(distance, _)| *distance <= 2)
+                .min();
+            match near {
+                Some((_, name)) => format!("no label `{term}` (did you mean `{name}`?)"),
                 None => format!("no label `{term}`"),
             }
         })

@@ -88,6 +88,14 @@ pub(crate) fn virtual_robot(
     Ok(robot)
 }
 
+/// [`virtual_robot`] without the cards' and surroundings' scripts.
+pub(crate) fn bare_robot(
+    baud: u32,
+    rom: Option<&(String, linker::Image)>,
+) -> miette::Result<VirtualScorpion> {
+    virtual_robot(baud, rom, &crate::cmd::rig::Rig::default())
+}
+
 /// Opens `--port`: a serial device path, or `emu` for a fresh virtual
 /// Scorpion in this process (the transport's clock is then its emulated
 /// time) with the cards and surroundings of `rig`.

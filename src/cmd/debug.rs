@@ -1,0 +1,559 @@
+//! `scorpion debug`: a monitor on the virtual Scorpion. The robot with
+//! the project's (or the given) images, cards and surroundings; commands
+//! in the spirit of VICE's monitor read from stdin (typed, or a script),
+//! the robot's serial line driven from the same prompt.
+
+use std::io::{BufRead, IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use debugger::session::{Line, Stopped};
+use debugger::{Breakpoint, Debugger, Watch, WatchKind, Why};
+use miette::{Context, IntoDiagnostic};
+
+use crate::cmd::ports;
+
+/// Debug a program on the virtual Scorpion: breakpoints (an address, a
+/// label, a robot command arriving), watchpoints, step, next, finish, and
+/// back in time. Type `help` at the prompt.
+///
+/// In a project it loads the project's images, cards and surroundings;
+/// `--image`, `--card`, `--world` and `--rom` replace them. Commands come
+/// from stdin, so a file of them is a repeatable session:
+/// `scorpion debug < session.txt`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// The line's baud rate.
+    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
+    baud: u32,
+    /// A linked image (ELF) to load, as an upload leaves it; repeat to
+    /// chain extensions.
+    #[arg(long = "image", value_name = "ELF")]
+    images: Vec<PathBuf>,
+    /// A ROM profile (the ROM's linked ELF) instead of the reference ROM.
+    #[arg(long, value_name = "ELF")]
+    rom: Option<PathBuf>,
+    /// Cards on the KIM bus and the robot's surroundings.
+    #[command(flatten)]
+    rig: crate::cmd::rig::Rig,
+}
+
+/// What `continue`, `next` and `finish` run for at most, in robot cycles,
+/// unless given: one second of the robot's time.
+const BUDGET: u64 = 1_000_000;
+
+const HELP: &str = "\
+commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
+  /1P                  send a command down the serial line (any line starting with /)
+  send TEXT            send TEXT as it is
+  bumpers HEX          close the bumpers whose bits are set ($00 opens them all)
+  break ADDR | /3A | unknown
+                       stop before the instruction at ADDR, when the ROM has command /3A,
+                       or when it jumps through HOOK_UNKNOWN                    (b)
+  watch [read|write|access] ADDR[..ADDR]
+                       stop after an instruction that reads or writes there       (w)
+  delete N | delete watch N
+                       remove breakpoint N or watchpoint N
+  info                 list the breakpoints and watchpoints
+  continue [CYCLES]    run until a stop, at most CYCLES (1 s of robot time)       (c)
+  step [N]             run N instructions (1)                                     (s)
+  next                 one instruction, a JSR with its whole subroutine            (n)
+  finish               run until the current subroutine returns                   (f)
+  back [N]             go back N instructions (1), exactly                        (bs)
+  reverse-continue     go back to the last breakpoint or watchpoint hit           (rc)
+  who-wrote ADDR       the last instruction that wrote ADDR, and the byte
+  regs                 the registers                                              (r)
+  mem ADDR [LEN]       bytes from ADDR (16)                                       (m)
+  dis [ADDR] [N]       N instructions from ADDR (the PC; 8)                       (d)
+  trace FILE | trace off
+                       write every instruction run to FILE
+  help, quit (q)";
+
+pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    let (make, images) = recipe(args)?;
+    let mut debugger = Debugger::new(make, &images)?;
+    let stdin = std::io::stdin();
+    let interactive = stdin.is_terminal();
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "the virtual Scorpion, stopped at ${:04X} after power-up; `help` lists the commands",
+        debugger.cpu().pc
+    )
+    .into_diagnostic()?;
+    let mut broken = false;
+    let mut lines = stdin.lock().lines();
+    loop {
+        write!(out, "(scorpion) ").into_diagnostic()?;
+        out.flush().into_diagnostic()?;
+        let Some(line) = lines.next() else {
+            writeln!(out).into_diagnostic()?;
+            break;
+        };
+        let line = line.into_diagnostic()?;
+        if !interactive {
+            // A script's session reads as a transcript.
+            writeln!(out, "{line}").into_diagnostic()?;
+        }
+        match command(&mut debugger, line.trim()) {
+            Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,
+            Ok(Reply::Quit) => break,
+            Err(error) => {
+                let robot_broke = matches!(error, Failure::Robot(_));
+                broken |= robot_broke;
+                writeln!(out, "error: {}", error.message()).into_diagnostic()?;
+            }
+        }
+    }
+    // A session in which the robot broke (a JAM, a card's fault) fails.
+    Ok(if broken {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// The robot the options (or the project) describe, as a function that
+/// builds it afresh, and the images it loads.
+fn recipe(args: &Args) -> miette::Result<(debugger::MakeRobot, Vec<linker::Image>)> {
+    let mut rig = args.rig.clone();
+    let mut rom_path = args.rom.clone();
+    let mut images = Vec::new();
+    for path in &args.images {
+        let bytes = std::fs::read(path)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot read {}", path.display()))?;
+        images.push(linker::Image::parse(&path.display().to_string(), &bytes)?);
+    }
+    let project = std::env::current_dir()
+        .ok()
+        .and_then(|cwd| crate::project::Project::find(&cwd))
+        .map(|root| crate::project::config::Found::load(&root))
+        .transpose()?;
+    if let Some(crate::project::config::Found::Project(project)) = project {
+        if rig.is_empty() {
+            rig = project.rig()?;
+        }
+        if rom_path.is_none() {
+            rom_path = project
+                .file
+                .robot
+                .rom
+                .as_ref()
+                .map(|r| project.root.join(r));
+        }
+        if args.images.is_empty() {
+            for spec in &project.file.images {
+                images.push(crate::project::build::build(&project, spec)?.linked.image);
+            }
+        }
+    }
+    let rom = match &rom_path {
+        Some(path) => {
+            let bytes = std::fs::read(path)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot read the ROM profile {}", path.display()))?;
+            let name = path.display().to_string();
+            let image = linker::Image::parse(&name, &bytes)?;
+            Some((name, image))
+        }
+        None => None,
+    };
+    let baud = args.baud;
+    let loaded = images.clone();
+    let build = move || -> miette::Result<romlib::VirtualScorpion> {
+        let mut robot = ports::bare_robot(baud, rom.as_ref())?;
+        // Cards first: an image cannot be loaded over a card's registers.
+        rig.attach(&mut robot)?;
+        for image in &loaded {
+            robot.load_image(image)?;
+        }
+        Ok(robot)
+    };
+    // The first build shows its errors in full.
+    build()?;
+    let make: debugger::MakeRobot = Box::new(move || {
+        build().map_err(|report| debugger::Error::Setup {
+            message: format!("{report}"),
+        })
+    });
+    Ok((make, images))
+}
+
+/// What a command prints, or the end of the session.
+enum Reply {
+    Text(String),
+    Quit,
+}
+
+/// A command's failure: the user's mistake, or the robot's.
+enum Failure {
+    Usage(String),
+    Robot(debugger::Error),
+}
+
+impl Failure {
+    fn message(&self) -> String {
+        match self {
+            Failure::Usage(text) => text.clone(),
+            Failure::Robot(error) => {
+                let help = miette::Diagnostic::help(error)
+                    .map(|help| format!(" ({help})"))
+                    .unwrap_or_default();
+                format!("{error}{help}")
+            }
+        }
+    }
+}
+
+impl From<debugger::Error> for Failure {
+    fn from(error: debugger::Error) -> Failure {
+        match error {
+            debugger::Error::Address { .. } | debugger::Error::BeforePowerUp { .. } => {
+                Failure::Usage(error.to_string())
+            }
+            other => Failure::Robot(other),
+        }
+    }
+}
+
+fn usage(text: &str) -> Failure {
+    Failure::Usage(text.to_owned())
+}
+
+/// Runs one monitor command.
+fn command(d: &mut Debugger, line: &str) -> Result<Reply, Failure> {
+    let mut words = line.split_whitespace();
+    let Some(verb) = words.next() else {
+        return Ok(Reply::Text(String::new()));
+    };
+    let rest: Vec<&str> = words.collect();
+    let text = match verb {
+        "help" | "h" | "?" => format!("{HELP}\n"),
+        "quit" | "q" | "exit" => return Ok(Reply::Quit),
+        _ if verb.starts_with('/') => {
+            d.send(line.as_bytes());
+            format!("sent {line}\n")
+        }
+        "send" => {
+            let what = line.trim_start_matches("send").trim();
+            d.send(what.as_bytes());
+            format!("sent {what}\n")
+        }
+        "bumpers" => {
+            let mask = rest
+                .first()
+                .and_then(|t| u8::from_str_radix(t.trim_start_matches('$'), 16).ok())
+                .ok_or_else(|| usage("bumpers HEX: a bit per closed bumper, 00 to FF"))?;
+            d.set_bumpers(mask);
+            format!("bumpers ${mask:02X}\n")
+        }
+        "break" | "b" => {
+            let what = rest
+                .first()
+                .ok_or_else(|| usage("break ADDR, break /3A or break unknown"))?;
+            let point = if *what == "unknown" {
+                Breakpoint::UnknownHook
+            } else if what.starts_with('/') {
+                Breakpoint::command(what).ok_or_else(|| {
+                    usage("a command breakpoint is /, a count 1-9 and a letter: /3A")
+                })?
+            } else {
+                Breakpoint::At(d.symbols().address(&rest.join(" "))?)
+            };
+            let shown = describe(d, &point);
+            let id = d.add_breakpoint(point);
+            format!("breakpoint {id}: {shown}\n")
+        }
+        "watch" | "w" => {
+            let (kind, range) = match rest.first().copied() {
+                Some("read") => (WatchKind::Read, &rest[1..]),
+                Some("write") => (WatchKind::Write, &rest[1..]),
+                Some("access") => (WatchKind::Access, &rest[1..]),
+                _ => (WatchKind::Access, &rest[..]),
+            };
+            let range = range.join(" ");
+            if range.is_empty() {
+                return Err(usage("watch [read|write|access] ADDR[..ADDR]"));
+            }
+            let (start, end) = match range.split_once("..") {
+                Some((a, b)) => (d.symbols().address(a)?, d.symbols().address(b)?),
+                None => {
+                    let a = d.symbols().address(&range)?;
+                    (a, a)
+                }
+            };
+            if end < start {
+                return Err(usage("the range's end is below its start"));
+            }
+            let id = d.add_watch(Watch { start, end, kind });
+            format!(
+                "watchpoint {id}: {} of {}\n",
+                kind_name(kind),
+                range_text(start, end)
+            )
+        }
+        "delete" => match rest.as_slice() {
+            ["watch", n] => {
+                let id = n.parse().map_err(|_| usage("delete watch N"))?;
+                if !d.delete_watch(id) {
+                    return Err(usage(&format!("no watchpoint {id}")));
+                }
+                format!("deleted watchpoint {id}\n")
+            }
+            [n] => {
+                let id = n.parse().map_err(|_| usage("delete N"))?;
+                if !d.delete_breakpoint(id) {
+                    return Err(usage(&format!("no breakpoint {id}")));
+                }
+                format!("deleted breakpoint {id}\n")
+            }
+            _ => return Err(usage("delete N or delete watch N")),
+        },
+        "info" => {
+            let mut text = String::new();
+            for (id, point) in d.breakpoints() {
+                text.push_str(&format!("breakpoint {id}: {}\n", describe(d, &point)));
+            }
+            for (id, watch) in d.watches() {
+                text.push_str(&format!(
+                    "watchpoint {id}: {} of {}\n",
+                    kind_name(watch.kind),
+                    range_text(watch.start, watch.end)
+                ));
+            }
+            if text.is_empty() {
+                text = "no breakpoints or watchpoints\n".into();
+            }
+            text
+        }
+        "continue" | "c" | "run" => {
+            let budget = match rest.first() {
+                Some(n) => n.parse().map_err(|_| usage("continue [CYCLES]"))?,
+                None => BUDGET,
+            };
+            {
+                let stop = d.run(budget)?;
+                stop_report(d, &stop)
+            }
+        }
+        "step" | "s" | "stepi" | "si" => {
+            let n = count(&rest, "step [N]")?;
+            {
+                let stop = d.step(n)?;
+                stop_report(d, &stop)
+            }
+        }
+        "next" | "n" => {
+            let stop = d.next(BUDGET)?;
+            stop_report(d, &stop)
+        }
+        "finish" | "f" => {
+            let stop = d.finish(BUDGET)?;
+            stop_report(d, &stop)
+        }
+        "back" | "bs" | "reverse-step" => {
+            let n = count(&rest, "back [N]")?;
+            {
+                let stop = d.back(n)?;
+                stop_report(d, &stop)
+            }
+        }
+        "reverse-continue" | "rc" => match d.reverse_continue()? {
+            Some(stopped) => stop_report(d, &stopped),
+            None => "no breakpoint or watchpoint was hit before here\n".into(),
+        },
+        "who-wrote" => {
+            let address = d.symbols().address(&rest.join(" "))?;
+            match d.who_wrote(address)? {
+                Some(write) => format!(
+                    "${address:04X} was last written ${:02X} by instruction {} at {}\n",
+                    write.value,
+                    write.instruction,
+                    place(d, write.pc)
+                ),
+                None => format!("nothing has written ${address:04X} since power-up\n"),
+            }
+        }
+        "regs" | "r" => format!("{}\n", registers(d)),
+        "mem" | "m" => {
+            let (address, len) = match rest.as_slice() {
+                [] => return Err(usage("mem ADDR [LEN]")),
+                [a] => (d.symbols().address(a)?, 16),
+                [a, n] => (
+                    d.symbols().address(a)?,
+                    n.parse()
+                        .map_err(|_| usage("mem ADDR [LEN]: LEN is a number"))?,
+                ),
+                _ => return Err(usage("mem ADDR [LEN]")),
+            };
+            memory(d, address, len)
+        }
+        "dis" | "d" => {
+            let address = match rest.first() {
+                Some(a) => d.symbols().address(a)?,
+                None => d.cpu().pc,
+            };
+            let n = match rest.get(1) {
+                Some(n) => n.parse().map_err(|_| usage("dis [ADDR] [N]"))?,
+                None => 8,
+            };
+            d.disassemble(address, n)
+                .iter()
+                .map(|l| line_text(d, l))
+                .collect()
+        }
+        "trace" => match rest.first() {
+            Some(&"off") => {
+                d.trace(None);
+                "trace off\n".into()
+            }
+            Some(path) => {
+                let file = std::fs::File::create(path)
+                    .map_err(|e| usage(&format!("cannot write {path}: {e}")))?;
+                d.trace(Some(Box::new(std::io::BufWriter::new(file))));
+                format!("tracing into {path}\n")
+            }
+            None => return Err(usage("trace FILE or trace off")),
+        },
+        other => {
+            return Err(usage(&format!("no command `{other}`; `help` lists them")));
+        }
+    };
+    Ok(Reply::Text(text))
+}
+
+fn count(rest: &[&str], form: &str) -> Result<u64, Failure> {
+    match rest.first() {
+        Some(n) => n.parse().map_err(|_| usage(form)),
+        None => Ok(1),
+    }
+}
+
+fn kind_name(kind: WatchKind) -> &'static str {
+    match kind {
+        WatchKind::Read => "reads",
+        WatchKind::Write => "writes",
+        WatchKind::Access => "reads and writes",
+    }
+}
+
+fn range_text(start: u16, end: u16) -> String {
+    if start == end {
+        format!("${start:04X}")
+    } else {
+        format!("${start:04X}-${end:04X}")
+    }
+}
+
+fn describe(d: &Debugger, point: &Breakpoint) -> String {
+    match point {
+        Breakpoint::At(address) => place(d, *address),
+        other => other.to_string(),
+    }
+}
+
+/// `$0403 (handler+$3)`.
+fn place(d: &Debugger, address: u16) -> String {
+    match d.symbols().place(address) {
+        Some(name) => format!("${address:04X} ({name})"),
+        None => format!("${address:04X}"),
+    }
+}
+
+fn registers(d: &Debugger) -> String {
+    let cpu = d.cpu();
+    format!(
+        "PC=${:04X} A=${:02X} X=${:02X} Y=${:02X} S=${:02X} P={} cycle {} instruction {}",
+        cpu.pc,
+        cpu.a,
+        cpu.x,
+        cpu.y,
+        cpu.s,
+        emulator::cpu::flags_text(cpu.p()),
+        d.robot().cycles(),
+        cpu.instructions()
+    )
+}
+
+fn memory(d: &Debugger, address: u16, len: usize) -> String {
+    let bus = &d.robot().robot().bus;
+    let mut text = String::new();
+    let mut at = address;
+    let mut left = len;
+    while left > 0 {
+        let n = left.min(16);
+        let bytes: Vec<u8> = (0..n as u16)
+            .map(|i| emulator::Bus::peek(bus, at.wrapping_add(i)))
+            .collect();
+        let hex: Vec<String> = bytes.iter().map(|b| format!("{b:02X}")).collect();
+        let ascii: String = bytes
+            .iter()
+            .map(|&b| {
+                if (0x20..0x7F).contains(&b) {
+                    char::from(b)
+                } else {
+                    '.'
+                }
+            })
+            .collect();
+        text.push_str(&format!("${at:04X}  {:<47}  {ascii}\n", hex.join(" ")));
+        at = at.wrapping_add(n as u16);
+        left -= n;
+    }
+    text
+}
+
+fn line_text(d: &Debugger, line: &Line) -> String {
+    let bytes: Vec<String> = line.bytes.iter().map(|b| format!("{b:02X}")).collect();
+    let label = line
+        .label
+        .clone()
+        .or_else(|| d.symbols().place(line.address))
+        .unwrap_or_default();
+    let marker = if line.address == d.cpu().pc { '>' } else { ' ' };
+    format!(
+        "{marker} ${:04X}  {:<8}  {:<20} {}\n",
+        line.address,
+        bytes.join(" "),
+        label,
+        line.text
+    )
+}
+
+fn stop_report(d: &Debugger, stop: &Stopped) -> String {
+    let why = match &stop.why {
+        Why::Breakpoint { id, point } => format!("breakpoint {id} ({})", describe(d, point)),
+        Why::Watch { id, access, pc } => format!(
+            "watchpoint {id}: {} ${:02X} {} ${:04X} by {}",
+            if access.write { "wrote" } else { "read" },
+            access.value,
+            if access.write { "to" } else { "from" },
+            access.address,
+            place(d, *pc)
+        ),
+        Why::Stepped => "stepped".into(),
+        Why::Finished => "returned".into(),
+        Why::Budget => "still running (no stop in the cycles given)".into(),
+        Why::Back => "back".into(),
+    };
+    let mut text = String::new();
+    if !stop.received.is_empty() {
+        let answer = String::from_utf8_lossy(&stop.received).replace('\r', "\\r");
+        text.push_str(&format!("< {answer}\n"));
+    }
+    let plural = |n: i64| if n.abs() == 1 { "" } else { "s" };
+    // Back in time, the cycles count down as the instructions do.
+    let sign = if stop.instructions < 0 { "-" } else { "" };
+    text.push_str(&format!(
+        "{why}: {sign}{} cycles, {} instruction{}\n",
+        stop.cycles,
+        stop.instructions,
+        plural(stop.instructions)
+    ));
+    if let Some(line) = d.disassemble(d.cpu().pc, 1).first() {
+        text.push_str(&line_text(d, line));
+    }
+    text.push_str(&format!("  {}\n", registers(d)));
+    text
+}

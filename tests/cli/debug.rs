@@ -1,0 +1,78 @@
+//! `scorpion debug` driven by scripted sessions, as a user at its prompt
+//! would: the session files sit beside this one (`debug/*.txt`), their
+//! transcripts in snapshots.
+
+use std::path::Path;
+
+use crate::{scorpion, scorpion_with_input, transcript};
+
+fn session(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cli/debug/{name}"));
+    std::fs::read_to_string(path).expect("the session file")
+}
+
+/// The ADC example with its card: break at the handler's label, send its
+/// command, step, see the registers, step back three instructions and see
+/// the earlier registers again, read the card's registers, stop at the read
+/// of its data register, find who wrote its control register, go back to
+/// the breakpoint, and continue to the answer.
+#[test]
+fn a_session_on_the_adc_example_with_its_card() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(Some(&adc), &["debug"], &session("adc_session.txt"));
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    // The registers before the three instructions, and after going back.
+    let regs: Vec<&str> = text.lines().filter(|l| l.starts_with("PC=")).collect();
+    assert_eq!(
+        regs[0], regs[2],
+        "back 3 gives the registers three instructions earlier"
+    );
+    assert_ne!(regs[0], regs[1]);
+    assert!(text.contains("< A57\\r"), "{text}");
+    insta::assert_snapshot!(text);
+}
+
+#[test]
+fn mistakes_are_said_and_the_session_goes_on() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        "frobnicate\nbreak nowhere\nbreak read_chanel\nback 999999\nwatch $20..$10\nmem\ndelete 7\nregs\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    insta::assert_snapshot!(text);
+}
+
+/// A handler that jams the CPU: the session says so and fails.
+#[test]
+fn a_robot_that_breaks_fails_the_session() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("jam.s"),
+        "        .include \"scorpion.inc\"\n        SCORPION_UNKNOWN_HANDLER\nhandler: .byte $02\n",
+    )
+    .expect("write");
+    let built = scorpion(
+        dir.path(),
+        &[
+            "build",
+            "jam.s",
+            "-o",
+            "jam.elf",
+            "--target",
+            "scorpion-ext",
+        ],
+    );
+    assert_eq!(built.status.code(), Some(0), "{}", transcript(&built));
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--image", "jam.elf"],
+        "/1Z\ncontinue\nregs\n",
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(text.contains("error: ") && text.contains("$0400"), "{text}");
+}
