@@ -115,6 +115,9 @@ pub(crate) enum Found {
 /// `matches` function (given the PC and the bus, it says which breakpoint
 /// if any stops here); the rest are plain conditions.
 pub(crate) struct Look<'a, M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> {
+    /// Every PC a breakpoint may stop at: one bit test per instruction,
+    /// and `breakpoint` asked only there.
+    pub(crate) places: &'a emulator::Breakpoints,
     /// Which breakpoint, if any, stops at this PC.
     pub(crate) breakpoint: M,
     /// Stop before the instruction with this count (instructions run so
@@ -150,7 +153,7 @@ impl<M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> Hooks for Look<'_, M> {
             Some(Found::Returned)
         } else if !first && self.finish_at.is_some_and(|s| cpu.s >= s) {
             Some(Found::Finished)
-        } else if first {
+        } else if first || !self.places.contains(cpu.pc) {
             None
         } else {
             (self.breakpoint)(cpu, &|address| bus.peek(address)).map(Found::Breakpoint)

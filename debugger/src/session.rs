@@ -596,6 +596,27 @@ fn run_hooked(
     until: u64,
     goal: Goal,
 ) -> Result<Option<Found>, Error> {
+    let idle = goal.at_count.is_none()
+        && goal.returning_to.is_none()
+        && goal.finish_at.is_none()
+        && trace.is_none()
+        && points.breakpoints.iter().all(Option::is_none)
+        && points.watches.iter().all(Option::is_none);
+    if idle {
+        // Nothing to look for: the robot's own run, idle loops skipped.
+        robot.run_until_with(until, |robot, to| robot.run(to))?;
+        return Ok(None);
+    }
+    let mut places = emulator::Breakpoints::new();
+    for point in points.breakpoints.iter().flatten() {
+        match point {
+            Breakpoint::At(address) => places.insert(*address),
+            Breakpoint::UnknownHook => places.insert(points.arrival.unknown),
+            Breakpoint::Command { .. } => {
+                places.insert(points.arrival.dispatch.unwrap_or(points.arrival.unknown))
+            }
+        };
+    }
     let hit = Cell::new(None);
     let matches = |cpu: &Cpu, peek: &dyn Fn(u16) -> u8| {
         points.breakpoints.iter().position(|point| {
@@ -605,6 +626,7 @@ fn run_hooked(
         })
     };
     let mut look = Look {
+        places: &places,
         breakpoint: matches,
         at_count: goal.at_count,
         returning_to: goal.returning_to,
