@@ -145,7 +145,11 @@ fn main() {
     let history = best[1] / best[0];
     println!(
         "  goal: history on keeps at least a third of the speed ({history:.2}: {})",
-        if history >= 1.0 / 3.0 { "met" } else { "MISSED" }
+        if history >= 1.0 / 3.0 {
+            "met"
+        } else {
+            "MISSED"
+        }
     );
     println!(
         "  history's memory: what the host did (a few bytes per command) and nothing per instruction"

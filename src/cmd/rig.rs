@@ -64,10 +64,7 @@ impl Rig {
     /// [`Rig::apply`] without a word: also returns each card's name and
     /// window, for the caller to show or not (the debugger builds the robot
     /// again for every step back).
-    pub(crate) fn attach(
-        &self,
-        robot: &mut VirtualScorpion,
-    ) -> miette::Result<Attached> {
+    pub(crate) fn attach(&self, robot: &mut VirtualScorpion) -> miette::Result<Attached> {
         let mut printed = Vec::new();
         let mut windows = Vec::new();
         for card in &self.cards {

@@ -76,3 +76,25 @@ fn a_robot_that_breaks_fails_the_session() {
     let text = String::from_utf8_lossy(&output.stdout).into_owned();
     assert!(text.contains("error: ") && text.contains("$0400"), "{text}");
 }
+
+#[test]
+fn the_readmes_debugging_section_runs_as_written() {
+    let tmp = tempfile::tempdir().expect("a temporary directory");
+    let script = crate::readme_block("## Debug on the virtual Scorpion", "sh");
+    let output = std::process::Command::new("sh")
+        .arg("-e")
+        .arg("-c")
+        .arg(format!("exec 2>&1\n{script}"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("PATH", crate::path_with_scorpion())
+        .env("TMPDIR", tmp.path())
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("sh runs");
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        String::from_utf8_lossy(&output.stdout),
+        crate::readme_block("## Debug on the virtual Scorpion", "text"),
+        "README.md's debugging section is stale"
+    );
+}
