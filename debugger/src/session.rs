@@ -87,6 +87,8 @@ pub struct Debugger {
     make: MakeRobot,
     robot: VirtualScorpion,
     symbols: Symbols,
+    /// The loaded images, for their source lines.
+    images: Vec<linker::Image>,
     breakpoints: Vec<Option<Breakpoint>>,
     watches: Vec<Option<Watch>>,
     /// What the host did, in order, up to now.
@@ -122,6 +124,8 @@ pub struct Line {
     pub bytes: Vec<u8>,
     /// The label at its address, if any.
     pub label: Option<String>,
+    /// The source file and line its bytes came from, if an image says.
+    pub source: Option<(String, u32)>,
     /// The instruction, its operand named by a label where one fits.
     pub text: String,
 }
@@ -140,6 +144,7 @@ impl Debugger {
             make,
             robot,
             symbols,
+            images: images.to_vec(),
             breakpoints: Vec::new(),
             watches: Vec::new(),
             done: Vec::new(),
@@ -187,11 +192,33 @@ impl Debugger {
                 address: at,
                 bytes: (0..len).map(|i| peek(at.wrapping_add(i))).collect(),
                 label: self.symbols.label(at).map(str::to_owned),
+                source: self.source_of(at),
                 text,
             });
             at = at.wrapping_add(len);
         }
         lines
+    }
+
+    /// The source file (as the assembler was given it) and line that the
+    /// byte at `address` came from, if a loaded image says.
+    #[must_use]
+    pub fn source_of(&self, address: u16) -> Option<(String, u32)> {
+        self.images.iter().find_map(|image| {
+            let (file, line, _) = image.source_of(u32::from(address))?;
+            Some((file.to_owned(), line))
+        })
+    }
+
+    /// The first address whose bytes came from `line` of `file` (a path,
+    /// or its last components: `adc.s`).
+    #[must_use]
+    pub fn address_of_line(&self, file: &str, line: u32) -> Option<u16> {
+        self.images
+            .iter()
+            .filter_map(|image| image.address_of_line(file, line))
+            .min()
+            .and_then(|address| u16::try_from(address).ok())
     }
 
     /// Traces every instruction run from now on into `out` (`None`: stop).

@@ -194,3 +194,29 @@ fn going_back_before_power_up_is_an_error() {
     let error = d.back(11).expect_err("only ten ran");
     assert!(error.to_string().contains("only 10 have run"), "{error}");
 }
+
+/// The linked image says which source line each byte came from, in memory
+/// and through its ELF file (`.scorpion.lines`); the debugger reads it.
+#[test]
+fn source_lines_of_the_image() {
+    let image = image();
+    let handler = image.symbol("handler").expect("the handler");
+    // `cpx #1` is line 9 of SOURCE (its first line is empty).
+    assert_eq!(image.source_of(handler), Some(("q.s", 9, 9)));
+    assert_eq!(image.address_of_line("q.s", 9), Some(handler));
+    assert_eq!(
+        image.address_of_line("q.s", 13),
+        Some(handler + 8),
+        "lda CARD"
+    );
+    assert_eq!(image.source_of(0xF000), None, "the ROM is not the image's");
+    let elf = linker::Format::Elf.write(&image).expect("an ELF image");
+    let read = linker::Image::parse("q.elf", &elf).expect("it reads back");
+    assert_eq!(read.lines, image.lines);
+    let d = debugger();
+    let at = u16::try_from(handler).expect("16-bit");
+    assert_eq!(d.source_of(at), Some(("q.s".to_owned(), 9)));
+    assert_eq!(d.address_of_line("q.s", 13), Some(at + 8));
+    let lines = d.disassemble(at, 2);
+    assert_eq!(lines[1].source, Some(("q.s".to_owned(), 10)));
+}

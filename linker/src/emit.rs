@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use isa::objfmt::Hooks;
+use isa::objfmt::{Hooks, SourceLoc, SrcMap, SrcMapEntry};
 
 use crate::image::{Image, ImageSection, ImageSymbol, LoadArea};
 use crate::input::{Binding, Definition, Object};
@@ -163,7 +163,51 @@ pub(crate) fn build_image(
         sections,
         symbols,
         hooks,
+        lines: lines(objects, placement),
     }
+}
+
+/// The objects' source maps by run address: every entry of every placed
+/// section moved to where its bytes run, the files of all objects in one
+/// list.
+fn lines(objects: &[Object], placement: &Placement) -> SrcMap {
+    let mut lines = SrcMap::default();
+    let mut file_numbers: BTreeMap<String, u32> = BTreeMap::new();
+    for (object_index, object) in objects.iter().enumerate() {
+        let Some(map) = &object.srcmap else {
+            continue;
+        };
+        for entry in &map.entries {
+            let Some(position) = object
+                .sections
+                .iter()
+                .position(|section| section.index == entry.section as usize)
+            else {
+                continue;
+            };
+            let Some((segment, offset)) = placement.sections[object_index][position] else {
+                continue;
+            };
+            let address = placement.segments[segment].run + offset + u64::from(entry.offset);
+            let (Ok(address), Some(name)) = (u32::try_from(address), map.file_name(entry.loc))
+            else {
+                continue;
+            };
+            let next = u32::try_from(file_numbers.len()).unwrap_or(u32::MAX);
+            let file = *file_numbers.entry(name.to_owned()).or_insert(next);
+            lines.entries.push(SrcMapEntry {
+                section: 0,
+                offset: address,
+                loc: SourceLoc { file, ..entry.loc },
+            });
+        }
+    }
+    lines.files = vec![String::new(); file_numbers.len()];
+    for (name, number) in file_numbers {
+        lines.files[number as usize] = name;
+    }
+    lines.entries.sort();
+    lines
 }
 
 /// What the map file shows besides the image.

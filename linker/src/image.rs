@@ -14,7 +14,7 @@
 
 use goblin::elf::{Elf, program_header as ph, section_header as sh, sym};
 use isa::elf as mos;
-use isa::objfmt::{HOOKS_SECTION, HookKind, Hooks};
+use isa::objfmt::{HOOKS_SECTION, HookKind, Hooks, LINES_SECTION, SrcMap};
 
 use crate::error::Error;
 use crate::layout::SegmentKind;
@@ -87,9 +87,46 @@ pub struct Image {
     pub symbols: Vec<ImageSymbol>,
     /// The ROM hooks it takes over.
     pub hooks: Hooks,
+    /// Where its bytes came from, by run address (`.scorpion.lines`: see
+    /// [`isa::objfmt::LINES_SECTION`]); empty if its objects had no source
+    /// map.
+    pub lines: SrcMap,
 }
 
 impl Image {
+    /// Where the byte at run address `address` came from: the source
+    /// file (as given to the assembler), line and column. `None` outside
+    /// the image's sections.
+    #[must_use]
+    pub fn source_of(&self, address: u32) -> Option<(&str, u32, u32)> {
+        let inside = self.sections.iter().any(|s| {
+            (u64::from(s.run)..u64::from(s.run) + u64::from(s.size)).contains(&u64::from(address))
+        });
+        if !inside {
+            return None;
+        }
+        let loc = self.lines.lookup(0, address)?;
+        Some((self.lines.file_name(loc)?, loc.line, loc.column))
+    }
+
+    /// The lowest run address whose bytes came from line `line` of the
+    /// source file whose path ends with `file` (`adc.s` finds
+    /// `examples/adc/adc.s`).
+    #[must_use]
+    pub fn address_of_line(&self, file: &str, line: u32) -> Option<u32> {
+        self.lines
+            .entries
+            .iter()
+            .filter(|entry| entry.loc.line == line)
+            .filter(|entry| {
+                self.lines
+                    .file_name(entry.loc)
+                    .is_some_and(|name| same_file(name, file))
+            })
+            .map(|entry| entry.offset)
+            .min()
+    }
+
     /// A symbol's value, globals before locals.
     #[must_use]
     pub fn symbol(&self, name: &str) -> Option<u32> {
@@ -183,11 +220,17 @@ impl Image {
         let mut sections = Vec::new();
         let mut position_of = vec![None; elf.section_headers.len()];
         let mut hooks = Hooks::default();
+        let mut lines = SrcMap::default();
         for (index, header) in elf.section_headers.iter().enumerate() {
             let section_name = elf.shdr_strtab.get_at(header.sh_name).unwrap_or("");
             if section_name == HOOKS_SECTION {
                 let data = file_range(header.sh_offset, header.sh_size, HOOKS_SECTION)?;
                 hooks = Hooks::decode(data).map_err(|error| bad(error.to_string()))?;
+                continue;
+            }
+            if section_name == LINES_SECTION {
+                let data = file_range(header.sh_offset, header.sh_size, LINES_SECTION)?;
+                lines = SrcMap::decode(data).map_err(|error| bad(error.to_string()))?;
                 continue;
             }
             if header.sh_flags & u64::from(sh::SHF_ALLOC) == 0 {
@@ -262,6 +305,7 @@ impl Image {
             sections,
             symbols,
             hooks,
+            lines,
         };
         image.check_hooks(name)?;
         Ok(image)
@@ -314,4 +358,12 @@ impl Image {
             area.bytes.get(offset).copied()
         })
     }
+}
+
+/// Whether the path `name` (as the assembler was given it) is `file`, or
+/// ends with it at a path component.
+fn same_file(name: &str, file: &str) -> bool {
+    let name = name.replace('\\', "/");
+    let file = file.trim_start_matches("./");
+    name == file || name.ends_with(&format!("/{file}"))
 }

@@ -47,8 +47,9 @@ commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
   /1P                  send a command down the serial line (any line starting with /)
   send TEXT            send TEXT as it is
   bumpers HEX          close the bumpers whose bits are set ($00 opens them all)
-  break ADDR | /3A | unknown
-                       stop before the instruction at ADDR, when the ROM has command /3A,
+  break ADDR | FILE:LINE | /3A | unknown
+                       stop before the instruction at ADDR or from FILE:LINE, when the ROM
+                       has command /3A,
                        or when it jumps through HOOK_UNKNOWN                    (b)
   watch [read|write|access] ADDR[..ADDR]
                        stop after an instruction that reads or writes there       (w)
@@ -67,11 +68,16 @@ commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
   dis [ADDR] [N]       N instructions from ADDR (the PC; 8)                       (d)
   trace FILE | trace off
                        write every instruction run to FILE
+  list [FILE:LINE|ADDR] the source around the PC (or there)                       (l)
   help, quit (q)";
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let (make, images) = recipe(args)?;
+    let (make, images, root) = recipe(args)?;
     let mut debugger = Debugger::new(make, &images)?;
+    let mut sources = Sources {
+        root,
+        files: std::collections::HashMap::new(),
+    };
     let stdin = std::io::stdin();
     let interactive = stdin.is_terminal();
     let mut out = std::io::stdout().lock();
@@ -95,7 +101,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             // A script's session reads as a transcript.
             writeln!(out, "{line}").into_diagnostic()?;
         }
-        match command(&mut debugger, line.trim()) {
+        match command(&mut debugger, &mut sources, line.trim()) {
             Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,
             Ok(Reply::Quit) => break,
             Err(error) => {
@@ -113,12 +119,44 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     })
 }
 
+/// The source files the images name, read when shown: relative to the
+/// project's root (or the current directory); `scorpion.inc` built in.
+struct Sources {
+    root: PathBuf,
+    files: std::collections::HashMap<String, Option<Vec<String>>>,
+}
+
+impl Sources {
+    /// Line `line` (from 1) of `file`, if it can be read.
+    fn line(&mut self, file: &str, line: u32) -> Option<String> {
+        let root = &self.root;
+        let lines = self.files.entry(file.to_owned()).or_insert_with(|| {
+            let text = if file == "scorpion.inc" && !root.join(file).is_file() {
+                Some(romlib::SCORPION_INC.to_owned())
+            } else {
+                std::fs::read_to_string(root.join(file)).ok()
+            };
+            text.map(|t| t.lines().map(str::to_owned).collect())
+        });
+        lines
+            .as_ref()?
+            .get(usize::try_from(line).ok()?.checked_sub(1)?)
+            .cloned()
+    }
+}
+
+/// What [`recipe`] makes: the robot's builder, the images it loads, and
+/// where their sources are.
+type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
+
 /// The robot the options (or the project) describe, as a function that
-/// builds it afresh, and the images it loads.
-fn recipe(args: &Args) -> miette::Result<(debugger::MakeRobot, Vec<linker::Image>)> {
+/// builds it afresh, the images it loads, and the directory their source
+/// paths are relative to.
+fn recipe(args: &Args) -> miette::Result<Recipe> {
     let mut rig = args.rig.clone();
     let mut rom_path = args.rom.clone();
     let mut images = Vec::new();
+    let mut root = std::env::current_dir().into_diagnostic()?;
     for path in &args.images {
         let bytes = std::fs::read(path)
             .into_diagnostic()
@@ -131,6 +169,7 @@ fn recipe(args: &Args) -> miette::Result<(debugger::MakeRobot, Vec<linker::Image
         .map(|root| crate::project::config::Found::load(&root))
         .transpose()?;
     if let Some(crate::project::config::Found::Project(project)) = project {
+        root.clone_from(&project.root);
         if rig.is_empty() {
             rig = project.rig()?;
         }
@@ -164,7 +203,7 @@ fn recipe(args: &Args) -> miette::Result<(debugger::MakeRobot, Vec<linker::Image
     let build = move || -> miette::Result<romlib::VirtualScorpion> {
         let mut robot = ports::bare_robot(baud, rom.as_ref())?;
         // Cards first: an image cannot be loaded over a card's registers.
-        rig.attach(&mut robot)?;
+        rig.attach(&mut robot, &mut |_, _, _| {})?;
         for image in &loaded {
             robot.load_image(image)?;
         }
@@ -177,7 +216,7 @@ fn recipe(args: &Args) -> miette::Result<(debugger::MakeRobot, Vec<linker::Image
             message: format!("{report}"),
         })
     });
-    Ok((make, images))
+    Ok((make, images, root))
 }
 
 /// What a command prints, or the end of the session.
@@ -222,7 +261,7 @@ fn usage(text: &str) -> Failure {
 }
 
 /// Runs one monitor command.
-fn command(d: &mut Debugger, line: &str) -> Result<Reply, Failure> {
+fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply, Failure> {
     let mut words = line.split_whitespace();
     let Some(verb) = words.next() else {
         return Ok(Reply::Text(String::new()));
@@ -258,6 +297,11 @@ fn command(d: &mut Debugger, line: &str) -> Result<Reply, Failure> {
                 Breakpoint::command(what).ok_or_else(|| {
                     usage("a command breakpoint is /, a count 1-9 and a letter: /3A")
                 })?
+            } else if let Some((file, line)) = file_line(what) {
+                Breakpoint::At(
+                    d.address_of_line(file, line)
+                        .ok_or_else(|| usage(&format!("no code came from {file}:{line}")))?,
+                )
             } else {
                 Breakpoint::At(d.symbols().address(&rest.join(" "))?)
             };
@@ -334,33 +378,33 @@ fn command(d: &mut Debugger, line: &str) -> Result<Reply, Failure> {
             };
             {
                 let stop = d.run(budget)?;
-                stop_report(d, &stop)
+                stop_report(d, sources, &stop)
             }
         }
         "step" | "s" | "stepi" | "si" => {
             let n = count(&rest, "step [N]")?;
             {
                 let stop = d.step(n)?;
-                stop_report(d, &stop)
+                stop_report(d, sources, &stop)
             }
         }
         "next" | "n" => {
             let stop = d.next(BUDGET)?;
-            stop_report(d, &stop)
+            stop_report(d, sources, &stop)
         }
         "finish" | "f" => {
             let stop = d.finish(BUDGET)?;
-            stop_report(d, &stop)
+            stop_report(d, sources, &stop)
         }
         "back" | "bs" | "reverse-step" => {
             let n = count(&rest, "back [N]")?;
             {
                 let stop = d.back(n)?;
-                stop_report(d, &stop)
+                stop_report(d, sources, &stop)
             }
         }
         "reverse-continue" | "rc" => match d.reverse_continue()? {
-            Some(stopped) => stop_report(d, &stopped),
+            Some(stopped) => stop_report(d, sources, &stopped),
             None => "no breakpoint or watchpoint was hit before here\n".into(),
         },
         "who-wrote" => {
@@ -376,6 +420,20 @@ fn command(d: &mut Debugger, line: &str) -> Result<Reply, Failure> {
             }
         }
         "regs" | "r" => format!("{}\n", registers(d)),
+        "list" | "l" => {
+            let (file, line) = match rest.first() {
+                Some(place) => match file_line(place) {
+                    Some((file, line)) => (file.to_owned(), line),
+                    None => d
+                        .source_of(d.symbols().address(place)?)
+                        .ok_or_else(|| usage(&format!("no source line for {place}")))?,
+                },
+                None => d.source_of(d.cpu().pc).ok_or_else(|| {
+                    usage("no source line for the PC (the ROM, or an image without a source map)")
+                })?,
+            };
+            listing(sources, &file, line)
+        }
         "mem" | "m" => {
             let (address, len) = match rest.as_slice() {
                 [] => return Err(usage("mem ADDR [LEN]")),
@@ -512,16 +570,20 @@ fn line_text(d: &Debugger, line: &Line) -> String {
         .or_else(|| d.symbols().place(line.address))
         .unwrap_or_default();
     let marker = if line.address == d.cpu().pc { '>' } else { ' ' };
+    let text = match &line.source {
+        Some((file, n)) => format!("{:<30} {file}:{n}", line.text),
+        None => line.text.clone(),
+    };
     format!(
         "{marker} ${:04X}  {:<8}  {:<20} {}\n",
         line.address,
         bytes.join(" "),
         label,
-        line.text
+        text.trim_end()
     )
 }
 
-fn stop_report(d: &Debugger, stop: &Stopped) -> String {
+fn stop_report(d: &Debugger, sources: &mut Sources, stop: &Stopped) -> String {
     let why = match &stop.why {
         Why::Breakpoint { id, point } => format!("breakpoint {id} ({})", describe(d, point)),
         Why::Watch { id, access, pc } => format!(
@@ -553,7 +615,34 @@ fn stop_report(d: &Debugger, stop: &Stopped) -> String {
     ));
     if let Some(line) = d.disassemble(d.cpu().pc, 1).first() {
         text.push_str(&line_text(d, line));
+        if let Some((file, n)) = &line.source
+            && let Some(source) = sources.line(file, *n)
+        {
+            text.push_str(&format!("  {file}:{n}: {}\n", source.trim_end()));
+        }
     }
     text.push_str(&format!("  {}\n", registers(d)));
+    text
+}
+
+/// `adc.s:27` as a file and a line.
+fn file_line(text: &str) -> Option<(&str, u32)> {
+    let (file, line) = text.rsplit_once(':')?;
+    Some((file, line.parse().ok()?)).filter(|(file, _)| !file.is_empty())
+}
+
+/// The source around `line` of `file`, the line marked.
+fn listing(sources: &mut Sources, file: &str, line: u32) -> String {
+    let mut text = String::new();
+    for n in line.saturating_sub(4).max(1)..=line + 4 {
+        let Some(source) = sources.line(file, n) else {
+            break;
+        };
+        let marker = if n == line { '>' } else { ' ' };
+        text.push_str(&format!("{marker} {file}:{n:<4} {source}\n"));
+    }
+    if text.is_empty() {
+        text = format!("cannot read {file}\n");
+    }
     text
 }

@@ -9,13 +9,6 @@ use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 
-/// A card's name and the first and last address of its window.
-pub(crate) type CardWindow = (String, u16, u16);
-
-/// What [`Rig::attach`] returns: each script's name and what it prints,
-/// and each card's window.
-pub(crate) type Attached = (Vec<(String, Printed)>, Vec<CardWindow>);
-
 /// Cards and surroundings of the virtual Scorpion.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub(crate) struct Rig {
@@ -53,20 +46,20 @@ impl Rig {
         &self,
         robot: &mut VirtualScorpion,
     ) -> miette::Result<Vec<(String, Printed)>> {
-        let (printed, windows) = self.attach(robot)?;
-        let mut err = std::io::stderr().lock();
-        for (name, start, end) in windows {
-            let _ = writeln!(err, "card {name}: ${start:04X}-${end:04X}");
-        }
-        Ok(printed)
+        self.attach(robot, &mut |name, start, end| {
+            let _ = writeln!(std::io::stderr(), "card {name}: ${start:04X}-${end:04X}");
+        })
     }
 
-    /// [`Rig::apply`] without a word: also returns each card's name and
-    /// window, for the caller to show or not (the debugger builds the robot
-    /// again for every step back).
-    pub(crate) fn attach(&self, robot: &mut VirtualScorpion) -> miette::Result<Attached> {
+    /// [`Rig::apply`], telling `mapped` (name, first and last address)
+    /// where each card went instead of saying it (the debugger builds the
+    /// robot again for every step back, without a word).
+    pub(crate) fn attach(
+        &self,
+        robot: &mut VirtualScorpion,
+        mapped: &mut dyn FnMut(&str, u16, u16),
+    ) -> miette::Result<Vec<(String, Printed)>> {
         let mut printed = Vec::new();
-        let mut windows = Vec::new();
         for card in &self.cards {
             let name = card.path.display().to_string();
             let text = read(self.root.as_deref(), &card.path)?;
@@ -78,7 +71,7 @@ impl Rig {
                 .wrap_err_with(|| {
                     format!("cannot put the card {name} at ${start:04X}-${end:04X}")
                 })?;
-            windows.push((name, start, end));
+            mapped(&name, start, end);
         }
         if let Some(path) = &self.world {
             let name = path.display().to_string();
@@ -87,7 +80,7 @@ impl Rig {
             printed.push((name, world.printed()));
             robot.set_surroundings(Box::new(world));
         }
-        Ok((printed, windows))
+        Ok(printed)
     }
 }
 

@@ -35,6 +35,7 @@ fn extension_elf(len: usize) -> Vec<u8> {
                 chain: Some(0x0401),
             }],
         },
+        lines: isa::objfmt::SrcMap::default(),
     };
     Format::Elf.write(&image).expect("an ELF image")
 }
@@ -306,6 +307,7 @@ fn refuses_what_it_cannot_upload_safely() {
         sections: vec![],
         symbols: vec![],
         hooks: Hooks::default(),
+        lines: isa::objfmt::SrcMap::default(),
     };
     std::fs::write(
         dir.path().join("stack.elf"),

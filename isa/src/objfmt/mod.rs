@@ -48,3 +48,7 @@ pub const ASSERT_SECTION: &str = ".scorpion.assert";
 pub const FILL_SECTION: &str = ".scorpion.fill";
 /// Hook records of a linked image (linker to uploader and simulator).
 pub const HOOKS_SECTION: &str = ".scorpion.hooks";
+/// Where a linked image's bytes came from (linker to debugger): a
+/// [`SrcMap`] in the same encoding whose entries' `section` is 0 and whose
+/// `offset` is the run address; each entry covers the bytes up to the next.
+pub const LINES_SECTION: &str = ".scorpion.lines";

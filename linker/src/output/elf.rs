@@ -6,7 +6,7 @@
 //! with bytes points into the area that stores it, so the bytes exist once.
 
 use isa::elf as mos;
-use isa::objfmt::HOOKS_SECTION;
+use isa::objfmt::{HOOKS_SECTION, LINES_SECTION};
 use object::elf;
 use object::write::elf::{FileHeader, ProgramHeader, SectionHeader, SectionIndex, Sym, Writer};
 
@@ -30,6 +30,11 @@ pub fn write_elf(image: &Image) -> Result<Vec<u8>, Error> {
         None
     } else {
         Some(image.hooks.encode())
+    };
+    let lines = if image.lines.entries.is_empty() {
+        None
+    } else {
+        Some(image.lines.encode())
     };
     let mut buffer = Vec::new();
     let mut writer = Writer::new(object::Endianness::Little, false, &mut buffer);
@@ -58,6 +63,13 @@ pub fn write_elf(image: &Image) -> Result<Vec<u8>, Error> {
         .map(|_| writer.add_section_name(HOOKS_SECTION.as_bytes()));
     let hooks_index = hooks.as_ref().map(|_| writer.reserve_section_index());
     let hooks_offset = hooks
+        .as_ref()
+        .map_or(0, |data| writer.reserve(data.len() as u64, 1));
+    let lines_name = lines
+        .as_ref()
+        .map(|_| writer.add_section_name(LINES_SECTION.as_bytes()));
+    let lines_index = lines.as_ref().map(|_| writer.reserve_section_index());
+    let lines_offset = lines
         .as_ref()
         .map_or(0, |data| writer.reserve(data.len() as u64, 1));
     writer.reserve_null_symbol_index();
@@ -106,6 +118,9 @@ pub fn write_elf(image: &Image) -> Result<Vec<u8>, Error> {
         writer.write(&area.bytes);
     }
     if let Some(data) = &hooks {
+        writer.write(data);
+    }
+    if let Some(data) = &lines {
         writer.write(data);
     }
     writer.write_null_symbol();
@@ -183,6 +198,20 @@ pub fn write_elf(image: &Image) -> Result<Vec<u8>, Error> {
             sh_flags: elf::SectionFlags(0),
             sh_addr: 0,
             sh_offset: hooks_offset,
+            sh_size: data.len() as u64,
+            sh_link: 0,
+            sh_info: 0,
+            sh_addralign: 1,
+            sh_entsize: 0,
+        });
+    }
+    if let (Some(data), Some(name), Some(_)) = (&lines, lines_name, lines_index) {
+        writer.write_section_header(&SectionHeader {
+            sh_name: writer.section_name_offset(Some(name)),
+            sh_type: elf::SHT_PROGBITS,
+            sh_flags: elf::SectionFlags(0),
+            sh_addr: 0,
+            sh_offset: lines_offset,
             sh_size: data.len() as u64,
             sh_link: 0,
             sh_info: 0,
