@@ -53,6 +53,8 @@ enum Command {
     /// Debug a program on the virtual Scorpion: breakpoints, stepping,
     /// back in time.
     Debug(cmd::debug::Args),
+    /// Serve the Debug Adapter Protocol on stdin/stdout, for editors.
+    Dap(cmd::dap::Args),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
         Command::New(args) => cmd::new::run(&args),
         Command::Test(args) => cmd::test::run(&args),
         Command::Debug(args) => cmd::debug::run(&args),
+        Command::Dap(args) => cmd::dap::run(&args),
     };
     match result {
         Ok(code) => code,

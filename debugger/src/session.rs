@@ -221,6 +221,29 @@ impl Debugger {
             .and_then(|address| u16::try_from(address).ok())
     }
 
+    /// The PC, then the return addresses on the 6502 stack, innermost
+    /// first: every pair of stack bytes above S that points just past a
+    /// `JSR` (the stack has no frames to walk; this is how 6502 monitors
+    /// show a call chain).
+    #[must_use]
+    pub fn backtrace(&self) -> Vec<u16> {
+        let bus = &self.robot.robot().bus;
+        let peek = |at: u16| emulator::Bus::peek(bus, at);
+        let mut frames = vec![self.cpu().pc];
+        let mut s = u16::from(self.cpu().s) + 1;
+        while s < 0xFF {
+            let pushed = u16::from_le_bytes([peek(0x0100 + s), peek(0x0100 + s + 1)]);
+            let call = pushed.wrapping_sub(2);
+            if peek(call) == 0x20 {
+                frames.push(pushed.wrapping_add(1));
+                s += 2;
+            } else {
+                s += 1;
+            }
+        }
+        frames
+    }
+
     /// Traces every instruction run from now on into `out` (`None`: stop).
     pub fn trace(&mut self, out: Option<Box<dyn Write + Send>>) {
         self.trace = out.map(Tracer::new);

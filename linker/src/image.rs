@@ -360,10 +360,12 @@ impl Image {
     }
 }
 
-/// Whether the path `name` (as the assembler was given it) is `file`, or
-/// ends with it at a path component.
+/// Whether the path `name` (as the assembler was given it) and `file`
+/// name the same file: equal, or one ends with the other at a path
+/// component (`adc.s` and `/home/me/adc/adc.s`).
 fn same_file(name: &str, file: &str) -> bool {
     let name = name.replace('\\', "/");
-    let file = file.trim_start_matches("./");
-    name == file || name.ends_with(&format!("/{file}"))
+    let file = file.replace('\\', "/");
+    let (name, file) = (name.trim_start_matches("./"), file.trim_start_matches("./"));
+    name == file || name.ends_with(&format!("/{file}")) || file.ends_with(&format!("/{name}"))
 }

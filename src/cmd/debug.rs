@@ -21,21 +21,21 @@ use crate::cmd::ports;
 /// `--image`, `--card`, `--world` and `--rom` replace them. Commands come
 /// from stdin, so a file of them is a repeatable session:
 /// `scorpion debug < session.txt`.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Default, clap::Args)]
 pub(crate) struct Args {
     /// The line's baud rate.
     #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
-    baud: u32,
+    pub(crate) baud: u32,
     /// A linked image (ELF) to load, as an upload leaves it; repeat to
     /// chain extensions.
     #[arg(long = "image", value_name = "ELF")]
-    images: Vec<PathBuf>,
+    pub(crate) images: Vec<PathBuf>,
     /// A ROM profile (the ROM's linked ELF) instead of the reference ROM.
     #[arg(long, value_name = "ELF")]
-    rom: Option<PathBuf>,
+    pub(crate) rom: Option<PathBuf>,
     /// Cards on the KIM bus and the robot's surroundings.
     #[command(flatten)]
-    rig: crate::cmd::rig::Rig,
+    pub(crate) rig: crate::cmd::rig::Rig,
 }
 
 /// What `continue`, `next` and `finish` run for at most, in robot cycles,
@@ -72,12 +72,10 @@ commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
   help, quit (q)";
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let (make, images, root) = recipe(args)?;
+    let here = std::env::current_dir().into_diagnostic()?;
+    let (make, images, root) = recipe(args, &here)?;
     let mut debugger = Debugger::new(make, &images)?;
-    let mut sources = Sources {
-        root,
-        files: std::collections::HashMap::new(),
-    };
+    let mut sources = Sources::new(root);
     let stdin = std::io::stdin();
     let interactive = stdin.is_terminal();
     let mut out = std::io::stdout().lock();
@@ -121,14 +119,22 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 
 /// The source files the images name, read when shown: relative to the
 /// project's root (or the current directory); `scorpion.inc` built in.
-struct Sources {
-    root: PathBuf,
+pub(crate) struct Sources {
+    pub(crate) root: PathBuf,
     files: std::collections::HashMap<String, Option<Vec<String>>>,
 }
 
 impl Sources {
+    /// Sources relative to `root`.
+    pub(crate) fn new(root: PathBuf) -> Sources {
+        Sources {
+            root,
+            files: std::collections::HashMap::new(),
+        }
+    }
+
     /// Line `line` (from 1) of `file`, if it can be read.
-    fn line(&mut self, file: &str, line: u32) -> Option<String> {
+    pub(crate) fn line(&mut self, file: &str, line: u32) -> Option<String> {
         let root = &self.root;
         let lines = self.files.entry(file.to_owned()).or_insert_with(|| {
             let text = if file == "scorpion.inc" && !root.join(file).is_file() {
@@ -147,25 +153,23 @@ impl Sources {
 
 /// What [`recipe`] makes: the robot's builder, the images it loads, and
 /// where their sources are.
-type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
+pub(crate) type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
 
-/// The robot the options (or the project) describe, as a function that
-/// builds it afresh, the images it loads, and the directory their source
-/// paths are relative to.
-fn recipe(args: &Args) -> miette::Result<Recipe> {
+/// The robot the options (or the project found from `here` up) describe,
+/// as a function that builds it afresh, the images it loads, and the
+/// directory their source paths are relative to.
+pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Recipe> {
     let mut rig = args.rig.clone();
     let mut rom_path = args.rom.clone();
     let mut images = Vec::new();
-    let mut root = std::env::current_dir().into_diagnostic()?;
+    let mut root = here.to_path_buf();
     for path in &args.images {
         let bytes = std::fs::read(path)
             .into_diagnostic()
             .wrap_err_with(|| format!("cannot read {}", path.display()))?;
         images.push(linker::Image::parse(&path.display().to_string(), &bytes)?);
     }
-    let project = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| crate::project::Project::find(&cwd))
+    let project = crate::project::Project::find(here)
         .map(|root| crate::project::config::Found::load(&root))
         .transpose()?;
     if let Some(crate::project::config::Found::Project(project)) = project {

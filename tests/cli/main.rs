@@ -5,6 +5,7 @@ mod ask;
 mod asm;
 mod build;
 mod cards;
+mod dap;
 mod debug;
 mod disasm;
 mod emu;
