@@ -182,6 +182,9 @@ fn command_watch_next_and_finish() {
     assert_eq!(over.pc, before + 3);
     assert!(over.instructions > 1, "the whole of PUTCH ran");
     d.step(2).expect("into PUTHEX");
+    // The call chain: here, then where PUTHEX returns to.
+    let chain = d.backtrace();
+    assert_eq!(chain, vec![d.cpu().pc, before + 9], "{chain:04X?}");
     let finished = d.finish(100_000).expect("runs");
     assert_eq!(finished.why, Why::Finished);
     assert_eq!(finished.pc, before + 9, "back after the JSR PUTHEX");
@@ -219,4 +222,36 @@ fn source_lines_of_the_image() {
     assert_eq!(d.address_of_line("q.s", 13), Some(at + 8));
     let lines = d.disassemble(at, 2);
     assert_eq!(lines[1].source, Some(("q.s".to_owned(), 10)));
+}
+
+#[test]
+fn the_unknown_command_hook_and_a_watched_range() {
+    let mut d = debugger();
+    let hook = d.add_breakpoint(Breakpoint::UnknownHook);
+    d.send(b"/1X");
+    let known = d.run(100_000).expect("runs");
+    assert_eq!(known.why, Why::Budget, "the ROM knows /1X");
+    d.send(b"/1Q");
+    let unknown = d.run(100_000).expect("runs");
+    assert!(
+        matches!(unknown.why, Why::Breakpoint { id, .. } if id == hook),
+        "{unknown:?}"
+    );
+    assert_eq!(
+        unknown.pc,
+        d.robot().hook_address(isa::objfmt::HookKind::Unknown)
+    );
+    d.delete_breakpoint(hook);
+    // A range around `result`: the handler's store into it stops.
+    let result = d.symbols().address("result").expect("`result`");
+    let watch = d.add_watch(Watch {
+        start: result - 1,
+        end: result + 1,
+        kind: WatchKind::Write,
+    });
+    let wrote = d.run(100_000).expect("runs");
+    let Why::Watch { id, access, .. } = wrote.why else {
+        panic!("{wrote:?}");
+    };
+    assert_eq!((id, access.address, access.value), (watch, result, 0x42));
 }

@@ -643,7 +643,9 @@ fn listing(sources: &mut Sources, file: &str, line: u32) -> String {
             break;
         };
         let marker = if n == line { '>' } else { ' ' };
-        text.push_str(&format!("{marker} {file}:{n:<4} {source}\n"));
+        let shown = format!("{marker} {file}:{n:<4} {source}");
+        text.push_str(shown.trim_end());
+        text.push('\n');
     }
     if text.is_empty() {
         text = format!("cannot read {file}\n");

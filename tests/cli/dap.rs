@@ -159,13 +159,59 @@ fn a_dap_session_on_the_adc_example() {
     assert_eq!(c.top_frame()["line"], 33);
     assert_eq!(c.register("A"), "$31");
 
+    // Into a subroutine and out: step to the `jsr PUTCH` after the wait
+    // loop's breakpoint, in, out.
+    c.request(
+        "setBreakpoints",
+        json!({"source": {"path": source}, "breakpoints": [{"line": 45}]}),
+    );
+    assert_eq!(
+        c.request("continue", json!({"threadId": 1}))["success"],
+        true
+    );
+    assert_eq!(c.event("stopped")["body"]["reason"], "breakpoint");
+    assert_eq!(c.top_frame()["line"], 45, "jsr PUTCH");
+    assert_eq!(c.request("stepIn", json!({"threadId": 1}))["success"], true);
+    c.event("stopped");
+    let trace = c.request("stackTrace", json!({"threadId": 1}));
+    let frames = trace["body"]["stackFrames"]
+        .as_array()
+        .expect("frames")
+        .clone();
+    assert_eq!(
+        frames.len(),
+        2,
+        "PUTCH, and the handler it returns to: {trace}"
+    );
+    assert_eq!(frames[1]["line"], 46, "the line after the JSR: {trace}");
+    assert!(
+        frames[0]["source"].is_null(),
+        "the ROM has no source here: {trace}"
+    );
+    assert_eq!(
+        c.request("stepOut", json!({"threadId": 1}))["success"],
+        true
+    );
+    c.event("stopped");
+    assert_eq!(c.top_frame()["line"], 46);
+    // Back to the last breakpoint hit (line 45), then on.
+    assert_eq!(
+        c.request("reverseContinue", json!({"threadId": 1}))["success"],
+        true
+    );
+    assert_eq!(c.event("stopped")["body"]["reason"], "breakpoint");
+    assert_eq!(c.top_frame()["line"], 45);
+
     // The card's registers, as memory.
     let memory = c.request(
         "readMemory",
         json!({"memoryReference": "0x9000", "count": 3}),
     );
     assert_eq!(memory["body"]["address"], "0x9000", "{memory}");
-    assert_eq!(memory["body"]["data"], "AAAA", "three zero bytes: {memory}");
+    assert_eq!(
+        memory["body"]["data"], "AEAA",
+        "the status register's result bit: {memory}"
+    );
 
     // No more breakpoints: the answer comes, the robot runs on until paused.
     c.request(

@@ -98,3 +98,23 @@ fn the_readmes_debugging_section_runs_as_written() {
         "README.md's debugging section is stale"
     );
 }
+
+#[test]
+fn trace_writes_every_instruction_run_to_a_file() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let file = dir.path().join("trace.txt");
+    let script = format!(
+        "break read_channel\n/2A1\ncontinue\ntrace {}\nstep 3\ntrace off\nstep 2\n",
+        file.display()
+    );
+    let output = scorpion_with_input(Some(&adc), &["debug"], &script);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let trace = std::fs::read_to_string(&file).expect("the trace");
+    let lines: Vec<&str> = trace.lines().collect();
+    assert_eq!(lines.len(), 3, "{trace}");
+    assert!(
+        lines[0].contains("0400") && lines[0].contains("CPX"),
+        "{trace}"
+    );
+}
