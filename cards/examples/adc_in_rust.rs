@@ -106,24 +106,7 @@ fn extension() -> linker::Image {
     };
     let assembly = assembler::assemble(&assembler::FsSource, &source, &options)
         .expect("the example assembles");
-    let rom = linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("the ROM's ELF");
-    let target = linker::Target::builtin("scorpion-ext", None).expect("a built-in target");
-    linker::link(
-        &[linker::Input {
-            name: "adc.s",
-            bytes: &assembly.object,
-        }],
-        &linker::LinkOptions {
-            target: &target,
-            just_symbols: &[linker::SymbolFile {
-                name: "scorpion-rom.elf",
-                image: &rom,
-            }],
-            sources: &linker::NoSources,
-        },
-    )
-    .expect("the example links")
-    .image
+    romlib::link_against_rom("adc.s", &assembly.object, "scorpion-ext").expect("the example links")
 }
 
 /// The robot's answers to reading three channels.

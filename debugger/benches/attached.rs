@@ -36,24 +36,7 @@ fn patrol() -> linker::Image {
     };
     let assembly =
         assembler::assemble(&assembler::FsSource, &source, &options).expect("patrol assembles");
-    let rom = linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("the ROM's ELF");
-    let target = linker::Target::builtin("scorpion-os", None).expect("a built-in target");
-    linker::link(
-        &[linker::Input {
-            name: "patrol.s",
-            bytes: &assembly.object,
-        }],
-        &linker::LinkOptions {
-            target: &target,
-            just_symbols: &[linker::SymbolFile {
-                name: "scorpion-rom.elf",
-                image: &rom,
-            }],
-            sources: &linker::NoSources,
-        },
-    )
-    .expect("patrol links")
-    .image
+    romlib::link_against_rom("patrol.s", &assembly.object, "scorpion-os").expect("patrol links")
 }
 
 fn robot(image: &linker::Image) -> VirtualScorpion {

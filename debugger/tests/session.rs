@@ -68,24 +68,7 @@ fn image() -> linker::Image {
     };
     let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
         .expect("the handler assembles");
-    let rom = linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("the ROM's ELF");
-    let target = linker::Target::builtin("scorpion-ext", None).expect("a built-in target");
-    linker::link(
-        &[linker::Input {
-            name: "q.s",
-            bytes: &assembly.object,
-        }],
-        &linker::LinkOptions {
-            target: &target,
-            just_symbols: &[linker::SymbolFile {
-                name: "scorpion-rom.elf",
-                image: &rom,
-            }],
-            sources: &linker::NoSources,
-        },
-    )
-    .expect("the handler links")
-    .image
+    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
 }
 
 fn debugger() -> Debugger {

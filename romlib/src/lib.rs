@@ -32,3 +32,34 @@ pub const ROM_ELF: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/scorpion-ro
 /// `scorpion.inc`: the ROM's exported names and the hook macros, for
 /// `.include "scorpion.inc"` in extensions.
 pub const SCORPION_INC: &str = include_str!(concat!(env!("OUT_DIR"), "/scorpion.inc"));
+
+/// Links one assembled object (`name` for messages) against the reference
+/// ROM's symbols with the built-in target `target` (`scorpion-ext`,
+/// `scorpion-os`): what a test or a tool needs to turn an extension's
+/// object into an image the virtual Scorpion loads.
+///
+/// # Errors
+/// The linker's: an unknown target, an undefined symbol, an overflow.
+pub fn link_against_rom(
+    name: &str,
+    object: &[u8],
+    target: &str,
+) -> Result<linker::Image, linker::Error> {
+    let rom = linker::Image::parse("scorpion-rom.elf", ROM_ELF)?;
+    let target = linker::Target::builtin(target, None)?;
+    let linked = linker::link(
+        &[linker::Input {
+            name,
+            bytes: object,
+        }],
+        &linker::LinkOptions {
+            target: &target,
+            just_symbols: &[linker::SymbolFile {
+                name: "scorpion-rom.elf",
+                image: &rom,
+            }],
+            sources: &linker::NoSources,
+        },
+    )?;
+    Ok(linked.image)
+}

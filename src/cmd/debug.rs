@@ -540,30 +540,13 @@ fn registers(d: &Debugger) -> String {
 
 fn memory(d: &Debugger, address: u16, len: usize) -> String {
     let bus = &d.robot().robot().bus;
-    let mut text = String::new();
-    let mut at = address;
-    let mut left = len;
-    while left > 0 {
-        let n = left.min(16);
-        let bytes: Vec<u8> = (0..n as u16)
-            .map(|i| emulator::Bus::peek(bus, at.wrapping_add(i)))
-            .collect();
-        let hex: Vec<String> = bytes.iter().map(|b| format!("{b:02X}")).collect();
-        let ascii: String = bytes
-            .iter()
-            .map(|&b| {
-                if (0x20..0x7F).contains(&b) {
-                    char::from(b)
-                } else {
-                    '.'
-                }
-            })
-            .collect();
-        text.push_str(&format!("${at:04X}  {:<47}  {ascii}\n", hex.join(" ")));
-        at = at.wrapping_add(n as u16);
-        left -= n;
-    }
-    text
+    let bytes: Vec<u8> = (0..len)
+        .map(|i| emulator::Bus::peek(bus, address.wrapping_add(i as u16)))
+        .collect();
+    let mut text = Vec::new();
+    // As `scorpion read` shows a robot's memory.
+    let _ = crate::cmd::read::write_dump(&mut text, address, &bytes);
+    String::from_utf8_lossy(&text).into_owned()
 }
 
 fn line_text(d: &Debugger, line: &Line) -> String {

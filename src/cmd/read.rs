@@ -51,7 +51,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 }
 
 /// Sixteen bytes a line: address, hex, and the printable characters.
-fn write_dump(out: &mut impl Write, address: u16, bytes: &[u8]) -> std::io::Result<()> {
+pub(crate) fn write_dump(out: &mut impl Write, address: u16, bytes: &[u8]) -> std::io::Result<()> {
     for (row, chunk) in bytes.chunks(16).enumerate() {
         let at = usize::from(address) + row * 16;
         write!(out, "{at:04X}:")?;
