@@ -319,6 +319,21 @@ fn a_loop_polling_a_stable_card_register_is_skipped_to_the_cards_events() {
     assert!(skipped.cpu.skipped_cycles() > 40_000);
 }
 
+/// `program` at $0400 on the plain RAM machine, run to `until` with idle
+/// skipping and without: [skipped, run].
+fn both_ways(program: &[u8], until: u64) -> [emulator::RamMachine; 2] {
+    [true, false].map(|skip| {
+        let mut ram = Ram::new();
+        ram.load(0x0400, program).expect("fits");
+        let mut machine = Machine::new(ram);
+        machine.cpu.pc = 0x0400;
+        machine.cpu.set_idle_skip(skip);
+        let stop = machine.run_with(until, &mut NoHooks);
+        assert_eq!(stop, Stop::Limit);
+        machine
+    })
+}
+
 #[test]
 fn a_loop_on_plain_ram_is_skipped_to_the_limit_and_counted_exactly() {
     // $0400: LDX $10 / INX / DEX / CPX $11 / BNE $0400 / JMP $0400 - the
@@ -326,17 +341,7 @@ fn a_loop_on_plain_ram_is_skipped_to_the_limit_and_counted_exactly() {
     let program = [
         0xA6, 0x10, 0xE8, 0xCA, 0xE4, 0x11, 0xD0, 0xF8, 0x4C, 0x00, 0x04,
     ];
-    let machines = [true, false].map(|skip| {
-        let mut ram = Ram::new();
-        ram.load(0x0400, &program).expect("fits");
-        let mut machine = Machine::new(ram);
-        machine.cpu.pc = 0x0400;
-        machine.cpu.set_idle_skip(skip);
-        let stop = machine.run_with(1_000_003, &mut NoHooks);
-        assert_eq!(stop, Stop::Limit);
-        machine
-    });
-    let [skipped, run] = machines;
+    let [skipped, run] = both_ways(&program, 1_000_003);
     assert_eq!(skipped.cpu, run.cpu);
     assert!(skipped.cpu.cycles() >= 1_000_003 && skipped.cpu.cycles() < 1_000_003 + 4);
     assert!(skipped.cpu.skipped_cycles() > 990_000);
@@ -351,17 +356,7 @@ fn a_loop_that_stores_what_is_there_is_skipped_exactly() {
     let mut program = vec![0x20, 0x10, 0x04, 0xA5, 0x10, 0x85, 0x11, 0x4C, 0x00, 0x04];
     program.resize(0x10, 0xEA);
     program.push(0x60);
-    let machines = [true, false].map(|skip| {
-        let mut ram = Ram::new();
-        ram.load(0x0400, &program).expect("fits");
-        let mut machine = Machine::new(ram);
-        machine.cpu.pc = 0x0400;
-        machine.cpu.set_idle_skip(skip);
-        let stop = machine.run_with(500_001, &mut NoHooks);
-        assert_eq!(stop, Stop::Limit);
-        machine
-    });
-    let [skipped, run] = machines;
+    let [skipped, run] = both_ways(&program, 500_001);
     assert_eq!(skipped.cpu, run.cpu);
     assert_eq!(skipped.bus.bytes(), run.bus.bytes());
     assert!(skipped.cpu.skipped_cycles() > 490_000);

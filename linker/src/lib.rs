@@ -33,7 +33,7 @@ pub use error::Error;
 pub use image::{Image, ImageSection, ImageSymbol, LoadArea};
 pub use input::Input;
 pub use layout::{Layout, Target};
-pub use link::{LinkOptions, SymbolFile, link};
+pub use link::{LinkOptions, SymbolFile, link, link_one};
 pub use model::Linked;
 pub use output::Format;
 pub use source::{MemorySources, NoSources, SourceProvider};

@@ -45,6 +45,31 @@ impl core::fmt::Debug for LinkOptions<'_> {
     }
 }
 
+/// Links one object (`name` for messages) for `target` against one symbol
+/// file, with no sources to quote: a ROM profile's extension, the RAM
+/// loader against a profile's services.
+///
+/// # Errors
+/// As [`link`].
+pub fn link_one(
+    name: &str,
+    object: &[u8],
+    target: &Target,
+    symbols: SymbolFile<'_>,
+) -> Result<Linked, Error> {
+    link(
+        &[Input {
+            name,
+            bytes: object,
+        }],
+        &LinkOptions {
+            target,
+            just_symbols: &[symbols],
+            sources: &crate::NoSources,
+        },
+    )
+}
+
 /// Links `inputs` into an image.
 ///
 /// # Errors

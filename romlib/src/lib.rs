@@ -47,19 +47,9 @@ pub fn link_against_rom(
 ) -> Result<linker::Image, linker::Error> {
     let rom = linker::Image::parse("scorpion-rom.elf", ROM_ELF)?;
     let target = linker::Target::builtin(target, None)?;
-    let linked = linker::link(
-        &[linker::Input {
-            name,
-            bytes: object,
-        }],
-        &linker::LinkOptions {
-            target: &target,
-            just_symbols: &[linker::SymbolFile {
-                name: "scorpion-rom.elf",
-                image: &rom,
-            }],
-            sources: &linker::NoSources,
-        },
-    )?;
-    Ok(linked.image)
+    let symbols = linker::SymbolFile {
+        name: "scorpion-rom.elf",
+        image: &rom,
+    };
+    Ok(linker::link_one(name, object, &target, symbols)?.image)
 }

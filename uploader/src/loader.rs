@@ -274,21 +274,11 @@ fn link(object: &[u8], address: u16, symbols: &Symbols) -> Result<(UploadImage, 
     };
     let target = linker::Target::builtin("flat", Some(u64::from(address)))
         .map_err(|error| failed(error.to_string()))?;
-    let linked = linker::link(
-        &[linker::Input {
-            name,
-            bytes: object,
-        }],
-        &linker::LinkOptions {
-            target: &target,
-            just_symbols: &[linker::SymbolFile {
-                name: "rom profile",
-                image: &rom,
-            }],
-            sources: &linker::NoSources,
-        },
-    )
-    .map_err(|error| match error {
+    let symbols = linker::SymbolFile {
+        name: "rom profile",
+        image: &rom,
+    };
+    let linked = linker::link_one(name, object, &target, symbols).map_err(|error| match error {
         linker::Error::Failed { errors, .. } => failed(
             errors
                 .iter()
