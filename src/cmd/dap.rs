@@ -35,7 +35,9 @@ use crate::cmd::ports;
 ///
 /// `launch`'s `program` is a linked image (ELF) or a project's directory;
 /// `stopOnEntry` stops before anything runs; `commands` (a list like
-/// `["/2A1"]`) go down the robot's serial line once configured. In the
+/// `["/2A1"]`) go down the robot's serial line once configured; `cwd` is
+/// where an image's source paths start (default: the project's root, or
+/// the image's directory). In the
 /// debug console, a line starting with `/` is sent to the robot; anything
 /// else is an address whose byte is shown.
 #[derive(Debug, clap::Args)]
@@ -245,7 +247,8 @@ impl Session {
                             .collect()
                     })
                     .unwrap_or_default();
-                self.launch(Path::new(program))
+                let cwd = data.get("cwd").and_then(|c| c.as_str()).map(PathBuf::from);
+                self.launch(Path::new(program), cwd)
                     .map_err(|e| format!("{e:?}"))?;
                 None
             }
@@ -446,7 +449,7 @@ impl Session {
 
     /// `launch`: the robot with `program` (an image, or a project's
     /// directory).
-    fn launch(&mut self, program: &Path) -> miette::Result<()> {
+    fn launch(&mut self, program: &Path, cwd: Option<PathBuf>) -> miette::Result<()> {
         let (here, images) = if program.is_dir() {
             (program.to_path_buf(), Vec::new())
         } else {
@@ -463,7 +466,9 @@ impl Session {
         };
         let (make, images, root) = debug::recipe(&args, &here)?;
         self.debugger = Some(Debugger::new(make, &images)?);
-        self.sources = Sources::new(root);
+        // An image's source paths are as its build was given them: `cwd`
+        // says from where.
+        self.sources = Sources::new(cwd.unwrap_or(root));
         Ok(())
     }
 }

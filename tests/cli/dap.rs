@@ -247,3 +247,55 @@ fn requests_before_launch_and_bad_programs_are_errors() {
     c.request("disconnect", json!({}));
     assert!(c.child.wait().expect("the adapter ends").success());
 }
+
+/// `program` an image: built here from a copy of the ADC source, its
+/// source lines found from `cwd`; without `stopOnEntry` it runs at once.
+#[test]
+fn an_image_launched_runs_to_a_breakpoint_by_line() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    std::fs::copy(examples.join("adc.s"), dir.path().join("adc.s")).expect("copy");
+    let built = crate::scorpion(
+        dir.path(),
+        &[
+            "build",
+            "adc.s",
+            "-o",
+            "adc.elf",
+            "--target",
+            "scorpion-ext",
+        ],
+    );
+    assert_eq!(
+        built.status.code(),
+        Some(0),
+        "{}",
+        crate::transcript(&built)
+    );
+    let mut c = Client::start();
+    c.request("initialize", json!({"adapterID": "scorpion"}));
+    let launch = c.request(
+        "launch",
+        json!({
+            "program": dir.path().join("adc.elf").display().to_string(),
+            "cwd": dir.path().display().to_string(),
+            "commands": ["/2A1"],
+        }),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    let source = dir.path().join("adc.s").display().to_string();
+    let set = c.request(
+        "setBreakpoints",
+        json!({"source": {"path": source}, "breakpoints": [{"line": 28}]}),
+    );
+    assert_eq!(set["body"]["breakpoints"][0]["verified"], true, "{set}");
+    c.request("configurationDone", json!({}));
+    assert_eq!(c.event("stopped")["body"]["reason"], "breakpoint");
+    let frame = c.top_frame();
+    assert_eq!(
+        (frame["line"].clone(), frame["source"]["path"].clone()),
+        (json!(28), json!(source))
+    );
+    c.request("disconnect", json!({}));
+    assert!(c.child.wait().expect("the adapter ends").success());
+}
