@@ -104,6 +104,7 @@ directives! {
     Org = "org";
     Out = "out";
     P02 = "p02";
+    OtherCpu = "p816" | "pc02" | "psc02" | "p4510";
     Paramcount = "paramcount";
     Proc = "proc";
     Referenced = "referenced" | "ref";

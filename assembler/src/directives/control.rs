@@ -45,6 +45,30 @@ impl Asm<'_> {
         Ok(())
     }
 
+    /// `.p816`, `.pc02`, `.psc02`, `.p4510`: ca65's switches to other CPUs,
+    /// refused by name (the robot has an NMOS 6502).
+    pub(super) fn other_cpu(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let name = self.names.name(c.current().name()).to_ascii_lowercase();
+        let name = name.trim_start_matches('.');
+        let span = c.current().span;
+        let cpu = match name {
+            "p816" => "the 65816",
+            "pc02" => "the 65C02",
+            "psc02" => "the 65SC02",
+            _ => "the 4510",
+        };
+        Err(self.report(
+            diag::error(
+                "asm::cpu",
+                span,
+                format!(
+                    "`.{name}` selects {cpu}; this toolchain is for the NMOS 6502, the Scorpion's CPU"
+                ),
+            )
+            .help("remove it (`.p02` is the default), or `.setcpu \"6502X\"` for the NMOS 6502's undocumented opcodes"),
+        ))
+    }
+
     /// The span from the directive at `c` to the end of the line.
     fn whole_statement(&self, c: &Cursor<'_>) -> diag::Span {
         self.join(c.current().span, c.span_of(c.tokens().len() - 1))
