@@ -122,6 +122,16 @@ impl Program {
             }
             Node::Binary(op, left, right) => {
                 let left = self.eval_at(left, depth + 1);
+                // `.and`/`&&` with a false left side and `.or`/`||` with a
+                // true one are settled without their right side, as in
+                // ca65 (`.if .def(x) .and x < 10` with `x` not defined).
+                match (op, &left) {
+                    (BinaryOp::LogAnd, Ok(Value::Const(0))) => return Ok(Value::Const(0)),
+                    (BinaryOp::LogOr, Ok(Value::Const(v))) if *v != 0 => {
+                        return Ok(Value::Const(1));
+                    }
+                    _ => {}
+                }
                 let right = self.eval_at(right, depth + 1);
                 // A hard error on either side wins over "not yet".
                 let (left, right) = match (left, right) {

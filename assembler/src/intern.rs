@@ -98,6 +98,7 @@ directives! {
     Lobytes = "lobytes";
     Loword = "loword";
     Macro = "macro" | "mac";
+    Macpack = "macpack";
     Mod = "mod";
     Not = "not";
     Or = "or";

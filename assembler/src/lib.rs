@@ -32,6 +32,7 @@ mod instr;
 mod intern;
 mod lexer;
 mod listing;
+mod macpack;
 mod model;
 mod output;
 mod parse;

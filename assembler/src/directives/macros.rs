@@ -243,3 +243,46 @@ impl Asm<'_> {
         Ok(())
     }
 }
+
+impl Asm<'_> {
+    /// `.macpack NAME`: one of ca65's macro packages, read as if included
+    /// (a second `.macpack` of it defines its macros again, an error as in
+    /// ca65).
+    pub(super) fn macpack(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let head = c.current();
+        c.advance();
+        let Some(tok) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+            let span = c.span();
+            return Err(self.err(
+                "asm::syntax",
+                span,
+                format!(
+                    "expected a macro package's name ({})",
+                    crate::macpack::NAMES
+                ),
+            ));
+        };
+        c.advance();
+        self.expect_end(c)?;
+        let name = self.names.name(tok.name()).to_ascii_lowercase();
+        let Some(text) = crate::macpack::package(&name) else {
+            return Err(self.report(
+                crate::diag::error(
+                    "asm::macpack",
+                    tok.span,
+                    format!("no macro package `{name}`"),
+                )
+                .help(format!("the packages: {}", crate::macpack::NAMES)),
+            ));
+        };
+        self.frame_room(tok.span)?;
+        let ctx = self.new_ctx(CtxKind::Include, self.join(head.span, tok.span));
+        self.push_file(
+            format!("<macpack {name}>"),
+            text.into_bytes(),
+            std::path::PathBuf::new(),
+            ctx,
+        );
+        Ok(())
+    }
+}

@@ -53,6 +53,7 @@ impl Asm<'_> {
                 matches!(dir, Dir::Global | Dir::Globalzp),
             ),
             Dir::Macro => self.define_macro(c),
+            Dir::Macpack => self.macpack(c),
             Dir::Endmacro => {
                 Err(self.err("asm::unbalanced", head.span, "`.endmacro` without `.macro`"))
             }
