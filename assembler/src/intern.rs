@@ -120,6 +120,7 @@ directives! {
     Shl = "shl";
     Shr = "shr";
     Sizeof = "sizeof";
+    Strat = "strat";
     Strlen = "strlen";
     Struct = "struct";
     Tag = "tag";

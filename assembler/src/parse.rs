@@ -514,6 +514,32 @@ impl Asm<'_> {
                 let len = self.string_bytes(&tok).len();
                 Ok(self.prog.node(Node::Const(len as i64)))
             }
+            Dir::Strat => {
+                // `.strat(string, index)`: the character at `index` (from
+                // 0), through the character map as a `.byte` string is.
+                self.expect(c, Tok::LParen, "`(`")?;
+                let Some(tok) = c.peek().filter(|t| t.kind == Tok::Str).copied() else {
+                    let span = c.span();
+                    return Err(self.err("asm::syntax", span, "expected a string"));
+                };
+                c.advance();
+                self.expect(c, Tok::Comma, "`,` and the index")?;
+                let at = c.span();
+                let index = self.const_expr(c, "the `.strat` index")?;
+                self.expect(c, Tok::RParen, "`)`")?;
+                let bytes = self.string_bytes(&tok);
+                let Some(&byte) = usize::try_from(index).ok().and_then(|i| bytes.get(i)) else {
+                    return Err(self.report(crate::resolver::range_diag(
+                        at,
+                        "the `.strat` index",
+                        index,
+                        (0, bytes.len() as i64 - 1),
+                    )));
+                };
+                Ok(self
+                    .prog
+                    .node(Node::Const(i64::from(self.charmap[usize::from(byte)]))))
+            }
             Dir::Sizeof => {
                 self.expect(c, Tok::LParen, "`(`")?;
                 let node = self.sizeof(c)?;
