@@ -110,3 +110,17 @@ mod tests {
         assert_eq!(length("0x10000"), Ok(0x10000));
     }
 }
+
+/// `--feature NAME`: a ca65 feature this assembler implements.
+pub(crate) fn feature(text: &str) -> Result<String, String> {
+    match assembler::Features::default().set(text, true) {
+        Ok(()) => Ok(text.to_ascii_lowercase()),
+        Err(assembler::FeatureError::Unsupported) => Err(format!(
+            "`{text}` is a ca65 feature this assembler does not support yet (it has: force_range)"
+        )),
+        Err(assembler::FeatureError::Unknown) => Err(format!(
+            "no feature `{text}`; ca65's: {}",
+            assembler::CA65_FEATURES.join(", ")
+        )),
+    }
+}

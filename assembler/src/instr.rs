@@ -476,7 +476,18 @@ impl Asm<'_> {
     /// Writes an operand or data value: bytes now if constant, else a
     /// placeholder and a fixup resolved after layout.
     pub(crate) fn operand_bytes(&mut self, expr: NodeId, kind: FixKind, span: Span) -> PResult<()> {
-        let value = self.prog.eval(expr);
+        let mut expr = expr;
+        if self.features.force_range && matches!(kind, FixKind::Imm8 | FixKind::Byte) {
+            // `.feature force_range`: the low byte, whatever the value.
+            expr = self.prog.node(Node::Unary(UnaryOp::LoByte, expr));
+        }
+        let mut value = self.prog.eval(expr);
+        if self.features.force_range
+            && kind == FixKind::Word
+            && let Ok(Value::Const(v)) = value
+        {
+            value = Ok(Value::Const(v & 0xFFFF));
+        }
         self.operand_value(expr, value, kind, span)
     }
 

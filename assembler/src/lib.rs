@@ -28,6 +28,7 @@ mod diag;
 mod directives;
 mod elf;
 mod expr;
+mod features;
 mod instr;
 mod intern;
 mod lexer;
@@ -44,6 +45,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 pub use diag::{Diagnostic, Location, Severity};
+pub use features::{CA65_FEATURES, FeatureError, Features};
 pub use source::{FileSource, FsSource, MemorySource};
 
 /// How to assemble.
@@ -71,6 +73,8 @@ pub struct Options {
     /// with an error: the guard against runaway `.repeat`s and recursive
     /// macros (default 4,000,000, twenty times the 200,000-line benchmark).
     pub max_lines: u64,
+    /// `.feature` switches on from the first line (`--feature`).
+    pub features: Features,
 }
 
 impl Default for Options {
@@ -84,6 +88,7 @@ impl Default for Options {
             max_errors: 50,
             undocumented: false,
             max_lines: 4_000_000,
+            features: Features::default(),
         }
     }
 }

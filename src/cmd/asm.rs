@@ -42,6 +42,10 @@ pub(crate) struct AsmOptions {
     /// Stop keeping errors of a source after this many (the rest are counted).
     #[arg(long, default_value_t = 50, value_name = "N")]
     max_errors: usize,
+    /// Switch a ca65 feature on from the first line, as `.feature NAME`
+    /// does (repeatable; `force_range` is implemented).
+    #[arg(long = "feature", value_name = "NAME", value_parser = crate::args::feature)]
+    features: Vec<String>,
 }
 
 impl AsmOptions {
@@ -56,6 +60,14 @@ impl AsmOptions {
             max_errors: self.max_errors,
             undocumented: self.undocumented,
             builtin_includes: builtin_includes(),
+            features: {
+                let mut features = assembler::Features::default();
+                for name in &self.features {
+                    // Checked by the argument's parser.
+                    let _ = features.set(name, true);
+                }
+                features
+            },
             ..assembler::Options::default()
         }
     }

@@ -216,3 +216,29 @@ fn scorpion_build_flat_equals_ld65() {
         );
     }
 }
+
+/// `--feature NAME` switches a ca65 feature on from the first line; a
+/// feature not implemented, or not ca65's, is refused with the list.
+#[test]
+fn features_from_the_command_line() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(dir.path().join("f.s"), "        lda #-1\n").expect("write");
+    let without = scorpion(dir.path(), &["asm", "f.s"]);
+    assert_eq!(without.status.code(), Some(1), "{}", transcript(&without));
+    let with = scorpion(dir.path(), &["asm", "f.s", "--feature", "force_range"]);
+    assert_eq!(with.status.code(), Some(0), "{}", transcript(&with));
+    let later = scorpion(dir.path(), &["asm", "f.s", "--feature", "c_comments"]);
+    assert_eq!(later.status.code(), Some(2), "{}", transcript(&later));
+    assert!(
+        transcript(&later).contains("does not support yet"),
+        "{}",
+        transcript(&later)
+    );
+    let bogus = scorpion(dir.path(), &["asm", "f.s", "--feature", "bogus"]);
+    assert_eq!(bogus.status.code(), Some(2), "{}", transcript(&bogus));
+    assert!(
+        transcript(&bogus).contains("underline_in_numbers"),
+        "{}",
+        transcript(&bogus)
+    );
+}

@@ -144,6 +144,8 @@ pub(crate) struct Asm<'a> {
     pub(crate) listing: Option<ListingBuilder>,
     pub(crate) charmap: [u8; 256],
     pub(crate) cpu_x: bool,
+    /// The `.feature` switches in force.
+    pub(crate) features: crate::Features,
     pub(crate) used_undoc: bool,
     pub(crate) messages: Vec<String>,
     pub(crate) stop: bool,
@@ -180,6 +182,7 @@ impl<'a> Asm<'a> {
             listing: None,
             charmap,
             cpu_x: opts.undocumented,
+            features: opts.features,
             used_undoc: false,
             messages: Vec::new(),
             stop: false,

@@ -86,15 +86,46 @@ impl Asm<'_> {
         Ok(())
     }
 
+    /// `.feature name [+|-] {, name [+|-]}`: each switch on (or off with
+    /// `-`); a ca65 feature this assembler does not implement is a warning
+    /// naming it, a name ca65 does not know an error.
     pub(super) fn feature(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
-        let span = self.whole_statement(c);
-        let diag = diag::warning(
-            "asm::feature",
-            span,
-            "`.feature` switches are not supported; this line is ignored",
-        );
-        self.report(diag);
-        Ok(())
+        c.advance();
+        loop {
+            let Some(tok) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+                let span = c.span();
+                return Err(self.err("asm::syntax", span, "expected a feature's name"));
+            };
+            c.advance();
+            let on = if c.eat(Tok::Minus) {
+                false
+            } else {
+                c.eat(Tok::Plus);
+                true
+            };
+            let name = self.names.name(tok.name()).to_ascii_lowercase();
+            match self.features.set(&name, on) {
+                Ok(()) => {}
+                Err(crate::FeatureError::Unsupported) => {
+                    self.report(diag::warning(
+                        "asm::feature",
+                        tok.span,
+                        format!("`.feature {name}` is not supported by this assembler yet; it is ignored"),
+                    ));
+                }
+                Err(crate::FeatureError::Unknown) => {
+                    return Err(self.report(
+                        diag::error("asm::feature", tok.span, format!("no feature `{name}`")).help(
+                            format!("ca65's features: {}", crate::CA65_FEATURES.join(", ")),
+                        ),
+                    ));
+                }
+            }
+            if !c.eat(Tok::Comma) {
+                break;
+            }
+        }
+        self.expect_end(c)
     }
 
     pub(super) fn list(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
