@@ -73,6 +73,20 @@ pub(crate) fn define(text: &str) -> Result<(String, i64), String> {
     Ok((name.to_owned(), if negative { -number } else { number }))
 }
 
+/// `--feature NAME`: a ca65 feature this assembler implements.
+pub(crate) fn feature(text: &str) -> Result<String, String> {
+    match assembler::Features::default().set(text, true) {
+        Ok(()) => Ok(text.to_ascii_lowercase()),
+        Err(assembler::FeatureError::Unsupported) => Err(format!(
+            "`{text}` is a ca65 feature this assembler does not support yet (it has: force_range)"
+        )),
+        Err(assembler::FeatureError::Unknown) => Err(format!(
+            "no feature `{text}`; ca65's: {}",
+            assembler::CA65_FEATURES.join(", ")
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,19 +122,5 @@ mod tests {
         assert!(address("12ab").unwrap_err().contains("not a number"));
         assert!(address("-1").is_err());
         assert_eq!(length("0x10000"), Ok(0x10000));
-    }
-}
-
-/// `--feature NAME`: a ca65 feature this assembler implements.
-pub(crate) fn feature(text: &str) -> Result<String, String> {
-    match assembler::Features::default().set(text, true) {
-        Ok(()) => Ok(text.to_ascii_lowercase()),
-        Err(assembler::FeatureError::Unsupported) => Err(format!(
-            "`{text}` is a ca65 feature this assembler does not support yet (it has: force_range)"
-        )),
-        Err(assembler::FeatureError::Unknown) => Err(format!(
-            "no feature `{text}`; ca65's: {}",
-            assembler::CA65_FEATURES.join(", ")
-        )),
     }
 }
