@@ -57,6 +57,7 @@ directives! {
     Else = "else";
     Elseif = "elseif";
     Endenum = "endenum";
+    End = "end";
     Endif = "endif";
     Endmacro = "endmacro" | "endmac";
     Endproc = "endproc";

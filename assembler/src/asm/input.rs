@@ -302,7 +302,7 @@ impl<'a> Asm<'a> {
         self.input.toks.clear();
     }
 
-    fn pop_frame(&mut self) {
+    pub(crate) fn pop_frame(&mut self) {
         let Some(frame) = self.input.frames.pop() else {
             return;
         };

@@ -69,6 +69,20 @@ impl Asm<'_> {
         ))
     }
 
+    /// `.end`: the forced end of the assembly, even inside an include:
+    /// nothing after it is read (what is still open is reported as at the
+    /// end of the input).
+    pub(super) fn end(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        c.advance();
+        self.expect_end(c)?;
+        // Every file and expansion ends here, each reporting the `.if`s it
+        // leaves open; the input is then exhausted.
+        while !self.input.frames.is_empty() {
+            self.pop_frame();
+        }
+        Ok(())
+    }
+
     /// The span from the directive at `c` to the end of the line.
     fn whole_statement(&self, c: &Cursor<'_>) -> diag::Span {
         self.join(c.current().span, c.span_of(c.tokens().len() - 1))
