@@ -43,11 +43,13 @@ directives! {
     Bitnot = "bitnot";
     Bitor = "bitor";
     Bitxor = "bitxor";
+    Autoimport = "autoimport";
     Blank = "blank";
     Bss = "bss";
     Byte = "byte" | "byt";
     Charmap = "charmap";
     Code = "code";
+    Case = "case";
     Const = "const";
     Data = "data";
     Dbyt = "dbyt";

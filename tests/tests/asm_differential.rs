@@ -343,6 +343,78 @@ fn the_assemblers_cases_match_ld65() {
     report(failures, 2 * total);
 }
 
+/// C programs of ours (`cc65/*.c`), compiled by cc65 at three
+/// optimisation levels; each output (with `.autoimport`, `.case`,
+/// `.macpack longbranch`, `.proc name: near`...) assembled by ca65 and by
+/// us and linked with a stub of the runtime names it calls: the same
+/// binary.
+#[test]
+fn c_programs_compiled_by_cc65_match_ld65() {
+    let test = "c_programs_compiled_by_cc65_match_ld65";
+    let Some((ca65, ld65)) = toolchain(test) else {
+        return;
+    };
+    let Some(cc65) = tools::require("cc65", test) else {
+        return;
+    };
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cc65");
+    let stub = std::fs::read(dir.join("runtime_stub.s")).expect("the runtime stub");
+    let mut programs: Vec<_> = std::fs::read_dir(&dir)
+        .expect("the C programs")
+        .map(|entry| entry.expect("an entry").path())
+        .filter(|path| path.extension().is_some_and(|e| e == "c"))
+        .collect();
+    programs.sort();
+    assert!(programs.len() >= 2, "{programs:?}");
+    let mut failures = Vec::new();
+    let mut total = 0;
+    for program in &programs {
+        for level in ["", "-O", "-Oirs"] {
+            let out = tempfile::tempdir().expect("a temporary directory");
+            let assembly = out.path().join("program.s");
+            let mut command = Command::new(&cc65);
+            if !level.is_empty() {
+                command.arg(level);
+            }
+            let compiled = command
+                .arg(program)
+                .arg("-o")
+                .arg(&assembly)
+                .output()
+                .expect("cc65 runs");
+            assert!(
+                compiled.status.success(),
+                "cc65 {level} {}: {}",
+                program.display(),
+                String::from_utf8_lossy(&compiled.stderr)
+            );
+            let files = vec![
+                (
+                    "program.s".to_owned(),
+                    std::fs::read(&assembly).expect("cc65's output"),
+                ),
+                ("runtime_stub.s".to_owned(), stub.clone()),
+            ];
+            let mains = ["program.s".to_owned(), "runtime_stub.s".to_owned()];
+            let name = program
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            total += 1;
+            if let Err(failure) = compare(
+                &format!("{name} (cc65 {level})"),
+                &files,
+                &mains,
+                (ca65.as_path(), ld65.as_path()),
+                0,
+            ) {
+                failures.push(failure);
+            }
+        }
+    }
+    report(failures, total);
+}
+
 #[test]
 fn random_programs_match_ld65() {
     let Some((ca65, ld65)) = toolchain("random_programs_match_ld65") else {

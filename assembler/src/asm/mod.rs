@@ -146,6 +146,8 @@ pub(crate) struct Asm<'a> {
     pub(crate) cpu_x: bool,
     /// The `.feature` switches in force.
     pub(crate) features: crate::Features,
+    /// `.autoimport on`: names never defined are imported.
+    pub(crate) autoimport: bool,
     pub(crate) used_undoc: bool,
     pub(crate) messages: Vec<String>,
     pub(crate) stop: bool,
@@ -183,6 +185,7 @@ impl<'a> Asm<'a> {
             charmap,
             cpu_x: opts.undocumented,
             features: opts.features,
+            autoimport: false,
             used_undoc: false,
             messages: Vec::new(),
             stop: false,

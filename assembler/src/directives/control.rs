@@ -143,6 +143,41 @@ impl Asm<'_> {
     }
 
     pub(super) fn list(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let on = self.switch(c)?;
+        if let Some(listing) = self.listing.as_mut() {
+            listing.enabled = on;
+        }
+        Ok(())
+    }
+
+    /// `.autoimport on|off|+|-`: names used and never defined become
+    /// imports (as the C compiler's output expects) instead of errors; the
+    /// setting at the end of the source decides, as in ca65.
+    pub(super) fn autoimport(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        self.autoimport = self.switch(c)?;
+        Ok(())
+    }
+
+    /// `.case on|off|+|-`: names are case-sensitive (on, the default);
+    /// `off` is refused: this assembler keeps `Foo` and `foo` apart.
+    pub(super) fn case(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+        let span = self.whole_statement(c);
+        if !self.switch(c)? {
+            return Err(self.report(
+                diag::error(
+                    "asm::case",
+                    span,
+                    "case-insensitive names are not supported",
+                )
+                .help("names are case-sensitive here, as with `.case on` (ca65's default)"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The operand of a switch: `on`, `off`, `+` or `-`, then the end of
+    /// the line.
+    fn switch(&mut self, c: &mut Cursor<'_>) -> PResult<bool> {
         c.advance();
         let on = match c.peek() {
             Some(tok) if tok.kind == Tok::Plus => true,
@@ -164,9 +199,6 @@ impl Asm<'_> {
         };
         c.advance();
         self.expect_end(c)?;
-        if let Some(listing) = self.listing.as_mut() {
-            listing.enabled = on;
-        }
-        Ok(())
+        Ok(on)
     }
 }

@@ -87,6 +87,8 @@ impl Asm<'_> {
             Dir::Endproc | Dir::Endscope => self.close_scope(c, dir == Dir::Endproc),
             Dir::Setcpu => self.setcpu(c),
             Dir::P02 => self.p02(c),
+            Dir::Autoimport => self.autoimport(c),
+            Dir::Case => self.case(c),
             Dir::End => self.end(c),
             Dir::OtherCpu => self.other_cpu(c),
             Dir::NoEffect => self.no_effect(c),

@@ -314,6 +314,28 @@ impl Asm<'_> {
         if name_tok.is_some() {
             c.advance();
         }
+        // `.proc name: near` (the C compiler writes it): the name's address
+        // size, which for code on a 6502 is absolute.
+        if name_tok.is_some() && c.peek_kind() == Some(Tok::Colon) {
+            c.advance();
+            let size = c.peek().filter(|t| t.kind == Tok::Ident).copied();
+            let word = size.map(|t| self.names.name(t.name()).to_ascii_lowercase());
+            match word.as_deref() {
+                Some("near" | "abs" | "absolute") => c.advance(),
+                _ => {
+                    // Reported; the scope still opens, so its end matches.
+                    let span = size.map_or(c.span(), |t| t.span);
+                    let _ = self.err(
+                        "asm::syntax",
+                        span,
+                        "a scope's address size here is `near` (absolute): code on the 6502 lives in 16-bit addresses",
+                    );
+                    while c.peek().is_some() {
+                        c.advance();
+                    }
+                }
+            }
+        }
         self.expect_end(c)?;
         if let Some(tok) = name_tok {
             // Reported; the scope still opens, so its end matches.

@@ -25,19 +25,37 @@ impl Asm<'_> {
                 continue;
             }
             let (name, mut scope) = (s.name, s.scope);
+            let (referenced, mut found) = (s.ref_loc, false);
             while scope != GLOBAL_SCOPE {
                 scope = self.prog.scopes[scope as usize].parent;
                 if let Some(outer) = self.find_sym(scope, name)
                     && self.prog.syms[outer as usize].is_defined()
                 {
                     self.prog.syms[sym].def = SymDef::Alias(outer);
+                    found = true;
                     break;
+                }
+            }
+            // `.autoimport on`: a name used in a scope and defined nowhere
+            // is the global one, which is imported below.
+            if !found && self.autoimport && referenced.is_some() {
+                let global = self.sym_in(GLOBAL_SCOPE, name);
+                if global as usize != sym {
+                    let g = &mut self.prog.syms[global as usize];
+                    g.ref_loc = g.ref_loc.or(referenced);
+                    self.prog.syms[sym].def = SymDef::Alias(global);
                 }
             }
         }
         for sym in 0..self.prog.syms.len() {
             let s = &self.prog.syms[sym];
-            if s.def == SymDef::Undefined && s.global {
+            // `.autoimport on`: a global name used and never defined is
+            // another file's, as if imported.
+            let auto = self.autoimport
+                && s.kind == SymKind::Normal
+                && s.scope == GLOBAL_SCOPE
+                && s.ref_loc.is_some();
+            if s.def == SymDef::Undefined && (s.global || auto) {
                 let zp = s.export.unwrap_or(false);
                 let s = &mut self.prog.syms[sym];
                 s.def = SymDef::Import { zp };
