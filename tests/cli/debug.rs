@@ -118,3 +118,19 @@ fn trace_writes_every_instruction_run_to_a_file() {
         "{trace}"
     );
 }
+
+#[test]
+fn breaks_at_a_source_line_and_lists_the_source_there() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        "break adc.s:43\n/2A1\ncontinue\nlist\nbreak adc.s:2\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(text.contains("breakpoint 1: $041E (read_channel+$1E)"), "{text}");
+    assert!(text.contains("  adc.s:43:         bvc @wait"), "{text}");
+    assert!(text.contains("> adc.s:43           bvc @wait"), "{text}");
+    assert!(text.contains("error: no code came from adc.s:2"), "{text}");
+}
