@@ -129,7 +129,10 @@ fn breaks_at_a_source_line_and_lists_the_source_there() {
     );
     assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
     let text = String::from_utf8_lossy(&output.stdout).into_owned();
-    assert!(text.contains("breakpoint 1: $041E (read_channel+$1E)"), "{text}");
+    assert!(
+        text.contains("breakpoint 1: $041E (read_channel+$1E)"),
+        "{text}"
+    );
     assert!(text.contains("  adc.s:43:         bvc @wait"), "{text}");
     assert!(text.contains("> adc.s:43           bvc @wait"), "{text}");
     assert!(text.contains("error: no code came from adc.s:2"), "{text}");

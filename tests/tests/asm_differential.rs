@@ -343,6 +343,54 @@ fn the_assemblers_cases_match_ld65() {
     report(failures, 2 * total);
 }
 
+/// Programs of several files (`asm_multi/*/`, every `.s` assembled,
+/// all linked together): what one file cannot show alone, imports
+/// among them.
+#[test]
+fn programs_of_several_files_match_ld65() {
+    let Some((ca65, ld65)) = toolchain("programs_of_several_files_match_ld65") else {
+        return;
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/asm_multi");
+    let mut dirs: Vec<_> = std::fs::read_dir(&root)
+        .expect("the programs")
+        .map(|entry| entry.expect("an entry").path())
+        .filter(|path| path.is_dir())
+        .collect();
+    dirs.sort();
+    assert!(!dirs.is_empty());
+    let mut failures = Vec::new();
+    for dir in &dirs {
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+            .expect("a program")
+            .map(|entry| entry.expect("an entry").path())
+            .map(|path| {
+                let name = path
+                    .file_name()
+                    .expect("a name")
+                    .to_string_lossy()
+                    .into_owned();
+                (name, std::fs::read(&path).expect("a file"))
+            })
+            .collect();
+        files.sort();
+        let mains: Vec<String> = files
+            .iter()
+            .map(|(name, _)| name.clone())
+            .filter(|name| name.ends_with(".s"))
+            .collect();
+        let what = dir
+            .file_name()
+            .expect("a name")
+            .to_string_lossy()
+            .into_owned();
+        if let Err(failure) = compare(&what, &files, &mains, (ca65.as_path(), ld65.as_path()), 0) {
+            failures.push(failure);
+        }
+    }
+    report(failures, dirs.len());
+}
+
 /// C programs of ours (`cc65/*.c`), compiled by cc65 at three
 /// optimisation levels; each output (with `.autoimport`, `.case`,
 /// `.macpack longbranch`, `.proc name: near`...) assembled by ca65 and by

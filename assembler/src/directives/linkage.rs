@@ -8,8 +8,9 @@ use crate::lexer::{Tok, Token};
 use crate::model::SymDef;
 
 /// A name in an `.import`/`.export` list, with `(label_like, expression
-/// start)` when it is `name = expr` or `name := expr`.
-type NameItem = (Token, Option<(bool, usize)>);
+/// start)` when it is `name = expr` or `name := expr`, and its address
+/// size when given (`name: zp` is `Some(true)`, `name: abs` `Some(false)`).
+type NameItem = (Token, Option<(bool, usize)>, Option<bool>);
 
 impl Asm<'_> {
     /// A comma-separated list of names after the directive at `c`.
@@ -22,6 +23,28 @@ impl Asm<'_> {
                 return Err(self.err("asm::syntax", span, "expected a symbol name"));
             };
             c.advance();
+            // `name: zp`, `name: abs` (ca65's address sizes).
+            let mut size = None;
+            if c.peek_kind() == Some(Tok::Colon) {
+                c.advance();
+                let word = c
+                    .peek()
+                    .filter(|t| t.kind == Tok::Ident)
+                    .copied()
+                    .map(|t| (t, self.names.name(t.name()).to_ascii_lowercase()));
+                size = match word.as_ref().map(|(_, w)| w.as_str()) {
+                    Some("zp" | "zeropage" | "direct") => Some(true),
+                    Some("abs" | "absolute" | "near") => Some(false),
+                    _ => {
+                        let span = word.map_or(c.span(), |(t, _)| t.span);
+                        return Err(self.report(
+                            diag::error("asm::syntax", span, "expected an address size: `zp` or `abs`")
+                                .help("the 6502 has 8-bit (zero page) and 16-bit addresses; `far` and `long` are the 65816's"),
+                        ));
+                    }
+                };
+                c.advance();
+            }
             // `.export name = expr` / `name := expr`.
             let mut assignment = None;
             if let Some(kind @ (Tok::Eq | Tok::Assign)) = c.peek_kind() {
@@ -38,7 +61,7 @@ impl Asm<'_> {
                     c.advance();
                 }
             }
-            names.push((tok, assignment));
+            names.push((tok, assignment, size));
             match c.peek_kind() {
                 None => return Ok(names),
                 Some(Tok::Comma) => c.advance(),
@@ -51,7 +74,8 @@ impl Asm<'_> {
     }
 
     pub(super) fn import(&mut self, c: &mut Cursor<'_>, zp: bool) -> PResult<()> {
-        for (tok, assignment) in self.name_list(c)? {
+        for (tok, assignment, size) in self.name_list(c)? {
+            let zp = size.unwrap_or(zp);
             if assignment.is_some() {
                 return Err(self.err("asm::syntax", tok.span, "an import has no value here"));
             }
@@ -80,7 +104,8 @@ impl Asm<'_> {
     }
 
     pub(super) fn export(&mut self, c: &mut Cursor<'_>, zp: bool, global: bool) -> PResult<()> {
-        for (tok, assignment) in self.name_list(c)? {
+        for (tok, assignment, size) in self.name_list(c)? {
+            let zp = size.unwrap_or(zp);
             let sym = self.sym_in(self.symtab.scope, tok.name());
             if let Some((_, start)) = assignment {
                 let mut value = c.at(start);
