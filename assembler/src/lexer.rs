@@ -190,7 +190,10 @@ impl Lexer {
                 }
                 b'@' | b'.' => {
                     let mut j = i + 1;
-                    if j < end && is_ident_start(text[j]) {
+                    // A cheap local may start with a digit (`@1:`), as in
+                    // ca65; a directive may not.
+                    let starts = |b: u8| is_ident_start(b) || (byte == b'@' && b.is_ascii_digit());
+                    if j < end && starts(text[j]) {
                         while j < end && is_ident_char(text[j]) {
                             j += 1;
                         }
