@@ -578,11 +578,26 @@ impl Asm<'_> {
                 (Some(s), _) => self.child_scope(s, tok.name()),
             };
             let Some(found) = found else {
+                // A label's size: what its line emitted.
+                if scope.is_none() && !absolute {
+                    let mut at = self.symtab.scope;
+                    loop {
+                        if let Some(sym) = self.find_sym(at, tok.name())
+                            && let Some(&size) = self.label_sizes.get(&sym)
+                        {
+                            return Ok(self.prog.node(Node::Const(size)));
+                        }
+                        if at == GLOBAL_SCOPE {
+                            break;
+                        }
+                        at = self.prog.scopes[at as usize].parent;
+                    }
+                }
                 let name = self.names.name(tok.name()).to_string();
                 return Err(self.err(
                     "asm::undefined",
                     self.join(start, tok.span),
-                    format!("`.sizeof` needs a struct, union, enum or scope; `{name}` is none of these (yet)"),
+                    format!("`.sizeof` needs a struct, union, enum, scope or label; `{name}` is none of these (yet)"),
                 ));
             };
             scope = Some(found);

@@ -148,6 +148,8 @@ pub(crate) struct Asm<'a> {
     pub(crate) features: crate::Features,
     /// `.autoimport on`: names never defined are imported.
     pub(crate) autoimport: bool,
+    /// Labels' sizes: the bytes their line emits (`.sizeof(label)`).
+    pub(crate) label_sizes: std::collections::HashMap<SymId, i64>,
     pub(crate) used_undoc: bool,
     pub(crate) messages: Vec<String>,
     pub(crate) stop: bool,
@@ -186,6 +188,7 @@ impl<'a> Asm<'a> {
             cpu_x: opts.undocumented,
             features: opts.features,
             autoimport: false,
+            label_sizes: std::collections::HashMap::new(),
             used_undoc: false,
             messages: Vec::new(),
             stop: false,

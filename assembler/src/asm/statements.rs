@@ -17,7 +17,21 @@ impl<'a> Asm<'a> {
         )
     }
 
+    /// A line's statement; a label at its start gets the size of what
+    /// the rest of the line emits (ca65's size of a label: `.sizeof(msg)`
+    /// after `msg: .byte "hello"` is 5).
     pub(super) fn statement(&mut self, t: &[Token]) -> PResult<()> {
+        let before = self.total_bytes;
+        let mut label = None;
+        let result = self.labelled_statement(t, &mut label);
+        if let Some(sym) = label {
+            let size = i64::try_from(self.total_bytes - before).unwrap_or(i64::MAX);
+            self.label_sizes.insert(sym, size);
+        }
+        result
+    }
+
+    fn labelled_statement(&mut self, t: &[Token], label: &mut Option<SymId>) -> PResult<()> {
         if t.is_empty() {
             return Ok(());
         }
@@ -42,7 +56,7 @@ impl<'a> Asm<'a> {
             }
             (Tok::Ident | Tok::Local, Some(Tok::Colon)) => {
                 // `name:` is a label even where a macro has the name.
-                self.define_label(&t[0])?;
+                *label = Some(self.define_label(&t[0])?);
                 c.advance_by(2);
             }
             (Tok::Colon, _) => {
