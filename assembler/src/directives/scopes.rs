@@ -5,9 +5,11 @@
 use crate::asm::{Asm, PResult};
 use crate::cursor::Cursor;
 use crate::diag::Span;
+use crate::expr::Value;
 use crate::intern::{Dir, Keyword};
 use crate::lexer::Tok;
-use crate::model::{GLOBAL_SCOPE, ScopeId, ScopeKind, SymDef};
+use crate::model::{GLOBAL_SCOPE, Node, NodeId, ScopeId, ScopeKind, SymDef};
+use isa::objfmt::BinaryOp;
 
 impl Asm<'_> {
     /// Resolves a scope name (`s`, `a::s`, `::s`) that must exist.
@@ -253,7 +255,9 @@ impl Asm<'_> {
             Some(name) => self.child_scope_or_new(self.symtab.scope, name.name(), ScopeKind::Enum),
             None => self.symtab.scope,
         };
-        let mut next: i64 = 0;
+        // The next member's value: a constant, or (after a member that
+        // a later one defines, `red = green - 1`) that member plus one.
+        let mut next = self.prog.node(Node::Const(0));
         let mut count: i64 = 0;
         loop {
             let Some(_) = self.fetch_raw() else {
@@ -261,14 +265,19 @@ impl Asm<'_> {
             };
             let t = std::mem::take(&mut self.input.toks);
             let mut c = self.cursor(&t);
+            // Names in a member's value are looked up in the enum first
+            // (`red = green - 1` is the enum's `green`), as in ca65.
+            let outer = std::mem::replace(&mut self.symtab.scope, scope);
             let result = self.enum_member(&mut c, scope, next);
+            self.symtab.scope = outer;
             self.input.toks = t;
             match result {
-                Ok(Some(value)) => {
-                    next = isa::objfmt::BinaryOp::Add.apply(value, 1).unwrap_or(value);
+                Ok(Member::Defined(following)) => {
+                    next = following;
                     count += 1;
                 }
-                Ok(None) => break,
+                Ok(Member::Blank) => {}
+                Ok(Member::End) => break,
                 Err(_) => {}
             }
         }
@@ -278,33 +287,48 @@ impl Asm<'_> {
         Ok(())
     }
 
-    fn enum_member(
-        &mut self,
-        c: &mut Cursor<'_>,
-        scope: ScopeId,
-        next: i64,
-    ) -> PResult<Option<i64>> {
+    /// One line of an `.enum`: a member (`name` or `name = value`, its
+    /// value `next` when not given), a blank line, or `.endenum`.
+    fn enum_member(&mut self, c: &mut Cursor<'_>, scope: ScopeId, next: NodeId) -> PResult<Member> {
         let Some(first) = c.next_token() else {
-            return Ok(Some(next.wrapping_sub(1)));
+            return Ok(Member::Blank);
         };
         if first.kind == Tok::Directive
             && self.names.keyword(first.name()) == Keyword::Directive(Dir::Endenum)
         {
             self.expect_end(c)?;
-            return Ok(None);
+            return Ok(Member::End);
         }
         if first.kind != Tok::Ident {
             return Err(self.err("asm::syntax", first.span, "expected a member name"));
         }
-        let mut value = next;
-        if c.eat(Tok::Eq) {
-            value = self.const_expr(c, "an `.enum` value")?;
-        }
+        let expr = if c.eat(Tok::Eq) {
+            self.expression(c)?
+        } else {
+            next
+        };
         self.expect_end(c)?;
         self.reserved_name(&first, false)?;
         let sym = self.sym_in(scope, first.name());
-        self.define(sym, SymDef::Const(value), first.span)?;
-        Ok(Some(value))
+        // Known now: a constant; else (a later member or symbol defines
+        // it, as ca65 allows) settled when that is known.
+        let (def, following) = match self.prog.eval(expr) {
+            Ok(Value::Const(value)) => {
+                let after = BinaryOp::Add.apply(value, 1).unwrap_or(value);
+                (SymDef::Const(value), self.prog.node(Node::Const(after)))
+            }
+            _ => {
+                self.keep_nodes = true;
+                let this = self.prog.node(Node::Sym(sym));
+                let one = self.prog.node(Node::Const(1));
+                (
+                    SymDef::Expr(expr),
+                    self.prog.node(Node::Binary(BinaryOp::Add, this, one)),
+                )
+            }
+        };
+        self.define(sym, def, first.span)?;
+        Ok(Member::Defined(following))
     }
 
     pub(super) fn open_scope(&mut self, c: &mut Cursor<'_>, proc_: bool) -> PResult<()> {
@@ -409,4 +433,14 @@ impl Asm<'_> {
         self.symtab.scope = self.prog.scopes[scope as usize].parent;
         Ok(())
     }
+}
+
+/// What a line of an `.enum` was.
+enum Member {
+    /// A member; the next member's value (unless it gives its own).
+    Defined(NodeId),
+    /// Nothing.
+    Blank,
+    /// `.endenum`.
+    End,
 }
