@@ -401,23 +401,28 @@ impl Debugger {
             if found.is_none() && self.robot.cycles() < until {
                 continue;
             }
-            let why = match found {
-                Some(Found::Breakpoint(index)) => Why::Breakpoint {
-                    id: index + 1,
-                    point: self.breakpoints[index]
-                        .clone()
-                        .unwrap_or(Breakpoint::UnknownHook),
-                },
-                Some(Found::Watch { access, pc }) => Why::Watch {
-                    id: access.watch + 1,
-                    access,
-                    pc,
-                },
-                Some(Found::Count | Found::Returned) => Why::Stepped,
-                Some(Found::Finished) => Why::Finished,
-                None => Why::Budget,
-            };
+            let why = self.why(found);
             return Ok(self.stopped(why, received));
+        }
+    }
+
+    /// Why a run under the hooks ended (`None`: its robot time ran out).
+    fn why(&self, found: Option<Found>) -> Why {
+        match found {
+            Some(Found::Breakpoint(index)) => Why::Breakpoint {
+                id: index + 1,
+                point: self.breakpoints[index]
+                    .clone()
+                    .unwrap_or(Breakpoint::UnknownHook),
+            },
+            Some(Found::Watch { access, pc }) => Why::Watch {
+                id: access.watch + 1,
+                access,
+                pc,
+            },
+            Some(Found::Count | Found::Returned) => Why::Stepped,
+            Some(Found::Finished) => Why::Finished,
+            None => Why::Budget,
         }
     }
 
@@ -486,20 +491,8 @@ impl Debugger {
             return Ok(None);
         };
         self.rerun_to(count)?;
-        let why = match found {
-            Found::Breakpoint(index) => Why::Breakpoint {
-                id: index + 1,
-                point: self.breakpoints[index]
-                    .clone()
-                    .unwrap_or(Breakpoint::UnknownHook),
-            },
-            Found::Watch { access, pc } => Why::Watch {
-                id: access.watch + 1,
-                access,
-                pc,
-            },
-            _ => Why::Back,
-        };
+        // A re-run reports only breakpoint and watchpoint hits.
+        let why = self.why(Some(found));
         Ok(Some(self.stopped(why, Vec::new())))
     }
 

@@ -272,6 +272,25 @@ const KNOWN_DIFFERENCES: [(&str, &str); 11] = [
 /// A case's directory: every file's name and bytes.
 type CaseFiles = Vec<(String, Vec<u8>)>;
 
+/// Every file of `dir` (not its subdirectories): name and bytes, by name.
+fn files_of(dir: &Path) -> CaseFiles {
+    let mut files: CaseFiles = std::fs::read_dir(dir)
+        .expect("a directory of sources")
+        .map(|entry| entry.expect("a directory entry").path())
+        .filter(|path| path.is_file())
+        .map(|path| {
+            let name = path
+                .file_name()
+                .expect("a name")
+                .to_string_lossy()
+                .into_owned();
+            (name, std::fs::read(&path).expect("a source file"))
+        })
+        .collect();
+    files.sort();
+    files
+}
+
 /// The assembler's `ok_*.s` cases, each with the other files of its
 /// directory (includes, binaries).
 fn cases() -> Vec<(String, CaseFiles)> {
@@ -284,20 +303,7 @@ fn cases() -> Vec<(String, CaseFiles)> {
         .collect();
     dirs.sort();
     for dir in dirs {
-        let mut files: CaseFiles = std::fs::read_dir(&dir)
-            .expect("a case directory")
-            .map(|entry| entry.expect("a directory entry").path())
-            .filter(|path| path.is_file())
-            .map(|path| {
-                let name = path
-                    .file_name()
-                    .expect("a name")
-                    .to_string_lossy()
-                    .into_owned();
-                (name, std::fs::read(&path).expect("a case file"))
-            })
-            .collect();
-        files.sort();
+        let files = files_of(&dir);
         for (name, _) in &files {
             if name.starts_with("ok_") && name.ends_with(".s") {
                 let dir_name = dir.file_name().expect("a name").to_string_lossy();
@@ -361,19 +367,7 @@ fn programs_of_several_files_match_ld65() {
     assert!(!dirs.is_empty());
     let mut failures = Vec::new();
     for dir in &dirs {
-        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-            .expect("a program")
-            .map(|entry| entry.expect("an entry").path())
-            .map(|path| {
-                let name = path
-                    .file_name()
-                    .expect("a name")
-                    .to_string_lossy()
-                    .into_owned();
-                (name, std::fs::read(&path).expect("a file"))
-            })
-            .collect();
-        files.sort();
+        let files = files_of(dir);
         let mains: Vec<String> = files
             .iter()
             .map(|(name, _)| name.clone())
