@@ -6,12 +6,13 @@
 
 use isa::elf::SHF_MOS_ZEROPAGE;
 use isa::objfmt::{
-    AssertAction, Assertion, Binding, Definition, Expr, FillRun, Numbering, ObjReloc, ObjSection,
-    ObjSymbol, RelObject, RelocTarget, SourceLoc, SrcMap, SymbolLoc,
+    AssertAction, Assertion, Binding, Definition, Expr, ExprField, FieldKind, FillRun, Numbering,
+    ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget, SourceLoc, SrcMap, SymbolLoc,
 };
 use object::elf;
 
 use crate::diag::Files;
+use crate::model::FixKind;
 use crate::output::{OutSymKind, Output, Target, assert_ops};
 
 fn section_flags(name: &str, zp: bool) -> u64 {
@@ -142,6 +143,29 @@ pub(crate) fn write_object(
                 message: a.message.clone(),
                 expr: Expr {
                     ops: assert_ops(&a.ops, |target| {
+                        Some(numbering.target(reloc_target(target)))
+                    })?,
+                },
+            })
+        })
+        .collect();
+    object.fields = out
+        .fields
+        .iter()
+        .filter_map(|field| {
+            Some(ExprField {
+                section: Numbering::section(field.section),
+                offset: field.offset,
+                kind: match field.kind {
+                    FixKind::Imm8 | FixKind::Byte | FixKind::Zp | FixKind::Branch => {
+                        FieldKind::Byte
+                    }
+                    FixKind::Abs | FixKind::Word => FieldKind::Word,
+                    FixKind::Dbyt => FieldKind::WordBigEndian,
+                    FixKind::Dword => FieldKind::Dword,
+                },
+                expr: Expr {
+                    ops: assert_ops(&field.ops, |target| {
                         Some(numbering.target(reloc_target(target)))
                     })?,
                 },

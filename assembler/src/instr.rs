@@ -517,7 +517,9 @@ impl Asm<'_> {
                     }
                 }
             }
-            Ok(_) | Err(EvalErr::NotYet(_)) => {
+            // Arithmetic on addresses (`(a - b) / 2`) waits for the
+            // resolver, which leaves it to the linker if it must.
+            Ok(_) | Err(EvalErr::NotYet(_) | EvalErr::NotRelocatable) => {
                 let (chunk, off) = self.here();
                 let loc = self.loc(span);
                 self.prog.fixups.push(Fixup {

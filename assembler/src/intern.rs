@@ -91,6 +91,7 @@ directives! {
     Ifp816 = "ifp816";
     Ifpc02 = "ifpc02";
     Ifref = "ifref";
+    Forceimport = "forceimport";
     Import = "import";
     Importzp = "importzp";
     Incbin = "incbin";

@@ -74,6 +74,16 @@ pub(crate) struct OutAssert {
     pub(crate) ops: Vec<AssertOp>,
 }
 
+/// A field the linker computes from `ops` (`.scorpion.exprs`).
+#[derive(Debug, Clone)]
+pub(crate) struct OutField {
+    /// Index in [`Output::sections`].
+    pub(crate) section: usize,
+    pub(crate) offset: u32,
+    pub(crate) kind: FixKind,
+    pub(crate) ops: Vec<AssertOp>,
+}
+
 /// Everything the object writer needs.
 #[derive(Debug, Default)]
 pub(crate) struct Output {
@@ -83,6 +93,8 @@ pub(crate) struct Output {
     /// [`Output::sections`] until the object writer numbers the sections.
     pub(crate) items: Vec<SrcMapEntry>,
     pub(crate) asserts: Vec<OutAssert>,
+    /// Fields the linker computes.
+    pub(crate) fields: Vec<OutField>,
     /// Output section of each segment (`None` when the segment is empty).
     pub(crate) seg_section: Vec<Option<usize>>,
     /// Reserved bytes the linker fills; `section` as in [`Output::items`].

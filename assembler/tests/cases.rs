@@ -190,6 +190,27 @@ fn dump(object: &[u8]) -> String {
         .section_headers
         .iter()
         .enumerate()
+        .find(|(i, _)| name(*i) == isa::objfmt::EXPRS_SECTION)
+    {
+        let start = sh.sh_offset as usize;
+        let fields =
+            isa::objfmt::ExprField::decode_all(&object[start..start + sh.sh_size as usize])
+                .expect("the fields decode");
+        for field in fields {
+            let _ = writeln!(
+                out,
+                "field {}+{:04X} {:?} {:?}",
+                name(field.section as usize),
+                field.offset,
+                field.kind,
+                field.expr.ops
+            );
+        }
+    }
+    if let Some((_, sh)) = elf
+        .section_headers
+        .iter()
+        .enumerate()
         .find(|(i, _)| name(*i) == isa::objfmt::FILL_SECTION)
     {
         let start = sh.sh_offset as usize;

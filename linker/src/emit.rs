@@ -9,21 +9,51 @@ use crate::image::{Image, ImageSection, ImageSymbol, LoadArea};
 use crate::input::{Binding, Definition, Object};
 use crate::layout::{Layout, SegmentKind};
 use crate::map::{MapArea, MapData, MapModule, MapPart, MapSegment};
-use crate::model::{Global, Origin};
+use crate::model::{Global, Origin, OutputFile};
 use crate::place::{self, Placement};
 
 /// The image: areas split where the run address stops following the load
-/// address, a section per non-empty segment, locals then globals.
+/// address, a section per non-empty segment, locals then globals; and the
+/// areas that go to other output files than the image's.
 pub(crate) fn build_image(
     objects: &[Object],
     placement: &Placement,
     values: &[Vec<Option<i64>>],
     globals: &BTreeMap<String, Global>,
     hooks: Hooks,
-) -> Image {
+) -> (Image, Vec<OutputFile>) {
     // Areas, split where the run address stops following the load address.
-    let mut areas = Vec::new();
+    let mut main_areas = Vec::new();
+    let mut others: Vec<OutputFile> = Vec::new();
     for placed in &placement.areas {
+        let areas = match &placed.area.file {
+            None => &mut main_areas,
+            Some(name) => {
+                let index = match others.iter().position(|file| file.name == *name) {
+                    Some(index) => index,
+                    None => {
+                        others.push(OutputFile {
+                            name: name.clone(),
+                            areas: Vec::new(),
+                            holes: Vec::new(),
+                        });
+                        others.len() - 1
+                    }
+                };
+                let file = &mut others[index];
+                file.holes.extend(
+                    placement
+                        .segments
+                        .iter()
+                        .filter(|s| {
+                            s.rule.load == placed.area.name
+                                && matches!(s.rule.kind, SegmentKind::Bss | SegmentKind::ZeroPage)
+                        })
+                        .map(|s| (s.load, s.load + s.size)),
+                );
+                &mut file.areas
+            }
+        };
         let area = &placed.area;
         if !area.output || placed.written_end <= area.start {
             continue;
@@ -156,15 +186,16 @@ pub(crate) fn build_image(
         })
         .unwrap_or(0);
 
-    Image {
+    let image = Image {
         entry: entry as u32,
         flags: objects.iter().fold(0, |flags, object| flags | object.flags),
-        areas,
+        areas: main_areas,
         sections,
         symbols,
         hooks,
         lines: lines(objects, placement),
-    }
+    };
+    (image, others)
 }
 
 /// The objects' source maps by run address: every entry of every placed

@@ -121,6 +121,25 @@ pub enum Error {
         span: Option<SourceSpan>,
     },
 
+    /// A value an ld65 configuration computes while linking (an area's
+    /// start or size, a symbol) cannot be had.
+    #[error("{path}: {message}")]
+    #[diagnostic(code(linker::layout_value), help("{help}"))]
+    LayoutValue {
+        /// The configuration file.
+        path: String,
+        /// What went wrong.
+        message: String,
+        /// What to check.
+        help: String,
+        /// The configuration's text.
+        #[source_code]
+        src: Option<Arc<NamedSource<String>>>,
+        /// The expression.
+        #[label("here")]
+        span: Option<SourceSpan>,
+    },
+
     /// A layout parses but makes no sense.
     #[error("{path}: {reason}")]
     #[diagnostic(code(linker::layout_invalid))]
@@ -401,6 +420,23 @@ pub enum Error {
         at: String,
         /// Why.
         reason: String,
+    },
+
+    /// A field computed from an expression (`.scorpion.exprs`) has no
+    /// value.
+    #[error("the expression at {at} cannot be evaluated: {reason}")]
+    #[diagnostic(code(linker::expression_invalid))]
+    ExpressionInvalid {
+        /// Where the field is.
+        at: String,
+        /// Why.
+        reason: String,
+        /// The source file.
+        #[source_code]
+        src: Option<Arc<NamedSource<String>>>,
+        /// The field.
+        #[label("here")]
+        span: Option<SourceSpan>,
     },
 
     /// A segment's start is not a multiple of its inputs' alignment (the

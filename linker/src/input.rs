@@ -7,7 +7,10 @@
 
 use goblin::elf::{Elf, section_header as sh, sym};
 use isa::elf as mos;
-use isa::objfmt::{ASSERT_SECTION, Assertion, FILL_SECTION, FillRun, SRCMAP_SECTION, SrcMap};
+use isa::objfmt::{
+    ASSERT_SECTION, Assertion, CONDES_SECTION, CondesEntry, EXPRS_SECTION, ExprField, FILL_SECTION,
+    FieldKind, FillRun, SRCMAP_SECTION, SrcMap,
+};
 
 use crate::error::Error;
 use crate::source::Place;
@@ -88,6 +91,20 @@ pub(crate) struct Object {
     pub(crate) symbols: Vec<Symbol>,
     pub(crate) srcmap: Option<SrcMap>,
     pub(crate) asserts: Vec<Assertion>,
+    /// Routines for the linker's tables (`.constructor` and the like).
+    pub(crate) condes: Vec<CondesEntry>,
+    /// Fields the linker computes from expressions (`.scorpion.exprs`).
+    pub(crate) fields: Vec<Field>,
+}
+
+/// A field of a section whose value the linker computes.
+#[derive(Debug, Clone)]
+pub(crate) struct Field {
+    /// Position of the section in [`Object::sections`].
+    pub(crate) section: usize,
+    pub(crate) offset: u32,
+    pub(crate) kind: FieldKind,
+    pub(crate) expr: isa::objfmt::Expr,
 }
 
 impl Object {
@@ -267,6 +284,8 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
     let mut srcmap = None;
     let mut asserts = Vec::new();
     let mut fills = Vec::new();
+    let mut raw_fields = Vec::new();
+    let mut condes = Vec::new();
     for (index, header) in elf.section_headers.iter().enumerate() {
         let name = section_name(index);
         if header.sh_flags & u64::from(sh::SHF_ALLOC) == 0 {
@@ -279,6 +298,12 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
                     .map_err(|error| malformed(error.to_string()))?;
             } else if name == FILL_SECTION {
                 fills = FillRun::decode_all(section_bytes(index)?)
+                    .map_err(|error| malformed(error.to_string()))?;
+            } else if name == EXPRS_SECTION {
+                raw_fields = ExprField::decode_all(section_bytes(index)?)
+                    .map_err(|error| malformed(error.to_string()))?;
+            } else if name == CONDES_SECTION {
+                condes = CondesEntry::decode_all(section_bytes(index)?)
                     .map_err(|error| malformed(error.to_string()))?;
             }
             continue;
@@ -492,6 +517,39 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
             )));
         }
     }
+    if let Some(bad) = condes.iter().find(|e| e.symbol as usize >= symbols.len()) {
+        return Err(malformed(format!(
+            "{CONDES_SECTION} names symbol {}, past the end of the symbol table",
+            bad.symbol
+        )));
+    }
+    let mut fields = Vec::with_capacity(raw_fields.len());
+    for field in raw_fields {
+        let position = position_of.get(field.section as usize).copied().flatten();
+        let fits = position.is_some_and(|p| {
+            let section: &Section = &sections[p];
+            !section.nobits && field.offset as usize + field.kind.size() <= section.data.len()
+        });
+        let (Some(section), true) = (position, fits) else {
+            return Err(malformed(format!(
+                "{EXPRS_SECTION} names bytes {}..{} of section {}, which has no such bytes",
+                field.offset,
+                field.offset as usize + field.kind.size(),
+                field.section
+            )));
+        };
+        if let Some(bad) = field.expr.symbols().find(|s| *s as usize >= symbols.len()) {
+            return Err(malformed(format!(
+                "{EXPRS_SECTION} names symbol {bad}, past the end of the symbol table"
+            )));
+        }
+        fields.push(Field {
+            section,
+            offset: field.offset,
+            kind: field.kind,
+            expr: field.expr,
+        });
+    }
 
     Ok(Object {
         name: file.to_owned(),
@@ -500,6 +558,8 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
         symbols,
         srcmap,
         asserts,
+        condes,
+        fields,
     })
 }
 

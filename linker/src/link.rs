@@ -90,10 +90,14 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
     }
 
     let (rom, file_symbols) = known_values(&objects, options.just_symbols);
-    let layout = options.target.resolve(&rom)?;
+    let mut layout = options.target.resolve(&rom)?;
 
     let mut warnings = Vec::new();
-    let placement = place::place(&objects, &layout, &mut errors, &mut warnings);
+    let placement = place::place(&objects, &layout, &rom, &mut errors, &mut warnings);
+    // Areas whose bounds are expressions have them now.
+    for (area, placed) in layout.areas.iter_mut().zip(&placement.areas) {
+        area.clone_from(&placed.area);
+    }
 
     let Resolved {
         values,
@@ -118,6 +122,16 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         &mut errors,
     );
 
+    crate::relocate::apply_fields(
+        &objects,
+        &values,
+        &unresolved,
+        &mut placement.segments,
+        options.sources,
+        &mut errors,
+    );
+    fill_tables(&mut placement, &values);
+
     check_asserts(
         &objects,
         &values,
@@ -135,7 +149,7 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         return Err(Error::Failed { count, errors });
     }
 
-    let image = build_image(&objects, &placement, &values, &globals, hooks);
+    let (image, other_files) = build_image(&objects, &placement, &values, &globals, hooks);
     if let Err(Error::BadImage { reason, .. }) = image.check_hooks("") {
         return Err(failed(vec![hook_error(&reason, &objects, &globals)]));
     }
@@ -144,8 +158,23 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         image,
         layout,
         warnings,
+        other_files,
         map,
     })
+}
+
+/// Writes each table's routine addresses into its segment, low byte first.
+fn fill_tables(placement: &mut place::Placement, values: &[Vec<Option<i64>>]) {
+    for table in &placement.tables {
+        let segment = &mut placement.segments[table.segment];
+        for (index, (object, symbol)) in table.entries.iter().enumerate() {
+            let at = (table.offset + 2 * index as u64) as usize;
+            let value = values[*object][*symbol].unwrap_or(0) as u16;
+            if let Some(slot) = segment.bytes.get_mut(at..at + 2) {
+                slot.copy_from_slice(&value.to_le_bytes());
+            }
+        }
+    }
 }
 
 /// What the layout may refer to before anything is placed (the ROM's

@@ -16,7 +16,42 @@ pub struct Linked {
     /// Warnings (failed `.assert`s with the warning action, misaligned
     /// segments, empty required segments).
     pub warnings: Vec<Error>,
+    /// Output files besides the image, from a layout whose areas name
+    /// other files (ld65's `file = "%O.1"`): each written as raw bytes.
+    pub other_files: Vec<OutputFile>,
     pub(crate) map: MapData,
+}
+
+/// Another output file of a link: the bytes of the areas that name it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutputFile {
+    /// Its name as the layout gives it; `%O` stands for the image's file
+    /// name (see [`OutputFile::path`]).
+    pub name: String,
+    /// Its areas, in layout order.
+    pub areas: Vec<crate::image::LoadArea>,
+    /// Load ranges of the BSS and zero-page segments in its areas, which
+    /// take no room in the file (`start..end`).
+    pub(crate) holes: Vec<(u64, u64)>,
+}
+
+impl OutputFile {
+    /// Its name with `%O` replaced by `output`, the image's file name.
+    #[must_use]
+    pub fn path(&self, output: &str) -> String {
+        self.name.replace("%O", output)
+    }
+
+    /// Its contents: the areas' bytes one after the other, as ld65's
+    /// binary format writes them (see [`crate::output::write_bin`]).
+    #[must_use]
+    pub fn bytes(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        for area in &self.areas {
+            crate::output::append_without(&mut out, area, &self.holes);
+        }
+        out
+    }
 }
 
 /// Where a global symbol comes from.

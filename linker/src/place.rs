@@ -5,9 +5,14 @@
 //! one cursor; the layout's segments are placed in the order it lists
 //! them, in their run area and (when different) their load area.
 
+use std::collections::HashMap;
+
 use crate::error::Error;
 use crate::input::Object;
-use crate::layout::{Area, Layout, Segment, SegmentKind};
+use crate::layout::{
+    Area, EvalError, Expr, Layout, RomSymbols, START_ADDRESS_SYMBOL, Segment, SegmentKind,
+    SymbolKind,
+};
 
 /// One object's section inside a segment.
 #[derive(Debug, Clone, Copy)]
@@ -57,6 +62,27 @@ pub(crate) struct PlacedArea {
     pub(crate) written_end: u64,
 }
 
+/// A table the linker builds (ld65's `CONDES`), after placement.
+#[derive(Debug, Clone)]
+pub(crate) struct PlacedTable {
+    /// Its position in the layout's tables.
+    pub(crate) table: usize,
+    pub(crate) segment: usize,
+    /// Offset from the segment's start.
+    pub(crate) offset: u64,
+    /// The routines it lists, in table order: (object, symbol).
+    pub(crate) entries: Vec<(usize, usize)>,
+}
+
+/// A symbol the layout defines (`SYMBOLS`, tables' labels and counts).
+#[derive(Debug, Clone)]
+pub(crate) struct LayoutValue {
+    pub(crate) name: String,
+    pub(crate) value: i64,
+    /// Loses to an object's definition.
+    pub(crate) weak: bool,
+}
+
 /// The result of placement.
 #[derive(Debug, Clone)]
 pub(crate) struct Placement {
@@ -64,6 +90,9 @@ pub(crate) struct Placement {
     pub(crate) areas: Vec<PlacedArea>,
     /// Per object, per section position: (segment, offset in segment).
     pub(crate) sections: Vec<Vec<Option<(usize, u64)>>>,
+    pub(crate) tables: Vec<PlacedTable>,
+    /// Symbols the layout defines besides `define = yes` ones.
+    pub(crate) values: Vec<LayoutValue>,
 }
 
 impl Placement {
@@ -83,6 +112,7 @@ fn align_up(value: u64, align: u64) -> u64 {
 pub(crate) fn place(
     objects: &[Object],
     layout: &Layout,
+    known: &RomSymbols,
     errors: &mut Vec<Error>,
     warnings: &mut Vec<Error>,
 ) -> Placement {
@@ -154,8 +184,40 @@ pub(crate) fn place(
         }
     }
 
+    let tables = append_tables(objects, layout, &mut segments);
+
+    // What the layout's expressions may name, growing as areas are placed.
+    let mut env: HashMap<String, i64> = known
+        .iter()
+        .map(|(name, value)| (name.to_owned(), value))
+        .collect();
+    env.insert(
+        START_ADDRESS_SYMBOL.to_owned(),
+        layout.config.start_address as i64,
+    );
     let mut areas = Vec::with_capacity(layout.areas.len());
     for area in &layout.areas {
+        let mut area = area.clone();
+        if let Some((start, size)) = &area.exprs {
+            settle_symbols(layout, &mut env);
+            match area_bounds(layout, &area.name, start, size, &env) {
+                Ok((start, size)) => {
+                    area.start = start;
+                    area.size = size;
+                }
+                Err(error) => {
+                    errors.push(error);
+                    area.size = 0;
+                    areas.push(PlacedArea {
+                        used_end: area.start,
+                        written_end: area.start,
+                        area,
+                    });
+                    continue;
+                }
+            }
+        }
+        let area = &area;
         let mut cursor = area.start;
         // The highest address reached: a fixed start may move the cursor back.
         let mut reached = area.start;
@@ -170,7 +232,11 @@ pub(crate) fn place(
                 continue;
             }
             let address = if runs_here {
-                if let Some(start) = segment.rule.start {
+                let fixed = segment
+                    .rule
+                    .start
+                    .or(segment.rule.offset.map(|offset| area.start + offset));
+                if let Some(start) = fixed {
                     if cursor > start {
                         errors.push(Error::FixedStartOverlap {
                             segment: segment.rule.name.clone(),
@@ -232,12 +298,27 @@ pub(crate) fn place(
         if area.fill && area.output {
             written_end = area.end();
         }
+        if area.define {
+            let name = &area.name;
+            env.insert(format!("__{name}_START__"), area.start as i64);
+            env.insert(format!("__{name}_SIZE__"), area.size as i64);
+            env.insert(format!("__{name}_LAST__"), reached as i64);
+        }
+        for segment in segments.iter().filter(|s| {
+            s.rule.define && (s.rule.load == area.name || s.rule.run_area() == area.name)
+        }) {
+            let name = &segment.rule.name;
+            env.insert(format!("__{name}_LOAD__"), segment.load as i64);
+            env.insert(format!("__{name}_RUN__"), segment.run as i64);
+            env.insert(format!("__{name}_SIZE__"), segment.size as i64);
+        }
         areas.push(PlacedArea {
             area: area.clone(),
             used_end: reached,
             written_end,
         });
     }
+    let values = layout_values(layout, &segments, &tables, &mut env, errors);
 
     for segment in &mut segments {
         if segment.run % segment.align != 0 && segment.size > 0 {
@@ -254,9 +335,9 @@ pub(crate) fn place(
                 end: segment.run + segment.size - 1,
             });
         }
-        let load_area = layout
-            .areas
+        let load_area = areas
             .iter()
+            .map(|placed| &placed.area)
             .find(|area| area.name == segment.rule.load);
         // A segment that does not fit its area (already an error) gets no
         // buffer: a corrupt size must not make the linker allocate it.
@@ -301,7 +382,155 @@ pub(crate) fn place(
         segments,
         areas,
         sections,
+        tables,
+        values,
     }
+}
+
+/// Appends each table of the layout to its segment: two bytes per routine
+/// of its kind that the objects declare, sorted by priority (stable, so
+/// equal priorities keep the objects' order).
+fn append_tables(objects: &[Object], layout: &Layout, segments: &mut [Placed]) -> Vec<PlacedTable> {
+    let mut placed = Vec::new();
+    for (index, table) in layout.config.tables.iter().enumerate() {
+        let Some(segment) = segments.iter().position(|s| s.rule.name == table.segment) else {
+            continue;
+        };
+        let mut entries: Vec<(u8, usize, usize)> = Vec::new();
+        for (object_index, object) in objects.iter().enumerate() {
+            for entry in object
+                .condes
+                .iter()
+                .filter(|e| e.kind == table.kind.number())
+            {
+                entries.push((entry.priority, object_index, entry.symbol as usize));
+            }
+        }
+        entries.sort_by_key(|(priority, ..)| *priority);
+        if !table.increasing {
+            entries.reverse();
+        }
+        let offset = segments[segment].size;
+        segments[segment].size += 2 * entries.len() as u64;
+        placed.push(PlacedTable {
+            table: index,
+            segment,
+            offset,
+            entries: entries.into_iter().map(|(_, o, s)| (o, s)).collect(),
+        });
+    }
+    placed
+}
+
+/// Gives the layout's `SYMBOLS` the values they can have now, weak ones
+/// only where no object defines the name.
+fn settle_symbols(layout: &Layout, env: &mut HashMap<String, i64>) {
+    loop {
+        let mut progress = false;
+        for symbol in &layout.config.symbols {
+            let Some(expr) = &symbol.value else { continue };
+            if env.contains_key(&symbol.name) {
+                continue;
+            }
+            if let Ok(value) = expr.eval(env) {
+                env.insert(symbol.name.clone(), value);
+                progress = true;
+            }
+        }
+        if !progress {
+            return;
+        }
+    }
+}
+
+/// An area's start and size from its expressions.
+fn area_bounds(
+    layout: &Layout,
+    area: &str,
+    start: &Expr,
+    size: &Expr,
+    env: &HashMap<String, i64>,
+) -> Result<(u64, u64), Error> {
+    let eval = |expr: &Expr, what: &str| -> Result<i64, Error> {
+        expr.eval(env).map_err(|error| match error {
+            EvalError::Undefined(name, span) => layout.value_error(
+                format!("the {what} of memory area {area} names `{name}`, which has no value here"),
+                "an area may use the SYMBOLS, the objects' constants and the `define = yes` symbols of the areas before it",
+                Some(span),
+            ),
+            EvalError::DivisionByZero => layout.value_error(
+                format!("the {what} of memory area {area} divides by zero"),
+                "check the SYMBOLS it uses",
+                expr.span(),
+            ),
+        })
+    };
+    let (start_value, size_value) = (eval(start, "start")?, eval(size, "size")?);
+    if !(0..=0xFFFF_FFFF).contains(&start_value) {
+        return Err(layout.value_error(
+            format!("memory area {area} starts at {start_value}, outside $0-$FFFFFFFF"),
+            "check the SYMBOLS its start uses",
+            start.span(),
+        ));
+    }
+    if size_value <= 0 || start_value + size_value > 1 << 32 {
+        return Err(layout.value_error(
+            format!("memory area {area} comes out {size_value} bytes long from ${start_value:04X}"),
+            "an area's size must be positive and end by $FFFFFFFF; check the SYMBOLS its size uses",
+            size.span(),
+        ));
+    }
+    Ok((start_value as u64, size_value as u64))
+}
+
+/// The layout's own symbols once everything is placed: `SYMBOLS` with a
+/// value, and each table's label and count.
+fn layout_values(
+    layout: &Layout,
+    segments: &[Placed],
+    tables: &[PlacedTable],
+    env: &mut HashMap<String, i64>,
+    errors: &mut Vec<Error>,
+) -> Vec<LayoutValue> {
+    settle_symbols(layout, env);
+    let mut values = Vec::new();
+    for symbol in &layout.config.symbols {
+        let Some(expr) = &symbol.value else { continue };
+        match expr.eval(env) {
+            Ok(value) => values.push(LayoutValue {
+                name: symbol.name.clone(),
+                value,
+                weak: symbol.kind == SymbolKind::Weak,
+            }),
+            Err(EvalError::Undefined(name, span)) => errors.push(layout.value_error(
+                format!("symbol {} names `{name}`, which nothing defines", symbol.name),
+                "a symbol's value may use numbers, %S, the other SYMBOLS, the objects' constants and `define = yes` symbols",
+                Some(span),
+            )),
+            Err(EvalError::DivisionByZero) => errors.push(layout.value_error(
+                format!("symbol {} divides by zero", symbol.name),
+                "check the SYMBOLS it uses",
+                Some(symbol.span.clone()),
+            )),
+        }
+    }
+    for placed in tables {
+        let table = &layout.config.tables[placed.table];
+        let segment = &segments[placed.segment];
+        values.push(LayoutValue {
+            name: table.label.clone(),
+            value: (segment.run + placed.offset) as i64,
+            weak: false,
+        });
+        if let Some(count) = &table.count {
+            values.push(LayoutValue {
+                name: count.clone(),
+                value: placed.entries.len() as i64,
+                weak: false,
+            });
+        }
+    }
+    values
 }
 
 /// "main.o CODE 812 bytes, lib.o CODE 300 bytes, ...": the three largest

@@ -16,6 +16,7 @@
 //! | `R_MOS_FK_DATA_4` / `_8` | S + A, 32 / 64-bit little-endian | none |
 
 use isa::elf as mos;
+use isa::objfmt::{EvalError, FieldKind};
 
 use crate::error::Error;
 use crate::input::{Definition, Object};
@@ -156,6 +157,82 @@ pub(crate) fn apply(
                     if let Some(target) = segment_bytes.get_mut(start..start + bytes.len()) {
                         target.copy_from_slice(&bytes);
                     }
+                }
+            }
+        }
+    }
+}
+
+/// Writes every field the objects compute from expressions into
+/// `segments`' bytes (after relocation: a field may overlap nothing else),
+/// range-checked as ld65 checks them. Expressions naming a symbol that was
+/// reported undefined are skipped.
+pub(crate) fn apply_fields(
+    objects: &[Object],
+    values: &[Vec<Option<i64>>],
+    unresolved: &[Vec<bool>],
+    segments: &mut [Placed],
+    sources: &dyn SourceProvider,
+    errors: &mut Vec<Error>,
+) {
+    for segment in segments.iter_mut() {
+        let Placed {
+            fragments, bytes, ..
+        } = segment;
+        for fragment in fragments.iter() {
+            let object = &objects[fragment.object];
+            for field in object
+                .fields
+                .iter()
+                .filter(|f| f.section == fragment.section)
+            {
+                let place = || object.place_of_byte(fragment.section, field.offset);
+                let result = field.expr.evaluate(|index| {
+                    values[fragment.object]
+                        .get(index as usize)
+                        .copied()
+                        .flatten()
+                });
+                let value = match result {
+                    Ok(value) => value,
+                    Err(EvalError::UnresolvedSymbol(index))
+                        if unresolved[fragment.object].get(index as usize) == Some(&true) =>
+                    {
+                        continue;
+                    }
+                    Err(error) => {
+                        let place = place();
+                        let (src, span) = place.snippet(sources);
+                        errors.push(Error::ExpressionInvalid {
+                            at: place.text,
+                            reason: error.to_string(),
+                            src,
+                            span,
+                        });
+                        continue;
+                    }
+                };
+                let Some(encoded) = field.kind.encode(value) else {
+                    let place = place();
+                    let (src, span) = place.snippet(sources);
+                    errors.push(Error::ValueRange {
+                        kind: "computed",
+                        target: "of the expression".to_owned(),
+                        value,
+                        range: match field.kind {
+                            FieldKind::Byte => "a byte (0 to 255)",
+                            FieldKind::Word | FieldKind::WordBigEndian => "a word (0 to $FFFF)",
+                            FieldKind::Dword => "a dword (0 to $FFFFFFFF)",
+                        },
+                        at: place.text,
+                        src,
+                        span,
+                    });
+                    continue;
+                };
+                let start = (fragment.offset + u64::from(field.offset)) as usize;
+                if let Some(target) = bytes.get_mut(start..start + encoded.len()) {
+                    target.copy_from_slice(&encoded);
                 }
             }
         }

@@ -8,7 +8,7 @@ use std::collections::{BTreeMap, HashMap};
 
 use crate::error::Error;
 use crate::input::{Binding, Definition, Object};
-use crate::layout::Layout;
+use crate::layout::{Layout, SymbolKind};
 use crate::model::{Global, Origin};
 use crate::place::Placement;
 use crate::source::{Place, SourceProvider};
@@ -94,7 +94,7 @@ pub(crate) fn resolve(
                         Origin::Object { object, symbol } => {
                             objects[*object].place_of_symbol(*symbol).text
                         }
-                        Origin::Layout => format!("layout {} (define = true)", layout.name),
+                        Origin::Layout => format!("layout {}", layout.name),
                         Origin::File(file) => file.clone(),
                     };
                     let second = object.place_of_symbol(symbol_index);
@@ -110,6 +110,8 @@ pub(crate) fn resolve(
             }
         }
     }
+
+    layout_imports(layout, placement, &globals, errors);
 
     // Undefined references: globals, then --just-symbols, then weak zero.
     let mut undefined: BTreeMap<String, Vec<Place>> = BTreeMap::new();
@@ -246,8 +248,57 @@ fn layout_symbols(layout: &Layout, placement: &Placement) -> BTreeMap<String, Gl
         define(format!("__{name}_SIZE__"), area.area.size);
         define(format!("__{name}_LAST__"), area.used_end);
     }
+    for value in &placement.values {
+        globals.insert(
+            value.name.clone(),
+            Global {
+                value: Some(value.value),
+                origin: Origin::Layout,
+                weak: value.weak,
+                segment: None,
+                size: 0,
+            },
+        );
+    }
     let _ = layout;
     globals
+}
+
+/// The layout's imports (`SYMBOLS { name: type = import; }` and a
+/// non-empty table's `import`) that no object defines.
+fn layout_imports(
+    layout: &Layout,
+    placement: &Placement,
+    globals: &BTreeMap<String, Global>,
+    errors: &mut Vec<Error>,
+) {
+    let symbols = layout
+        .config
+        .symbols
+        .iter()
+        .filter(|symbol| symbol.kind == SymbolKind::Import)
+        .map(|symbol| (symbol.name.as_str(), symbol.span.clone()));
+    let tables = placement
+        .tables
+        .iter()
+        .filter(|placed| !placed.entries.is_empty())
+        .filter_map(|placed| {
+            let table = &layout.config.tables[placed.table];
+            Some((table.import.as_deref()?, table.segment_span.clone()))
+        });
+    for (name, span) in symbols.chain(tables) {
+        let defined = globals
+            .get(name)
+            .is_some_and(|global| matches!(global.origin, Origin::Object { .. }));
+        if !defined {
+            let error = layout.value_error(
+                format!("the layout imports `{name}`, which no object exports"),
+                "export it from one of the objects (`.export`), as the target's start-up code would",
+                Some(span),
+            );
+            errors.push(error);
+        }
+    }
 }
 
 /// The defined name nearest `name` by edit distance, if near enough to be

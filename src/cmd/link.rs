@@ -18,11 +18,16 @@ pub(crate) struct LinkArgs {
     /// project, which writes into `target/scorpion/`).
     #[arg(short, long, value_name = "OUT")]
     pub(crate) output: Option<PathBuf>,
-    /// Where things go: flat, scorpion-ext, scorpion-os, scorpion-rom, or a
-    /// layout file (FILE.toml).
-    #[arg(long, value_name = "NAME|FILE.toml", default_value = "scorpion-ext")]
+    /// Where things go: flat, scorpion-ext, scorpion-os, scorpion-rom, a
+    /// layout file (FILE.toml) or an ld65 configuration (FILE.cfg).
+    #[arg(
+        long,
+        value_name = "NAME|FILE.toml|FILE.cfg",
+        default_value = "scorpion-ext"
+    )]
     pub(crate) target: String,
-    /// First address of the flat target's area.
+    /// First address of the flat target's area; for an ld65
+    /// configuration, what `%S` stands for (ld65's `-S`).
     #[arg(long, value_name = "ADDR", value_parser = args::address)]
     pub(crate) start: Option<u16>,
     /// Output format: elf (the linked image the emulator and uploader load),
@@ -90,6 +95,14 @@ fn target(args: &LinkArgs) -> miette::Result<Target> {
             .wrap_err_with(|| format!("cannot read layout {name}"))?;
         return Ok(Target::Custom(linker::Layout::from_toml(name, &text)?));
     }
+    if name.ends_with(".cfg") {
+        let text = std::fs::read_to_string(name)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot read the ld65 configuration {name}"))?;
+        return Ok(Target::Custom(linker::Layout::from_ld65(
+            name, &text, start,
+        )?));
+    }
     Ok(Target::builtin(name, start)?)
 }
 
@@ -149,6 +162,10 @@ pub(crate) fn link_and_write(
     report_warnings(&mut linked);
     let bytes = args.format.write(&linked.image)?;
     write(output, &bytes)?;
+    for file in &linked.other_files {
+        let path = PathBuf::from(file.path(&output.display().to_string()));
+        write(&path, &file.bytes())?;
+    }
     if let Some(path) = &args.map {
         write(path, linked.map().as_bytes())?;
     }

@@ -15,11 +15,26 @@
 
 #[path = "asm_gen/mod.rs"]
 mod asm_gen;
+#[path = "ld65_diff/mod.rs"]
+mod ld65_diff;
 
 use std::path::Path;
 use std::process::Command;
 
+use ld65_diff::{report, toolchain};
 use scorpion_tests::tools;
+
+/// Both toolchains on one program linked for the flat layout at [`START`]
+/// with the main area's fill value `fill`.
+fn compare(
+    what: &str,
+    files: &[(String, Vec<u8>)],
+    mains: &[String],
+    tools: (&Path, &Path),
+    fill: u8,
+) -> Result<(), String> {
+    ld65_diff::compare(what, files, mains, &ld65_config(START, fill), tools)
+}
 
 /// Where the flat image starts.
 const START: u16 = 0x0800;
@@ -44,155 +59,6 @@ SEGMENTS {{
     )
 }
 
-/// ca65 + ld65 on `files` (written to `dir`); the binary or their output.
-fn reference(
-    dir: &Path,
-    files: &[(String, Vec<u8>)],
-    mains: &[String],
-    (ca65, ld65): (&Path, &Path),
-    fill: u8,
-) -> Result<Vec<u8>, String> {
-    for (name, text) in files {
-        std::fs::write(dir.join(name), text).expect("write a source");
-    }
-    let mut objects = Vec::new();
-    for name in mains {
-        let object = format!("{name}.o");
-        let output = Command::new(ca65)
-            .current_dir(dir)
-            .args([name.as_str(), "-o", object.as_str()])
-            .output()
-            .expect("ca65 runs");
-        if !output.status.success() {
-            return Err(format!(
-                "ca65 rejected {name}: {}",
-                String::from_utf8_lossy(&output.stderr)
-            ));
-        }
-        objects.push(object);
-    }
-    std::fs::write(dir.join("flat.cfg"), ld65_config(START, fill)).expect("write the config");
-    let output = Command::new(ld65)
-        .current_dir(dir)
-        .args(["-C", "flat.cfg", "-o", "ld65.bin"])
-        .args(&objects)
-        .output()
-        .expect("ld65 runs");
-    if !output.status.success() {
-        return Err(format!(
-            "ld65 failed: {}",
-            String::from_utf8_lossy(&output.stderr)
-        ));
-    }
-    Ok(std::fs::read(dir.join("ld65.bin")).expect("ld65 wrote its output"))
-}
-
-/// Our assembler and linker, in memory: the `flat` target, its main
-/// area's fill value set to `fill` (the layout files' `fill-value`).
-fn ours(files: &[(String, Vec<u8>)], mains: &[String], fill: u8) -> Result<Vec<u8>, String> {
-    let mut source = assembler::MemorySource::new();
-    for (name, text) in files {
-        source.insert(name.as_str(), text.as_slice());
-    }
-    let options = assembler::Options::default();
-    let mut objects = Vec::new();
-    for name in mains {
-        let assembly =
-            assembler::assemble(&source, Path::new(name), &options).map_err(|error| {
-                let details: Vec<String> = error
-                    .diagnostics()
-                    .iter()
-                    .map(assembler::Diagnostic::summary)
-                    .collect();
-                format!("we rejected {name}: {error}\n{}", details.join("\n"))
-            })?;
-        objects.push((name.clone(), assembly.object));
-    }
-    let inputs: Vec<linker::Input<'_>> = objects
-        .iter()
-        .map(|(name, bytes)| linker::Input { name, bytes })
-        .collect();
-    let mut layout = linker::Target::builtin("flat", Some(u64::from(START)))
-        .and_then(|target| target.resolve(&linker::layout::RomSymbols::default()))
-        .map_err(|e| format!("{e:?}"))?;
-    for area in &mut layout.areas {
-        area.fill_value = fill;
-    }
-    let target = linker::Target::Custom(layout);
-    let linked = linker::link(
-        &inputs,
-        &linker::LinkOptions {
-            target: &target,
-            just_symbols: &[],
-            sources: &linker::NoSources,
-        },
-    )
-    .map_err(|error| format!("our link failed: {error:?}"))?;
-    linker::Format::Bin
-        .write(&linked.image)
-        .map_err(|error| format!("cannot write the binary: {error:?}"))
-}
-
-/// Compares both toolchains on one program (`files` written, `mains`
-/// assembled and linked) with the main area's fill value `fill`; the
-/// differences, if any.
-fn compare(
-    what: &str,
-    files: &[(String, Vec<u8>)],
-    mains: &[String],
-    tools: (&Path, &Path),
-    fill: u8,
-) -> Result<(), String> {
-    let dir = tempfile::tempdir().expect("a temporary directory");
-    let expected = match reference(dir.path(), files, mains, tools, fill) {
-        Ok(bytes) => bytes,
-        Err(message) => {
-            let kept = dir.keep();
-            return Err(format!(
-                "{what}: the reference toolchain failed (sources kept in {}):\n{message}",
-                kept.display()
-            ));
-        }
-    };
-    let actual = match ours(files, mains, fill) {
-        Ok(bytes) => bytes,
-        Err(message) => {
-            let kept = dir.keep();
-            return Err(format!(
-                "{what}: {message}\n(sources kept in {})",
-                kept.display()
-            ));
-        }
-    };
-    if expected != actual {
-        let first = expected
-            .iter()
-            .zip(&actual)
-            .position(|(a, b)| a != b)
-            .unwrap_or(expected.len().min(actual.len()));
-        let show = |bytes: &[u8]| -> String {
-            bytes
-                .iter()
-                .skip(first.saturating_sub(4))
-                .take(12)
-                .map(|b| format!("{b:02X}"))
-                .collect::<Vec<_>>()
-                .join(" ")
-        };
-        let kept = dir.keep();
-        return Err(format!(
-            "{what}: binaries differ at ${:04X} (ld65 {} bytes, ours {} bytes)\n  ld65: {}\n  ours: {}\nsources kept in {}",
-            usize::from(START) + first,
-            expected.len(),
-            actual.len(),
-            show(&expected),
-            show(&actual),
-            kept.display()
-        ));
-    }
-    Ok(())
-}
-
 /// A generated program's files, every one of them assembled.
 fn generated(program: &[(String, String)]) -> (Vec<(String, Vec<u8>)>, Vec<String>) {
     let files = program
@@ -201,22 +67,6 @@ fn generated(program: &[(String, String)]) -> (Vec<(String, Vec<u8>)>, Vec<Strin
         .collect();
     let mains = program.iter().map(|(name, _)| name.clone()).collect();
     (files, mains)
-}
-
-/// Panics with every failure.
-fn report(failures: Vec<String>, total: usize) {
-    assert!(
-        failures.is_empty(),
-        "{} of {total} programs differ:\n\n{}",
-        failures.len(),
-        failures.join("\n\n")
-    );
-}
-
-fn toolchain(test: &str) -> Option<(std::path::PathBuf, std::path::PathBuf)> {
-    let ca65 = tools::require("ca65", test)?;
-    let ld65 = tools::require("ld65", test)?;
-    Some((ca65, ld65))
 }
 
 /// Cases where ca65 + ld65 do not build the same bytes, and why. Each must

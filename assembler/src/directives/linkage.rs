@@ -73,7 +73,10 @@ impl Asm<'_> {
         }
     }
 
-    pub(super) fn import(&mut self, c: &mut Cursor<'_>, zp: bool) -> PResult<()> {
+    /// `.import`/`.importzp`; `.forceimport` (`force`) writes the import
+    /// to the object even if nothing here uses it, so the linker pulls in
+    /// the module that defines it (ld65's libraries; cc65's `__STARTUP__`).
+    pub(super) fn import(&mut self, c: &mut Cursor<'_>, zp: bool, force: bool) -> PResult<()> {
         for (tok, assignment, size) in self.name_list(c)? {
             let zp = size.unwrap_or(zp);
             if assignment.is_some() {
@@ -98,6 +101,9 @@ impl Asm<'_> {
                     }
                     return Err(self.report(diag));
                 }
+            }
+            if force {
+                self.prog.syms[sym as usize].global = true;
             }
         }
         Ok(())

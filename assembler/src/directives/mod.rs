@@ -46,7 +46,8 @@ impl Asm<'_> {
             Dir::Code | Dir::Rodata | Dir::Data | Dir::Bss | Dir::Zeropage => {
                 self.named_segment(dir, c)
             }
-            Dir::Import | Dir::Importzp => self.import(c, dir == Dir::Importzp),
+            Dir::Import | Dir::Importzp => self.import(c, dir == Dir::Importzp, false),
+            Dir::Forceimport => self.import(c, false, true),
             Dir::Export | Dir::Exportzp | Dir::Global | Dir::Globalzp => self.export(
                 c,
                 matches!(dir, Dir::Exportzp | Dir::Globalzp),

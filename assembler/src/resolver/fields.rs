@@ -13,7 +13,8 @@ use crate::diag::{self, RawDiag};
 use crate::expr::{Base, EvalErr, Sel, Value};
 use crate::model::{ChunkId, FixKind, LocId, Node, NodeId, SegId, SymDef, SymId, SymKind, VarKind};
 use crate::output::{
-    AssertOp, OutAssert, OutReloc, OutSection, OutSym, OutSymKind, Output, Target, const_bytes,
+    AssertOp, OutAssert, OutField, OutReloc, OutSection, OutSym, OutSymKind, Output, Target,
+    const_bytes,
 };
 
 impl Asm<'_> {
@@ -354,6 +355,29 @@ impl Asm<'_> {
         let pos_usize = pos as usize;
         let value = match value {
             Ok(value) => value,
+            // Arithmetic on addresses that ELF relocations cannot carry:
+            // the linker finishes it from bytecode, as ld65 does.
+            Err(EvalErr::NotRelocatable)
+                if kind != FixKind::Branch && out.seg_section[seg as usize].is_some() =>
+            {
+                let mut ops = Vec::new();
+                if self.compile(expr, out, sym_index, &mut ops, 0).is_some()
+                    && let Some(section) = out.seg_section[seg as usize]
+                {
+                    out.fields.push(OutField {
+                        section,
+                        offset: pos,
+                        kind,
+                        ops,
+                    });
+                } else {
+                    let saved = self.input.line_ctx;
+                    self.input.line_ctx = self.prog.locs.get(loc as usize).map_or(0, |l| l.ctx);
+                    self.eval_error(EvalErr::NotRelocatable, span);
+                    self.input.line_ctx = saved;
+                }
+                return;
+            }
             Err(error) => {
                 let saved = self.input.line_ctx;
                 self.input.line_ctx = self.prog.locs.get(loc as usize).map_or(0, |l| l.ctx);

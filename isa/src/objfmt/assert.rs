@@ -286,6 +286,56 @@ impl Expr {
     }
 }
 
+/// Writes an expression: its op count, then the ops.
+pub(super) fn encode_ops(out: &mut Writer, expr: &Expr) {
+    out.len32(expr.ops.len());
+    for op in &expr.ops {
+        match *op {
+            ExprOp::Const(value) => {
+                out.u8(0x01);
+                out.i64(value);
+            }
+            ExprOp::Symbol(index) => {
+                out.u8(0x02);
+                out.u32(index);
+            }
+            ExprOp::Unary(unary) => {
+                let code = UNARY.iter().position(|u| *u == unary).unwrap_or(0);
+                out.u8(0x10 + code as u8);
+            }
+            ExprOp::Binary(binary) => {
+                let code = BINARY.iter().position(|b| *b == binary).unwrap_or(0);
+                out.u8(0x20 + code as u8);
+            }
+        }
+    }
+}
+
+/// Reads what [`encode_ops`] wrote.
+pub(super) fn decode_ops(input: &mut Reader<'_>) -> Result<Expr, FormatError> {
+    let op_count = input.count(1)?;
+    let mut ops = Vec::with_capacity(op_count);
+    for _ in 0..op_count {
+        let tag = input.u8()?;
+        ops.push(match tag {
+            0x01 => ExprOp::Const(input.i64()?),
+            0x02 => ExprOp::Symbol(input.u32()?),
+            0x10..=0x1F => ExprOp::Unary(
+                *UNARY
+                    .get(usize::from(tag - 0x10))
+                    .ok_or_else(|| input.error(format!("unknown operator {tag:#04x}")))?,
+            ),
+            0x20..=0x3F => ExprOp::Binary(
+                *BINARY
+                    .get(usize::from(tag - 0x20))
+                    .ok_or_else(|| input.error(format!("unknown operator {tag:#04x}")))?,
+            ),
+            _ => return Err(input.error(format!("unknown operator {tag:#04x}"))),
+        });
+    }
+    Ok(Expr { ops })
+}
+
 /// One deferred `.assert`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Assertion {
@@ -318,27 +368,7 @@ impl Assertion {
             out.u32(assertion.line);
             out.u32(assertion.column);
             out.string(&assertion.message);
-            out.len32(assertion.expr.ops.len());
-            for op in &assertion.expr.ops {
-                match *op {
-                    ExprOp::Const(value) => {
-                        out.u8(0x01);
-                        out.i64(value);
-                    }
-                    ExprOp::Symbol(index) => {
-                        out.u8(0x02);
-                        out.u32(index);
-                    }
-                    ExprOp::Unary(unary) => {
-                        let code = UNARY.iter().position(|u| *u == unary).unwrap_or(0);
-                        out.u8(0x10 + code as u8);
-                    }
-                    ExprOp::Binary(binary) => {
-                        let code = BINARY.iter().position(|b| *b == binary).unwrap_or(0);
-                        out.u8(0x20 + code as u8);
-                    }
-                }
-            }
+            encode_ops(&mut out, &assertion.expr);
         }
         out.bytes
     }
@@ -362,33 +392,14 @@ impl Assertion {
             let line = input.u32()?;
             let column = input.u32()?;
             let message = input.string()?;
-            let op_count = input.count(1)?;
-            let mut ops = Vec::with_capacity(op_count);
-            for _ in 0..op_count {
-                let tag = input.u8()?;
-                ops.push(match tag {
-                    0x01 => ExprOp::Const(input.i64()?),
-                    0x02 => ExprOp::Symbol(input.u32()?),
-                    0x10..=0x1F => ExprOp::Unary(
-                        *UNARY
-                            .get(usize::from(tag - 0x10))
-                            .ok_or_else(|| input.error(format!("unknown operator {tag:#04x}")))?,
-                    ),
-                    0x20..=0x3F => ExprOp::Binary(
-                        *BINARY
-                            .get(usize::from(tag - 0x20))
-                            .ok_or_else(|| input.error(format!("unknown operator {tag:#04x}")))?,
-                    ),
-                    _ => return Err(input.error(format!("unknown operator {tag:#04x}"))),
-                });
-            }
+            let expr = decode_ops(&mut input)?;
             assertions.push(Assertion {
                 action,
                 file,
                 line,
                 column,
                 message,
-                expr: Expr { ops },
+                expr,
             });
         }
         if !input.is_empty() {

@@ -1,12 +1,14 @@
 //! Our own metadata sections in 6502 ELF files, beside llvm-mos's numbering.
 //!
-//! ELF has no place for four things our tools pass along, so they travel in
+//! ELF has no place for six things our tools pass along, so they travel in
 //! non-allocated `SHT_PROGBITS` sections that other tools ignore:
 //!
 //! | section | written by | read by | holds |
 //! |---|---|---|---|
 //! | [`SRCMAP_SECTION`] | assembler | linker | where each instruction, data item and symbol came from (file:line:col) |
 //! | [`ASSERT_SECTION`] | assembler | linker | `.assert`s that depend on addresses, as expression bytecode |
+//! | [`EXPRS_SECTION`] | assembler | linker | bytes computed from expressions no relocation can express, as bytecode |
+//! | [`CONDES_SECTION`] | assembler | linker | routines for the linker's tables (`.constructor`, `.destructor`, `.interruptor`) |
 //! | [`FILL_SECTION`] | assembler | linker | reserved bytes (`.res`, `.align` without a fill value) that take the load area's fill value |
 //! | [`HOOKS_SECTION`] | linker | uploader, `scorpion sim` | which ROM hooks an image takes over, and where its fallthrough lives |
 //!
@@ -21,6 +23,8 @@
 mod assert;
 mod builder;
 mod codec;
+mod condes;
+mod fields;
 mod fill;
 mod hooks;
 mod srcmap;
@@ -29,6 +33,8 @@ mod write;
 pub use assert::{AssertAction, Assertion, BinaryOp, EvalError, Expr, ExprOp, UnaryOp};
 pub use builder::{ObjectBuilder, SectionId, SymbolDef, SymbolId};
 pub use codec::FormatError;
+pub use condes::{CondesEntry, MAX_CONDES_TYPE};
+pub use fields::{ExprField, FieldKind};
 pub use fill::FillRun;
 pub use hooks::{
     CHAIN_LOOP_SYMBOL, CHAIN_UNKNOWN_SYMBOL, HOOK_LOOP_SYMBOL, HOOK_UNKNOWN_SYMBOL, HookKind,
@@ -43,6 +49,10 @@ pub use write::{
 pub const SRCMAP_SECTION: &str = ".scorpion.srcmap";
 /// Deferred assertions (assembler to linker).
 pub const ASSERT_SECTION: &str = ".scorpion.assert";
+/// Fields the linker computes from expressions (assembler to linker).
+pub const EXPRS_SECTION: &str = ".scorpion.exprs";
+/// Routines for the linker's tables (assembler to linker).
+pub const CONDES_SECTION: &str = ".scorpion.condes";
 /// Reserved byte ranges that take the load area's fill value (assembler to
 /// linker).
 pub const FILL_SECTION: &str = ".scorpion.fill";

@@ -23,7 +23,10 @@
 use object::elf;
 use object::write::elf::{FileHeader, Rel, SectionHeader, SectionIndex, Sym, Writer};
 
-use super::{ASSERT_SECTION, Assertion, FILL_SECTION, FillRun, SRCMAP_SECTION, SrcMap};
+use super::{
+    ASSERT_SECTION, Assertion, CONDES_SECTION, CondesEntry, EXPRS_SECTION, ExprField, FILL_SECTION,
+    FillRun, SRCMAP_SECTION, SrcMap,
+};
 use crate::elf::{EF_MOS_ARCH_6502, EM_MOS, STO_MOS_ZEROPAGE};
 
 /// A section of a [`RelObject`].
@@ -142,6 +145,11 @@ pub struct RelObject {
     pub asserts: Vec<Assertion>,
     /// `.scorpion.fill` (left out when empty); `section` is the ELF index.
     pub fills: Vec<FillRun>,
+    /// `.scorpion.exprs` (left out when empty); `section` is the ELF index,
+    /// symbols numbered by [`RelObject::numbering`].
+    pub fields: Vec<ExprField>,
+    /// `.scorpion.condes` (left out when empty), numbered the same way.
+    pub condes: Vec<CondesEntry>,
 }
 
 impl Default for RelObject {
@@ -158,6 +166,8 @@ impl Default for RelObject {
             srcmap: None,
             asserts: Vec::new(),
             fills: Vec::new(),
+            fields: Vec::new(),
+            condes: Vec::new(),
         }
     }
 }
@@ -249,10 +259,14 @@ impl RelObject {
         let srcmap = self.srcmap.as_ref().map(SrcMap::encode);
         let asserts = (!self.asserts.is_empty()).then(|| Assertion::encode_all(&self.asserts));
         let fills = (!self.fills.is_empty()).then(|| FillRun::encode_all(&self.fills));
+        let fields = (!self.fields.is_empty()).then(|| ExprField::encode_all(&self.fields));
+        let condes = (!self.condes.is_empty()).then(|| CondesEntry::encode_all(&self.condes));
         let metadata: Vec<(&str, Vec<u8>)> = [
             (SRCMAP_SECTION, srcmap),
             (ASSERT_SECTION, asserts),
             (FILL_SECTION, fills),
+            (EXPRS_SECTION, fields),
+            (CONDES_SECTION, condes),
         ]
         .into_iter()
         .filter_map(|(name, bytes)| Some((name, bytes?)))

@@ -42,6 +42,13 @@ impl RomSymbols {
         self.values.get(name).copied()
     }
 
+    /// Every symbol and its value.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, i64)> {
+        self.values
+            .iter()
+            .map(|(name, value)| (name.as_str(), *value))
+    }
+
     fn require<const N: usize>(&self, target: &str, names: [&str; N]) -> Result<[u64; N], Error> {
         let missing: Vec<&str> = names
             .iter()
@@ -103,6 +110,8 @@ fn area(name: &str, start: u64, end_inclusive: u64, output: bool) -> Area {
         fill_value: 0,
         output,
         define: false,
+        file: None,
+        exprs: None,
     }
 }
 
@@ -132,6 +141,7 @@ pub(crate) fn flat(start: u64) -> Layout {
             segment("BSS", "MAIN", SegmentKind::Bss),
         ],
         ld65_alignment: true,
+        config: super::Config::default(),
     }
 }
 
@@ -172,6 +182,7 @@ pub(crate) fn scorpion_ext(rom: &RomSymbols) -> Result<Layout, Error> {
             segment("BSS", "RAM", SegmentKind::Bss),
         ],
         ld65_alignment: false,
+        config: super::Config::default(),
     })
 }
 
@@ -194,6 +205,7 @@ pub(crate) fn scorpion_os(rom: &RomSymbols) -> Result<Layout, Error> {
             segment("BSS", "URAM", SegmentKind::Bss),
         ],
         ld65_alignment: false,
+        config: super::Config::default(),
     })
 }
 
@@ -237,5 +249,6 @@ pub(crate) fn scorpion_rom(rom: &RomSymbols) -> Result<Layout, Error> {
             vectors,
         ],
         ld65_alignment: false,
+        config: super::Config::default(),
     })
 }

@@ -176,6 +176,8 @@ pub(super) fn parse(path: &str, text: &str) -> Result<Layout, Error> {
             fill_value,
             output: area.output,
             define: area.define,
+            file: None,
+            exprs: None,
         });
     }
     let mut segments = Vec::with_capacity(file.segment.len());
@@ -224,6 +226,7 @@ pub(super) fn parse(path: &str, text: &str) -> Result<Layout, Error> {
                 Some(start) => Some(parser.number(start, 0xFFFF_FFFF, "start")?),
                 None => None,
             },
+            offset: None,
             optional: segment.optional,
             define: segment.define,
         });
@@ -233,6 +236,7 @@ pub(super) fn parse(path: &str, text: &str) -> Result<Layout, Error> {
         areas,
         segments,
         ld65_alignment: false,
+        config: super::Config::default(),
     };
     layout.validate()?;
     Ok(layout)

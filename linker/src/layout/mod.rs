@@ -92,9 +92,16 @@
 //! as ld65's `define = yes` makes them.
 
 mod builtin;
+mod expr;
 mod file;
+mod ld65;
+
+use std::ops::Range;
+use std::sync::Arc;
 
 pub use builtin::{BUILTIN_TARGETS, RomSymbols};
+pub use expr::{EvalError, Expr, Op};
+pub(crate) use ld65::START_ADDRESS_SYMBOL;
 
 use crate::error::Error;
 
@@ -121,6 +128,13 @@ pub struct Area {
     pub output: bool,
     /// Define `__NAME_START__`, `__NAME_SIZE__`, `__NAME_LAST__`.
     pub define: bool,
+    /// The output file its bytes go to when not the main one (ld65's
+    /// `file = "%O.1"`; `%O` is the main output's name).
+    pub file: Option<String>,
+    /// `start` and `size` as an ld65 configuration writes them when they
+    /// name symbols: evaluated when placement reaches the area (earlier
+    /// areas' and segments' symbols known), replacing `start` and `size`.
+    pub exprs: Option<(Expr, Expr)>,
 }
 
 impl Area {
@@ -161,6 +175,8 @@ pub struct Segment {
     pub align_load: Option<u64>,
     /// A fixed start address.
     pub start: Option<u64>,
+    /// A fixed start relative to its run area's start (ld65's `offset`).
+    pub offset: Option<u64>,
     /// No warning when no input has it.
     pub optional: bool,
     /// Define `__NAME_LOAD__`, `__NAME_RUN__`, `__NAME_SIZE__`.
@@ -182,6 +198,7 @@ impl Segment {
             align: None,
             align_load: None,
             start: None,
+            offset: None,
             optional: true,
             define: false,
             sections: vec![name.to_owned()],
@@ -217,6 +234,118 @@ pub struct Layout {
     pub segments: Vec<Segment>,
     /// ld65 compatibility: segment starts are not aligned automatically.
     pub ld65_alignment: bool,
+    /// What only an ld65 configuration gives: symbols, tables, the start
+    /// address, output formats.
+    pub config: Config,
+}
+
+/// The parts of an ld65 configuration beyond areas and segments.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Config {
+    /// `SYMBOLS`, in order.
+    pub symbols: Vec<LayoutSymbol>,
+    /// `FEATURES { CONDES: ... }`: the constructor, destructor and
+    /// interruptor tables the linker builds.
+    pub tables: Vec<CondesTable>,
+    /// `%S`: `--start`, else `STARTADDRESS`'s default, else $200.
+    pub start_address: u64,
+    /// `FILES`: output formats by file (`%O` for the main one), with the
+    /// place of the format's name.
+    pub formats: Vec<(String, OutputFormat, Range<usize>)>,
+    /// The configuration's text, for errors found while linking.
+    pub source: Option<Arc<str>>,
+}
+
+/// How a layout symbol is defined (ld65's `SYMBOLS` `type`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SymbolKind {
+    /// Defined with its value.
+    Export,
+    /// Defined with its value unless an object defines it.
+    Weak,
+    /// Must be defined by an object (the link fails otherwise).
+    Import,
+}
+
+/// A symbol of the layout.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LayoutSymbol {
+    /// Its name.
+    pub name: String,
+    /// How it is defined.
+    pub kind: SymbolKind,
+    /// Its value (none for an import).
+    pub value: Option<Expr>,
+    /// Where the layout names it.
+    pub span: Range<usize>,
+}
+
+/// Which routines a table lists (ca65's `.constructor`, `.destructor`,
+/// `.interruptor`, or `.condes name, N`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum CondesKind {
+    /// Type 0.
+    Constructor,
+    /// Type 1.
+    Destructor,
+    /// Type 2.
+    Interruptor,
+    /// Types 3 to 6, which ca65 reserves for the user.
+    User(u8),
+}
+
+impl CondesKind {
+    /// The kind of ca65's type number `n` (0 to 6).
+    #[must_use]
+    pub fn from_number(n: u8) -> CondesKind {
+        match n {
+            0 => CondesKind::Constructor,
+            1 => CondesKind::Destructor,
+            2 => CondesKind::Interruptor,
+            n => CondesKind::User(n),
+        }
+    }
+
+    /// ca65's type number.
+    #[must_use]
+    pub fn number(self) -> u8 {
+        match self {
+            CondesKind::Constructor => 0,
+            CondesKind::Destructor => 1,
+            CondesKind::Interruptor => 2,
+            CondesKind::User(n) => n,
+        }
+    }
+}
+
+/// A table of routine addresses the linker builds (ld65's `CONDES`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CondesTable {
+    /// Which routines.
+    pub kind: CondesKind,
+    /// The symbol for the table's address.
+    pub label: String,
+    /// The symbol for the number of entries, if wanted.
+    pub count: Option<String>,
+    /// The segment the table is appended to.
+    pub segment: String,
+    /// Where the configuration names that segment.
+    pub segment_span: Range<usize>,
+    /// Entries by increasing priority (ld65's default) or decreasing.
+    pub increasing: bool,
+    /// A symbol imported when the table is not empty (`__CALLIRQ__`).
+    pub import: Option<String>,
+}
+
+/// An ld65 output format (`FILES { %O: format = ...; }`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// The areas' bytes, one after the other.
+    Bin,
+    /// Atari DOS executables.
+    Atari,
+    /// André Fachat's relocatable o65.
+    O65,
 }
 
 impl Layout {
@@ -234,7 +363,7 @@ impl Layout {
             if self.areas[..index].iter().any(|a| a.name == area.name) {
                 return Err(invalid(format!("area {} is defined twice", area.name)));
             }
-            if area.size == 0 {
+            if area.size == 0 && area.exprs.is_none() {
                 return Err(invalid(format!("area {} has size 0", area.name)));
             }
             if area.end() > 1 << 32 {
@@ -289,6 +418,36 @@ impl Layout {
     /// [`Error::LayoutInvalid`] for inconsistent layouts.
     pub fn from_toml(path: &str, text: &str) -> Result<Layout, Error> {
         file::parse(path, text)
+    }
+
+    /// An error about the value at `span` of this layout's file.
+    pub(crate) fn value_error(
+        &self,
+        message: String,
+        help: &str,
+        span: Option<Range<usize>>,
+    ) -> Error {
+        Error::LayoutValue {
+            path: self.name.clone(),
+            message,
+            help: help.to_owned(),
+            src: self
+                .config
+                .source
+                .as_ref()
+                .map(|text| Arc::new(miette::NamedSource::new(&self.name, text.to_string()))),
+            span: span.map(|span| miette::SourceSpan::from(span.start..span.end)),
+        }
+    }
+
+    /// Reads an ld65 configuration (`FILE.cfg`); `start` is `--start`,
+    /// what `%S` stands for (ld65's `-S`).
+    ///
+    /// # Errors
+    /// [`Error::LayoutSyntax`] at the place in the file for anything ld65
+    /// 2.19 would not read or this linker does not support.
+    pub fn from_ld65(path: &str, text: &str, start: Option<u64>) -> Result<Layout, Error> {
+        ld65::parse(path, text, start)
     }
 }
 

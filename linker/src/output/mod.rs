@@ -19,6 +19,7 @@ use core::fmt;
 use core::str::FromStr;
 
 pub use elf::write_elf;
+pub(crate) use records::append_without;
 pub use records::{write_bin, write_ihex, write_kim, write_srec};
 
 use crate::error::Error;

@@ -4,7 +4,8 @@
 use core::fmt::Write as _;
 
 use crate::error::Error;
-use crate::image::Image;
+use crate::image::{Image, LoadArea};
+use crate::layout::SegmentKind;
 
 /// Data bytes per Intel HEX and S-record record (what most programmers use).
 const RECORD_BYTES: usize = 16;
@@ -12,13 +13,34 @@ const RECORD_BYTES: usize = 16;
 const KIM_RECORD_BYTES: usize = 24;
 
 /// The loaded areas' bytes back to back, in output order (ld65's `bin`).
+/// As ld65 writes them, a BSS or zero-page segment inside an area takes
+/// no room in the file: the bytes after it follow the bytes before it.
 #[must_use]
 pub fn write_bin(image: &Image) -> Vec<u8> {
-    image
-        .areas
+    let holes: Vec<(u64, u64)> = image
+        .sections
         .iter()
-        .flat_map(|area| area.bytes.iter().copied())
-        .collect()
+        .filter(|s| matches!(s.kind, SegmentKind::Bss | SegmentKind::ZeroPage))
+        .map(|s| (u64::from(s.load), u64::from(s.load) + u64::from(s.size)))
+        .collect();
+    let mut out = Vec::new();
+    for area in &image.areas {
+        append_without(&mut out, area, &holes);
+    }
+    out
+}
+
+/// Appends `area`'s bytes to `out` but those whose load address lies in
+/// one of `holes` (`start..end`).
+pub(crate) fn append_without(out: &mut Vec<u8>, area: &LoadArea, holes: &[(u64, u64)]) {
+    let start = u64::from(area.load);
+    out.extend(area.bytes.iter().enumerate().filter_map(|(index, byte)| {
+        let address = start + index as u64;
+        let inside = holes
+            .iter()
+            .any(|(from, to)| (*from..*to).contains(&address));
+        (!inside).then_some(*byte)
+    }));
 }
 
 /// Each area cut into records of at most `max` bytes that do not cross a

@@ -1,0 +1,233 @@
+//! Both toolchains on one program: ca65 + ld65 (Debian's cc65) and our
+//! assembler + linker, each reading the same ld65 configuration (ours
+//! through `--target FILE.cfg`'s reader), every output file compared byte
+//! for byte. Shared by the differential tests (`asm_differential.rs`,
+//! `cc65_corpus.rs`).
+
+#![allow(dead_code, reason = "each test file uses part of it")]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use scorpion_tests::tools;
+
+/// The name both toolchains give the main output; other files are named
+/// from it (`%O.1`).
+pub(crate) const OUTPUT: &str = "out.bin";
+
+/// A program's files: name and bytes.
+pub(crate) type Files = Vec<(String, Vec<u8>)>;
+
+/// ca65 and ld65, or `None` after saying why `test` skips.
+pub(crate) fn toolchain(test: &str) -> Option<(PathBuf, PathBuf)> {
+    let ca65 = tools::require("ca65", test)?;
+    let ld65 = tools::require("ld65", test)?;
+    Some((ca65, ld65))
+}
+
+/// ca65 on `name` in `dir`: the object's path, or what ca65 said.
+pub(crate) fn ca65(dir: &Path, ca65: &Path, name: &str) -> Result<PathBuf, String> {
+    let object = format!("{name}.o");
+    let output = Command::new(ca65)
+        .current_dir(dir)
+        .args([name, "-o", object.as_str()])
+        .output()
+        .expect("ca65 runs");
+    if !output.status.success() {
+        return Err(format!(
+            "ca65 rejected {name}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    Ok(dir.join(object))
+}
+
+/// ca65 + ld65 on `files` (written to `dir`, `mains` assembled) with the
+/// configuration `cfg`: every output file by name, or their complaint.
+pub(crate) fn reference(
+    dir: &Path,
+    files: &[(String, Vec<u8>)],
+    mains: &[String],
+    cfg: &str,
+    (ca65_path, ld65): (&Path, &Path),
+) -> Result<Files, String> {
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).expect("write a source");
+    }
+    let mut objects = Vec::new();
+    for name in mains {
+        objects.push(ca65(dir, ca65_path, name)?);
+    }
+    let out = dir.join("ld65");
+    std::fs::create_dir_all(&out).expect("an output directory");
+    std::fs::write(dir.join("layout.cfg"), cfg).expect("write the configuration");
+    let output = Command::new(ld65)
+        .current_dir(&out)
+        .args(["-C", "../layout.cfg", "-o", OUTPUT])
+        .args(&objects)
+        .output()
+        .expect("ld65 runs");
+    if !output.status.success() {
+        return Err(format!(
+            "ld65 failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    let mut written: Files = std::fs::read_dir(&out)
+        .expect("ld65's outputs")
+        .map(|entry| entry.expect("an entry").path())
+        .map(|path| {
+            let name = path
+                .file_name()
+                .expect("a name")
+                .to_string_lossy()
+                .into_owned();
+            (name, std::fs::read(&path).expect("an output"))
+        })
+        .collect();
+    written.sort();
+    Ok(written)
+}
+
+/// Our assembler and linker, in memory, with the configuration `cfg`:
+/// every output file by name (the image as raw bytes, and the other files
+/// the configuration names), or our errors.
+pub(crate) fn ours(
+    files: &[(String, Vec<u8>)],
+    mains: &[String],
+    cfg: &str,
+) -> Result<Files, String> {
+    let mut source = assembler::MemorySource::new();
+    for (name, text) in files {
+        source.insert(name.as_str(), text.as_slice());
+    }
+    let options = assembler::Options::default();
+    let mut objects = Vec::new();
+    for name in mains {
+        let assembly =
+            assembler::assemble(&source, Path::new(name), &options).map_err(|error| {
+                let details: Vec<String> = error
+                    .diagnostics()
+                    .iter()
+                    .map(assembler::Diagnostic::summary)
+                    .collect();
+                format!("we rejected {name}: {error}\n{}", details.join("\n"))
+            })?;
+        objects.push((name.clone(), assembly.object));
+    }
+    let inputs: Vec<linker::Input<'_>> = objects
+        .iter()
+        .map(|(name, bytes)| linker::Input { name, bytes })
+        .collect();
+    let layout = linker::Layout::from_ld65("layout.cfg", cfg, None)
+        .map_err(|error| format!("our reading of the configuration failed: {error:?}"))?;
+    let target = linker::Target::Custom(layout);
+    let linked = linker::link(
+        &inputs,
+        &linker::LinkOptions {
+            target: &target,
+            just_symbols: &[],
+            sources: &linker::NoSources,
+        },
+    )
+    .map_err(|error| format!("our link failed: {error:?}"))?;
+    let mut written = Vec::new();
+    // ld65 writes the main file when an area names it, even an empty one.
+    if linked
+        .layout
+        .areas
+        .iter()
+        .any(|area| area.output && area.file.is_none())
+    {
+        let bytes = linker::Format::Bin
+            .write(&linked.image)
+            .map_err(|error| format!("cannot write the binary: {error:?}"))?;
+        written.push((OUTPUT.to_owned(), bytes));
+    }
+    for file in &linked.other_files {
+        written.push((file.path(OUTPUT), file.bytes()));
+    }
+    written.sort();
+    Ok(written)
+}
+
+/// Both toolchains on one program; the differences, if any, with the
+/// sources kept for `ca65 -l`.
+pub(crate) fn compare(
+    what: &str,
+    files: &[(String, Vec<u8>)],
+    mains: &[String],
+    cfg: &str,
+    tools: (&Path, &Path),
+) -> Result<(), String> {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let expected = match reference(dir.path(), files, mains, cfg, tools) {
+        Ok(outputs) => outputs,
+        Err(message) => {
+            let kept = dir.keep();
+            return Err(format!(
+                "{what}: the reference toolchain failed (sources kept in {}):\n{message}",
+                kept.display()
+            ));
+        }
+    };
+    let actual = match ours(files, mains, cfg) {
+        Ok(outputs) => outputs,
+        Err(message) => {
+            let kept = dir.keep();
+            return Err(format!(
+                "{what}: {message}\n(sources kept in {})",
+                kept.display()
+            ));
+        }
+    };
+    let names =
+        |outputs: &Files| -> Vec<String> { outputs.iter().map(|(n, _)| n.clone()).collect() };
+    if names(&expected) != names(&actual) {
+        let kept = dir.keep();
+        return Err(format!(
+            "{what}: ld65 wrote {:?}, we wrote {:?} (sources kept in {})",
+            names(&expected),
+            names(&actual),
+            kept.display()
+        ));
+    }
+    for ((name, expected), (_, actual)) in expected.iter().zip(&actual) {
+        if expected != actual {
+            let first = expected
+                .iter()
+                .zip(actual)
+                .position(|(a, b)| a != b)
+                .unwrap_or(expected.len().min(actual.len()));
+            let show = |bytes: &[u8]| -> String {
+                bytes
+                    .iter()
+                    .skip(first.saturating_sub(4))
+                    .take(12)
+                    .map(|b| format!("{b:02X}"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            };
+            let kept = dir.keep();
+            return Err(format!(
+                "{what}: {name} differs at offset {first:#06X} (ld65 {} bytes, ours {} bytes)\n  ld65: {}\n  ours: {}\nsources kept in {}",
+                expected.len(),
+                actual.len(),
+                show(expected),
+                show(actual),
+                kept.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Panics with every failure.
+pub(crate) fn report(failures: Vec<String>, total: usize) {
+    assert!(
+        failures.is_empty(),
+        "{} of {total} programs differ:\n\n{}",
+        failures.len(),
+        failures.join("\n\n")
+    );
+}
