@@ -13,21 +13,29 @@ use crate::model::{Global, Origin, OutputFile};
 use crate::place::{self, Placement};
 
 /// The image: areas split where the run address stops following the load
-/// address, a section per non-empty segment, locals then globals; and the
-/// areas that go to other output files than the image's.
+/// address, a section per non-empty segment, locals then globals; the
+/// main output file's BSS holes (its areas are the image's); and the
+/// areas that go to other output files.
 pub(crate) fn build_image(
     objects: &[Object],
     placement: &Placement,
     values: &[Vec<Option<i64>>],
     globals: &BTreeMap<String, Global>,
     hooks: Hooks,
-) -> (Image, Vec<OutputFile>) {
+) -> (Image, OutputFile, Vec<OutputFile>) {
     // Areas, split where the run address stops following the load address.
-    let mut main_areas = Vec::new();
+    let mut main = OutputFile {
+        name: "%O".to_owned(),
+        areas: Vec::new(),
+        holes: Vec::new(),
+    };
     let mut others: Vec<OutputFile> = Vec::new();
     for placed in &placement.areas {
-        let areas = match &placed.area.file {
-            None => &mut main_areas,
+        if !placed.area.output {
+            continue;
+        }
+        let file = match &placed.area.file {
+            None => &mut main,
             Some(name) => {
                 let index = match others.iter().position(|file| file.name == *name) {
                     Some(index) => index,
@@ -40,20 +48,18 @@ pub(crate) fn build_image(
                         others.len() - 1
                     }
                 };
-                let file = &mut others[index];
-                file.holes.extend(
-                    placement
-                        .segments
-                        .iter()
-                        .filter(|s| {
-                            s.rule.load == placed.area.name
-                                && matches!(s.rule.kind, SegmentKind::Bss | SegmentKind::ZeroPage)
-                        })
-                        .map(|s| (s.load, s.load + s.size)),
-                );
-                &mut file.areas
+                &mut others[index]
             }
         };
+        // BSS inside a written area takes no room in ld65's binary files.
+        file.holes.extend(
+            placement
+                .segments
+                .iter()
+                .filter(|s| s.rule.load == placed.area.name && s.rule.kind == SegmentKind::Bss)
+                .map(|s| (s.load, s.load + s.size)),
+        );
+        let areas = &mut file.areas;
         let area = &placed.area;
         if !area.output || placed.written_end <= area.start {
             continue;
@@ -189,13 +195,14 @@ pub(crate) fn build_image(
     let image = Image {
         entry: entry as u32,
         flags: objects.iter().fold(0, |flags, object| flags | object.flags),
-        areas: main_areas,
+        areas: main.areas.clone(),
         sections,
         symbols,
         hooks,
         lines: lines(objects, placement),
     };
-    (image, others)
+    main.areas.clear();
+    (image, main, others)
 }
 
 /// The objects' source maps by run address: every entry of every placed

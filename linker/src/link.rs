@@ -149,7 +149,7 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         return Err(Error::Failed { count, errors });
     }
 
-    let (image, other_files) = build_image(&objects, &placement, &values, &globals, hooks);
+    let (image, main_file, other_files) = build_image(&objects, &placement, &values, &globals, hooks);
     if let Err(Error::BadImage { reason, .. }) = image.check_hooks("") {
         return Err(failed(vec![hook_error(&reason, &objects, &globals)]));
     }
@@ -159,6 +159,7 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         layout,
         warnings,
         other_files,
+        main_holes: main_file.holes,
         map,
     })
 }
@@ -166,7 +167,10 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
 /// Writes each table's routine addresses into its segment, low byte first.
 fn fill_tables(placement: &mut place::Placement, values: &[Vec<Option<i64>>]) {
     for table in &placement.tables {
-        let segment = &mut placement.segments[table.segment];
+        let Some(segment) = table.segment else {
+            continue;
+        };
+        let segment = &mut placement.segments[segment];
         for (index, (object, symbol)) in table.entries.iter().enumerate() {
             let at = (table.offset + 2 * index as u64) as usize;
             let value = values[*object][*symbol].unwrap_or(0) as u16;

@@ -19,7 +19,28 @@ pub struct Linked {
     /// Output files besides the image, from a layout whose areas name
     /// other files (ld65's `file = "%O.1"`): each written as raw bytes.
     pub other_files: Vec<OutputFile>,
+    /// The image's BSS holes for the `bin` format (see [`Linked::write`]).
+    pub(crate) main_holes: Vec<(u64, u64)>,
     pub(crate) map: MapData,
+}
+
+impl Linked {
+    /// The image in `format`. For `bin`, a BSS segment inside a written
+    /// area takes no room, as in ld65's output (the bytes after it follow
+    /// the bytes before it); every other format keeps addresses.
+    ///
+    /// # Errors
+    /// As [`crate::Format::write`].
+    pub fn write(&self, format: crate::Format) -> Result<Vec<u8>, Error> {
+        if format != crate::Format::Bin {
+            return format.write(&self.image);
+        }
+        let mut out = Vec::new();
+        for area in &self.image.areas {
+            crate::output::append_without(&mut out, area, &self.main_holes);
+        }
+        Ok(out)
+    }
 }
 
 /// Another output file of a link: the bytes of the areas that name it.
@@ -30,7 +51,7 @@ pub struct OutputFile {
     pub name: String,
     /// Its areas, in layout order.
     pub areas: Vec<crate::image::LoadArea>,
-    /// Load ranges of the BSS and zero-page segments in its areas, which
+    /// Load ranges of the BSS segments in its areas, which
     /// take no room in the file (`start..end`).
     pub(crate) holes: Vec<(u64, u64)>,
 }

@@ -67,7 +67,9 @@ pub(crate) struct PlacedArea {
 pub(crate) struct PlacedTable {
     /// Its position in the layout's tables.
     pub(crate) table: usize,
-    pub(crate) segment: usize,
+    /// `None` when the layout does not define the table's segment (ld65
+    /// then gives the label 0; an entry is an error).
+    pub(crate) segment: Option<usize>,
     /// Offset from the segment's start.
     pub(crate) offset: u64,
     /// The routines it lists, in table order: (object, symbol).
@@ -393,9 +395,7 @@ pub(crate) fn place(
 fn append_tables(objects: &[Object], layout: &Layout, segments: &mut [Placed]) -> Vec<PlacedTable> {
     let mut placed = Vec::new();
     for (index, table) in layout.config.tables.iter().enumerate() {
-        let Some(segment) = segments.iter().position(|s| s.rule.name == table.segment) else {
-            continue;
-        };
+        let segment = segments.iter().position(|s| s.rule.name == table.segment);
         let mut entries: Vec<(u8, usize, usize)> = Vec::new();
         for (object_index, object) in objects.iter().enumerate() {
             for entry in object
@@ -410,8 +410,11 @@ fn append_tables(objects: &[Object], layout: &Layout, segments: &mut [Placed]) -
         if !table.increasing {
             entries.reverse();
         }
-        let offset = segments[segment].size;
-        segments[segment].size += 2 * entries.len() as u64;
+        let mut offset = 0;
+        if let Some(segment) = segment {
+            offset = segments[segment].size;
+            segments[segment].size += 2 * entries.len() as u64;
+        }
         placed.push(PlacedTable {
             table: index,
             segment,
@@ -443,7 +446,8 @@ fn settle_symbols(layout: &Layout, env: &mut HashMap<String, i64>) {
     }
 }
 
-/// An area's start and size from its expressions.
+/// An area's start and size from its expressions. The size may name the
+/// area's own start (`__MAIN_START__`): ld65 defines it first.
 fn area_bounds(
     layout: &Layout,
     area: &str,
@@ -451,21 +455,7 @@ fn area_bounds(
     size: &Expr,
     env: &HashMap<String, i64>,
 ) -> Result<(u64, u64), Error> {
-    let eval = |expr: &Expr, what: &str| -> Result<i64, Error> {
-        expr.eval(env).map_err(|error| match error {
-            EvalError::Undefined(name, span) => layout.value_error(
-                format!("the {what} of memory area {area} names `{name}`, which has no value here"),
-                "an area may use the SYMBOLS, the objects' constants and the `define = yes` symbols of the areas before it",
-                Some(span),
-            ),
-            EvalError::DivisionByZero => layout.value_error(
-                format!("the {what} of memory area {area} divides by zero"),
-                "check the SYMBOLS it uses",
-                expr.span(),
-            ),
-        })
-    };
-    let (start_value, size_value) = (eval(start, "start")?, eval(size, "size")?);
+    let start_value = area_value(layout, area, "start", start, env)?;
     if !(0..=0xFFFF_FFFF).contains(&start_value) {
         return Err(layout.value_error(
             format!("memory area {area} starts at {start_value}, outside $0-$FFFFFFFF"),
@@ -473,14 +463,41 @@ fn area_bounds(
             start.span(),
         ));
     }
-    if size_value <= 0 || start_value + size_value > 1 << 32 {
+    let mut env = env.clone();
+    env.insert(format!("__{area}_START__"), start_value);
+    let size_value = area_value(layout, area, "size", size, &env)?;
+    // Size 0 is an area nothing may use (ld65's overlays before a program
+    // sets `__OVERLAYSIZE__`).
+    if size_value < 0 || start_value + size_value > 1 << 32 {
         return Err(layout.value_error(
             format!("memory area {area} comes out {size_value} bytes long from ${start_value:04X}"),
-            "an area's size must be positive and end by $FFFFFFFF; check the SYMBOLS its size uses",
+            "an area's size must not be negative and must end by $FFFFFFFF; check the SYMBOLS its size uses",
             size.span(),
         ));
     }
     Ok((start_value as u64, size_value as u64))
+}
+
+/// One of an area's expressions, `what` naming it for errors.
+fn area_value(
+    layout: &Layout,
+    area: &str,
+    what: &str,
+    expr: &Expr,
+    env: &HashMap<String, i64>,
+) -> Result<i64, Error> {
+    expr.eval(env).map_err(|error| match error {
+        EvalError::Undefined(name, span) => layout.value_error(
+            format!("the {what} of memory area {area} names `{name}`, which has no value here"),
+            "an area may use the SYMBOLS, the objects' constants and the `define = yes` symbols of the areas before it",
+            Some(span),
+        ),
+        EvalError::DivisionByZero => layout.value_error(
+            format!("the {what} of memory area {area} divides by zero"),
+            "check the SYMBOLS it uses",
+            expr.span(),
+        ),
+    })
 }
 
 /// The layout's own symbols once everything is placed: `SYMBOLS` with a
@@ -516,10 +533,25 @@ fn layout_values(
     }
     for placed in tables {
         let table = &layout.config.tables[placed.table];
-        let segment = &segments[placed.segment];
+        let label = match placed.segment {
+            Some(segment) => (segments[segment].run + placed.offset) as i64,
+            None if placed.entries.is_empty() => 0,
+            None => {
+                errors.push(layout.value_error(
+                    format!(
+                        "{} routines go to a table in segment {}, which SEGMENTS does not define",
+                        placed.entries.len(),
+                        table.segment
+                    ),
+                    "define the segment, or leave the routines out of the link",
+                    Some(table.segment_span.clone()),
+                ));
+                0
+            }
+        };
         values.push(LayoutValue {
             name: table.label.clone(),
-            value: (segment.run + placed.offset) as i64,
+            value: label,
             weak: false,
         });
         if let Some(count) = &table.count {

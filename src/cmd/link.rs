@@ -160,7 +160,7 @@ pub(crate) fn link_and_write(
     }
     let mut linked = link_objects(objects, &target, &symbol_images, sources)?;
     report_warnings(&mut linked);
-    let bytes = args.format.write(&linked.image)?;
+    let bytes = linked.write(args.format)?;
     write(output, &bytes)?;
     for file in &linked.other_files {
         let path = PathBuf::from(file.path(&output.display().to_string()));

@@ -473,8 +473,31 @@ fn program_for(cfg: &str) -> String {
     for (name, attrs) in items(cfg, "SYMBOLS") {
         if attribute(&attrs, "type") == Some("import") {
             text.push_str(&format!(".export {name}\n{name} = $1234\n"));
+        } else if name == "__OVERLAYSIZE__" {
+            // Overlays are empty until the program sizes them, as a GEOS
+            // program's resources do.
+            text.push_str(&format!(".export {name}\n{name} = $1000\n"));
         } else {
             words.push(name);
+        }
+    }
+    // The start and initialisation routines an executable format names.
+    for (_, attrs) in items(cfg, "FORMATS") {
+        for key in ["runad", "initad"] {
+            if let Some(value) = attribute(&attrs, key) {
+                let routine = attrs[attrs.find(value).unwrap_or(0)..]
+                    .split(|c: char| c == ',' || c == ';')
+                    .next()
+                    .unwrap_or(value)
+                    .rsplit(':')
+                    .next()
+                    .unwrap_or(value)
+                    .trim()
+                    .to_owned();
+                if !text.contains(&format!(".export {routine}\n")) {
+                    text.push_str(&format!(".segment \"CODE\"\n.export {routine}\n{routine}: rts\n"));
+                }
+            }
         }
     }
     for (_, attrs) in items(cfg, "FEATURES") {

@@ -477,8 +477,8 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
                                 _ => return Err(r.error(format!("a segment's type is ro, rw, bss or zp, not `{word}`"), span)),
                             });
                         }
-                        "align" => segment.align = Some(power_of_two(r, "align")?),
-                        "align_load" => segment.align_load = Some(power_of_two(r, "align_load")?),
+                        "align" => segment.align = Some(alignment(r, "align")?),
+                        "align_load" => segment.align_load = Some(alignment(r, "align_load")?),
                         "start" => segment.start = Some(r.constant("start", 0xFFFF_FFFF)?),
                         "offset" => segment.offset = Some(r.constant("offset", 0xFFFF_FFFF)?),
                         "optional" => segment.optional = r.boolean()?,
@@ -676,17 +676,6 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
             }
         }
     }
-    for table in &layout.config.tables {
-        if !layout.segments.iter().any(|s| s.name == table.segment) {
-            return Err(r.error(
-                format!(
-                    "CONDES names segment {}, which SEGMENTS does not define",
-                    table.segment
-                ),
-                table.segment_span.clone(),
-            ));
-        }
-    }
     for (area, span) in layout.areas.iter().zip(&area_spans) {
         if area.exprs.is_none() && area.size == 0 {
             return Err(r.error(
@@ -700,11 +689,12 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
     Ok(layout)
 }
 
-fn power_of_two(r: &mut Reader<'_>, what: &str) -> R<u64> {
+/// An alignment: ld65 takes any from 1 (GEOS's VLIR records align to 254).
+fn alignment(r: &mut Reader<'_>, what: &str) -> R<u64> {
     let span = r.here();
     let value = r.constant(what, 1 << 24)?;
-    if !value.is_power_of_two() {
-        return Err(r.error(format!("{what} {value} is not a power of two"), span));
+    if value == 0 {
+        return Err(r.error(format!("{what} must be at least 1"), span));
     }
     Ok(value)
 }

@@ -400,9 +400,10 @@ impl Layout {
                 }
             }
             for align in [segment.align, segment.align_load].into_iter().flatten() {
-                if !align.is_power_of_two() {
+                // ld65 takes any alignment (GEOS's VLIR records use 254).
+                if align == 0 {
                     return Err(invalid(format!(
-                        "segment {} has alignment {align}, not a power of two",
+                        "segment {} has alignment 0",
                         segment.name
                     )));
                 }

@@ -5,7 +5,6 @@ use core::fmt::Write as _;
 
 use crate::error::Error;
 use crate::image::{Image, LoadArea};
-use crate::layout::SegmentKind;
 
 /// Data bytes per Intel HEX and S-record record (what most programmers use).
 const RECORD_BYTES: usize = 16;
@@ -13,19 +12,14 @@ const RECORD_BYTES: usize = 16;
 const KIM_RECORD_BYTES: usize = 24;
 
 /// The loaded areas' bytes back to back, in output order (ld65's `bin`).
-/// As ld65 writes them, a BSS or zero-page segment inside an area takes
-/// no room in the file: the bytes after it follow the bytes before it.
+/// A link's own output ([`crate::Linked::write`]) also leaves out the BSS
+/// segments inside written areas, as ld65 does; an image read back from
+/// ELF no longer knows which area a segment was in, and keeps every byte.
 #[must_use]
 pub fn write_bin(image: &Image) -> Vec<u8> {
-    let holes: Vec<(u64, u64)> = image
-        .sections
-        .iter()
-        .filter(|s| matches!(s.kind, SegmentKind::Bss | SegmentKind::ZeroPage))
-        .map(|s| (u64::from(s.load), u64::from(s.load) + u64::from(s.size)))
-        .collect();
     let mut out = Vec::new();
     for area in &image.areas {
-        append_without(&mut out, area, &holes);
+        append_without(&mut out, area, &[]);
     }
     out
 }

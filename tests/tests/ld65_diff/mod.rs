@@ -139,8 +139,8 @@ pub(crate) fn ours(
         .iter()
         .any(|area| area.output && area.file.is_none())
     {
-        let bytes = linker::Format::Bin
-            .write(&linked.image)
+        let bytes = linked
+            .write(linker::Format::Bin)
             .map_err(|error| format!("cannot write the binary: {error:?}"))?;
         written.push((OUTPUT.to_owned(), bytes));
     }
