@@ -52,14 +52,17 @@ pub(crate) fn build_image(
             }
         };
         // BSS inside a written area takes no room in ld65's binary files.
-        file.holes.extend(
-            placement
-                .segments
-                .iter()
-                .filter(|s| s.rule.load == placed.area.name && s.rule.kind == SegmentKind::Bss)
-                .map(|s| (s.load, s.load + s.size)),
-        );
-        let areas = &mut file.areas;
+        let holes: Vec<(u64, u64)> = placement
+            .segments
+            .iter()
+            .filter(|s| s.rule.load == placed.area.name && s.rule.kind == SegmentKind::Bss)
+            .map(|s| (s.load, s.load + s.size))
+            .collect();
+        let OutputFile {
+            areas,
+            holes: file_holes,
+            ..
+        } = file;
         let area = &placed.area;
         if !area.output || placed.written_end <= area.start {
             continue;
@@ -104,6 +107,7 @@ pub(crate) fn build_image(
                 run: (*start as i64 + offset) as u32,
                 bytes: bytes[from..to].to_vec(),
             });
+            file_holes.push(holes.clone());
         }
     }
 

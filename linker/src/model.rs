@@ -19,8 +19,9 @@ pub struct Linked {
     /// Output files besides the image, from a layout whose areas name
     /// other files (ld65's `file = "%O.1"`): each written as raw bytes.
     pub other_files: Vec<OutputFile>,
-    /// The image's BSS holes for the `bin` format (see [`Linked::write`]).
-    pub(crate) main_holes: Vec<(u64, u64)>,
+    /// Per image area, its BSS holes for the `bin` format (see
+    /// [`Linked::write`]).
+    pub(crate) main_holes: Vec<Vec<(u64, u64)>>,
     pub(crate) map: MapData,
 }
 
@@ -36,8 +37,8 @@ impl Linked {
             return format.write(&self.image);
         }
         let mut out = Vec::new();
-        for area in &self.image.areas {
-            crate::output::append_without(&mut out, area, &self.main_holes);
+        for (area, holes) in self.image.areas.iter().zip(&self.main_holes) {
+            crate::output::append_without(&mut out, area, holes);
         }
         Ok(out)
     }
@@ -51,9 +52,9 @@ pub struct OutputFile {
     pub name: String,
     /// Its areas, in layout order.
     pub areas: Vec<crate::image::LoadArea>,
-    /// Load ranges of the BSS segments in its areas, which
-    /// take no room in the file (`start..end`).
-    pub(crate) holes: Vec<(u64, u64)>,
+    /// Per area, the load ranges of the BSS segments in it, which take
+    /// no room in the file (`start..end`).
+    pub(crate) holes: Vec<Vec<(u64, u64)>>,
 }
 
 impl OutputFile {
@@ -68,8 +69,8 @@ impl OutputFile {
     #[must_use]
     pub fn bytes(&self) -> Vec<u8> {
         let mut out = Vec::new();
-        for area in &self.areas {
-            crate::output::append_without(&mut out, area, &self.holes);
+        for (area, holes) in self.areas.iter().zip(&self.holes) {
+            crate::output::append_without(&mut out, area, holes);
         }
         out
     }
