@@ -7,28 +7,34 @@ use isa::objfmt::{Hooks, SourceLoc, SrcMap, SrcMapEntry};
 
 use crate::image::{Image, ImageSection, ImageSymbol, LoadArea};
 use crate::input::{Binding, Definition, Object};
-use crate::layout::{Layout, SegmentKind};
+use crate::layout::{Layout, OutputFormat, SegmentKind};
 use crate::map::{MapArea, MapData, MapModule, MapPart, MapSegment};
-use crate::model::{Global, Origin, OutputFile};
+use crate::model::{Global, Origin};
+use crate::output::{OutputFile, Part};
 use crate::place::{self, Placement};
 
 /// The image: areas split where the run address stops following the load
 /// address, a section per non-empty segment, locals then globals; the
-/// main output file's BSS holes (its areas are the image's); and the
-/// areas that go to other output files.
+/// main output file (its areas are the image's); and the other output
+/// files.
 pub(crate) fn build_image(
     objects: &[Object],
+    layout: &Layout,
     placement: &Placement,
     values: &[Vec<Option<i64>>],
     globals: &BTreeMap<String, Global>,
     hooks: Hooks,
 ) -> (Image, OutputFile, Vec<OutputFile>) {
     // Areas, split where the run address stops following the load address.
-    let mut main = OutputFile {
-        name: "%O".to_owned(),
-        areas: Vec::new(),
-        holes: Vec::new(),
+    let format_of = |file: &str| {
+        layout
+            .config
+            .formats
+            .iter()
+            .find(|(name, ..)| name == file)
+            .map_or(OutputFormat::Bin, |(_, format, _)| *format)
     };
+    let mut main = OutputFile::new("%O", format_of("%O"));
     let mut others: Vec<OutputFile> = Vec::new();
     for placed in &placement.areas {
         if !placed.area.output {
@@ -40,11 +46,7 @@ pub(crate) fn build_image(
                 let index = match others.iter().position(|file| file.name == *name) {
                     Some(index) => index,
                     None => {
-                        others.push(OutputFile {
-                            name: name.clone(),
-                            areas: Vec::new(),
-                            holes: Vec::new(),
-                        });
+                        others.push(OutputFile::new(name, format_of(name)));
                         others.len() - 1
                     }
                 };
@@ -52,17 +54,16 @@ pub(crate) fn build_image(
             }
         };
         // BSS inside a written area takes no room in ld65's binary files.
-        let holes: Vec<(u64, u64)> = placement
-            .segments
-            .iter()
-            .filter(|s| s.rule.load == placed.area.name && s.rule.kind == SegmentKind::Bss)
-            .map(|s| (s.load, s.load + s.size))
-            .collect();
-        let OutputFile {
-            areas,
-            holes: file_holes,
-            ..
-        } = file;
+        let part = Part {
+            area: placed.area.name.clone(),
+            holes: placement
+                .segments
+                .iter()
+                .filter(|s| s.rule.load == placed.area.name && s.rule.kind == SegmentKind::Bss)
+                .map(|s| (s.load, s.load + s.size))
+                .collect(),
+        };
+        let OutputFile { areas, parts, .. } = file;
         let area = &placed.area;
         if !area.output || placed.written_end <= area.start {
             continue;
@@ -107,7 +108,7 @@ pub(crate) fn build_image(
                 run: (*start as i64 + offset) as u32,
                 bytes: bytes[from..to].to_vec(),
             });
-            file_holes.push(holes.clone());
+            parts.push(part.clone());
         }
     }
 
@@ -205,7 +206,6 @@ pub(crate) fn build_image(
         hooks,
         lines: lines(objects, placement),
     };
-    main.areas.clear();
     (image, main, others)
 }
 

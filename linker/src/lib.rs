@@ -34,6 +34,6 @@ pub use image::{Image, ImageSection, ImageSymbol, LoadArea};
 pub use input::Input;
 pub use layout::{Layout, Target};
 pub use link::{LinkOptions, SymbolFile, link, link_one};
-pub use model::{Linked, OutputFile};
-pub use output::Format;
+pub use model::Linked;
+pub use output::{Format, OutputFile};
 pub use source::{MemorySources, NoSources, SourceProvider};

@@ -9,7 +9,8 @@ use crate::emit::{build_image, map_data};
 use crate::error::Error;
 use crate::image::Image;
 use crate::input::{self, Binding, Definition, Input, Object};
-use crate::layout::{RomSymbols, Target};
+use crate::layout::{Layout, RomSymbols, Target};
+use crate::output::OutputFile;
 use crate::model::{Global, Linked};
 use crate::place;
 use crate::resolve::{Resolved, resolve};
@@ -149,7 +150,11 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         return Err(Error::Failed { count, errors });
     }
 
-    let (image, main_file, other_files) = build_image(&objects, &placement, &values, &globals, hooks);
+    let (image, mut main_file, mut other_files) =
+        build_image(&objects, &layout, &placement, &values, &globals, hooks);
+    for file in std::iter::once(&mut main_file).chain(&mut other_files) {
+        atari_vectors(file, &layout, &globals);
+    }
     if let Err(Error::BadImage { reason, .. }) = image.check_hooks("") {
         return Err(failed(vec![hook_error(&reason, &objects, &globals)]));
     }
@@ -159,9 +164,22 @@ pub fn link(inputs: &[Input<'_>], options: &LinkOptions<'_>) -> Result<Linked, E
         layout,
         warnings,
         other_files,
-        main_holes: main_file.holes,
+        main_file,
         map,
     })
+}
+
+/// The Atari format's RUNAD and INITAD addresses for `file`, from the
+/// symbols the layout names (each checked defined by resolution).
+fn atari_vectors(file: &mut OutputFile, layout: &Layout, globals: &BTreeMap<String, Global>) {
+    let value = |name: &str| globals.get(name).and_then(|g| g.value).map(|v| v as u16);
+    let options = &layout.config.atari;
+    file.run = options.runad.as_ref().and_then(|(name, _)| value(name));
+    file.inits = options
+        .initad
+        .iter()
+        .filter_map(|(area, name, _)| Some((area.clone(), value(name)?)))
+        .collect();
 }
 
 /// Writes each table's routine addresses into its segment, low byte first.

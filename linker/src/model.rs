@@ -5,6 +5,7 @@ use crate::error::Error;
 use crate::image::Image;
 use crate::layout::Layout;
 use crate::map::MapData;
+use crate::output::OutputFile;
 
 /// A successful link.
 #[derive(Debug)]
@@ -19,16 +20,18 @@ pub struct Linked {
     /// Output files besides the image, from a layout whose areas name
     /// other files (ld65's `file = "%O.1"`): each written as raw bytes.
     pub other_files: Vec<OutputFile>,
-    /// Per image area, its BSS holes for the `bin` format (see
+    /// The main output file as ld65 would write it (see
     /// [`Linked::write`]).
-    pub(crate) main_holes: Vec<Vec<(u64, u64)>>,
+    pub(crate) main_file: OutputFile,
     pub(crate) map: MapData,
 }
 
 impl Linked {
-    /// The image in `format`. For `bin`, a BSS segment inside a written
-    /// area takes no room, as in ld65's output (the bytes after it follow
-    /// the bytes before it); every other format keeps addresses.
+    /// The image in `format`. `bin` is the main output file as ld65
+    /// writes it: a BSS segment inside a written area takes no room (the
+    /// bytes after it follow the bytes before it), and an ld65
+    /// configuration's `FILES` format applies (`atari`); every other
+    /// format keeps addresses.
     ///
     /// # Errors
     /// As [`crate::Format::write`].
@@ -36,43 +39,7 @@ impl Linked {
         if format != crate::Format::Bin {
             return format.write(&self.image);
         }
-        let mut out = Vec::new();
-        for (area, holes) in self.image.areas.iter().zip(&self.main_holes) {
-            crate::output::append_without(&mut out, area, holes);
-        }
-        Ok(out)
-    }
-}
-
-/// Another output file of a link: the bytes of the areas that name it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OutputFile {
-    /// Its name as the layout gives it; `%O` stands for the image's file
-    /// name (see [`OutputFile::path`]).
-    pub name: String,
-    /// Its areas, in layout order.
-    pub areas: Vec<crate::image::LoadArea>,
-    /// Per area, the load ranges of the BSS segments in it, which take
-    /// no room in the file (`start..end`).
-    pub(crate) holes: Vec<Vec<(u64, u64)>>,
-}
-
-impl OutputFile {
-    /// Its name with `%O` replaced by `output`, the image's file name.
-    #[must_use]
-    pub fn path(&self, output: &str) -> String {
-        self.name.replace("%O", output)
-    }
-
-    /// Its contents: the areas' bytes one after the other, as ld65's
-    /// binary format writes them (see [`crate::output::write_bin`]).
-    #[must_use]
-    pub fn bytes(&self) -> Vec<u8> {
-        let mut out = Vec::new();
-        for (area, holes) in self.areas.iter().zip(&self.holes) {
-            crate::output::append_without(&mut out, area, holes);
-        }
-        out
+        Ok(self.main_file.bytes())
     }
 }
 

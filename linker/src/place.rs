@@ -274,6 +274,10 @@ pub(crate) fn place(
                     if area.output {
                         segment.written = true;
                         written_end = written_end.max(address + segment.size);
+                    } else if layout.config.ld65 {
+                        // ld65 drops bytes loaded where no file goes
+                        // (`file = ""`), which configurations use to hide
+                        // headers they do not want.
                     } else {
                         errors.push(Error::NotLoaded {
                             segment: segment.rule.name.clone(),

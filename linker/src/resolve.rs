@@ -264,8 +264,9 @@ fn layout_symbols(layout: &Layout, placement: &Placement) -> BTreeMap<String, Gl
     globals
 }
 
-/// The layout's imports (`SYMBOLS { name: type = import; }` and a
-/// non-empty table's `import`) that no object defines.
+/// The layout's imports (`SYMBOLS { name: type = import; }`, a
+/// non-empty table's `import`, the Atari format's run and init routines)
+/// that no object defines.
 fn layout_imports(
     layout: &Layout,
     placement: &Placement,
@@ -286,7 +287,13 @@ fn layout_imports(
             let table = &layout.config.tables[placed.table];
             Some((table.import.as_deref()?, table.segment_span.clone()))
         });
-    for (name, span) in symbols.chain(tables) {
+    let atari = &layout.config.atari;
+    let vectors = atari
+        .runad
+        .iter()
+        .map(|(name, span)| (name.as_str(), span.clone()))
+        .chain(atari.initad.iter().map(|(_, name, span)| (name.as_str(), span.clone())));
+    for (name, span) in symbols.chain(tables).chain(vectors) {
         let defined = globals
             .get(name)
             .is_some_and(|global| matches!(global.origin, Origin::Object { .. }));

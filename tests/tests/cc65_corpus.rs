@@ -481,22 +481,19 @@ fn program_for(cfg: &str) -> String {
             words.push(name);
         }
     }
-    // The start and initialisation routines an executable format names.
+    // The start and initialisation routines an executable format names
+    // (`runad = start`, `initad = AREA: routine`).
     for (_, attrs) in items(cfg, "FORMATS") {
-        for key in ["runad", "initad"] {
-            if let Some(value) = attribute(&attrs, key) {
-                let routine = attrs[attrs.find(value).unwrap_or(0)..]
-                    .split(|c: char| c == ',' || c == ';')
-                    .next()
-                    .unwrap_or(value)
-                    .rsplit(':')
-                    .next()
-                    .unwrap_or(value)
-                    .trim()
-                    .to_owned();
-                if !text.contains(&format!(".export {routine}\n")) {
-                    text.push_str(&format!(".segment \"CODE\"\n.export {routine}\n{routine}: rts\n"));
-                }
+        for option in attrs.split(',') {
+            let Some((key, value)) = option.split_once('=') else {
+                continue;
+            };
+            if !matches!(key.trim(), "runad" | "initad") {
+                continue;
+            }
+            let routine = value.rsplit(':').next().unwrap_or(value).trim();
+            if !text.contains(&format!(".export {routine}\n")) {
+                text.push_str(&format!(".segment \"CODE\"\n.export {routine}\n{routine}: rts\n"));
             }
         }
     }
@@ -517,7 +514,16 @@ fn program_for(cfg: &str) -> String {
 }
 
 /// Configurations not linked, and why: each must still be refused.
-const CONFIGS_NOT_LINKED: [(&str, &str); 0] = [];
+const CONFIGS_NOT_LINKED: [(&str, &str); 2] = [
+    (
+        "lunix.cfg",
+        "writes o65, a relocatable format for LUnix's loader; we write absolute images (bin, atari) and refuse `format = o65` by name",
+    ),
+    (
+        "module.cfg",
+        "writes o65 (cc65's loadable drivers); refused by name, as lunix.cfg",
+    ),
+];
 
 #[test]
 fn ld65_configurations_link_as_ld65_links() {

@@ -333,7 +333,8 @@ impl Reader<'_> {
             }
             let (name, span) = self.ident("an attribute name or `;`")?;
             let lower = name.to_ascii_lowercase();
-            if seen.contains(&lower) {
+            // The Atari format may name an init routine for several areas.
+            if seen.contains(&lower) && lower != "initad" {
                 return Err(self.error(format!("`{name}` is given twice"), span));
             }
             seen.push(lower.clone());
@@ -372,6 +373,7 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
         ld65_alignment: true,
         config: super::Config {
             source: Some(Arc::from(text)),
+            ld65: true,
             ..super::Config::default()
         },
     };
@@ -626,25 +628,49 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
                     let format = match word.as_str() {
                         "bin" | "binary" => OutputFormat::Bin,
                         "atari" => OutputFormat::Atari,
-                        "o65" => OutputFormat::O65,
+                        "o65" => {
+                            return Err(r.error(
+                                "the o65 format is not supported: this linker writes absolute images (format = bin or atari); link for a fixed address instead",
+                                span,
+                            ));
+                        }
                         _ => return Err(r.error(format!("`{word}` is not an output format of ld65 2.19 (bin, o65, atari)"), span)),
                     };
                     layout.config.formats.push((file.clone(), format, span));
                     Ok(())
                 })
             })?,
-            "FORMATS" => r.items(|r, _name| {
-                // The o65 and Atari formats' options: read for their
-                // syntax; a link with either format is refused anyway.
-                r.attributes(|r, _attr, _span| {
-                    let found = r.describe();
-                    match r.next("a value")?.tok {
-                        Tok::Ident(_) | Tok::Number(_) | Tok::Str(_) => {}
-                        _ => return Err(r.error(format!("expected a value, found {found}"), r.tokens[r.pos - 1].span.clone())),
-                    }
-                    if r.is(':') {
-                        r.pos += 1;
-                        r.ident("a symbol")?;
+            "FORMATS" => r.items(|r, name| {
+                let format = match &name.tok {
+                    Tok::Ident(format) => format.clone(),
+                    _ => return Err(r.error("expected a format's name", name.span)),
+                };
+                r.attributes(|r, attr, span| {
+                    match (format.as_str(), attr) {
+                        // The Atari executable's run and init addresses:
+                        // `runad = symbol`, `initad = AREA: symbol`.
+                        ("atari", "runad") => {
+                            let (symbol, span) = r.ident("a symbol")?;
+                            layout.config.atari.runad = Some((symbol, span));
+                        }
+                        ("atari", "initad") => {
+                            let (area, _) = r.ident("a memory area")?;
+                            r.expect(':')?;
+                            let (symbol, span) = r.ident("a symbol")?;
+                            layout.config.atari.initad.push((area, symbol, span));
+                        }
+                        ("atari", _) => {
+                            return Err(r.error(format!("`{attr}` is not an option of the atari format (runad, initad)"), span));
+                        }
+                        // o65's options: read for their syntax; FILES
+                        // refuses the format.
+                        _ => {
+                            let found = r.describe();
+                            match r.next("a value")?.tok {
+                                Tok::Ident(_) | Tok::Number(_) | Tok::Str(_) => {}
+                                _ => return Err(r.error(format!("expected a value, found {found}"), r.tokens[r.pos - 1].span.clone())),
+                            }
+                        }
                     }
                     Ok(())
                 })

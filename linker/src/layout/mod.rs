@@ -254,6 +254,22 @@ pub struct Config {
     pub formats: Vec<(String, OutputFormat, Range<usize>)>,
     /// The configuration's text, for errors found while linking.
     pub source: Option<Arc<str>>,
+    /// `FORMATS { atari: ... }`.
+    pub atari: AtariOptions,
+    /// Read from an ld65 configuration: bytes loaded in an area that goes
+    /// to no file are dropped, as ld65 drops them, instead of an error.
+    pub ld65: bool,
+}
+
+/// The Atari executable format's options (ld65's `FORMATS { atari: ...}`):
+/// symbols whose addresses go to the DOS's run and init vectors.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct AtariOptions {
+    /// `runad = symbol`: written to RUNAD ($02E0) after the last block.
+    pub runad: Option<(String, Range<usize>)>,
+    /// `initad = AREA: symbol`: written to INITAD ($02E2) after that
+    /// area's block.
+    pub initad: Vec<(String, String, Range<usize>)>,
 }
 
 /// How a layout symbol is defined (ld65's `SYMBOLS` `type`).
@@ -342,10 +358,10 @@ pub struct CondesTable {
 pub enum OutputFormat {
     /// The areas' bytes, one after the other.
     Bin,
-    /// Atari DOS executables.
+    /// Atari DOS executables: `$FFFF`, then per area its first and last
+    /// address and its bytes; RUNAD and INITAD blocks from
+    /// [`AtariOptions`].
     Atari,
-    /// André Fachat's relocatable o65.
-    O65,
 }
 
 impl Layout {

@@ -13,12 +13,15 @@
 //! the same bytes for the same image.
 
 mod elf;
+mod files;
 mod records;
 
 use core::fmt;
 use core::str::FromStr;
 
 pub use elf::write_elf;
+pub use files::OutputFile;
+pub(crate) use files::Part;
 pub(crate) use records::append_without;
 pub use records::{write_bin, write_ihex, write_kim, write_srec};
 
