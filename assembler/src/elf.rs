@@ -162,6 +162,7 @@ pub(crate) fn write_object(
                     }
                     FixKind::Abs | FixKind::Word => FieldKind::Word,
                     FixKind::Dbyt => FieldKind::WordBigEndian,
+                    FixKind::Far => FieldKind::Far,
                     FixKind::Dword => FieldKind::Dword,
                 },
                 expr: Expr {

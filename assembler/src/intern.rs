@@ -91,6 +91,7 @@ directives! {
     Ifp816 = "ifp816";
     Ifpc02 = "ifpc02";
     Ifref = "ifref";
+    Faraddr = "faraddr";
     Forceimport = "forceimport";
     Import = "import";
     Importzp = "importzp";
@@ -111,6 +112,7 @@ directives! {
     P02 = "p02";
     OtherCpu = "p816" | "pc02" | "psc02" | "p4510";
     Paramcount = "paramcount";
+    Cpu = "cpu";
     Proc = "proc";
     Referenced = "referenced" | "ref";
     Reloc = "reloc";

@@ -239,6 +239,8 @@ pub(crate) enum FixKind {
     Dbyt,
     /// `.dword`: 32 bits, constants only.
     Dword,
+    /// `.faraddr`: 24 bits, 0..=$FFFFFF, `R_MOS_ADDR24`.
+    Far,
     /// Branch displacement.
     Branch,
 }
@@ -248,6 +250,7 @@ impl FixKind {
         match self {
             FixKind::Imm8 | FixKind::Byte | FixKind::Zp | FixKind::Branch => 1,
             FixKind::Abs | FixKind::Word | FixKind::Dbyt => 2,
+            FixKind::Far => 3,
             FixKind::Dword => 4,
         }
     }

@@ -113,6 +113,7 @@ pub(crate) fn const_bytes(
         FixKind::Abs => ("address", (0, 0xFFFF)),
         FixKind::Word => ("word value", (0, 0xFFFF)),
         FixKind::Dbyt => ("word value", (0, 0xFFFF)),
+        FixKind::Far => ("far address", (0, 0xFF_FFFF)),
         FixKind::Dword => ("dword value", (0, i64::from(u32::MAX))),
         FixKind::Branch => ("branch distance", (-128, 127)),
     };

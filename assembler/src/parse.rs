@@ -484,6 +484,16 @@ impl Asm<'_> {
                 self.expect(c, Tok::RParen, "`)`")?;
                 Ok(bool_node(self, count == 0))
             }
+            // The instruction set now in use, as `.macpack cpu`'s masks
+            // spell it.
+            Dir::Cpu => {
+                let mask = if self.cpu_x {
+                    crate::macpack::CPU_6502X
+                } else {
+                    crate::macpack::CPU_6502
+                };
+                Ok(self.prog.node(Node::Const(mask)))
+            }
             Dir::Paramcount => {
                 let count = self
                     .input

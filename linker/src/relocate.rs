@@ -222,6 +222,7 @@ pub(crate) fn apply_fields(
                         range: match field.kind {
                             FieldKind::Byte => "a byte (0 to 255)",
                             FieldKind::Word | FieldKind::WordBigEndian => "a word (0 to $FFFF)",
+                            FieldKind::Far => "a far address (0 to $FFFFFF)",
                             FieldKind::Dword => "a dword (0 to $FFFFFFFF)",
                         },
                         at: place.text,

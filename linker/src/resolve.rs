@@ -292,7 +292,12 @@ fn layout_imports(
         .runad
         .iter()
         .map(|(name, span)| (name.as_str(), span.clone()))
-        .chain(atari.initad.iter().map(|(_, name, span)| (name.as_str(), span.clone())));
+        .chain(
+            atari
+                .initad
+                .iter()
+                .map(|(_, name, span)| (name.as_str(), span.clone())),
+        );
     for (name, span) in symbols.chain(tables).chain(vectors) {
         let defined = globals
             .get(name)

@@ -30,6 +30,7 @@ impl Asm<'_> {
             Dir::Word | Dir::Addr => FixKind::Word,
             Dir::Dbyt => FixKind::Dbyt,
             Dir::Dword => FixKind::Dword,
+            Dir::Faraddr => FixKind::Far,
             _ => FixKind::Byte,
         };
         loop {

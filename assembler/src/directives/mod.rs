@@ -34,6 +34,7 @@ impl Asm<'_> {
             | Dir::Addr
             | Dir::Dbyt
             | Dir::Dword
+            | Dir::Faraddr
             | Dir::Lobytes
             | Dir::Hibytes
             | Dir::Bankbytes => self.data(dir, c),

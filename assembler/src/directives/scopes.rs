@@ -124,21 +124,24 @@ impl Asm<'_> {
             let result = self.struct_member(&mut c, scope, union, closer, offset, depth);
             self.input.toks = t;
             match result {
-                Ok(Some(member_size)) => {
+                Ok(Line::Member(member_size)) => {
                     if union {
                         size = size.max(member_size);
                     } else {
                         offset = offset.saturating_add(member_size);
-                        size = offset;
+                        size = size.saturating_add(member_size);
                     }
                 }
-                Ok(None) => return Ok(size),
+                // `.org n`: the next members start at n; the size still
+                // counts the members only, as ca65's.
+                Ok(Line::Org(at)) => offset = at,
+                Ok(Line::End) => return Ok(size),
                 Err(_) => {}
             }
         }
     }
 
-    /// One member line; `Ok(None)` at the closing directive.
+    /// One member line.
     fn struct_member(
         &mut self,
         c: &mut Cursor<'_>,
@@ -147,9 +150,9 @@ impl Asm<'_> {
         closer: Dir,
         offset: i64,
         depth: u32,
-    ) -> PResult<Option<i64>> {
+    ) -> PResult<Line> {
         let Some(&first) = c.peek() else {
-            return Ok(Some(0));
+            return Ok(Line::Member(0));
         };
         let mut name = None;
         if first.kind == Tok::Ident {
@@ -175,12 +178,24 @@ impl Asm<'_> {
         };
         if dir == closer && name.is_none() {
             self.expect_end(c)?;
-            return Ok(None);
+            return Ok(Line::End);
+        }
+        if dir == Dir::Org && name.is_none() {
+            let at = self.const_expr(c, "a member offset")?;
+            self.expect_end(c)?;
+            return Ok(Line::Org(at));
         }
         let member_size = match dir {
-            Dir::Byte | Dir::Word | Dir::Addr | Dir::Dword | Dir::Dbyt | Dir::Res => {
+            Dir::Byte
+            | Dir::Word
+            | Dir::Addr
+            | Dir::Faraddr
+            | Dir::Dword
+            | Dir::Dbyt
+            | Dir::Res => {
                 let unit = match dir {
                     Dir::Byte | Dir::Res => 1,
+                    Dir::Faraddr => 3,
                     Dir::Dword => 4,
                     _ => 2,
                 };
@@ -191,12 +206,13 @@ impl Asm<'_> {
                 } else {
                     1
                 };
-                if !(0..=0xFFFF).contains(&count) {
+                // Up to 16 MiB, as a 65816's banks (cx16.inc's VRAM).
+                if !(0..=0xFF_FFFF).contains(&count) {
                     return Err(self.report(crate::resolver::range_diag(
                         dir_tok.span,
                         "member size",
                         count,
-                        (0, 0xFFFF),
+                        (0, 0xFF_FFFF),
                     )));
                 }
                 unit * count
@@ -211,13 +227,17 @@ impl Asm<'_> {
                 };
                 unit.saturating_mul(count.clamp(0, 0xFFFF))
             }
-            Dir::Struct | Dir::Union if name.is_none() && depth < 16 => {
+            // A nested block: its members belong to this struct, offset
+            // from here; a named one (`JUMPTAB .struct`) is also a member
+            // itself, as in ca65.
+            Dir::Struct | Dir::Union if depth < 16 => {
+                self.expect_end(c)?;
                 let closer = if dir == Dir::Union {
                     Dir::Endunion
                 } else {
                     Dir::Endstruct
                 };
-                // Members of the nested block are offset from here.
+                let here = if union { 0 } else { offset };
                 let before = self.prog.syms.len();
                 let size =
                     self.struct_members(scope, dir == Dir::Union, closer, dir_tok.span, depth + 1)?;
@@ -225,10 +245,15 @@ impl Asm<'_> {
                     if let SymDef::Const(value) = self.prog.syms[sym].def
                         && self.prog.syms[sym].scope == scope
                     {
-                        self.prog.syms[sym].def = SymDef::Const(value + offset);
+                        self.prog.syms[sym].def = SymDef::Const(value + here);
                     }
                 }
-                return Ok(Some(size));
+                if let Some(name) = name {
+                    self.reserved_name(&name, false)?;
+                    let sym = self.sym_in(scope, name.name());
+                    self.define(sym, SymDef::Const(here), name.span)?;
+                }
+                return Ok(Line::Member(size));
             }
             _ => {
                 return Err(self.err(
@@ -245,7 +270,7 @@ impl Asm<'_> {
             let value = if union { 0 } else { offset };
             self.define(sym, SymDef::Const(value), name.span)?;
         }
-        Ok(Some(member_size))
+        Ok(Line::Member(member_size))
     }
 
     pub(super) fn enumeration(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
@@ -442,5 +467,15 @@ enum Member {
     /// Nothing.
     Blank,
     /// `.endenum`.
+    End,
+}
+
+/// What one line inside a `.struct` or `.union` was.
+enum Line {
+    /// A member (or a blank line) of this many bytes.
+    Member(i64),
+    /// `.org n`: the next member's offset.
+    Org(i64),
+    /// The closing directive.
     End,
 }

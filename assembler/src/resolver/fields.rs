@@ -2,8 +2,8 @@
 //! symbols and fills, branch distances and assertions.
 
 use isa::elf::{
-    R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_ADDR16_HI, R_MOS_ADDR16_LO, R_MOS_ADDR24_BANK, R_MOS_IMM8,
-    R_MOS_PCREL_8,
+    R_MOS_ADDR8, R_MOS_ADDR16, R_MOS_ADDR16_HI, R_MOS_ADDR16_LO, R_MOS_ADDR24, R_MOS_ADDR24_BANK,
+    R_MOS_IMM8, R_MOS_PCREL_8,
 };
 use isa::objfmt::{BinaryOp, FillRun, SourceLoc, SrcMapEntry, UnaryOp};
 
@@ -416,6 +416,7 @@ impl Asm<'_> {
                     FixKind::Imm8 | FixKind::Byte => R_MOS_IMM8,
                     FixKind::Zp => R_MOS_ADDR8,
                     FixKind::Abs | FixKind::Word | FixKind::Dword => R_MOS_ADDR16,
+                    FixKind::Far => R_MOS_ADDR24,
                     FixKind::Dbyt => {
                         // Big-endian: the high byte first, then the low byte.
                         self.push_reloc(out, sym_index, base, seg, pos, R_MOS_ADDR16_HI, off);

@@ -27,15 +27,18 @@ pub enum FieldKind {
     Word,
     /// Two bytes, high first, 0 to $FFFF (`.dbyt`).
     WordBigEndian,
+    /// Three bytes, low first, 0 to $FFFFFF (`.faraddr`).
+    Far,
     /// Four bytes, low first, 0 to $FFFFFFFF (`.dword`).
     Dword,
 }
 
-const KINDS: [FieldKind; 4] = [
+const KINDS: [FieldKind; 5] = [
     FieldKind::Byte,
     FieldKind::Word,
     FieldKind::WordBigEndian,
     FieldKind::Dword,
+    FieldKind::Far,
 ];
 
 impl FieldKind {
@@ -45,6 +48,7 @@ impl FieldKind {
         match self {
             FieldKind::Byte => 1,
             FieldKind::Word | FieldKind::WordBigEndian => 2,
+            FieldKind::Far => 3,
             FieldKind::Dword => 4,
         }
     }
@@ -55,6 +59,7 @@ impl FieldKind {
         match self {
             FieldKind::Byte => (0, 0xFF),
             FieldKind::Word | FieldKind::WordBigEndian => (0, 0xFFFF),
+            FieldKind::Far => (0, 0xFF_FFFF),
             FieldKind::Dword => (0, i64::from(u32::MAX)),
         }
     }

@@ -418,10 +418,7 @@ impl Layout {
             for align in [segment.align, segment.align_load].into_iter().flatten() {
                 // ld65 takes any alignment (GEOS's VLIR records use 254).
                 if align == 0 {
-                    return Err(invalid(format!(
-                        "segment {} has alignment 0",
-                        segment.name
-                    )));
+                    return Err(invalid(format!("segment {} has alignment 0", segment.name)));
                 }
             }
         }

@@ -95,7 +95,10 @@ impl OutputFile {
                 let holes = &self.parts[index].holes;
                 for (offset, byte) in area.bytes.iter().enumerate() {
                     let address = u64::from(area.load) + offset as u64;
-                    if holes.iter().any(|(from, to)| (*from..*to).contains(&address)) {
+                    if holes
+                        .iter()
+                        .any(|(from, to)| (*from..*to).contains(&address))
+                    {
                         continue;
                     }
                     match runs.last_mut() {
