@@ -495,7 +495,8 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
                 if load_span.is_none() {
                     return Err(r.error(format!("segment {name_text} has no `load`"), name.span));
                 }
-                segment.kind = kind.ok_or_else(|| r.error(format!("segment {name_text} has no `type` (ro, rw, bss or zp)"), name.span.clone()))?;
+                // ld65's default type.
+                segment.kind = kind.unwrap_or(SegmentKind::ReadOnly);
                 segment_spans.push((name.span, load_span.unwrap_or_default(), run_span));
                 layout.segments.push(segment);
                 Ok(())
