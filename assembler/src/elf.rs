@@ -6,8 +6,9 @@
 
 use isa::elf::SHF_MOS_ZEROPAGE;
 use isa::objfmt::{
-    AssertAction, Assertion, Binding, Definition, Expr, ExprField, FieldKind, FillRun, Numbering,
-    ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget, SourceLoc, SrcMap, SymbolLoc,
+    AssertAction, Assertion, Binding, CondesEntry, Definition, Expr, ExprField, FieldKind, FillRun,
+    Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget, SourceLoc, SrcMap,
+    SymbolLoc,
 };
 use object::elf;
 
@@ -171,6 +172,15 @@ pub(crate) fn write_object(
                     })?,
                 },
             })
+        })
+        .collect();
+    object.condes = out
+        .condes
+        .iter()
+        .map(|&(symbol, kind, priority)| CondesEntry {
+            kind,
+            priority,
+            symbol: numbering.symbols[symbol],
         })
         .collect();
     object.fills = out

@@ -92,6 +92,10 @@ directives! {
     Ifpc02 = "ifpc02";
     Ifref = "ifref";
     Faraddr = "faraddr";
+    Condes = "condes";
+    Constructor = "constructor";
+    Destructor = "destructor";
+    Interruptor = "interruptor";
     Forceimport = "forceimport";
     Import = "import";
     Importzp = "importzp";

@@ -310,6 +310,8 @@ pub(crate) struct Program {
     pub(crate) locs: Vec<Loc>,
     pub(crate) items: Vec<Item>,
     pub(crate) asserts: Vec<AssertRec>,
+    /// `.constructor` and its kin: (symbol, table type, priority).
+    pub(crate) condes: Vec<(SymId, u8, u8)>,
     /// Reserved bytes in chunks' fixed data (chunk, offset, length):
     /// `.res` and `.align` without a fill value, which the linker fills.
     pub(crate) fills: Vec<(ChunkId, u32, u32)>,

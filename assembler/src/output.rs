@@ -95,6 +95,8 @@ pub(crate) struct Output {
     pub(crate) asserts: Vec<OutAssert>,
     /// Fields the linker computes.
     pub(crate) fields: Vec<OutField>,
+    /// Routines for the linker's tables: (output symbol, type, priority).
+    pub(crate) condes: Vec<(usize, u8, u8)>,
     /// Output section of each segment (`None` when the segment is empty).
     pub(crate) seg_section: Vec<Option<usize>>,
     /// Reserved bytes the linker fills; `section` as in [`Output::items`].

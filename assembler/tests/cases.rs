@@ -211,6 +211,24 @@ fn dump(object: &[u8]) -> String {
         .section_headers
         .iter()
         .enumerate()
+        .find(|(i, _)| name(*i) == isa::objfmt::CONDES_SECTION)
+    {
+        let start = sh.sh_offset as usize;
+        let entries =
+            isa::objfmt::CondesEntry::decode_all(&object[start..start + sh.sh_size as usize])
+                .expect("the table entries decode");
+        for entry in entries {
+            let _ = writeln!(
+                out,
+                "condes type {} priority {} symbol #{}",
+                entry.kind, entry.priority, entry.symbol
+            );
+        }
+    }
+    if let Some((_, sh)) = elf
+        .section_headers
+        .iter()
+        .enumerate()
         .find(|(i, _)| name(*i) == isa::objfmt::FILL_SECTION)
     {
         let start = sh.sh_offset as usize;

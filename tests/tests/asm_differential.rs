@@ -239,6 +239,44 @@ fn programs_of_several_files_match_ld65() {
     report(failures, dirs.len());
 }
 
+/// Programs with their own ld65 configuration (`asm_cfg/*/layout.cfg`,
+/// every `.s` assembled): what the flat layout cannot show, such as the
+/// linker's tables of constructors.
+#[test]
+fn programs_with_their_own_configuration_match_ld65() {
+    let Some((ca65, ld65)) = toolchain("programs_with_their_own_configuration_match_ld65") else {
+        return;
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/asm_cfg");
+    let mut dirs: Vec<_> = std::fs::read_dir(&root)
+        .expect("the programs")
+        .map(|entry| entry.expect("an entry").path())
+        .filter(|path| path.is_dir())
+        .collect();
+    dirs.sort();
+    assert!(!dirs.is_empty());
+    let mut failures = Vec::new();
+    for dir in &dirs {
+        let files = files_of(dir);
+        let cfg = std::fs::read_to_string(dir.join("layout.cfg")).expect("the configuration");
+        let mains: Vec<String> = files
+            .iter()
+            .map(|(name, _)| name.clone())
+            .filter(|name| name.ends_with(".s"))
+            .collect();
+        let what = dir
+            .file_name()
+            .expect("a name")
+            .to_string_lossy()
+            .into_owned();
+        let tools = (ca65.as_path(), ld65.as_path());
+        if let Err(failure) = ld65_diff::compare(&what, &files, &mains, &cfg, tools) {
+            failures.push(failure);
+        }
+    }
+    report(failures, dirs.len());
+}
+
 /// C programs of ours (`cc65/*.c`), compiled by cc65 at three
 /// optimisation levels; each output (with `.autoimport`, `.case`,
 /// `.macpack longbranch`, `.proc name: near`...) assembled by ca65 and by

@@ -109,6 +109,68 @@ impl Asm<'_> {
         Ok(())
     }
 
+    /// `.constructor name [, priority]` (type 0), `.destructor` (1),
+    /// `.interruptor` (2), `.condes name, type [, priority]`: exports
+    /// `name` and lists it for the linker's table of that type (a layout's
+    /// `CONDES`), priority 1 to 32, 7 by default, as ca65's.
+    pub(super) fn condes(&mut self, c: &mut Cursor<'_>, kind: Option<u8>) -> PResult<()> {
+        c.advance();
+        let Some(tok) = c.peek().filter(|t| t.kind == Tok::Ident).copied() else {
+            let span = c.span();
+            return Err(self.err("asm::syntax", span, "expected the routine's name"));
+        };
+        c.advance();
+        let kind = match kind {
+            Some(kind) => kind,
+            None => {
+                if !c.eat(Tok::Comma) {
+                    let span = c.span();
+                    return Err(self.err("asm::syntax", span, "expected `,` and the table type"));
+                }
+                let span = c.span();
+                let kind = self.const_expr(c, "a table type")?;
+                match u8::try_from(kind)
+                    .ok()
+                    .filter(|kind| *kind <= isa::objfmt::MAX_CONDES_TYPE)
+                {
+                    Some(kind) => kind,
+                    None => {
+                        return Err(self.err(
+                            "asm::range",
+                            span,
+                            format!("table type {kind} is outside 0 to 6 (0 constructor, 1 destructor, 2 interruptor)"),
+                        ));
+                    }
+                }
+            }
+        };
+        let mut priority = 7;
+        if c.eat(Tok::Comma) {
+            let span = c.span();
+            let value = self.const_expr(c, "a priority")?;
+            priority = match u8::try_from(value).ok().filter(|p| (1..=32).contains(p)) {
+                Some(priority) => priority,
+                None => {
+                    return Err(self.err(
+                        "asm::range",
+                        span,
+                        format!("priority {value} is outside 1 to 32"),
+                    ));
+                }
+            };
+        }
+        self.expect_end(c)?;
+        let sym = self.sym_in(self.symtab.scope, tok.name());
+        let loc = self.loc(tok.span);
+        let s = &mut self.prog.syms[sym as usize];
+        s.export = Some(s.export.unwrap_or(false));
+        if s.export_loc.is_none() {
+            s.export_loc = Some(loc);
+        }
+        self.prog.condes.push((sym, kind, priority));
+        Ok(())
+    }
+
     pub(super) fn export(&mut self, c: &mut Cursor<'_>, zp: bool, global: bool) -> PResult<()> {
         for (tok, assignment, size) in self.name_list(c)? {
             let zp = size.unwrap_or(zp);

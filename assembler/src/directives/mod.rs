@@ -49,6 +49,10 @@ impl Asm<'_> {
             }
             Dir::Import | Dir::Importzp => self.import(c, dir == Dir::Importzp, false),
             Dir::Forceimport => self.import(c, false, true),
+            Dir::Constructor => self.condes(c, Some(0)),
+            Dir::Destructor => self.condes(c, Some(1)),
+            Dir::Interruptor => self.condes(c, Some(2)),
+            Dir::Condes => self.condes(c, None),
             Dir::Export | Dir::Exportzp | Dir::Global | Dir::Globalzp => self.export(
                 c,
                 matches!(dir, Dir::Exportzp | Dir::Globalzp),

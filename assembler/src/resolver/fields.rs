@@ -124,6 +124,11 @@ impl Asm<'_> {
             }
         }
         self.check_asserts(&mut out, &sym_index);
+        for &(sym, kind, priority) in &self.prog.condes {
+            if let Some(index) = sym_index[sym as usize] {
+                out.condes.push((index, kind, priority));
+            }
+        }
         out
     }
 

@@ -23,7 +23,7 @@ pub const MAX_CONDES_TYPE: u8 = 6;
 pub struct CondesEntry {
     /// The table type.
     pub kind: u8,
-    /// Its priority, 1 to 32 (ca65's default 24).
+    /// Its priority, 1 to 32 (ca65's default 7).
     pub priority: u8,
     /// The routine's `.symtab` index.
     pub symbol: u32,
