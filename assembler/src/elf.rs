@@ -6,9 +6,9 @@
 
 use isa::elf::SHF_MOS_ZEROPAGE;
 use isa::objfmt::{
-    AssertAction, Assertion, Binding, CondesEntry, Definition, Expr, ExprField, FieldKind, FillRun,
-    Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget, SourceLoc, SrcMap,
-    SymbolLoc,
+    AssertAction, Assertion, Binding, CondesEntry, Definition, Expr, ExprField, ExprSymbol,
+    FieldKind, FillRun, Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget,
+    SourceLoc, SrcMap, SymbolLoc,
 };
 use object::elf;
 
@@ -170,6 +170,18 @@ pub(crate) fn write_object(
                     ops: assert_ops(&field.ops, |target| {
                         Some(numbering.target(reloc_target(target)))
                     })?,
+                },
+            })
+        })
+        .collect();
+    object.values = out
+        .values
+        .iter()
+        .filter_map(|(symbol, ops)| {
+            Some(ExprSymbol {
+                symbol: numbering.symbols[*symbol],
+                expr: Expr {
+                    ops: assert_ops(ops, |target| Some(numbering.target(reloc_target(target))))?,
                 },
             })
         })

@@ -97,6 +97,10 @@ pub(crate) struct Output {
     pub(crate) fields: Vec<OutField>,
     /// Routines for the linker's tables: (output symbol, type, priority).
     pub(crate) condes: Vec<(usize, u8, u8)>,
+    /// Exported symbols the linker computes: (output symbol, bytecode).
+    pub(crate) values: Vec<(usize, Vec<AssertOp>)>,
+    /// The same before compiling: (output symbol, symbol).
+    pub(crate) pending_values: Vec<(usize, crate::model::SymId)>,
     /// Output section of each segment (`None` when the segment is empty).
     pub(crate) seg_section: Vec<Option<usize>>,
     /// Reserved bytes the linker fills; `section` as in [`Output::items`].

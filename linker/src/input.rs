@@ -8,8 +8,8 @@
 use goblin::elf::{Elf, section_header as sh, sym};
 use isa::elf as mos;
 use isa::objfmt::{
-    ASSERT_SECTION, Assertion, CONDES_SECTION, CondesEntry, EXPRS_SECTION, ExprField, FILL_SECTION,
-    FieldKind, FillRun, SRCMAP_SECTION, SrcMap,
+    ASSERT_SECTION, Assertion, CONDES_SECTION, CondesEntry, EXPRS_SECTION, ExprField, ExprSymbol,
+    FILL_SECTION, FieldKind, FillRun, SRCMAP_SECTION, SrcMap, VALUES_SECTION,
 };
 
 use crate::error::Error;
@@ -60,6 +60,8 @@ pub(crate) enum Definition {
     Absolute(i64),
     /// Position of the section in [`Object::sections`], and the offset.
     Section(usize, u32),
+    /// Computed by the linker: position in [`Object::values`].
+    Computed(usize),
 }
 
 /// Symbol binding, reduced to what linking needs.
@@ -95,6 +97,9 @@ pub(crate) struct Object {
     pub(crate) condes: Vec<CondesEntry>,
     /// Fields the linker computes from expressions (`.scorpion.exprs`).
     pub(crate) fields: Vec<Field>,
+    /// Values of the symbols defined as [`Definition::Computed`]
+    /// (`.scorpion.values`).
+    pub(crate) values: Vec<isa::objfmt::Expr>,
 }
 
 /// A field of a section whose value the linker computes.
@@ -285,6 +290,7 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
     let mut asserts = Vec::new();
     let mut fills = Vec::new();
     let mut raw_fields = Vec::new();
+    let mut raw_values = Vec::new();
     let mut condes = Vec::new();
     for (index, header) in elf.section_headers.iter().enumerate() {
         let name = section_name(index);
@@ -301,6 +307,9 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
                     .map_err(|error| malformed(error.to_string()))?;
             } else if name == EXPRS_SECTION {
                 raw_fields = ExprField::decode_all(section_bytes(index)?)
+                    .map_err(|error| malformed(error.to_string()))?;
+            } else if name == VALUES_SECTION {
+                raw_values = ExprSymbol::decode_all(section_bytes(index)?)
                     .map_err(|error| malformed(error.to_string()))?;
             } else if name == CONDES_SECTION {
                 condes = CondesEntry::decode_all(section_bytes(index)?)
@@ -523,6 +532,25 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
             bad.symbol
         )));
     }
+    let mut values = Vec::with_capacity(raw_values.len());
+    for value in raw_values {
+        let bad = value.expr.symbols().find(|s| *s as usize >= symbols.len());
+        let target = symbols
+            .get_mut(value.symbol as usize)
+            .filter(|_| value.symbol != 0);
+        match (target, bad) {
+            (Some(symbol), None) if symbol.binding != Binding::Local => {
+                symbol.definition = Definition::Computed(values.len());
+                values.push(value.expr);
+            }
+            _ => {
+                return Err(malformed(format!(
+                    "{VALUES_SECTION} gives a value to symbol {} or names a symbol past the end of the symbol table",
+                    value.symbol
+                )));
+            }
+        }
+    }
     let mut fields = Vec::with_capacity(raw_fields.len());
     for field in raw_fields {
         let position = position_of.get(field.section as usize).copied().flatten();
@@ -560,6 +588,7 @@ pub(crate) fn read_object(input: Input<'_>) -> Result<Object, Error> {
         asserts,
         condes,
         fields,
+        values,
     })
 }
 

@@ -45,7 +45,7 @@ pub(crate) fn resolve(
                 .symbols
                 .iter()
                 .map(|symbol| match symbol.definition {
-                    Definition::Undefined => None,
+                    Definition::Undefined | Definition::Computed(_) => None,
                     Definition::Absolute(value) => Some(value),
                     Definition::Section(section, offset) => placement
                         .section_run(object_index, section)
@@ -111,6 +111,14 @@ pub(crate) fn resolve(
         }
     }
 
+    computed_symbols(
+        objects,
+        &mut values,
+        &mut globals,
+        file_symbols,
+        sources,
+        errors,
+    );
     layout_imports(layout, placement, &globals, errors);
 
     // Undefined references: globals, then --just-symbols, then weak zero.
@@ -216,6 +224,96 @@ pub(crate) fn resolve(
         values,
         globals,
         unresolved,
+    }
+}
+
+/// Gives the symbols the linker computes (`alias = imported + 1`,
+/// exported) their values, in as many rounds as they depend on each other;
+/// one that never gets a value is an error at its definition.
+fn computed_symbols(
+    objects: &[Object],
+    values: &mut [Vec<Option<i64>>],
+    globals: &mut BTreeMap<String, Global>,
+    file_symbols: &HashMap<&str, (i64, &str)>,
+    sources: &dyn SourceProvider,
+    errors: &mut Vec<Error>,
+) {
+    let computed: Vec<(usize, usize, usize)> = objects
+        .iter()
+        .enumerate()
+        .flat_map(|(o, object)| {
+            object
+                .symbols
+                .iter()
+                .enumerate()
+                .filter_map(move |(s, symbol)| match symbol.definition {
+                    Definition::Computed(k) => Some((o, s, k)),
+                    _ => None,
+                })
+        })
+        .collect();
+    if computed.is_empty() {
+        return;
+    }
+    let mut failures: Vec<(usize, usize, String)> = Vec::new();
+    loop {
+        let mut progress = false;
+        failures.clear();
+        for &(o, s, k) in &computed {
+            if values[o][s].is_some() {
+                continue;
+            }
+            let object = &objects[o];
+            let result = object.values[k].evaluate(|index| {
+                let index = index as usize;
+                values[o].get(index).copied().flatten().or_else(|| {
+                    let symbol = object.symbols.get(index)?;
+                    if symbol.binding == Binding::Local {
+                        return None;
+                    }
+                    globals
+                        .get(&symbol.name)
+                        .and_then(|g| g.value)
+                        .or_else(|| file_symbols.get(symbol.name.as_str()).map(|(v, _)| *v))
+                })
+            });
+            match result {
+                Ok(value) => {
+                    values[o][s] = Some(value);
+                    let name = &object.symbols[s].name;
+                    if let Some(global) = globals.get_mut(name)
+                        && matches!(global.origin, Origin::Object { object, symbol } if object == o && symbol == s)
+                    {
+                        global.value = Some(value);
+                    }
+                    progress = true;
+                }
+                Err(isa::objfmt::EvalError::UnresolvedSymbol(index)) => {
+                    let missing = object
+                        .symbols
+                        .get(index as usize)
+                        .map_or_else(|| format!("symbol #{index}"), |m| format!("`{}`", m.name));
+                    failures.push((o, s, format!("it names {missing}, which has no value")));
+                }
+                Err(error) => failures.push((o, s, error.to_string())),
+            }
+        }
+        if !progress {
+            break;
+        }
+    }
+    for (o, s, reason) in failures {
+        let place = objects[o].place_of_symbol(s);
+        let (src, span) = place.snippet(sources);
+        errors.push(Error::ExpressionInvalid {
+            at: format!(
+                "{} (the value of `{}`)",
+                place.text, objects[o].symbols[s].name
+            ),
+            reason,
+            src,
+            span,
+        });
     }
 }
 

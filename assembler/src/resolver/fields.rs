@@ -77,6 +77,7 @@ impl Asm<'_> {
         out.seg_section = seg_section;
         // Symbols first: relocations against imports need their indices.
         let sym_index = self.collect_symbols(&mut out);
+        self.symbol_values(&mut out, &sym_index);
         let fixups = std::mem::take(&mut self.prog.fixups);
         for fixup in &fixups {
             self.resolve_field(
@@ -162,6 +163,30 @@ impl Asm<'_> {
         }
     }
 
+    /// The exported symbols whose value is an expression of others,
+    /// compiled to bytecode for the linker; an expression that cannot be
+    /// is reported where the symbol is exported.
+    fn symbol_values(&mut self, out: &mut Output, sym_index: &[Option<usize>]) {
+        for (index, sym) in std::mem::take(&mut out.pending_values) {
+            let node = self.prog.node(Node::Sym(sym));
+            let mut ops = Vec::new();
+            if self.compile(node, out, sym_index, &mut ops, 0).is_some() {
+                out.values.push((index, ops));
+            } else if let Some(loc) = self.prog.syms[sym as usize].export_loc {
+                let name = self.sym_name(sym);
+                let span = self.loc_span(loc);
+                self.report_at(
+                    loc,
+                    diag::error(
+                        "asm::export",
+                        span,
+                        format!("`{name}` cannot be exported: its value is neither a constant nor an expression of addresses"),
+                    ),
+                );
+            }
+        }
+    }
+
     /// The output symbols; returns, per symbol id, its output index.
     fn collect_symbols(&mut self, out: &mut Output) -> Vec<Option<usize>> {
         let mut index = vec![None; self.prog.syms.len()];
@@ -209,6 +234,15 @@ impl Asm<'_> {
                             Some(section) => OutSymKind::Sec(section, off as u32),
                             None => continue,
                         },
+                        // An exported expression of imports (`alias =
+                        // return0`): the linker computes it.
+                        Ok(Value::Addr { .. } | Value::Byte { .. })
+                        | Err(EvalErr::NotRelocatable)
+                            if exported =>
+                        {
+                            out.pending_values.push((out.symbols.len(), sym as SymId));
+                            OutSymKind::Abs(0)
+                        }
                         other => {
                             if exported
                                 && let Some(loc) = export_loc

@@ -10,10 +10,10 @@
 //! (the order of [`FieldKind`]), an op count and the ops as in
 //! `.scorpion.assert`.
 
-use super::EXPRS_SECTION;
 use super::Expr;
 use super::assert::{decode_ops, encode_ops};
 use super::codec::{FormatError, Reader, Writer};
+use super::{EXPRS_SECTION, VALUES_SECTION};
 
 const MAGIC: &[u8; 4] = b"SCEX";
 const VERSION: u8 = 1;
@@ -138,6 +138,55 @@ impl ExprField {
     }
 }
 
+/// A symbol whose value the linker computes (`alias = imported + 1`,
+/// exported): in the symbol table it is an absolute 0; its value is the
+/// expression's.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ExprSymbol {
+    /// The symbol's `.symtab` index.
+    pub symbol: u32,
+    /// Its value.
+    pub expr: Expr,
+}
+
+const SYMBOLS_MAGIC: &[u8; 4] = b"SCSV";
+
+impl ExprSymbol {
+    /// Serialises symbols as a section's contents (`.scorpion.values`:
+    /// magic `SCSV`, version 1, a count, then per symbol its index `u32`
+    /// and the expression as in `.scorpion.assert`).
+    #[must_use]
+    pub fn encode_all(symbols: &[ExprSymbol]) -> Vec<u8> {
+        let mut out = Writer::header(SYMBOLS_MAGIC, VERSION);
+        out.len32(symbols.len());
+        for symbol in symbols {
+            out.u32(symbol.symbol);
+            encode_ops(&mut out, &symbol.expr);
+        }
+        out.bytes
+    }
+
+    /// Parses a section's contents.
+    ///
+    /// # Errors
+    /// [`FormatError`] if the bytes are not version-1 symbol values.
+    pub fn decode_all(bytes: &[u8]) -> Result<Vec<ExprSymbol>, FormatError> {
+        let mut input = Reader::new(VALUES_SECTION, bytes);
+        input.header(SYMBOLS_MAGIC, VERSION)?;
+        let count = input.count(8)?;
+        let mut symbols = Vec::with_capacity(count);
+        for _ in 0..count {
+            let symbol = input.u32()?;
+            let expr = decode_ops(&mut input)?;
+            symbols.push(ExprSymbol { symbol, expr });
+        }
+        if !input.is_empty() {
+            return Err(input.error("trailing bytes after the last symbol"));
+        }
+        Ok(symbols)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,6 +229,25 @@ mod tests {
         let mut bad_kind = bytes.clone();
         bad_kind[4 + 1 + 4 + 8] = 9;
         assert!(ExprField::decode_all(&bad_kind).is_err());
+    }
+
+    #[test]
+    fn symbol_values_round_trip() {
+        let symbols = vec![ExprSymbol {
+            symbol: 4,
+            expr: Expr {
+                ops: vec![
+                    ExprOp::Symbol(2),
+                    ExprOp::Const(1),
+                    ExprOp::Binary(BinaryOp::Add),
+                ],
+            },
+        }];
+        let bytes = ExprSymbol::encode_all(&symbols);
+        assert_eq!(ExprSymbol::decode_all(&bytes), Ok(symbols));
+        for cut in 0..bytes.len() {
+            assert!(ExprSymbol::decode_all(&bytes[..cut]).is_err());
+        }
     }
 
     #[test]

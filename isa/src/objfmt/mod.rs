@@ -1,6 +1,6 @@
 //! Our own metadata sections in 6502 ELF files, beside llvm-mos's numbering.
 //!
-//! ELF has no place for six things our tools pass along, so they travel in
+//! ELF has no place for seven things our tools pass along, so they travel in
 //! non-allocated `SHT_PROGBITS` sections that other tools ignore:
 //!
 //! | section | written by | read by | holds |
@@ -8,6 +8,7 @@
 //! | [`SRCMAP_SECTION`] | assembler | linker | where each instruction, data item and symbol came from (file:line:col) |
 //! | [`ASSERT_SECTION`] | assembler | linker | `.assert`s that depend on addresses, as expression bytecode |
 //! | [`EXPRS_SECTION`] | assembler | linker | bytes computed from expressions no relocation can express, as bytecode |
+//! | [`VALUES_SECTION`] | assembler | linker | exported symbols whose value is an expression of others (`alias = imported + 1`) |
 //! | [`CONDES_SECTION`] | assembler | linker | routines for the linker's tables (`.constructor`, `.destructor`, `.interruptor`) |
 //! | [`FILL_SECTION`] | assembler | linker | reserved bytes (`.res`, `.align` without a fill value) that take the load area's fill value |
 //! | [`HOOKS_SECTION`] | linker | uploader, `scorpion sim` | which ROM hooks an image takes over, and where its fallthrough lives |
@@ -34,7 +35,7 @@ pub use assert::{AssertAction, Assertion, BinaryOp, EvalError, Expr, ExprOp, Una
 pub use builder::{ObjectBuilder, SectionId, SymbolDef, SymbolId};
 pub use codec::FormatError;
 pub use condes::{CondesEntry, MAX_CONDES_TYPE};
-pub use fields::{ExprField, FieldKind};
+pub use fields::{ExprField, ExprSymbol, FieldKind};
 pub use fill::FillRun;
 pub use hooks::{
     CHAIN_LOOP_SYMBOL, CHAIN_UNKNOWN_SYMBOL, HOOK_LOOP_SYMBOL, HOOK_UNKNOWN_SYMBOL, HookKind,
@@ -51,6 +52,8 @@ pub const SRCMAP_SECTION: &str = ".scorpion.srcmap";
 pub const ASSERT_SECTION: &str = ".scorpion.assert";
 /// Fields the linker computes from expressions (assembler to linker).
 pub const EXPRS_SECTION: &str = ".scorpion.exprs";
+/// Symbols whose value the linker computes (assembler to linker).
+pub const VALUES_SECTION: &str = ".scorpion.values";
 /// Routines for the linker's tables (assembler to linker).
 pub const CONDES_SECTION: &str = ".scorpion.condes";
 /// Reserved byte ranges that take the load area's fill value (assembler to

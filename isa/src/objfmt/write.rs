@@ -24,8 +24,8 @@ use object::elf;
 use object::write::elf::{FileHeader, Rel, SectionHeader, SectionIndex, Sym, Writer};
 
 use super::{
-    ASSERT_SECTION, Assertion, CONDES_SECTION, CondesEntry, EXPRS_SECTION, ExprField, FILL_SECTION,
-    FillRun, SRCMAP_SECTION, SrcMap,
+    ASSERT_SECTION, Assertion, CONDES_SECTION, CondesEntry, EXPRS_SECTION, ExprField, ExprSymbol,
+    FILL_SECTION, FillRun, SRCMAP_SECTION, SrcMap, VALUES_SECTION,
 };
 use crate::elf::{EF_MOS_ARCH_6502, EM_MOS, STO_MOS_ZEROPAGE};
 
@@ -150,6 +150,8 @@ pub struct RelObject {
     pub fields: Vec<ExprField>,
     /// `.scorpion.condes` (left out when empty), numbered the same way.
     pub condes: Vec<CondesEntry>,
+    /// `.scorpion.values` (left out when empty), numbered the same way.
+    pub values: Vec<ExprSymbol>,
 }
 
 impl Default for RelObject {
@@ -168,6 +170,7 @@ impl Default for RelObject {
             fills: Vec::new(),
             fields: Vec::new(),
             condes: Vec::new(),
+            values: Vec::new(),
         }
     }
 }
@@ -261,12 +264,14 @@ impl RelObject {
         let fills = (!self.fills.is_empty()).then(|| FillRun::encode_all(&self.fills));
         let fields = (!self.fields.is_empty()).then(|| ExprField::encode_all(&self.fields));
         let condes = (!self.condes.is_empty()).then(|| CondesEntry::encode_all(&self.condes));
+        let values = (!self.values.is_empty()).then(|| ExprSymbol::encode_all(&self.values));
         let metadata: Vec<(&str, Vec<u8>)> = [
             (SRCMAP_SECTION, srcmap),
             (ASSERT_SECTION, asserts),
             (FILL_SECTION, fills),
             (EXPRS_SECTION, fields),
             (CONDES_SECTION, condes),
+            (VALUES_SECTION, values),
         ]
         .into_iter()
         .filter_map(|(name, bytes)| Some((name, bytes?)))
