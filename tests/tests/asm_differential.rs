@@ -72,7 +72,7 @@ fn generated(program: &[(String, String)]) -> (Vec<(String, Vec<u8>)>, Vec<Strin
 /// Cases where ca65 + ld65 do not build the same bytes, and why. Each must
 /// still differ: a case that comes to match fails the test until it is
 /// taken off this list.
-const KNOWN_DIFFERENCES: [(&str, &str); 12] = [
+const KNOWN_DIFFERENCES: [(&str, &str); 11] = [
     (
         "define/ok_define.s",
         "ca65 2.19 gives 0 for `MAX(3, 9)` of this parameterised .define (issue 16)",
@@ -88,10 +88,6 @@ const KNOWN_DIFFERENCES: [(&str, &str); 12] = [
     (
         "linkage/ok_forceimport.s",
         "imports a symbol no other object defines (asm_multi/forceimport links it)",
-    ),
-    (
-        "org/ok_org.s",
-        "`.org` chunks: ld65 pads to the address, our flat link does not (issue 16)",
     ),
     (
         "relocations/ok_relocations.s",

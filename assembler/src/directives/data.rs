@@ -169,16 +169,13 @@ impl Asm<'_> {
         let align = align as u32;
         let seg = self.seg as usize;
         let cur = self.prog.segs[seg].cur as usize;
+        // ca65 aligns the offset in the segment, and the segment, even
+        // under `.org` (where `*` then moves by the padding whatever the
+        // address).
+        let s = &mut self.prog.segs[seg];
+        s.align = s.align.max(align);
         let chunk = &self.prog.chunks[cur];
-        if !chunk.org {
-            let s = &mut self.prog.segs[seg];
-            s.align = s.align.max(align);
-        }
-        let position = if chunk.org {
-            chunk.known_abs.map(|abs| abs + i64::from(chunk.len))
-        } else {
-            chunk.known_start.map(|start| i64::from(start + chunk.len))
-        };
+        let position = chunk.known_start.map(|start| i64::from(start + chunk.len));
         self.item(head.span, 0);
         match position {
             Some(position) => {

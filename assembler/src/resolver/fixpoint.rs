@@ -23,12 +23,10 @@ impl Asm<'_> {
                     Some(var) => {
                         let size = match var.kind {
                             VarKind::Instr { is_wide, .. } => 2 + u32::from(is_wide),
+                            // The offset in the segment, under `.org` too,
+                            // as ca65 aligns.
                             VarKind::Align { align, .. } => {
-                                let position = if chunk.org {
-                                    chunk.abs + i64::from(chunk.len)
-                                } else {
-                                    i64::from(end)
-                                };
+                                let position = i64::from(end);
                                 let align = i64::from(align);
                                 ((align - position.rem_euclid(align)) % align) as u32
                             }
