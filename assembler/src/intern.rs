@@ -117,6 +117,16 @@ directives! {
     OtherCpu = "p816" | "pc02" | "psc02" | "p4510";
     Paramcount = "paramcount";
     Cpu = "cpu";
+    Left = "left";
+    Mid = "mid";
+    Right = "right";
+    Concat = "concat";
+    String = "string";
+    Ident = "ident";
+    Sprintf = "sprintf";
+    Tcount = "tcount";
+    Match = "match";
+    Xmatch = "xmatch";
     Proc = "proc";
     Referenced = "referenced" | "ref";
     Reloc = "reloc";

@@ -403,7 +403,7 @@ impl Asm<'_> {
         })
     }
 
-    fn expect(&mut self, c: &mut Cursor<'_>, kind: Tok, what: &str) -> PResult<()> {
+    pub(crate) fn expect(&mut self, c: &mut Cursor<'_>, kind: Tok, what: &str) -> PResult<()> {
         if c.peek_kind() == Some(kind) {
             c.advance();
             return Ok(());
@@ -483,6 +483,14 @@ impl Asm<'_> {
                 }
                 self.expect(c, Tok::RParen, "`)`")?;
                 Ok(bool_node(self, count == 0))
+            }
+            Dir::Tcount => {
+                let count = self.tcount(c)?;
+                Ok(self.prog.node(Node::Const(count)))
+            }
+            Dir::Match | Dir::Xmatch => {
+                let answer = self.token_match(c, dir == Dir::Xmatch)?;
+                Ok(bool_node(self, answer))
             }
             // The instruction set now in use, as `.macpack cpu`'s masks
             // spell it.

@@ -28,6 +28,8 @@ pub(crate) struct Expander {
     pub(crate) line_ctx: CtxId,
     lines_read: u64,
     pub(crate) expansions: u32,
+    /// Sources made by token functions (`.concat`...), by text.
+    pub(crate) generated: std::collections::HashMap<Vec<u8>, u32>,
 }
 
 impl Expander {
@@ -47,6 +49,7 @@ impl Expander {
             line_ctx: 0,
             lines_read: 0,
             expansions: 0,
+            generated: std::collections::HashMap::new(),
         }
     }
 }
@@ -380,6 +383,10 @@ impl<'a> Asm<'a> {
         } else {
             if self.input.any_define && !self.input.toks.is_empty() {
                 self.substitute_defines();
+            }
+            // A failed token function is reported; the line is dropped.
+            if self.has_token_functions() && self.expand_token_functions().is_err() {
+                self.input.toks.clear();
             }
             let toks = std::mem::take(&mut self.input.toks);
             let mark = self.prog.nodes.len();

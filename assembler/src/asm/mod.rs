@@ -32,6 +32,7 @@ mod macros;
 mod segments;
 mod statements;
 mod symbols;
+mod tokenfns;
 
 /// An error already reported; the caller abandons the statement.
 #[derive(Debug, Clone, Copy)]
