@@ -8,6 +8,10 @@ pub struct Features {
     /// keeps its low byte (and a constant `.word`, its low 16 bits)
     /// instead of being an error.
     pub force_range: bool,
+    /// `org_per_seg`: `.org` and `.reloc` affect the current segment only
+    /// (without it, absolute mode is global and carries over when the
+    /// segment changes).
+    pub org_per_seg: bool,
 }
 
 /// Every feature ca65 2.19 knows.
@@ -49,6 +53,7 @@ impl Features {
     pub fn set(&mut self, name: &str, on: bool) -> Result<(), FeatureError> {
         match name.to_ascii_lowercase().as_str() {
             "force_range" => self.force_range = on,
+            "org_per_seg" => self.org_per_seg = on,
             other if CA65_FEATURES.contains(&other) => return Err(FeatureError::Unsupported),
             _ => return Err(FeatureError::Unknown),
         }

@@ -206,6 +206,10 @@ pub(crate) struct Chunk {
     pub(crate) org: bool,
     /// The `.org` value if this chunk starts with one.
     pub(crate) org_base: Option<i64>,
+    /// Absolute mode carried over from another segment's chunk (ca65's
+    /// `.org` is global unless `.feature org_per_seg`): this chunk starts
+    /// where that one ends.
+    pub(crate) org_after: Option<ChunkId>,
     /// Where the chunk's fixed bytes start in the segment's data.
     pub(crate) data_start: u32,
     /// Fixed bytes.

@@ -147,6 +147,9 @@ pub(crate) struct Asm<'a> {
     pub(crate) cpu_x: bool,
     /// The `.feature` switches in force.
     pub(crate) features: crate::Features,
+    /// ca65's global absolute mode: a `.org` is in force (until `.reloc`)
+    /// in whichever segment is current.
+    pub(crate) org_global: bool,
     /// `.autoimport on`: names never defined are imported.
     pub(crate) autoimport: bool,
     /// Labels' sizes: the bytes their line emits (`.sizeof(label)`).
@@ -188,6 +191,7 @@ impl<'a> Asm<'a> {
             charmap,
             cpu_x: opts.undocumented,
             features: opts.features,
+            org_global: false,
             autoimport: false,
             label_sizes: std::collections::HashMap::new(),
             used_undoc: false,

@@ -15,6 +15,7 @@ impl<'a> Asm<'a> {
             seg,
             org: false,
             org_base: None,
+            org_after: None,
             data_start: 0,
             len: 0,
             var: None,
@@ -46,6 +47,31 @@ impl<'a> Asm<'a> {
     /// Starts a new chunk in the current segment (after a variable item,
     /// or for `.org`/`.reloc`).
     pub(crate) fn new_chunk(&mut self, org: bool, org_base: Option<i64>) {
+        self.new_chunk_from(org, org_base, None);
+    }
+
+    /// Makes `seg` current. Under ca65's global `.org` (no `.feature
+    /// org_per_seg`), absolute mode follows: the segment goes on at the
+    /// address where the one left ends; after `.reloc`, it is relocatable
+    /// again.
+    pub(crate) fn switch_segment(&mut self, seg: SegId) {
+        if seg == self.seg {
+            return;
+        }
+        let left = self.prog.segs[self.seg as usize].cur;
+        self.seg = seg;
+        if self.features.org_per_seg {
+            return;
+        }
+        let target_org = self.prog.chunks[self.prog.segs[seg as usize].cur as usize].org;
+        if self.org_global {
+            self.new_chunk_from(true, None, Some(left));
+        } else if target_org {
+            self.new_chunk(false, None);
+        }
+    }
+
+    fn new_chunk_from(&mut self, org: bool, org_base: Option<i64>, org_after: Option<ChunkId>) {
         let seg = &self.prog.segs[self.seg as usize];
         let cur = &self.prog.chunks[seg.cur as usize];
         let continues = cur.var.is_none();
@@ -53,17 +79,25 @@ impl<'a> Asm<'a> {
             Some(start) if continues => Some(start + cur.len),
             _ => None,
         };
-        let known_abs = match org_base {
-            Some(base) => Some(base),
-            None if org && cur.org && continues => {
+        let known_abs = match (org_base, org_after) {
+            (Some(base), _) => Some(base),
+            (None, Some(after)) => {
+                let after = &self.prog.chunks[after as usize];
+                after
+                    .known_abs
+                    .filter(|_| after.var.is_none())
+                    .map(|abs| abs + i64::from(after.len))
+            }
+            (None, None) if org && cur.org && continues => {
                 cur.known_abs.map(|abs| abs + i64::from(cur.len))
             }
-            None => None,
+            (None, None) => None,
         };
         let chunk = Chunk {
             seg: self.seg,
             org,
             org_base,
+            org_after,
             data_start: seg.data.len() as u32,
             len: 0,
             var: None,

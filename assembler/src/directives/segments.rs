@@ -22,6 +22,7 @@ impl Asm<'_> {
             )));
         }
         self.new_chunk(true, Some(value));
+        self.org_global = !self.features.org_per_seg;
         Ok(())
     }
 
@@ -29,6 +30,7 @@ impl Asm<'_> {
         c.advance();
         self.expect_end(c)?;
         self.new_chunk(false, None);
+        self.org_global = false;
         Ok(())
     }
 
@@ -42,7 +44,8 @@ impl Asm<'_> {
             Dir::Bss => ("BSS", false),
             _ => ("ZEROPAGE", true),
         };
-        self.seg = self.segment(name, zp);
+        let seg = self.segment(name, zp);
+        self.switch_segment(seg);
         Ok(())
     }
 
@@ -94,7 +97,7 @@ impl Asm<'_> {
                 format!("segment `{text}` was first used as an absolute segment"),
             ));
         }
-        self.seg = seg;
+        self.switch_segment(seg);
         Ok(())
     }
 }

@@ -5,8 +5,25 @@ use crate::asm::Asm;
 use crate::model::{ChunkId, SegId, VarKind};
 
 impl Asm<'_> {
-    /// Places every chunk with the current sizes.
+    /// Places every chunk with the current sizes. Chunks whose absolute
+    /// address follows a chunk of another segment (global `.org`) take a
+    /// few rounds to settle.
     pub(super) fn place(&mut self) {
+        let carried = self.prog.chunks.iter().any(|c| c.org_after.is_some());
+        for _ in 0..16 {
+            let before: Vec<i64> = if carried {
+                self.prog.chunks.iter().map(|c| c.abs).collect()
+            } else {
+                Vec::new()
+            };
+            self.place_once();
+            if !carried || self.prog.chunks.iter().map(|c| c.abs).eq(before) {
+                return;
+            }
+        }
+    }
+
+    fn place_once(&mut self) {
         let prog = &mut self.prog;
         for seg in &mut prog.segs {
             let mut offset: u32 = 0;
@@ -17,6 +34,17 @@ impl Asm<'_> {
                 if chunk.org {
                     chunk.abs = chunk.org_base.unwrap_or(abs);
                 }
+                let after = chunk.org_after;
+                if let Some(after) = after.filter(|_| prog.chunks[c as usize].org_base.is_none()) {
+                    let from = &prog.chunks[after as usize];
+                    let var = from
+                        .var
+                        .and_then(|v| prog.vars.get(v as usize))
+                        .map_or(0, |v| v.size);
+                    let end = from.abs + i64::from(from.len) + i64::from(var);
+                    prog.chunks[c as usize].abs = end;
+                }
+                let chunk = &mut prog.chunks[c as usize];
                 let end = offset.saturating_add(chunk.len);
                 let var_size = match chunk.var.and_then(|v| prog.vars.get_mut(v as usize)) {
                     None => 0,
