@@ -73,13 +73,10 @@ pub(crate) fn define(text: &str) -> Result<(String, i64), String> {
     Ok((name.to_owned(), if negative { -number } else { number }))
 }
 
-/// `--feature NAME`: a ca65 feature this assembler implements.
+/// `--feature NAME`: a ca65 feature.
 pub(crate) fn feature(text: &str) -> Result<String, String> {
     match assembler::Features::default().set(text, true) {
         Ok(()) => Ok(text.to_ascii_lowercase()),
-        Err(assembler::FeatureError::Unsupported) => Err(format!(
-            "`{text}` is a ca65 feature this assembler does not support yet (it has: force_range)"
-        )),
         Err(assembler::FeatureError::Unknown) => Err(format!(
             "no feature `{text}`; ca65's: {}",
             assembler::CA65_FEATURES.join(", ")

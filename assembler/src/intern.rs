@@ -125,6 +125,8 @@ directives! {
     Ident = "ident";
     Sprintf = "sprintf";
     Tcount = "tcount";
+    Addrsize = "addrsize";
+    Linecont = "linecont";
     Match = "match";
     Xmatch = "xmatch";
     Proc = "proc";

@@ -4,10 +4,41 @@
 //! ca65's lexical rules: `;` comments, `$hex`, `%binary`, decimal and
 //! `0FFh` numbers, `'c'` characters, `"strings"` without escapes, `@cheap`
 //! locals, `.directives`, `:+`/`:-` unnamed-label references, `::` scope
-//! separators.
+//! separators; and what ca65's `.feature`s change in them
+//! ([`LexFeatures`]).
 
 use crate::diag::Span;
-use crate::intern::{Interner, NameId};
+use crate::intern::{Interner, Keyword, NameId};
+
+/// The `.feature`s that change how a line is read.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct LexFeatures {
+    /// `@` inside names.
+    pub(crate) at_in_identifiers: bool,
+    /// `$` inside names.
+    pub(crate) dollar_in_identifiers: bool,
+    /// `.name` that is no directive is a name.
+    pub(crate) leading_dot_in_identifiers: bool,
+    /// `_` between digits is ignored.
+    pub(crate) underline_in_numbers: bool,
+    /// `/* ... */` comments, across lines too.
+    pub(crate) c_comments: bool,
+    /// `'text'` is a string too.
+    pub(crate) loose_string_term: bool,
+    /// `'a` without its closing quote is a character.
+    pub(crate) missing_char_term: bool,
+    /// `\n`, `\t`, `\r`, `\\`, `\"`, `\'`, `\xHH` in strings.
+    pub(crate) string_escapes: bool,
+    /// `$` alone is the program counter.
+    pub(crate) dollar_is_pc: bool,
+    /// `[` and `]` are parentheses (indirect addressing).
+    pub(crate) bracket_as_indirect: bool,
+    /// `\` at the end of a line joins the next one.
+    pub(crate) line_continuations: bool,
+}
+
+/// A string token's `value`: its text has escapes to decode.
+pub(crate) const STRING_ESCAPED: u64 = 1;
 
 /// Token kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,6 +129,10 @@ pub(crate) struct Lexer {
     file: u32,
     pos: usize,
     line: u32,
+    /// The switches in force for the next line.
+    pub(crate) features: LexFeatures,
+    /// Inside a `/* */` comment that began on an earlier line.
+    in_comment: bool,
 }
 
 /// Bytes that continue an identifier: a table, as the lexer asks for
@@ -127,6 +162,8 @@ impl Lexer {
             file,
             pos: 0,
             line: 0,
+            features: LexFeatures::default(),
+            in_comment: false,
         }
     }
 
@@ -153,237 +190,334 @@ impl Lexer {
             return None;
         }
         self.line += 1;
+        let f = self.features;
+        let ident_char = |b: u8| {
+            is_ident_char(b)
+                || (f.at_in_identifiers && b == b'@')
+                || (f.dollar_in_identifiers && b == b'$')
+        };
         let line_start = self.pos;
-        let line_end = memchr_newline(text, self.pos);
+        let mut line_end = memchr_newline(text, self.pos);
         let mut end = line_end;
         if end > line_start && text[end - 1] == b'\r' {
             end -= 1;
         }
         self.pos = line_end + 1;
         let mut i = line_start;
-        while i < end {
-            let byte = text[i];
-            let start = i;
-            let simple = |kind: Tok, len: usize| (kind, len);
-            let (kind, len) = match byte {
-                b' ' | b'\t' | b'\x0C' => {
-                    i += 1;
-                    while i < end && matches!(text[i], b' ' | b'\t') {
+        loop {
+            if self.in_comment {
+                match find(text, i, end, b"*/") {
+                    Some(close) => {
+                        self.in_comment = false;
+                        i = close + 2;
+                    }
+                    None => i = end,
+                }
+            }
+            let mut continued = false;
+            while i < end {
+                let byte = text[i];
+                let start = i;
+                let simple = |kind: Tok, len: usize| (kind, len);
+                let (kind, len) = match byte {
+                    b' ' | b'\t' | b'\x0C' => {
                         i += 1;
+                        while i < end && matches!(text[i], b' ' | b'\t') {
+                            i += 1;
+                        }
+                        continue;
                     }
-                    continue;
-                }
-                b';' => break,
-                b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
-                    let mut j = i + 1;
-                    while j < end && is_ident_char(text[j]) {
-                        j += 1;
+                    b';' => break,
+                    b'/' if f.c_comments && text.get(i + 1) == Some(&b'*') && i + 1 < end => {
+                        match find(text, i + 2, end, b"*/") {
+                            Some(close) => i = close + 2,
+                            None => {
+                                self.in_comment = true;
+                                i = end;
+                            }
+                        }
+                        continue;
                     }
-                    let id = names.intern_bytes(&text[i..j]);
-                    out.push(Token {
-                        kind: Tok::Ident,
-                        span: self.span(i, j),
-                        value: u64::from(id),
-                    });
-                    i = j;
-                    continue;
-                }
-                b'@' | b'.' => {
-                    let mut j = i + 1;
-                    // A cheap local may start with a digit (`@1:`), as in
-                    // ca65; a directive may not.
-                    let starts = |b: u8| is_ident_start(b) || (byte == b'@' && b.is_ascii_digit());
-                    if j < end && starts(text[j]) {
-                        while j < end && is_ident_char(text[j]) {
+                    b'\\'
+                        if f.line_continuations
+                            && text[i + 1..end].iter().all(|b| matches!(b, b' ' | b'\t')) =>
+                    {
+                        continued = true;
+                        break;
+                    }
+                    b'[' if f.bracket_as_indirect => simple(Tok::LParen, 1),
+                    b']' if f.bracket_as_indirect => simple(Tok::RParen, 1),
+                    b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
+                        let mut j = i + 1;
+                        while j < end && ident_char(text[j]) {
                             j += 1;
                         }
                         let id = names.intern_bytes(&text[i..j]);
                         out.push(Token {
-                            kind: if byte == b'@' {
-                                Tok::Local
-                            } else {
-                                Tok::Directive
-                            },
+                            kind: Tok::Ident,
                             span: self.span(i, j),
                             value: u64::from(id),
-                        });
-                    } else {
-                        let what = if byte == b'@' {
-                            "`@` must start a cheap local label name (`@loop`)"
-                        } else {
-                            "`.` must start a directive name (`.byte`)"
-                        };
-                        errors.push((self.span(i, j), what.to_string()));
-                    }
-                    i = j;
-                    continue;
-                }
-                b'0'..=b'9' => {
-                    let mut j = i + 1;
-                    while j < end && is_ident_char(text[j]) {
-                        j += 1;
-                    }
-                    match number(&text[i..j]) {
-                        Ok(value) => out.push(Token {
-                            kind: Tok::Number,
-                            span: self.span(i, j),
-                            value,
-                        }),
-                        Err(message) => errors.push((self.span(i, j), message)),
-                    }
-                    i = j;
-                    continue;
-                }
-                b'$' | b'%' => {
-                    let radix = if byte == b'$' { 16 } else { 2 };
-                    let mut j = i + 1;
-                    while j < end && is_ident_char(text[j]) {
-                        j += 1;
-                    }
-                    let digits = &text[i + 1..j];
-                    match digits_value(digits, radix) {
-                        Ok(value) => out.push(Token {
-                            kind: Tok::Number,
-                            span: self.span(i, j),
-                            value,
-                        }),
-                        Err(message) => errors.push((self.span(i, j.max(i + 1)), message)),
-                    }
-                    i = j.max(i + 1);
-                    continue;
-                }
-                b'"' => {
-                    let close = text[i + 1..end].iter().position(|b| *b == b'"');
-                    match close {
-                        Some(len) => {
-                            let j = i + 1 + len + 1;
-                            out.push(Token {
-                                kind: Tok::Str,
-                                span: self.span(i, j),
-                                value: 0,
-                            });
-                            i = j;
-                        }
-                        None => {
-                            errors.push((
-                                self.span(i, end),
-                                "this string has no closing `\"` on its line".to_string(),
-                            ));
-                            i = end;
-                        }
-                    }
-                    continue;
-                }
-                b'\'' => {
-                    match char_constant(&text[i + 1..end]) {
-                        Some((value, len)) => {
-                            let j = i + 1 + len + 1;
-                            out.push(Token {
-                                kind: Tok::Char,
-                                span: self.span(i, j),
-                                value: u64::from(value),
-                            });
-                            i = j;
-                        }
-                        None => {
-                            // Skip to the closing quote, if any, so one bad
-                            // constant is one error.
-                            let j = text[i + 1..end]
-                                .iter()
-                                .position(|b| *b == b'\'')
-                                .map_or((i + 2).min(end), |len| i + 1 + len + 1);
-                            errors.push((
-                                self.span(i, j),
-                                "a character constant is one character between quotes (`'a'`)"
-                                    .to_string(),
-                            ));
-                            i = j;
-                        }
-                    }
-                    continue;
-                }
-                b'+' => simple(Tok::Plus, 1),
-                b'-' => simple(Tok::Minus, 1),
-                b'*' => simple(Tok::Star, 1),
-                b'/' => simple(Tok::Slash, 1),
-                b'~' => simple(Tok::Tilde, 1),
-                b'^' => simple(Tok::Caret, 1),
-                b'!' => simple(Tok::Bang, 1),
-                b'#' => simple(Tok::Hash, 1),
-                b',' => simple(Tok::Comma, 1),
-                b'(' => simple(Tok::LParen, 1),
-                b')' => simple(Tok::RParen, 1),
-                b'[' => simple(Tok::LBracket, 1),
-                b']' => simple(Tok::RBracket, 1),
-                b'{' => simple(Tok::LBrace, 1),
-                b'}' => simple(Tok::RBrace, 1),
-                b'=' => simple(Tok::Eq, 1),
-                b'&' => {
-                    if text.get(i + 1) == Some(&b'&') && i + 1 < end {
-                        (Tok::AndAnd, 2)
-                    } else {
-                        (Tok::Amp, 1)
-                    }
-                }
-                b'|' => {
-                    if i + 1 < end && text[i + 1] == b'|' {
-                        (Tok::OrOr, 2)
-                    } else {
-                        (Tok::Pipe, 1)
-                    }
-                }
-                b'<' => match text.get(i + 1).filter(|_| i + 1 < end) {
-                    Some(b'>') => (Tok::Ne, 2),
-                    Some(b'=') => (Tok::Le, 2),
-                    Some(b'<') => (Tok::Shl, 2),
-                    _ => (Tok::Lt, 1),
-                },
-                b'>' => match text.get(i + 1).filter(|_| i + 1 < end) {
-                    Some(b'=') => (Tok::Ge, 2),
-                    Some(b'>') => (Tok::Shr, 2),
-                    _ => (Tok::Gt, 1),
-                },
-                b':' => match text.get(i + 1).filter(|_| i + 1 < end) {
-                    Some(b':') => (Tok::ColonColon, 2),
-                    Some(b'=') => (Tok::Assign, 2),
-                    Some(sign @ (b'+' | b'-')) => {
-                        let mut j = i + 1;
-                        while j < end && text[j] == *sign {
-                            j += 1;
-                        }
-                        let count = (j - i - 1) as i64;
-                        let value = if *sign == b'+' { count } else { -count };
-                        out.push(Token {
-                            kind: Tok::Unnamed,
-                            span: self.span(i, j),
-                            value: value as u64,
                         });
                         i = j;
                         continue;
                     }
-                    _ => (Tok::Colon, 1),
-                },
-                _ => {
-                    // Skip a whole UTF-8 character so the span is readable.
-                    let mut j = i + 1;
-                    while j < end && (text[j] & 0xC0) == 0x80 {
-                        j += 1;
+                    b'@' | b'.' => {
+                        let mut j = i + 1;
+                        // A cheap local may start with a digit (`@1:`), as in
+                        // ca65; a directive may not.
+                        let starts =
+                            |b: u8| is_ident_start(b) || (byte == b'@' && b.is_ascii_digit());
+                        if j < end && starts(text[j]) {
+                            while j < end && ident_char(text[j]) {
+                                j += 1;
+                            }
+                            let id = names.intern_bytes(&text[i..j]);
+                            // `.feature leading_dot_in_identifiers`: a dotted
+                            // name that is no directive is a name.
+                            let dotted_name = byte == b'.'
+                                && f.leading_dot_in_identifiers
+                                && !matches!(names.keyword(id), Keyword::Directive(_));
+                            out.push(Token {
+                                kind: if byte == b'@' {
+                                    Tok::Local
+                                } else if dotted_name {
+                                    Tok::Ident
+                                } else {
+                                    Tok::Directive
+                                },
+                                span: self.span(i, j),
+                                value: u64::from(id),
+                            });
+                        } else {
+                            let what = if byte == b'@' {
+                                "`@` must start a cheap local label name (`@loop`)"
+                            } else {
+                                "`.` must start a directive name (`.byte`)"
+                            };
+                            errors.push((self.span(i, j), what.to_string()));
+                        }
+                        i = j;
+                        continue;
                     }
-                    let shown = String::from_utf8_lossy(&text[i..j]).into_owned();
-                    errors.push((
-                        self.span(i, j),
-                        format!("unexpected character `{}`", shown.escape_debug()),
-                    ));
-                    i = j;
-                    continue;
-                }
-            };
-            out.push(Token {
-                kind,
-                span: self.span(start, start + len),
-                value: 0,
-            });
-            i = start + len;
+                    b'0'..=b'9' => {
+                        let mut j = i + 1;
+                        while j < end && is_ident_char(text[j]) {
+                            j += 1;
+                        }
+                        match number(&digits_of(&text[i..j], f.underline_in_numbers)) {
+                            Ok(value) => out.push(Token {
+                                kind: Tok::Number,
+                                span: self.span(i, j),
+                                value,
+                            }),
+                            Err(message) => errors.push((self.span(i, j), message)),
+                        }
+                        i = j;
+                        continue;
+                    }
+                    b'$' if f.dollar_is_pc
+                        && !text[i + 1..end].first().is_some_and(u8::is_ascii_hexdigit) =>
+                    {
+                        simple(Tok::Star, 1)
+                    }
+                    b'$' | b'%' => {
+                        let radix = if byte == b'$' { 16 } else { 2 };
+                        let mut j = i + 1;
+                        while j < end && is_ident_char(text[j]) {
+                            j += 1;
+                        }
+                        let digits = digits_of(&text[i + 1..j], f.underline_in_numbers);
+                        match digits_value(&digits, radix) {
+                            Ok(value) => out.push(Token {
+                                kind: Tok::Number,
+                                span: self.span(i, j),
+                                value,
+                            }),
+                            Err(message) => errors.push((self.span(i, j.max(i + 1)), message)),
+                        }
+                        i = j.max(i + 1);
+                        continue;
+                    }
+                    b'"' => {
+                        let close = closing_quote(text, i + 1, end, b'"', f.string_escapes);
+                        match close {
+                            Some(close) => {
+                                let j = close + 1;
+                                let escaped =
+                                    f.string_escapes && text[i + 1..close].contains(&b'\\');
+                                out.push(Token {
+                                    kind: Tok::Str,
+                                    span: self.span(i, j),
+                                    value: if escaped { STRING_ESCAPED } else { 0 },
+                                });
+                                i = j;
+                            }
+                            None => {
+                                errors.push((
+                                    self.span(i, end),
+                                    "this string has no closing `\"` on its line".to_string(),
+                                ));
+                                i = end;
+                            }
+                        }
+                        continue;
+                    }
+                    // `.feature loose_string_term`: 'text' is a string.
+                    b'\''
+                        if f.loose_string_term
+                            && char_constant(&text[i + 1..end]).is_none()
+                            && closing_quote(text, i + 1, end, b'\'', f.string_escapes)
+                                .is_some() =>
+                    {
+                        let close =
+                            closing_quote(text, i + 1, end, b'\'', f.string_escapes).unwrap_or(end);
+                        let escaped = f.string_escapes && text[i + 1..close].contains(&b'\\');
+                        out.push(Token {
+                            kind: Tok::Str,
+                            span: self.span(i, close + 1),
+                            value: if escaped { STRING_ESCAPED } else { 0 },
+                        });
+                        i = close + 1;
+                        continue;
+                    }
+                    // `.feature missing_char_term`: 'a with no closing quote.
+                    b'\''
+                        if f.missing_char_term
+                            && char_constant(&text[i + 1..end]).is_none()
+                            && text.get(i + 1).is_some_and(|b| b.is_ascii() && *b != b'\'')
+                            && i + 1 < end =>
+                    {
+                        out.push(Token {
+                            kind: Tok::Char,
+                            span: self.span(i, i + 2),
+                            value: u64::from(text[i + 1]),
+                        });
+                        i += 2;
+                        continue;
+                    }
+                    b'\'' => {
+                        match char_constant(&text[i + 1..end]) {
+                            Some((value, len)) => {
+                                let j = i + 1 + len + 1;
+                                out.push(Token {
+                                    kind: Tok::Char,
+                                    span: self.span(i, j),
+                                    value: u64::from(value),
+                                });
+                                i = j;
+                            }
+                            None => {
+                                // Skip to the closing quote, if any, so one bad
+                                // constant is one error.
+                                let j = text[i + 1..end]
+                                    .iter()
+                                    .position(|b| *b == b'\'')
+                                    .map_or((i + 2).min(end), |len| i + 1 + len + 1);
+                                errors.push((
+                                    self.span(i, j),
+                                    "a character constant is one character between quotes (`'a'`)"
+                                        .to_string(),
+                                ));
+                                i = j;
+                            }
+                        }
+                        continue;
+                    }
+                    b'+' => simple(Tok::Plus, 1),
+                    b'-' => simple(Tok::Minus, 1),
+                    b'*' => simple(Tok::Star, 1),
+                    b'/' => simple(Tok::Slash, 1),
+                    b'~' => simple(Tok::Tilde, 1),
+                    b'^' => simple(Tok::Caret, 1),
+                    b'!' => simple(Tok::Bang, 1),
+                    b'#' => simple(Tok::Hash, 1),
+                    b',' => simple(Tok::Comma, 1),
+                    b'(' => simple(Tok::LParen, 1),
+                    b')' => simple(Tok::RParen, 1),
+                    b'[' => simple(Tok::LBracket, 1),
+                    b']' => simple(Tok::RBracket, 1),
+                    b'{' => simple(Tok::LBrace, 1),
+                    b'}' => simple(Tok::RBrace, 1),
+                    b'=' => simple(Tok::Eq, 1),
+                    b'&' => {
+                        if text.get(i + 1) == Some(&b'&') && i + 1 < end {
+                            (Tok::AndAnd, 2)
+                        } else {
+                            (Tok::Amp, 1)
+                        }
+                    }
+                    b'|' => {
+                        if i + 1 < end && text[i + 1] == b'|' {
+                            (Tok::OrOr, 2)
+                        } else {
+                            (Tok::Pipe, 1)
+                        }
+                    }
+                    b'<' => match text.get(i + 1).filter(|_| i + 1 < end) {
+                        Some(b'>') => (Tok::Ne, 2),
+                        Some(b'=') => (Tok::Le, 2),
+                        Some(b'<') => (Tok::Shl, 2),
+                        _ => (Tok::Lt, 1),
+                    },
+                    b'>' => match text.get(i + 1).filter(|_| i + 1 < end) {
+                        Some(b'=') => (Tok::Ge, 2),
+                        Some(b'>') => (Tok::Shr, 2),
+                        _ => (Tok::Gt, 1),
+                    },
+                    b':' => match text.get(i + 1).filter(|_| i + 1 < end) {
+                        Some(b':') => (Tok::ColonColon, 2),
+                        Some(b'=') => (Tok::Assign, 2),
+                        Some(sign @ (b'+' | b'-')) => {
+                            let mut j = i + 1;
+                            while j < end && text[j] == *sign {
+                                j += 1;
+                            }
+                            let count = (j - i - 1) as i64;
+                            let value = if *sign == b'+' { count } else { -count };
+                            out.push(Token {
+                                kind: Tok::Unnamed,
+                                span: self.span(i, j),
+                                value: value as u64,
+                            });
+                            i = j;
+                            continue;
+                        }
+                        _ => (Tok::Colon, 1),
+                    },
+                    _ => {
+                        // Skip a whole UTF-8 character so the span is readable.
+                        let mut j = i + 1;
+                        while j < end && (text[j] & 0xC0) == 0x80 {
+                            j += 1;
+                        }
+                        let shown = String::from_utf8_lossy(&text[i..j]).into_owned();
+                        errors.push((
+                            self.span(i, j),
+                            format!("unexpected character `{}`", shown.escape_debug()),
+                        ));
+                        i = j;
+                        continue;
+                    }
+                };
+                out.push(Token {
+                    kind,
+                    span: self.span(start, start + len),
+                    value: 0,
+                });
+                i = start + len;
+            }
+            // `\` at the end: the next physical line goes on this one.
+            if !continued || self.pos >= text.len() {
+                break;
+            }
+            self.line += 1;
+            i = self.pos;
+            line_end = memchr_newline(text, self.pos);
+            end = line_end;
+            if end > i && text[end - 1] == b'\r' {
+                end -= 1;
+            }
+            self.pos = line_end + 1;
         }
         Some(LineInfo {
             file: self.file,
@@ -393,6 +527,80 @@ impl Lexer {
             ascii: text[line_start..end].is_ascii(),
         })
     }
+}
+
+/// Where `needle` starts in `text[from..to]`, if it does.
+fn find(text: &[u8], from: usize, to: usize, needle: &[u8]) -> Option<usize> {
+    text.get(from..to)?
+        .windows(needle.len())
+        .position(|w| w == needle)
+        .map(|at| from + at)
+}
+
+/// The closing `quote` of a string or character whose text starts at
+/// `from`, skipping `\`-escaped characters when `escapes`.
+fn closing_quote(text: &[u8], from: usize, to: usize, quote: u8, escapes: bool) -> Option<usize> {
+    let mut i = from;
+    while i < to {
+        match text[i] {
+            b'\\' if escapes => i += 2,
+            b if b == quote => return Some(i),
+            _ => i += 1,
+        }
+    }
+    None
+}
+
+/// A number's digits, without the `_`s that `.feature
+/// underline_in_numbers` allows between them.
+fn digits_of(digits: &[u8], underline: bool) -> std::borrow::Cow<'_, [u8]> {
+    if underline && digits.contains(&b'_') {
+        std::borrow::Cow::Owned(digits.iter().copied().filter(|b| *b != b'_').collect())
+    } else {
+        std::borrow::Cow::Borrowed(digits)
+    }
+}
+
+/// A string's bytes with its escapes decoded (`.feature string_escapes`):
+/// `\n` `\r` `\t` `\\` `\"` `\'` and `\xHH`; another escaped character stands
+/// for itself.
+pub(crate) fn unescape(raw: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(raw.len());
+    let mut i = 0;
+    while i < raw.len() {
+        if raw[i] != b'\\' || i + 1 >= raw.len() {
+            out.push(raw[i]);
+            i += 1;
+            continue;
+        }
+        let next = raw[i + 1];
+        i += 2;
+        match next {
+            b'n' => out.push(b'\n'),
+            b'r' => out.push(b'\r'),
+            b't' => out.push(b'\t'),
+            b'x' => {
+                let hex: Vec<u8> = raw[i..]
+                    .iter()
+                    .take(2)
+                    .take_while(|b| b.is_ascii_hexdigit())
+                    .copied()
+                    .collect();
+                let value = std::str::from_utf8(&hex)
+                    .ok()
+                    .and_then(|h| u8::from_str_radix(h, 16).ok());
+                match value {
+                    Some(value) => {
+                        out.push(value);
+                        i += hex.len();
+                    }
+                    None => out.push(b'x'),
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    out
 }
 
 fn memchr_newline(text: &[u8], from: usize) -> usize {

@@ -558,6 +558,15 @@ impl Asm<'_> {
                     .prog
                     .node(Node::Const(i64::from(self.charmap[usize::from(byte)]))))
             }
+            // `.addrsize(name)` (`.feature addrsize`): 1 for zero page, 2
+            // absolute, 3 far, 0 unknown, as ca65's.
+            Dir::Addrsize if self.features.addrsize => {
+                self.expect(c, Tok::LParen, "`(`")?;
+                let sym = self.symbol_ref(c)?;
+                self.expect(c, Tok::RParen, "`)`")?;
+                let size = self.address_size(sym);
+                Ok(self.prog.node(Node::Const(size)))
+            }
             Dir::Sizeof => {
                 self.expect(c, Tok::LParen, "`(`")?;
                 let node = self.sizeof(c)?;
@@ -572,6 +581,34 @@ impl Asm<'_> {
                     format!("`{name}` cannot be used in an expression"),
                 ))
             }
+        }
+    }
+
+    /// A symbol's address size as ca65 numbers it.
+    fn address_size(&mut self, sym: SymId) -> i64 {
+        let by_value = |value: i64| match value {
+            0..=0xFF => 1,
+            0x100..=0xFFFF => 2,
+            _ => 3,
+        };
+        match self.prog.syms[sym as usize].def {
+            SymDef::Import { zp } => {
+                if zp {
+                    1
+                } else {
+                    2
+                }
+            }
+            SymDef::Undefined => 0,
+            _ => match self.prog.eval_sym(sym) {
+                Ok(Value::Const(value)) => by_value(value),
+                Ok(Value::Addr {
+                    base: crate::expr::Base::Sec(seg),
+                    ..
+                }) if self.prog.segs[seg as usize].zp => 1,
+                Ok(_) => 2,
+                Err(_) => 0,
+            },
         }
     }
 
@@ -640,6 +677,9 @@ impl Asm<'_> {
         let end = (tok.span.end as usize)
             .saturating_sub(1)
             .clamp(start, text.len());
+        if tok.value == crate::lexer::STRING_ESCAPED {
+            return crate::lexer::unescape(&text[start..end]);
+        }
         text[start..end].to_vec()
     }
 

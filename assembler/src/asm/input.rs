@@ -156,6 +156,7 @@ impl<'a> Asm<'a> {
     /// Reads the next line into `self.input.toks`. `Some(None)` means the
     /// innermost frame ended; `None` that no input is left.
     fn fetch(&mut self) -> Option<Option<LineInfo>> {
+        let features = self.features.lexer();
         let frame = self.input.frames.last_mut()?;
         self.input.toks.clear();
         match frame {
@@ -163,6 +164,7 @@ impl<'a> Asm<'a> {
                 text, lexer, ctx, ..
             } => {
                 self.input.line_ctx = *ctx;
+                lexer.features = features;
                 Some(lexer.next_line(
                     text,
                     &mut self.names,

@@ -49,6 +49,12 @@ impl<'a> Asm<'a> {
             (Tok::Ident | Tok::Local, Some(Tok::Eq | Tok::Assign)) => {
                 return self.assignment(&mut c);
             }
+            // `.feature pc_assignment`: `* = addr` is `.org addr`.
+            (Tok::Star, Some(Tok::Eq)) if self.features.pc_assignment => {
+                // `.org` reads its value after the token at the cursor.
+                c.advance();
+                return self.directive(Dir::Org, &mut c);
+            }
             (Tok::Ident, Some(Tok::Directive))
                 if self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set) =>
             {
@@ -76,6 +82,15 @@ impl<'a> Asm<'a> {
                 }
                 match info.keyword {
                     Keyword::Mnemonic(mnemonic) => self.instruction(mnemonic, &mut c),
+                    // `.feature labels_without_colons`: a name at the very
+                    // start of the line is a label.
+                    _ if self.features.labels_without_colons
+                        && c.pos() == 0
+                        && head.span.start == self.input.line.start =>
+                    {
+                        *label = Some(self.define_label(&head)?);
+                        self.labelled_statement(&t[1..], &mut None)
+                    }
                     _ => {
                         let name = self.names.name(head.name()).to_string();
                         // `name` alone, or before an instruction: a label

@@ -230,8 +230,11 @@ impl<'a> Asm<'a> {
         }
         let what = match self.names.keyword(tok.name()) {
             Keyword::RegA | Keyword::RegX | Keyword::RegY => "a register",
+            // `.feature ubiquitous_idents`: instruction names are free.
             Keyword::Mnemonic(mnemonic)
-                if instructions_too && (mnemonic.is_documented() || self.cpu_x) =>
+                if instructions_too
+                    && !self.features.ubiquitous_idents
+                    && (mnemonic.is_documented() || self.cpu_x) =>
             {
                 "an instruction"
             }

@@ -120,13 +120,6 @@ impl Asm<'_> {
             let name = self.names.name(tok.name()).to_ascii_lowercase();
             match self.features.set(&name, on) {
                 Ok(()) => {}
-                Err(crate::FeatureError::Unsupported) => {
-                    self.report(diag::warning(
-                        "asm::feature",
-                        tok.span,
-                        format!("`.feature {name}` is not supported by this assembler yet; it is ignored"),
-                    ));
-                }
                 Err(crate::FeatureError::Unknown) => {
                     return Err(self.report(
                         diag::error("asm::feature", tok.span, format!("no feature `{name}`")).help(
@@ -177,7 +170,7 @@ impl Asm<'_> {
 
     /// The operand of a switch: `on`, `off`, `+` or `-`, then the end of
     /// the line.
-    fn switch(&mut self, c: &mut Cursor<'_>) -> PResult<bool> {
+    pub(super) fn switch(&mut self, c: &mut Cursor<'_>) -> PResult<bool> {
         c.advance();
         let on = match c.peek() {
             Some(tok) if tok.kind == Tok::Plus => true,

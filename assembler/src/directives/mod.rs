@@ -42,6 +42,11 @@ impl Asm<'_> {
             Dir::Align => self.align(c),
             Dir::Charmap => self.charmap(c),
             Dir::Org => self.org(c),
+            // ca65 2.19's `.linecont +`: `.feature line_continuations`.
+            Dir::Linecont => {
+                self.features.line_continuations = self.switch(c)?;
+                Ok(())
+            }
             Dir::Reloc => self.reloc(c),
             Dir::Segment => self.segment_directive(c),
             Dir::Code | Dir::Rodata | Dir::Data | Dir::Bss | Dir::Zeropage => {
