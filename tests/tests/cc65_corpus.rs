@@ -405,6 +405,82 @@ fn asminc_files_are_accepted_where_ca65_accepts_them() {
     report(failures, total);
 }
 
+/// A program using each macro file of `asminc/` (`*.mac`), included as a
+/// ca65 project includes it: what including alone cannot show.
+const MACRO_USES: [(&str, &str); 7] = [
+    ("apple2.mac", "scrcode \"Hello, World! @[]abc\", 65, 'x'\n"),
+    ("atari.mac", "scrcode \"Hello, World! @[]abc\", 65, 'x'\n"),
+    (
+        "cbm.mac",
+        "scrcode \"Hello, World! @[]abc\", 65, 'x'\n        .byte scrbyte('a')\n",
+    ),
+    (
+        "cpu.mac",
+        ".byte <CPU_6502X, <CPU_65C02, >CPU_4510\n.if .cpu .bitand CPU_ISET_6502\n        nop\n.endif\n",
+    ),
+    (
+        "generic.mac",
+        "add #1\n        sub $10\n        add $1234, x\nback:   bge back\n        blt back\n        bgt back\n        ble back\n        bnz back\n        bze back\n",
+    ),
+    (
+        "longbranch.mac",
+        "back:   jeq back\n        jne fwd\n        jcc back\n        .res 200\n        jcs back\nfwd:    jmi fwd\n        jpl back\n        jvc back\n        jvs back\n",
+    ),
+    ("module.mac", "module_header _drv\n        .byte 1\n"),
+];
+
+#[test]
+fn asminc_macro_files_expand_as_ca65_expands_them() {
+    let test = "asminc_macro_files_expand_as_ca65_expands_them";
+    let Some(share) = share(test) else { return };
+    let Some((ca65, ld65)) = toolchain(test) else {
+        return;
+    };
+    let asminc = share.join("asminc");
+    let shipped: Vec<String> = files_with(&asminc, "mac")
+        .iter()
+        .map(|p| name_of(p))
+        .collect();
+    let covered: Vec<String> = MACRO_USES
+        .iter()
+        .map(|(name, _)| (*name).to_owned())
+        .collect();
+    assert_eq!(
+        shipped, covered,
+        "every macro file of the package is used here"
+    );
+    let cfg = "MEMORY { ZP: start = $0000, size = $0100, type = rw, file = \"\"; MAIN: start = $0800, size = $7800, file = %O; }\nSEGMENTS { ZEROPAGE: load = ZP, type = zp, optional = yes; CODE: load = MAIN, type = ro; RODATA: load = MAIN, type = ro, optional = yes; HEADER: load = MAIN, type = ro, optional = yes; }\n";
+    let mut failures = Vec::new();
+    for (name, uses) in MACRO_USES {
+        let mut files: Files = vec![(
+            "program.s".to_owned(),
+            format!("        .include \"{name}\"\n        .code\n        {uses}").into_bytes(),
+        )];
+        for path in files_with(&asminc, "mac")
+            .iter()
+            .chain(&files_with(&asminc, "inc"))
+        {
+            files.push((name_of(path), std::fs::read(path).expect("an include")));
+        }
+        if let Err(failure) = compare(
+            name,
+            &files,
+            &["program.s".to_owned()],
+            cfg,
+            (ca65.as_path(), ld65.as_path()),
+        ) {
+            failures.push(failure);
+        }
+    }
+    row(
+        "asminc macro files (each used by a program)",
+        MACRO_USES.len(),
+        MACRO_USES.len() - failures.len(),
+        &[],
+    );
+    report(failures, MACRO_USES.len());
+}
+
 /// The words after `key =` in an item's attributes (`type`, `define`).
 fn attribute<'a>(item: &'a str, key: &str) -> Option<&'a str> {
     let mut rest = item;

@@ -424,6 +424,16 @@ impl<'a> Asm<'a> {
                 seen_else: false,
             }),
             Dir::Else | Dir::Elseif | Dir::Endif => {
+                // An `.elseif` condition reads as any line: defines and
+                // token functions first.
+                if dir == Dir::Elseif {
+                    if self.input.any_define {
+                        self.substitute_defines();
+                    }
+                    if self.has_token_functions() && self.expand_token_functions().is_err() {
+                        return;
+                    }
+                }
                 let toks = std::mem::take(&mut self.input.toks);
                 let mut c = self.cursor(&toks);
                 let _ = self.conditional(dir, &mut c);
@@ -501,6 +511,41 @@ impl<'a> Asm<'a> {
                     }
                     args.push(current);
                     j += 1;
+                } else {
+                    // `name arg, arg` without parentheses, as ca65 takes it
+                    // (cbm.mac's `scrbyte {char}`): each argument a braced
+                    // list or the tokens up to a comma, one per parameter.
+                    for index in 0..define.params.len() {
+                        if index > 0 {
+                            if toks.get(j).map(|t| t.kind) != Some(Tok::Comma) {
+                                break;
+                            }
+                            j += 1;
+                        }
+                        let mut current = Vec::new();
+                        let mut depth = 0usize;
+                        while let Some(&t) = toks.get(j) {
+                            match t.kind {
+                                Tok::Comma if depth == 0 => break,
+                                Tok::LParen | Tok::LBrace => depth += 1,
+                                Tok::RParen | Tok::RBrace => depth = depth.saturating_sub(1),
+                                _ => {}
+                            }
+                            current.push(t);
+                            j += 1;
+                        }
+                        args.push(current);
+                    }
+                }
+                // A braced argument stands for what is inside the braces.
+                for arg in &mut args {
+                    if arg.len() >= 2
+                        && arg.first().map(|t| t.kind) == Some(Tok::LBrace)
+                        && arg.last().map(|t| t.kind) == Some(Tok::RBrace)
+                    {
+                        arg.pop();
+                        arg.remove(0);
+                    }
                 }
                 for t in &define.tokens {
                     let param = if t.kind == Tok::Ident {
