@@ -126,6 +126,7 @@ directives! {
     Sprintf = "sprintf";
     Tcount = "tcount";
     Addrsize = "addrsize";
+    Version = "version";
     Linecont = "linecont";
     Match = "match";
     Xmatch = "xmatch";

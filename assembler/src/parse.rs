@@ -26,6 +26,9 @@ use crate::model::{GLOBAL_SCOPE, Node, NodeId, ScopeId, SymDef, SymId};
 
 const MAX_NESTING: u32 = 256;
 
+/// `.version`: ca65 2.18, as Debian's ca65 2.19 package reports itself.
+const CA65_VERSION: i64 = 2 * 0x100 + 18 * 0x10;
+
 impl Asm<'_> {
     fn directive_of(&self, tok: &Token) -> Option<Dir> {
         if tok.kind != Tok::Directive {
@@ -484,6 +487,9 @@ impl Asm<'_> {
                 self.expect(c, Tok::RParen, "`)`")?;
                 Ok(bool_node(self, count == 0))
             }
+            // The ca65 this assembler answers for: Debian's, which calls
+            // itself 2.18 (major * $100 + minor * $10).
+            Dir::Version => Ok(self.prog.node(Node::Const(CA65_VERSION))),
             Dir::Tcount => {
                 let count = self.tcount(c)?;
                 Ok(self.prog.node(Node::Const(count)))
@@ -633,6 +639,13 @@ impl Asm<'_> {
                 (Some(s), _) => self.child_scope(s, tok.name()),
             };
             let Some(found) = found else {
+                // A struct member's size (`.sizeof(HDR::JUMPTAB)`).
+                if let Some(outer) = scope
+                    && let Some(sym) = self.find_sym(outer, tok.name())
+                    && let Some(&size) = self.label_sizes.get(&sym)
+                {
+                    return Ok(self.prog.node(Node::Const(size)));
+                }
                 // A label's size: what its line emitted.
                 if scope.is_none() && !absolute {
                     let mut at = self.symtab.scope;

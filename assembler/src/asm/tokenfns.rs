@@ -145,17 +145,17 @@ impl Asm<'_> {
                 }
                 vec![self.generated_string(&text, span)]
             }
+            // A name's text, or a constant's value in decimal, as ca65's.
             Dir::String => {
                 let text = match braced(&args[0]) {
                     [tok] if tok.kind == Tok::Ident || tok.kind == Tok::Local => {
                         self.names.name(tok.name()).as_bytes().to_vec()
                     }
-                    _ => {
-                        return Err(self.err(
-                            "asm::syntax",
-                            span,
-                            "`.string` takes one name (`.string(label)`)",
-                        ));
+                    list => {
+                        let list = list.to_vec();
+                        self.constant_of(&list, span, "a name or a constant")?
+                            .to_string()
+                            .into_bytes()
                     }
                 };
                 vec![self.generated_string(&text, span)]

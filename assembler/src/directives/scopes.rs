@@ -252,6 +252,7 @@ impl Asm<'_> {
                     self.reserved_name(&name, false)?;
                     let sym = self.sym_in(scope, name.name());
                     self.define(sym, SymDef::Const(here), name.span)?;
+                    self.label_sizes.insert(sym, size);
                 }
                 return Ok(Line::Member(size));
             }
@@ -269,6 +270,8 @@ impl Asm<'_> {
             let sym = self.sym_in(scope, name.name());
             let value = if union { 0 } else { offset };
             self.define(sym, SymDef::Const(value), name.span)?;
+            // `.sizeof(S::member)`.
+            self.label_sizes.insert(sym, member_size);
         }
         Ok(Line::Member(member_size))
     }

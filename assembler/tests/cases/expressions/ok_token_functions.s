@@ -7,7 +7,8 @@
         .byte .mid(2, 1, {1, 2, 3})
         .byte .right(1, {1, 2, 3})
         .byte .concat("ab", "c"), .strlen(.concat("x", "yz"))
-        .byte .string(foo)
+        .byte .string(foo), .string(3 + 4), .string(>.version)
+        .word .version
 .ident(.concat("lab", "el")):
         .word label
         .byte .sprintf("%d-%02x-%s-%c-%5d-%-3d|", 5, 10, "hi", 65, 42, 7)

@@ -18,3 +18,4 @@
 .endstruct
         .byte   HDR::JUMPTAB, HDR::INSTALL, HDR::REMOVE, HDR::FLAGS
         .byte   HDR::WIDE, HDR::NARROW, HDR::FAR, HDR::LAST, .sizeof(HDR)
+        .byte   .sizeof(HDR::JUMPTAB), .sizeof(HDR::FLAGS), .sizeof(HDR::FAR)
