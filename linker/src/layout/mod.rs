@@ -91,6 +91,26 @@
 //! `__NAME_SIZE__` are the segment's load address, run address and size,
 //! as ld65's `define = yes` makes them.
 
+//!
+//! # ld65 configurations (`--target FILE.cfg`)
+//!
+//! [`Layout::from_ld65`] reads ld65 2.19's configuration language, so a
+//! ca65 project links with its own file: `MEMORY` (`start`, `size`,
+//! `file` (`%O`, `""` or another name), `fill`, `fillval`, `define`,
+//! `type`, `bank`), `SEGMENTS` (`load`, `run`, `type` (`ro` by default),
+//! `align` (any value, as GEOS's 254), `align_load`, `start`, `offset`,
+//! `optional`, `define`), `SYMBOLS` (`export`, `weak`, `import`),
+//! `FEATURES` (`CONDES` tables the linker fills from the objects'
+//! `.constructor` and kin, `STARTADDRESS`), `FILES` (`bin`, `atari`) and
+//! `FORMATS` (`atari: runad, initad`). An area's start and size may name
+//! symbols (`start = __HEADER_LAST__`, `size = __HIMEM__ - __MAIN_START__`,
+//! `%S`); they are [`Expr`]s evaluated when placement reaches the area, as
+//! ld65 evaluates them. As ld65: segment starts are not aligned, bytes
+//! loaded where no file goes are dropped, and a BSS segment inside a
+//! written area takes no room in the binary file
+//! ([`crate::Linked::write`]). o65 output and `type = overwrite` are
+//! refused by name.
+
 mod builtin;
 mod expr;
 mod file;
