@@ -162,9 +162,12 @@ pub(crate) fn link_and_write(
     report_warnings(&mut linked);
     let bytes = linked.write(args.format)?;
     write(output, &bytes)?;
+    let mut others = Vec::new();
     for file in &linked.other_files {
         let path = PathBuf::from(file.path(&output.display().to_string()));
-        write(&path, &file.bytes())?;
+        let bytes = file.bytes();
+        write(&path, &bytes)?;
+        others.push(format!("{} ({} bytes)", path.display(), bytes.len()));
     }
     if let Some(path) = &args.map {
         write(path, linked.map().as_bytes())?;
@@ -172,7 +175,7 @@ pub(crate) fn link_and_write(
     if let Some(path) = &args.labels {
         write(path, linked.vice_labels().as_bytes())?;
     }
-    summary(&linked, args, output);
+    summary(&linked, args, output, &others);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -191,7 +194,7 @@ fn report_warnings(linked: &mut Linked) {
     }
 }
 
-fn summary(linked: &Linked, args: &LinkArgs, output: &Path) {
+fn summary(linked: &Linked, args: &LinkArgs, output: &Path, others: &[String]) {
     let image = &linked.image;
     let ranges: Vec<String> = image
         .areas
@@ -215,6 +218,9 @@ fn summary(linked: &Linked, args: &LinkArgs, output: &Path) {
             },
             image.entry
         );
+        if !others.is_empty() {
+            println!("also wrote {}", others.join(", "));
+        }
     }
 }
 

@@ -89,6 +89,15 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
             )
         })?;
         Target::Custom(linker::Layout::from_toml(&spec.target, &text)?)
+    } else if spec.target.ends_with(".cfg") {
+        let text = std::fs::read_to_string(project.path(&spec.target)).map_err(|e| {
+            miette::miette!(
+                "image {}: cannot read the ld65 configuration {}: {e}",
+                spec.name,
+                spec.target
+            )
+        })?;
+        Target::Custom(linker::Layout::from_ld65(&spec.target, &text, None)?)
     } else {
         Target::builtin(&spec.target, None)?
     };

@@ -57,7 +57,8 @@ pub(crate) struct ImageSpec {
     pub(crate) name: String,
     /// The sources, in link order, relative to the project.
     pub(crate) sources: Vec<String>,
-    /// A built-in target (`scorpion-ext`, `scorpion-os`) or a layout file.
+    /// A built-in target (`scorpion-ext`, `scorpion-os`), a layout file
+    /// (`FILE.toml`) or an ld65 configuration (`FILE.cfg`).
     #[serde(default = "default_target")]
     pub(crate) target: String,
     /// Include directories, relative to the project.

@@ -202,6 +202,62 @@ fn layout_files_and_errors() {
     assert_eq!(bin[..6], [0x20, 0x06, 0x20, 0xA5, 0x10, 0x60]);
 }
 
+/// An ld65 configuration as the target: `%S` from `--start`, an area
+/// that starts where another ends, a second output file; and mistakes in
+/// configurations named at their line and column.
+#[test]
+fn ld65_configurations_and_their_errors() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_program(dir.path());
+    std::fs::write(
+        dir.path().join("two.cfg"),
+        "# main code at %S, read-only data in a second file\n\
+         MEMORY {\n\
+             ZP:   start = $10, size = $10, type = rw, file = \"\";\n\
+             MAIN: start = %S, size = $100, define = yes;\n\
+             DATA: start = __MAIN_LAST__, size = $10, file = \"%O.data\";\n\
+         }\n\
+         SEGMENTS {\n\
+             ZEROPAGE: load = ZP, type = zp;\n\
+             CODE:     load = MAIN;\n\
+             RODATA:   load = DATA, type = ro;\n\
+         }\n",
+    )
+    .expect("write the configuration");
+    std::fs::write(
+        dir.path().join("typo.cfg"),
+        "MEMORY {\n    MAIN: start = $1000, size = $100;\n}\nSEGMENTS {\n    CODE: load = MIAN, type = ro;\n}\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("o65.cfg"),
+        "MEMORY { M: start = 0, size = $100; }\nSEGMENTS { CODE: load = M; }\nFILES { %O: format = o65; }\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("unknown.cfg"),
+        "MEMORY {\n    M: start = $1000, size = __HIMEM__ - $1000;\n}\nSEGMENTS { CODE: load = M; RODATA: load = M; ZEROPAGE: load = M, type = zp; }\n",
+    )
+    .expect("write");
+    let link = |target: &str, extra: &[&str]| {
+        let mut args = vec![
+            "link", "main.o", "util.o", "-o", "p.bin", "--format", "bin", "--target", target,
+        ];
+        args.extend_from_slice(extra);
+        let output = scorpion(dir.path(), &args);
+        format!("$ scorpion {}\n{}\n", args.join(" "), transcript(&output))
+    };
+    let mut all = link("two.cfg", &["--start", "$2000"]);
+    for bad in ["typo.cfg", "o65.cfg", "unknown.cfg"] {
+        all.push_str(&link(bad, &[]));
+    }
+    insta::assert_snapshot!("link_ld65_configurations", all);
+    let main = std::fs::read(dir.path().join("p.bin")).expect("the main file");
+    assert_eq!(main, [0x20, 0x06, 0x20, 0xA5, 0x10, 0x60, 0xEA, 0x60]);
+    let data = std::fs::read(dir.path().join("p.bin.data")).expect("the second file");
+    assert_eq!(data, b"HI\0");
+}
+
 #[test]
 fn out_of_range_branch_shows_the_source_line_from_disk() {
     let dir = tempfile::tempdir().expect("temporary directory");
