@@ -7,6 +7,7 @@ mod diagnostics;
 mod formats;
 mod layouts;
 mod ld65;
+mod ld65_config;
 mod properties;
 mod relocations;
 mod robustness;
