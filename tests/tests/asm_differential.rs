@@ -273,7 +273,8 @@ fn programs_with_their_own_configuration_match_ld65() {
     report(failures, dirs.len());
 }
 
-/// C programs of ours (`cc65/*.c`), compiled by cc65 at three
+/// C programs of ours (`cc65/*.c` and the extension in
+/// `c_extension/range_sum.c`), compiled by cc65 at three
 /// optimisation levels; each output (with `.autoimport`, `.case`,
 /// `.macpack longbranch`, `.proc name: near`...) assembled by ca65 and by
 /// us and linked with a stub of the runtime names it calls: the same
@@ -284,17 +285,19 @@ fn c_programs_compiled_by_cc65_match_ld65() {
     let Some((ca65, ld65)) = toolchain(test) else {
         return;
     };
-    let Some(cc65) = tools::require("cc65", test) else {
+    let (Some(cc65), Some(od65)) = (tools::require("cc65", test), tools::require("od65", test))
+    else {
         return;
     };
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cc65");
-    let stub = std::fs::read(dir.join("runtime_stub.s")).expect("the runtime stub");
     let mut programs: Vec<_> = std::fs::read_dir(&dir)
         .expect("the C programs")
         .map(|entry| entry.expect("an entry").path())
         .filter(|path| path.extension().is_some_and(|e| e == "c"))
         .collect();
     programs.sort();
+    // The Scorpion extension written in C (`c_extension.rs` runs it).
+    programs.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c_extension/range_sum.c"));
     assert!(programs.len() >= 2, "{programs:?}");
     let mut failures = Vec::new();
     let mut total = 0;
@@ -318,12 +321,17 @@ fn c_programs_compiled_by_cc65_match_ld65() {
                 program.display(),
                 String::from_utf8_lossy(&compiled.stderr)
             );
+            // A stub of the runtime names it calls, read from ca65's
+            // object of it.
+            let object = ld65_diff::ca65(out.path(), &ca65, "program.s")
+                .unwrap_or_else(|message| panic!("{}: {message}", program.display()));
+            let stub = ld65_diff::stub(&ld65_diff::od65(&od65, &object, "--dump-imports"));
             let files = vec![
                 (
                     "program.s".to_owned(),
                     std::fs::read(&assembly).expect("cc65's output"),
                 ),
-                ("runtime_stub.s".to_owned(), stub.clone()),
+                ("runtime_stub.s".to_owned(), stub.into_bytes()),
             ];
             let mains = ["program.s".to_owned(), "runtime_stub.s".to_owned()];
             let name = program

@@ -25,7 +25,7 @@ mod ld65_diff;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use ld65_diff::{Files, compare, report, toolchain};
+use ld65_diff::{Files, compare, od65, report, stub, toolchain};
 use scorpion_tests::tools;
 
 /// The package's shared directory (`/usr/share/cc65`), from cl65.
@@ -71,63 +71,6 @@ fn name_of(path: &Path) -> String {
         .expect("a file name")
         .to_string_lossy()
         .into_owned()
-}
-
-/// od65's list of `what` (`--dump-imports`, `--dump-segments`) in
-/// `object`: each entry's name and whether its address size is zero page.
-fn od65(od65: &Path, object: &Path, what: &str) -> Vec<(String, bool)> {
-    let output = Command::new(od65)
-        .arg(what)
-        .arg(object)
-        .output()
-        .expect("od65 runs");
-    assert!(output.status.success(), "od65 {what} {}", object.display());
-    let text = String::from_utf8_lossy(&output.stdout);
-    let mut found = Vec::new();
-    let mut zp = false;
-    for line in text.lines().map(str::trim) {
-        if let Some(size) = line.strip_prefix("Address size:") {
-            zp = size.contains("zeropage");
-        }
-        if let Some(name) = line.strip_prefix("Name:") {
-            let name = name.trim().trim_matches('"').to_owned();
-            // A name imported at two places is listed twice.
-            if !found.iter().any(|(n, _)| *n == name) {
-                found.push((name, zp));
-            }
-            zp = false;
-        }
-    }
-    found
-}
-
-/// A stub for `imports`: zero-page cells, bare `RTS` labels, and for
-/// the names a linker configuration would define constants like the ones
-/// it would give (a `_START__` below its `_LAST__`, small `_SIZE__`s),
-/// all exported.
-fn stub(imports: &[(String, bool)]) -> String {
-    let mut text = String::from("; The imports of a corpus program.\n");
-    let (zp, abs): (Vec<_>, Vec<_>) = imports.iter().partition(|(_, zp)| *zp);
-    text.push_str("        .zeropage\n");
-    for (name, _) in &zp {
-        text.push_str(&format!("        .exportzp {name}\n{name}: .res 2\n"));
-    }
-    text.push_str("        .code\n");
-    for (index, (name, _)) in abs.iter().enumerate() {
-        if name.starts_with("__") && name.ends_with("__") && name != "__STARTUP__" {
-            let value = if name.ends_with("_SIZE__") {
-                0x10 + index
-            } else if name.ends_with("_LAST__") {
-                0x1800 + 0x10 * index
-            } else {
-                0x1000 + index
-            };
-            text.push_str(&format!("        .export {name}\n{name} = ${value:04X}\n"));
-        } else {
-            text.push_str(&format!("        .export {name}\n{name}: rts\n"));
-        }
-    }
-    text
 }
 
 /// An ld65 configuration that places `segments` (ca65's names, from the
