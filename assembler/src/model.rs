@@ -189,6 +189,10 @@ pub(crate) enum VarKind {
     /// `.align` at a position unknown when read; without a fill value the
     /// padding is reserved (the linker's fill value).
     Align { align: u32, fill: Option<u8> },
+    /// `.res n` whose `n` depends on a position not known when read
+    /// (`.res $1E00 - *` after instructions whose size the layout passes
+    /// decide): its size follows the placement.
+    Res { count: NodeId, fill: Option<u8> },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -210,6 +214,9 @@ pub(crate) struct Chunk {
     /// `.org` is global unless `.feature org_per_seg`): this chunk starts
     /// where that one ends.
     pub(crate) org_after: Option<ChunkId>,
+    /// `.org expr` whose value depends on a position not known when read
+    /// (`.org VTOC + 256`): evaluated as placement goes, into `org_base`.
+    pub(crate) org_expr: Option<NodeId>,
     /// Where the chunk's fixed bytes start in the segment's data.
     pub(crate) data_start: u32,
     /// Fixed bytes.
@@ -314,6 +321,8 @@ pub(crate) struct Program {
     pub(crate) locs: Vec<Loc>,
     pub(crate) items: Vec<Item>,
     pub(crate) asserts: Vec<AssertRec>,
+    /// `.org`s whose address waited for placement: (chunk, where).
+    pub(crate) deferred_orgs: Vec<(ChunkId, LocId)>,
     /// `.constructor` and its kin: (symbol, table type, priority).
     pub(crate) condes: Vec<(SymId, u8, u8)>,
     /// Reserved bytes in chunks' fixed data (chunk, offset, length):

@@ -105,6 +105,9 @@ impl Placement {
     }
 }
 
+/// The segments ca65 puts in every object.
+const CA65_SEGMENTS: [&str; 6] = ["CODE", "RODATA", "BSS", "DATA", "ZEROPAGE", "NULL"];
+
 fn align_up(value: u64, align: u64) -> u64 {
     value.div_ceil(align.max(1)) * align.max(1)
 }
@@ -177,7 +180,10 @@ pub(crate) fn place(
     }
 
     for segment in &segments {
-        if segment.fragments.is_empty() && !segment.rule.optional {
+        // ca65 writes its standard segments into every object, empty or
+        // not, so ld65 never misses them: neither do we with its layouts.
+        let standard = layout.config.ld65 && CA65_SEGMENTS.contains(&segment.rule.name.as_str());
+        if segment.fragments.is_empty() && !segment.rule.optional && !standard {
             // Not an error: ld65 warns too. A layout lists what it may take.
             warnings.push(Error::EmptySegment {
                 layout: layout.name.clone(),

@@ -6,6 +6,7 @@ use isa::objfmt::UnaryOp;
 use crate::asm::{Asm, MAX_BYTES, PResult};
 use crate::cursor::Cursor;
 use crate::diag::{self, Span};
+use crate::expr::EvalErr;
 use crate::intern::Dir;
 use crate::lexer::Tok;
 use crate::model::{FixKind, Node, VarItem, VarKind};
@@ -140,12 +141,47 @@ impl Asm<'_> {
         let head = c.current();
         c.advance();
         let start = c.pos();
-        let count = self.const_expr(c, "`.res`")?;
+        // `.res $1E00 - *` after instructions whose size the layout passes
+        // decide: the size follows the placement (ca65, one pass, knows
+        // `*` here).
+        let node = self.expression(c)?;
+        let deferred = matches!(
+            self.prog.eval(node),
+            Err(EvalErr::NotYet(None)) | Ok(crate::expr::Value::Chunk { .. })
+        );
+        if !deferred {
+            *c = c.at(start);
+        }
+        let count = if deferred {
+            0
+        } else {
+            self.const_expr(c, "`.res`")?
+        };
         let fill = self.fill_value(c, "the `.res` fill value", None)?;
         self.expect_end(c)?;
         self.item(head.span, 0);
         let span = self.join(c.span_of(start), c.last_span());
-        self.reserve(count, fill, span)
+        if !deferred {
+            return self.reserve(count, fill, span);
+        }
+        self.keep_nodes = true;
+        let loc = self.loc(span);
+        let id = self.prog.vars.len() as u32;
+        self.prog.vars.push(VarItem {
+            kind: VarKind::Res { count: node, fill },
+            loc,
+            size: 0,
+        });
+        let seg = self.seg as usize;
+        let cur = self.prog.segs[seg].cur as usize;
+        self.prog.chunks[cur].var = Some(id);
+        self.prog.segs[seg].used = true;
+        if fill.is_some() {
+            self.prog.segs[seg].has_data = true;
+        }
+        let org = self.prog.chunks[cur].org;
+        self.new_chunk(org, None);
+        Ok(())
     }
 
     pub(super) fn align(&mut self, c: &mut Cursor<'_>) -> PResult<()> {

@@ -10,6 +10,26 @@ impl Asm<'_> {
     pub(super) fn org(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
         c.advance();
         let start = c.pos();
+        // `.org VTOC + 256` after instructions whose size the layout
+        // passes decide: the address follows the placement.
+        let node = self.expression(c)?;
+        if matches!(
+            self.prog.eval(node),
+            Err(crate::expr::EvalErr::NotYet(None)) | Ok(crate::expr::Value::Chunk { .. })
+        ) {
+            self.expect_end(c)?;
+            let span = self.join(c.span_of(start), c.last_span());
+            self.keep_nodes = true;
+            self.new_chunk(true, None);
+            let cur = self.prog.segs[self.seg as usize].cur;
+            self.prog.chunks[cur as usize].org_expr = Some(node);
+            self.prog.chunks[cur as usize].known_abs = None;
+            let loc = self.loc(span);
+            self.prog.deferred_orgs.push((cur, loc));
+            self.org_global = !self.features.org_per_seg;
+            return Ok(());
+        }
+        *c = c.at(start);
         let value = self.const_expr(c, "`.org`")?;
         self.expect_end(c)?;
         if !(0..=0xFF_FFFF).contains(&value) {

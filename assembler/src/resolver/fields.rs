@@ -51,7 +51,7 @@ impl Asm<'_> {
                             var_fixups.push((c, chunk.len + 1, kind, expr, var.loc));
                             data.extend_from_slice(&[0; 2][..kind.len() as usize]);
                         }
-                        VarKind::Align { fill, .. } => {
+                        VarKind::Align { fill, .. } | VarKind::Res { fill, .. } => {
                             data.resize(data.len() + var.size as usize, fill.unwrap_or(0));
                         }
                     }
@@ -75,6 +75,7 @@ impl Asm<'_> {
             datas.push(data);
         }
         out.seg_section = seg_section;
+        self.check_deferred();
         // Symbols first: relocations against imports need their indices.
         let sym_index = self.collect_symbols(&mut out);
         self.symbol_values(&mut out, &sym_index);
@@ -144,7 +145,9 @@ impl Asm<'_> {
             .filter_map(|(c, chunk)| {
                 let var = self.prog.vars.get(chunk.var? as usize)?;
                 match var.kind {
-                    VarKind::Align { fill: None, .. } => Some((c as ChunkId, chunk.len, var.size)),
+                    VarKind::Align { fill: None, .. } | VarKind::Res { fill: None, .. } => {
+                        Some((c as ChunkId, chunk.len, var.size))
+                    }
                     _ => None,
                 }
             });
@@ -159,6 +162,72 @@ impl Asm<'_> {
                     offset,
                     length,
                 });
+            }
+        }
+    }
+
+    /// `.res` sizes and `.org` values that waited for placement must have
+    /// settled to a constant in range.
+    fn check_deferred(&mut self) {
+        for v in 0..self.prog.vars.len() {
+            let VarKind::Res { count, .. } = self.prog.vars[v].kind else {
+                continue;
+            };
+            let loc = self.prog.vars[v].loc;
+            let span = self.loc_span(loc);
+            match self.prog.eval(count) {
+                Ok(Value::Const(size)) if (0..=i64::from(u32::MAX)).contains(&size) => {
+                    if i64::from(self.prog.vars[v].size) != size {
+                        self.report_at(
+                            loc,
+                            diag::error(
+                                "asm::too-big",
+                                span,
+                                format!(
+                                    "`.res` of {size} bytes makes the program larger than 16 MiB"
+                                ),
+                            ),
+                        );
+                    }
+                }
+                Ok(Value::Const(size)) => self.report_at(
+                    loc,
+                    diag::error(
+                        "asm::range",
+                        span,
+                        format!("`.res` comes to {size} bytes here, which is negative"),
+                    )
+                    .help("the code before it reaches past the address it pads to"),
+                ),
+                _ => self.report_at(
+                    loc,
+                    diag::error(
+                        "asm::not-constant",
+                        span,
+                        "`.res` needs a constant size, and this one never became one",
+                    ),
+                ),
+            }
+        }
+        for (chunk, loc) in std::mem::take(&mut self.prog.deferred_orgs) {
+            let span = self.loc_span(loc);
+            let Some(expr) = self.prog.chunks[chunk as usize].org_expr else {
+                continue;
+            };
+            match self.prog.eval(expr) {
+                Ok(Value::Const(value)) if (0..=0xFF_FFFF).contains(&value) => {}
+                Ok(Value::Const(value)) => self.report_at(
+                    loc,
+                    crate::resolver::range_diag(span, "`.org` address", value, (0, 0xFF_FFFF)),
+                ),
+                _ => self.report_at(
+                    loc,
+                    diag::error(
+                        "asm::not-constant",
+                        span,
+                        "`.org` needs a constant address, and this one never became one",
+                    ),
+                ),
             }
         }
     }

@@ -4,23 +4,67 @@
 use crate::asm::Asm;
 use crate::model::{ChunkId, SegId, VarKind};
 
+/// The most bytes a `.res` sized by placement may take (the 16 MiB output
+/// limit): a size that is still wrong in an early round stays bounded.
+const MAX_DEFERRED_RES: u32 = 1 << 24;
+
 impl Asm<'_> {
     /// Places every chunk with the current sizes. Chunks whose absolute
-    /// address follows a chunk of another segment (global `.org`) take a
-    /// few rounds to settle.
+    /// address follows a chunk of another segment (global `.org`), `.org`s
+    /// and `.res`es whose values depend on positions take a few rounds to
+    /// settle.
     pub(super) fn place(&mut self) {
-        let carried = self.prog.chunks.iter().any(|c| c.org_after.is_some());
-        for _ in 0..16 {
-            let before: Vec<i64> = if carried {
+        let rounds = self
+            .prog
+            .chunks
+            .iter()
+            .any(|c| c.org_after.is_some() || c.org_expr.is_some())
+            || self
+                .prog
+                .vars
+                .iter()
+                .any(|v| matches!(v.kind, VarKind::Res { .. }));
+        for _ in 0..32 {
+            let before: Vec<i64> = if rounds {
                 self.prog.chunks.iter().map(|c| c.abs).collect()
             } else {
                 Vec::new()
             };
+            let settled = !rounds || self.settle_deferred();
             self.place_once();
-            if !carried || self.prog.chunks.iter().map(|c| c.abs).eq(before) {
+            if !rounds || (settled && self.prog.chunks.iter().map(|c| c.abs).eq(before)) {
                 return;
             }
         }
+    }
+
+    /// Evaluates the deferred `.org` values and `.res` sizes with the
+    /// positions of the last placement; whether none changed.
+    fn settle_deferred(&mut self) -> bool {
+        let mut unchanged = true;
+        for c in 0..self.prog.chunks.len() {
+            if let Some(expr) = self.prog.chunks[c].org_expr {
+                let value = match self.prog.eval(expr) {
+                    Ok(crate::expr::Value::Const(value)) => value.clamp(0, 0xFF_FFFF),
+                    _ => 0,
+                };
+                unchanged &= self.prog.chunks[c].org_base == Some(value);
+                self.prog.chunks[c].org_base = Some(value);
+            }
+        }
+        for v in 0..self.prog.vars.len() {
+            if let VarKind::Res { count, .. } = self.prog.vars[v].kind {
+                let size = match self.prog.eval(count) {
+                    Ok(crate::expr::Value::Const(size)) => {
+                        size.clamp(0, i64::from(MAX_DEFERRED_RES))
+                    }
+                    _ => 0,
+                } as u32;
+                unchanged &= self.prog.vars[v].size == size;
+                self.prog.vars[v].size = size;
+            }
+        }
+        unchanged
     }
 
     fn place_once(&mut self) {
@@ -51,6 +95,7 @@ impl Asm<'_> {
                     Some(var) => {
                         let size = match var.kind {
                             VarKind::Instr { is_wide, .. } => 2 + u32::from(is_wide),
+                            VarKind::Res { .. } => var.size,
                             // The offset in the segment, under `.org` too,
                             // as ca65 aligns.
                             VarKind::Align { align, .. } => {
