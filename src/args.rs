@@ -73,6 +73,31 @@ pub(crate) fn define(text: &str) -> Result<(String, i64), String> {
     Ok((name.to_owned(), if negative { -number } else { number }))
 }
 
+/// `-t SYSTEM`: one of ca65's target systems whose CPU is the NMOS 6502.
+pub(crate) fn system(text: &str) -> Result<&'static assembler::systems::System, String> {
+    let names = || {
+        assembler::systems::SYSTEMS
+            .iter()
+            .filter(|s| s.other_cpu.is_none())
+            .map(|s| s.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match assembler::systems::find(text) {
+        Some(system) => match system.other_cpu {
+            None => Ok(system),
+            Some(cpu) => Err(format!(
+                "`{text}` has a {cpu}; this toolchain is for the NMOS 6502 (systems: {})",
+                names()
+            )),
+        },
+        None => Err(format!(
+            "no system `{text}` (ca65's with a 6502: {})",
+            names()
+        )),
+    }
+}
+
 /// `--feature NAME`: a ca65 feature.
 pub(crate) fn feature(text: &str) -> Result<String, String> {
     match assembler::Features::default().set(text, true) {

@@ -39,6 +39,7 @@ mod output;
 mod parse;
 mod resolver;
 mod source;
+pub mod systems;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -75,6 +76,8 @@ pub struct Options {
     pub max_lines: u64,
     /// `.feature` switches on from the first line (`--feature`).
     pub features: Features,
+    /// ca65's target system (`-t`): its symbols and character set.
+    pub system: Option<&'static systems::System>,
 }
 
 impl Default for Options {
@@ -89,6 +92,7 @@ impl Default for Options {
             undocumented: false,
             max_lines: 4_000_000,
             features: Features::default(),
+            system: None,
         }
     }
 }
@@ -167,6 +171,13 @@ pub fn assemble(
     if options.listing {
         asm.listing = Some(listing::ListingBuilder::new());
     }
+    let system_defines: Vec<(String, i64)> = options
+        .system
+        .iter()
+        .flat_map(|s| s.defines.iter().map(|name| ((*name).to_owned(), 1)))
+        .filter(|(name, _)| !options.defines.iter().any(|(own, _)| own == name))
+        .collect();
+    define_symbols(&mut asm, &system_defines);
     define_symbols(&mut asm, &options.defines);
     let name = path.display().to_string();
     asm.main_name = path

@@ -43,9 +43,14 @@ pub(crate) struct AsmOptions {
     #[arg(long, default_value_t = 50, value_name = "N")]
     max_errors: usize,
     /// Switch a ca65 feature on from the first line, as `.feature NAME`
-    /// does (repeatable; `force_range` is implemented).
+    /// does (repeatable).
     #[arg(long = "feature", value_name = "NAME", value_parser = crate::args::feature)]
     features: Vec<String>,
+    /// ca65's target system (`ca65 -t c64`): defines its symbols
+    /// (`__C64__`, `__CBM__`) and translates strings and characters to its
+    /// character set (PETSCII, ATASCII).
+    #[arg(short = 't', long = "system", value_name = "SYSTEM", value_parser = crate::args::system)]
+    system: Option<&'static assembler::systems::System>,
 }
 
 impl AsmOptions {
@@ -68,6 +73,7 @@ impl AsmOptions {
                 }
                 features
             },
+            system: self.system,
             ..assembler::Options::default()
         }
     }

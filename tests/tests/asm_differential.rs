@@ -403,3 +403,95 @@ fn benchmark_flavour_matches_ld65() {
         report(vec![failure], 1);
     }
 }
+
+/// ca65's target systems (`-t`): every byte a source can hold in a string
+/// and in a character constant, and the symbols each system defines,
+/// assembled by `ca65 -t SYSTEM` and by ours with the same system.
+#[test]
+fn target_systems_translate_and_define_as_ca65s() {
+    let Some((ca65, ld65)) = toolchain("target_systems_translate_and_define_as_ca65s") else {
+        return;
+    };
+    let mut source: Vec<u8> = b"        .byte \"".to_vec();
+    // Every byte but the string's quote, the line ends and a NUL.
+    source.extend((1..=0xFEu8).filter(|b| !matches!(b, b'"' | b'\n' | b'\r')));
+    source.extend(b"\"\n        lda #'A'\n        .byte 'z', '_', .strat(\"Hi\", 1)\n");
+    let probes = [
+        "__CBM__",
+        "__C64__",
+        "__ATARI__",
+        "__APPLE2__",
+        "__GEOS__",
+        "__C16__",
+    ];
+    for (bit, name) in probes.iter().enumerate() {
+        source.extend(format!(".ifdef {name}\n        .byte {}\n.endif\n", 0x80 | bit).bytes());
+    }
+    let cfg = ld65_config(START, 0);
+    let mut failures = Vec::new();
+    let systems: Vec<_> = assembler::systems::SYSTEMS
+        .iter()
+        .filter(|s| s.other_cpu.is_none())
+        .collect();
+    for system in &systems {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        std::fs::write(dir.path().join("chars.s"), &source).expect("write");
+        std::fs::write(dir.path().join("flat.cfg"), &cfg).expect("write");
+        let assembled = Command::new(&ca65)
+            .current_dir(dir.path())
+            .args(["-t", system.name, "chars.s", "-o", "chars.o"])
+            .output()
+            .expect("ca65 runs");
+        assert!(
+            assembled.status.success(),
+            "ca65 -t {}: {}",
+            system.name,
+            String::from_utf8_lossy(&assembled.stderr)
+        );
+        let linked = Command::new(&ld65)
+            .current_dir(dir.path())
+            .args(["-C", "flat.cfg", "-o", "chars.bin", "chars.o"])
+            .output()
+            .expect("ld65 runs");
+        assert!(
+            linked.status.success(),
+            "ld65: {}",
+            String::from_utf8_lossy(&linked.stderr)
+        );
+        let expected = std::fs::read(dir.path().join("chars.bin")).expect("ld65's output");
+        let options = assembler::Options {
+            system: Some(system),
+            ..assembler::Options::default()
+        };
+        let mut files = assembler::MemorySource::new();
+        files.insert("chars.s", source.as_slice());
+        let assembly = assembler::assemble(&files, Path::new("chars.s"), &options);
+        let object = match assembly {
+            Ok(assembly) => assembly.object,
+            Err(error) => {
+                failures.push(format!("-t {}: we rejected it: {error}", system.name));
+                continue;
+            }
+        };
+        let layout =
+            linker::Layout::from_ld65("flat.cfg", &cfg, None).expect("the flat configuration");
+        let linked = linker::link(
+            &[linker::Input {
+                name: "chars.o",
+                bytes: &object,
+            }],
+            &linker::LinkOptions {
+                target: &linker::Target::Custom(layout),
+                just_symbols: &[],
+                sources: &linker::NoSources,
+            },
+        )
+        .expect("our link");
+        let actual = linked.write(linker::Format::Bin).expect("bin");
+        if actual != expected {
+            let at = actual.iter().zip(&expected).position(|(a, b)| a != b);
+            failures.push(format!("-t {}: differs at {at:?}", system.name));
+        }
+    }
+    report(failures, systems.len());
+}

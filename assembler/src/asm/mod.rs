@@ -168,10 +168,11 @@ pub(crate) struct Asm<'a> {
 
 impl<'a> Asm<'a> {
     pub(crate) fn new(source: &'a dyn FileSource, opts: &'a Options) -> Asm<'a> {
-        let mut charmap = [0u8; 256];
-        for (i, slot) in charmap.iter_mut().enumerate() {
-            *slot = i as u8;
-        }
+        // A target system's character set (`-t c64`: PETSCII).
+        let charmap = opts
+            .system
+            .map_or(crate::systems::Charset::Ascii, |s| s.charset)
+            .table();
         let mut asm = Asm {
             prog: Program::default(),
             names: Interner::new(),
