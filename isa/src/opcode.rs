@@ -2224,8 +2224,13 @@ const fn build_encodings() -> [[u16; AddressingMode::ALL.len()]; Mnemonic::ALL.l
 /// The opcode byte an assembler should emit for `mnemonic` in `mode`, if the
 /// NMOS 6502 has one. Where several bytes decode the same way (the NOP
 /// forms, `SBC #` at `$E9` and `$EB`), the documented or lowest one wins.
+/// ca65 spells `LXA #` (`$AB`) as `LAX #`, so that form is `LXA`'s.
 #[must_use]
 pub fn encode(mnemonic: Mnemonic, mode: AddressingMode) -> Option<u8> {
+    let mnemonic = match (mnemonic, mode) {
+        (Mnemonic::Lax, AddressingMode::Immediate) => Mnemonic::Lxa,
+        _ => mnemonic,
+    };
     let code = ENCODINGS[mnemonic as usize][mode as usize];
     u8::try_from(code).ok()
 }

@@ -51,7 +51,7 @@
         sha $3412,y             ; $9F
         lax ($12,x)             ; $A3
         lax $12                 ; $A7
-        lxa #$12                ; $AB
+        lax #$12                ; $AB (ca65 spelling; also lxa)
         lax $3412               ; $AF
         lax ($12),y             ; $B3
         lax $12,y               ; $B7
@@ -59,7 +59,7 @@
         lax $3412,y             ; $BF
         dcp ($12,x)             ; $C3
         dcp $12                 ; $C7
-        sbx #$12                ; $CB
+        axs #$12                ; $CB (ca65 spelling; also sbx)
         dcp $3412               ; $CF
         dcp ($12),y             ; $D3
         dcp $12,x               ; $D7
