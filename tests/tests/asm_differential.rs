@@ -21,7 +21,7 @@ mod ld65_diff;
 use std::path::Path;
 use std::process::Command;
 
-use ld65_diff::{report, toolchain};
+use ld65_diff::{files_of, report, toolchain};
 use scorpion_tests::tools;
 
 /// Both toolchains on one program linked for the flat layout at [`START`]
@@ -33,7 +33,7 @@ fn compare(
     tools: (&Path, &Path),
     fill: u8,
 ) -> Result<(), String> {
-    ld65_diff::compare(what, files, mains, &ld65_config(START, fill), tools)
+    ld65_diff::compare(what, files, mains, &ld65_config(START, fill), tools, None)
 }
 
 /// Where the flat image starts.
@@ -120,26 +120,7 @@ const KNOWN_DIFFERENCES: [(&str, &str); 11] = [
 ];
 
 /// A case's directory: every file's name and bytes.
-type CaseFiles = Vec<(String, Vec<u8>)>;
-
-/// Every file of `dir` (not its subdirectories): name and bytes, by name.
-fn files_of(dir: &Path) -> CaseFiles {
-    let mut files: CaseFiles = std::fs::read_dir(dir)
-        .expect("a directory of sources")
-        .map(|entry| entry.expect("a directory entry").path())
-        .filter(|path| path.is_file())
-        .map(|path| {
-            let name = path
-                .file_name()
-                .expect("a name")
-                .to_string_lossy()
-                .into_owned();
-            (name, std::fs::read(&path).expect("a source file"))
-        })
-        .collect();
-    files.sort();
-    files
-}
+type CaseFiles = ld65_diff::Files;
 
 /// The assembler's `ok_*.s` cases, each with the other files of its
 /// directory (includes, binaries).
@@ -199,78 +180,76 @@ fn the_assemblers_cases_match_ld65() {
     report(failures, 2 * total);
 }
 
-/// Programs of several files (`asm_multi/*/`, every `.s` assembled,
-/// all linked together): what one file cannot show alone, imports
-/// among them.
+/// Every program in `tests/<under>/*/`: its name, its files and the
+/// sources to assemble (every `.s`).
+fn programs_in(under: &str) -> Vec<(String, CaseFiles, Vec<String>)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests")
+        .join(under);
+    let mut dirs: Vec<_> = std::fs::read_dir(&root)
+        .expect("the programs")
+        .map(|entry| entry.expect("an entry").path())
+        .filter(|path| path.is_dir())
+        .collect();
+    dirs.sort();
+    assert!(!dirs.is_empty(), "no programs in {}", root.display());
+    dirs.iter()
+        .map(|dir| {
+            let files = files_of(dir);
+            let mains = files
+                .iter()
+                .map(|(name, _)| name.clone())
+                .filter(|name| name.ends_with(".s"))
+                .collect();
+            let name = dir
+                .file_name()
+                .expect("a name")
+                .to_string_lossy()
+                .into_owned();
+            (name, files, mains)
+        })
+        .collect()
+}
+
+/// Programs of several files (`asm_multi/*/`, all linked together): what
+/// one file cannot show alone, imports among them.
 #[test]
 fn programs_of_several_files_match_ld65() {
     let Some((ca65, ld65)) = toolchain("programs_of_several_files_match_ld65") else {
         return;
     };
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/asm_multi");
-    let mut dirs: Vec<_> = std::fs::read_dir(&root)
-        .expect("the programs")
-        .map(|entry| entry.expect("an entry").path())
-        .filter(|path| path.is_dir())
+    let programs = programs_in("asm_multi");
+    let failures: Vec<String> = programs
+        .iter()
+        .filter_map(|(what, files, mains)| {
+            compare(what, files, mains, (ca65.as_path(), ld65.as_path()), 0).err()
+        })
         .collect();
-    dirs.sort();
-    assert!(!dirs.is_empty());
-    let mut failures = Vec::new();
-    for dir in &dirs {
-        let files = files_of(dir);
-        let mains: Vec<String> = files
-            .iter()
-            .map(|(name, _)| name.clone())
-            .filter(|name| name.ends_with(".s"))
-            .collect();
-        let what = dir
-            .file_name()
-            .expect("a name")
-            .to_string_lossy()
-            .into_owned();
-        if let Err(failure) = compare(&what, &files, &mains, (ca65.as_path(), ld65.as_path()), 0) {
-            failures.push(failure);
-        }
-    }
-    report(failures, dirs.len());
+    report(failures, programs.len());
 }
 
-/// Programs with their own ld65 configuration (`asm_cfg/*/layout.cfg`,
-/// every `.s` assembled): what the flat layout cannot show, such as the
-/// linker's tables of constructors.
+/// Programs with their own ld65 configuration (`asm_cfg/*/layout.cfg`):
+/// what the flat layout cannot show, such as the linker's tables of
+/// constructors.
 #[test]
 fn programs_with_their_own_configuration_match_ld65() {
     let Some((ca65, ld65)) = toolchain("programs_with_their_own_configuration_match_ld65") else {
         return;
     };
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/asm_cfg");
-    let mut dirs: Vec<_> = std::fs::read_dir(&root)
-        .expect("the programs")
-        .map(|entry| entry.expect("an entry").path())
-        .filter(|path| path.is_dir())
+    let programs = programs_in("asm_cfg");
+    let failures: Vec<String> = programs
+        .iter()
+        .filter_map(|(what, files, mains)| {
+            let cfg = files
+                .iter()
+                .find(|(name, _)| name == "layout.cfg")
+                .map(|(_, text)| String::from_utf8_lossy(text).into_owned())
+                .expect("the configuration");
+            let tools = (ca65.as_path(), ld65.as_path());
+            ld65_diff::compare(what, files, mains, &cfg, tools, None).err()
+        })
         .collect();
-    dirs.sort();
-    assert!(!dirs.is_empty());
-    let mut failures = Vec::new();
-    for dir in &dirs {
-        let files = files_of(dir);
-        let cfg = std::fs::read_to_string(dir.join("layout.cfg")).expect("the configuration");
-        let mains: Vec<String> = files
-            .iter()
-            .map(|(name, _)| name.clone())
-            .filter(|name| name.ends_with(".s"))
-            .collect();
-        let what = dir
-            .file_name()
-            .expect("a name")
-            .to_string_lossy()
-            .into_owned();
-        let tools = (ca65.as_path(), ld65.as_path());
-        if let Err(failure) = ld65_diff::compare(&what, &files, &mains, &cfg, tools) {
-            failures.push(failure);
-        }
-    }
-    report(failures, dirs.len());
+    report(failures, programs.len());
 }
 
 /// C programs of ours (`cc65/*.c` and the extension in
@@ -323,7 +302,7 @@ fn c_programs_compiled_by_cc65_match_ld65() {
             );
             // A stub of the runtime names it calls, read from ca65's
             // object of it.
-            let object = ld65_diff::ca65(out.path(), &ca65, "program.s")
+            let object = ld65_diff::ca65(out.path(), &ca65, "program.s", None)
                 .unwrap_or_else(|message| panic!("{}: {message}", program.display()));
             let stub = ld65_diff::stub(&ld65_diff::od65(&od65, &object, "--dump-imports"));
             let files = vec![
@@ -428,70 +407,19 @@ fn target_systems_translate_and_define_as_ca65s() {
         source.extend(format!(".ifdef {name}\n        .byte {}\n.endif\n", 0x80 | bit).bytes());
     }
     let cfg = ld65_config(START, 0);
-    let mut failures = Vec::new();
     let systems: Vec<_> = assembler::systems::SYSTEMS
         .iter()
         .filter(|s| s.other_cpu.is_none())
         .collect();
-    for system in &systems {
-        let dir = tempfile::tempdir().expect("a temporary directory");
-        std::fs::write(dir.path().join("chars.s"), &source).expect("write");
-        std::fs::write(dir.path().join("flat.cfg"), &cfg).expect("write");
-        let assembled = Command::new(&ca65)
-            .current_dir(dir.path())
-            .args(["-t", system.name, "chars.s", "-o", "chars.o"])
-            .output()
-            .expect("ca65 runs");
-        assert!(
-            assembled.status.success(),
-            "ca65 -t {}: {}",
-            system.name,
-            String::from_utf8_lossy(&assembled.stderr)
-        );
-        let linked = Command::new(&ld65)
-            .current_dir(dir.path())
-            .args(["-C", "flat.cfg", "-o", "chars.bin", "chars.o"])
-            .output()
-            .expect("ld65 runs");
-        assert!(
-            linked.status.success(),
-            "ld65: {}",
-            String::from_utf8_lossy(&linked.stderr)
-        );
-        let expected = std::fs::read(dir.path().join("chars.bin")).expect("ld65's output");
-        let options = assembler::Options {
-            system: Some(system),
-            ..assembler::Options::default()
-        };
-        let mut files = assembler::MemorySource::new();
-        files.insert("chars.s", source.as_slice());
-        let assembly = assembler::assemble(&files, Path::new("chars.s"), &options);
-        let object = match assembly {
-            Ok(assembly) => assembly.object,
-            Err(error) => {
-                failures.push(format!("-t {}: we rejected it: {error}", system.name));
-                continue;
-            }
-        };
-        let layout =
-            linker::Layout::from_ld65("flat.cfg", &cfg, None).expect("the flat configuration");
-        let linked = linker::link(
-            &[linker::Input {
-                name: "chars.o",
-                bytes: &object,
-            }],
-            &linker::LinkOptions {
-                target: &linker::Target::Custom(layout),
-                just_symbols: &[],
-                sources: &linker::NoSources,
-            },
-        )
-        .expect("our link");
-        let actual = linked.write(linker::Format::Bin).expect("bin");
-        if actual != expected {
-            let at = actual.iter().zip(&expected).position(|(a, b)| a != b);
-            failures.push(format!("-t {}: differs at {at:?}", system.name));
-        }
-    }
+    let files = vec![("chars.s".to_owned(), source)];
+    let mains = ["chars.s".to_owned()];
+    let failures: Vec<String> = systems
+        .iter()
+        .filter_map(|system| {
+            let what = format!("-t {}", system.name);
+            let tools = (ca65.as_path(), ld65.as_path());
+            ld65_diff::compare(&what, &files, &mains, &cfg, tools, Some(system)).err()
+        })
+        .collect();
     report(failures, systems.len());
 }

@@ -109,7 +109,7 @@ fn assembly_program(
     for (name, bytes) in files {
         std::fs::write(dir.path().join(name), bytes).expect("write a source");
     }
-    let object = ld65_diff::ca65(dir.path(), tools.0, main)
+    let object = ld65_diff::ca65(dir.path(), tools.0, main, None)
         .map_err(|message| format!("{what}: {message}"))?;
     let imports = od65(od65_path, &object, "--dump-imports");
     let mut segments = od65(od65_path, &object, "--dump-segments");
@@ -117,7 +117,7 @@ fn assembly_program(
     let mut all = files.clone();
     all.push(("stub.s".to_owned(), stub(&imports).into_bytes()));
     let mains = [main.to_owned(), "stub.s".to_owned()];
-    compare(what, &all, &mains, &program_config(&segments), tools)
+    compare(what, &all, &mains, &program_config(&segments), tools, None)
 }
 
 /// Samples not built, and why: each must still be refused as said.
@@ -411,6 +411,7 @@ fn asminc_macro_files_expand_as_ca65_expands_them() {
             &["program.s".to_owned()],
             cfg,
             (ca65.as_path(), ld65.as_path()),
+            None,
         ) {
             failures.push(failure);
         }
@@ -569,7 +570,7 @@ fn ld65_configurations_link_as_ld65_links() {
         let mains = ["program.s".to_owned()];
         if let Some((_, why)) = CONFIGS_NOT_LINKED.iter().find(|(n, _)| *n == name) {
             // Still refused, by name.
-            match ld65_diff::ours(&files, &mains, &cfg) {
+            match ld65_diff::ours(&files, &mains, &cfg, None) {
                 Err(error) if error.contains("the o65 format is not supported") => {}
                 other => failures.push(format!(
                     "{name} is no longer refused as listed ({why}): {:?}",
@@ -579,7 +580,7 @@ fn ld65_configurations_link_as_ld65_links() {
             continue;
         }
         total += 1;
-        if let Err(failure) = compare(&name, &files, &mains, &cfg, tools) {
+        if let Err(failure) = compare(&name, &files, &mains, &cfg, tools, None) {
             failures.push(failure);
         }
     }

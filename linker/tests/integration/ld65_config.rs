@@ -174,6 +174,18 @@ const WORDS: &[&str] = &[
     "\n",
 ];
 
+/// Links one `RTS` with `layout`, whatever comes of it.
+fn link_a_return(layout: Layout) {
+    let mut object = ObjectBuilder::new();
+    object.code("CODE", &[0x60]);
+    let _ = link_with(
+        &[("p.o", object.build())],
+        &Target::Custom(layout),
+        &[],
+        &MemorySources::default(),
+    );
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3000))]
 
@@ -186,14 +198,7 @@ proptest! {
     ) {
         let text = words.join(" ");
         if let Ok(layout) = Layout::from_ld65("fuzz.cfg", &text, start) {
-            let mut object = ObjectBuilder::new();
-            object.code("CODE", &[0x60]);
-            let _ = link_with(
-                &[("p.o", object.build())],
-                &Target::Custom(layout),
-                &[],
-                &MemorySources::default(),
-            );
+            link_a_return(layout);
         }
     }
 
@@ -209,14 +214,7 @@ proptest! {
         }
         let text: String = text.into_iter().collect();
         if let Ok(layout) = Layout::from_ld65("fuzz.cfg", &text, None) {
-            let mut object = ObjectBuilder::new();
-            object.code("CODE", &[0x60]);
-            let _ = link_with(
-                &[("p.o", object.build())],
-                &Target::Custom(layout),
-                &[],
-                &MemorySources::default(),
-            );
+            link_a_return(layout);
         }
     }
 }

@@ -25,11 +25,16 @@ pub(crate) fn toolchain(test: &str) -> Option<(PathBuf, PathBuf)> {
     Some((ca65, ld65))
 }
 
-/// ca65 on `name` in `dir`: the object's path, or what ca65 said.
-pub(crate) fn ca65(dir: &Path, ca65: &Path, name: &str) -> Result<PathBuf, String> {
+/// A target system (`-t`) for both assemblers, or none.
+pub(crate) type System = Option<&'static assembler::systems::System>;
+
+/// ca65 on `name` in `dir` (for `system`): the object's path, or what
+/// ca65 said.
+pub(crate) fn ca65(dir: &Path, ca65: &Path, name: &str, system: System) -> Result<PathBuf, String> {
     let object = format!("{name}.o");
     let output = Command::new(ca65)
         .current_dir(dir)
+        .args(system.iter().flat_map(|s| ["-t", s.name]))
         .args([name, "-o", object.as_str()])
         .output()
         .expect("ca65 runs");
@@ -42,6 +47,25 @@ pub(crate) fn ca65(dir: &Path, ca65: &Path, name: &str) -> Result<PathBuf, Strin
     Ok(dir.join(object))
 }
 
+/// Every file of `dir` (not its subdirectories): name and bytes, by name.
+pub(crate) fn files_of(dir: &Path) -> Files {
+    let mut files: Files = std::fs::read_dir(dir)
+        .expect("a directory")
+        .map(|entry| entry.expect("a directory entry").path())
+        .filter(|path| path.is_file())
+        .map(|path| {
+            let name = path
+                .file_name()
+                .expect("a name")
+                .to_string_lossy()
+                .into_owned();
+            (name, std::fs::read(&path).expect("a file"))
+        })
+        .collect();
+    files.sort();
+    files
+}
+
 /// ca65 + ld65 on `files` (written to `dir`, `mains` assembled) with the
 /// configuration `cfg`: every output file by name, or their complaint.
 pub(crate) fn reference(
@@ -50,13 +74,14 @@ pub(crate) fn reference(
     mains: &[String],
     cfg: &str,
     (ca65_path, ld65): (&Path, &Path),
+    system: System,
 ) -> Result<Files, String> {
     for (name, text) in files {
         std::fs::write(dir.join(name), text).expect("write a source");
     }
     let mut objects = Vec::new();
     for name in mains {
-        objects.push(ca65(dir, ca65_path, name)?);
+        objects.push(ca65(dir, ca65_path, name, system)?);
     }
     let out = dir.join("ld65");
     std::fs::create_dir_all(&out).expect("an output directory");
@@ -73,19 +98,7 @@ pub(crate) fn reference(
             String::from_utf8_lossy(&output.stderr)
         ));
     }
-    let mut written: Files = std::fs::read_dir(&out)
-        .expect("ld65's outputs")
-        .map(|entry| entry.expect("an entry").path())
-        .map(|path| {
-            let name = path
-                .file_name()
-                .expect("a name")
-                .to_string_lossy()
-                .into_owned();
-            (name, std::fs::read(&path).expect("an output"))
-        })
-        .collect();
-    written.sort();
+    let written = files_of(&out);
     Ok(written)
 }
 
@@ -96,12 +109,16 @@ pub(crate) fn ours(
     files: &[(String, Vec<u8>)],
     mains: &[String],
     cfg: &str,
+    system: System,
 ) -> Result<Files, String> {
     let mut source = assembler::MemorySource::new();
     for (name, text) in files {
         source.insert(name.as_str(), text.as_slice());
     }
-    let options = assembler::Options::default();
+    let options = assembler::Options {
+        system,
+        ..assembler::Options::default()
+    };
     let mut objects = Vec::new();
     for name in mains {
         let assembly =
@@ -159,9 +176,10 @@ pub(crate) fn compare(
     mains: &[String],
     cfg: &str,
     tools: (&Path, &Path),
+    system: System,
 ) -> Result<(), String> {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let expected = match reference(dir.path(), files, mains, cfg, tools) {
+    let expected = match reference(dir.path(), files, mains, cfg, tools, system) {
         Ok(outputs) => outputs,
         Err(message) => {
             let kept = dir.keep();
@@ -171,7 +189,7 @@ pub(crate) fn compare(
             ));
         }
     };
-    let actual = match ours(files, mains, cfg) {
+    let actual = match ours(files, mains, cfg, system) {
         Ok(outputs) => outputs,
         Err(message) => {
             let kept = dir.keep();
