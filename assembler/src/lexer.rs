@@ -131,8 +131,9 @@ pub(crate) struct Lexer {
     line: u32,
     /// The switches in force for the next line.
     pub(crate) features: LexFeatures,
-    /// Inside a `/* */` comment that began on an earlier line.
+    /// Inside a `/* */` comment that began on an earlier line (where).
     in_comment: bool,
+    comment_start: usize,
 }
 
 /// Bytes that continue an identifier: a table, as the lexer asks for
@@ -164,6 +165,7 @@ impl Lexer {
             line: 0,
             features: LexFeatures::default(),
             in_comment: false,
+            comment_start: 0,
         }
     }
 
@@ -233,6 +235,7 @@ impl Lexer {
                             Some(close) => i = close + 2,
                             None => {
                                 self.in_comment = true;
+                                self.comment_start = i;
                                 i = end;
                             }
                         }
@@ -505,6 +508,15 @@ impl Lexer {
                     value: 0,
                 });
                 i = start + len;
+            }
+            // A `/*` comment still open at the end of the file.
+            if self.in_comment && self.pos >= text.len() {
+                self.in_comment = false;
+                let start = self.comment_start;
+                errors.push((
+                    self.span(start, (start + 2).min(text.len())),
+                    "this `/*` comment has no `*/` before the end of the file".to_string(),
+                ));
             }
             // `\` at the end: the next physical line goes on this one.
             if !continued || self.pos >= text.len() {

@@ -17,6 +17,9 @@ use crate::lexer::{Lexer, Tok, Token};
 /// runaway expansion.
 const MAX_CALLS: usize = 256;
 
+/// The widest `.sprintf` field (a string is at most a line).
+const MAX_WIDTH: usize = 1024;
+
 impl Asm<'_> {
     /// The token function `tok` names, if any.
     fn token_function(&self, tok: &Token) -> Option<Dir> {
@@ -266,8 +269,17 @@ impl Asm<'_> {
             }
             let mut width = 0usize;
             while let Some(digit) = format.get(i).filter(|b| b.is_ascii_digit()) {
-                width = width * 10 + usize::from(digit - b'0');
+                width = width
+                    .saturating_mul(10)
+                    .saturating_add(usize::from(digit - b'0'));
                 i += 1;
+            }
+            if width > MAX_WIDTH {
+                return Err(self.err(
+                    "asm::range",
+                    span,
+                    format!("a `.sprintf` width of {width} is more than {MAX_WIDTH}"),
+                ));
             }
             let Some(&conversion) = format.get(i) else {
                 return Err(self.err(
