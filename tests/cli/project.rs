@@ -428,3 +428,43 @@ fn sim_in_a_project_takes_overrides_part_by_part() {
     assert_eq!(stdout(&output), "V01\n", "{}", transcript(&output));
     assert!(!String::from_utf8_lossy(&output.stderr).contains("from Scorpion.toml"));
 }
+
+/// An image whose target is an ld65 configuration: a ca65 project's own
+/// `.cfg` builds the image, and a mistake in it is named at its line.
+#[test]
+fn an_image_links_with_its_ld65_configuration() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("Scorpion.toml"),
+        "[project]\nname = \"cfg\"\n\n[[image]]\nname = \"os\"\nsources = [\"os.s\"]\ntarget = \"os.cfg\"\n",
+    )
+    .expect("write the project");
+    std::fs::write(
+        dir.path().join("os.s"),
+        "        .code\nstart:  jmp start\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("os.cfg"),
+        "MEMORY { KIM: start = $2000, size = $1000; }\nSEGMENTS { CODE: load = KIM, type = ro; }\n",
+    )
+    .expect("write");
+    let built = scorpion(dir.path(), &["build"]);
+    assert_eq!(built.status.code(), Some(0), "{}", transcript(&built));
+    let image = std::fs::read(dir.path().join("target/scorpion/os.elf")).expect("the image");
+    let image = linker::Image::parse("os.elf", &image).expect("an image");
+    assert_eq!(image.areas[0].load, 0x2000);
+    assert_eq!(image.areas[0].bytes, [0x4C, 0x00, 0x20]);
+    std::fs::write(
+        dir.path().join("os.cfg"),
+        "MEMORY { KIM: start = $2000, size = $1000; }\nSEGMENTS { CODE: load = KIM, typ = ro; }\n",
+    )
+    .expect("write");
+    let broken = scorpion(dir.path(), &["build"]);
+    assert_eq!(broken.status.code(), Some(1), "{}", transcript(&broken));
+    assert!(
+        transcript(&broken).contains("os.cfg:2:"),
+        "{}",
+        transcript(&broken)
+    );
+}
