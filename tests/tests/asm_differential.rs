@@ -252,8 +252,8 @@ fn programs_with_their_own_configuration_match_ld65() {
     report(failures, programs.len());
 }
 
-/// C programs of ours (`cc65/*.c` and the extension in
-/// `c_extension/range_sum.c`), compiled by cc65 at three
+/// C programs of ours (`cc65/*.c` and the two Scorpion extensions in
+/// `c_extension/*/range_sum.c`), compiled by cc65 at three
 /// optimisation levels; each output (with `.autoimport`, `.case`,
 /// `.macpack longbranch`, `.proc name: near`...) assembled by ca65 and by
 /// us and linked with a stub of the runtime names it calls: the same
@@ -276,7 +276,14 @@ fn c_programs_compiled_by_cc65_match_ld65() {
         .collect();
     programs.sort();
     // The Scorpion extension written in C (`c_extension.rs` runs it).
-    programs.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c_extension/range_sum.c"));
+    for kind in ["static", "stack"] {
+        programs.push(
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/c_extension")
+                .join(kind)
+                .join("range_sum.c"),
+        );
+    }
     assert!(programs.len() >= 2, "{programs:?}");
     let mut failures = Vec::new();
     let mut total = 0;
