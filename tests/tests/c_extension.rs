@@ -16,7 +16,7 @@ use romlib::protocol::Command as RobotCommand;
 use scorpion_tests::tools;
 
 /// Compiles `dir/range_sum.c` with `cc65_args`, assembles it with the
-/// other sources of `dir`, links for `scorpion-ext` against the reference
+/// other sources of `dir` and the shared `answer.s`, links for `scorpion-ext` against the reference
 /// ROM, and asks the virtual Scorpion `/1K`: its answer.
 fn build_and_ask(cc65: &Path, dir: &str, cc65_args: &[&str]) -> String {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -43,8 +43,14 @@ fn build_and_ask(cc65: &Path, dir: &str, cc65_args: &[&str]) -> String {
         "range_sum.s",
         std::fs::read(&compiled).expect("cc65's output"),
     );
-    for entry in std::fs::read_dir(&dir).expect("the extension's sources") {
-        let path = entry.expect("an entry").path();
+    let shared = dir
+        .parent()
+        .expect("the extensions' directory")
+        .join("answer.s");
+    let own = std::fs::read_dir(&dir)
+        .expect("the extension's sources")
+        .map(|entry| entry.expect("an entry").path());
+    for path in own.chain([shared]) {
         if path.extension().is_some_and(|e| e == "s") {
             let name = path
                 .file_name()

@@ -2,11 +2,10 @@
 ; the C stack, passes `table` and 4 as cc65 passes arguments (the first
 ; pushed, the last in A) and answers K and the sum in four hex digits.
         .include "scorpion.inc"
-        .import _range_sum, pushax
+        .import answer_sum, _range_sum, pushax
         .importzp sp
 
         .bss
-sum:    .res 2
 cstack: .res 32                 ; the C stack, growing down from its end
 cstack_end:
 
@@ -29,15 +28,6 @@ handler:
         jsr pushax              ; start
         lda #4                  ; length, in A
         jsr _range_sum          ; the sum in A (low) and X (high)
-        sta sum
-        stx sum+1
-        lda #'K'
-        jsr PUTCH
-        lda sum+1
-        jsr PUTHEX
-        lda sum
-        jsr PUTHEX
-        jsr PUTEOL
-        jmp CMD_DONE
+        jmp answer_sum
 not_mine:
         SCORPION_CHAIN_UNKNOWN

@@ -1,14 +1,11 @@
 ; The command /1K for the C function range_sum: it sums the four bytes of
 ; `table` and answers K and the sum in four hex digits (K015F).
         .include "scorpion.inc"
-        .import _range_sum, _range_start, _range_length
+        .import answer_sum, _range_sum, _range_start, _range_length
         .exportzp ptr1
 
         .zeropage
 ptr1:   .res 2                  ; the compiler's pointer cell
-
-        .bss
-sum:    .res 2
 
         .rodata
 table:  .byte $10, $20, $30, $FF
@@ -27,15 +24,6 @@ handler:
         lda #4
         sta _range_length
         jsr _range_sum          ; the sum in A (low) and X (high)
-        sta sum
-        stx sum+1
-        lda #'K'
-        jsr PUTCH
-        lda sum+1
-        jsr PUTHEX
-        lda sum
-        jsr PUTHEX
-        jsr PUTEOL
-        jmp CMD_DONE
+        jmp answer_sum
 not_mine:
         SCORPION_CHAIN_UNKNOWN
