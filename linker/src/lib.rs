@@ -3,7 +3,10 @@
 //! - [`link`] reads relocatable objects (`goblin`), places their sections
 //!   by a [`layout`], resolves symbols (with `--just-symbols` images as a
 //!   fallback), applies `R_MOS_*` relocations with lld's semantics and range
-//!   checks, checks deferred `.assert`s and records ROM hooks. Problems are
+//!   checks, computes the fields and symbols the assembler left as
+//!   expressions (`.scorpion.exprs`, `.scorpion.values`), builds ld65's
+//!   constructor tables, checks deferred `.assert`s and records ROM hooks.
+//!   Layouts are built in, TOML files or ld65 configurations. Problems are
 //!   collected: one [`Error::Failed`] carries them all, each naming its
 //!   source line through the objects' `.scorpion.srcmap`.
 //! - [`image`]: the linked image model and its one reader, used by the
