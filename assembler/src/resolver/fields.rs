@@ -176,7 +176,17 @@ impl Asm<'_> {
             let loc = self.prog.vars[v].loc;
             let span = self.loc_span(loc);
             match self.prog.eval(count) {
-                Ok(Value::Const(size)) if (0..=i64::from(u32::MAX)).contains(&size) => {
+                Ok(Value::Const(size)) if size < 0 => self.report_at(
+                    loc,
+                    diag::error(
+                        "asm::range",
+                        span,
+                        format!("`.res` comes to {size} bytes here, which is negative"),
+                    )
+                    .help("the code before it reaches past the address it pads to"),
+                ),
+                // Placement clamps the size to the output limit.
+                Ok(Value::Const(size)) => {
                     if i64::from(self.prog.vars[v].size) != size {
                         self.report_at(
                             loc,
@@ -190,15 +200,6 @@ impl Asm<'_> {
                         );
                     }
                 }
-                Ok(Value::Const(size)) => self.report_at(
-                    loc,
-                    diag::error(
-                        "asm::range",
-                        span,
-                        format!("`.res` comes to {size} bytes here, which is negative"),
-                    )
-                    .help("the code before it reaches past the address it pads to"),
-                ),
                 _ => self.report_at(
                     loc,
                     diag::error(
