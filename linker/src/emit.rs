@@ -200,7 +200,8 @@ pub(crate) fn build_image(
     let image = Image {
         entry: entry as u32,
         flags: objects.iter().fold(0, |flags, object| flags | object.flags),
-        areas: main.areas.clone(),
+        // The main file's areas are the image's.
+        areas: std::mem::take(&mut main.areas),
         sections,
         symbols,
         hooks,

@@ -21,7 +21,7 @@ pub struct Linked {
     /// other files (ld65's `file = "%O.1"`): each written as raw bytes.
     pub other_files: Vec<OutputFile>,
     /// The main output file as ld65 would write it (see
-    /// [`Linked::write`]).
+    /// [`Linked::write`]), without areas of its own: they are the image's.
     pub(crate) main_file: OutputFile,
     pub(crate) map: MapData,
 }
@@ -39,7 +39,7 @@ impl Linked {
         if format != crate::Format::Bin {
             return format.write(&self.image);
         }
-        Ok(self.main_file.bytes())
+        Ok(self.main_file.bytes_of(&self.image.areas))
     }
 }
 

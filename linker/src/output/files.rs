@@ -60,15 +60,21 @@ impl OutputFile {
     /// Its contents, as ld65 writes them in its format.
     #[must_use]
     pub fn bytes(&self) -> Vec<u8> {
+        self.bytes_of(&self.areas)
+    }
+
+    /// The contents with `areas` as its areas: the main file's are the
+    /// image's, which it does not keep a copy of.
+    pub(crate) fn bytes_of(&self, areas: &[LoadArea]) -> Vec<u8> {
         match self.format {
             OutputFormat::Bin => {
                 let mut out = Vec::new();
-                for (area, part) in self.areas.iter().zip(&self.parts) {
+                for (area, part) in areas.iter().zip(&self.parts) {
                     super::append_without(&mut out, area, &part.holes);
                 }
                 out
             }
-            OutputFormat::Atari => self.atari(),
+            OutputFormat::Atari => self.atari(areas),
         }
     }
 
@@ -76,7 +82,7 @@ impl OutputFile {
     /// it starts a new run, as it takes no room) as blocks of first
     /// address, last address and bytes, followed by an INITAD block if
     /// the area names one; a RUNAD block last.
-    fn atari(&self) -> Vec<u8> {
+    fn atari(&self, areas: &[LoadArea]) -> Vec<u8> {
         let mut out = vec![0xFF, 0xFF];
         let block = |out: &mut Vec<u8>, start: u64, bytes: &[u8]| {
             let start = start as u16;
@@ -86,12 +92,12 @@ impl OutputFile {
             out.extend(bytes);
         };
         let mut index = 0;
-        while index < self.areas.len() {
+        while index < areas.len() {
             let name = &self.parts[index].area;
             // Runs of (start address, bytes) over the area's pieces.
             let mut runs: Vec<(u64, Vec<u8>)> = Vec::new();
-            while index < self.areas.len() && self.parts[index].area == *name {
-                let area = &self.areas[index];
+            while index < areas.len() && self.parts[index].area == *name {
+                let area = &areas[index];
                 let holes = &self.parts[index].holes;
                 for (offset, byte) in area.bytes.iter().enumerate() {
                     let address = u64::from(area.load) + offset as u64;
