@@ -208,7 +208,7 @@ pub(crate) fn place(
         let mut area = area.clone();
         if let Some((start, size)) = &area.exprs {
             settle_symbols(layout, &mut env);
-            match area_bounds(layout, &area.name, start, size, &env) {
+            match area_bounds(layout, &area.name, start, size, &mut env) {
                 Ok((start, size)) => {
                     area.start = start;
                     area.size = size;
@@ -463,7 +463,7 @@ fn area_bounds(
     area: &str,
     start: &Expr,
     size: &Expr,
-    env: &HashMap<String, i64>,
+    env: &mut HashMap<String, i64>,
 ) -> Result<(u64, u64), Error> {
     let start_value = area_value(layout, area, "start", start, env)?;
     if !(0..=0xFFFF_FFFF).contains(&start_value) {
@@ -473,9 +473,15 @@ fn area_bounds(
             start.span(),
         ));
     }
-    let mut env = env.clone();
-    env.insert(format!("__{area}_START__"), start_value);
-    let size_value = area_value(layout, area, "size", size, &env)?;
+    // Known for the size only; `define = yes` makes it a symbol later.
+    let own_start = format!("__{area}_START__");
+    let before = env.insert(own_start.clone(), start_value);
+    let size_value = area_value(layout, area, "size", size, env);
+    match before {
+        Some(value) => env.insert(own_start, value),
+        None => env.remove(&own_start),
+    };
+    let size_value = size_value?;
     // Size 0 is an area nothing may use (ld65's overlays before a program
     // sets `__OVERLAYSIZE__`).
     if size_value < 0 || start_value + size_value > 1 << 32 {

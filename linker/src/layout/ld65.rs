@@ -507,7 +507,6 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
                 };
                 let mut kind = SymbolKind::Export;
                 let mut value = None;
-                let mut zp = false;
                 r.attributes(|r, attr, span| {
                     match attr {
                         "type" => {
@@ -520,19 +519,18 @@ pub(super) fn parse(path: &str, text: &str, start: Option<u64>) -> R<Layout> {
                             };
                         }
                         "value" => value = Some(r.expr()?),
+                        // Checked, not kept: a value's size does not change
+                        // where the linker puts anything.
                         "addrsize" => {
                             let (word, span) = r.ident("an address size")?;
-                            zp = match word.as_str() {
-                                "zp" | "zeropage" | "direct" => true,
-                                "abs" | "absolute" | "near" => false,
-                                _ => return Err(r.error(format!("`{word}` is not an address size of the 6502 (zp or abs)"), span)),
-                            };
+                            if !matches!(word.as_str(), "zp" | "zeropage" | "direct" | "abs" | "absolute" | "near") {
+                                return Err(r.error(format!("`{word}` is not an address size of the 6502 (zp or abs)"), span));
+                            }
                         }
                         _ => return Err(r.error(format!("`{attr}` is not an attribute of a symbol (type, value, addrsize)"), span)),
                     }
                     Ok(())
                 })?;
-                let _ = zp;
                 match (kind, &value) {
                     (SymbolKind::Import, Some(_)) => {
                         return Err(r.error(format!("{name_text} is imported and cannot have a value"), name.span));
