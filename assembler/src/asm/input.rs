@@ -383,11 +383,7 @@ impl<'a> Asm<'a> {
                 self.err("asm::syntax", span, message);
             }
         } else {
-            if self.input.any_define && !self.input.toks.is_empty() {
-                self.substitute_defines();
-            }
-            // A failed token function is reported; the line is dropped.
-            if self.has_token_functions() && self.expand_token_functions().is_err() {
+            if !self.expand_line() {
                 self.input.toks.clear();
             }
             let toks = std::mem::take(&mut self.input.toks);
@@ -402,6 +398,16 @@ impl<'a> Asm<'a> {
         if let Some(listing) = self.listing.as_mut() {
             listing.end_line(&self.prog, self.seg);
         }
+    }
+
+    /// Substitutes the `.define`s in the current line, then expands its
+    /// token functions; `false` when one failed (reported: the line is to
+    /// be dropped).
+    fn expand_line(&mut self) -> bool {
+        if self.input.any_define && !self.input.toks.is_empty() {
+            self.substitute_defines();
+        }
+        !(self.has_token_functions() && self.expand_token_functions().is_err())
     }
 
     /// A line inside a false conditional: only nesting matters.
@@ -426,13 +432,8 @@ impl<'a> Asm<'a> {
             Dir::Else | Dir::Elseif | Dir::Endif => {
                 // An `.elseif` condition reads as any line: defines and
                 // token functions first.
-                if dir == Dir::Elseif {
-                    if self.input.any_define {
-                        self.substitute_defines();
-                    }
-                    if self.has_token_functions() && self.expand_token_functions().is_err() {
-                        return;
-                    }
+                if dir == Dir::Elseif && !self.expand_line() {
+                    return;
                 }
                 let toks = std::mem::take(&mut self.input.toks);
                 let mut c = self.cursor(&toks);
