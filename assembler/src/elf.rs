@@ -7,13 +7,12 @@
 use isa::elf::SHF_MOS_ZEROPAGE;
 use isa::objfmt::{
     AssertAction, Assertion, Binding, CondesEntry, Definition, Expr, ExprField, ExprSymbol,
-    FieldKind, FillRun, Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget,
-    SourceLoc, SrcMap, SymbolLoc,
+    FillRun, Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget, SourceLoc, SrcMap,
+    SymbolLoc,
 };
 use object::elf;
 
 use crate::diag::Files;
-use crate::model::FixKind;
 use crate::output::{OutSymKind, Output, Target, assert_ops};
 
 fn section_flags(name: &str, zp: bool) -> u64 {
@@ -157,15 +156,7 @@ pub(crate) fn write_object(
             Some(ExprField {
                 section: Numbering::section(field.section),
                 offset: field.offset,
-                kind: match field.kind {
-                    FixKind::Imm8 | FixKind::Byte | FixKind::Zp | FixKind::Branch => {
-                        FieldKind::Byte
-                    }
-                    FixKind::Abs | FixKind::Word => FieldKind::Word,
-                    FixKind::Dbyt => FieldKind::WordBigEndian,
-                    FixKind::Far => FieldKind::Far,
-                    FixKind::Dword => FieldKind::Dword,
-                },
+                kind: field.kind.field()?,
                 expr: Expr {
                     ops: assert_ops(&field.ops, |target| {
                         Some(numbering.target(reloc_target(target)))

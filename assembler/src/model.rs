@@ -257,6 +257,21 @@ pub(crate) enum FixKind {
 }
 
 impl FixKind {
+    /// How a field of this kind is stored, as the linker stores it too
+    /// (`.scorpion.exprs`); `None` for a branch, whose value is a
+    /// distance.
+    pub(crate) fn field(self) -> Option<isa::objfmt::FieldKind> {
+        use isa::objfmt::FieldKind;
+        Some(match self {
+            FixKind::Imm8 | FixKind::Byte | FixKind::Zp => FieldKind::Byte,
+            FixKind::Abs | FixKind::Word => FieldKind::Word,
+            FixKind::Dbyt => FieldKind::WordBigEndian,
+            FixKind::Far => FieldKind::Far,
+            FixKind::Dword => FieldKind::Dword,
+            FixKind::Branch => return None,
+        })
+    }
+
     pub(crate) fn len(self) -> u32 {
         match self {
             FixKind::Imm8 | FixKind::Byte | FixKind::Zp | FixKind::Branch => 1,

@@ -112,17 +112,20 @@ pub(crate) fn const_bytes(
     kind: FixKind,
     value: i64,
 ) -> Result<[u8; 4], (&'static str, (i64, i64))> {
-    let (what, range) = match kind {
-        FixKind::Imm8 => ("immediate value", (0, 0xFF)),
-        FixKind::Byte => ("byte value", (0, 0xFF)),
-        FixKind::Zp => ("zero-page address", (0, 0xFF)),
-        FixKind::Abs => ("address", (0, 0xFFFF)),
-        FixKind::Word => ("word value", (0, 0xFFFF)),
-        FixKind::Dbyt => ("word value", (0, 0xFFFF)),
-        FixKind::Far => ("far address", (0, 0xFF_FFFF)),
-        FixKind::Dword => ("dword value", (0, i64::from(u32::MAX))),
-        FixKind::Branch => ("branch distance", (-128, 127)),
+    let what = match kind {
+        FixKind::Imm8 => "immediate value",
+        FixKind::Byte => "byte value",
+        FixKind::Zp => "zero-page address",
+        FixKind::Abs => "address",
+        FixKind::Word | FixKind::Dbyt => "word value",
+        FixKind::Far => "far address",
+        FixKind::Dword => "dword value",
+        FixKind::Branch => "branch distance",
     };
+    // The linker checks the fields it computes against the same ranges.
+    let range = kind
+        .field()
+        .map_or((-128, 127), isa::objfmt::FieldKind::range);
     if value < range.0 || value > range.1 {
         return Err((what, range));
     }
