@@ -202,6 +202,11 @@ impl Program {
             SymDef::Undefined => {
                 if self.placed {
                     Err(EvalErr::Undefined(sym))
+                } else if self.outer_fallback
+                    && let Some(outer) = self.outer.get(&sym).map(|o| o.outer)
+                {
+                    self.outer_hits.push(sym);
+                    self.sym_value(outer, depth + 1)
                 } else {
                     Err(EvalErr::NotYet(Some(sym)))
                 }
@@ -216,6 +221,20 @@ impl Program {
             SymDef::Var(node) => self.eval_at(node, depth + 1),
             SymDef::Expr(node) => {
                 let memo = s.memo.as_deref().copied().unwrap_or_default();
+                if self.outer_fallback && !self.placed {
+                    // A value borrowed from outer names is no scope's
+                    // final value: not kept in the memo.
+                    if let Some(value) = memo.front {
+                        return Ok(value);
+                    }
+                    if s.busy {
+                        return Err(EvalErr::Circular(sym));
+                    }
+                    self.syms[sym as usize].busy = true;
+                    let result = self.eval_at(node, depth + 1);
+                    self.syms[sym as usize].busy = false;
+                    return result;
+                }
                 if !self.placed {
                     if let Some(value) = memo.front {
                         return Ok(value);

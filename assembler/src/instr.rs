@@ -327,7 +327,7 @@ impl Asm<'_> {
                 let value = self.prog.eval(expr);
                 let choice = match choice {
                     Some(fit) => fit,
-                    None => self.fit(value, operand_span)?,
+                    None => self.fit(expr, value, operand_span)?,
                 };
                 self.direct(
                     mnemonic,
@@ -435,14 +435,29 @@ impl Asm<'_> {
     }
 
     /// Whether an operand is zero-page, absolute or not known yet.
-    fn fit(&mut self, value: Result<Value, EvalErr>, span: Span) -> PResult<Fit> {
+    /// A value not known yet is ca65's guess from what is known now
+    /// ([`Asm::guess_zero_page`]), or with
+    /// [`forward_zero_page`](crate::Options::forward_zero_page) left to
+    /// the layout passes.
+    fn fit(&mut self, expr: NodeId, value: Result<Value, EvalErr>, span: Span) -> PResult<Fit> {
         match value {
             Ok(value) => Ok(match self.value_fit(value) {
                 Some(true) => Fit::Zp,
                 Some(false) => Fit::Abs,
                 None => Fit::Unknown,
             }),
-            Err(EvalErr::NotYet(_)) => Ok(Fit::Unknown),
+            Err(EvalErr::NotYet(_)) if self.opts.forward_zero_page => Ok(Fit::Unknown),
+            Err(EvalErr::NotYet(_)) => {
+                if self.guess_zero_page(expr) {
+                    return Ok(Fit::Zp);
+                }
+                let loc = self.loc(span);
+                self.keep_nodes = true;
+                self.prog
+                    .absolute_guesses
+                    .push(crate::addrsize::AbsoluteGuess { expr, loc });
+                Ok(Fit::Abs)
+            }
             Err(error) => Err(self.eval_error(error, span)),
         }
     }

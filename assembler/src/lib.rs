@@ -22,6 +22,7 @@
 //! Constant folding uses `isa::objfmt`'s operators, so the linker computes
 //! deferred assertions exactly as the assembler would.
 
+mod addrsize;
 mod asm;
 mod cursor;
 mod diag;
@@ -78,6 +79,11 @@ pub struct Options {
     pub features: Features,
     /// ca65's target system (`-t`): its symbols and character set.
     pub system: Option<&'static systems::System>,
+    /// Zero page for operands whose value is defined further down,
+    /// wherever the final value fits (the layout passes settle it). Off
+    /// by default: ca65 assembles them as absolute, and so do we (with a
+    /// warning where zero page was possible), byte for byte as ca65.
+    pub forward_zero_page: bool,
 }
 
 impl Default for Options {
@@ -93,6 +99,7 @@ impl Default for Options {
             max_lines: 4_000_000,
             features: Features::default(),
             system: None,
+            forward_zero_page: false,
         }
     }
 }

@@ -354,6 +354,32 @@ pub(crate) struct Program {
     pub(crate) budget: u32,
     /// Symbol definitions so far (front-end memo validity).
     pub(crate) defs: u32,
+    /// Names used inside a scope that does not define them (yet), with
+    /// the outer symbol of that name visible where they were used. As in
+    /// ca65 the use belongs to the scope's own symbol, which may still be
+    /// defined further down; the outer one only lends its address size,
+    /// and its value where a constant is needed at once
+    /// ([`Program::outer_fallback`]).
+    pub(crate) outer: rustc_hash::FxHashMap<SymId, OuterUse>,
+    /// Evaluating where a value is needed at once (`.if`, `.res`): an
+    /// undefined name of a scope takes the value of its outer namesake,
+    /// and the use is remembered ([`OuterUse::used`]) so that a later
+    /// definition in the scope is refused instead of silently disagreeing.
+    pub(crate) outer_fallback: bool,
+    /// The names that took an outer value in the last fallback evaluation.
+    pub(crate) outer_hits: Vec<SymId>,
+    /// Operands assembled as absolute because their value was not known
+    /// yet (ca65's choice), to warn at where zero page was possible.
+    pub(crate) absolute_guesses: Vec<crate::addrsize::AbsoluteGuess>,
+}
+
+/// A scope's name that stood for an outer symbol when it was used.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct OuterUse {
+    /// The outer symbol of the same name, where the name was first used.
+    pub(crate) outer: SymId,
+    /// Where the outer symbol's value was taken for a constant.
+    pub(crate) used: Option<LocId>,
 }
 
 impl Program {

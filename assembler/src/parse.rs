@@ -701,7 +701,7 @@ impl Asm<'_> {
         let start = c.pos();
         let node = self.expression(c)?;
         let span = self.join(c.span_of(start), c.last_span());
-        match self.prog.eval(node) {
+        match self.eval_now(node, span) {
             Ok(Value::Const(value)) => Ok(value),
             Ok(_) => {
                 let diag = diag::error(
@@ -730,6 +730,28 @@ impl Asm<'_> {
             )),
             Err(error) => Err(self.eval_error(error, span)),
         }
+    }
+
+    /// Evaluates `node` where its value is needed at once: names a scope
+    /// has not defined yet take their outer namesake's value, and each
+    /// such use is remembered (at `span`) so that a later definition in
+    /// the scope is an error rather than a silent disagreement with ca65.
+    pub(crate) fn eval_now(&mut self, node: NodeId, span: Span) -> Result<Value, EvalErr> {
+        if self.prog.outer.is_empty() {
+            return self.prog.eval(node);
+        }
+        self.prog.outer_fallback = true;
+        let value = self.prog.eval(node);
+        self.prog.outer_fallback = false;
+        if !self.prog.outer_hits.is_empty() {
+            let loc = self.loc(span);
+            for sym in std::mem::take(&mut self.prog.outer_hits) {
+                if let Some(use_) = self.prog.outer.get_mut(&sym) {
+                    use_.used.get_or_insert(loc);
+                }
+            }
+        }
+        value
     }
 
     /// Where `sym` is named inside `span` on the current line, if it is:

@@ -51,6 +51,11 @@ pub(crate) struct AsmOptions {
     /// character set (PETSCII, ATASCII).
     #[arg(short = 't', long = "system", value_name = "SYSTEM", value_parser = crate::args::system)]
     system: Option<&'static assembler::systems::System>,
+    /// Zero page for operands whose symbol is defined further down,
+    /// wherever its final value fits (ca65, and so the default, assembles
+    /// them as absolute and warns).
+    #[arg(long)]
+    forward_zero_page: bool,
 }
 
 impl AsmOptions {
@@ -74,6 +79,7 @@ impl AsmOptions {
                 features
             },
             system: self.system,
+            forward_zero_page: self.forward_zero_page,
             ..assembler::Options::default()
         }
     }

@@ -72,11 +72,7 @@ fn generated(program: &[(String, String)]) -> (Vec<(String, Vec<u8>)>, Vec<Strin
 /// Cases where ca65 + ld65 do not build the same bytes, and why. Each must
 /// still differ: a case that comes to match fails the test until it is
 /// taken off this list.
-const KNOWN_DIFFERENCES: [(&str, &str); 11] = [
-    (
-        "define/ok_define.s",
-        "ca65 2.19 gives 0 for `MAX(3, 9)` of this parameterised .define: it cuts a body that starts with `(` at the matching `)` (`T(3,9)` with the body `((p) <= (q)) * (q)` is a syntax error there); we expand the whole body",
-    ),
+const KNOWN_DIFFERENCES: [(&str, &str); 7] = [
     (
         "include/ok_include.s",
         "includes `builtin.inc`, a built-in include only our assembler has",
@@ -100,18 +96,6 @@ const KNOWN_DIFFERENCES: [(&str, &str); 11] = [
     (
         "warnings/ok_warnings.s",
         "ld65 fails on the `.assert` warnings this case exists to raise",
-    ),
-    (
-        "zeropage/ok_align.s",
-        "forward references settled to zero page; ca65 assumes absolute",
-    ),
-    (
-        "zeropage/ok_chain.s",
-        "forward references settled to zero page; ca65 assumes absolute",
-    ),
-    (
-        "zeropage/ok_fixpoint.s",
-        "forward references settled to zero page; ca65 assumes absolute",
     ),
     (
         "zeropage/ok_forward.s",

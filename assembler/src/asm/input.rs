@@ -402,12 +402,30 @@ impl<'a> Asm<'a> {
 
     /// Substitutes the `.define`s in the current line, then expands its
     /// token functions; `false` when one failed (reported: the line is to
-    /// be dropped).
+    /// be dropped). A `.define`'s body keeps its token functions, as in
+    /// ca65: they work on the arguments of each use
+    /// (`.define IV(arg) .match(.left(1,{arg}),#)`,
+    /// `.define NAME(b) .concat(b, "x")`).
     fn expand_line(&mut self) -> bool {
+        if self.names_a_define() {
+            return true;
+        }
         if self.input.any_define && !self.input.toks.is_empty() {
             self.substitute_defines();
         }
         !(self.has_token_functions() && self.expand_token_functions().is_err())
+    }
+
+    /// Whether the current line is `.define` or `.undefine`, which name a
+    /// define rather than use one.
+    fn names_a_define(&self) -> bool {
+        self.input.toks.first().is_some_and(|first| {
+            first.kind == Tok::Directive
+                && matches!(
+                    self.names.keyword(first.name()),
+                    Keyword::Directive(Dir::Define | Dir::Undefine)
+                )
+        })
     }
 
     /// A line inside a false conditional: only nesting matters.
@@ -446,17 +464,6 @@ impl<'a> Asm<'a> {
 
     /// Replaces `.define`d names in the current line.
     fn substitute_defines(&mut self) {
-        // `.define`, `.undefine` and `.ifdef`-like lines name a define
-        // rather than use it.
-        if let Some(first) = self.input.toks.first()
-            && first.kind == Tok::Directive
-            && matches!(
-                self.names.keyword(first.name()),
-                Keyword::Directive(Dir::Define | Dir::Undefine)
-            )
-        {
-            return;
-        }
         let mut rounds = 0;
         loop {
             let mut changed = false;
@@ -487,66 +494,37 @@ impl<'a> Asm<'a> {
                     i += 1;
                     continue;
                 }
-                // name(arg, arg): split the arguments at top-level commas.
+                // The arguments as ca65 reads them (`StartExpDefine`): one
+                // per parameter, each a braced list (up to the first `}`,
+                // braces dropped) or the tokens up to the next comma or
+                // the end of the line. Parentheses are not special:
+                // `SQ(2+1)` passes `(2+1)`, as ca65 does.
                 let mut args: Vec<Vec<Token>> = Vec::new();
                 let mut j = i + 1;
-                if toks.get(j).map(|t| t.kind) == Some(Tok::LParen) {
-                    j += 1;
-                    let mut depth = 0;
+                for index in 0..define.params.len() {
+                    if index > 0 {
+                        if toks.get(j).map(|t| t.kind) != Some(Tok::Comma) {
+                            break;
+                        }
+                        j += 1;
+                    }
+                    let braced = toks.get(j).map(|t| t.kind) == Some(Tok::LBrace);
+                    if braced {
+                        j += 1;
+                    }
+                    let term = if braced { Tok::RBrace } else { Tok::Comma };
                     let mut current = Vec::new();
-                    while j < toks.len() {
-                        let t = toks[j];
-                        match t.kind {
-                            Tok::LParen => depth += 1,
-                            Tok::RParen if depth == 0 => break,
-                            Tok::RParen => depth -= 1,
-                            Tok::Comma if depth == 0 => {
-                                args.push(std::mem::take(&mut current));
-                                j += 1;
-                                continue;
-                            }
-                            _ => {}
+                    while let Some(&t) = toks.get(j) {
+                        if t.kind == term {
+                            break;
                         }
                         current.push(t);
                         j += 1;
                     }
+                    if braced && toks.get(j).map(|t| t.kind) == Some(Tok::RBrace) {
+                        j += 1;
+                    }
                     args.push(current);
-                    j += 1;
-                } else {
-                    // `name arg, arg` without parentheses, as ca65 takes it
-                    // (cbm.mac's `scrbyte {char}`): each argument a braced
-                    // list or the tokens up to a comma, one per parameter.
-                    for index in 0..define.params.len() {
-                        if index > 0 {
-                            if toks.get(j).map(|t| t.kind) != Some(Tok::Comma) {
-                                break;
-                            }
-                            j += 1;
-                        }
-                        let mut current = Vec::new();
-                        let mut depth = 0usize;
-                        while let Some(&t) = toks.get(j) {
-                            match t.kind {
-                                Tok::Comma if depth == 0 => break,
-                                Tok::LParen | Tok::LBrace => depth += 1,
-                                Tok::RParen | Tok::RBrace => depth = depth.saturating_sub(1),
-                                _ => {}
-                            }
-                            current.push(t);
-                            j += 1;
-                        }
-                        args.push(current);
-                    }
-                }
-                // A braced argument stands for what is inside the braces.
-                for arg in &mut args {
-                    if arg.len() >= 2
-                        && arg.first().map(|t| t.kind) == Some(Tok::LBrace)
-                        && arg.last().map(|t| t.kind) == Some(Tok::RBrace)
-                    {
-                        arg.pop();
-                        arg.remove(0);
-                    }
                 }
                 for t in &define.tokens {
                     let param = if t.kind == Tok::Ident {

@@ -90,21 +90,32 @@ impl<'a> Asm<'a> {
         }
     }
 
-    /// A reference to `name` from the current scope: an existing symbol in
-    /// this scope or an enclosing one, else a new one here (bound to an
-    /// outer definition at the end if none appears here).
+    /// A reference to `name` from the current scope. As in ca65, a name
+    /// the current scope does not define is its own symbol all the same,
+    /// which the scope may define further down (`bmi done` before the
+    /// proc's `done:`); at the end of the input an undefined one is bound
+    /// to the outer definition. The outer symbol visible now is noted
+    /// ([`Program::outer`]) for its address size and for constants needed
+    /// at once.
     pub(crate) fn ref_sym(&mut self, name: NameId, span: Span) -> SymId {
-        let mut scope = self.symtab.scope;
-        let sym = loop {
-            if let Some(sym) = self.find_sym(scope, name) {
-                break sym;
+        let here = self.symtab.scope;
+        let sym = match self.find_sym(here, name) {
+            Some(sym) => sym,
+            None => {
+                let sym = self.new_sym(name, here, SymKind::Normal);
+                self.bind_sym(here, name, sym);
+                let mut scope = here;
+                while scope != GLOBAL_SCOPE {
+                    scope = self.prog.scopes[scope as usize].parent;
+                    if let Some(outer) = self.find_sym(scope, name) {
+                        self.prog
+                            .outer
+                            .insert(sym, crate::model::OuterUse { outer, used: None });
+                        break;
+                    }
+                }
+                sym
             }
-            if scope == GLOBAL_SCOPE {
-                let sym = self.new_sym(name, self.symtab.scope, SymKind::Normal);
-                self.bind_sym(self.symtab.scope, name, sym);
-                break sym;
-            }
-            scope = self.prog.scopes[scope as usize].parent;
         };
         self.note_ref(sym, span);
         sym
@@ -193,6 +204,24 @@ impl<'a> Asm<'a> {
                     diag.help("rename one of them, or use `.set` for a value that changes"),
                 ));
             }
+        }
+        if let Some(use_) = self.prog.outer.remove(&sym)
+            && let Some(used) = use_.used
+        {
+            let name = self.sym_name(sym);
+            let outer = self.sym_name(use_.outer);
+            let first = self.prog.locs[used as usize].span;
+            let diag = diag::error(
+                "asm::scope-order",
+                span,
+                format!("`{name}` is defined here, after a use above took the value of `{outer}`"),
+            )
+            .label("the scope's own definition")
+            .also(first, "used here as a constant before this definition")
+            .help(format!(
+                "ca65 binds that use to this definition and refuses it (not a constant yet); write `{outer}` there if the outer one is meant, or move this definition up"
+            ));
+            return Err(self.report(diag));
         }
         self.prog.defs = self.prog.defs.wrapping_add(1);
         let loc = self.loc(span);

@@ -60,7 +60,12 @@ impl Asm<'_> {
             };
             let dir = self.token_function(&toks[at]).unwrap_or(Dir::Left);
             let head = toks[at];
-            let (args, end) = self.call_arguments(at + 1)?;
+            let lists = match dir {
+                Dir::Left | Dir::Right => Some(1),
+                Dir::Mid => Some(2),
+                _ => None,
+            };
+            let (args, end) = self.call_arguments(at + 1, lists)?;
             let replacement = self.call(dir, head.span, &args)?;
             self.input.toks.splice(at..end, replacement);
         }
@@ -73,13 +78,34 @@ impl Asm<'_> {
     }
 
     /// The arguments of the call whose `(` is at `open` (split at commas
-    /// outside parentheses and braces), and the index after its `)`.
-    fn call_arguments(&mut self, open: usize) -> PResult<(Vec<Vec<Token>>, usize)> {
+    /// outside parentheses and braces), and the index after its `)`. The
+    /// argument after `list_after` commas is a token list, read as ca65
+    /// reads one: a braced list up to the first `}`, or the tokens up to
+    /// the first `)`, parentheses not counted (`.left(1, (a))` is `(`).
+    fn call_arguments(
+        &mut self,
+        open: usize,
+        list_after: Option<usize>,
+    ) -> PResult<(Vec<Vec<Token>>, usize)> {
         let toks = &self.input.toks;
         let mut args = vec![Vec::new()];
         let mut depth = 0usize;
         let mut i = open + 1;
         while let Some(&tok) = toks.get(i) {
+            let at_list = depth == 0
+                && Some(args.len() - 1) == list_after
+                && args.last().is_some_and(Vec::is_empty);
+            if at_list {
+                let (list, next) = raw_list(toks, i, Tok::RParen);
+                if toks.get(next).map(|t| t.kind) == Some(Tok::RParen) {
+                    if let Some(last) = args.last_mut() {
+                        *last = list;
+                    }
+                    return Ok((args, next + 1));
+                }
+                // Something other than `)` after a braced list: read on
+                // as other arguments (an arity error follows).
+            }
             match tok.kind {
                 Tok::LParen | Tok::LBrace => depth += 1,
                 Tok::RParen if depth == 0 => return Ok((args, i + 1)),
@@ -433,22 +459,38 @@ impl Asm<'_> {
         Ok(list)
     }
 
-    /// Tokens up to `stop` outside parentheses and braces.
+    /// A token list as ca65 reads one ([`raw_list`]), the cursor left on
+    /// what follows it.
     fn list_until(&mut self, c: &mut Cursor<'_>, stop: Tok) -> PResult<Vec<Token>> {
-        let mut depth = 0usize;
-        let mut list = Vec::new();
-        while let Some(&tok) = c.peek() {
-            match tok.kind {
-                kind if kind == stop && depth == 0 => break,
-                Tok::LParen | Tok::LBrace => depth += 1,
-                Tok::RParen | Tok::RBrace => depth = depth.saturating_sub(1),
-                _ => {}
-            }
-            list.push(tok);
-            c.advance();
-        }
+        let toks = c.tokens();
+        let (list, next) = raw_list(toks, c.pos(), stop);
+        c.advance_by(next.saturating_sub(c.pos()));
         Ok(list)
     }
+}
+
+/// A token list from `toks[at..]` as ca65 reads one (`GetTokListTerm`):
+/// `{...}` up to the first `}` (braces kept, for [`braced`] to drop), or
+/// the tokens up to the first `stop`, with no nesting of parentheses. The
+/// list and the index after it.
+fn raw_list(toks: &[Token], at: usize, stop: Tok) -> (Vec<Token>, usize) {
+    let term = if toks.get(at).map(|t| t.kind) == Some(Tok::LBrace) {
+        Tok::RBrace
+    } else {
+        stop
+    };
+    let mut i = at + usize::from(term == Tok::RBrace);
+    while let Some(tok) = toks.get(i) {
+        if tok.kind == term {
+            break;
+        }
+        i += 1;
+    }
+    if term == Tok::RBrace {
+        let end = (i + 1).min(toks.len());
+        return (toks[at..end].to_vec(), end);
+    }
+    (toks[at..i].to_vec(), i)
 }
 
 /// A token-list argument without the braces that may enclose it.

@@ -146,6 +146,7 @@ impl Asm<'_> {
             }
         }
         self.prog.stamp += 1;
+        self.check_absolute_guesses();
     }
 
     pub(super) fn chunk_pos(&self, chunk: ChunkId, off: u32) -> (SegId, u32) {

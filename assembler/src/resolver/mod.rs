@@ -76,14 +76,14 @@ pub(crate) fn branch_diag(span: Span, distance: i64) -> RawDiag {
 }
 
 impl Asm<'_> {
-    pub(super) fn report_at(&mut self, loc: LocId, mut diag: RawDiag) {
+    pub(crate) fn report_at(&mut self, loc: LocId, mut diag: RawDiag) {
         if let Some(l) = self.prog.locs.get(loc as usize) {
             diag.ctx = l.ctx;
         }
         self.rep.push(diag);
     }
 
-    pub(super) fn loc_span(&self, loc: LocId) -> Span {
+    pub(crate) fn loc_span(&self, loc: LocId) -> Span {
         self.prog
             .locs
             .get(loc as usize)

@@ -1,0 +1,235 @@
+//! Small programs where ca65 + ld65 and our toolchain once disagreed (a
+//! silent difference: both build, other bytes) or where we refused what
+//! ca65 builds (issue 24). One case per directory in `asm_ca65_cases/`:
+//! `main.s` (assembled; other files are what it includes), and beside it
+//! in `main.s`'s own comments what ca65 2.19 + ld65 make of it:
+//!
+//! - `; bytes: 30 01 EA 60` the image, linked at $0800 with the flat
+//!   configuration of `asm_differential.rs` (or `layout.cfg` of the case);
+//! - `; system: apple2enh` assembled by both with `-t SYSTEM`;
+//! - `; out: at 2003` a line `.out` prints;
+//! - `; warns: asm::zp-forward` a warning we must give (with its place).
+//!
+//! Our side needs no outside tool: the recorded bytes are the expectation.
+//! With ca65 and ld65 installed (always under `CI=true`) the same bytes
+//! and `.out` lines are checked against them, so the record cannot drift
+//! from ca65's answer.
+
+#[path = "ld65_diff/mod.rs"]
+mod ld65_diff;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use scorpion_tests::tools;
+
+/// The flat layout at $0800 (as `asm_differential.rs`'s, fill value 0).
+const FLAT_CFG: &str = "MEMORY {
+    ZP:   start = $0000, size = $0100, type = rw;
+    MAIN: start = $0800, size = $F800, file = %O;
+}
+SEGMENTS {
+    ZEROPAGE: load = ZP,   type = zp;
+    CODE:     load = MAIN, type = ro;
+    RODATA:   load = MAIN, type = ro;
+    DATA:     load = MAIN, type = rw;
+    BSS:      load = MAIN, type = bss;
+}
+";
+
+/// One case: its files and what ca65 + ld65 make of it.
+struct Case {
+    name: String,
+    files: ld65_diff::Files,
+    cfg: String,
+    bytes: Vec<u8>,
+    system: ld65_diff::System,
+    out: Vec<String>,
+    warns: Vec<String>,
+}
+
+/// The values of the `; KEY: value` comment lines of `text`.
+fn field<'t>(text: &'t str, key: &str) -> Vec<&'t str> {
+    let prefix = format!("; {key}:");
+    text.lines()
+        .filter_map(|line| line.strip_prefix(prefix.as_str()))
+        .map(str::trim)
+        .collect()
+}
+
+fn cases() -> Vec<Case> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/asm_ca65_cases");
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&root)
+        .expect("the cases")
+        .map(|entry| entry.expect("an entry").path())
+        .filter(|path| path.is_dir())
+        .collect();
+    dirs.sort();
+    dirs.iter()
+        .map(|dir| {
+            let name = dir
+                .file_name()
+                .expect("a name")
+                .to_string_lossy()
+                .into_owned();
+            let files = ld65_diff::files_of(dir);
+            let main = files
+                .iter()
+                .find(|(file, _)| file == "main.s")
+                .map(|(_, text)| String::from_utf8_lossy(text).into_owned())
+                .unwrap_or_else(|| panic!("{name} has no main.s"));
+            let cfg = files
+                .iter()
+                .find(|(file, _)| file == "layout.cfg")
+                .map_or_else(
+                    || FLAT_CFG.to_owned(),
+                    |(_, text)| String::from_utf8_lossy(text).into_owned(),
+                );
+            let bytes = field(&main, "bytes")
+                .iter()
+                .flat_map(|line| line.split_whitespace())
+                .map(|byte| {
+                    u8::from_str_radix(byte, 16)
+                        .unwrap_or_else(|_| panic!("{name}: `{byte}` in `; bytes:`"))
+                })
+                .collect();
+            let system = field(&main, "system").first().map(|system| {
+                assembler::systems::find(system)
+                    .unwrap_or_else(|| panic!("{name}: no system `{system}`"))
+            });
+            let owned = |key| field(&main, key).into_iter().map(str::to_owned).collect();
+            Case {
+                out: owned("out"),
+                warns: owned("warns"),
+                name,
+                files,
+                cfg,
+                bytes,
+                system,
+            }
+        })
+        .collect()
+}
+
+/// Our assembler's warnings and `.out` lines for the case's `main.s`.
+fn our_messages(case: &Case) -> Result<(Vec<String>, Vec<String>), String> {
+    let mut source = assembler::MemorySource::new();
+    for (name, text) in &case.files {
+        source.insert(name.as_str(), text.as_slice());
+    }
+    let options = assembler::Options {
+        system: case.system,
+        ..assembler::Options::default()
+    };
+    let assembly = assembler::assemble(&source, Path::new("main.s"), &options)
+        .map_err(|error| format!("{}: we rejected it: {error:?}", case.name))?;
+    let warnings = assembly
+        .warnings
+        .iter()
+        .map(|w| format!("{} {}", w.code(), w.summary()))
+        .collect();
+    Ok((warnings, assembly.messages))
+}
+
+/// Each case's image as ld65 writes it, and every `.out` line and warning
+/// it names, from our assembler and linker.
+#[test]
+fn we_build_what_ca65_and_ld65_build() {
+    let cases = cases();
+    assert!(cases.len() >= 3, "only {} cases", cases.len());
+    let mut failures = Vec::new();
+    for case in &cases {
+        let mains = ["main.s".to_owned()];
+        match ld65_diff::ours(&case.files, &mains, &case.cfg, case.system) {
+            Err(message) => failures.push(format!("{}: {message}", case.name)),
+            Ok(outputs) => {
+                let image = outputs
+                    .iter()
+                    .find(|(name, _)| name == ld65_diff::OUTPUT)
+                    .map(|(_, bytes)| bytes.clone())
+                    .unwrap_or_default();
+                if image != case.bytes {
+                    failures.push(format!(
+                        "{}: ca65 + ld65 {:02X?}\n  ours {image:02X?}",
+                        case.name, case.bytes
+                    ));
+                }
+            }
+        }
+        match our_messages(case) {
+            Err(message) => failures.push(message),
+            Ok((warnings, messages)) => {
+                for code in &case.warns {
+                    if !warnings.iter().any(|w| w.starts_with(&format!("{code} "))) {
+                        failures.push(format!(
+                            "{}: no `{code}` warning among {warnings:?}",
+                            case.name
+                        ));
+                    }
+                }
+                if messages != case.out {
+                    failures.push(format!(
+                        "{}: `.out` printed {messages:?}, ca65 {:?}",
+                        case.name, case.out
+                    ));
+                }
+            }
+        }
+    }
+    ld65_diff::report(failures, cases.len());
+}
+
+/// The recorded bytes and `.out` lines are ca65 + ld65's.
+#[test]
+fn the_records_are_ca65_and_ld65s() {
+    let Some((ca65, ld65)) = ld65_diff::toolchain("the_records_are_ca65_and_ld65s") else {
+        return;
+    };
+    let cases = cases();
+    let mut failures = Vec::new();
+    for case in &cases {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let mains = ["main.s".to_owned()];
+        let tools = (ca65.as_path(), ld65.as_path());
+        match ld65_diff::reference(
+            dir.path(),
+            &case.files,
+            &mains,
+            &case.cfg,
+            tools,
+            case.system,
+        ) {
+            Err(message) => failures.push(format!("{}: {message}", case.name)),
+            Ok(outputs) => {
+                let image = outputs
+                    .iter()
+                    .find(|(name, _)| name == ld65_diff::OUTPUT)
+                    .map(|(_, bytes)| bytes.clone())
+                    .unwrap_or_default();
+                if image != case.bytes {
+                    failures.push(format!(
+                        "{}: recorded {:02X?}, ca65 + ld65 {image:02X?}",
+                        case.name, case.bytes
+                    ));
+                }
+            }
+        }
+        let printed = Command::new(&ca65)
+            .current_dir(dir.path())
+            .args(case.system.iter().flat_map(|s| ["-t", s.name]))
+            .args(["main.s", "-o", "out.o"])
+            .output()
+            .expect("ca65 runs");
+        let lines: Vec<String> = String::from_utf8_lossy(&printed.stdout)
+            .lines()
+            .map(str::to_owned)
+            .collect();
+        if lines != case.out {
+            failures.push(format!(
+                "{}: recorded `.out` {:?}, ca65 {lines:?}",
+                case.name, case.out
+            ));
+        }
+    }
+    ld65_diff::report(failures, cases.len());
+}
