@@ -22,10 +22,12 @@ pub(crate) fn did_you_mean<'a>(
     candidates: impl IntoIterator<Item = &'a str>,
 ) -> Option<&'a str> {
     let wanted = name.to_ascii_lowercase();
-    let limit = if name.len() <= 5 { 1 } else { 2 };
+    let limit = suggestion_limit(name);
     candidates
         .into_iter()
-        .filter(|candidate| *candidate != name)
+        // The distance is at least the difference in length: most
+        // candidates are out before the edit distance is computed.
+        .filter(|candidate| *candidate != name && candidate.len().abs_diff(name.len()) <= limit)
         .map(|candidate| {
             let distance = strsim::osa_distance(&wanted, &candidate.to_ascii_lowercase());
             (distance, candidate)
@@ -33,6 +35,104 @@ pub(crate) fn did_you_mean<'a>(
         .filter(|(distance, _)| *distance <= limit)
         .min()
         .map(|(_, candidate)| candidate)
+}
+
+/// The optimal-string-alignment distance of `a` and `b` (strsim's
+/// `osa_distance` on bytes) if it is at most `limit`: rows of the table
+/// stop as soon as every cell exceeds the limit, and short names need no
+/// allocation, so rejecting a candidate costs a few dozen steps.
+fn osa_within(a: &[u8], b: &[u8], limit: usize) -> Option<usize> {
+    const MAX: usize = 64;
+    if a.len().abs_diff(b.len()) > limit {
+        return None;
+    }
+    if a.len() >= MAX || b.len() >= MAX {
+        let distance =
+            strsim::osa_distance(&String::from_utf8_lossy(a), &String::from_utf8_lossy(b));
+        return (distance <= limit).then_some(distance);
+    }
+    // Three rows of the table: two back (for transpositions), one back,
+    // and the one being filled.
+    let mut before = [0usize; MAX];
+    let mut previous = [0usize; MAX];
+    let mut current = [0usize; MAX];
+    for (j, cell) in previous.iter_mut().enumerate().take(b.len() + 1) {
+        *cell = j;
+    }
+    let mut previous_min = 0;
+    for i in 1..=a.len() {
+        current[0] = i;
+        let mut row_min = i;
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut value = (previous[j] + 1)
+                .min(current[j - 1] + 1)
+                .min(previous[j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                value = value.min(before[j - 2] + 1);
+            }
+            current[j] = value;
+            row_min = row_min.min(value);
+        }
+        // A later cell comes from this row or (a transposition, plus
+        // one) the row before: past the limit in both, it stays past.
+        if row_min > limit && previous_min >= limit {
+            return None;
+        }
+        previous_min = row_min;
+        before = previous;
+        previous = current;
+    }
+    let distance = previous[b.len()];
+    (distance <= limit).then_some(distance)
+}
+
+/// The largest edit distance a suggestion for `name` may have.
+fn suggestion_limit(name: &str) -> usize {
+    if name.len() <= 5 { 1 } else { 2 }
+}
+
+/// Names to suggest from, indexed by length: a suggestion for a name
+/// compares it only with names whose length is within the edit-distance
+/// limit, so an error costs what the names of about its length cost,
+/// not the whole symbol table ([`did_you_mean`]'s answer, faster).
+#[derive(Debug, Default)]
+pub(crate) struct Suggestions {
+    /// By length: (lowercased, as written), sorted, for the same ties as
+    /// [`did_you_mean`].
+    by_len: Vec<Vec<(String, String)>>,
+}
+
+impl Suggestions {
+    /// The index of `names`.
+    pub(crate) fn new(names: impl IntoIterator<Item = String>) -> Suggestions {
+        let mut by_len: Vec<Vec<(String, String)>> = Vec::new();
+        for name in names {
+            let len = name.len();
+            if by_len.len() <= len {
+                by_len.resize_with(len + 1, Vec::new);
+            }
+            by_len[len].push((name.to_ascii_lowercase(), name));
+        }
+        Suggestions { by_len }
+    }
+
+    /// The closest name to `name` within the limit, as [`did_you_mean`].
+    pub(crate) fn suggest(&self, name: &str) -> Option<&str> {
+        let wanted = name.to_ascii_lowercase();
+        let limit = suggestion_limit(name);
+        let lengths = name.len().saturating_sub(limit)..=name.len() + limit;
+        lengths
+            .filter_map(|len| self.by_len.get(len))
+            .flatten()
+            .filter(|(_, written)| written != name)
+            .filter_map(|(lower, written)| {
+                let distance = osa_within(wanted.as_bytes(), lower.as_bytes(), limit)?;
+                Some((distance, written.as_str()))
+            })
+            .min()
+            .map(|(_, written)| written)
+    }
 }
 
 /// A byte range in one source file.
@@ -251,6 +351,11 @@ impl Reporter {
             }
         }
         self.diags.push(diag);
+    }
+
+    /// Whether another error would only be counted, not kept.
+    pub(crate) fn is_full(&self) -> bool {
+        self.errors >= self.max_errors
     }
 
     /// So many errors that going on only costs time (ten times the cap):
@@ -529,5 +634,81 @@ impl miette::Diagnostic for Diagnostic {
                 .iter()
                 .map(|diagnostic| diagnostic as &dyn miette::Diagnostic),
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Suggestions, did_you_mean, osa_within};
+
+    /// The bounded distance is strsim's wherever that is within the limit.
+    #[test]
+    fn bounded_distance_is_strsims() {
+        let words = [
+            "",
+            "a",
+            "ab",
+            "ba",
+            "abc",
+            "acb",
+            "bca",
+            "value_00012",
+            "valeu_00012",
+            "value_0012",
+            "vlaue_00021",
+            "label",
+            "lable",
+            "labels",
+            "missing_name_7",
+            "CA",
+            "ac",
+            "abcdef",
+            "badcfe",
+            "xyzzy",
+        ];
+        for a in words {
+            for b in words {
+                let exact = strsim::osa_distance(a, b);
+                for limit in 0..4 {
+                    let bounded = osa_within(a.as_bytes(), b.as_bytes(), limit);
+                    assert_eq!(
+                        bounded,
+                        (exact <= limit).then_some(exact),
+                        "{a} {b} {limit}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The index suggests what the plain search suggests.
+    #[test]
+    fn the_index_agrees_with_the_plain_search() {
+        let names: Vec<String> = [
+            "value_00012",
+            "value_00013",
+            "label_1",
+            "Label_2",
+            "lda_x",
+            "start",
+        ]
+        .iter()
+        .map(|s| (*s).to_owned())
+        .collect();
+        let index = Suggestions::new(names.clone());
+        for wanted in [
+            "valeu_00012",
+            "label_2",
+            "strat",
+            "nothing_like_it",
+            "lda_y",
+            "value_00012",
+        ] {
+            assert_eq!(
+                index.suggest(wanted),
+                did_you_mean(wanted, names.iter().map(String::as_str)),
+                "{wanted}"
+            );
+        }
     }
 }

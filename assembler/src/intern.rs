@@ -116,6 +116,10 @@ directives! {
     P02 = "p02";
     OtherCpu = "p816" | "pc02" | "psc02" | "p4510";
     Paramcount = "paramcount";
+    Pushseg = "pushseg";
+    Popseg = "popseg";
+    Pushcpu = "pushcpu";
+    Popcpu = "popcpu";
     Cpu = "cpu";
     Left = "left";
     Mid = "mid";

@@ -56,6 +56,11 @@ pub struct Options {
     /// Directories searched by `.include` after the including file's own
     /// directory (`-I`, as ca65's).
     pub include_dirs: Vec<PathBuf>,
+    /// Directories searched by `.include` after [`Options::include_dirs`]:
+    /// ca65's own path (`CA65_INC`, cc65's `asminc`), from
+    /// [`cc65_include_dirs`], where `.include "apple2.inc"` is found
+    /// without `-I`.
+    pub system_include_dirs: Vec<PathBuf>,
     /// Directories searched by `.incbin` after the working directory and
     /// the including file's directory (ca65's `--bin-include-dir`).
     pub bin_include_dirs: Vec<PathBuf>,
@@ -90,6 +95,7 @@ impl Default for Options {
     fn default() -> Options {
         Options {
             include_dirs: Vec::new(),
+            system_include_dirs: Vec::new(),
             bin_include_dirs: Vec::new(),
             defines: Vec::new(),
             builtin_includes: BTreeMap::new(),
@@ -102,6 +108,30 @@ impl Default for Options {
             forward_zero_page: false,
         }
     }
+}
+
+/// The directories ca65 searches for `.include` after its `-I` ones, in
+/// its order: each of `CA65_INC` (a path list), `$CC65_HOME/asminc`, then
+/// the places cc65's packages install `asminc` (`/usr/share/cc65/asminc`,
+/// `/usr/local/share/cc65/asminc`); only those that exist.
+#[must_use]
+pub fn cc65_include_dirs() -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> = Vec::new();
+    if let Some(list) = std::env::var_os("CA65_INC") {
+        dirs.extend(std::env::split_paths(&list));
+    }
+    if let Some(home) = std::env::var_os("CC65_HOME") {
+        dirs.push(PathBuf::from(home).join("asminc"));
+    }
+    dirs.push(PathBuf::from("/usr/share/cc65/asminc"));
+    dirs.push(PathBuf::from("/usr/local/share/cc65/asminc"));
+    let mut seen = Vec::new();
+    dirs.retain(|dir| {
+        let keep = dir.is_dir() && !seen.contains(dir);
+        seen.push(dir.clone());
+        keep
+    });
+    dirs
 }
 
 /// A successful assembly.

@@ -95,12 +95,18 @@ pub(crate) struct Placement {
     pub(crate) tables: Vec<PlacedTable>,
     /// Symbols the layout defines besides `define = yes` ones.
     pub(crate) values: Vec<LayoutValue>,
+    /// Empty sections an ld65 configuration has no segment for, by
+    /// (object, section): ld65 links them, their labels at address 0
+    /// (ca65's `CODE` holding only a label before the first `.segment`).
+    pub(crate) nowhere: Vec<(usize, usize)>,
 }
 
 impl Placement {
     /// The run address of a section's first byte.
     pub(crate) fn section_run(&self, object: usize, section: usize) -> Option<u64> {
-        let (segment, offset) = self.sections[object][section]?;
+        let Some((segment, offset)) = self.sections[object][section] else {
+            return self.nowhere.contains(&(object, section)).then_some(0);
+        };
         Some(self.segments[segment].run + offset)
     }
 }
@@ -138,11 +144,16 @@ pub(crate) fn place(
         })
         .collect();
     let mut sections = Vec::with_capacity(objects.len());
+    let mut nowhere = Vec::new();
     for (object_index, object) in objects.iter().enumerate() {
         let mut positions = vec![None; object.sections.len()];
         for (section_index, section) in object.sections.iter().enumerate() {
             let Some(segment_index) = segments.iter().position(|s| s.rule.takes(&section.name))
             else {
+                if layout.config.ld65 && section.size == 0 {
+                    nowhere.push((object_index, section_index));
+                    continue;
+                }
                 errors.push(Error::UnplacedSection {
                     file: object.name.clone(),
                     section: section.name.clone(),
@@ -396,6 +407,7 @@ pub(crate) fn place(
         sections,
         tables,
         values,
+        nowhere,
     }
 }
 

@@ -27,11 +27,16 @@
 //! exponent of a least-squares fit of log(time) against log(lines): 1.00
 //! is linear, 2.00 quadratic. The last line names the part that grows.
 //!
+//! Last, the error case: a file defining 20,000 symbols that uses 300
+//! names it never defines (each error with its "did you mean"), assembled
+//! by ca65 and by us, each failing, each a fresh process; the ratio of
+//! the medians (issue 24: ours must stay within twice ca65's time).
+//!
 //! Run: `cargo bench -p scorpion-tests --bench asm_200k`
 //! (`ASM_BENCH_RUNS=N` sets the rounds, default 9; `ASM_BENCH_MAX_LINES=N`
 //! caps the linearity sizes, default 1,600,000; `ASM_BENCH_OURS_ONLY=1`
 //! skips the peers; `ASM_BENCH_KEEP=1` keeps the generated sources and
-//! prints where).
+//! prints where; `ASM_BENCH_ERRORS_ONLY=1` runs only the error case).
 
 #[path = "../tests/asm_gen/mod.rs"]
 mod asm_gen;
@@ -60,6 +65,12 @@ SEGMENTS { CODE: load = MAIN, type = rw; }
 
 /// Set in the child: `SOURCE` and `OUTPUT` paths, tab-separated.
 const CHILD_VAR: &str = "ASM_BENCH_CHILD";
+
+/// Set in the error case's child: the failing source's path.
+const ERRORS_CHILD_VAR: &str = "ASM_BENCH_ERRORS_CHILD";
+
+/// The error case: symbols defined, and names used but never defined.
+const ERROR_CASE: (usize, usize) = (20_000, 300);
 
 /// The linearity sizes (capped by `ASM_BENCH_MAX_LINES`).
 const SIZES: [usize; 8] = [
@@ -320,7 +331,16 @@ fn main() {
         child(&spec);
         return;
     }
+    if let Ok(source) = std::env::var(ERRORS_CHILD_VAR) {
+        errors_child(Path::new(&source));
+        return;
+    }
     let runs = env_number("ASM_BENCH_RUNS").unwrap_or(9).max(1);
+    if std::env::var_os("ASM_BENCH_ERRORS_ONLY").is_some() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        error_case(dir.path(), runs);
+        return;
+    }
     let max_lines = env_number("ASM_BENCH_MAX_LINES").unwrap_or(1_600_000);
     let dir = tempfile::tempdir().expect("a temporary directory");
     let dir_path = dir.path().to_path_buf();
@@ -411,6 +431,7 @@ fn main() {
     );
 
     linearity(&dir_path, &peers, runs, max_lines, (main.size, &cc65_times));
+    error_case(&dir_path, runs);
 
     if std::env::var_os("ASM_BENCH_KEEP").is_some() {
         println!("sources kept in {}", dir.keep().display());
@@ -551,6 +572,91 @@ fn linearity(
             "  what grows: {small:.0} -> {large:.0} ns/line from {first} to {last} lines ({:.2}x per doubling), \
              most of it in {part} ({from:.0} -> {to:.0} ns/line); why: assembler/README.md, \"Linearity\"",
             2f64.powf(k - 1.0)
+        );
+    }
+}
+
+/// The error case's source: `defined` constants and labels, then `used`
+/// lines naming a symbol that is not defined (a near miss of a defined
+/// name every other time, so "did you mean" has something to find).
+fn error_source(defined: usize, used: usize) -> String {
+    let mut text = String::with_capacity(defined * 24 + used * 24);
+    for n in 0..defined {
+        if n % 2 == 0 {
+            text.push_str(&format!("value_{n:05} = {}\n", n % 256));
+        } else {
+            text.push_str(&format!("label_{n:05}: nop\n"));
+        }
+    }
+    for n in 0..used {
+        if n % 2 == 0 {
+            text.push_str(&format!("        lda valeu_{:05}\n", (n * 37) % defined));
+        } else {
+            text.push_str(&format!("        jmp missing_name_{n}\n"));
+        }
+    }
+    text
+}
+
+/// The error case's child: one timed assembly that must fail, its time in
+/// nanoseconds on stdout.
+#[allow(clippy::print_stdout, reason = "the child reports to its parent")]
+fn errors_child(source: &Path) {
+    let start = Instant::now();
+    let result = assembler::assemble(&assembler::FsSource, source, &assembler::Options::default());
+    let elapsed = start.elapsed();
+    assert!(result.is_err(), "the error case assembled");
+    println!("{}", elapsed.as_nanos());
+}
+
+/// A file with errors: ca65 and us, each failing, fresh processes,
+/// interleaved; the ratio of the medians.
+#[allow(clippy::print_stdout, reason = "a benchmark reports on stdout")]
+fn error_case(dir: &Path, runs: usize) {
+    let (defined, used) = ERROR_CASE;
+    let source = dir.join("errors.s");
+    std::fs::write(&source, error_source(defined, used)).expect("write the error case");
+    let ca65 = scorpion_tests::tools::require("ca65", "asm_200k (error case)");
+    let exe = std::env::current_exe().expect("the benchmark knows its own path");
+    let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let output = Command::new(&exe)
+            .env(ERRORS_CHILD_VAR, &source)
+            .output()
+            .expect("the benchmark starts itself");
+        assert!(
+            output.status.success(),
+            "our error run failed:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let nanos: u64 = String::from_utf8_lossy(&output.stdout)
+            .trim()
+            .parse()
+            .expect("the child prints a number");
+        ours.push(Duration::from_nanos(nanos));
+        if let Some(ca65) = &ca65 {
+            let start = Instant::now();
+            let status = Command::new(ca65)
+                .arg(&source)
+                .args(["-o", "/dev/null"])
+                .output()
+                .expect("ca65 runs");
+            theirs.push(start.elapsed());
+            assert!(!status.status.success(), "ca65 accepted the error case");
+        }
+    }
+    let our_median = median(ours);
+    println!(
+        "error case ({defined} symbols defined, {used} undefined names used, each with a suggestion): \
+         scorpion {} (median of {runs})",
+        seconds(our_median)
+    );
+    if !theirs.is_empty() {
+        let their_median = median(theirs);
+        println!(
+            "  ca65 {} -> scorpion takes {:.2}x ca65's time (the target: at most 2x)",
+            seconds(their_median),
+            our_median.as_secs_f64() / their_median.as_secs_f64()
         );
     }
 }

@@ -232,14 +232,25 @@ fn features_from_the_command_line() {
     assert_eq!(plain.status.code(), Some(1), "{}", transcript(&plain));
     let comments = scorpion(dir.path(), &["asm", "c.s", "--feature", "c_comments"]);
     assert_eq!(comments.status.code(), Some(0), "{}", transcript(&comments));
-    // ca65's target systems: a 6502 one translates strings; others are
-    // refused by their CPU.
+    // ca65's target systems translate strings; one with another CPU is
+    // taken too (its symbols, its characters), and its CPU's instructions
+    // are refused where they are used.
     std::fs::write(dir.path().join("t.s"), "        .byte \"Ab\"\n").expect("write");
     let c64 = scorpion(dir.path(), &["asm", "t.s", "-t", "c64", "-o", "t.o"]);
     assert_eq!(c64.status.code(), Some(0), "{}", transcript(&c64));
-    let cx16 = scorpion(dir.path(), &["asm", "t.s", "-t", "cx16"]);
-    assert_eq!(cx16.status.code(), Some(2), "{}", transcript(&cx16));
-    assert!(transcript(&cx16).contains("65C02"), "{}", transcript(&cx16));
+    let cx16 = scorpion(dir.path(), &["asm", "t.s", "-t", "cx16", "-o", "t.o"]);
+    assert_eq!(cx16.status.code(), Some(0), "{}", transcript(&cx16));
+    std::fs::write(dir.path().join("z.s"), "        stz $12\n").expect("write");
+    let stz = scorpion(dir.path(), &["asm", "z.s", "-t", "apple2enh"]);
+    assert_eq!(stz.status.code(), Some(1), "{}", transcript(&stz));
+    assert!(transcript(&stz).contains("65C02"), "{}", transcript(&stz));
+    let bogus_system = scorpion(dir.path(), &["asm", "t.s", "-t", "c65536"]);
+    assert_eq!(
+        bogus_system.status.code(),
+        Some(2),
+        "{}",
+        transcript(&bogus_system)
+    );
     let bogus = scorpion(dir.path(), &["asm", "f.s", "--feature", "bogus"]);
     assert_eq!(bogus.status.code(), Some(2), "{}", transcript(&bogus));
     assert!(

@@ -8,7 +8,10 @@
 //!   configuration of `asm_differential.rs` (or `layout.cfg` of the case);
 //! - `; system: apple2enh` assembled by both with `-t SYSTEM`;
 //! - `; out: at 2003` a line `.out` prints;
-//! - `; warns: asm::zp-forward` a warning we must give (with its place).
+//! - `; warns: asm::zp-forward` a warning we must give (with its place);
+//! - `; cc65-include: yes` includes from cc65's `asminc`, found as ca65
+//!   finds them without `-I` (`assembler::cc65_include_dirs`; needs
+//!   cc65 installed, as the record check does).
 //!
 //! Our side needs no outside tool: the recorded bytes are the expectation.
 //! With ca65 and ld65 installed (always under `CI=true`) the same bytes
@@ -46,6 +49,7 @@ struct Case {
     system: ld65_diff::System,
     out: Vec<String>,
     warns: Vec<String>,
+    cc65_include: bool,
 }
 
 /// The values of the `; KEY: value` comment lines of `text`.
@@ -99,6 +103,7 @@ fn cases() -> Vec<Case> {
             });
             let owned = |key| field(&main, key).into_iter().map(str::to_owned).collect();
             Case {
+                cc65_include: !field(&main, "cc65-include").is_empty(),
                 out: owned("out"),
                 warns: owned("warns"),
                 name,
@@ -111,54 +116,79 @@ fn cases() -> Vec<Case> {
         .collect()
 }
 
-/// Our assembler's warnings and `.out` lines for the case's `main.s`.
-fn our_messages(case: &Case) -> Result<(Vec<String>, Vec<String>), String> {
-    let mut source = assembler::MemorySource::new();
+/// Our assembler and linker on the case: the image, the warnings and the
+/// `.out` lines.
+fn ours(case: &Case) -> Result<(Vec<u8>, Vec<String>, Vec<String>), String> {
+    let dir = tempfile::tempdir().expect("a temporary directory");
     for (name, text) in &case.files {
-        source.insert(name.as_str(), text.as_slice());
+        std::fs::write(dir.path().join(name), text).expect("write a case file");
     }
     let options = assembler::Options {
         system: case.system,
+        system_include_dirs: if case.cc65_include {
+            assembler::cc65_include_dirs()
+        } else {
+            Vec::new()
+        },
         ..assembler::Options::default()
     };
-    let assembly = assembler::assemble(&source, Path::new("main.s"), &options)
-        .map_err(|error| format!("{}: we rejected it: {error:?}", case.name))?;
+    let main = dir.path().join("main.s");
+    let assembly = assembler::assemble(&assembler::FsSource, &main, &options).map_err(|error| {
+        let details: Vec<String> = error
+            .diagnostics()
+            .iter()
+            .map(assembler::Diagnostic::summary)
+            .collect();
+        format!("we rejected it: {error}\n{}", details.join("\n"))
+    })?;
+    let layout = linker::Layout::from_ld65("layout.cfg", &case.cfg, None)
+        .map_err(|error| format!("our reading of the configuration failed: {error:?}"))?;
+    let target = linker::Target::Custom(layout);
+    let inputs = [linker::Input {
+        name: "main.s",
+        bytes: &assembly.object,
+    }];
+    let linked = linker::link(
+        &inputs,
+        &linker::LinkOptions {
+            target: &target,
+            just_symbols: &[],
+            sources: &linker::NoSources,
+        },
+    )
+    .map_err(|error| format!("our link failed: {error:?}"))?;
+    let image = linked
+        .write(linker::Format::Bin)
+        .map_err(|error| format!("cannot write the binary: {error:?}"))?;
     let warnings = assembly
         .warnings
         .iter()
         .map(|w| format!("{} {}", w.code(), w.summary()))
         .collect();
-    Ok((warnings, assembly.messages))
+    Ok((image, warnings, assembly.messages))
 }
 
 /// Each case's image as ld65 writes it, and every `.out` line and warning
 /// it names, from our assembler and linker.
 #[test]
 fn we_build_what_ca65_and_ld65_build() {
+    let test = "we_build_what_ca65_and_ld65_build";
     let cases = cases();
     assert!(cases.len() >= 3, "only {} cases", cases.len());
     let mut failures = Vec::new();
     for case in &cases {
-        let mains = ["main.s".to_owned()];
-        match ld65_diff::ours(&case.files, &mains, &case.cfg, case.system) {
+        if case.cc65_include && tools::require("ca65", test).is_none() {
+            continue;
+        }
+        match ours(case) {
             Err(message) => failures.push(format!("{}: {message}", case.name)),
-            Ok(outputs) => {
-                let image = outputs
-                    .iter()
-                    .find(|(name, _)| name == ld65_diff::OUTPUT)
-                    .map(|(_, bytes)| bytes.clone())
-                    .unwrap_or_default();
+            Ok((image, warnings, messages)) => {
                 if image != case.bytes {
                     failures.push(format!(
                         "{}: ca65 + ld65 {:02X?}\n  ours {image:02X?}",
                         case.name, case.bytes
                     ));
                 }
-            }
-        }
-        match our_messages(case) {
-            Err(message) => failures.push(message),
-            Ok((warnings, messages)) => {
                 for code in &case.warns {
                     if !warnings.iter().any(|w| w.starts_with(&format!("{code} "))) {
                         failures.push(format!(

@@ -67,12 +67,12 @@ impl<'a> Asm<'a> {
             dirs.push(PathBuf::new());
         }
         dirs.push(from_dir.to_path_buf());
-        let extra = if binary {
-            &self.opts.bin_include_dirs
+        if binary {
+            dirs.extend(self.opts.bin_include_dirs.iter().cloned());
         } else {
-            &self.opts.include_dirs
-        };
-        dirs.extend(extra.iter().cloned());
+            dirs.extend(self.opts.include_dirs.iter().cloned());
+            dirs.extend(self.opts.system_include_dirs.iter().cloned());
+        }
         dirs.dedup();
         dirs
     }
@@ -130,6 +130,43 @@ impl<'a> Asm<'a> {
             conds: self.input.conds.len(),
             dir,
         });
+    }
+
+    /// Moves the file just pushed (by `.include`) below the macro and
+    /// `.repeat` expansions being read, if any: ca65 reads an include
+    /// met inside an expansion after the expansions end (its input files
+    /// are a stack of their own), so a second include of the same
+    /// expansion is read before the first.
+    pub(crate) fn defer_file_after_expansions(&mut self) {
+        let frames = &mut self.input.frames;
+        let Some(file) = frames.pop() else {
+            return;
+        };
+        let at = frames
+            .iter()
+            .rposition(|frame| matches!(frame, Frame::File { .. }))
+            .map_or(0, |index| index + 1);
+        let Some(conds) = frames.get(at).map(Frame::conds) else {
+            frames.push(file);
+            return;
+        };
+        let file = match file {
+            Frame::File {
+                text,
+                lexer,
+                ctx,
+                dir,
+                ..
+            } => Frame::File {
+                text,
+                lexer,
+                ctx,
+                conds,
+                dir,
+            },
+            other => other,
+        };
+        frames.insert(at, file);
     }
 
     /// The directory of the innermost file being read.
@@ -205,7 +242,7 @@ impl<'a> Asm<'a> {
                                 self.input.toks.extend_from_slice(arg);
                             }
                         }
-                        Tok::Ident if !locals.is_empty() => {
+                        Tok::Ident | Tok::Local if !locals.is_empty() => {
                             let renamed = locals
                                 .iter()
                                 .find(|(from, _)| *from == tok.name())

@@ -161,6 +161,10 @@ pub(crate) struct Asm<'a> {
     /// on the part that was read, whose errors would only repeat it.
     pub(crate) fatal: bool,
     pub(crate) keep_nodes: bool,
+    /// `.pushseg`'s stack of segments.
+    pub(crate) pushed_segs: Vec<SegId>,
+    /// `.pushcpu`'s stack: whether the undocumented opcodes were on.
+    pub(crate) pushed_cpus: Vec<bool>,
     pub(crate) total_bytes: usize,
     /// Main file's display name, for the `STT_FILE` symbol.
     pub(crate) main_name: String,
@@ -200,6 +204,8 @@ impl<'a> Asm<'a> {
             stop: false,
             fatal: false,
             keep_nodes: false,
+            pushed_segs: Vec::new(),
+            pushed_cpus: Vec::new(),
             total_bytes: 0,
             main_name: String::new(),
         };

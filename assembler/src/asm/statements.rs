@@ -3,6 +3,10 @@
 
 use super::*;
 
+/// The 65C02's and 65SC02's instructions that the NMOS 6502 lacks (the
+/// Rockwell/WDC bit instructions aside).
+const CMOS_MNEMONICS: [&str; 8] = ["bra", "phx", "phy", "plx", "ply", "stz", "trb", "tsb"];
+
 impl<'a> Asm<'a> {
     /// The cursor over a line's tokens, placing what is missing at the
     /// line's end.
@@ -58,7 +62,19 @@ impl<'a> Asm<'a> {
             (Tok::Ident, Some(Tok::Directive))
                 if self.names.keyword(t[1].name()) == Keyword::Directive(Dir::Set) =>
             {
-                return self.set_variable(&mut c);
+                let sym = self.sym_in(self.symtab.scope, t[0].name());
+                return self.set_variable(&mut c, sym);
+            }
+            // `::name .set expr`, `scope::name .set expr`: a variable of
+            // another scope (a global counter bumped inside a scope).
+            (Tok::ColonColon, _) | (Tok::Ident, Some(Tok::ColonColon))
+                if self.scoped_set(t).is_some() =>
+            {
+                let at = self.scoped_set(t).unwrap_or(0);
+                let mut path = self.cursor(&t[..at]);
+                let sym = self.symbol_ref(&mut path)?;
+                c.advance_by(at - 1);
+                return self.set_variable(&mut c, sym);
             }
             (Tok::Ident | Tok::Local, Some(Tok::Colon)) => {
                 // `name:` is a label even where a macro has the name.
@@ -93,6 +109,17 @@ impl<'a> Asm<'a> {
                     }
                     _ => {
                         let name = self.names.name(head.name()).to_string();
+                        // A 65C02 instruction (`-t apple2enh` sources): named
+                        // as such, where it is used.
+                        if CMOS_MNEMONICS.contains(&name.to_ascii_lowercase().as_str()) {
+                            let diag = diag::error(
+                                "asm::cpu",
+                                head.span,
+                                format!("`{name}` is a 65C02 instruction; the Scorpion's CPU is an NMOS 6502"),
+                            )
+                            .help("write it with NMOS instructions (`stz x` is `lda #0` + `sta x`, `bra` a `jmp`); ca65 refuses it too after `.setcpu \"6502\"`");
+                            return Err(self.report(diag));
+                        }
                         // `name` alone, or before an instruction: a label
                         // missing its colon.
                         let label_like = match c.peek_at(1) {
@@ -105,7 +132,11 @@ impl<'a> Asm<'a> {
                             }
                             _ => false,
                         };
-                        let suggestion = self.similar_statement_head(&name);
+                        let suggestion = if self.rep.is_full() {
+                            None
+                        } else {
+                            self.similar_statement_head(&name)
+                        };
                         let help = match suggestion {
                             Some(similar) if label_like => Some(format!(
                                 "did you mean `{similar}`? (a label needs a colon: `{name}:`)"
@@ -195,15 +226,37 @@ impl<'a> Asm<'a> {
         self.define(sym, def, name.span)
     }
 
-    /// `name .set expr`: a variable, taken by value where it is used.
-    fn set_variable(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
+    /// Where `.set` is in `t` when `t` starts with a scoped name
+    /// (`::name`, `a::b::name`) followed by `.set`.
+    fn scoped_set(&self, t: &[Token]) -> Option<usize> {
+        let mut i = usize::from(t.first()?.kind == Tok::ColonColon);
+        loop {
+            if t.get(i)?.kind != Tok::Ident {
+                return None;
+            }
+            i += 1;
+            match t.get(i)? {
+                tok if tok.kind == Tok::ColonColon => i += 1,
+                tok if tok.kind == Tok::Directive
+                    && self.names.keyword(tok.name()) == Keyword::Directive(Dir::Set) =>
+                {
+                    return Some(i);
+                }
+                _ => return None,
+            }
+        }
+    }
+
+    /// `name .set expr` (the cursor on the name, `sym` the variable): a
+    /// variable, taken by value where it is used.
+    fn set_variable(&mut self, c: &mut Cursor<'_>, sym: SymId) -> PResult<()> {
         let name = c.current();
         c.advance_by(2);
         let start = c.pos();
         let expr = self.expression(c)?;
         self.expect_end(c)?;
-        let sym = self.sym_in(self.symtab.scope, name.name());
-        let node = match self.prog.eval(expr) {
+        let span = self.join(c.span_of(start), c.last_span());
+        let node = match self.eval_now(expr, span) {
             Ok(crate::expr::Value::Const(value)) => {
                 self.prog.node(crate::model::Node::Const(value))
             }

@@ -42,6 +42,10 @@ impl Asm<'_> {
                     " (the working directory)"
                 } else if binary {
                     " (--bin-include-dir)"
+                } else if self.opts.system_include_dirs.contains(dir)
+                    && !self.opts.include_dirs.contains(dir)
+                {
+                    " (ca65's include path)"
                 } else {
                     " (-I)"
                 };
@@ -91,6 +95,7 @@ impl Asm<'_> {
         let ctx = self.new_ctx(CtxKind::Include, self.join(head.span, tok.span));
         let parent = path.parent().map(Path::to_path_buf).unwrap_or_default();
         self.push_file(path.display().to_string(), bytes, parent, ctx);
+        self.defer_file_after_expansions();
         Ok(())
     }
 

@@ -90,7 +90,9 @@ impl Asm<'_> {
         let mut names = Vec::new();
         while let Some(tok) = c.next_token() {
             match tok.kind {
-                Tok::Ident => names.push(tok.name()),
+                // `.local @j`: a cheap local of each expansion's own, as
+                // in ca65 (still bound to the region of the last label).
+                Tok::Ident | Tok::Local => names.push(tok.name()),
                 Tok::Comma => {}
                 _ => return Err(self.err("asm::syntax", tok.span, "expected a name")),
             }

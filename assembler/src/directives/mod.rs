@@ -48,6 +48,7 @@ impl Asm<'_> {
                 Ok(())
             }
             Dir::Reloc => self.reloc(c),
+            Dir::Pushseg | Dir::Popseg | Dir::Pushcpu | Dir::Popcpu => self.push_pop(dir, c),
             Dir::Segment => self.segment_directive(c),
             Dir::Code | Dir::Rodata | Dir::Data | Dir::Bss | Dir::Zeropage => {
                 self.named_segment(dir, c)

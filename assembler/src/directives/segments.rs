@@ -6,6 +6,9 @@ use crate::cursor::Cursor;
 use crate::intern::Dir;
 use crate::lexer::Tok;
 
+/// The deepest `.pushseg`/`.pushcpu` stack, as ca65's.
+const MAX_PUSHED: usize = 16;
+
 impl Asm<'_> {
     pub(super) fn org(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
         c.advance();
@@ -52,6 +55,45 @@ impl Asm<'_> {
         self.new_chunk(false, None);
         self.org_global = false;
         Ok(())
+    }
+
+    /// `.pushseg`/`.popseg` (the current segment) and `.pushcpu`/`.popcpu`
+    /// (whether the undocumented opcodes are on), as ca65's stacks of at
+    /// most 16 entries.
+    pub(super) fn push_pop(&mut self, dir: Dir, c: &mut Cursor<'_>) -> PResult<()> {
+        let head = c.current();
+        c.advance();
+        self.expect_end(c)?;
+        let full = |len: usize| len >= MAX_PUSHED;
+        match dir {
+            Dir::Pushseg if full(self.pushed_segs.len()) => {}
+            Dir::Pushseg => {
+                self.pushed_segs.push(self.seg);
+                return Ok(());
+            }
+            Dir::Pushcpu if full(self.pushed_cpus.len()) => {}
+            Dir::Pushcpu => {
+                self.pushed_cpus.push(self.cpu_x);
+                return Ok(());
+            }
+            Dir::Popseg => {
+                if let Some(seg) = self.pushed_segs.pop() {
+                    self.switch_segment(seg);
+                    return Ok(());
+                }
+            }
+            _ => {
+                if let Some(cpu_x) = self.pushed_cpus.pop() {
+                    self.cpu_x = cpu_x;
+                    return Ok(());
+                }
+            }
+        }
+        let message = match dir {
+            Dir::Pushseg | Dir::Pushcpu => format!("more than {MAX_PUSHED} entries pushed"),
+            _ => "nothing pushed to pop".to_string(),
+        };
+        Err(self.err("asm::unbalanced", head.span, message))
     }
 
     pub(super) fn named_segment(&mut self, dir: Dir, c: &mut Cursor<'_>) -> PResult<()> {

@@ -65,7 +65,7 @@ impl Asm<'_> {
         }
         // Built only if a name is undefined: the defined names, for "did
         // you mean".
-        let mut known: Option<Vec<String>> = None;
+        let mut known: Option<diag::Suggestions> = None;
         for sym in 0..self.prog.syms.len() {
             let s = &self.prog.syms[sym];
             if s.def != SymDef::Undefined {
@@ -95,8 +95,16 @@ impl Asm<'_> {
                         format!("`{name}` is not defined")
                     };
                     let short = self.names.name(s.name).to_string();
-                    let known = known.get_or_insert_with(|| self.defined_names());
-                    let help = match diag::did_you_mean(&name, known.iter().map(String::as_str)) {
+                    // Only for the errors that are kept: a suggestion is
+                    // the costly part of an error.
+                    let similar = if self.rep.is_full() {
+                        None
+                    } else {
+                        let known = known
+                            .get_or_insert_with(|| diag::Suggestions::new(self.defined_names()));
+                        known.suggest(&name).map(str::to_owned)
+                    };
+                    let help = match similar {
                         Some(similar) => format!("did you mean `{similar}`?"),
                         None => format!(
                             "define it, or import it with `.import {short}` if another file defines it"

@@ -6,12 +6,15 @@
 //! labels, cheap locals, unnamed labels, forward references, macros with
 //! `.local`, `.repeat` with a counter, conditionals, `.proc` scopes,
 //! structs, enums, `.define`, `.set`, expressions with ca65's precedence,
-//! and every data directive. Sizes are tracked (as upper bounds) so that
+//! and every data directive; and ca65's name rules (`scope_unit`): nested
+//! `.proc`/`.scope`s whose names shadow global ones and are used before
+//! the scope defines them, `::` paths in and out of scopes, cheap locals
+//! and `.local` inside them, and `#` and commas in brace arguments of
+//! macros and `.define`s. Sizes are tracked (as upper bounds) so that
 //! branches always reach and `.org` chunks stay under 64 KiB.
 //!
-//! Zero-page symbols are always defined before use: ca65 is one-pass and
-//! assembles a forward zero-page reference as absolute, where we choose
-//! zero page; the differential test compares like with like.
+//! Forward references to zero-page symbols come up too: ca65 (and our
+//! default) assembles them as absolute.
 
 #![allow(dead_code, reason = "each includer uses a part")]
 
@@ -117,6 +120,8 @@ struct Gen {
     /// Bytes in the current `.org` chunk (benchmark).
     chunk_bytes: usize,
     procs: Vec<usize>,
+    /// Scope units written so far (`S_n`).
+    scopes: usize,
     sets: usize,
     covered: std::collections::BTreeSet<(&'static str, Mode)>,
 }
@@ -515,8 +520,121 @@ impl Gen {
         }
     }
 
+    /// A `.proc` or `.scope` (maybe with one nested inside) that uses the
+    /// global names `sh0..sh3` (labels) and `shv0..shv3` (zero-page
+    /// constants) before it may define its own of the same names, which
+    /// ca65 binds to the scope's own where it defines one, else to the
+    /// outer one; then `::` paths into it and out of it. About 40 bytes
+    /// at most, so that branches around it still reach.
+    fn scope_unit(&mut self) -> usize {
+        let n = self.scopes;
+        self.scopes += 1;
+        let mut text = String::new();
+        let (size, defined) = self.scope_body(&format!("S_{n}"), &mut text, 0);
+        let k = self.rng.below(4) as usize;
+        let _ = writeln!(text, "        lda ::shv{k}");
+        if defined[k] {
+            let _ = write!(text, "        jmp S_{n}::sh{k}");
+        } else {
+            let _ = write!(text, "        jmp ::sh{k}");
+        }
+        self.lines += text.lines().count().saturating_sub(1);
+        self.ca_only(&text);
+        // The scope's labels are normal symbols: cheap locals end here.
+        self.cheap.clear();
+        size + 5
+    }
+
+    /// One scope into `text` (another nested once at most): its size and
+    /// which of `sh0..sh3` it defines.
+    fn scope_body(&mut self, name: &str, text: &mut String, depth: u32) -> (usize, [bool; 4]) {
+        let kind = if self.rng.chance(50) { "proc" } else { "scope" };
+        let defines: [bool; 4] = std::array::from_fn(|_| self.rng.chance(50));
+        let values: [bool; 4] = std::array::from_fn(|_| self.rng.chance(40));
+        let _ = writeln!(text, ".{kind} {name}");
+        let mut size = 0;
+        for _ in 0..1 + self.rng.below(4) {
+            let k = self.rng.below(4) as usize;
+            size += match self.rng.below(8) {
+                0 => {
+                    let _ = writeln!(text, "        jmp sh{k}");
+                    3
+                }
+                // The global `.set` variable: its last value (the name is
+                // bound at the end, as ca65 binds it).
+                7 => {
+                    let _ = writeln!(text, "        .byte cnt");
+                    1
+                }
+                // A branch only to a label this scope defines: near.
+                1 if defines[k] => {
+                    let _ = writeln!(text, "        bne sh{k}");
+                    2
+                }
+                2 => {
+                    let _ = writeln!(text, "        lda shv{k}");
+                    2
+                }
+                3 if depth == 0 => {
+                    let inner = format!("I_{}", self.scopes);
+                    self.scopes += 1;
+                    self.scope_body(&inner, text, depth + 1).0
+                }
+                4 => {
+                    let c = self.cheap_serial;
+                    self.cheap_serial += 1;
+                    let _ = writeln!(text, "@w{c}:   dex\n        bne @w{c}");
+                    3
+                }
+                5 => {
+                    let _ = writeln!(text, "        wait {}", 1 + self.rng.below(9));
+                    5
+                }
+                _ => {
+                    let _ = writeln!(text, "        .byte shv{k}, <sh{k}");
+                    2
+                }
+            };
+        }
+        for k in 0..4 {
+            if defines[k] {
+                let _ = writeln!(text, "sh{k}:   nop");
+                size += 1;
+            }
+            if values[k] {
+                let value = 0x40 + 0x10 * k as u64 + self.rng.below(16);
+                let _ = writeln!(text, "shv{k} = ${value:02X}");
+            }
+        }
+        let _ = writeln!(text, ".end{kind}");
+        (size, defines)
+    }
+
+    /// A macro or `.define` whose brace argument holds `#` or a comma:
+    /// the "is this operand immediate?" idiom.
+    fn brace_unit(&mut self) -> usize {
+        let arg = match self.rng.below(4) {
+            0 => format!("{{#${:02X}}}", self.rng.below(256)),
+            1 => format!("{{#<L_{}}}", self.label()),
+            2 => "{tab, x}".to_string(),
+            _ => format!("zpc{}", self.rng.below(3)),
+        };
+        if self.rng.chance(50) {
+            self.ca_only(&format!("        ldimm {arg}"));
+            3
+        } else {
+            self.ca_only(&format!("        .byte IMM {arg}, 7"));
+            2
+        }
+    }
+
     /// A unit that exercises a directive; returns its size.
     fn directive_unit(&mut self) -> usize {
+        match self.rng.below(10) {
+            8 => return self.scope_unit(),
+            9 => return self.brace_unit(),
+            _ => {}
+        }
         match self.rng.below(8) {
             0 => {
                 let n = 1 + self.rng.below(4);
@@ -665,14 +783,31 @@ loop:   dex
         lda value
         sta where
 .endmacro
+; Names that scopes shadow (`scope_unit`), and the immediate idiom.
+shv0 = $20
+shv1 = $21
+shv2 = $22
+shv3 = $23
+.define IMM(arg) .match(.left(1,{arg}),#)
+.macro ldimm arg
+.if .match(.left(1,{arg}),#)
+        lda arg
+.else
+        ldy arg
+.endif
+.endmacro
         .charmap $61, $41
         .segment \"ZEROPAGE\"
 zpv0:   .res 2
 zpv1:   .res 1
 zpv2:   .res 5
-        .code",
+        .code
+sh0:    nop
+sh1:    nop
+sh2:    nop
+sh3:    rts",
     );
-    g.lines += 40;
+    g.lines += 57;
 }
 
 /// Writes a program of about `lines` lines.
@@ -691,6 +826,7 @@ pub(crate) fn generate(seed: u64, lines: usize, flavor: Flavor) -> Program {
         block_bytes: 0,
         chunk_bytes: 0,
         procs: Vec::new(),
+        scopes: 0,
         sets: 0,
         covered: std::collections::BTreeSet::new(),
     };
