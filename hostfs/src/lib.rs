@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 mod limit;
 
-pub use limit::{BINARY, Limit, RAW_IMAGE, TEXT};
+pub use limit::{BINARY, Limit, RAW_IMAGE, SOURCE, TEXT};
 
 /// Why a file was not read.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
@@ -186,7 +186,8 @@ fn io_error(path: &Path, source: io::Error) -> Error {
 /// # Errors
 /// [`Error::NotFound`], [`Error::NotAFile`], [`Error::TooLarge`],
 /// [`Error::Io`].
-pub fn check(path: &Path, limit: Limit) -> Result<u64, Error> {
+pub fn check(path: impl AsRef<Path>, limit: Limit) -> Result<u64, Error> {
+    let path = path.as_ref();
     // Symbolic links are followed: what matters is what would be opened.
     let metadata = std::fs::metadata(path).map_err(|e| io_error(path, e))?;
     if let Some(what) = not_a_file(&metadata) {
@@ -216,7 +217,8 @@ fn too_large(path: &Path, size: u64, limit: Limit) -> Error {
 /// [`Error::NotFound`], [`Error::NotAFile`] (checked before opening, so a
 /// FIFO never blocks), [`Error::TooLarge`] (also when the file grows past
 /// the limit while it is read), [`Error::Io`].
-pub fn read(path: &Path, limit: Limit) -> Result<Vec<u8>, Error> {
+pub fn read(path: impl AsRef<Path>, limit: Limit) -> Result<Vec<u8>, Error> {
+    let path = path.as_ref();
     let size = check(path, limit)?;
     let file = File::open(path).map_err(|e| io_error(path, e))?;
     // The file may have been swapped or grown since its metadata was read:
@@ -236,7 +238,8 @@ pub fn read(path: &Path, limit: Limit) -> Result<Vec<u8>, Error> {
 ///
 /// # Errors
 /// As [`read`], and [`Error::NotText`] for bytes that are not UTF-8.
-pub fn read_text(path: &Path, limit: Limit) -> Result<String, Error> {
+pub fn read_text(path: impl AsRef<Path>, limit: Limit) -> Result<String, Error> {
+    let path = path.as_ref();
     let bytes = read(path, limit)?;
     String::from_utf8(bytes).map_err(|e| Error::NotText {
         path: path.to_path_buf(),

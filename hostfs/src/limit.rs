@@ -34,6 +34,10 @@ impl Limit {
 /// real program and still cheap to hold.
 pub const TEXT: Limit = Limit::new(16 << 20, "a text file");
 
+/// What the assembler reads: a source, its `.include`s and its `.incbin`
+/// data, through one reader that cannot tell them apart; as [`TEXT`].
+pub const SOURCE: Limit = Limit::new(16 << 20, "a source or .incbin file");
+
 /// Objects, linked images and ROM profiles (ELF), and `.incbin` data: the
 /// program's bytes are at most 64 KiB, but symbols, relocations, source
 /// maps and a slice taken out of a larger file make room for more.
