@@ -26,7 +26,7 @@ pub struct FsSource;
 
 impl FileSource for FsSource {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
-        std::fs::read(path)
+        Ok(hostfs::read(path, hostfs::SOURCE)?)
     }
 }
 

@@ -140,7 +140,7 @@ impl Sources {
             let text = if file == "scorpion.inc" && !root.join(file).is_file() {
                 Some(romlib::SCORPION_INC.to_owned())
             } else {
-                std::fs::read_to_string(root.join(file)).ok()
+                hostfs::read_text(root.join(file), hostfs::TEXT).ok()
             };
             text.map(|t| t.lines().map(str::to_owned).collect())
         });
@@ -164,8 +164,7 @@ pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Reci
     let mut images = Vec::new();
     let mut root = here.to_path_buf();
     for path in &args.images {
-        let bytes = std::fs::read(path)
-            .into_diagnostic()
+        let bytes = hostfs::read(path, hostfs::BINARY)
             .wrap_err_with(|| format!("cannot read {}", path.display()))?;
         images.push(linker::Image::parse(&path.display().to_string(), &bytes)?);
     }
@@ -193,8 +192,7 @@ pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Reci
     }
     let rom = match &rom_path {
         Some(path) => {
-            let bytes = std::fs::read(path)
-                .into_diagnostic()
+            let bytes = hostfs::read(path, hostfs::BINARY)
                 .wrap_err_with(|| format!("cannot read the ROM profile {}", path.display()))?;
             let name = path.display().to_string();
             let image = linker::Image::parse(&name, &bytes)?;

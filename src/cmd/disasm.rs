@@ -51,8 +51,7 @@ struct Block {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let bytes = std::fs::read(&args.file)
-        .into_diagnostic()
+    let bytes = hostfs::read(&args.file, hostfs::BINARY)
         .wrap_err_with(|| format!("cannot read {}", args.file.display()))?;
     let name = args.file.display().to_string();
     let is_elf = bytes.starts_with(b"\x7fELF");

@@ -87,8 +87,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 }
 
 fn run_image(args: &RunArgs) -> miette::Result<ExitCode> {
-    let image = std::fs::read(&args.image)
-        .into_diagnostic()
+    let image = hostfs::read(&args.image, hostfs::RAW_IMAGE)
         .wrap_err_with(|| format!("cannot read {}", args.image.display()))?;
     let mut machine = RamMachine::with_image(args.load, &image)
         .wrap_err_with(|| format!("cannot load {}", args.image.display()))?;

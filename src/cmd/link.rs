@@ -69,14 +69,12 @@ pub(crate) struct DiskSources;
 
 impl SourceProvider for DiskSources {
     fn source(&self, path: &str) -> Option<String> {
-        std::fs::read_to_string(path).ok()
+        hostfs::read_text(Path::new(path), hostfs::TEXT).ok()
     }
 }
 
 fn read(path: &Path) -> miette::Result<Vec<u8>> {
-    std::fs::read(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot read {}", path.display()))
+    hostfs::read(path, hostfs::BINARY).wrap_err_with(|| format!("cannot read {}", path.display()))
 }
 
 /// The target `--target` and `--start` name.
@@ -90,14 +88,12 @@ fn target(args: &LinkArgs) -> miette::Result<Target> {
                 "--start applies to the flat target, not a layout file"
             );
         }
-        let text = std::fs::read_to_string(name)
-            .into_diagnostic()
+        let text = hostfs::read_text(Path::new(name), hostfs::TEXT)
             .wrap_err_with(|| format!("cannot read layout {name}"))?;
         return Ok(Target::Custom(linker::Layout::from_toml(name, &text)?));
     }
     if name.ends_with(".cfg") {
-        let text = std::fs::read_to_string(name)
-            .into_diagnostic()
+        let text = hostfs::read_text(Path::new(name), hostfs::TEXT)
             .wrap_err_with(|| format!("cannot read the ld65 configuration {name}"))?;
         return Ok(Target::Custom(linker::Layout::from_ld65(
             name, &text, start,

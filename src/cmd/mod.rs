@@ -7,6 +7,7 @@ pub(crate) mod dap;
 pub(crate) mod debug;
 pub(crate) mod disasm;
 pub(crate) mod emu;
+pub(crate) mod host_line;
 pub(crate) mod installed;
 pub(crate) mod link;
 pub(crate) mod new;

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
-use miette::{Context, IntoDiagnostic};
+use miette::Context;
 use romlib::VirtualScorpion;
 
 /// Cards and surroundings of the virtual Scorpion.
@@ -28,8 +28,7 @@ pub(crate) struct Rig {
 
 fn read(root: Option<&Path>, path: &Path) -> miette::Result<String> {
     let full = root.map_or_else(|| path.to_path_buf(), |root| root.join(path));
-    std::fs::read_to_string(full)
-        .into_diagnostic()
+    hostfs::read_text(&full, hostfs::TEXT)
         .wrap_err_with(|| format!("cannot read the script {}", path.display()))
 }
 

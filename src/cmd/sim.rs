@@ -11,6 +11,7 @@ use emulator::board::{CPU_HZ, acia};
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 
+use crate::cmd::host_line::{self, HostLine};
 use crate::cmd::ports;
 
 /// Run the virtual Scorpion: the reference ROM (or your ROM profile) on the
@@ -76,8 +77,7 @@ pub(crate) fn robot(
 ) -> miette::Result<Rigged> {
     let mut robot = match rom {
         Some(path) => {
-            let bytes = std::fs::read(path)
-                .into_diagnostic()
+            let bytes = hostfs::read(path, hostfs::BINARY)
                 .wrap_err_with(|| format!("cannot read the ROM profile {}", path.display()))?;
             let image = linker::Image::parse(&path.display().to_string(), &bytes)?;
             VirtualScorpion::with_rom(&path.display().to_string(), &image)?
@@ -97,8 +97,7 @@ pub(crate) fn robot(
     // Cards first: an image cannot be loaded over a card's registers.
     let printed = rig.apply(&mut robot)?;
     for path in images {
-        let bytes = std::fs::read(path)
-            .into_diagnostic()
+        let bytes = hostfs::read(path, hostfs::BINARY)
             .wrap_err_with(|| format!("cannot read {}", path.display()))?;
         let image = linker::Image::parse(&path.display().to_string(), &bytes)?;
         let hooks = robot
@@ -214,8 +213,16 @@ impl Pace {
         }
     }
 
+    /// The robot time the wall clock has reached.
+    fn target(&self) -> u64 {
+        self.first_cycle + cycles(self.started.elapsed())
+    }
+
     fn catch_up(&self, robot: &mut VirtualScorpion) -> miette::Result<()> {
-        let target = self.first_cycle + cycles(self.started.elapsed());
+        self.run_to(robot, self.target())
+    }
+
+    fn run_to(&self, robot: &mut VirtualScorpion, target: u64) -> miette::Result<()> {
         let behind = target.saturating_sub(robot.cycles());
         robot.run_for(behind)?;
         Ok(())
@@ -255,10 +262,14 @@ fn serve_pty(
     // between the clients' opens and closes.
     let _slave = slave;
     let pace = Pace::new(robot);
-    let mut buffer = [0u8; 512];
+    let mut line = HostLine::new(host_line::HOLDS);
+    let mut overruns = Overruns::new(robot);
+    // A read takes what a flood has in the kernel's buffers at once, so
+    // the pseudo-terminal never holds back more than a real line would.
+    let mut buffer = vec![0u8; host_line::HOLDS];
     loop {
         match master.read(&mut buffer) {
-            Ok(count) => robot.send(&buffer[..count]),
+            Ok(count) => line.accept(&buffer[..count]),
             Err(error) if error.kind() == std::io::ErrorKind::TimedOut => {}
             Err(error) if error.kind() == std::io::ErrorKind::Interrupted => {}
             Err(error) => {
@@ -267,16 +278,125 @@ fn serve_pty(
                     .wrap_err("the pseudo-terminal failed");
             }
         }
-        pace.catch_up(robot)?;
+        let target = pace.target();
+        line.feed(robot, target);
+        pace.run_to(robot, target)?;
         crate::cmd::rig::show_printed(printed);
+        overruns.report(robot, line.take_dropped(), baud);
         let answer = robot.receive();
         if !answer.is_empty() {
-            master
-                .write_all(&answer)
-                .into_diagnostic()
-                .wrap_err("cannot write to the pseudo-terminal")?;
+            let unread = write_answer(&mut master, &answer)?;
+            overruns.unread += unread;
         }
     }
+}
+
+/// Writes the robot's answer to the pseudo-terminal; returns how many of
+/// its bytes were dropped because the clients are not reading (the
+/// kernel's buffer is full): a host UART nobody reads loses them too,
+/// where waiting would stop the robot's clock.
+#[cfg(unix)]
+fn write_answer(master: &mut impl Write, answer: &[u8]) -> miette::Result<u64> {
+    let mut rest = answer;
+    while !rest.is_empty() {
+        // A byte at a time: the kernel takes one whenever it says it has
+        // room, where a longer write could wait for room it never gets.
+        match master.write(&rest[..1]) {
+            Ok(0) => break,
+            Ok(count) => rest = &rest[count..],
+            Err(error) if error.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(error) if error.kind() == std::io::ErrorKind::TimedOut => break,
+            Err(error) => {
+                return Err(error)
+                    .into_diagnostic()
+                    .wrap_err("cannot write to the pseudo-terminal");
+            }
+        }
+    }
+    Ok(rest.len() as u64)
+}
+
+/// What the line lost, said on stderr as it happens (at most once a
+/// second, summed, so a flood does not flood the terminal too): bytes the
+/// host's end dropped (a client writing faster than the baud rate
+/// carries, more than a port holds), characters the 6551 lost to overrun
+/// (its receive register still full: the ROM or an extension did not
+/// read it in time), and answers the clients did not read.
+#[cfg(unix)]
+struct Overruns {
+    /// The 6551's count when last looked at.
+    seen: u64,
+    /// Host bytes dropped, not said yet.
+    dropped: u64,
+    /// Characters overrun, not said yet.
+    overrun: u64,
+    /// Answer bytes dropped, not said yet.
+    unread: u64,
+    /// When something was last said.
+    said_at: Option<Instant>,
+}
+
+#[cfg(unix)]
+impl Overruns {
+    fn new(robot: &VirtualScorpion) -> Overruns {
+        Overruns {
+            seen: robot.robot().board().acia().overruns(),
+            dropped: 0,
+            overrun: 0,
+            unread: 0,
+            said_at: None,
+        }
+    }
+
+    fn report(&mut self, robot: &VirtualScorpion, dropped: u64, baud: u32) {
+        let now = robot.robot().board().acia().overruns();
+        self.overrun += now.saturating_sub(self.seen);
+        self.seen = now;
+        self.dropped += dropped;
+        let pending = self.dropped + self.overrun + self.unread > 0;
+        if !pending
+            || self
+                .said_at
+                .is_some_and(|at| at.elapsed() < Duration::from_secs(1))
+        {
+            return;
+        }
+        self.said_at = Some(Instant::now());
+        let mut err = std::io::stderr().lock();
+        if self.dropped > 0 {
+            let _ = writeln!(
+                err,
+                "line full: {} byte{} dropped (written faster than {baud} baud carries, with {} already waiting)",
+                self.dropped,
+                plural(self.dropped),
+                host_line::HOLDS
+            );
+        }
+        if self.overrun > 0 {
+            let _ = writeln!(
+                err,
+                "6551 overrun: {} character{} lost (the receive register was still full when {} arrived)",
+                self.overrun,
+                plural(self.overrun),
+                if self.overrun == 1 { "it" } else { "they" }
+            );
+        }
+        if self.unread > 0 {
+            let _ = writeln!(
+                err,
+                "{} byte{} of answers dropped: no client is reading the pseudo-terminal",
+                self.unread,
+                plural(self.unread)
+            );
+        }
+        self.dropped = 0;
+        self.overrun = 0;
+        self.unread = 0;
+    }
+}
+
+fn plural(count: u64) -> &'static str {
+    if count == 1 { "" } else { "s" }
 }
 
 #[cfg(not(unix))]

@@ -164,8 +164,7 @@ fn relative(project: &Project, path: &Path) -> String {
 }
 
 fn read_transcript(path: &Path) -> miette::Result<Expectations> {
-    let text = std::fs::read_to_string(path)
-        .into_diagnostic()
+    let text = hostfs::read_text(path, hostfs::TEXT)
         .wrap_err_with(|| format!("cannot read {}", path.display()))?;
     Expectations::parse(&text).wrap_err_with(|| format!("in {}", path.display()))
 }
@@ -242,8 +241,7 @@ fn routine_calls(
     }
     for path in project.test_files("calls") {
         let shown = relative(project, &path);
-        let text = std::fs::read_to_string(&path)
-            .into_diagnostic()
+        let text = hostfs::read_text(&path, hostfs::TEXT)
             .wrap_err_with(|| format!("cannot read {shown}"))?;
         let calls = match crate::project::calls::parse(&text, &symbols) {
             Ok(calls) => calls,

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use miette::{Context, IntoDiagnostic};
+use miette::Context;
 use romlib::protocol::{Answer, Command};
 use uploader::transport::VirtualTransport;
 use uploader::{
@@ -174,17 +174,15 @@ impl Progress for Bar {
 /// The linked image, and what the uploader sends of it.
 fn read_image(path: &PathBuf) -> miette::Result<(linker::Image, UploadImage)> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot read {name}"))?;
+    let bytes =
+        hostfs::read(path, hostfs::BINARY).wrap_err_with(|| format!("cannot read {name}"))?;
     let linked = linker::Image::parse(&name, &bytes)?;
     let image = UploadImage::try_from(&linked)?;
     Ok((linked, image))
 }
 
 fn read_expectations(path: &PathBuf) -> miette::Result<Expectations> {
-    let text = std::fs::read_to_string(path)
-        .into_diagnostic()
+    let text = hostfs::read_text(path, hostfs::TEXT)
         .wrap_err_with(|| format!("cannot read {}", path.display()))?;
     Expectations::parse(&text).wrap_err_with(|| format!("in {}", path.display()))
 }

@@ -27,13 +27,13 @@ impl Rooted<'_> {
 
 impl assembler::FileSource for Rooted<'_> {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
-        std::fs::read(self.full(path))
+        Ok(hostfs::read(self.full(path), hostfs::SOURCE)?)
     }
 }
 
 impl SourceProvider for Rooted<'_> {
     fn source(&self, path: &str) -> Option<String> {
-        std::fs::read_to_string(self.full(Path::new(path))).ok()
+        hostfs::read_text(self.full(Path::new(path)), hostfs::TEXT).ok()
     }
 }
 
@@ -81,7 +81,7 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
         objects.push((path.clone(), assembly.object));
     }
     let target = if spec.target.ends_with(".toml") {
-        let text = std::fs::read_to_string(project.path(&spec.target)).map_err(|e| {
+        let text = hostfs::read_text(project.path(&spec.target), hostfs::TEXT).map_err(|e| {
             miette::miette!(
                 "image {}: cannot read the layout {}: {e}",
                 spec.name,
@@ -90,7 +90,7 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
         })?;
         Target::Custom(linker::Layout::from_toml(&spec.target, &text)?)
     } else if spec.target.ends_with(".cfg") {
-        let text = std::fs::read_to_string(project.path(&spec.target)).map_err(|e| {
+        let text = hostfs::read_text(project.path(&spec.target), hostfs::TEXT).map_err(|e| {
             miette::miette!(
                 "image {}: cannot read the ld65 configuration {}: {e}",
                 spec.name,

@@ -135,7 +135,7 @@ fn user_settings() -> miette::Result<Option<UserSettings>> {
     let Some(path) = user_file() else {
         return Ok(None);
     };
-    let Ok(text) = std::fs::read_to_string(&path) else {
+    let Ok(text) = hostfs::read_text(&path, hostfs::TEXT) else {
         return Ok(None);
     };
     let name = path.display().to_string();
@@ -306,7 +306,7 @@ impl Project {
         let Some(rom) = &self.file.robot.rom else {
             return Ok(None);
         };
-        let bytes = std::fs::read(self.root.join(rom))
+        let bytes = hostfs::read(self.root.join(rom), hostfs::BINARY)
             .map_err(|e| miette::miette!("{}: [robot] rom = \"{rom}\": {e}", super::FILE))?;
         Ok(Some((rom.clone(), linker::Image::parse(rom, &bytes)?)))
     }
@@ -429,7 +429,7 @@ impl Found {
     /// The file in `root`.
     pub(crate) fn load(root: &Path) -> miette::Result<Found> {
         let path = root.join(super::FILE);
-        let text = std::fs::read_to_string(&path)
+        let text = hostfs::read_text(&path, hostfs::TEXT)
             .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
         let name = shown(&path);
         let is_workspace = text

@@ -30,7 +30,7 @@ pub(crate) enum Outcome {
 
 /// Compares `content` with the snapshot at `path`.
 pub(crate) fn compare(path: &Path, content: &str) -> Outcome {
-    let Ok(old) = std::fs::read_to_string(path) else {
+    let Ok(old) = hostfs::read_text(path, hostfs::TEXT) else {
         return Outcome::New;
     };
     let old = self::content(&old).unwrap_or(&old);

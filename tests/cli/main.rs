@@ -9,11 +9,13 @@ mod dap;
 mod debug;
 mod disasm;
 mod emu;
+mod hostile_files;
 mod link;
 mod project;
 mod read;
 mod search_order;
 mod sim;
+mod sim_line;
 mod terminal;
 mod upload;
 

@@ -78,13 +78,15 @@ impl<'a> Asm<'a> {
     }
 
     /// Reads a file through the source for `.include` or `.incbin`,
-    /// following [`Asm::search_path`].
+    /// following [`Asm::search_path`]. Only a file that is not there sends
+    /// the search on; one that is there but cannot be read (a device, a
+    /// FIFO, one too large) ends it with that error.
     pub(crate) fn find_file(
         &self,
         name: &str,
         binary: bool,
         from_dir: &Path,
-    ) -> Option<(PathBuf, Vec<u8>)> {
+    ) -> std::io::Result<Option<(PathBuf, Vec<u8>)>> {
         let path = Path::new(name);
         let candidates = if path.is_absolute() {
             vec![path.to_path_buf()]
@@ -95,17 +97,20 @@ impl<'a> Asm<'a> {
                 .collect()
         };
         for candidate in candidates {
-            if let Ok(bytes) = self.source.read(&candidate) {
-                return Some((candidate, bytes));
+            match self.source.read(&candidate) {
+                Ok(bytes) => return Ok(Some((candidate, bytes))),
+                Err(error) if error.kind() == std::io::ErrorKind::NotFound => {}
+                Err(error) => return Err(error),
             }
         }
         if binary {
-            return None;
+            return Ok(None);
         }
-        self.opts
+        Ok(self
+            .opts
             .builtin_includes
             .get(name)
-            .map(|bytes| (PathBuf::from(name), bytes.clone()))
+            .map(|bytes| (PathBuf::from(name), bytes.clone())))
     }
 
     /// Pushes a file to read next.

@@ -83,14 +83,40 @@ impl Asm<'_> {
         self.report(diag)
     }
 
+    /// A file `.include` or `.incbin` found but cannot read (a device, a
+    /// FIFO, a file over the size limit): the error says what it is. Like
+    /// a missing include, an unreadable one ends the assembly.
+    fn unreadable(
+        &mut self,
+        tok: Token,
+        name: &str,
+        binary: bool,
+        error: &std::io::Error,
+    ) -> crate::asm::Reported {
+        if !binary {
+            self.fatal = true;
+            self.stop = true;
+        }
+        let diag = diag::error(
+            "asm::file-unreadable",
+            tok.span,
+            format!("cannot read `{name}`: {error}"),
+        )
+        .label("not readable")
+        .help("name a regular file within the size limit");
+        self.report(diag)
+    }
+
     pub(super) fn include(&mut self, c: &mut Cursor<'_>) -> PResult<()> {
         let head = c.current();
         let (tok, name) = self.file_operand(c)?;
         self.expect_end(c)?;
         self.frame_room(tok.span)?;
         let dir = self.current_dir();
-        let Some((path, bytes)) = self.find_file(&name, false, &dir) else {
-            return Err(self.not_found(tok, &name, false));
+        let (path, bytes) = match self.find_file(&name, false, &dir) {
+            Ok(Some(found)) => found,
+            Ok(None) => return Err(self.not_found(tok, &name, false)),
+            Err(error) => return Err(self.unreadable(tok, &name, false, &error)),
         };
         let ctx = self.new_ctx(CtxKind::Include, self.join(head.span, tok.span));
         let parent = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -112,8 +138,10 @@ impl Asm<'_> {
         }
         self.expect_end(c)?;
         let dir = self.current_dir();
-        let Some((_, bytes)) = self.find_file(&name, true, &dir) else {
-            return Err(self.not_found(tok, &name, true));
+        let (_, bytes) = match self.find_file(&name, true, &dir) {
+            Ok(Some(found)) => found,
+            Ok(None) => return Err(self.not_found(tok, &name, true)),
+            Err(error) => return Err(self.unreadable(tok, &name, true, &error)),
         };
         let len = bytes.len() as i64;
         let end = match size {
