@@ -5,6 +5,7 @@ mod ask;
 mod asm;
 mod build;
 mod cards;
+mod config;
 mod dap;
 mod debug;
 mod disasm;
