@@ -10,6 +10,7 @@ mod dap;
 mod debug;
 mod disasm;
 mod emu;
+mod layouts;
 mod link;
 mod project;
 mod read;
