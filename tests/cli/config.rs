@@ -376,8 +376,8 @@ fn every_command_that_runs_the_virtual_robot_takes_the_cards_from_each_source() 
         assert_eq!(run(&["sim"], "/2A1\n"), "A57\n", "{source:?}");
         let uploaded = run(&["upload", "--port", "emu", "--expect", expect], "");
         assert!(uploaded.contains("< A57"), "{source:?}: {uploaded}");
-        let debugged = run(&["debug"], "/2A1\n");
-        assert!(debugged.contains("A57"), "{source:?}: {debugged}");
+        let debugged = run(&["debug"], "/2A1\ncontinue 100000\n");
+        assert!(debugged.contains("< A57"), "{source:?}: {debugged}");
         if source == Source::Project {
             let tested = run(&["test"], "");
             assert!(
