@@ -55,6 +55,9 @@ enum Command {
     Debug(cmd::debug::Args),
     /// Serve the Debug Adapter Protocol on stdin/stdout, for editors.
     Dap(cmd::dap::Args),
+    /// Show the configuration a command here resolves, and where each
+    /// setting came from.
+    Config(cmd::config::Args),
 }
 
 fn main() -> ExitCode {
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
         Command::Test(args) => cmd::test::run(&args),
         Command::Debug(args) => cmd::debug::run(&args),
         Command::Dap(args) => cmd::dap::run(&args),
+        Command::Config(args) => cmd::config::run(&args),
     };
     match result {
         Ok(code) => code,

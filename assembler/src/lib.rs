@@ -50,6 +50,11 @@ pub use diag::{Diagnostic, Location, Severity};
 pub use features::{CA65_FEATURES, FeatureError, Features};
 pub use source::{FileSource, FsSource, MemorySource};
 
+/// The values a `-D NAME=VALUE` definition may take: ca65's 32-bit
+/// magnitudes, either sign. Every front end (the `-D` flag, a project's
+/// `defines`) refuses what lies outside rather than truncating it.
+pub const DEFINE_VALUES: std::ops::RangeInclusive<i64> = -(u32::MAX as i64)..=u32::MAX as i64;
+
 /// How to assemble.
 #[derive(Debug, Clone)]
 pub struct Options {

@@ -10,8 +10,8 @@
 ; the ROM's BAD_COMMAND. Both extensions answer; anything else is dropped
 ; as before.
 ;
-; Two extensions must not overlap: checksum.toml places this one in the top
-; kilobyte of user RAM ($0C00-$0FFF) and the top of the user zero page,
+; Two extensions must not overlap: checksum.toml places this one at the top
+; of user RAM ($0C00-$0F3F, USER_RAM_END) and the top of the user zero page,
 ; leaving $0400-$0BFF to the first.
 ;
 ;   scorpion build examples/checksum/checksum.s -o checksum.elf --target examples/checksum/checksum.toml

@@ -29,7 +29,8 @@ pub(crate) struct Args {
     /// How long an extension's command may take to answer, in milliseconds.
     #[arg(long, default_value_t = 500, value_name = "MS")]
     timeout: u64,
-    /// With `--port emu`: a linked image to load first (repeatable).
+    /// With `--port emu`: a linked image to load first (repeatable); in a
+    /// project its images are built and loaded when none is given.
     #[arg(long = "image", value_name = "ELF")]
     images: Vec<PathBuf>,
     /// The commands, in order.
@@ -93,12 +94,16 @@ impl Robot {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let mut robot = if args.line.is_emulated() {
+    let resolved = args.line.resolve()?;
+    let mut robot = if resolved.port()?.value == ports::EMU {
+        // The project's virtual robot: its cards, world, ROM and images.
+        let rom = crate::cmd::config::rom(&resolved)?;
+        let images = crate::cmd::config::images(&resolved, &args.images)?;
         Robot::Virtual(Box::new(sim::robot_only(
-            args.line.baud,
-            None,
-            &args.line.rig,
-            &args.images,
+            resolved.baud.value,
+            rom.as_ref(),
+            &crate::cmd::config::rig(&resolved),
+            &images,
         )?))
     } else {
         if !args.images.is_empty() {
@@ -107,7 +112,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 "--image loads images into the virtual Scorpion only (--port emu)"
             );
         }
-        let transport = args.line.open()?;
+        crate::cmd::config::note_unused_rig(&resolved);
+        let transport = ports::open_resolved(&resolved, &[])?;
         Robot::Serial(Client::new(transport, ClientConfig::default()))
     };
     let timeout = Duration::from_millis(args.timeout);

@@ -27,13 +27,37 @@ pub(crate) struct Args {
 
 /// Builds every image of the project found from here (of every member,
 /// in a workspace): `NAME.elf`, `NAME.lst` and `NAME.map` in each
-/// project's `target/scorpion/`.
-fn project() -> miette::Result<ExitCode> {
+/// project's `target/scorpion/`. The assembler's flags (`-D`, `-I`,
+/// `--feature`...) apply to every image, on top of its own; the output's
+/// flags are refused, saying why: a project's outputs are its own.
+fn project(args: &Args) -> miette::Result<ExitCode> {
+    let mut refused = args.link.given();
+    if args.listing.is_some() {
+        refused.insert(0, "-l");
+    }
+    if !refused.is_empty() {
+        miette::bail!(
+            help = "a project writes target/scorpion/NAME.elf, .lst and .map for each [[image]], where `upload`, `test` and `debug` find them, and each image's `target` in Scorpion.toml says where it goes; copy or convert the ELF (`scorpion link`), or build the sources outside a project (`scorpion build SRC... -o OUT`)",
+            "{} cannot apply to a project's build",
+            refused.join(", ")
+        );
+    }
+    // Relative directories are the user's, from here: made absolute, as
+    // the project's own are read from its root.
+    let here = std::env::current_dir().into_diagnostic()?;
+    let mut given = args.assembler.options(true);
+    for dir in given
+        .include_dirs
+        .iter_mut()
+        .chain(given.bin_include_dirs.iter_mut())
+    {
+        *dir = here.join(&*dir);
+    }
     match crate::project::config::Found::here()? {
-        crate::project::config::Found::Project(project) => build_project(&project, ""),
+        crate::project::config::Found::Project(project) => build_project(&project, "", &given),
         crate::project::config::Found::Workspace(workspace) => {
             for (name, project) in workspace.projects()? {
-                build_project(&project, &format!("{name}/"))?;
+                build_project(&project, &format!("{name}/"), &given)?;
             }
             Ok(())
         }
@@ -42,9 +66,13 @@ fn project() -> miette::Result<ExitCode> {
 }
 
 /// Builds `project`'s images; `at` is its directory as printed.
-fn build_project(project: &crate::project::Project, at: &str) -> miette::Result<()> {
+fn build_project(
+    project: &crate::project::Project,
+    at: &str,
+    given: &assembler::Options,
+) -> miette::Result<()> {
     for spec in &project.file.images {
-        let (built, _) = crate::project::build::build_to_target(project, spec)?;
+        let (built, _) = crate::project::build::build_to_target_with(project, spec, given)?;
         for warning in &built.warnings {
             #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
             {
@@ -65,7 +93,7 @@ fn build_project(project: &crate::project::Project, at: &str) -> miette::Result<
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     if args.sources.is_empty() {
-        return project();
+        return project(args);
     }
     let options = args.assembler.options(args.listing.is_some());
     let mut objects = Vec::with_capacity(args.sources.len());

@@ -28,7 +28,6 @@ use debugger::{Breakpoint, Debugger, Stopped, Why};
 use miette::IntoDiagnostic;
 
 use crate::cmd::debug::{self, Sources};
-use crate::cmd::ports;
 
 /// Serve the Debug Adapter Protocol on stdin and stdout (for an editor's
 /// debugger: see docs/DEBUGGING.md).
@@ -460,7 +459,6 @@ impl Session {
             (dir.to_path_buf(), vec![program.to_path_buf()])
         };
         let args = debug::Args {
-            baud: ports::DEFAULT_BAUD,
             images,
             ..debug::Args::default()
         };

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use debugger::session::{Line, Stopped};
 use debugger::{Breakpoint, Debugger, Watch, WatchKind, Why};
-use miette::{Context, IntoDiagnostic};
+use miette::IntoDiagnostic;
 
 use crate::cmd::ports;
 
@@ -23,9 +23,10 @@ use crate::cmd::ports;
 /// `scorpion debug < session.txt`.
 #[derive(Debug, Default, clap::Args)]
 pub(crate) struct Args {
-    /// The line's baud rate.
-    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
-    pub(crate) baud: u32,
+    /// The line's baud rate [env: SCORPION_BAUD; else the per-user file's
+    /// or Scorpion.toml's; default 9600].
+    #[arg(long)]
+    pub(crate) baud: Option<u32>,
     /// A linked image (ELF) to load, as an upload leaves it; repeat to
     /// chain extensions.
     #[arg(long = "image", value_name = "ELF")]
@@ -159,48 +160,22 @@ pub(crate) type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
 /// as a function that builds it afresh, the images it loads, and the
 /// directory their source paths are relative to.
 pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Recipe> {
-    let mut rig = args.rig.clone();
-    let mut rom_path = args.rom.clone();
-    let mut images = Vec::new();
-    let mut root = here.to_path_buf();
-    for path in &args.images {
-        let bytes = hostfs::read(path, hostfs::BINARY)
-            .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-        images.push(linker::Image::parse(&path.display().to_string(), &bytes)?);
-    }
-    let project = crate::project::Project::find(here)
-        .map(|root| crate::project::config::Found::load(&root))
-        .transpose()?;
-    if let Some(crate::project::config::Found::Project(project)) = project {
-        root.clone_from(&project.root);
-        if rig.is_empty() {
-            rig = project.rig()?;
-        }
-        if rom_path.is_none() {
-            rom_path = project
-                .file
-                .robot
-                .rom
-                .as_ref()
-                .map(|r| project.root.join(r));
-        }
-        if args.images.is_empty() {
-            for spec in &project.file.images {
-                images.push(crate::project::build::build(&project, spec)?.linked.image);
-            }
-        }
-    }
-    let rom = match &rom_path {
-        Some(path) => {
-            let bytes = hostfs::read(path, hostfs::BINARY)
-                .wrap_err_with(|| format!("cannot read the ROM profile {}", path.display()))?;
-            let name = path.display().to_string();
-            let image = linker::Image::parse(&name, &bytes)?;
-            Some((name, image))
-        }
-        None => None,
-    };
-    let baud = args.baud;
+    let resolved = crate::cmd::config::resolve_in(
+        &crate::cmd::config::flags(None, args.baud, &args.rig, args.rom.as_ref()),
+        here,
+    )?;
+    let rig = crate::cmd::config::rig(&resolved);
+    let rom = crate::cmd::config::rom(&resolved)?;
+    let images: Vec<linker::Image> = crate::cmd::config::images(&resolved, &args.images)?
+        .images
+        .into_iter()
+        .map(|(_, image)| image)
+        .collect();
+    let root = resolved
+        .project
+        .as_ref()
+        .map_or_else(|| here.to_path_buf(), |p| p.root.clone());
+    let baud = resolved.baud.value;
     let loaded = images.clone();
     let build = move || -> miette::Result<romlib::VirtualScorpion> {
         let mut robot = ports::bare_robot(baud, rom.as_ref())?;

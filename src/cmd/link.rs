@@ -19,21 +19,19 @@ pub(crate) struct LinkArgs {
     #[arg(short, long, value_name = "OUT")]
     pub(crate) output: Option<PathBuf>,
     /// Where things go: flat, scorpion-ext, scorpion-os, scorpion-rom, a
-    /// layout file (FILE.toml) or an ld65 configuration (FILE.cfg).
-    #[arg(
-        long,
-        value_name = "NAME|FILE.toml|FILE.cfg",
-        default_value = "scorpion-ext"
-    )]
-    pub(crate) target: String,
+    /// layout file (FILE.toml) or an ld65 configuration (FILE.cfg)
+    /// [default: scorpion-ext].
+    #[arg(long, value_name = "NAME|FILE.toml|FILE.cfg")]
+    pub(crate) target: Option<String>,
     /// First address of the flat target's area; for an ld65
     /// configuration, what `%S` stands for (ld65's `-S`).
     #[arg(long, value_name = "ADDR", value_parser = args::address)]
     pub(crate) start: Option<u16>,
     /// Output format: elf (the linked image the emulator and uploader load),
-    /// bin, ihex (Intel HEX), srec (Motorola S-record) or kim (KIM-1 tape).
-    #[arg(long, value_name = "FORMAT", default_value = "elf", value_parser = parse_format)]
-    pub(crate) format: Format,
+    /// bin, ihex (Intel HEX), srec (Motorola S-record) or kim (KIM-1 tape)
+    /// [default: elf].
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
+    pub(crate) format: Option<Format>,
     /// Also write a map file (areas, segments, modules, symbols).
     #[arg(long, value_name = "FILE")]
     pub(crate) map: Option<PathBuf>,
@@ -45,6 +43,37 @@ pub(crate) struct LinkArgs {
     /// Default for scorpion-ext and scorpion-os: the built-in reference ROM.
     #[arg(long = "just-symbols", value_name = "FILE")]
     pub(crate) just_symbols: Vec<PathBuf>,
+}
+
+impl LinkArgs {
+    /// `--target`, or the default.
+    pub(crate) fn target_name(&self) -> &str {
+        self.target.as_deref().unwrap_or("scorpion-ext")
+    }
+
+    /// `--format`, or the default.
+    pub(crate) fn format(&self) -> Format {
+        self.format.unwrap_or(Format::Elf)
+    }
+
+    /// The flags given that only a build outside a project can honour.
+    pub(crate) fn given(&self) -> Vec<&'static str> {
+        let mut given = Vec::new();
+        for (flag, is) in [
+            ("-o", self.output.is_some()),
+            ("--target", self.target.is_some()),
+            ("--start", self.start.is_some()),
+            ("--format", self.format.is_some()),
+            ("--map", self.map.is_some()),
+            ("--labels", self.labels.is_some()),
+            ("--just-symbols", !self.just_symbols.is_empty()),
+        ] {
+            if is {
+                given.push(flag);
+            }
+        }
+        given
+    }
 }
 
 /// How messages and maps name romlib's ROM image.
@@ -80,7 +109,7 @@ fn read(path: &Path) -> miette::Result<Vec<u8>> {
 /// The target `--target` and `--start` name.
 fn target(args: &LinkArgs) -> miette::Result<Target> {
     let start = args.start.map(u64::from);
-    let name = &args.target;
+    let name = args.target_name();
     if name.ends_with(".toml") {
         if start.is_some() {
             miette::bail!(
@@ -156,7 +185,7 @@ pub(crate) fn link_and_write(
     }
     let mut linked = link_objects(objects, &target, &symbol_images, sources)?;
     report_warnings(&mut linked);
-    let bytes = linked.write(args.format)?;
+    let bytes = linked.write(args.format())?;
     write(output, &bytes)?;
     let mut others = Vec::new();
     for file in &linked.other_files {
@@ -203,7 +232,7 @@ fn summary(linked: &Linked, args: &LinkArgs, output: &Path, others: &[String]) {
         println!(
             "{} ({}, target {}): {} byte{} at {}, entry ${:04X}",
             output.display(),
-            args.format,
+            args.format(),
             linked.layout.name,
             bytes,
             if bytes == 1 { "" } else { "s" },

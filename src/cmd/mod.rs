@@ -3,6 +3,7 @@
 pub(crate) mod ask;
 pub(crate) mod asm;
 pub(crate) mod build;
+pub(crate) mod config;
 pub(crate) mod dap;
 pub(crate) mod debug;
 pub(crate) mod disasm;

@@ -3,7 +3,7 @@
 
 use std::process::ExitCode;
 
-use miette::IntoDiagnostic;
+use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 use uploader::Transport;
 use uploader::transport::{SerialTransport, VirtualTransport, list_ports};
@@ -30,36 +30,67 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The line to a robot, for every command that talks to one.
+/// The line to a robot, for every command that talks to one. Each value
+/// not given here comes from the environment, the per-user file or the
+/// project (`scorpion config` shows what was resolved, and from where).
 #[derive(Debug, clap::Args)]
 pub(crate) struct Line {
     /// The serial port the robot is on (`scorpion ports` lists them), or
-    /// `emu` for the virtual Scorpion in this process.
+    /// `emu` for the virtual Scorpion in this process [env: SCORPION_PORT;
+    /// else the per-user file's or Scorpion.toml's [robot] port].
     #[arg(long)]
-    pub(crate) port: String,
-    /// The line's baud rate (the robot's).
-    #[arg(long, default_value_t = DEFAULT_BAUD)]
-    pub(crate) baud: u32,
+    pub(crate) port: Option<String>,
+    /// The line's baud rate (the robot's) [env: SCORPION_BAUD; else the
+    /// per-user file's or Scorpion.toml's [robot] baud; default 9600].
+    #[arg(long)]
+    pub(crate) baud: Option<u32>,
     /// The virtual Scorpion's cards and surroundings (with `--port emu`,
-    /// and for `upload`'s rehearsal).
+    /// and for `upload`'s rehearsal; else the project's [robot] cards and
+    /// world). A real robot has its own: they never stop work on one.
     #[command(flatten)]
     pub(crate) rig: crate::cmd::rig::Rig,
 }
 
 impl Line {
-    /// Whether `--port` names the virtual Scorpion in this process.
-    pub(crate) fn is_emulated(&self) -> bool {
-        self.port == EMU
-    }
-
-    /// Opens the line: see [`open`].
-    pub(crate) fn open(&self) -> miette::Result<Box<dyn Transport>> {
-        open(&self.port, self.baud, &self.rig)
+    /// Resolves these flags with the environment, the per-user file and
+    /// the project.
+    pub(crate) fn resolve(&self) -> miette::Result<scorpion_project::Resolved> {
+        crate::cmd::config::resolve(&crate::cmd::config::flags(
+            self.port.as_ref(),
+            self.baud,
+            &self.rig,
+            None,
+        ))
     }
 }
 
-/// The default baud rate: the board's as shipped (docs/PROTOCOL.md section 3).
-pub(crate) const DEFAULT_BAUD: u32 = platform::line::DEFAULT_BAUD;
+/// Opens the line to the robot `resolved` names: a serial port, or `emu`
+/// for a fresh virtual Scorpion with the resolved cards, surroundings and
+/// ROM profile, and `images` loaded as an upload leaves them.
+pub(crate) fn open_resolved(
+    resolved: &scorpion_project::Resolved,
+    images: &[(String, linker::Image)],
+) -> miette::Result<Box<dyn Transport>> {
+    let port = resolved.port()?;
+    if port.value == EMU {
+        let rom = crate::cmd::config::rom(resolved)?;
+        let mut robot = virtual_robot(
+            resolved.baud.value,
+            rom.as_ref(),
+            &crate::cmd::config::rig(resolved),
+        )?;
+        for (name, image) in images {
+            robot
+                .load_image(image)
+                .wrap_err_with(|| format!("cannot load {name}"))?;
+        }
+        return Ok(Box::new(VirtualTransport::new(robot)));
+    }
+    Ok(Box::new(SerialTransport::open(
+        &port.value,
+        resolved.baud.value,
+    )?))
+}
 
 /// The `--port` value that names the in-process virtual Scorpion.
 pub(crate) const EMU: &str = "emu";
@@ -96,9 +127,10 @@ pub(crate) fn bare_robot(
     virtual_robot(baud, rom, &crate::cmd::rig::Rig::default())
 }
 
-/// Opens `--port`: a serial device path, or `emu` for a fresh virtual
+/// Opens `port`: a serial device path, or `emu` for a fresh virtual
 /// Scorpion in this process (the transport's clock is then its emulated
-/// time) with the cards and surroundings of `rig`.
+/// time) with the cards and surroundings of `rig`. The rig is the virtual
+/// robot's: a real one has its own, and is opened without it.
 pub(crate) fn open(
     port: &str,
     baud: u32,
@@ -108,12 +140,6 @@ pub(crate) fn open(
         return Ok(Box::new(VirtualTransport::new(virtual_robot(
             baud, None, rig,
         )?)));
-    }
-    if !rig.is_empty() {
-        miette::bail!(
-            help = "cards and surroundings are scripts the virtual Scorpion runs: use them with `--port emu`, or with `upload`, whose rehearsal on the virtual Scorpion comes first",
-            "--card and --world do not apply to the robot on {port}"
-        );
     }
     Ok(Box::new(SerialTransport::open(port, baud)?))
 }

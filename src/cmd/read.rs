@@ -34,8 +34,17 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             args.address
         );
     }
-    let transport = args.line.open()?;
-    let mut client = uploader::client(transport, &uploader::RomProfile::reference());
+    let resolved = args.line.resolve()?;
+    // `--port emu` is the project's virtual robot, its images installed.
+    let images = if resolved.port()?.value == ports::EMU {
+        crate::cmd::config::images(&resolved, &[])?.images
+    } else {
+        crate::cmd::config::note_unused_rig(&resolved);
+        Vec::new()
+    };
+    let transport = ports::open_resolved(&resolved, &images)?;
+    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
+    let mut client = uploader::client(transport, &profile);
     client.probe()?;
     let bytes = client.read_memory(args.address, args.length as usize)?;
     match &args.output {

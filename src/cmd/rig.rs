@@ -20,10 +20,14 @@ pub(crate) struct Rig {
     /// lights the phototransistors over robot time (docs/CARDS.md).
     #[arg(long = "world", value_name = "FILE")]
     pub(crate) world: Option<PathBuf>,
-    /// The directory relative paths are read from (a project's root); the
-    /// paths are shown as given.
+    /// The directory the cards' relative paths are read from (a
+    /// project's root); the paths are shown as given.
     #[arg(skip)]
     pub(crate) root: Option<PathBuf>,
+    /// The directory the world's relative path is read from: each part
+    /// may come from its own source (`--world` with the project's cards).
+    #[arg(skip)]
+    pub(crate) world_root: Option<PathBuf>,
 }
 
 fn read(root: Option<&Path>, path: &Path) -> miette::Result<String> {
@@ -33,11 +37,6 @@ fn read(root: Option<&Path>, path: &Path) -> miette::Result<String> {
 }
 
 impl Rig {
-    /// Whether anything is asked for.
-    pub(crate) fn is_empty(&self) -> bool {
-        self.cards.is_empty() && self.world.is_none()
-    }
-
     /// Maps the cards into `robot`'s KIM bus and gives it the
     /// surroundings, saying on stderr where each card went. Returns each
     /// script's name and what it prints.
@@ -74,7 +73,7 @@ impl Rig {
         }
         if let Some(path) = &self.world {
             let name = path.display().to_string();
-            let text = read(self.root.as_deref(), path)?;
+            let text = read(self.world_root.as_deref(), path)?;
             let world = ScriptWorld::load(&name, &text)?;
             printed.push((name, world.printed()));
             robot.set_surroundings(Box::new(world));

@@ -12,7 +12,6 @@ use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 
 use crate::cmd::host_line::{self, HostLine};
-use crate::cmd::ports;
 
 /// Run the virtual Scorpion: the reference ROM (or your ROM profile) on the
 /// emulated board, extensions loaded as an upload leaves them.
@@ -26,9 +25,11 @@ pub(crate) struct Args {
     /// Serve a pseudo-terminal instead of stdin and stdout.
     #[arg(long)]
     pty: bool,
-    /// The line's baud rate (the robot's DIP switches are set to match).
-    #[arg(long, default_value_t = ports::DEFAULT_BAUD)]
-    baud: u32,
+    /// The line's baud rate (the robot's DIP switches are set to match)
+    /// [env: SCORPION_BAUD; else the per-user file's or Scorpion.toml's;
+    /// default 9600].
+    #[arg(long)]
+    baud: Option<u32>,
     /// A linked image (ELF) to load into RAM before serving, hooks
     /// installed last; repeat to chain extensions, in order.
     #[arg(long = "image", value_name = "ELF")]
@@ -60,9 +61,9 @@ fn bumper_mask(text: &str) -> Result<u8, String> {
 /// handles to what its scripts print.
 pub(crate) fn robot_only(
     baud: u32,
-    rom: Option<&PathBuf>,
+    rom: Option<&(String, linker::Image)>,
     rig: &crate::cmd::rig::Rig,
-    images: &[PathBuf],
+    images: &crate::cmd::config::Images,
 ) -> miette::Result<VirtualScorpion> {
     robot(baud, rom, rig, images).map(|(robot, _)| robot)
 }
@@ -71,17 +72,12 @@ pub(crate) fn robot_only(
 /// each of its scripts prints.
 pub(crate) fn robot(
     baud: u32,
-    rom: Option<&PathBuf>,
+    rom: Option<&(String, linker::Image)>,
     rig: &crate::cmd::rig::Rig,
-    images: &[PathBuf],
+    images: &crate::cmd::config::Images,
 ) -> miette::Result<Rigged> {
     let mut robot = match rom {
-        Some(path) => {
-            let bytes = hostfs::read(path, hostfs::BINARY)
-                .wrap_err_with(|| format!("cannot read the ROM profile {}", path.display()))?;
-            let image = linker::Image::parse(&path.display().to_string(), &bytes)?;
-            VirtualScorpion::with_rom(&path.display().to_string(), &image)?
-        }
+        Some((name, image)) => VirtualScorpion::with_rom(name, image)?,
         None => VirtualScorpion::new(),
     };
     if !robot.set_baud(baud) {
@@ -96,19 +92,19 @@ pub(crate) fn robot(
     }
     // Cards first: an image cannot be loaded over a card's registers.
     let printed = rig.apply(&mut robot)?;
-    for path in images {
-        let bytes = hostfs::read(path, hostfs::BINARY)
-            .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-        let image = linker::Image::parse(&path.display().to_string(), &bytes)?;
+    for (name, image) in &images.images {
         let hooks = robot
-            .load_image(&image)
-            .wrap_err_with(|| format!("cannot load {}", path.display()))?;
+            .load_image(image)
+            .wrap_err_with(|| format!("cannot load {name}"))?;
         let mut err = std::io::stderr().lock();
+        if images.from_project {
+            writeln!(err, "loaded {name} from {}", crate::project::FILE).into_diagnostic()?;
+            continue;
+        }
         for area in &image.areas {
             writeln!(
                 err,
-                "loaded {}: ${:04X}-${:04X}",
-                path.display(),
+                "loaded {name}: ${:04X}-${:04X}",
                 area.load,
                 u64::from(area.load) + area.bytes.len() as u64 - 1
             )
@@ -131,64 +127,29 @@ pub(crate) fn robot(
 /// The virtual robot and what each of its scripts prints.
 type Rigged = (VirtualScorpion, Vec<(String, cards::Printed)>);
 
-/// In a project: its ROM profile, cards and surroundings, and its images
-/// built and loaded; each given on the command line (`--rom`, `--card` or
-/// `--world`, `--image`) instead overrides that part.
-fn project_robot(args: &Args) -> miette::Result<Option<Rigged>> {
-    let Some(root) = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| crate::project::Project::find(&cwd))
-    else {
-        return Ok(None);
-    };
-    // A workspace holds no robot of its own: the options alone apply.
-    let crate::project::config::Found::Project(project) =
-        crate::project::config::Found::load(&root)?
-    else {
-        return Ok(None);
-    };
-    let rom = args.rom.clone().or_else(|| {
-        project
-            .file
-            .robot
-            .rom
-            .as_ref()
-            .map(|rom| project.root.join(rom))
-    });
-    let rig = if args.rig.is_empty() {
-        project.rig()?
-    } else {
-        args.rig.clone()
-    };
-    let (mut robot, printed) = robot(args.baud, rom.as_ref(), &rig, &args.images)?;
-    if !args.images.is_empty() {
-        return Ok(Some((robot, printed)));
-    }
-    for spec in &project.file.images {
-        let built = crate::project::build::build(&project, spec)?;
-        robot
-            .load_image(&built.linked.image)
-            .wrap_err_with(|| format!("cannot load {}", built.name))?;
-        let _ = writeln!(
-            std::io::stderr(),
-            "loaded {} from {}",
-            built.name,
-            crate::project::FILE
-        );
-    }
-    Ok(Some((robot, printed)))
-}
-
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let (mut robot, printed) = match project_robot(args)? {
-        Some(found) => found,
-        None => robot(args.baud, args.rom.as_ref(), &args.rig, &args.images)?,
-    };
+    // In a project: its ROM profile, cards and surroundings, and its
+    // images built and loaded; each given on the command line (`--rom`,
+    // `--card`, `--world`, `--image`) instead replaces that part.
+    let resolved = crate::cmd::config::resolve(&crate::cmd::config::flags(
+        None,
+        args.baud,
+        &args.rig,
+        args.rom.as_ref(),
+    ))?;
+    let rom = crate::cmd::config::rom(&resolved)?;
+    let images = crate::cmd::config::images(&resolved, &args.images)?;
+    let (mut robot, printed) = robot(
+        resolved.baud.value,
+        rom.as_ref(),
+        &crate::cmd::config::rig(&resolved),
+        &images,
+    )?;
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }
     if args.pty {
-        serve_pty(&mut robot, args.baud, &printed)
+        serve_pty(&mut robot, resolved.baud.value, &printed)
     } else {
         serve_stdio(&mut robot, &printed)
     }

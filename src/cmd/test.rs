@@ -32,9 +32,11 @@ pub(crate) struct Args {
     /// Take new and changed snapshots as they are now.
     #[arg(long)]
     accept: bool,
-    /// Run the transcripts on the robot on PORT after uploading the
-    /// images (no snapshots); `SCORPION_PORT` or the project's [robot]
-    /// port when given without a value.
+    /// Rehearse the transcripts on the virtual Scorpion (with the
+    /// project's cards and world), then, if they pass, upload the images
+    /// to the robot on PORT and run them there (no snapshots). Without a
+    /// value: SCORPION_PORT, else the per-user file's, else the project's
+    /// [robot] port.
     #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
     port: Option<String>,
     /// Also print the robot time the transcripts stood for and the wall
@@ -204,12 +206,28 @@ struct Setup {
 }
 
 impl Setup {
-    fn of(project: &Project) -> miette::Result<Setup> {
-        Ok(Setup {
-            baud: project.baud()?,
-            rom: project.rom()?,
-            rig: project.rig()?,
-        })
+    /// The virtual robot the one resolution gives `project` (its cards,
+    /// world and ROM profile; the rate from the environment, the per-user
+    /// file or the project), and the port, if `port` asks for one
+    /// (`Some("")`: the configured one).
+    fn of(project: &Project, port: Option<&str>) -> miette::Result<(Setup, Option<String>)> {
+        let flags = scorpion_project::Flags {
+            port: port.filter(|p| !p.is_empty()).map(str::to_owned),
+            ..scorpion_project::Flags::default()
+        };
+        let resolved = crate::cmd::config::resolve_in(&flags, &project.root)?;
+        let port = match port {
+            Some(_) => Some(resolved.port()?.value.clone()),
+            None => None,
+        };
+        Ok((
+            Setup {
+                baud: resolved.baud.value,
+                rom: crate::cmd::config::rom(&resolved)?,
+                rig: crate::cmd::config::rig(&resolved),
+            },
+            port,
+        ))
     }
 
     /// A fresh robot with the images loaded as an upload leaves them.
@@ -297,11 +315,14 @@ fn virtual_transcripts(
 /// Uploads the images to the robot on `port`, then runs the transcripts.
 fn robot_transcripts(
     project: &Project,
+    setup: &Setup,
     built: &[Built],
     port: &str,
     tally: &mut Tally,
 ) -> miette::Result<()> {
-    let transport = ports::open(port, project.baud()?, &crate::cmd::rig::Rig::default())?;
+    // On `emu` the robot is the virtual one with the project's parts; a
+    // real robot has its own cards, and is opened without them.
+    let transport = ports::open(port, setup.baud, &setup.rig)?;
     let mut client = client(transport);
     for image in built {
         let upload = UploadImage::try_from(&image.linked.image)?;
@@ -400,18 +421,21 @@ fn test_project(project: &Project, args: &Args, tally: &mut Tally) -> miette::Re
     }
     match &args.port {
         Some(port) => {
-            let port = if port.is_empty() {
-                project.port()?.ok_or_else(|| {
-                    miette::miette!(
-                        help = "give it (`--port /dev/ttyUSB0`), set SCORPION_PORT, or add `port` to [robot] in ~/.config/scorpion/config.toml (yours) or Scorpion.toml (the project's)",
-                        "no port for the robot"
-                    )
-                })?
-            } else {
-                port.clone()
-            };
+            let (setup, port) = Setup::of(project, Some(port))?;
+            let port = port.unwrap_or_default();
             if tally.failed == failed_before {
-                robot_transcripts(project, &built, &port, tally)?;
+                // The rehearsal: every transcript on the virtual robot with
+                // the project's cards and world first; the robot is
+                // touched only if they all pass.
+                virtual_transcripts(project, &setup, &built, tally)?;
+            }
+            if tally.failed == failed_before {
+                robot_transcripts(project, &setup, &built, &port, tally)?;
+            } else {
+                tally.record(
+                    &format!("upload to {port}"),
+                    Err("  the rehearsal on the virtual Scorpion failed; nothing was sent to the robot".to_owned()),
+                );
             }
         }
         None => {
@@ -422,7 +446,7 @@ fn test_project(project: &Project, args: &Args, tally: &mut Tally) -> miette::Re
                 stale_snapshots(project, args.accept, tally)?;
             }
             if tally.failed == failed_before || built.len() == project.file.images.len() {
-                let setup = Setup::of(project)?;
+                let (setup, _) = Setup::of(project, None)?;
                 virtual_transcripts(project, &setup, &built, tally)?;
                 routine_calls(project, &setup, &built, tally)?;
             }

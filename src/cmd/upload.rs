@@ -241,20 +241,24 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    // One resolution for the line and the virtual robot: the port and
+    // rate from the flags, the environment, the per-user file or the
+    // project; the project's cards, world and ROM profile rehearse the
+    // upload (and are the robot on `--port emu`), unless flags name others.
+    let resolved = args.line.resolve()?;
+    resolved.port()?;
     match &args.image {
-        Some(path) => upload_file(args, path, &args.line.rig),
+        Some(path) => upload_file(args, &resolved, path),
         None => {
-            let project = crate::project::Project::here()?;
-            // The project's cards rehearse the upload, unless the command
-            // line names others.
-            let rig = if args.line.rig.is_empty() {
-                project.rig()?
-            } else {
-                args.line.rig.clone()
+            let Some(project) = &resolved.project else {
+                return Err(scorpion_project::Error::NoProject {
+                    dir: std::env::current_dir().into_diagnostic()?,
+                }
+                .into());
             };
             for spec in &project.file.images {
-                let (_, path) = crate::project::build::build_to_target(&project, spec)?;
-                let code = upload_file(args, &path, &rig)?;
+                let (_, path) = crate::project::build::build_to_target(project, spec)?;
+                let code = upload_file(args, &resolved, &path)?;
                 if code != ExitCode::SUCCESS {
                     return Ok(code);
                 }
@@ -267,22 +271,28 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 /// Uploads the linked image at `path`.
 fn upload_file(
     args: &Args,
+    resolved: &scorpion_project::Resolved,
     path: &PathBuf,
-    rig: &crate::cmd::rig::Rig,
 ) -> miette::Result<ExitCode> {
     let (linked, image) = read_image(path)?;
     let expectations = args.expect.as_ref().map(read_expectations).transpose()?;
-    let options = args.options();
+    let rom = crate::cmd::config::rom(resolved)?;
+    let rig = crate::cmd::config::rig(resolved);
+    let options = UploadOptions {
+        profile: crate::cmd::config::profile(rom.as_ref())?,
+        ..args.options()
+    };
     let profile = &options.profile;
     profile.check(&image)?;
-    let emulated = args.line.is_emulated();
+    let baud = resolved.baud.value;
+    let emulated = resolved.is_emulated();
     let mut out = String::new();
 
     // The rehearsal: the same upload into a virtual Scorpion, then the
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let mut robot = ports::virtual_robot(args.line.baud, None, rig)?;
+        let mut robot = ports::virtual_robot(baud, rom.as_ref(), &rig)?;
         // A handler that hangs in the rehearsal is named by its label.
         robot.add_labels(&linked);
         let mut client = args.client(VirtualTransport::new(robot), profile);
@@ -314,7 +324,9 @@ fn upload_file(
         out.clear();
     }
 
-    let transport = ports::open(&args.line.port, args.line.baud, rig)?;
+    // The robot itself: on `emu`, a fresh virtual Scorpion with the same
+    // parts; on a port, the robot, which has its own.
+    let transport = ports::open_resolved(resolved, &[])?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
     let result = uploader::upload(&mut client, &image, &options, &mut bar);

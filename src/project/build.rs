@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use linker::{Image, Linked, SourceProvider, Target};
 
 use super::Project;
-use super::config::ImageSpec;
+use scorpion_project::ImageSpec;
 
 /// Files read relative to the project's root.
 struct Rooted<'a>(&'a Path);
@@ -55,17 +55,37 @@ pub(crate) struct Built {
 
 /// Assembles and links `spec`.
 pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built> {
+    build_with(project, spec, &assembler::Options::default())
+}
+
+/// Assembles and links `spec` with the command line's assembler options
+/// `given` (`scorpion build -D`, `-I`...) on top of the image's own: its
+/// include directories first, then the given ones; its defines, each
+/// replaced by a given one of the same name.
+pub(crate) fn build_with(
+    project: &Project,
+    spec: &ImageSpec,
+    given: &assembler::Options,
+) -> miette::Result<Built> {
     let source = Rooted(&project.root);
+    let mut defines: Vec<(String, i64)> = spec
+        .defines
+        .iter()
+        .filter(|(name, _)| !given.defines.iter().any(|(own, _)| own == *name))
+        .map(|(name, value)| (name.clone(), *value))
+        .collect();
+    defines.extend(given.defines.iter().cloned());
     let options = assembler::Options {
-        include_dirs: spec.include.iter().map(PathBuf::from).collect(),
-        defines: spec
-            .defines
+        include_dirs: spec
+            .include
             .iter()
-            .map(|(name, value)| (name.clone(), *value))
+            .map(PathBuf::from)
+            .chain(given.include_dirs.iter().cloned())
             .collect(),
+        defines,
         listing: true,
         builtin_includes: crate::cmd::asm::builtin_includes(),
-        ..assembler::Options::default()
+        ..given.clone()
     };
     let mut objects = Vec::new();
     let mut listing = String::new();
@@ -101,6 +121,14 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
     } else {
         Target::builtin(&spec.target, None)?
     };
+    if let Target::Custom(layout) = &target {
+        let profile = match project.rom()? {
+            Some((name, image)) => uploader::RomProfile::from_rom_image(&name, &image)?,
+            None => uploader::RomProfile::reference(),
+        };
+        super::memory::check(&spec.name, &spec.target, layout, &profile.writable)
+            .map_err(|outside| miette::Report::new(*outside))?;
+    }
     let rom = match project.rom()? {
         Some(profile) => profile,
         None => (
@@ -127,7 +155,17 @@ pub(crate) fn build_to_target(
     project: &Project,
     spec: &ImageSpec,
 ) -> miette::Result<(Built, PathBuf)> {
-    let built = build(project, spec)?;
+    build_to_target_with(project, spec, &assembler::Options::default())
+}
+
+/// [`build_to_target`] with the command line's assembler options (see
+/// [`build_with`]).
+pub(crate) fn build_to_target_with(
+    project: &Project,
+    spec: &ImageSpec,
+    given: &assembler::Options,
+) -> miette::Result<(Built, PathBuf)> {
+    let built = build_with(project, spec, given)?;
     let dir = project.target_dir();
     std::fs::create_dir_all(&dir)
         .map_err(|e| miette::miette!("cannot create {}: {e}", dir.display()))?;

@@ -1,23 +1,22 @@
-//! A Scorpion project: one `Scorpion.toml` that holds what the commands
-//! otherwise take as options (the images, the virtual robot's cards and
-//! surroundings, the robot's port and baud rate), found in the current
-//! directory or above, as cargo finds `Cargo.toml`.
+//! A Scorpion project as the CLI runs it. The project model and the
+//! resolution of every command's configuration are the `scorpion-project`
+//! library's (re-exported here as [`config`]); what stays here builds,
+//! snapshots and runs the project's tests.
 //!
-//! - [`config`]: the file, with errors at its line and key, and the
-//!   per-user settings (`SCORPION_PORT`, `SCORPION_BAUD`).
 //! - [`build`]: an image built in memory, with its listing, map, symbols
 //!   and bytes.
 //! - [`snapshot`]: insta-format snapshot files and their diffs.
 //! - [`calls`]: routine-level tests (`tests/*.calls`).
+//! - [`memory`]: a project's own layout checked against the memory an
+//!   upload may write.
 //!
 //! Nothing here prints: `scorpion build`, `test` and `new` do.
 
 pub(crate) mod build;
 pub(crate) mod calls;
-pub(crate) mod config;
+pub(crate) mod memory;
 pub(crate) mod snapshot;
 
-pub(crate) use config::Project;
-
-/// The project file's name.
-pub(crate) const FILE: &str = "Scorpion.toml";
+/// The project model and the configuration's resolution.
+pub(crate) use scorpion_project as config;
+pub(crate) use scorpion_project::{FILE, Project};
