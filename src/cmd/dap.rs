@@ -97,8 +97,11 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
                 continue;
             }
         };
-        if !forward(&outbox, &busy, &to_robot, request).into_diagnostic()? {
-            break;
+        match forward(&outbox, &busy, &to_robot, request).into_diagnostic()? {
+            Next::Read => {}
+            Next::End => break,
+            // The process's end ends the robot's thread too.
+            Next::Abandon => return Ok(ExitCode::SUCCESS),
         }
     }
     drop(to_robot);
@@ -117,15 +120,25 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// What follows a request.
+enum Next {
+    /// The next request.
+    Read,
+    /// The session is over: the robot's thread ends.
+    End,
+    /// The session is over, the robot's thread stuck: it is left behind.
+    Abandon,
+}
+
 /// Hands `request` to the robot's thread. `pause` and `disconnect` (and
 /// `terminate`) are answered here if that thread does not answer them in
-/// [`STUCK`]. False when the session is over.
+/// [`STUCK`].
 fn forward(
     outbox: &Outbox,
     busy: &Busy,
     to_robot: &mpsc::Sender<Request>,
     request: Request,
-) -> std::io::Result<bool> {
+) -> std::io::Result<Next> {
     let (seq, command) = (request.seq, request.command.clone());
     let ending = matches!(command.as_str(), "disconnect" | "terminate");
     let urgent = ending || command == "pause";
@@ -135,10 +148,10 @@ fn forward(
     if to_robot.send(request).is_err() {
         // The robot's thread ended (its output failed): nobody to answer.
         outbox.respond(seq, &command, Err("the session is over".into()))?;
-        return Ok(false);
+        return Ok(Next::End);
     }
     if !urgent || outbox.wait_answered(seq, STUCK) {
-        return Ok(!ending);
+        return Ok(if ending { Next::End } else { Next::Read });
     }
     let doing = busy.describe().unwrap_or_else(|| "its last request".into());
     if ending {
@@ -147,7 +160,7 @@ fn forward(
             &format!("the robot did not come back ({doing}); the session ends without it\n"),
         )?;
         outbox.respond(seq, &command, Ok(None))?;
-        return Ok(false);
+        return Ok(Next::Abandon);
     }
     outbox.respond(
         seq,
@@ -156,7 +169,7 @@ fn forward(
             "the robot has not come back to look for requests ({doing}): a card or world script may be asking to be woken at the same instant again and again; `disconnect` ends the session"
         )),
     )?;
-    Ok(true)
+    Ok(Next::Read)
 }
 
 /// The robot's thread: requests answered in turn; while the robot runs,

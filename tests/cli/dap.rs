@@ -565,7 +565,12 @@ fn a_card_that_never_lets_time_move_does_not_silence_the_adapter() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     std::fs::write(
         dir.path().join("Scorpion.toml"),
-        "[project]\nname = \"spin\"\n\n[robot]\ncards = [\"spin.rhai\"]\n",
+        "[project]\nname = \"spin\"\n\n[[image]]\nname = \"idle\"\nsources = [\"idle.s\"]\ntarget = \"scorpion-ext\"\n\n[robot]\ncards = [\"spin.rhai\"]\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("idle.s"),
+        "        .include \"scorpion.inc\"\n        SCORPION_UNKNOWN_HANDLER\nhandler:\n        SCORPION_CHAIN_UNKNOWN\n",
     )
     .expect("write");
     std::fs::write(
@@ -582,6 +587,10 @@ fn a_card_that_never_lets_time_move_does_not_silence_the_adapter() {
     if launch["success"] == true {
         c.request("configurationDone", json!({}));
         std::thread::sleep(Duration::from_millis(300));
+    } else {
+        // Refused at launch (by the card sandbox): nothing runs to spin.
+        let message = launch["message"].as_str().unwrap_or_default();
+        assert!(message.contains("spin.rhai"), "{launch}");
     }
     let start = Instant::now();
     let pause = c.request("pause", json!({"threadId": 1}));
