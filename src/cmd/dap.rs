@@ -21,6 +21,8 @@ use std::time::{Duration, Instant};
 use miette::IntoDiagnostic;
 
 mod framing;
+#[cfg(test)]
+mod fuzz;
 mod protocol;
 mod session;
 

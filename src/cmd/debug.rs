@@ -14,6 +14,8 @@ use miette::{Context, IntoDiagnostic};
 use crate::cmd::ports;
 
 mod counts;
+#[cfg(test)]
+mod fuzz;
 
 use counts::{BACK_COUNT, CONTINUE_CYCLES, DIS_COUNT, MEM_LEN, STEP_COUNT};
 
@@ -60,16 +62,16 @@ commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
   delete N | delete watch N
                        remove breakpoint N or watchpoint N
   info                 list the breakpoints and watchpoints
-  continue [CYCLES]    run until a stop, at most CYCLES (1 s of robot time)       (c)
-  step [N]             run N instructions (1)                                     (s)
+  continue [CYCLES]    run until a stop, at most CYCLES (1 s; 60000000 at most)   (c)
+  step [N]             run N instructions (1; 10000000 at most)                   (s)
   next                 one instruction, a JSR with its whole subroutine            (n)
   finish               run until the current subroutine returns                   (f)
   back [N]             go back N instructions (1), exactly                        (bs)
   reverse-continue     go back to the last breakpoint or watchpoint hit           (rc)
   who-wrote ADDR       the last instruction that wrote ADDR, and the byte
   regs                 the registers                                              (r)
-  mem ADDR [LEN]       bytes from ADDR (16)                                       (m)
-  dis [ADDR] [N]       N instructions from ADDR (the PC; 8)                       (d)
+  mem ADDR [LEN]       bytes from ADDR (16; 65536 at most)                        (m)
+  dis [ADDR] [N]       N instructions from ADDR (the PC; 8; 65536 at most)        (d)
   trace FILE | trace off
                        write every instruction run to FILE
   list [FILE:LINE|ADDR] the source around the PC (or there)                       (l)

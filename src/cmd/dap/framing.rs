@@ -406,7 +406,8 @@ mod tests {
 
     #[test]
     fn bad_headers_are_errors_and_the_next_message_is_read() {
-        let cases: [(&str, fn(&FrameError) -> bool); 5] = [
+        type Expected = fn(&FrameError) -> bool;
+        let cases: [(&str, Expected); 5] = [
             ("Content-Length: -4\r\n\r\n{}", |e| {
                 matches!(e, FrameError::BadLength { .. })
             }),

@@ -105,6 +105,12 @@ impl Session {
         self.running
     }
 
+    /// A program is launched.
+    #[cfg(test)]
+    pub(crate) fn launched(&self) -> bool {
+        self.debugger.is_some()
+    }
+
     fn stopped(&self, reason: &str, description: Option<String>) -> std::io::Result<()> {
         let mut body = json!({"reason": reason, "threadId": THREAD, "allThreadsStopped": true});
         if let Some(description) = description {
