@@ -52,4 +52,17 @@ pub enum Error {
         /// The cycle the re-run had.
         found: u64,
     },
+    /// The trace of the instructions run could not be written: the run
+    /// stopped there, and the trace ended.
+    #[error("cannot write the trace to {name}: {message}")]
+    #[diagnostic(
+        code(debugger::trace),
+        help("the trace is off; `trace FILE` starts another")
+    )]
+    Trace {
+        /// Where the trace went, as named.
+        name: String,
+        /// The write's error.
+        message: String,
+    },
 }

@@ -4,6 +4,7 @@
 use std::cell::Cell;
 use std::collections::VecDeque;
 use std::io::Write;
+use std::sync::{Arc, Mutex};
 
 use emulator::{Cpu, Tracer};
 use isa::objfmt::HookKind;
@@ -101,7 +102,46 @@ pub struct Debugger {
     /// Instructions run when the robot was handed over (no going back
     /// before them).
     power_up: u64,
-    trace: Option<Tracer<Box<dyn Write + Send>>>,
+    trace: Option<Trace>,
+}
+
+/// The trace being written: the tracer, and what its writer saw go wrong.
+struct Trace {
+    /// Where it goes, as the user named it (for the error).
+    name: String,
+    tracer: Tracer<Box<dyn Write + Send>>,
+    /// The first write error, noted by [`Noted`]: the tracer stops the run
+    /// at it, and the run must say why instead of starting again.
+    failed: Arc<Mutex<Option<String>>>,
+}
+
+/// A trace's writer that notes its first error where the debugger sees it.
+struct Noted {
+    out: Box<dyn Write + Send>,
+    failed: Arc<Mutex<Option<String>>>,
+}
+
+impl Noted {
+    fn note<T>(&self, result: std::io::Result<T>) -> std::io::Result<T> {
+        if let Err(error) = &result
+            && let Ok(mut failed) = self.failed.lock()
+        {
+            failed.get_or_insert_with(|| error.to_string());
+        }
+        result
+    }
+}
+
+impl Write for Noted {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let result = self.out.write(buf);
+        self.note(result)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        let result = self.out.flush();
+        self.note(result)
+    }
 }
 
 impl std::fmt::Debug for Debugger {
@@ -244,9 +284,52 @@ impl Debugger {
         frames
     }
 
-    /// Traces every instruction run from now on into `out` (`None`: stop).
-    pub fn trace(&mut self, out: Option<Box<dyn Write + Send>>) {
-        self.trace = out.map(Tracer::new);
+    /// Traces every instruction run from now on into `out` (`name` says
+    /// where, for errors), ending the trace there was.
+    ///
+    /// # Errors
+    /// [`Error::Trace`]: the trace there was could not be written out.
+    pub fn trace(&mut self, name: &str, out: Box<dyn Write + Send>) -> Result<(), Error> {
+        let ended = self.trace_off();
+        let failed = Arc::new(Mutex::new(None));
+        let out: Box<dyn Write + Send> = Box::new(Noted {
+            out,
+            failed: Arc::clone(&failed),
+        });
+        self.trace = Some(Trace {
+            name: name.to_owned(),
+            tracer: Tracer::new(out),
+            failed,
+        });
+        ended
+    }
+
+    /// Ends the trace (if one is written), flushing it.
+    ///
+    /// # Errors
+    /// [`Error::Trace`]: a write or the flush failed.
+    pub fn trace_off(&mut self) -> Result<(), Error> {
+        let Some(trace) = self.trace.take() else {
+            return Ok(());
+        };
+        let name = trace.name;
+        trace
+            .tracer
+            .finish()
+            .map(drop)
+            .map_err(|error| Error::Trace {
+                name,
+                message: error.to_string(),
+            })
+    }
+
+    /// The trace's write error, if one stopped the run: the trace ends.
+    fn trace_failure(&mut self) -> Option<Error> {
+        let trace = self.trace.as_ref()?;
+        let message = trace.failed.lock().ok()?.clone()?;
+        let name = trace.name.clone();
+        self.trace = None;
+        Some(Error::Trace { name, message })
     }
 
     /// Adds a breakpoint; returns its number.
@@ -388,7 +471,7 @@ impl Debugger {
             let arrival = self.arrival();
             let found = run_hooked(
                 &mut self.robot,
-                self.trace.as_mut(),
+                self.trace.as_mut().map(|trace| &mut trace.tracer),
                 Points {
                     breakpoints: &self.breakpoints,
                     watches: &self.watches,
@@ -398,6 +481,10 @@ impl Debugger {
                 goal,
             )?;
             received.extend(self.robot.receive());
+            // A failed write stops the tracer's run at once, each time.
+            if let Some(error) = self.trace_failure() {
+                return Err(error);
+            }
             if found.is_none() && self.robot.cycles() < until {
                 continue;
             }

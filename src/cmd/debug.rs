@@ -13,6 +13,12 @@ use miette::IntoDiagnostic;
 
 use crate::cmd::ports;
 
+mod counts;
+#[cfg(test)]
+mod fuzz;
+
+use counts::{BACK_COUNT, CONTINUE_CYCLES, DIS_COUNT, MEM_LEN, STEP_COUNT};
+
 /// Debug a program on the virtual Scorpion: breakpoints (an address, a
 /// label, a robot command arriving), watchpoints, step, next, finish, and
 /// back in time. Type `help` at the prompt.
@@ -57,16 +63,16 @@ commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
   delete N | delete watch N
                        remove breakpoint N or watchpoint N
   info                 list the breakpoints and watchpoints
-  continue [CYCLES]    run until a stop, at most CYCLES (1 s of robot time)       (c)
-  step [N]             run N instructions (1)                                     (s)
+  continue [CYCLES]    run until a stop, at most CYCLES (1 s; 60000000 at most)   (c)
+  step [N]             run N instructions (1; 10000000 at most)                   (s)
   next                 one instruction, a JSR with its whole subroutine            (n)
   finish               run until the current subroutine returns                   (f)
   back [N]             go back N instructions (1), exactly                        (bs)
   reverse-continue     go back to the last breakpoint or watchpoint hit           (rc)
   who-wrote ADDR       the last instruction that wrote ADDR, and the byte
   regs                 the registers                                              (r)
-  mem ADDR [LEN]       bytes from ADDR (16)                                       (m)
-  dis [ADDR] [N]       N instructions from ADDR (the PC; 8)                       (d)
+  mem ADDR [LEN]       bytes from ADDR (16; 65536 at most)                        (m)
+  dis [ADDR] [N]       N instructions from ADDR (the PC; 8; 65536 at most)        (d)
   trace FILE | trace off
                        write every instruction run to FILE
   list [FILE:LINE|ADDR] the source around the PC (or there)                       (l)
@@ -110,7 +116,13 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             }
         }
     }
-    // A session in which the robot broke (a JAM, a card's fault) fails.
+    // The trace's last lines, and its last chance to say it failed.
+    if let Err(error) = debugger.trace_off() {
+        broken = true;
+        writeln!(out, "error: {}", Failure::from(error).message()).into_diagnostic()?;
+    }
+    // A session in which the robot broke (a JAM, a card's fault) or whose
+    // trace could not be written fails.
     Ok(if broken {
         ExitCode::FAILURE
     } else {
@@ -349,17 +361,16 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
             text
         }
         "continue" | "c" | "run" => {
-            let budget = match rest.first() {
-                Some(n) => n.parse().map_err(|_| usage("continue [CYCLES]"))?,
-                None => BUDGET,
-            };
+            let budget = CONTINUE_CYCLES
+                .or(rest.first(), BUDGET)
+                .map_err(Failure::Usage)?;
             {
                 let stop = d.run(budget)?;
                 stop_report(d, sources, &stop)
             }
         }
         "step" | "s" | "stepi" | "si" => {
-            let n = count(&rest, "step [N]")?;
+            let n = STEP_COUNT.or(rest.first(), 1).map_err(Failure::Usage)?;
             {
                 let stop = d.step(n)?;
                 stop_report(d, sources, &stop)
@@ -374,7 +385,7 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
             stop_report(d, sources, &stop)
         }
         "back" | "bs" | "reverse-step" => {
-            let n = count(&rest, "back [N]")?;
+            let n = BACK_COUNT.or(rest.first(), 1).map_err(Failure::Usage)?;
             {
                 let stop = d.back(n)?;
                 stop_report(d, sources, &stop)
@@ -417,8 +428,7 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
                 [a] => (d.symbols().address(a)?, 16),
                 [a, n] => (
                     d.symbols().address(a)?,
-                    n.parse()
-                        .map_err(|_| usage("mem ADDR [LEN]: LEN is a number"))?,
+                    MEM_LEN.parse(n).map_err(Failure::Usage)?,
                 ),
                 _ => return Err(usage("mem ADDR [LEN]")),
             };
@@ -429,24 +439,21 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
                 Some(a) => d.symbols().address(a)?,
                 None => d.cpu().pc,
             };
-            let n = match rest.get(1) {
-                Some(n) => n.parse().map_err(|_| usage("dis [ADDR] [N]"))?,
-                None => 8,
-            };
-            d.disassemble(address, n)
+            let n = DIS_COUNT.or(rest.get(1), 8).map_err(Failure::Usage)?;
+            d.disassemble(address, usize::try_from(n).unwrap_or(usize::MAX))
                 .iter()
                 .map(|l| line_text(d, l))
                 .collect()
         }
         "trace" => match rest.first() {
             Some(&"off") => {
-                d.trace(None);
+                d.trace_off()?;
                 "trace off\n".into()
             }
             Some(path) => {
                 let file = std::fs::File::create(path)
                     .map_err(|e| usage(&format!("cannot write {path}: {e}")))?;
-                d.trace(Some(Box::new(std::io::BufWriter::new(file))));
+                d.trace(path, Box::new(std::io::BufWriter::new(file)))?;
                 format!("tracing into {path}\n")
             }
             None => return Err(usage("trace FILE or trace off")),
@@ -456,13 +463,6 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
         }
     };
     Ok(Reply::Text(text))
-}
-
-fn count(rest: &[&str], form: &str) -> Result<u64, Failure> {
-    match rest.first() {
-        Some(n) => n.parse().map_err(|_| usage(form)),
-        None => Ok(1),
-    }
 }
 
 fn kind_name(kind: WatchKind) -> &'static str {
@@ -511,14 +511,23 @@ fn registers(d: &Debugger) -> String {
     )
 }
 
-fn memory(d: &Debugger, address: u16, len: usize) -> String {
+/// `len` bytes from `address` (at most the address space, [`MEM_LEN`]:
+/// past $FFFF it wraps to $0000 as the 6502's addresses do).
+fn memory(d: &Debugger, address: u16, len: u64) -> String {
     let bus = &d.robot().robot().bus;
-    let bytes: Vec<u8> = (0..len)
-        .map(|i| emulator::Bus::peek(bus, address.wrapping_add(i as u16)))
-        .collect();
+    let len = len.min(MEM_LEN.max);
+    // Up to $FFFF, then on from $0000: each part dumped at its own
+    // addresses.
+    let to_top = (0x1_0000 - u64::from(address)).min(len);
     let mut text = Vec::new();
-    // As `scorpion read` shows a robot's memory.
-    let _ = crate::cmd::read::write_dump(&mut text, address, &bytes);
+    for (start, count) in [(address, to_top), (0, len - to_top)] {
+        let bytes: Vec<u8> = (0..count)
+            .filter_map(|i| u16::try_from(u64::from(start) + i).ok())
+            .map(|at| emulator::Bus::peek(bus, at))
+            .collect();
+        // As `scorpion read` shows a robot's memory.
+        let _ = crate::cmd::read::write_dump(&mut text, start, &bytes);
+    }
     String::from_utf8_lossy(&text).into_owned()
 }
 

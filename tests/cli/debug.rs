@@ -3,6 +3,7 @@
 //! transcripts in snapshots.
 
 use std::path::Path;
+use std::process::Output;
 
 use crate::{scorpion, scorpion_with_input, transcript};
 
@@ -136,4 +137,114 @@ fn breaks_at_a_source_line_and_lists_the_source_there() {
     assert!(text.contains("  adc.s:43:         bvc @wait"), "{text}");
     assert!(text.contains("> adc.s:43           bvc @wait"), "{text}");
     assert!(text.contains("error: no code came from adc.s:2"), "{text}");
+}
+
+/// Runs `scorpion debug` in `dir` on `input` as [`scorpion_with_input`]
+/// does, but under a memory limit (1 GB of address space, through the
+/// shell's `ulimit`) and a time limit: a command that allocates gigabytes
+/// or runs for ever fails the test instead of the machine.
+fn debug_bounded(dir: &Path, args: &[&str], input: &str, limit: std::time::Duration) -> Output {
+    use std::io::Write as _;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 1000000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_scorpion"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("RUST_BACKTRACE")
+        .env("NO_COLOR", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("sh runs");
+    let mut stdin = child.stdin.take().expect("stdin is piped");
+    let input = input.to_owned();
+    // Written on a thread of its own: a monitor stuck in a command stops
+    // reading, and the write must not stall the clock below.
+    let writer = std::thread::spawn(move || {
+        let _ = stdin.write_all(input.as_bytes());
+    });
+    let start = std::time::Instant::now();
+    while child.try_wait().expect("the child's status").is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let output = child.wait_with_output().expect("the killed child");
+            panic!(
+                "`scorpion {}` still runs after {limit:?}:\n{}",
+                args.join(" "),
+                transcript(&output)
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = writer.join();
+    child.wait_with_output().expect("the child's output")
+}
+
+/// Issue 23, item 11: counts and lengths beyond what the address space
+/// holds or what a session can wait for are refused, each saying its bound;
+/// at the old code they panicked (`mem 0 18446744073709551615`), allocated
+/// gigabytes (`mem 0 4294967296`, `dis 0 100000000`) or ran for hours
+/// (`step 4294967296`). A dump across $FFFF goes on at $0000, not at
+/// `10000:`. The robot is where it was after all of them.
+#[test]
+fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let script = session("hostile_counts.txt");
+    let output = debug_bounded(
+        &adc,
+        &["debug"],
+        &format!("regs\n{script}"),
+        std::time::Duration::from_secs(60),
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    let replies: Vec<&str> = text.split("(scorpion) ").skip(1).collect();
+    for (command, reply) in script.lines().zip(&replies[1..]) {
+        let reply = reply.strip_prefix(command).unwrap_or(reply);
+        let expected = match command {
+            "mem $FFF8 24" => "\nFFF8: FF FF 3B F6 00 F0 3C F6 ",
+            "regs" => "\nPC=",
+            _ if command.contains(" -") => " is a number of ",
+            _ if command.ends_with(" 0") => " is at least 1, not 0",
+            _ => " is at most ",
+        };
+        assert!(reply.contains(expected), "{command}: {reply}");
+    }
+    assert!(text.contains("\n0000: 00 00"), "{text}");
+    assert!(!text.contains("\n10000:"), "{text}");
+    let regs: Vec<&str> = text.lines().filter(|l| l.starts_with("PC=")).collect();
+    assert_eq!(regs.len(), 2, "{text}");
+    assert_eq!(regs[0], regs[1], "nothing ran: {text}");
+}
+
+/// Issue 23, item 11: a trace whose writes fail says so, naming the file,
+/// and the session fails; at the old code `continue` went on for ever
+/// (the tracer stops the run at its failed write, and the run started
+/// again) and `trace off` said nothing.
+#[test]
+fn a_trace_that_cannot_be_written_says_so() {
+    if !Path::new("/dev/full").exists() {
+        scorpion_tests::tools::skipped(
+            "a_trace_that_cannot_be_written_says_so",
+            "no /dev/full here",
+        );
+        return;
+    }
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    for script in [
+        "trace /dev/full\ncontinue\nregs\n",
+        "trace /dev/full\nstep 3\ntrace off\nregs\n",
+        "trace /dev/full\nstep 3\n",
+    ] {
+        let output = debug_bounded(&adc, &["debug"], script, std::time::Duration::from_secs(60));
+        assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+        let text = String::from_utf8_lossy(&output.stdout).into_owned();
+        assert!(
+            text.contains("error: cannot write the trace to /dev/full: No space left on device"),
+            "{script}: {text}"
+        );
+    }
 }
