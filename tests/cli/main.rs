@@ -12,6 +12,7 @@ mod emu;
 mod link;
 mod project;
 mod read;
+mod robot;
 mod search_order;
 mod sim;
 mod terminal;

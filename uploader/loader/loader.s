@@ -72,8 +72,9 @@ SUM1    = LZP + 2
 HEAD    = LZP + 3               ; the header, last byte first: c1 c0 count lo hi
 COUNT   = HEAD + 2
 DEST    = HEAD + 3              ; lo, hi: the frame's first address
-LENLO   = HEAD                  ; sums: bytes left to add, low, high
-LENHI   = HEAD + 1
+ARGS    = HEAD + 1              ; sums: its fields, last first: count lo, hi, DEST
+LENLO   = HEAD + 1
+LENHI   = HEAD + 2
 
         .export __scorpion_hook_unknown, rate, frames, sums
         .segment "CODE"
@@ -137,18 +138,12 @@ sums:   cmp #'K'
         cpx #9
         bne frames
         ldy #1
-        jsr GETHEX
+        ldx #3                  ; address high, low, count high, low
+args:   jsr GETHEX              ; X kept
         bcs sdrop
-        sta DEST + 1
-        jsr GETHEX
-        bcs sdrop
-        sta DEST
-        jsr GETHEX
-        bcs sdrop
-        sta LENHI
-        jsr GETHEX
-        bcs sdrop
-        sta LENLO
+        sta ARGS,x
+        dex
+        bpl args
         lda #'K'
         jsr PUTCH
         lda DEST + 1

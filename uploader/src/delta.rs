@@ -36,17 +36,25 @@ fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
     out
 }
 
-/// The ranges of `ranges` whose robot sum differs from the host's.
-fn differ<T: Transport>(client: &mut Client<T>, ranges: &[(Range, &[u8])]) -> Result<Vec<usize>> {
-    let asked: Vec<Range> = ranges.iter().map(|(range, _)| *range).collect();
-    let found = robot_sums(client, &asked)?;
-    Ok(ranges
+/// The ranges of `ranges` whose robot sum differs from the host's, and
+/// the robot's sums of `first` (asked first, in the same batch).
+fn differ<T: Transport>(
+    client: &mut Client<T>,
+    first: &[Range],
+    ranges: &[(Range, &[u8])],
+) -> Result<(Vec<usize>, Vec<u16>)> {
+    let mut asked: Vec<Range> = first.to_vec();
+    asked.extend(ranges.iter().map(|(range, _)| *range));
+    let mut found = robot_sums(client, &asked)?;
+    let rest = found.split_off(first.len());
+    let wrong = ranges
         .iter()
-        .zip(found)
+        .zip(rest)
         .enumerate()
         .filter(|(_, ((_, bytes), found))| fletcher16(bytes) != *found)
         .map(|(i, _)| i)
-        .collect())
+        .collect();
+    Ok((wrong, found))
 }
 
 /// The ranges of `image` the robot does not hold, merged where they
@@ -59,14 +67,28 @@ pub(crate) fn differing<T: Transport>(
     client: &mut Client<T>,
     image: &UploadImage,
 ) -> Result<Vec<Area>> {
+    Ok(differing_and(client, &[], image)?.0)
+}
+
+/// [`differing`], with the robot's sums of `first` asked in the same
+/// batch as the coarse pass (the whole ROM's, say: the robot sums it while
+/// the other questions are on their way).
+///
+/// # Errors
+/// As [`differing`].
+pub(crate) fn differing_and<T: Transport>(
+    client: &mut Client<T>,
+    first: &[Range],
+    image: &UploadImage,
+) -> Result<(Vec<Area>, Vec<u16>)> {
     let coarse = split(image.areas(), COARSE);
-    let wrong = differ(client, &coarse)?;
+    let (wrong, sums) = differ(client, first, &coarse)?;
     let mut out: Vec<Area> = Vec::new();
     if wrong.len() * 2 > coarse.len() {
         for i in wrong {
             push(&mut out, coarse[i].0.0, coarse[i].1);
         }
-        return Ok(out);
+        return Ok((out, sums));
     }
     let pieces: Vec<Area> = wrong
         .iter()
@@ -76,10 +98,10 @@ pub(crate) fn differing<T: Transport>(
         })
         .collect();
     let fine = split(&pieces, FINE);
-    for i in differ(client, &fine)? {
+    for i in differ(client, &[], &fine)?.0 {
         push(&mut out, fine[i].0.0, fine[i].1);
     }
-    Ok(out)
+    Ok((out, sums))
 }
 
 /// Appends a range, merged with the last one if it follows it.

@@ -15,7 +15,7 @@ use romlib::protocol::{Answer, Command, ReadSpan};
 
 use crate::client::{Client, spans};
 use crate::image::RomProfile;
-use crate::sums::{fletcher16, robot_sums};
+use crate::sums::fletcher16;
 use crate::transport::Transport;
 use crate::{Error, Result};
 
@@ -119,31 +119,55 @@ fn read_once<T: Transport>(client: &mut Client<T>, span: ReadSpan) -> Result<Opt
     }
 }
 
-/// Compares a checksum of the robot's whole ROM, computed by the loader's
-/// `sums` (which must be hooked), with the profile's.
-///
-/// # Errors
-/// [`Error::WrongRom`] with both sums; a line error.
-pub(crate) fn check_whole<T: Transport>(
-    client: &mut Client<T>,
-    profile: &RomProfile,
-) -> Result<()> {
-    let Some(rom) = &profile.rom else {
-        return Ok(());
-    };
+/// The range of the profile's ROM the loader's `sums` checks, and its
+/// sum; `None` for a profile without the ROM's bytes.
+pub(crate) fn whole_rom(profile: &RomProfile) -> Option<((u16, usize), u16)> {
+    let rom = profile.rom.as_ref()?;
     // A count of $10000 cannot be asked (a ROM from $0000 would lose its
     // last byte here; the jump table and vectors are read whole).
     let len = rom.bytes.len().min(0xFFFF);
-    let wanted = fletcher16(&rom.bytes[..len]);
-    let found = robot_sums(client, &[(rom.address, len)])?[0];
-    if found == wanted {
+    Some(((rom.address, len), fletcher16(&rom.bytes[..len])))
+}
+
+/// Compares the robot's sum of its whole ROM (from the loader's `sums`)
+/// with the profile's.
+///
+/// # Errors
+/// [`Error::WrongRom`] with both sums.
+pub(crate) fn check_whole(profile: &RomProfile, expected: u16, found: u16) -> Result<()> {
+    if found == expected {
         return Ok(());
     }
     Err(Error::WrongRom {
         profile: profile.name.clone(),
         differences: Vec::new(),
-        whole_sum: Some((wanted, found)),
+        whole_sum: Some((expected, found)),
     })
+}
+
+/// A ROM profile for a robot's ROM read whole: `base`'s image (its
+/// names, sections and hooks) with the bytes from `start` to `$FFFF`
+/// replaced by `bytes`, and how many of them differ from `base`'s.
+#[must_use]
+pub fn rom_profile_image(base: &linker::Image, start: u16, bytes: &[u8]) -> (linker::Image, usize) {
+    let first = u32::from(start);
+    let end = first + bytes.len() as u32;
+    let differences = bytes
+        .iter()
+        .enumerate()
+        .filter(|&(i, &byte)| base.byte_at(first + i as u32) != Some(byte))
+        .count();
+    let mut image = base.clone();
+    image
+        .areas
+        .retain(|area| area.end() <= u64::from(first) || u64::from(area.load) >= u64::from(end));
+    image.areas.push(linker::LoadArea {
+        load: first,
+        run: first,
+        bytes: bytes.to_vec(),
+    });
+    image.areas.sort_by_key(|area| area.load);
+    (image, differences)
 }
 
 /// What differs, for the error message.

@@ -43,7 +43,7 @@ pub use client::{Client, ClientConfig, ClientStats};
 pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, human_duration};
 pub use expect::{Expectation, Expectations, NOTHING, Required, answer_text};
-pub use fingerprint::SERVICES;
+pub use fingerprint::{SERVICES, rom_profile_image};
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
     UploadImage,

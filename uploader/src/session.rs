@@ -15,7 +15,7 @@
 use std::time::Duration;
 
 use isa::objfmt::HookKind;
-use romlib::protocol::{Command, Extension};
+use romlib::protocol::{Answer, Command, Extension, ReadSpan};
 
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::Client;
@@ -109,7 +109,14 @@ impl Session {
             }
             client.transport().set_baud(now)?;
         }
-        let mut start = Start::Write;
+        // A loader left in RAM by an earlier upload at the same place (the
+        // usual case when an extension is uploaded again after an edit)
+        // only needs verifying: reading it back costs less than writing it.
+        let mut start = if self.resident(client)? {
+            Start::Verify
+        } else {
+            Start::Write
+        };
         loop {
             let error = match self.hook_loader(client, start) {
                 Ok(()) => break,
@@ -133,6 +140,23 @@ impl Session {
             baud: self.target,
         });
         Ok(())
+    }
+
+    /// Whether `rate` reads back as linked (one read; anything else, a lost
+    /// answer included, says no): the loader is probably in RAM already.
+    fn resident<T: Transport>(&self, client: &mut Client<T>) -> Result<bool> {
+        let rate = self.loader.rate_part()?;
+        let area = &rate.areas()[0];
+        let Ok(span) = ReadSpan::new(area.address, area.bytes.len() as u8) else {
+            return Ok(false);
+        };
+        match client.ask(&Command::ReadMemory(span)) {
+            Ok(Answer::Memory(bytes)) => Ok(bytes == area.bytes),
+            Ok(_) | Err(Error::Protocol(_) | Error::NoAnswer { .. } | Error::WrongBaud { .. }) => {
+                Ok(false)
+            }
+            Err(error) => Err(error),
+        }
     }
 
     /// Verifies (or writes) the loader and hooks it, switching the line

@@ -380,13 +380,21 @@ pub fn upload_keeping<T: Transport>(
         );
         let result = running
             .install(client, progress)
-            .and_then(|()| fingerprint::check_whole(client, profile))
             .and_then(|()| {
-                let todo = if options.delta {
-                    delta::differing(client, &image)?
+                // The whole ROM is summed on the robot while the image's
+                // sums are on their way: all before anything of the image
+                // is written.
+                let rom = fingerprint::whole_rom(profile);
+                let first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
+                let (todo, found) = if options.delta {
+                    delta::differing_and(client, &first, &image)?
                 } else {
-                    image.areas().to_vec()
+                    let found = crate::sums::robot_sums(client, &first)?;
+                    (image.areas().to_vec(), found)
                 };
+                if let (Some((_, expected)), Some(&found)) = (rom, found.first()) {
+                    fingerprint::check_whole(profile, expected, found)?;
+                }
                 keep_old(client, kept.take(), &todo, keep)?;
                 written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
                 (rewrites, passes) =

@@ -10,7 +10,7 @@
 
 mod image;
 
-pub(crate) use image::extension;
+pub(crate) use image::{extension, one_byte_changed};
 
 use romlib::VirtualScorpion;
 use romlib::symbols::{BAD_COMMAND, HOOK_LOOP, HOOK_UNKNOWN, ROM_LOOP};
