@@ -15,6 +15,7 @@ mod layouts;
 mod link;
 mod project;
 mod read;
+mod robot;
 mod search_order;
 mod sim;
 mod sim_line;

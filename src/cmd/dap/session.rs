@@ -13,7 +13,6 @@ use serde_json::{Map, Value, json};
 
 use super::protocol::{Outbox, Request};
 use crate::cmd::debug::{self, Sources};
-use crate::cmd::ports;
 
 /// Robot time a running robot gets between looks for requests (10 ms).
 pub(crate) const SLICE: u64 = 10_000;
