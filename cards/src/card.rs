@@ -97,7 +97,7 @@ impl ScriptCard {
             Some(Err((value, kind))) => {
                 return Err(script.error_at_declaration(
                     "SIZE",
-                    format!("SIZE = {value} is a {kind}, not a number of registers"),
+                    format!("SIZE = {value:?} is a {kind}, not a number of registers"),
                     "SIZE is the number of registers (bytes) the card decodes, 1 to 4096".into(),
                 ));
             }
@@ -147,7 +147,7 @@ impl ScriptCard {
             (None, Some(Err((value, kind)))) => {
                 return Err(script.error_at_declaration(
                     "BASE",
-                    format!("BASE = {value} is a {kind}, not an address"),
+                    format!("BASE = {value:?} is a {kind}, not an address"),
                     "write `const BASE = 0x9000;`".into(),
                 ));
             }

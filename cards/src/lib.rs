@@ -30,7 +30,7 @@ pub use card::ScriptCard;
 pub use clock::OPERATIONS_PER_MICROSECOND;
 pub use error::{Located, ScriptError};
 pub use printed::{MAX_PRINTED_BYTES, MAX_PRINTED_LINES, Printed};
-pub use sandbox::{MAX_VARIABLES, OPERATION_BUDGET};
+pub use sandbox::{MAX_FUNCTIONS, MAX_VARIABLES, OPERATION_BUDGET};
 pub use world::ScriptWorld;
 
 /// `--card FILE[@ADDR]`: a card script and where to put it (hex, `$` or

@@ -27,6 +27,10 @@ pub const OPERATION_BUDGET: u64 = 200_000;
 /// them, so more would make loading quadratic in the script's length.
 pub const MAX_VARIABLES: usize = 256;
 
+/// Functions (and closures) a script may define: the compiler looks every
+/// name a script uses up through all of them.
+pub const MAX_FUNCTIONS: usize = 256;
+
 /// Deepest call nesting a script may reach.
 pub(crate) const MAX_CALL_LEVELS: usize = 32;
 
@@ -110,6 +114,11 @@ pub(crate) fn engine(host: &Arc<Host>) -> Engine {
     engine.set_max_array_size(65_536);
     engine.set_max_map_size(4096);
     engine.set_max_variables(MAX_VARIABLES);
+    engine.set_max_functions(MAX_FUNCTIONS);
+    // A name used but never declared is an error when the script loads,
+    // not when the line runs (and the compiler keeps no growing list of
+    // such names).
+    engine.set_strict_variables(true);
     // Nothing outside the script: no modules from files, no `eval`.
     engine.set_module_resolver(rhai::module_resolvers::DummyModuleResolver::new());
     engine.disable_symbol("eval");

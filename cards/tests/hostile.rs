@@ -59,7 +59,11 @@ fn run_world(name: &str, text: &str) -> (Option<String>, Option<Printed>) {
     let printed = world.printed();
     let mut robot = VirtualScorpion::new();
     robot.set_surroundings(Box::new(world));
-    let fault = robot.run_for(ROBOT_CYCLES).err().map(|e| e.to_string());
+    let fault = robot.run_for(ROBOT_CYCLES).err().map(|error| match error {
+        // The robot's error says whose; the script's says where and what.
+        romlib::Error::Surroundings { message, .. } => message,
+        other => other.to_string(),
+    });
     (fault, Some(printed))
 }
 
