@@ -17,7 +17,8 @@ use std::sync::{Arc, Mutex};
 use emulator::board::Device;
 
 use crate::error::ScriptError;
-use crate::script::{Script, engine};
+use crate::sandbox::{Host, engine};
+use crate::script::Script;
 
 /// What the script changes through the host's functions.
 #[derive(Debug, Default, Clone)]
@@ -26,8 +27,6 @@ struct Shared {
     table: Vec<u8>,
     /// The card's /IRQ output.
     irq: bool,
-    /// When the script asked to be woken.
-    wake: Option<u64>,
 }
 
 /// A card run by a script.
@@ -39,6 +38,8 @@ pub struct ScriptCard {
     /// it, and the board asks for the card's IRQ output and next event
     /// after every access, so those (and plain reads) need no lock.
     view: Shared,
+    /// The wake-up the script last asked for.
+    wake: Option<u64>,
     /// Registers read from the table without calling `read`.
     plain: Vec<bool>,
     has_write: bool,
@@ -58,62 +59,101 @@ impl ScriptCard {
     /// or the script's own `BASE`.
     ///
     /// # Errors
-    /// [`ScriptError::Script`] for a syntax error or a failing top level or
-    /// `init`; [`ScriptError::Window`] for a missing or bad `SIZE`/`BASE`
-    /// or a window outside the KIM bus.
+    /// [`ScriptError::Script`] for a syntax error, a failing top level or
+    /// `init`, or a `SIZE` or `BASE` out of range (at its declaration);
+    /// [`ScriptError::Window`] for a missing `SIZE` or `BASE`, or a window
+    /// given with `base` outside the KIM bus.
     pub fn load(name: &str, text: &str, base: Option<u16>) -> Result<ScriptCard, ScriptError> {
-        let printed = Arc::new(Mutex::new(Vec::new()));
+        let host = Arc::new(Host::default());
         let shared = Arc::new(Mutex::new(Shared::default()));
-        let mut engine = engine(&printed);
+        let mut engine = engine(&host);
         register(&mut engine, &shared);
-        let script = Script::load(engine, name, text, printed)?;
+        let script = Script::load(engine, host, name, text)?;
         let window = |message: String, help: &str| ScriptError::Window {
             file: name.to_owned(),
             message,
             help: Some(help.to_owned()),
         };
-        let size = script
-            .constant("SIZE")
-            .and_then(|v| v.as_int().ok())
-            .ok_or_else(|| {
-                window(
+        let integer = |constant: &str| {
+            script
+                .constant(constant)
+                .map(|value| value.as_int().map_err(|kind| (value, kind)))
+        };
+        let size = match integer("SIZE") {
+            None => {
+                return Err(window(
                     "the card declares no `SIZE`".into(),
                     "start the script with `const SIZE = 4;`: how many registers the card has",
-                )
-            })?;
-        let base = match base {
-            Some(base) => i64::from(base),
-            None => script
-                .constant("BASE")
-                .and_then(|v| v.as_int().ok())
-                .ok_or_else(|| {
-                    window(
-                        "the card declares no `BASE` and none was given".into(),
-                        "declare `const BASE = 0x9000;` or give the address: `--card card.rhai@9000`",
-                    )
-                })?,
+                ));
+            }
+            Some(Ok(size)) if (1..=0x1000).contains(&size) => size,
+            Some(Ok(size)) => {
+                return Err(script.error_at_declaration(
+                    "SIZE",
+                    format!("SIZE = {size}: a card has 1 to 4096 registers"),
+                    "SIZE is the number of registers (bytes) the card decodes".into(),
+                ));
+            }
+            Some(Err((value, kind))) => {
+                return Err(script.error_at_declaration(
+                    "SIZE",
+                    format!("SIZE = {value:?} is a {kind}, not a number of registers"),
+                    "SIZE is the number of registers (bytes) the card decodes, 1 to 4096".into(),
+                ));
+            }
         };
         let (kim_start, kim_end) = (
-            i64::from(platform::map::KIM_START),
-            i64::from(platform::map::KIM_END),
+            u32::from(platform::map::KIM_START),
+            u32::from(platform::map::KIM_END),
         );
-        if !(1..=0x1000).contains(&size) {
-            return Err(window(
-                format!("SIZE = {size}: a card has 1 to 4096 registers"),
-                "SIZE is the number of registers (bytes) the card decodes",
-            ));
-        }
-        if base < kim_start || base + size - 1 > kim_end {
-            return Err(window(
-                format!(
-                    "the window ${base:04X}-${:04X} is not inside the KIM bus (${kim_start:04X}-${kim_end:04X})",
-                    base + size - 1
-                ),
-                "cards sit on the KIM bus; move the card with `--card FILE@ADDR`",
-            ));
-        }
+        let outside = |base: u32| {
+            format!(
+                "the window ${base:04X}-${:04X} is not inside the KIM bus (${kim_start:04X}-${kim_end:04X})",
+                base + size as u32 - 1
+            )
+        };
+        let inside = |base: u32| base >= kim_start && base + size as u32 - 1 <= kim_end;
+        let base = match (base, integer("BASE")) {
+            (Some(base), _) if inside(u32::from(base)) => base,
+            (Some(base), _) => {
+                return Err(window(
+                    outside(u32::from(base)),
+                    "cards sit on the KIM bus; move the card with `--card FILE@ADDR`",
+                ));
+            }
+            (None, None) => {
+                return Err(window(
+                    "the card declares no `BASE` and none was given".into(),
+                    "declare `const BASE = 0x9000;` or give the address: `--card card.rhai@9000`",
+                ));
+            }
+            (None, Some(Ok(base))) => match u16::try_from(base) {
+                Ok(base) if inside(u32::from(base)) => base,
+                Ok(base) => {
+                    return Err(script.error_at_declaration(
+                        "BASE",
+                        outside(u32::from(base)),
+                        "cards sit on the KIM bus; move the card with `--card FILE@ADDR`".into(),
+                    ));
+                }
+                Err(_) => {
+                    return Err(script.error_at_declaration(
+                        "BASE",
+                        format!("BASE = {base} is not a 16-bit address"),
+                        format!("the KIM bus lies at ${kim_start:04X}-${kim_end:04X}"),
+                    ));
+                }
+            },
+            (None, Some(Err((value, kind)))) => {
+                return Err(script.error_at_declaration(
+                    "BASE",
+                    format!("BASE = {value:?} is a {kind}, not an address"),
+                    "write `const BASE = 0x9000;`".into(),
+                ));
+            }
+        };
+        // In 1..=0x1000, as checked above.
         let size = u16::try_from(size).unwrap_or(1);
-        let base = u16::try_from(base).unwrap_or(platform::map::KIM_START);
         let has_read = script.has_fn("read", 2);
         let mut plain = vec![!has_read; usize::from(size)];
         if let Some(list) = script.constant("PLAIN") {
@@ -146,6 +186,7 @@ impl ScriptCard {
         }
         let mut card = ScriptCard {
             view: Shared::default(),
+            wake: None,
             has_write: script.has_fn("write", 3),
             has_wake: script.has_fn("wake", 1),
             script,
@@ -158,7 +199,7 @@ impl ScriptCard {
             failed: false,
         };
         if card.script.has_fn("init", 0) {
-            let _ = card.call("init", ())?;
+            let _ = card.call("init", None, ())?;
         } else {
             card.look();
         }
@@ -187,13 +228,15 @@ impl ScriptCard {
             .unwrap_or(0xFF)
     }
 
-    /// Calls the script's `function`, then looks at what it changed.
+    /// Calls the script's `function` at robot time `now`, then looks at
+    /// what it changed.
     fn call(
         &mut self,
         function: &str,
+        now: Option<u64>,
         args: impl rhai::FuncArgs,
     ) -> Result<rhai::Dynamic, ScriptError> {
-        let result = self.script.call(function, args);
+        let result = self.script.call(function, now, args);
         self.look();
         result
     }
@@ -203,6 +246,7 @@ impl ScriptCard {
         if let Ok(shared) = self.shared.lock() {
             self.view.clone_from(&shared);
         }
+        self.wake = self.script.wake();
     }
 
     fn fail(&mut self, error: ScriptError) {
@@ -210,29 +254,28 @@ impl ScriptCard {
             self.failed = true;
             self.fault = Some(error);
         }
+        self.script.clear_wake();
         if let Ok(mut shared) = self.shared.lock() {
-            shared.wake = None;
             shared.irq = false;
         }
         self.look();
     }
 
-    /// Runs the wake-ups due by `cycle`.
+    /// Runs the wake-ups due by `cycle`. Each wake-up the script asks for
+    /// lies after the one being served, so this ends.
     fn catch_up(&mut self, cycle: u64) {
         self.now = self.now.max(cycle);
         while !self.failed {
-            let due = match self.view.wake {
+            let due = match self.wake {
                 Some(at) if at <= cycle => at,
                 _ => return,
             };
-            self.view.wake = None;
-            if let Ok(mut shared) = self.shared.lock() {
-                shared.wake = None;
-            }
+            self.wake = None;
+            self.script.clear_wake();
             if !self.has_wake {
                 continue;
             }
-            if let Err(error) = self.call("wake", (as_int(due),)) {
+            if let Err(error) = self.call("wake", Some(due), (as_int(due),)) {
                 self.fail(error);
             }
         }
@@ -273,13 +316,6 @@ fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
             shared.irq = on;
         }
     });
-    let state = Arc::clone(shared);
-    engine.register_fn("wake_at", move |cycle: i64| {
-        if let Ok(mut shared) = state.lock() {
-            let at = u64::try_from(cycle).unwrap_or(0);
-            shared.wake = Some(shared.wake.map_or(at, |old| old.min(at)));
-        }
-    });
 }
 
 impl Device for ScriptCard {
@@ -292,7 +328,7 @@ impl Device for ScriptCard {
         if self.plain[usize::from(register)] {
             return self.table(register);
         }
-        let value = self.call("read", (i64::from(register), as_int(cycle)));
+        let value = self.call("read", Some(cycle), (i64::from(register), as_int(cycle)));
         match value.map(|v| v.as_int()) {
             Ok(Ok(value)) if (0..=0xFF).contains(&value) => value as u8,
             Ok(Ok(value)) => {
@@ -337,6 +373,7 @@ impl Device for ScriptCard {
         }
         if let Err(error) = self.call(
             "write",
+            Some(cycle),
             (i64::from(register), i64::from(value), as_int(cycle)),
         ) {
             self.fail(error);
@@ -361,7 +398,7 @@ impl Device for ScriptCard {
         if self.failed {
             return None;
         }
-        self.view.wake
+        self.wake
     }
 
     fn irq(&self) -> bool {

@@ -10,19 +10,27 @@
 //!   robot time (a [`romlib::Surroundings`]).
 //! - [`CardArg`]: the `--card FILE[@ADDR]` argument.
 //!
-//! Scripts are untrusted input: they reach no file, network or process,
-//! each call into one has an operation budget ([`OPERATION_BUDGET`]), and
-//! every failure is a [`ScriptError`] located in the script. Cards in Rust
+//! Scripts are untrusted input: they reach no file, network or process
+//! and see no clock but robot time; each call into one has an operation
+//! budget ([`OPERATION_BUDGET`]) and a script earns
+//! [`OPERATIONS_PER_MICROSECOND`] of robot time; wake-ups move forward;
+//! what it prints is bounded ([`Printed`]); every failure is a
+//! [`ScriptError`] located in the script. Cards in Rust
 //! implement the same `Device` trait (`examples/adc_in_rust.rs`).
 
 mod card;
+mod clock;
 mod error;
+mod printed;
+mod sandbox;
 mod script;
 mod world;
 
 pub use card::ScriptCard;
+pub use clock::OPERATIONS_PER_MICROSECOND;
 pub use error::{Located, ScriptError};
-pub use script::{OPERATION_BUDGET, Printed};
+pub use printed::{MAX_PRINTED_BYTES, MAX_PRINTED_LINES, Printed};
+pub use sandbox::{MAX_FUNCTIONS, MAX_VARIABLES, OPERATION_BUDGET};
 pub use world::ScriptWorld;
 
 /// `--card FILE[@ADDR]`: a card script and where to put it (hex, `$` or

@@ -1,32 +1,31 @@
-//! A script, sandboxed: Rhai with no file, network or process access (no
-//! module loading, no `eval`), an operation budget on every call, bounded
-//! recursion and sizes; what it prints is kept for the host to show.
+//! A loaded script: its compiled form, its top-level constants and the
+//! `this` it keeps state in; calls into it at a robot time, within its
+//! budget, and its failures located in its text.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
 
 use miette::{NamedSource, SourceSpan};
 use rhai::{AST, CallFnOptions, Dynamic, Engine, EvalAltResult, ParseError, Position, Scope};
 
+use crate::clock::{Budget, OPERATIONS_PER_MICROSECOND};
 use crate::error::{Located, ScriptError, offset_of};
+use crate::printed::Printed;
+use crate::sandbox::{
+    Host, HostError, MAX_CALL_LEVELS, MAX_VARIABLES, OPERATION_BUDGET, is_robot_time,
+};
 
-/// Operations one call into a script may take: about a millisecond of the
-/// host's time. A script that loops without end is stopped here.
-pub const OPERATION_BUDGET: u64 = 200_000;
-
-/// Deepest call nesting a script may reach.
-const MAX_CALL_LEVELS: usize = 32;
-
-/// A loaded script: its engine (with the host's functions), its compiled
-/// form, its top-level constants and the `this` it keeps state in.
+/// A loaded script.
 pub(crate) struct Script {
-    pub(crate) engine: Engine,
+    engine: Engine,
     ast: AST,
     scope: Scope<'static>,
     /// The state the script's functions see as `this`.
     this: Dynamic,
     name: String,
     text: String,
-    printed: Arc<Mutex<Vec<String>>>,
+    host: Arc<Host>,
+    budget: Budget,
 }
 
 impl std::fmt::Debug for Script {
@@ -37,77 +36,27 @@ impl std::fmt::Debug for Script {
     }
 }
 
-/// What a script prints (`print`, `debug`), kept for the host to show: a
-/// handle that stays valid after the card is mapped into the board.
-#[derive(Debug, Clone, Default)]
-pub struct Printed(pub(crate) Arc<Mutex<Vec<String>>>);
-
-impl Printed {
-    /// The lines printed since the last call.
-    #[must_use]
-    pub fn take(&self) -> Vec<String> {
-        self.0
-            .lock()
-            .map(|mut lines| std::mem::take(&mut *lines))
-            .unwrap_or_default()
-    }
-}
-
-/// An engine with the sandbox's limits; `register` adds the host's
-/// functions for the kind of script.
-pub(crate) fn engine(printed: &Arc<Mutex<Vec<String>>>) -> Engine {
-    // Rhai's standard library, built once and shared by every script's
-    // engine: a robot with cards is set up per transcript test.
-    static STANDARD: std::sync::OnceLock<rhai::Shared<rhai::Module>> = std::sync::OnceLock::new();
-    let standard = STANDARD.get_or_init(|| {
-        use rhai::packages::Package as _;
-        rhai::packages::StandardPackage::new().as_shared_module()
-    });
-    let mut engine = Engine::new_raw();
-    engine.register_global_module(standard.clone());
-    engine.set_max_strings_interned(256);
-    engine.set_max_operations(OPERATION_BUDGET);
-    engine.set_max_call_levels(MAX_CALL_LEVELS);
-    engine.set_max_expr_depths(64, 32);
-    engine.set_max_string_size(4096);
-    engine.set_max_array_size(65_536);
-    engine.set_max_map_size(4096);
-    // Nothing outside the script: no modules from files, no `eval`.
-    engine.set_module_resolver(rhai::module_resolvers::DummyModuleResolver::new());
-    engine.disable_symbol("eval");
-    let out = Arc::clone(printed);
-    engine.on_print(move |text| {
-        if let Ok(mut lines) = out.lock() {
-            lines.push(text.to_string());
-        }
-    });
-    let out = Arc::clone(printed);
-    engine.on_debug(move |text, _, _| {
-        if let Ok(mut lines) = out.lock() {
-            lines.push(text.to_string());
-        }
-    });
-    // Robot time is counted in cycles of the 1 MHz CPU.
-    engine.register_fn("us", |n: i64| n);
-    engine.register_fn("ms", |n: i64| n.saturating_mul(1000));
-    engine
-}
-
 impl Script {
-    /// Compiles `text` and runs its top level (constants, `let`s).
+    /// Compiles `text` and runs its top level (constants, `let`s), with
+    /// `engine` made by [`crate::sandbox::engine`] for `host`.
     pub(crate) fn load(
         engine: Engine,
+        host: Arc<Host>,
         name: &str,
         text: &str,
-        printed: Arc<Mutex<Vec<String>>>,
     ) -> Result<Script, ScriptError> {
-        let located =
-            |line, column, message: String, help| located(name, text, line, column, message, help);
         let ast = engine.compile(text).map_err(|error: ParseError| {
             let (line, column) = place(error.1);
-            located(line, column, error.0.to_string(), None)
+            let (message, help) = if host.crowded.load(Ordering::Relaxed) {
+                (
+                    format!("more than {MAX_VARIABLES} variables in sight at once"),
+                    Some("keep many values in an array or a map (`const TABLE = [1, 2, 3];`), or in `this`".to_owned()),
+                )
+            } else {
+                (error.0.to_string(), None)
+            };
+            located(name, text, line, column, message, help)
         })?;
-        let mut scope = Scope::new();
         let mut script = Script {
             engine,
             ast,
@@ -115,12 +64,13 @@ impl Script {
             this: Dynamic::from_map(rhai::Map::new()),
             name: name.to_owned(),
             text: text.to_owned(),
-            printed,
+            host,
+            budget: Budget::default(),
         };
-        script
-            .engine
-            .run_ast_with_scope(&mut scope, &script.ast)
-            .map_err(|error| script.runtime_error_in(&error, None))?;
+        let mut scope = Scope::new();
+        script.start(None);
+        let result = script.engine.run_ast_with_scope(&mut scope, &script.ast);
+        result.map_err(|error| script.runtime_error_in(&error, None))?;
         script.scope = scope;
         Ok(script)
     }
@@ -132,17 +82,20 @@ impl Script {
             .any(|f| f.name == name && f.params.len() == params)
     }
 
-    /// A top-level integer constant or variable.
+    /// A top-level constant or variable.
     pub(crate) fn constant(&self, name: &str) -> Option<Dynamic> {
         self.scope.get_value::<Dynamic>(name)
     }
 
-    /// Calls `function` with `this` bound to the script's state.
+    /// Calls `function` at robot time `now` (`None`: `init`, before robot
+    /// time starts) with `this` bound to the script's state.
     pub(crate) fn call(
         &mut self,
         function: &str,
+        now: Option<u64>,
         args: impl rhai::FuncArgs,
     ) -> Result<Dynamic, ScriptError> {
+        self.start(now);
         let options = CallFnOptions::new()
             .eval_ast(true)
             .rewind_scope(true)
@@ -154,12 +107,37 @@ impl Script {
             function,
             args,
         );
+        self.budget
+            .spend(now, self.host.spent.load(Ordering::Relaxed));
         result.map_err(|error| self.runtime_error_in(&error, Some(function)))
+    }
+
+    /// Gets the host ready for a call at `now`: its robot time, its share
+    /// of operations.
+    fn start(&mut self, now: Option<u64>) {
+        if let Ok(mut alarm) = self.host.alarm.lock() {
+            alarm.set_now(now);
+        }
+        let allowance = self.budget.allowance(now);
+        self.host.allowance.store(allowance, Ordering::Relaxed);
+        self.host.spent.store(0, Ordering::Relaxed);
+    }
+
+    /// The wake-up the script asked for.
+    pub(crate) fn wake(&self) -> Option<u64> {
+        self.host.alarm.lock().ok().and_then(|alarm| alarm.at())
+    }
+
+    /// Forgets the wake-up asked for.
+    pub(crate) fn clear_wake(&self) {
+        if let Ok(mut alarm) = self.host.alarm.lock() {
+            alarm.clear();
+        }
     }
 
     /// The handle to what the script prints.
     pub(crate) fn printed(&self) -> Printed {
-        Printed(Arc::clone(&self.printed))
+        self.host.printed.clone()
     }
 
     /// A located error for a runtime failure in a call of `function`: the
@@ -178,20 +156,30 @@ impl Script {
         } else {
             place(inner.position())
         };
-        let help = match inner {
-            EvalAltResult::ErrorTooManyOperations(_) => Some(format!(
-                "one call may take {OPERATION_BUDGET} operations: a loop that waits for the robot never ends, since robot time stands still while the script runs; ask to be woken later with `wake_at(now + us(100))`"
-            )),
-            EvalAltResult::ErrorStackOverflow(_) => {
-                Some(format!("calls nest at most {MAX_CALL_LEVELS} deep"))
+        let (message, help) = match inner {
+            EvalAltResult::ErrorTooManyOperations(_) => (
+                "the script ran out of its operation budget".to_owned(),
+                Some(format!(
+                    "one call may take {OPERATION_BUDGET} operations: a loop that waits for the robot never ends, since robot time stands still while the script runs; ask to be woken later with `wake_at(now + us(100))`"
+                )),
+            ),
+            other if is_robot_time(other) => (
+                format!(
+                    "the script took more than its share of robot time ({OPERATIONS_PER_MICROSECOND} operations per microsecond)"
+                ),
+                Some(format!(
+                    "a call may take {OPERATION_BUDGET} operations, earned back at {OPERATIONS_PER_MICROSECOND} per microsecond of robot time: wake less often (`wake_at(now + ms(1))`), do less per call, or serve registers the program polls from `PLAIN`"
+                )),
+            ),
+            EvalAltResult::ErrorStackOverflow(_) => (
+                strip_position(&inner.to_string()),
+                Some(format!("calls nest at most {MAX_CALL_LEVELS} deep")),
+            ),
+            EvalAltResult::ErrorRuntime(value, _) if value.is::<HostError>() => {
+                let host = value.clone().cast::<HostError>();
+                (host.message, Some(host.help))
             }
-            _ => None,
-        };
-        let message = match inner {
-            EvalAltResult::ErrorTooManyOperations(_) => {
-                "the script ran out of its operation budget".to_string()
-            }
-            other => strip_position(&other.to_string()),
+            other => (strip_position(&other.to_string()), None),
         };
         located(&self.name, &self.text, line, column, message, help)
     }
@@ -203,14 +191,36 @@ impl Script {
         located(&self.name, &self.text, line, column, message, None)
     }
 
+    /// An error about the top-level declaration of `name` (a `const` or a
+    /// `let`), at that declaration.
+    pub(crate) fn error_at_declaration(
+        &self,
+        name: &str,
+        message: String,
+        help: String,
+    ) -> ScriptError {
+        let (line, column) = ["const", "let"]
+            .iter()
+            .find_map(|keyword| self.find(&format!("{keyword} {name}")))
+            .unwrap_or((1, 1));
+        located(&self.name, &self.text, line, column, message, Some(help))
+    }
+
     /// Where `fn name` is written.
     fn fn_line(&self, name: &str) -> (usize, usize) {
-        let needle = format!("fn {name}");
-        self.text
-            .lines()
-            .enumerate()
-            .find_map(|(index, line)| line.find(&needle).map(|at| (index + 1, at + 1)))
-            .unwrap_or((1, 1))
+        self.find(&format!("fn {name}")).unwrap_or((1, 1))
+    }
+
+    /// The first place `words` is written as whole words, line and column.
+    fn find(&self, words: &str) -> Option<(usize, usize)> {
+        let word = |c: char| c.is_alphanumeric() || c == '_';
+        self.text.lines().enumerate().find_map(|(index, line)| {
+            line.match_indices(words)
+                .find(|&(at, _)| {
+                    !line[..at].ends_with(word) && !line[at + words.len()..].starts_with(word)
+                })
+                .map(|(at, _)| (index + 1, line[..at].chars().count() + 1))
+        })
     }
 }
 

@@ -15,7 +15,8 @@ use emulator::board::{Motor, Scorpion};
 use romlib::Surroundings;
 
 use crate::error::ScriptError;
-use crate::script::{Script, engine};
+use crate::sandbox::{Host, engine};
+use crate::script::Script;
 
 /// One change to the robot's inputs a script asked for.
 #[derive(Debug, Clone, Copy)]
@@ -28,7 +29,6 @@ enum Change {
 
 #[derive(Debug, Default)]
 struct Shared {
-    wake: Option<u64>,
     changes: Vec<Change>,
     positions: (i64, i64),
 }
@@ -51,13 +51,13 @@ impl ScriptWorld {
     /// [`ScriptError::Script`] for a syntax error or a failing top level or
     /// `init`.
     pub fn load(name: &str, text: &str) -> Result<ScriptWorld, ScriptError> {
-        let printed = Arc::new(Mutex::new(Vec::new()));
+        let host = Arc::new(Host::default());
         let shared = Arc::new(Mutex::new(Shared::default()));
-        let mut engine = engine(&printed);
+        let mut engine = engine(&host);
         register(&mut engine, &shared);
-        let mut script = Script::load(engine, name, text, printed)?;
+        let mut script = Script::load(engine, host, name, text)?;
         if script.has_fn("init", 0) {
-            let _ = script.call("init", ())?;
+            let _ = script.call("init", None, ())?;
         }
         // What `init` set applies at once, at the first wake-up.
         let pending = shared.lock().is_ok_and(|s| !s.changes.is_empty());
@@ -99,13 +99,6 @@ fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
         push(&state, Change::SceneAt(h, v, (value & 0xFF) as u8));
     });
     let state = Arc::clone(shared);
-    engine.register_fn("wake_at", move |cycle: i64| {
-        if let Ok(mut s) = state.lock() {
-            let at = u64::try_from(cycle).unwrap_or(0);
-            s.wake = Some(s.wake.map_or(at, |old| old.min(at)));
-        }
-    });
-    let state = Arc::clone(shared);
     engine.register_fn("left_position", move || -> i64 {
         state.lock().map_or(0, |s| s.positions.0)
     });
@@ -120,7 +113,7 @@ impl Surroundings for ScriptWorld {
         if self.pending {
             return Some(0);
         }
-        self.shared.lock().ok().and_then(|s| s.wake)
+        self.script.wake()
     }
 
     fn wake(
@@ -128,10 +121,10 @@ impl Surroundings for ScriptWorld {
         now: u64,
         robot: &mut Scorpion,
     ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>> {
+        if !self.pending {
+            self.script.clear_wake();
+        }
         if let Ok(mut s) = self.shared.lock() {
-            if !self.pending {
-                s.wake = None;
-            }
             s.positions = (
                 robot.board().motor(Motor::Left).position(),
                 robot.board().motor(Motor::Right).position(),
@@ -140,10 +133,10 @@ impl Surroundings for ScriptWorld {
         if self.pending {
             self.pending = false;
         } else if self.has_wake {
-            let now = i64::try_from(now).unwrap_or(i64::MAX);
+            let at = i64::try_from(now).unwrap_or(i64::MAX);
             let _ = self
                 .script
-                .call("wake", (now,))
+                .call("wake", Some(now), (at,))
                 .map_err(|error| Box::new(error) as Box<dyn miette::Diagnostic + Send + Sync>)?;
         }
         let changes = self
