@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use miette::Context;
+use miette::{Context, IntoDiagnostic};
 use romlib::protocol::{Answer, Command};
 use uploader::transport::VirtualTransport;
 use uploader::{
