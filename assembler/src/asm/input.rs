@@ -78,13 +78,14 @@ impl<'a> Asm<'a> {
     }
 
     /// Reads a file through the source for `.include` or `.incbin`,
-    /// following [`Asm::search_path`].
+    /// following [`Asm::search_path`]; `true` beside it when it is one of
+    /// [`crate::Options::builtin_includes`].
     pub(crate) fn find_file(
         &self,
         name: &str,
         binary: bool,
         from_dir: &Path,
-    ) -> Option<(PathBuf, Vec<u8>)> {
+    ) -> Option<(PathBuf, Vec<u8>, bool)> {
         let path = Path::new(name);
         let candidates = if path.is_absolute() {
             vec![path.to_path_buf()]
@@ -96,7 +97,7 @@ impl<'a> Asm<'a> {
         };
         for candidate in candidates {
             if let Ok(bytes) = self.source.read(&candidate) {
-                return Some((candidate, bytes));
+                return Some((candidate, bytes, false));
             }
         }
         if binary {
@@ -105,7 +106,7 @@ impl<'a> Asm<'a> {
         self.opts
             .builtin_includes
             .get(name)
-            .map(|bytes| (PathBuf::from(name), bytes.clone()))
+            .map(|bytes| (PathBuf::from(name), bytes.clone(), true))
     }
 
     /// Pushes a file to read next.
@@ -311,6 +312,9 @@ impl<'a> Asm<'a> {
         let Some(frame) = self.input.frames.pop() else {
             return;
         };
+        if let Some(listing) = self.listing.as_mut() {
+            listing.frame_ended(self.input.frames.len());
+        }
         let base = frame.conds();
         while self.input.conds.len() > base {
             if let Some(cond) = self.input.conds.pop() {

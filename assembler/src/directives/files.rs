@@ -85,12 +85,18 @@ impl Asm<'_> {
         self.expect_end(c)?;
         self.frame_room(tok.span)?;
         let dir = self.current_dir();
-        let Some((path, bytes)) = self.find_file(&name, false, &dir) else {
+        let Some((path, bytes, builtin)) = self.find_file(&name, false, &dir) else {
             return Err(self.not_found(tok, &name, false));
         };
         let ctx = self.new_ctx(CtxKind::Include, self.join(head.span, tok.span));
         let parent = path.parent().map(Path::to_path_buf).unwrap_or_default();
         self.push_file(path.display().to_string(), bytes, parent, ctx);
+        if builtin
+            && !self.opts.list_builtin_includes
+            && let Some(listing) = self.listing.as_mut()
+        {
+            listing.unlisted_from(self.input.frames.len());
+        }
         Ok(())
     }
 
@@ -107,7 +113,7 @@ impl Asm<'_> {
         }
         self.expect_end(c)?;
         let dir = self.current_dir();
-        let Some((_, bytes)) = self.find_file(&name, true, &dir) else {
+        let Some((_, bytes, _)) = self.find_file(&name, true, &dir) else {
             return Err(self.not_found(tok, &name, true));
         };
         let len = bytes.len() as i64;
