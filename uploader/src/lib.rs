@@ -36,7 +36,7 @@ mod upload;
 
 pub use client::{Client, ClientConfig, ClientStats};
 pub use error::{Error, Result, human_duration};
-pub use expect::{Expectation, Expectations, NOTHING, Required, answer_text};
+pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
     UploadImage,
