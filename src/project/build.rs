@@ -64,6 +64,7 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
             .map(|(name, value)| (name.clone(), *value))
             .collect(),
         listing: true,
+        list_builtin_includes: project.file.tests.builtin_listing,
         builtin_includes: crate::cmd::asm::builtin_includes(),
         ..assembler::Options::default()
     };

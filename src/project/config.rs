@@ -100,6 +100,12 @@ pub(crate) struct TestsSpec {
     /// every `tests/*.expect`.
     #[serde(default)]
     pub(crate) transcripts: Vec<String>,
+    /// List the built-in `scorpion.inc` where the sources include it, in
+    /// the listing snapshots and `target/scorpion/NAME.lst` (off: the
+    /// snapshots show the project's own code, and a new ROM, whose
+    /// identity the include's text names, fails none of them).
+    #[serde(default)]
+    pub(crate) builtin_listing: bool,
 }
 
 /// The per-user file (`$XDG_CONFIG_HOME/scorpion/config.toml`, else
@@ -226,7 +232,7 @@ impl Project {
                 name,
                 text,
                 &error,
-                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts (or, for a workspace, [workspace] members alone)",
+                "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts, builtin_listing (or, for a workspace, [workspace] members alone)",
             )
         })?;
         if file.images.is_empty() {

@@ -9,6 +9,8 @@
 //!   and bytes.
 //! - [`snapshot`]: insta-format snapshot files and their diffs.
 //! - [`calls`]: routine-level tests (`tests/*.calls`).
+//! - [`transcript`]: transcripts read and their mismatches said as
+//!   failures, all of them, at their `file:line`.
 //!
 //! Nothing here prints: `scorpion build`, `test` and `new` do.
 
@@ -16,6 +18,7 @@ pub(crate) mod build;
 pub(crate) mod calls;
 pub(crate) mod config;
 pub(crate) mod snapshot;
+pub(crate) mod transcript;
 
 pub(crate) use config::Project;
 
