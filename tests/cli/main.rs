@@ -9,6 +9,7 @@ mod dap;
 mod debug;
 mod disasm;
 mod emu;
+mod journeys;
 mod link;
 mod project;
 mod read;
