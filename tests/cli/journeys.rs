@@ -368,7 +368,8 @@ fn an_operating_system_from_new_to_the_robot() {
         planted.contains("test kernel/bytes ... FAILED"),
         "{planted}"
     );
-    assert!(planted.contains("-   "), "a diff: {planted}");
+    assert!(planted.contains("\n    - $1010  "), "a diff: {planted}");
+    assert!(planted.contains("\n    + $1010  "), "a diff: {planted}");
     assert!(
         planted.contains("tests/kernel.expect:4: `/1V` answered `V02`, expected `V01` (at "),
         "{planted}"
