@@ -5,7 +5,12 @@
 # command. No hardware: `--port emu` is the emulated robot in the process.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-scorpion() { cargo run --quiet --release --manifest-path "$repo/Cargo.toml" --bin scorpion -- "$@"; }
+# The binary is built first, in the open: on a first run that takes a few
+# minutes, and cargo's progress (on stderr) shows it is under way. The
+# versions are the ones the tests ran with (Cargo.lock, --locked).
+echo "building scorpion (release; minutes the first time, cargo's progress below)..." >&2
+cargo build --release --locked --manifest-path "$repo/Cargo.toml" --bin scorpion
+scorpion() { cargo run --quiet --release --locked --manifest-path "$repo/Cargo.toml" --bin scorpion -- "$@"; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"

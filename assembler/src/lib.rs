@@ -76,6 +76,12 @@ pub struct Options {
     pub builtin_includes: BTreeMap<String, Vec<u8>>,
     /// Produce a listing.
     pub listing: bool,
+    /// List the text of [`Options::builtin_includes`] where `.include`
+    /// reads it (the default). Off, the listing shows the `.include` line
+    /// and what the including file makes of it, not the included text: a
+    /// project's snapshots then change with its own code, not with the
+    /// ROM's exported names.
+    pub list_builtin_includes: bool,
     /// Errors kept before the rest are only counted.
     pub max_errors: usize,
     /// Accept the undocumented NMOS opcodes from the start (as
@@ -105,6 +111,7 @@ impl Default for Options {
             defines: Vec::new(),
             builtin_includes: BTreeMap::new(),
             listing: false,
+            list_builtin_includes: true,
             max_errors: 50,
             undocumented: false,
             max_lines: 4_000_000,

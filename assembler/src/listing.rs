@@ -103,6 +103,9 @@ pub(crate) struct ListingBuilder {
     pub(crate) expanded: Option<String>,
     /// The last line was begun and awaits its end position.
     open: bool,
+    /// Lines read while the input is this many frames deep or deeper are
+    /// left out: a built-in include's, when they are not listed.
+    unlisted_depth: Option<usize>,
 }
 
 fn depth(frames: &[Frame]) -> u8 {
@@ -116,7 +119,31 @@ impl ListingBuilder {
             lines: Vec::new(),
             expanded: None,
             open: false,
+            unlisted_depth: None,
         }
+    }
+
+    /// Leaves out the lines of the file just pushed as frame `depth` (the
+    /// frames' count with it), and of everything it includes or expands.
+    pub(crate) fn unlisted_from(&mut self, depth: usize) {
+        // An unlisted file inside another is already covered.
+        if self.unlisted_depth.is_none() {
+            self.unlisted_depth = Some(depth);
+        }
+    }
+
+    /// The input is back to `depth` frames.
+    pub(crate) fn frame_ended(&mut self, depth: usize) {
+        if self.unlisted_depth.is_some_and(|unlisted| depth < unlisted) {
+            self.unlisted_depth = None;
+        }
+    }
+
+    fn listed(&self, frames: &[Frame]) -> bool {
+        self.enabled
+            && self
+                .unlisted_depth
+                .is_none_or(|unlisted| frames.len() < unlisted)
     }
 
     fn text(&mut self, info: LineInfo) -> Text {
@@ -133,7 +160,7 @@ impl ListingBuilder {
     /// A line that produces nothing (a macro or `.repeat` body being read).
     pub(crate) fn text_line(&mut self, frames: &[Frame], info: LineInfo) {
         let text = self.text(info);
-        if !self.enabled {
+        if !self.listed(frames) {
             return;
         }
         self.lines.push(Line {
@@ -154,8 +181,8 @@ impl ListingBuilder {
         seg: SegId,
     ) {
         let text = self.text(info);
-        self.open = self.enabled;
-        if !self.enabled {
+        self.open = self.listed(frames);
+        if !self.open {
             return;
         }
         let chunk = prog.segs[seg as usize].cur;

@@ -335,3 +335,42 @@ fn cases() {
         });
     });
 }
+
+/// A built-in include's text is listed by default; with
+/// `list_builtin_includes` off the listing keeps the `.include` line and the
+/// including file's own lines (a macro of the include expanded there too),
+/// and an include of the user's own stays listed.
+#[test]
+fn a_builtin_include_can_be_left_out_of_the_listing() {
+    let mut source = MemorySource::new();
+    source.insert(
+        "main.s".to_string(),
+        b".include \"builtin.inc\"\n.include \"own.inc\"\n        builtin_macro\n        nop\n"
+            .to_vec(),
+    );
+    source.insert("own.inc".to_string(), b"OWN_VALUE = 7\n".to_vec());
+    let listing = |list_builtin_includes| {
+        let options = Options {
+            list_builtin_includes,
+            ..options()
+        };
+        assembler::assemble(&source, Path::new("main.s"), &options)
+            .expect("it assembles")
+            .listing
+            .expect("a listing")
+    };
+    let full = listing(true);
+    assert!(full.contains("BUILTIN_VALUE = $42"), "{full}");
+    let own = listing(false);
+    assert!(!own.contains("BUILTIN_VALUE = $42"), "{own}");
+    assert!(!own.contains("a built-in include"), "{own}");
+    for kept in [
+        ".include \"builtin.inc\"",
+        "OWN_VALUE = 7",
+        "builtin_macro",
+        "lda #BUILTIN_VALUE",
+        "nop",
+    ] {
+        assert!(own.contains(kept), "{kept} is listed:\n{own}");
+    }
+}

@@ -102,6 +102,12 @@ pub struct TestsSpec {
     /// every `tests/*.expect`.
     #[serde(default)]
     pub transcripts: Vec<String>,
+    /// List the built-in `scorpion.inc` where the sources include it, in
+    /// the listing snapshots and `target/scorpion/NAME.lst` (off: the
+    /// snapshots show the project's own code, and a new ROM, whose
+    /// identity the include's text names, fails none of them).
+    #[serde(default)]
+    pub builtin_listing: bool,
 }
 
 /// The per-user file (`$XDG_CONFIG_HOME/scorpion/config.toml`, else

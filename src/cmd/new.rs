@@ -122,13 +122,16 @@ A Scorpion {KIND}, made by `scorpion new`.\n\n\
 ```sh\n\
 scorpion build                      # target/scorpion/{NAME}.elf, .lst, .map\n\
 scorpion test                       # snapshots and transcripts, on the virtual Scorpion\n\
-scorpion test --accept              # take new or changed snapshots after a review\n\
+scorpion test --review              # a new or changed snapshot at a time: accept, reject, skip\n\
+scorpion test {NAME}/listing --accept # take that one as it is now\n\
 echo /1V | scorpion sim             # try it by hand\n\
 scorpion upload --port /dev/ttyUSB0 # rehearse, upload, verify\n\
 scorpion test --port /dev/ttyUSB0   # the transcripts on the robot\n\
 ```\n\n\
 `src/` holds the source, `tests/*.expect` the transcripts, `tests/snapshots/`\n\
-the listing, map, symbols and bytes `scorpion test` compares with.\n";
+the listing, map, symbols and bytes `scorpion test` compares with (a failing\n\
+one leaves its new text beside it as `NAME.snap.new`, which `cargo insta\n\
+review` shows as well).\n";
 
 fn write(path: &Path, text: &str) -> miette::Result<()> {
     if let Some(dir) = path.parent() {
@@ -183,7 +186,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         &root.join("tests").join(format!("{name}.expect")),
         &fill(TRANSCRIPT),
     )?;
-    write(&root.join(".gitignore"), "/target/\n*.snap.new\n")?;
+    // Pending snapshots (`*.snap.new`) are not ignored: `cargo insta
+    // review` and `pending-snapshots` skip what git ignores.
+    write(&root.join(".gitignore"), "/target/\n")?;
     write(&root.join("README.md"), &fill(README))?;
     // The snapshots of what it builds now, so that its tests pass at once.
     let project = Project::load(&root)?;

@@ -4,34 +4,55 @@
 //! Scorpion with the images loaded as an upload leaves them and the
 //! project's cards and surroundings; with `--port`, the transcripts on a
 //! real robot after uploading the images, and no snapshots.
+//!
+//! A snapshot that fails leaves its new text beside the accepted one
+//! (`NAME.snap.new`, as insta's assertions do), for `--review`, `--accept`,
+//! `--reject` or `cargo insta review`. `scorpion test NAME` runs the tests
+//! whose name contains NAME, as `cargo test NAME` does.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
+use std::io::{BufRead as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use miette::{Context, IntoDiagnostic};
 use uploader::transport::VirtualTransport;
-use uploader::{
-    Client, ClientConfig, Expectations, NoProgress, RomProfile, Transport, UploadImage,
-};
+use uploader::{Client, ClientConfig, NoProgress, RomProfile, Transport, UploadImage};
 
 use crate::cmd::ports;
 use crate::project::build::{Built, SNAPSHOT_KINDS, build};
 use crate::project::config::Found;
 use crate::project::snapshot::{self, Outcome};
+use crate::project::transcript::{self, Clock};
 use crate::project::{FILE, Project};
 
 /// Run the project's tests: snapshots of the assembled output and
 /// transcripts on the virtual Scorpion.
 ///
 /// Prints a line per test and `N passed, N failed`; exits 1 if any failed.
-/// A new or changed snapshot fails with its diff until `--accept` takes it.
+/// A new or changed snapshot fails with its diff, its new text left beside
+/// the accepted one as `NAME.snap.new` (what `cargo insta review` shows
+/// too), until `--accept` or `--review` takes it.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// Take new and changed snapshots as they are now.
-    #[arg(long)]
+    /// Only the tests whose name contains NAME: an image's (`probe`), one
+    /// snapshot (`probe/listing`), one file's (`probe.expect`,
+    /// `tests/io.calls`).
+    #[arg(value_name = "NAME")]
+    filter: Option<String>,
+    /// Take the new and changed snapshots (of the tests NAME selects) as
+    /// they are now, and delete the stale ones.
+    #[arg(long, conflicts_with_all = ["reject", "review", "port"])]
     accept: bool,
+    /// Leave the accepted snapshots as they are and delete the pending
+    /// `.snap.new` files (of the tests NAME selects).
+    #[arg(long, conflicts_with_all = ["review", "port"])]
+    reject: bool,
+    /// Ask about each new, changed or stale snapshot, one at a time: `a`
+    /// accepts it, `r` rejects it (deletes the pending file), `s` skips it
+    /// (leaves it pending).
+    #[arg(long, conflicts_with = "port")]
+    review: bool,
     /// Rehearse the transcripts on the virtual Scorpion (with the
     /// project's cards and world), then, if they pass, upload the images
     /// to the robot on PORT and run them there (no snapshots). Without a
@@ -46,10 +67,49 @@ pub(crate) struct Args {
     timing: bool,
 }
 
+/// What to do with a snapshot that differs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// Fail, leaving the new text pending.
+    Fail,
+    /// Take it.
+    Accept,
+    /// Fail, deleting the pending text.
+    Reject,
+    /// Ask.
+    Review,
+}
+
+impl Args {
+    fn mode(&self) -> Mode {
+        if self.accept {
+            Mode::Accept
+        } else if self.reject {
+            Mode::Reject
+        } else if self.review {
+            Mode::Review
+        } else {
+            Mode::Fail
+        }
+    }
+}
+
+/// An answer to `--review`'s question.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Decision {
+    Accept,
+    Reject,
+    Skip,
+}
+
 /// The results, printed as they come.
 struct Tally {
     passed: usize,
     failed: usize,
+    /// Tests NAME did not select.
+    filtered_out: usize,
+    /// `scorpion test NAME`'s NAME.
+    filter: Option<String>,
     /// Robot time the virtual transcripts took, all told.
     robot_time: std::time::Duration,
     /// Wall time they took (robots set up and images loaded included).
@@ -70,52 +130,139 @@ impl Tally {
             }
         }
     }
+
+    /// Whether the test `name` runs; counted as filtered out if not.
+    fn selects(&mut self, name: &str) -> bool {
+        let selected = self
+            .filter
+            .as_deref()
+            .is_none_or(|filter| name.contains(filter));
+        if !selected {
+            self.filtered_out += 1;
+        }
+        selected
+    }
+
+    /// Asks what to do with the snapshot `name`, after its diff (`why`).
+    /// The end of the input skips the rest.
+    fn ask(&mut self, name: &str, why: &str, accept: &str) -> miette::Result<Decision> {
+        let _ = write!(self.out, "review {name}\n{why}");
+        loop {
+            let _ = write!(
+                self.out,
+                "  a {accept}, r reject, s skip (leave it pending)? "
+            );
+            let _ = self.out.flush();
+            let mut line = String::new();
+            let read = std::io::stdin()
+                .lock()
+                .read_line(&mut line)
+                .into_diagnostic()
+                .wrap_err("cannot read the answer")?;
+            if read == 0 {
+                let _ = writeln!(self.out);
+                return Ok(Decision::Skip);
+            }
+            match line.trim().to_ascii_lowercase().as_str() {
+                "a" | "accept" => return Ok(Decision::Accept),
+                "r" | "reject" => return Ok(Decision::Reject),
+                "s" | "skip" | "" => return Ok(Decision::Skip),
+                _ => {}
+            }
+        }
+    }
+}
+
+/// Deletes `path` if it is there.
+fn remove(path: &Path) -> miette::Result<()> {
+    match std::fs::remove_file(path) {
+        Err(error) if error.kind() != std::io::ErrorKind::NotFound => Err(error)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot delete {}", path.display())),
+        _ => Ok(()),
+    }
+}
+
+fn write_file(path: &Path, text: &str) -> miette::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).into_diagnostic()?;
+    }
+    std::fs::write(path, text)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot write {}", path.display()))
 }
 
 fn check_snapshots(
     project: &Project,
     built: &Built,
-    accept: bool,
+    mode: Mode,
     tally: &mut Tally,
 ) -> miette::Result<()> {
     for (kind, content) in built.snapshots() {
-        let path = project.snapshot_path(&built.name, kind);
         let name = format!("{}/{kind}", built.name);
+        if !tally.selects(&name) {
+            continue;
+        }
+        let path = project.snapshot_path(&built.name, kind);
+        let pending = snapshot::pending_path(&path);
         let outcome = snapshot::compare(&path, &content);
         if outcome == Outcome::Same {
+            // A pending text from an earlier failure is out of date.
+            remove(&pending)?;
             tally.record(&name, Ok("ok"));
             continue;
         }
-        if accept {
-            if let Some(dir) = path.parent() {
-                std::fs::create_dir_all(dir).into_diagnostic()?;
-            }
-            std::fs::write(&path, snapshot::render(FILE, &name, &content))
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot write {}", path.display()))?;
-            tally.record(&name, Ok("accepted"));
-            continue;
-        }
         let shown = relative(project, &path);
-        let why = match outcome {
-            Outcome::New => format!(
-                "  no snapshot {shown} yet; `scorpion test --accept` takes this one:\n{}",
-                indent(&content)
-            ),
-            Outcome::Changed(diff) => format!(
-                "  {shown} differs (- snapshot, + now); `scorpion test --accept` takes the new one:\n{}",
-                indent(&diff)
-            ),
+        let why = match &outcome {
+            Outcome::New => format!("  no snapshot {shown} yet:\n{}", indent(&content)),
+            Outcome::Changed(diff) => {
+                format!("  {shown} differs (- snapshot, + now):\n{}", indent(diff))
+            }
             Outcome::Same => String::new(),
         };
-        tally.record(&name, Err(why));
+        let decision = match mode {
+            Mode::Accept => Decision::Accept,
+            Mode::Reject => Decision::Reject,
+            Mode::Fail => Decision::Skip,
+            Mode::Review => tally.ask(&name, &why, "accept")?,
+        };
+        let rendered = snapshot::render(FILE, &name, &content);
+        // The review showed the diff already.
+        let why = if mode == Mode::Review {
+            String::new()
+        } else {
+            why
+        };
+        match decision {
+            Decision::Accept => {
+                write_file(&path, &rendered)?;
+                remove(&pending)?;
+                tally.record(&name, Ok("accepted"));
+            }
+            Decision::Reject => {
+                remove(&pending)?;
+                tally.record(
+                    &name,
+                    Err(format!("{why}  rejected: the snapshot stays as it was\n")),
+                );
+            }
+            Decision::Skip => {
+                write_file(&pending, &rendered)?;
+                let pending = relative(project, &pending);
+                let why = format!(
+                    "{why}  the new one is in {pending}: `scorpion test {name} --accept` takes it, `scorpion test --review` (or `cargo insta review`) asks\n"
+                );
+                tally.record(&name, Err(why));
+            }
+        }
     }
     Ok(())
 }
 
 /// Snapshot files no image and kind of the project makes (an image renamed
-/// or removed): a failure, or deleted with `--accept`.
-fn stale_snapshots(project: &Project, accept: bool, tally: &mut Tally) -> miette::Result<()> {
+/// or removed): a failure, or deleted with `--accept` (pending ones with
+/// `--reject` too).
+fn stale_snapshots(project: &Project, mode: Mode, tally: &mut Tally) -> miette::Result<()> {
     let dir = project.root.join("tests").join("snapshots");
     let Ok(entries) = std::fs::read_dir(&dir) else {
         return Ok(());
@@ -129,23 +276,43 @@ fn stale_snapshots(project: &Project, accept: bool, tally: &mut Tally) -> miette
     let mut stale: Vec<PathBuf> = entries
         .filter_map(Result::ok)
         .map(|entry| entry.path())
-        .filter(|path| path.extension().is_some_and(|ext| ext == "snap") && !wanted.contains(path))
+        .filter(|path| {
+            let accepted = snapshot::accepted_path(path).unwrap_or_default();
+            let snap = path.extension().is_some_and(|ext| ext == "snap");
+            let pending = path.extension().is_some_and(|ext| ext == "new")
+                && accepted.extension().is_some_and(|ext| ext == "snap");
+            (snap && !wanted.contains(path)) || (pending && !wanted.contains(&accepted))
+        })
         .collect();
     stale.sort();
     for path in stale {
         let shown = relative(project, &path);
-        if accept {
-            std::fs::remove_file(&path)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot delete {shown}"))?;
-            tally.record(&format!("stale {shown}"), Ok("deleted"));
-        } else {
-            tally.record(
-                &format!("stale {shown}"),
+        let name = format!("stale {shown}");
+        if !tally.selects(&name) {
+            continue;
+        }
+        let pending = path.extension().is_some_and(|ext| ext == "new");
+        let why = format!("  no image of {FILE} makes {shown}\n");
+        let decision = match mode {
+            Mode::Accept => Decision::Accept,
+            Mode::Reject if pending => Decision::Accept,
+            Mode::Reject | Mode::Fail => Decision::Skip,
+            Mode::Review if pending => Decision::Skip,
+            Mode::Review => tally.ask(&name, &why, "delete it")?,
+        };
+        match decision {
+            Decision::Accept => {
+                remove(&path)?;
+                tally.record(&name, Ok("deleted"));
+            }
+            // A pending text nothing makes is left for whoever made it.
+            Decision::Reject | Decision::Skip if pending => {}
+            Decision::Reject | Decision::Skip => tally.record(
+                &name,
                 Err(format!(
-                    "  no image of {FILE} makes {shown}; `scorpion test --accept` deletes it"
+                    "{why}  `scorpion test --accept` deletes it, `scorpion test --review` asks\n"
                 )),
-            );
+            ),
         }
     }
     Ok(())
@@ -165,25 +332,28 @@ fn relative(project: &Project, path: &Path) -> String {
         .to_string()
 }
 
-fn read_transcript(path: &Path) -> miette::Result<Expectations> {
-    let text = hostfs::read_text(path, hostfs::TEXT)
-        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-    Expectations::parse(&text).wrap_err_with(|| format!("in {}", path.display()))
-}
-
-/// Runs `expectations`, a difference said as a test's failure (not as an
-/// upload's rehearsal).
-fn check<T: Transport>(expectations: &Expectations, client: &mut Client<T>) -> miette::Result<()> {
-    match expectations.check(client) {
-        Ok(_) => Ok(()),
-        Err(uploader::Error::RehearsalFailed {
-            command,
-            expected,
-            found,
-        }) => Err(miette::miette!(
-            "`{command}` answered `{found}`, expected `{expected}`"
-        )),
-        Err(other) => Err(other.into()),
+/// Runs the transcript at `path` on `client`: every line that differs is
+/// a line of the failure.
+fn run_transcript<T: Transport>(
+    project: &Project,
+    path: &Path,
+    client: &mut Client<T>,
+    clock: Clock,
+) -> Result<(), String> {
+    let shown = relative(project, path);
+    let expectations = transcript::read(path, &shown).map_err(|e| indent(&format!("{e:?}")))?;
+    let checked = expectations
+        .check_all(client)
+        .map_err(|e| indent(&format!("{:?}", miette::Report::new(e))))?;
+    if checked.mismatches.is_empty() {
+        Ok(())
+    } else {
+        Err(transcript::describe(&shown, &checked.mismatches, clock)
+            .lines()
+            .fold(String::new(), |mut out, line| {
+                let _ = writeln!(out, "  {line}");
+                out
+            }))
     }
 }
 
@@ -264,12 +434,18 @@ fn routine_calls(
         let calls = match crate::project::calls::parse(&text, &symbols) {
             Ok(calls) => calls,
             Err(why) => {
-                tally.record(&format!("calls {shown}"), Err(format!("  {shown}: {why}")));
+                let name = format!("calls {shown}");
+                if tally.selects(&name) {
+                    tally.record(&name, Err(format!("  {shown}: {why}")));
+                }
                 continue;
             }
         };
         for call in calls {
             let name = format!("call {shown}:{} {}", call.line, call.routine);
+            if !tally.selects(&name) {
+                continue;
+            }
             let result = setup
                 .robot(built)
                 .map_err(|e| format!("{e:?}"))
@@ -294,18 +470,19 @@ fn virtual_transcripts(
     let started = std::time::Instant::now();
     for path in project.transcripts() {
         let name = format!("transcript {}", relative(project, &path));
-        let result = (|| -> miette::Result<()> {
-            let expectations = read_transcript(&path)?;
-            let robot = setup.robot(built)?;
-            let mut client = client(VirtualTransport::new(robot));
-            let result = check(&expectations, &mut client);
-            robot_time += client.transport().now();
-            result
-        })();
-        tally.record(
-            &name,
-            result.map(|()| "ok").map_err(|e| indent(&format!("{e:?}"))),
-        );
+        if !tally.selects(&name) {
+            continue;
+        }
+        let result = match setup.robot(built) {
+            Ok(robot) => {
+                let mut client = client(VirtualTransport::new(robot));
+                let result = run_transcript(project, &path, &mut client, Clock::Robot);
+                robot_time += client.transport().now();
+                result
+            }
+            Err(error) => Err(indent(&format!("{error:?}"))),
+        };
+        tally.record(&name, result.map(|()| "ok"));
     }
     tally.robot_time += robot_time;
     tally.wall_time += started.elapsed();
@@ -335,13 +512,18 @@ fn robot_transcripts(
         .wrap_err_with(|| format!("cannot upload {}", image.name))?;
         tally.record(&format!("upload {}", image.name), Ok("ok"));
     }
+    let clock = if port == ports::EMU {
+        Clock::Robot
+    } else {
+        Clock::Line
+    };
     for path in project.transcripts() {
         let name = format!("transcript {}", relative(project, &path));
-        let result = read_transcript(&path).and_then(|e| Ok(e.check(&mut client)?));
-        tally.record(
-            &name,
-            result.map(|_| "ok").map_err(|e| indent(&format!("{e:?}"))),
-        );
+        if !tally.selects(&name) {
+            continue;
+        }
+        let result = run_transcript(project, &path, &mut client, clock);
+        tally.record(&name, result.map(|()| "ok"));
     }
     Ok(())
 }
@@ -352,6 +534,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let mut tally = Tally {
         passed: 0,
         failed: 0,
+        filtered_out: 0,
+        filter: args.filter.clone().filter(|f| !f.is_empty()),
         robot_time: std::time::Duration::ZERO,
         wall_time: std::time::Duration::ZERO,
         out: std::io::stdout().lock(),
@@ -391,11 +575,25 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             started.elapsed().as_secs_f64()
         );
     }
-    let _ = writeln!(
-        tally.out,
-        "{} passed, {} failed",
-        tally.passed, tally.failed
-    );
+    if let Some(filter) = &tally.filter {
+        if tally.passed + tally.failed == 0 {
+            miette::bail!(
+                help = "NAME is part of a test's name: an image's (`myext`), a snapshot's (`myext/listing`), a file's (`myext.expect`); `scorpion test` lists them all",
+                "no test's name contains `{filter}`"
+            );
+        }
+        let _ = writeln!(
+            tally.out,
+            "{} passed, {} failed, {} filtered out",
+            tally.passed, tally.failed, tally.filtered_out
+        );
+    } else {
+        let _ = writeln!(
+            tally.out,
+            "{} passed, {} failed",
+            tally.passed, tally.failed
+        );
+    }
     Ok(if tally.failed == 0 {
         ExitCode::SUCCESS
     } else {
@@ -440,10 +638,10 @@ fn test_project(project: &Project, args: &Args, tally: &mut Tally) -> miette::Re
         }
         None => {
             for image in &built {
-                check_snapshots(project, image, args.accept, tally)?;
+                check_snapshots(project, image, args.mode(), tally)?;
             }
             if built.len() == project.file.images.len() {
-                stale_snapshots(project, args.accept, tally)?;
+                stale_snapshots(project, args.mode(), tally)?;
             }
             if tally.failed == failed_before || built.len() == project.file.images.len() {
                 let (setup, _) = Setup::of(project, None)?;

@@ -2,7 +2,7 @@
 //! into a robot, verify every byte, then switch its hooks.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -16,6 +16,7 @@ use uploader::{
 };
 
 use crate::cmd::ports;
+use crate::project::transcript::{self, Clock, TranscriptFailed};
 
 /// Upload a linked image (`scorpion link` or `scorpion build` output) into
 /// the robot with its own RAM-write commands: every byte verified with
@@ -234,10 +235,34 @@ fn read_image(path: &PathBuf) -> miette::Result<(linker::Image, UploadImage)> {
     Ok((linked, image))
 }
 
-fn read_expectations(path: &PathBuf) -> miette::Result<Expectations> {
-    let text = hostfs::read_text(path, hostfs::TEXT)
-        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-    Expectations::parse(&text).wrap_err_with(|| format!("in {}", path.display()))
+fn read_expectations(path: &Path) -> miette::Result<(String, Expectations)> {
+    let shown = path.display().to_string();
+    let expectations = transcript::read(path, &shown)?;
+    Ok((shown, expectations))
+}
+
+/// Checks every line of `expectations` on `client`: the transcript, or
+/// every line that differs, each at its `file:line` on stderr, then the
+/// error.
+fn check_expectations<T: Transport>(
+    (shown, expectations): &(String, Expectations),
+    client: &mut Client<T>,
+    help: &str,
+) -> miette::Result<Vec<(Command, Option<Answer>)>> {
+    let checked = expectations.check_all(client)?;
+    match TranscriptFailed::of(shown, expectations, &checked.mismatches, help) {
+        Some(failed) => {
+            #[allow(clippy::print_stderr, reason = "the CLI reports each failure")]
+            {
+                eprint!(
+                    "{}",
+                    transcript::describe(shown, &checked.mismatches, Clock::Robot)
+                );
+            }
+            Err(failed.into())
+        }
+        None => Ok(checked.transcript),
+    }
 }
 
 /// `> command` and `< answer` lines.
@@ -344,7 +369,7 @@ fn upload_file(
     path: &PathBuf,
 ) -> miette::Result<ExitCode> {
     let (linked, image) = read_image(path)?;
-    let expectations = args.expect.as_ref().map(read_expectations).transpose()?;
+    let expectations = args.expect.as_deref().map(read_expectations).transpose()?;
     let rom = crate::cmd::config::rom(resolved)?;
     let rig = crate::cmd::config::rig(resolved);
     let options = UploadOptions {
@@ -375,7 +400,11 @@ fn upload_file(
             report.device_time.as_secs_f64()
         );
         if let Some(expectations) = &expectations {
-            let lines = expectations.check(&mut client)?;
+            let lines = check_expectations(
+                expectations,
+                &mut client,
+                "the image does not behave on the virtual Scorpion as the expectations say; nothing was sent to the robot",
+            )?;
             let _ = writeln!(
                 out,
                 ", {} expectation{} met",
@@ -414,7 +443,11 @@ fn upload_file(
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
     if emulated && let Some(expectations) = &expectations {
-        let lines = expectations.check(&mut client)?;
+        let lines = check_expectations(
+            expectations,
+            &mut client,
+            "the image is installed on the virtual Scorpion and answers otherwise than the expectations say",
+        )?;
         let _ = write!(
             out,
             "the virtual Scorpion answers, after the upload:\n{}",

@@ -84,6 +84,7 @@ pub(crate) fn build_with(
             .collect(),
         defines,
         listing: true,
+        list_builtin_includes: project.file.tests.builtin_listing,
         builtin_includes: crate::cmd::asm::builtin_includes(),
         ..given.clone()
     };

@@ -9,6 +9,8 @@
 //! - [`calls`]: routine-level tests (`tests/*.calls`).
 //! - [`memory`]: a project's own layout checked against the memory an
 //!   upload may write.
+//! - [`transcript`]: transcripts read and their mismatches said as
+//!   failures, all of them, at their `file:line`.
 //!
 //! Nothing here prints: `scorpion build`, `test` and `new` do.
 
@@ -16,6 +18,7 @@ pub(crate) mod build;
 pub(crate) mod calls;
 pub(crate) mod memory;
 pub(crate) mod snapshot;
+pub(crate) mod transcript;
 
 /// The project model and the configuration's resolution.
 pub(crate) use scorpion_project as config;

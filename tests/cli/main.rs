@@ -12,6 +12,7 @@ mod disasm;
 mod emu;
 mod hostile_files;
 mod layouts;
+mod journeys;
 mod link;
 mod project;
 mod read;

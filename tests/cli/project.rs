@@ -468,3 +468,36 @@ fn an_image_links_with_its_ld65_configuration() {
         transcript(&broken)
     );
 }
+
+/// An upload's rehearsal says every expectation line the image does not
+/// meet, each at its `file:line`, and touches nothing.
+#[test]
+fn a_failing_rehearsal_names_every_line_that_differs() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "twice"]);
+    assert_eq!(made.status.code(), Some(0), "{}", transcript(&made));
+    let project = dir.path().join("twice");
+    std::fs::write(
+        project.join("wrong.expect"),
+        "# two lines wrong\n/1V => V02\n/1X => X00\n/1V => V03\n",
+    )
+    .expect("write");
+    let output = scorpion(
+        &project,
+        &["upload", "--port", "emu", "--expect", "wrong.expect"],
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let text = transcript(&output);
+    assert!(text.contains("wrong.expect: 2 of 3 lines"), "{text}");
+    assert!(
+        text.contains(
+            "wrong.expect:2: `/1V` answered `V01`, expected `V02` (at 0.000 ms of robot time"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains("wrong.expect:4: `/1V` answered `V01`, expected `V03` (at "),
+        "{text}"
+    );
+    assert!(!text.contains("uploaded and verified"), "{text}");
+}

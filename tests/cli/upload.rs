@@ -401,6 +401,19 @@ fn the_readme_main_job_prints_what_the_readme_says() {
     ] {
         assert!(script.contains(step), "demo/main-job.sh lost `{step}`");
     }
+    // A first run builds for minutes: the build runs on its own, before
+    // the first step, with cargo's progress shown (not `--quiet`), from
+    // the versions the tests ran with.
+    let build = script
+        .find("cargo build --release --locked")
+        .expect("demo/main-job.sh builds the binary on its own first");
+    let first_step = script.find("scorpion build").expect("the first step");
+    assert!(build < first_step, "the build comes before the first step");
+    let build_line = script[build..].lines().next().unwrap_or_default();
+    assert!(
+        !build_line.contains("--quiet"),
+        "the build shows its progress"
+    );
 }
 
 /// Issue 11's second reproduction, through a real pseudo-terminal: a

@@ -1,6 +1,6 @@
 //! Outside tools that differential tests compare against.
 //!
-//! The rule (DEVELOPERS.md): a test that needs an outside tool fails when
+//! The rule (CONTRIBUTING.md): a test that needs an outside tool fails when
 //! the tool is missing and `CI=true`; locally it skips, saying so on stderr
 //! past the test harness's capture, so that `cargo test` shows it.
 //! `.ci/install-test-tools` installs every tool named here.

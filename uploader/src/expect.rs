@@ -155,7 +155,8 @@ impl Expectations {
         Ok(Expectations { lines })
     }
 
-    /// Sends every command and checks every answer.
+    /// Sends every command and checks every answer, stopping at the first
+    /// difference (an upload's rehearsal: nothing more is needed to refuse).
     ///
     /// # Errors
     /// [`Error::RehearsalFailed`] at the first difference, or a line error.
@@ -163,9 +164,38 @@ impl Expectations {
         &self,
         client: &mut Client<T>,
     ) -> Result<Vec<(Command, Option<Answer>)>> {
-        let mut transcript = Vec::new();
+        let checked = self.check_all(client)?;
+        match checked.mismatches.into_iter().next() {
+            Some(first) => Err(Error::RehearsalFailed {
+                command: first.command,
+                expected: first.expected,
+                found: first.found,
+            }),
+            None => Ok(checked.transcript),
+        }
+    }
+
+    /// Sends every command and checks every answer, going on after a
+    /// difference, as a test run reports all of a file's failures.
+    ///
+    /// # Errors
+    /// A line error, or a robot that stopped (it can say why): what leaves
+    /// nothing to check the rest against.
+    pub fn check_all<T: Transport>(&self, client: &mut Client<T>) -> Result<Checked> {
+        let started = client.transport().now();
+        let mut checked = Checked::default();
         for expectation in &self.lines {
             let command = &expectation.command;
+            let sent_at = client.transport().now();
+            let mut differs = |expected: String, found: String| {
+                checked.mismatches.push(Mismatch {
+                    line: expectation.line,
+                    command: command.to_string(),
+                    expected,
+                    found,
+                    at: sent_at.saturating_sub(started),
+                });
+            };
             let answer = match &expectation.required {
                 Required::Sent => {
                     client.send(command)?;
@@ -174,66 +204,73 @@ impl Expectations {
                 Required::Nothing | Required::Whatever => {
                     let heard = client.listen(command)?;
                     if let (Required::Nothing, Some(answer)) = (&expectation.required, &heard) {
-                        return Err(Error::RehearsalFailed {
-                            command: command.to_string(),
-                            expected: "no answer".into(),
-                            found: answer_text(answer),
-                        });
+                        differs("no answer".into(), answer_text(answer));
                     }
                     heard
                 }
-                Required::Any | Required::Exactly(_) => {
-                    let sent_at = client.transport().now();
-                    let answer = match client.ask(command) {
-                        Ok(answer) => answer,
-                        Err(error) => {
-                            // Silence from a robot that can show why says so.
-                            client.transport().diagnose_silence()?;
-                            return Err(Error::RehearsalFailed {
-                                command: command.to_string(),
-                                expected: match &expectation.required {
-                                    Required::Exactly(text) => text.clone(),
-                                    _ => "an answer".into(),
-                                },
-                                found: format!("no valid answer ({error})"),
-                            });
-                        }
-                    };
-                    if let Required::Exactly(text) = &expectation.required {
+                Required::Any | Required::Exactly(_) => match client.ask(command) {
+                    Ok(answer) => {
                         let found = answer_text(&answer);
-                        if found != *text {
-                            return Err(Error::RehearsalFailed {
-                                command: command.to_string(),
-                                expected: text.clone(),
-                                found,
-                            });
-                        }
-                    }
-                    let took = client.transport().now().saturating_sub(sent_at);
-                    if let Some(within) = expectation.within
-                        && took > within
-                    {
-                        return Err(Error::RehearsalFailed {
-                            command: command.to_string(),
-                            expected: format!("an answer within {} us", within.as_micros()),
-                            found: format!(
-                                "{} after {} us",
-                                answer_text(&answer),
-                                took.as_micros()
+                        let took = client.transport().now().saturating_sub(sent_at);
+                        match (&expectation.required, expectation.within) {
+                            (Required::Exactly(text), _) if found != *text => {
+                                differs(text.clone(), found);
+                            }
+                            (_, Some(within)) if took > within => differs(
+                                format!("an answer within {} us", within.as_micros()),
+                                format!("{found} after {} us", took.as_micros()),
                             ),
-                        });
+                            _ => {}
+                        }
+                        Some(answer)
                     }
-                    Some(answer)
-                }
+                    Err(error) => {
+                        // Silence from a robot that can show why says so.
+                        client.transport().diagnose_silence()?;
+                        differs(
+                            match &expectation.required {
+                                Required::Exactly(text) => text.clone(),
+                                _ => "an answer".into(),
+                            },
+                            format!("no valid answer ({error})"),
+                        );
+                        None
+                    }
+                },
             };
-            transcript.push((command.clone(), answer));
+            checked.transcript.push((command.clone(), answer));
         }
         // The robot must still be running its loop after the last line (a
         // handler that never returns answers nothing, which a line without
         // `=>` accepts).
         client.transport().diagnose_silence()?;
-        Ok(transcript)
+        Ok(checked)
     }
+}
+
+/// A line whose answer was not the one required.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Mismatch {
+    /// The line of the expectation file (1-based).
+    pub line: usize,
+    /// The command sent.
+    pub command: String,
+    /// What the line requires.
+    pub expected: String,
+    /// What came back (or `no valid answer (why)`).
+    pub found: String,
+    /// When the command was sent, from the start of the check: robot time
+    /// on the virtual Scorpion, time on the line on a real one.
+    pub at: std::time::Duration,
+}
+
+/// What [`Expectations::check_all`] found.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Checked {
+    /// Every command sent and its answer, in order.
+    pub transcript: Vec<(Command, Option<Answer>)>,
+    /// The lines that were not answered as they require, in order.
+    pub mismatches: Vec<Mismatch>,
 }
 
 /// An answer as the robot sent it, without its carriage return.

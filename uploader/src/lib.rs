@@ -42,7 +42,7 @@ pub use backup::{Backup, Keep, MAGIC, NoKeep, backup, backup_ranges, restore};
 pub use client::{Client, ClientConfig, ClientStats};
 pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, human_duration};
-pub use expect::{Expectation, Expectations, NOTHING, Required, answer_text};
+pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};
 pub use fingerprint::{SERVICES, rom_profile_image};
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,

@@ -390,6 +390,41 @@ fn probe_tells_no_answer_from_wrong_baud() {
     );
 }
 
+/// Every line that differs is reported, with its line and when it was
+/// sent, and the lines after a difference are still checked.
+#[test]
+fn check_all_reports_every_mismatch_with_its_line_and_time() {
+    let text = "/1X => X00\n/7R020001 => R00   # wrong\n/1X => X00\n/1X => X01   # wrong too\n";
+    let expectations = Expectations::parse(text).expect("parses");
+    let mut client = Client::new(robot(), ClientConfig::default());
+    let checked = expectations.check_all(&mut client).expect("checked");
+    assert_eq!(checked.transcript.len(), 4, "every line was sent");
+    let found: Vec<(usize, &str, &str, &str)> = checked
+        .mismatches
+        .iter()
+        .map(|m| {
+            (
+                m.line,
+                m.command.as_str(),
+                m.expected.as_str(),
+                m.found.as_str(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        found,
+        [(2, "/7R020001", "R00", "R4C"), (4, "/1X", "X01", "X00")]
+    );
+    let [first, second] = &checked.mismatches[..] else {
+        panic!("two mismatches");
+    };
+    assert!(first.at > Duration::ZERO, "after line 1's exchange");
+    assert!(
+        second.at > first.at,
+        "robot time goes on: {first:?} {second:?}"
+    );
+}
+
 #[test]
 fn expectations_parse_and_check() {
     let text =

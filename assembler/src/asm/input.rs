@@ -78,15 +78,16 @@ impl<'a> Asm<'a> {
     }
 
     /// Reads a file through the source for `.include` or `.incbin`,
-    /// following [`Asm::search_path`]. Only a file that is not there sends
-    /// the search on; one that is there but cannot be read (a device, a
-    /// FIFO, one too large) ends it with that error.
+    /// following [`Asm::search_path`]; `true` beside it when it is one of
+    /// [`crate::Options::builtin_includes`]. Only a file that is not there
+    /// sends the search on; one that is there but cannot be read (a device,
+    /// a FIFO, one too large) ends it with that error.
     pub(crate) fn find_file(
         &self,
         name: &str,
         binary: bool,
         from_dir: &Path,
-    ) -> std::io::Result<Option<(PathBuf, Vec<u8>)>> {
+    ) -> std::io::Result<Option<(PathBuf, Vec<u8>, bool)>> {
         let path = Path::new(name);
         let candidates = if path.is_absolute() {
             vec![path.to_path_buf()]
@@ -98,7 +99,7 @@ impl<'a> Asm<'a> {
         };
         for candidate in candidates {
             match self.source.read(&candidate) {
-                Ok(bytes) => return Ok(Some((candidate, bytes))),
+                Ok(bytes) => return Ok(Some((candidate, bytes, false))),
                 Err(error) if error.kind() == std::io::ErrorKind::NotFound => {}
                 Err(error) => return Err(error),
             }
@@ -110,7 +111,7 @@ impl<'a> Asm<'a> {
             .opts
             .builtin_includes
             .get(name)
-            .map(|bytes| (PathBuf::from(name), bytes.clone())))
+            .map(|bytes| (PathBuf::from(name), bytes.clone(), true)))
     }
 
     /// Pushes a file to read next.
@@ -353,6 +354,9 @@ impl<'a> Asm<'a> {
         let Some(frame) = self.input.frames.pop() else {
             return;
         };
+        if let Some(listing) = self.listing.as_mut() {
+            listing.frame_ended(self.input.frames.len());
+        }
         let base = frame.conds();
         while self.input.conds.len() > base {
             if let Some(cond) = self.input.conds.pop() {

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::asm::{Asm, MAX_BYTES, PResult};
+use crate::asm::{Asm, Frame, MAX_BYTES, PResult};
 use crate::cursor::Cursor;
 use crate::diag::{self, CtxKind};
 use crate::lexer::{Tok, Token};
@@ -113,7 +113,7 @@ impl Asm<'_> {
         self.expect_end(c)?;
         self.frame_room(tok.span)?;
         let dir = self.current_dir();
-        let (path, bytes) = match self.find_file(&name, false, &dir) {
+        let (path, bytes, builtin) = match self.find_file(&name, false, &dir) {
             Ok(Some(found)) => found,
             Ok(None) => return Err(self.not_found(tok, &name, false)),
             Err(error) => return Err(self.unreadable(tok, &name, false, &error)),
@@ -122,6 +122,20 @@ impl Asm<'_> {
         let parent = path.parent().map(Path::to_path_buf).unwrap_or_default();
         self.push_file(path.display().to_string(), bytes, parent, ctx);
         self.defer_file_after_expansions();
+        if builtin
+            && !self.opts.list_builtin_includes
+            && let Some(listing) = self.listing.as_mut()
+        {
+            // The file sits below any expansions it was deferred after:
+            // its depth is its own place in the stack, not the stack's top.
+            let depth = self
+                .input
+                .frames
+                .iter()
+                .rposition(|frame| matches!(frame, Frame::File { .. }))
+                .map_or(self.input.frames.len(), |index| index + 1);
+            listing.unlisted_from(depth);
+        }
         Ok(())
     }
 
@@ -138,7 +152,7 @@ impl Asm<'_> {
         }
         self.expect_end(c)?;
         let dir = self.current_dir();
-        let (_, bytes) = match self.find_file(&name, true, &dir) {
+        let (_, bytes, _) = match self.find_file(&name, true, &dir) {
             Ok(Some(found)) => found,
             Ok(None) => return Err(self.not_found(tok, &name, true)),
             Err(error) => return Err(self.unreadable(tok, &name, true, &error)),
