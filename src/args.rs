@@ -73,29 +73,15 @@ pub(crate) fn define(text: &str) -> Result<(String, i64), String> {
     Ok((name.to_owned(), if negative { -number } else { number }))
 }
 
-/// `-t SYSTEM`: one of ca65's target systems whose CPU is the NMOS 6502.
+/// `-t SYSTEM`: one of ca65's target systems. Its symbols and character
+/// set are taken whatever its CPU; instructions of another CPU (a
+/// 65C02's `stz`) are refused where a source uses them, so a source that
+/// says `.setcpu "6502"` builds for `apple2enh` as with ca65.
 pub(crate) fn system(text: &str) -> Result<&'static assembler::systems::System, String> {
-    let names = || {
-        assembler::systems::SYSTEMS
-            .iter()
-            .filter(|s| s.other_cpu.is_none())
-            .map(|s| s.name)
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    match assembler::systems::find(text) {
-        Some(system) => match system.other_cpu {
-            None => Ok(system),
-            Some(cpu) => Err(format!(
-                "`{text}` has a {cpu}; this toolchain is for the NMOS 6502 (systems: {})",
-                names()
-            )),
-        },
-        None => Err(format!(
-            "no system `{text}` (ca65's with a 6502: {})",
-            names()
-        )),
-    }
+    assembler::systems::find(text).ok_or_else(|| {
+        let names: Vec<&str> = assembler::systems::SYSTEMS.iter().map(|s| s.name).collect();
+        format!("no system `{text}` (ca65's: {})", names.join(", "))
+    })
 }
 
 /// `--feature NAME`: a ca65 feature.

@@ -74,12 +74,19 @@ impl Asm<'_> {
                 if s.global && s.export == Some(true) {
                     return true;
                 }
-                // ca65 lends a scope's name the address size of the outer
-                // symbol of that name.
+                // ca65 lends a scope's name the address size of the
+                // nearest outer symbol of that name, only its own: one
+                // not defined yet lends nothing (absolute), even where a
+                // symbol further out would have been zero page.
                 match self.prog.outer.get(&sym).map(|o| o.outer) {
                     Some(outer) if *steps > 0 => {
                         *steps -= 1;
-                        self.guess_sym(outer, steps)
+                        let o = &self.prog.syms[outer as usize];
+                        if o.def == SymDef::Undefined {
+                            o.global && o.export == Some(true)
+                        } else {
+                            self.guess_sym(outer, steps)
+                        }
                     }
                     _ => false,
                 }

@@ -51,28 +51,28 @@ fn osa_within(a: &[u8], b: &[u8], limit: usize) -> Option<usize> {
             strsim::osa_distance(&String::from_utf8_lossy(a), &String::from_utf8_lossy(b));
         return (distance <= limit).then_some(distance);
     }
-    // Three rows of the table: two back (for transpositions), one back,
-    // and the one being filled.
-    let mut before = [0usize; MAX];
-    let mut previous = [0usize; MAX];
-    let mut current = [0usize; MAX];
-    for (j, cell) in previous.iter_mut().enumerate().take(b.len() + 1) {
-        *cell = j;
+    // Three rows of the table, used in turn: two back (for
+    // transpositions), one back, and the one being filled. Cells are
+    // bytes: names this short have distances below 64.
+    let mut rows = [[0u8; MAX]; 3];
+    for (j, cell) in rows[0].iter_mut().enumerate().take(b.len() + 1) {
+        *cell = j as u8;
     }
     let mut previous_min = 0;
     for i in 1..=a.len() {
-        current[0] = i;
+        let (cur, prev, before) = (i % 3, (i + 2) % 3, (i + 1) % 3);
+        rows[cur][0] = i as u8;
         let mut row_min = i;
         for j in 1..=b.len() {
-            let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut value = (previous[j] + 1)
-                .min(current[j - 1] + 1)
-                .min(previous[j - 1] + cost);
+            let cost = u8::from(a[i - 1] != b[j - 1]);
+            let mut value = (rows[prev][j] + 1)
+                .min(rows[cur][j - 1] + 1)
+                .min(rows[prev][j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                value = value.min(before[j - 2] + 1);
+                value = value.min(rows[before][j - 2] + 1);
             }
-            current[j] = value;
-            row_min = row_min.min(value);
+            rows[cur][j] = value;
+            row_min = row_min.min(usize::from(value));
         }
         // A later cell comes from this row or (a transposition, plus
         // one) the row before: past the limit in both, it stays past.
@@ -80,10 +80,8 @@ fn osa_within(a: &[u8], b: &[u8], limit: usize) -> Option<usize> {
             return None;
         }
         previous_min = row_min;
-        before = previous;
-        previous = current;
     }
-    let distance = previous[b.len()];
+    let distance = usize::from(rows[a.len() % 3][b.len()]);
     (distance <= limit).then_some(distance)
 }
 

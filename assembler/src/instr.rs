@@ -2,8 +2,9 @@
 //!
 //! Opcodes come only from `isa::encode`. Where an operand could be
 //! zero-page or absolute and its value is not known yet (a symbol defined
-//! later), the instruction becomes a variable-size item that the layout
-//! passes settle; everything else is encoded at once.
+//! later), the size is ca65's guess from what is known at the line
+//! (`addrsize`), or with `Options::forward_zero_page` a variable-size
+//! item that the layout passes settle; everything else is encoded at once.
 
 use isa::objfmt::{BinaryOp, UnaryOp};
 use isa::{AddressingMode as Mode, Mnemonic};

@@ -12,9 +12,11 @@
 //!    macros, `.repeat`s and `.define`s, evaluates conditionals and builds
 //!    a `model::Program`: segments cut into chunks of known size, symbols,
 //!    expression nodes, fixups;
-//! 2. the layout passes (`layout`) settle the operands that could be
-//!    zero-page or absolute (symbols defined later, `.importzp`) by a
-//!    widening fixpoint;
+//! 2. the layout passes (`layout`) place the chunks; with
+//!    [`Options::forward_zero_page`] they also settle the operands that
+//!    could be zero-page or absolute (symbols defined later) by a widening
+//!    fixpoint, where by default such an operand is decided at its line
+//!    as ca65 decides it (`addrsize`);
 //! 3. resolution turns every fixup into bytes or an `R_MOS_*` relocation,
 //!    checks ranges, branches and `.assert`s;
 //! 4. `elf` writes the object (docs/ARCHITECTURE.md, "The object format").

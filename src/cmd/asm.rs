@@ -64,6 +64,8 @@ impl AsmOptions {
     pub(crate) fn options(&self, listing: bool) -> assembler::Options {
         assembler::Options {
             include_dirs: self.include_dirs.clone(),
+            // As ca65: `.include "apple2.inc"` with no `-I`.
+            system_include_dirs: assembler::cc65_include_dirs(),
             bin_include_dirs: self.bin_include_dirs.clone(),
             defines: self.defines.clone(),
             listing,

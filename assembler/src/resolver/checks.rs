@@ -32,6 +32,10 @@ impl Asm<'_> {
                     && self.prog.syms[outer as usize].is_defined()
                 {
                     self.prog.syms[sym].def = SymDef::Alias(outer);
+                    // The outer symbol is the one used (an import is
+                    // written to the object only where it is used).
+                    let o = &mut self.prog.syms[outer as usize];
+                    o.ref_loc = o.ref_loc.or(referenced);
                     found = true;
                     break;
                 }
