@@ -379,7 +379,7 @@ fn every_command_that_runs_the_virtual_robot_takes_the_cards_from_each_source() 
         let debugged = run(&["debug"], "/2A1\ncontinue 100000\n");
         assert!(debugged.contains("< A57"), "{source:?}: {debugged}");
         if source == Source::Project {
-            let tested = run(&["test"], "");
+            let tested = run(&["test", "--accept"], "");
             assert!(
                 tested.contains("transcript adc.expect ... ok"),
                 "{source:?}: {tested}"

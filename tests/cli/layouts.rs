@@ -50,11 +50,14 @@ fn every_example_layout_links_inside_the_roms_memory_map() {
 fn a_layout_over_the_roms_own_ram_is_refused_at_link_time() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     for file in ["Scorpion.toml", "checksum.s"] {
-        std::fs::copy(examples().join("checksum").join(file), dir.path().join(file))
-            .expect("copy");
+        std::fs::copy(
+            examples().join("checksum").join(file),
+            dir.path().join(file),
+        )
+        .expect("copy");
     }
-    let layout = std::fs::read_to_string(examples().join("checksum/checksum.toml"))
-        .expect("the layout");
+    let layout =
+        std::fs::read_to_string(examples().join("checksum/checksum.toml")).expect("the layout");
     assert!(layout.contains("end = \"$0F3F\""), "{layout}");
     std::fs::write(
         dir.path().join("checksum.toml"),
