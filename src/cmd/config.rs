@@ -42,7 +42,21 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         &args.rig,
         args.rom.as_ref(),
     ))?;
-    let rows = resolved.rows();
+    let mut rows = resolved.rows();
+    // A workspace has no robot of its own: say it is one.
+    if resolved.project.is_none()
+        && let Ok(scorpion_project::Found::Workspace(workspace)) = scorpion_project::Found::here()
+    {
+        rows[0] = (
+            "project",
+            "(none)".to_owned(),
+            format!(
+                "{} is a workspace of {}: run this in a member's directory",
+                scorpion_project::shown(&workspace.root.join(scorpion_project::FILE)),
+                workspace.member_names().join(", ")
+            ),
+        );
+    }
     let width = rows.iter().map(|(key, _, _)| key.len()).max().unwrap_or(0);
     let mut out = std::io::stdout().lock();
     for (key, value, origin) in rows {

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use miette::{Context, IntoDiagnostic};
+use miette::Context;
 use romlib::protocol::{Answer, Command};
 use uploader::transport::VirtualTransport;
 use uploader::{
@@ -345,10 +345,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         Some(path) => upload_file(args, &resolved, path),
         None => {
             let Some(project) = &resolved.project else {
-                return Err(scorpion_project::Error::NoProject {
-                    dir: std::env::current_dir().into_diagnostic()?,
-                }
-                .into());
+                // None here, or a workspace: the error says which.
+                crate::project::Project::here()?;
+                miette::bail!("no project here");
             };
             for spec in &project.file.images {
                 let (_, path) = crate::project::build::build_to_target(project, spec)?;

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Duration;
 
-use miette::{Context, IntoDiagnostic};
+use miette::Context;
 use uploader::{Expectations, Mismatch};
 
 /// Reads the transcript at `path`, shown to the user as `shown`.

@@ -379,7 +379,7 @@ fn every_command_that_runs_the_virtual_robot_takes_the_cards_from_each_source() 
         let debugged = run(&["debug"], "/2A1\ncontinue 100000\n");
         assert!(debugged.contains("< A57"), "{source:?}: {debugged}");
         if source == Source::Project {
-            let tested = run(&["test"], "");
+            let tested = run(&["test", "--accept"], "");
             assert!(
                 tested.contains("transcript adc.expect ... ok"),
                 "{source:?}: {tested}"
@@ -471,6 +471,47 @@ fn build_in_a_project_honours_defines_and_includes_and_refuses_outputs() {
         assert!(
             stderr.contains(&format!("{} cannot apply to a project's build", flags[0])),
             "{}",
+            transcript(&output)
+        );
+    }
+}
+
+/// The world from the project or from `--world`, each setting by itself:
+/// `--world` keeps the project's cards (it replaced them all in `sim`,
+/// and `ask --port emu` took neither from the project).
+#[test]
+fn the_world_comes_from_the_project_or_the_flag_and_keeps_the_projects_cards() {
+    let adc = Adc::new();
+    let project = adc.project();
+    std::fs::write(
+        project.join("wall.rhai"),
+        "// Against a wall from power-up.\nfn init() { bumpers(0x04); }\n",
+    )
+    .expect("write the world");
+    let toml = project.join("Scorpion.toml");
+    let original = std::fs::read_to_string(&toml).expect("the project");
+    std::fs::write(
+        &toml,
+        original.replace("[robot]\n", "[robot]\nworld = \"wall.rhai\"\n"),
+    )
+    .expect("write");
+    let asked = adc.run(&project, &["ask", "--port", "emu", "/1B", "/2A1"], &[]);
+    assert_eq!(stdout(&asked), "B04\nA57\n", "{}", transcript(&asked));
+    let shown = stdout(&adc.run(&project, &["config"], &[]));
+    assert!(
+        shown.contains("world      wall.rhai  (project Scorpion.toml:12)"),
+        "{shown}"
+    );
+
+    std::fs::write(&toml, &original).expect("write");
+    for command in [&["ask", "--port", "emu", "/1B", "/2A1"][..], &["sim"]] {
+        let mut args = command.to_vec();
+        args.extend(["--world", "wall.rhai"]);
+        let output = crate::scorpion_with_input(Some(&project), &args, "/1B\n/2A1\n");
+        assert_eq!(
+            stdout(&output),
+            "B04\nA57\n",
+            "{args:?}\n{}",
             transcript(&output)
         );
     }
