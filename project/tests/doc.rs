@@ -90,6 +90,7 @@ fn everything() -> ProjectFile {
         },
         tests: TestsSpec {
             transcripts: vec!["t.expect".into()],
+            builtin_listing: true,
         },
     }
 }
