@@ -439,6 +439,24 @@ fn a_routine_with_snapshots_from_new_to_the_robot() {
         listing.starts_with("---\nsource: Scorpion.toml\nexpression: mathlib/listing\n---\n"),
         "{listing}"
     );
+    // insta reads it as its own, and what `cargo insta accept` would make
+    // of it is byte for byte what `scorpion test --accept` writes.
+    let insta_pending =
+        insta::Snapshot::from_file(&project.join("tests/snapshots/mathlib__listing.snap.new"))
+            .expect("insta reads the pending snapshot");
+    assert_eq!(insta_pending.metadata().source(), Some("Scorpion.toml"));
+    assert_eq!(
+        insta_pending.metadata().expression(),
+        Some("mathlib/listing")
+    );
+    let insta_accepted = user.home().join("insta-accepted.snap");
+    insta_pending
+        .save(&insta_accepted)
+        .expect("insta writes it back");
+    assert!(
+        !read(&project.join(".gitignore")).contains("snap"),
+        "git, and so cargo insta, sees the pending snapshots"
+    );
     // One taken by name, the rest all at once.
     let one = user.run(&project, &["test", "mathlib/listing", "--accept"]);
     let one = ok("scorpion test mathlib/listing --accept", &one);
@@ -447,6 +465,10 @@ fn a_routine_with_snapshots_from_new_to_the_robot() {
         "{one}"
     );
     assert_eq!(pending(&project).len(), 3, "{:?}", pending(&project));
+    assert_eq!(
+        read(&project.join("tests/snapshots/mathlib__listing.snap")),
+        read(&insta_accepted)
+    );
     ok(
         "scorpion test --accept",
         &user.run(&project, &["test", "--accept"]),

@@ -42,6 +42,12 @@ fn new_test_change_fail_accept_pass() {
     let changed = scorpion(&project, &["test"]);
     assert_eq!(changed.status.code(), Some(1), "{}", transcript(&changed));
     insta::assert_snapshot!("project_change_fails_with_a_diff", stdout(&changed));
+    // README shows this failure, for a project named myext.
+    let shown = crate::readme_block("A transcript that fails says", "text");
+    assert!(
+        stdout(&changed).contains(&shown.replace("myext", "probe")),
+        "README.md's failing transcript is stale:\n{shown}"
+    );
 
     // The transcript says V01: accepting the snapshots leaves it failing,
     // until it says what the robot now answers.

@@ -256,8 +256,9 @@ fn a_failed_rehearsal_touches_nothing() {
         ],
     );
     assert_eq!(output.status.code(), Some(1));
+    // Named at its file:line.
     assert!(
-        transcript(&output).contains("line 1"),
+        transcript(&output).contains("bad.expect:1: "),
         "{}",
         transcript(&output)
     );
