@@ -277,8 +277,9 @@ fn write_answer(master: &mut impl Write, answer: &[u8]) -> miette::Result<u64> {
     Ok(rest.len() as u64)
 }
 
-/// What the line lost, said on stderr as it happens (at most once a
-/// second, summed, so a flood does not flood the terminal too): bytes the
+/// What the line lost, said on stderr as it happens (summed over a
+/// quarter of a second, at most once a second, so a burst is one line and
+/// a flood does not flood the terminal too): bytes the
 /// host's end dropped (a client writing faster than the baud rate
 /// carries, more than a port holds), characters the 6551 lost to overrun
 /// (its receive register still full: the ROM or an extension did not
@@ -295,6 +296,8 @@ struct Overruns {
     unread: u64,
     /// When something was last said.
     said_at: Option<Instant>,
+    /// When the first loss not said yet happened.
+    pending_since: Option<Instant>,
 }
 
 #[cfg(unix)]
@@ -306,6 +309,7 @@ impl Overruns {
             overrun: 0,
             unread: 0,
             said_at: None,
+            pending_since: None,
         }
     }
 
@@ -314,8 +318,11 @@ impl Overruns {
         self.overrun += now.saturating_sub(self.seen);
         self.seen = now;
         self.dropped += dropped;
-        let pending = self.dropped + self.overrun + self.unread > 0;
-        if !pending
+        if self.dropped + self.overrun + self.unread == 0 {
+            return;
+        }
+        let since = *self.pending_since.get_or_insert_with(Instant::now);
+        if since.elapsed() < Duration::from_millis(250)
             || self
                 .said_at
                 .is_some_and(|at| at.elapsed() < Duration::from_secs(1))
@@ -323,6 +330,7 @@ impl Overruns {
             return;
         }
         self.said_at = Some(Instant::now());
+        self.pending_since = None;
         let mut err = std::io::stderr().lock();
         if self.dropped > 0 {
             let _ = writeln!(

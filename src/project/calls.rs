@@ -23,6 +23,9 @@ use romlib::VirtualScorpion;
 const RETURN: u16 = 0x0100;
 /// Cycles a call may run without `within`: a second of robot time.
 const DEFAULT_LIMIT: u64 = 1_000_000;
+/// The most `within` may allow: a minute of robot time, so a routine that
+/// never returns ends the test in seconds, not hours.
+const MAX_WITHIN: u64 = 60_000_000;
 
 /// A register or flag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -82,16 +85,17 @@ pub(crate) fn parse(text: &str, symbols: &HashMap<String, u16>) -> Result<Vec<Ca
             continue;
         }
         let bad = |why: String| format!("line {line}: {why}");
-        let Some(rest) = content.strip_prefix("call ") else {
-            return Err(bad(format!(
-                "`{content}`: a line is `call ROUTINE ... => ...`"
-            )));
-        };
+        // `call` and the routine are words: any blanks between them.
+        let rest = content
+            .strip_prefix("call")
+            .filter(|rest| rest.is_empty() || rest.starts_with(char::is_whitespace))
+            .ok_or_else(|| bad(format!("`{content}`: a line is `call ROUTINE ... => ...`")))?;
         let (before, after) = rest.split_once("=>").unwrap_or((rest, ""));
         let mut words = before.split_whitespace();
         let routine = words
             .next()
             .ok_or_else(|| bad("no routine after `call`".into()))?;
+        let settings = words.collect::<Vec<_>>().join(" ");
         let address = |name: &str| -> Result<u16, String> {
             number(name)
                 .and_then(|n| u16::try_from(n).ok())
@@ -113,7 +117,7 @@ pub(crate) fn parse(text: &str, symbols: &HashMap<String, u16>) -> Result<Vec<Ca
             want_mem: Vec::new(),
             within: None,
         };
-        for (side, text) in [(false, before.trim_start_matches(routine)), (true, after)] {
+        for (side, text) in [(false, settings.as_str()), (true, after)] {
             let tokens: Vec<&str> = text.split_whitespace().collect();
             let mut i = 0;
             while i < tokens.len() {
@@ -122,6 +126,11 @@ pub(crate) fn parse(text: &str, symbols: &HashMap<String, u16>) -> Result<Vec<Ca
                     let limit = tokens.get(i + 1).and_then(|n| number(n)).ok_or_else(|| {
                         bad("`within` needs a number of cycles: `within 200 cycles`".into())
                     })?;
+                    if u64::from(limit) > MAX_WITHIN {
+                        return Err(bad(format!(
+                            "`within {limit}`: at most {MAX_WITHIN} cycles (a minute of robot time)"
+                        )));
+                    }
                     call.within = Some(u64::from(limit));
                     i += 2;
                     if tokens.get(i) == Some(&"cycles") {
@@ -160,6 +169,12 @@ pub(crate) fn parse(text: &str, symbols: &HashMap<String, u16>) -> Result<Vec<Ca
                             .map_err(|_| bad(format!("`{next}` is not a hex byte")))?,
                     );
                     i += 1;
+                }
+                if usize::from(at) + bytes.len() > 0x1_0000 {
+                    return Err(bad(format!(
+                        "{} bytes from ${at:04X} run past $FFFF",
+                        bytes.len()
+                    )));
                 }
                 if side {
                     &mut call.want_mem
@@ -289,3 +304,6 @@ pub(crate) fn run(call: &Call, robot: &mut VirtualScorpion) -> Result<(), String
         Err(format!("after {took} cycles: {}", wrong.join("; ")))
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -140,6 +140,21 @@ fn flood(path: &str, total: usize, limit: Duration) -> usize {
     written
 }
 
+/// Asks `/1E` every half second until the robot answers `E0` (while the
+/// line is full a question is dropped, as a full port refuses a write),
+/// for at most a minute; how long that took.
+fn recover(port: &mut dyn serialport::SerialPort) -> Duration {
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_secs(60) {
+        let (answer, _) = ask(port, b"/1E", Duration::from_millis(500));
+        if answer.ends_with("E0\r") {
+            let _ = port.clear(serialport::ClearBuffer::Input);
+            return started.elapsed();
+        }
+    }
+    panic!("no answer a minute after the flood");
+}
+
 #[test]
 fn a_flood_keeps_memory_small_and_the_next_command_is_answered_soon() {
     let dir = tempfile::tempdir().expect("a temporary directory");
@@ -156,8 +171,7 @@ fn a_flood_keeps_memory_small_and_the_next_command_is_answered_soon() {
     // command behind it 18 minutes later.
     let written = flood(&sim.path, 1 << 20, Duration::from_secs(60));
     assert_eq!(written, 1 << 20, "the flood was taken");
-    let (answer, took) = ask(&mut *port, b"/1E", Duration::from_secs(20));
-    assert_eq!(answer, "E0\r", "after a 1 MiB flood: {}", sim.stderr());
+    let took = recover(&mut *port);
     // What a port holds (4 KiB) takes 4.3 s at 9600 baud; then the ROM
     // answers at once.
     assert!(took < Duration::from_secs(8), "answered after {took:?}");
@@ -169,8 +183,7 @@ fn a_flood_keeps_memory_small_and_the_next_command_is_answered_soon() {
     assert_eq!(written, 64 << 20, "the flood was taken");
     let grown = sim.peak_kib().saturating_sub(before);
     assert!(grown < 16 << 10, "the simulator grew by {grown} KiB");
-    let (answer, took) = ask(&mut *port, b"/1E", Duration::from_secs(20));
-    assert_eq!(answer, "E0\r", "after a 64 MiB flood: {}", sim.stderr());
+    let took = recover(&mut *port);
     assert!(took < Duration::from_secs(8), "answered after {took:?}");
     let said = sim.stderr();
     assert!(
@@ -205,10 +218,12 @@ fn characters_the_6551_overran_are_lost_and_said() {
         std::thread::sleep(Duration::from_millis(20));
     }
     let said = sim.stderr();
-    assert!(
-        said.contains("6551 overrun: 11 characters lost"),
-        "the overrun is said: {said}"
-    );
+    let lost: u64 = said
+        .lines()
+        .filter_map(|line| line.strip_prefix("6551 overrun: "))
+        .filter_map(|rest| rest.split(' ').next()?.parse::<u64>().ok())
+        .sum();
+    assert_eq!(lost, 11, "the overrun is said: {said}");
     // The robot recovers: the next question is answered.
     let (answer, _) = ask(&mut *port, b"/1E", Duration::from_secs(5));
     assert_eq!(answer, "E0\r");
