@@ -603,7 +603,7 @@ fn file_line(text: &str) -> Option<(&str, u32)> {
 /// The source around `line` of `file`, the line marked.
 fn listing(sources: &mut Sources, file: &str, line: u32) -> String {
     let mut text = String::new();
-    for n in line.saturating_sub(4).max(1)..=line + 4 {
+    for n in line.saturating_sub(4).max(1)..=line.saturating_add(4) {
         let Some(source) = sources.line(file, n) else {
             break;
         };
@@ -613,7 +613,11 @@ fn listing(sources: &mut Sources, file: &str, line: u32) -> String {
         text.push('\n');
     }
     if text.is_empty() {
-        text = format!("cannot read {file}\n");
+        text = if sources.line(file, 1).is_some() {
+            format!("{file} has no line {line}\n")
+        } else {
+            format!("cannot read {file}\n")
+        };
     }
     text
 }

@@ -188,7 +188,8 @@ fn debug_bounded(dir: &Path, args: &[&str], input: &str, limit: std::time::Durat
 /// at the old code they panicked (`mem 0 18446744073709551615`), allocated
 /// gigabytes (`mem 0 4294967296`, `dis 0 100000000`) or ran for hours
 /// (`step 4294967296`). A dump across $FFFF goes on at $0000, not at
-/// `10000:`. The robot is where it was after all of them.
+/// `10000:`. A listing at the last line a u32 holds panicked (overflow).
+/// The robot is where it was after all of them.
 #[test]
 fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
     let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
@@ -207,6 +208,7 @@ fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
         let expected = match command {
             "mem $FFF8 24" => "\nFFF8: FF FF 3B F6 00 F0 3C F6 ",
             "regs" => "\nPC=",
+            "list adc.s:4294967295" => "adc.s has no line 4294967295",
             _ if command.contains(" -") => " is a number of ",
             _ if command.ends_with(" 0") => " is at least 1, not 0",
             _ => " is at most ",

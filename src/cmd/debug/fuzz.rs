@@ -44,6 +44,7 @@ fn address() -> impl Strategy<Value = String> {
         Just("$20..$10".to_owned()),
         Just("adc.s:43".to_owned()),
         Just("adc.s:99999999999".to_owned()),
+        Just("adc.s:4294967295".to_owned()),
         Just(":4".to_owned()),
         Just("$10000".to_owned()),
         Just("%".to_owned()),
