@@ -405,6 +405,33 @@ impl Device for ScriptCard {
         self.view.irq
     }
 
+    /// The card with its script's state (`this`), register table, IRQ
+    /// output and wake-up copied; what the copy prints goes to its own
+    /// [`ScriptCard::printed`]. `None` while a failure waits to be taken,
+    /// or if the script's state shares a closure's variable.
+    fn snapshot(&self) -> Option<Box<dyn Device>> {
+        if self.fault.is_some() {
+            return None;
+        }
+        let printed = Arc::new(Mutex::new(Vec::new()));
+        let shared = Arc::new(Mutex::new(self.shared.lock().ok()?.clone()));
+        let mut engine = engine(&printed);
+        register(&mut engine, &shared);
+        Some(Box::new(ScriptCard {
+            script: self.script.fork(engine, printed)?,
+            shared,
+            view: self.view.clone(),
+            plain: self.plain.clone(),
+            has_write: self.has_write,
+            has_wake: self.has_wake,
+            base: self.base,
+            size: self.size,
+            now: self.now,
+            fault: None,
+            failed: self.failed,
+        }))
+    }
+
     fn take_fault(&mut self) -> Option<Box<dyn miette::Diagnostic + Send + Sync>> {
         self.fault
             .take()

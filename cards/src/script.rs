@@ -75,6 +75,28 @@ impl Script {
         Ok(script)
     }
 
+    /// A copy of the script as it is now, on `engine` (an engine like
+    /// this one's, with the host's functions bound to the copy's own
+    /// state), printing into `printed`: the compiled script and its
+    /// constants shared, `this` copied. The engine keeps no state between
+    /// calls (its limits are per call), so the copy goes on as this script
+    /// would. `None` if part of `this` is shared (a closure's captured
+    /// variable), which a copy could not keep apart from the original.
+    pub(crate) fn fork(&self, engine: Engine, printed: Arc<Mutex<Vec<String>>>) -> Option<Script> {
+        if has_shared(&self.this) {
+            return None;
+        }
+        Some(Script {
+            engine,
+            ast: self.ast.clone(),
+            scope: self.scope.clone(),
+            this: self.this.clone(),
+            name: self.name.clone(),
+            text: self.text.clone(),
+            printed,
+        })
+    }
+
     /// Whether the script defines `name` with `params` parameters.
     pub(crate) fn has_fn(&self, name: &str, params: usize) -> bool {
         self.ast
@@ -222,6 +244,24 @@ impl Script {
                 .map(|(at, _)| (index + 1, line[..at].chars().count() + 1))
         })
     }
+}
+
+/// Whether some part of `value` is shared (a closure's captured
+/// variable): cloning copies everything else.
+fn has_shared(value: &Dynamic) -> bool {
+    if value.is_shared() {
+        return true;
+    }
+    if let Some(map) = value.read_lock::<rhai::Map>() {
+        return map.values().any(has_shared);
+    }
+    if let Some(array) = value.read_lock::<rhai::Array>() {
+        return array.iter().any(has_shared);
+    }
+    if let Some(function) = value.read_lock::<rhai::FnPtr>() {
+        return function.curry().iter().any(has_shared);
+    }
+    false
 }
 
 fn place(position: Position) -> (usize, usize) {

@@ -27,7 +27,7 @@ enum Change {
     SceneAt(i64, i64, u8),
 }
 
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct Shared {
     changes: Vec<Change>,
     positions: (i64, i64),
@@ -109,6 +109,23 @@ fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
 }
 
 impl Surroundings for ScriptWorld {
+    /// The surroundings with their script's state (`this`) and wake-up
+    /// copied; what the copy prints goes to its own
+    /// [`ScriptWorld::printed`]. `None` if the script's state shares a
+    /// closure's variable.
+    fn snapshot(&self) -> Option<Box<dyn Surroundings>> {
+        let printed = Arc::new(Mutex::new(Vec::new()));
+        let shared = Arc::new(Mutex::new(self.shared.lock().ok()?.clone()));
+        let mut engine = engine(&printed);
+        register(&mut engine, &shared);
+        Some(Box::new(ScriptWorld {
+            script: self.script.fork(engine, printed)?,
+            shared,
+            has_wake: self.has_wake,
+            pending: self.pending,
+        }))
+    }
+
     fn next_wake(&self) -> Option<u64> {
         if self.pending {
             return Some(0);

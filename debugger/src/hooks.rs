@@ -4,13 +4,57 @@
 //! the board and notes the first one a watchpoint covers; the hooks see
 //! the note before the next instruction and stop there, so a watch stops
 //! just after the instruction that made the access, with its effect seen.
+//!
+//! Nothing that never stops costs more than a bit test where it could:
+//! breakpoints are a bitmap of the PCs they may stop at, tested once per
+//! instruction (the breakpoint itself, its command or a condition, is
+//! looked at only there); watchpoints are two bitmaps of the addresses
+//! read or written that they cover, tested on reads only if some watch
+//! reads, on writes only if some watch writes. Both answer from the PC,
+//! registers and memory alone, so an idle loop that passes no breakpoint
+//! and touches no watched byte is still skipped as the plain run skips it
+//! ([`emulator::Hooks::may_skip_idle`]).
 
 use std::cell::Cell;
 
 use emulator::board::Board;
-use emulator::{Bus, Control, Cpu, Hooks, Interrupts};
+use emulator::{Breakpoints, Bus, Control, Cpu, Hooks, Interrupts};
 
 use crate::points::Watch;
+
+/// The addresses watchpoints cover, by kind of access: a bit per address.
+pub(crate) struct Watched {
+    /// Addresses some watch stops reads of.
+    reads: Breakpoints,
+    /// Addresses some watch stops writes of.
+    writes: Breakpoints,
+}
+
+impl Watched {
+    /// The tables of `watches`.
+    pub(crate) fn new(watches: &[Option<Watch>]) -> Watched {
+        let mut table = Watched {
+            reads: Breakpoints::new(),
+            writes: Breakpoints::new(),
+        };
+        for watch in watches.iter().flatten() {
+            for address in watch.start..=watch.end {
+                if watch.kind.covers(false) {
+                    table.reads.insert(address);
+                }
+                if watch.kind.covers(true) {
+                    table.writes.insert(address);
+                }
+            }
+        }
+        table
+    }
+
+    /// Whether some watch covers reads, and whether some covers writes.
+    pub(crate) fn kinds(&self) -> (bool, bool) {
+        (self.reads.len() > 0, self.writes.len() > 0)
+    }
+}
 
 /// An access a watchpoint covered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,11 +73,32 @@ pub struct Access {
 pub(crate) struct WatchBus<'a> {
     pub(crate) board: &'a mut Board,
     pub(crate) watches: &'a [Option<Watch>],
+    /// Where they are: only an access the tables mark looks further.
+    pub(crate) watched: &'a Watched,
+    /// Some watch covers reads (else reads are not looked at).
+    pub(crate) reads: bool,
+    /// Some watch covers writes.
+    pub(crate) writes: bool,
     pub(crate) hit: &'a Cell<Option<Access>>,
 }
 
 impl WatchBus<'_> {
-    #[inline]
+    #[inline(always)]
+    fn read_seen(&self, address: u16, value: u8) {
+        if self.reads && self.watched.reads.contains(address) {
+            self.note(address, value, false);
+        }
+    }
+
+    #[inline(always)]
+    fn write_seen(&self, address: u16, value: u8) {
+        if self.writes && self.watched.writes.contains(address) {
+            self.note(address, value, true);
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
     fn note(&self, address: u16, value: u8, write: bool) {
         if self.hit.get().is_some() {
             return;
@@ -54,43 +119,66 @@ impl WatchBus<'_> {
 }
 
 impl Bus for WatchBus<'_> {
+    #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
         let value = self.board.read(address, cycle);
-        self.note(address, value, false);
+        self.read_seen(address, value);
         value
     }
 
+    #[inline(always)]
     fn write(&mut self, address: u16, value: u8, cycle: u64) {
         self.board.write(address, value, cycle);
-        self.note(address, value, true);
+        self.write_seen(address, value);
+    }
+
+    // Page zero and the stack keep the board's fast path.
+    #[inline(always)]
+    fn read_zp_stack(&mut self, address: u16, cycle: u64) -> u8 {
+        let value = self.board.read_zp_stack(address, cycle);
+        self.read_seen(address, value);
+        value
+    }
+
+    #[inline(always)]
+    fn write_zp_stack(&mut self, address: u16, value: u8, cycle: u64) {
+        self.board.write_zp_stack(address, value, cycle);
+        self.write_seen(address, value);
     }
 
     // A read whose value the CPU ignores is not the program reading: it
     // still reaches the devices, but stops nothing.
+    #[inline(always)]
     fn dummy_read(&mut self, address: u16, cycle: u64) {
         self.board.dummy_read(address, cycle);
     }
 
+    #[inline(always)]
     fn peek(&self, address: u16) -> u8 {
         self.board.peek(address)
     }
 
+    #[inline(always)]
     fn poll(&mut self, cycle: u64) -> Interrupts {
         self.board.poll(cycle)
     }
 
+    #[inline(always)]
     fn quiet_until(&self) -> u64 {
         self.board.quiet_until()
     }
 
+    #[inline(always)]
     fn is_plain_memory(&self, address: u16) -> bool {
         self.board.is_plain_memory(address)
     }
 
+    #[inline(always)]
     fn is_plain_store(&self, address: u16) -> bool {
         self.board.is_plain_store(address)
     }
 
+    #[inline(always)]
     fn stop_requested(&self) -> bool {
         self.board.stop_requested()
     }
@@ -109,6 +197,77 @@ pub(crate) enum Found {
     Returned,
     /// `finish`: the routine returned.
     Finished,
+}
+
+/// Why [`Lean`] stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum LeanStop {
+    /// At a PC a breakpoint may stop at: which one, if any, is asked
+    /// there.
+    Place,
+    /// The count to stop at.
+    Count,
+    /// A watchpoint: the access, made by the instruction at `pc`.
+    Watch { access: Access, pc: u16 },
+}
+
+/// The hooks of a run that only breakpoints, watchpoints (with `WATCH`)
+/// and a count can stop: a bit test of the PC and a comparison of the
+/// count per instruction (and a look at the bus's note, with `WATCH`),
+/// nothing else. A run to a breakpoint, a step back's re-run, a search
+/// for a hit all run here; `next`, `finish` and tracing use [`Look`].
+pub(crate) struct Lean<'a, const WATCH: bool> {
+    /// Every PC a breakpoint may stop at.
+    pub(crate) places: &'a Breakpoints,
+    /// The count of the run's first instruction: a breakpoint there is
+    /// where the last stop was, so it does not stop again.
+    pub(crate) start: u64,
+    /// Stop before the instruction with this count.
+    pub(crate) stop_at: u64,
+    /// The watchpoint hit the bus noted (with `WATCH`).
+    pub(crate) hit: &'a Cell<Option<Access>>,
+    /// The PC of the instruction last let run (with `WATCH`).
+    pub(crate) last_pc: u16,
+    /// Why it stopped.
+    pub(crate) stopped: Option<LeanStop>,
+}
+
+impl<const WATCH: bool> Hooks for Lean<'_, WATCH> {
+    // Every answer comes from the PC, memory and the bus's note, except
+    // the count, which bounds the skip.
+    #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        true
+    }
+
+    #[inline(always)]
+    fn instruction_bound(&self) -> u64 {
+        self.stop_at
+    }
+
+    #[inline(always)]
+    fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, _bus: &B) -> Control {
+        if WATCH {
+            if let Some(access) = self.hit.get() {
+                self.hit.set(None);
+                self.stopped = Some(LeanStop::Watch {
+                    access,
+                    pc: self.last_pc,
+                });
+                return Control::Stop;
+            }
+            self.last_pc = cpu.pc;
+        }
+        if cpu.instructions() >= self.stop_at {
+            self.stopped = Some(LeanStop::Count);
+            return Control::Stop;
+        }
+        if self.places.contains(cpu.pc) && cpu.instructions() != self.start {
+            self.stopped = Some(LeanStop::Place);
+            return Control::Stop;
+        }
+        Control::Continue
+    }
 }
 
 /// What the hooks look for. Breakpoints are matched by the debugger's
@@ -139,6 +298,20 @@ pub(crate) struct Look<'a, M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> {
 }
 
 impl<M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> Hooks for Look<'_, M> {
+    // Every answer comes from the PC, S, memory and the watch the bus
+    // noted (all the same on every lap of an idle loop), except the count
+    // to stop at, which bounds the skip. A point with a count of its own
+    // (a hit count) would have to say no here.
+    #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        true
+    }
+
+    #[inline(always)]
+    fn instruction_bound(&self) -> u64 {
+        self.at_count.unwrap_or(u64::MAX)
+    }
+
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
         let first = std::mem::replace(&mut self.first, false);
         // The watch first: it is about the instruction already run.

@@ -12,29 +12,47 @@
 //! - [`symbols`]: labels for addresses, addresses for expressions
 //!   (`CMDBUF+1`, `handler`, `$8001`);
 //! - [`session`]: run, step, next (over `JSR`), finish (to the `RTS`),
-//!   and back in time.
+//!   and back in time;
+//! - [`checkpoints`]: copies of the robot taken as it runs, to go back
+//!   from.
 //!
 //! # Back in time
 //!
-//! The emulator is exact and deterministic, so the debugger keeps no
-//! snapshots: it keeps what the host did (each command sent, each bumper
-//! change) and the instruction count at which it did it. Stepping back N
-//! instructions builds the robot again as it was at power-up and runs it,
-//! replaying the host's actions at their instruction counts, to N
-//! instructions before where it was: the same state, exactly. History
-//! costs nothing per instruction and a few bytes per host action; a step
-//! back costs a re-run from power-up (measured by the bench). "Who last
-//! wrote this byte" and reverse-continue are re-runs that watch on the
-//! way.
+//! The emulator is exact and deterministic, so the debugger keeps what
+//! the host did (each command sent, each bumper change) with the
+//! instruction count and cycle at which it did it, and [`checkpoints`]:
+//! copies of the whole robot (CPU, memory, board devices, cards' and
+//! surroundings' script state) taken every [`CHECKPOINT_EVERY`] cycles,
+//! at most [`MAX_CHECKPOINTS`] kept, thinned out to be dense near now and
+//! log-spaced into the past. Stepping back N instructions copies the
+//! newest checkpoint before the target and runs it on, replaying the
+//! host's actions at their cycles, to N instructions before where it was:
+//! the same state, exactly, in the time of a re-run of at most about two
+//! intervals for a step back near now (measured by the bench). A robot
+//! with a card or surroundings that cannot be copied is built again from
+//! power-up and re-run instead, as a robot with no checkpoint would be.
+//! "Who last wrote this byte" and reverse-continue re-run stretch by
+//! stretch backwards, from checkpoint to checkpoint, watching on the way,
+//! until a stretch has what they look for.
+//!
+//! # What points cost
+//!
+//! Breakpoints are a bitmap of the PCs where one may stop, tested once per
+//! instruction; watchpoints a bitmap of the addresses read or written that
+//! one covers, tested on those accesses only ([`hooks`]). Both answer from
+//! registers and memory alone, so an idle loop that none of them touches
+//! is skipped as the plain run skips it.
 //!
 //! Nothing here prints: the monitor (`scorpion debug`) does.
 
+pub mod checkpoints;
 pub mod error;
 pub mod hooks;
 pub mod points;
 pub mod session;
 pub mod symbols;
 
+pub use checkpoints::{CHECKPOINT_EVERY, MAX_CHECKPOINTS};
 pub use error::Error;
 pub use points::{Breakpoint, Watch, WatchKind};
 pub use session::{Debugger, Event, MakeRobot, Stopped, Why};

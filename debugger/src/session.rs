@@ -11,12 +11,14 @@ use isa::objfmt::HookKind;
 use romlib::VirtualScorpion;
 
 use crate::Error;
-use crate::hooks::{Access, Found, Look, WatchBus};
+use crate::checkpoints::{Checkpoint, Checkpoints};
+use crate::hooks::{Access, Found, Lean, LeanStop, Look, WatchBus, Watched};
 use crate::points::{Breakpoint, Watch};
 use crate::symbols::Symbols;
 
 /// Builds the robot as it is at power-up with everything loaded: called
-/// once, and again for every step back.
+/// once, and again for a step back that no checkpoint serves (a robot
+/// that cannot be copied, a target before the first checkpoint).
 pub type MakeRobot = Box<dyn Fn() -> Result<VirtualScorpion, Error> + Send>;
 
 /// Something the host did to the robot, kept to be done again.
@@ -102,6 +104,8 @@ pub struct Debugger {
     /// Instructions run when the robot was handed over (no going back
     /// before them).
     power_up: u64,
+    /// Copies of the robot taken as it ran, to re-run from.
+    checkpoints: Checkpoints,
     trace: Option<Trace>,
 }
 
@@ -151,6 +155,7 @@ impl std::fmt::Debug for Debugger {
             .field("breakpoints", &self.breakpoints)
             .field("watches", &self.watches)
             .field("done", &self.done.len())
+            .field("checkpoints", &self.checkpoints.len())
             .finish_non_exhaustive()
     }
 }
@@ -180,6 +185,8 @@ impl Debugger {
         let robot = make()?;
         let symbols = Symbols::new(&robot, images);
         let last_stop = (robot.cycles(), robot.robot().cpu.instructions());
+        let mut checkpoints = Checkpoints::new();
+        checkpoints.take(&robot, 0);
         Ok(Debugger {
             make,
             robot,
@@ -191,6 +198,7 @@ impl Debugger {
             ahead: VecDeque::new(),
             last_stop,
             power_up: last_stop.1,
+            checkpoints,
             trace: None,
         })
     }
@@ -382,9 +390,20 @@ impl Debugger {
         self.act(Event::Bumpers(closed));
     }
 
+    /// How many checkpoints of the robot the session keeps now (at most
+    /// [`crate::MAX_CHECKPOINTS`]; none for a robot that cannot be copied).
+    #[must_use]
+    pub fn checkpoints(&self) -> usize {
+        self.checkpoints.len()
+    }
+
     fn act(&mut self, event: Event) {
-        // Something new: what the host had done further on is not redone.
+        // Something new: what the host had done further on is not redone,
+        // and the robot's copies from then on are of a future that will
+        // not happen.
         self.ahead.clear();
+        self.checkpoints
+            .forget_after(self.robot.cycles(), self.cpu().instructions());
         let done = Done {
             instructions: self.cpu().instructions(),
             cycle: self.robot.cycles(),
@@ -454,6 +473,8 @@ impl Debugger {
 
     fn go(&mut self, until: u64, goal: Goal) -> Result<Stopped, Error> {
         let mut received = Vec::new();
+        // Only the run's first instruction is where the last stop was.
+        let mut first = true;
         loop {
             // After a step back, the host's recorded actions are done
             // again when the run gets to them.
@@ -467,7 +488,9 @@ impl Debugger {
                     self.done.push(done);
                 }
             }
-            let to = until.min(self.ahead.front().map_or(u64::MAX, |d| d.cycle));
+            let to = until
+                .min(self.ahead.front().map_or(u64::MAX, |d| d.cycle))
+                .min(self.checkpoints.next_due());
             let arrival = self.arrival();
             let found = run_hooked(
                 &mut self.robot,
@@ -479,11 +502,15 @@ impl Debugger {
                 },
                 to,
                 goal,
+                std::mem::replace(&mut first, false),
             )?;
             received.extend(self.robot.receive());
             // A failed write stops the tracer's run at once, each time.
             if let Some(error) = self.trace_failure() {
                 return Err(error);
+            }
+            if self.robot.cycles() >= self.checkpoints.next_due() {
+                self.checkpoints.take(&self.robot, self.done.len());
             }
             if found.is_none() && self.robot.cycles() < until {
                 continue;
@@ -566,15 +593,9 @@ impl Debugger {
             watches: &self.watches,
             arrival,
         };
-        let mut scout = self.replayer()?;
-        let mut last = None;
         // Short of now: a hit at now is the stop the robot is at.
-        while let Some(hit) = scout.run_to(now, points)? {
-            if hit.0 < now {
-                last = Some(hit);
-            }
-        }
-        let Some((count, found)) = last else {
+        let Some(Hit { count, found, .. }) = self.last_hit(points, now, now.saturating_sub(1))?
+        else {
             return Ok(None);
         };
         self.rerun_to(count)?;
@@ -601,32 +622,95 @@ impl Debugger {
             watches: &watches,
             arrival: self.arrival(),
         };
-        let mut scout = self.replayer()?;
-        let mut last = None;
-        while let Some((count, found)) = scout.run_to(now, points)? {
-            if let Found::Watch { access, pc } = found {
-                last = Some(LastWrite {
-                    instruction: count - 1,
+        // The write of the instruction just run counts.
+        let last = self
+            .last_hit(points, now, now)?
+            .and_then(|hit| match hit.found {
+                Found::Watch { access, pc } => Some(LastWrite {
+                    instruction: hit.count - 1,
                     pc,
                     value: access.value,
-                    cycle: scout.robot.cycles(),
-                });
-            }
-        }
+                    cycle: hit.cycle,
+                }),
+                _ => None,
+            });
         Ok(last)
     }
 
+    /// The last hit of `points` at an instruction count up to `latest`
+    /// before the robot's `now`: a re-run from the
+    /// newest checkpoint before now to now, then from the one before it to
+    /// that one, and so on back to power-up, until a stretch has one. It
+    /// costs a re-run as long as the way back to the hit. A stretch from
+    /// instruction `s` to `e` sees the breakpoints at `s` up to but not at
+    /// `e` (the next stretch's), and the watches after `s` up to `e`.
+    fn last_hit(&self, points: Points<'_>, now: u64, latest: u64) -> Result<Option<Hit>, Error> {
+        let starts = self.checkpoints.all().iter().rev();
+        let starts = starts.filter(|c| c.instructions < now).map(Some);
+        let mut end = now;
+        for start in starts.chain([None]) {
+            let mut scout = match start.and_then(|c| self.replayer_at(c)) {
+                Some(scout) => scout,
+                None => self.replayer()?,
+            };
+            let from = scout.robot.robot().cpu.instructions();
+            if from >= end {
+                continue;
+            }
+            // From power-up, as the session began: not at its first PC.
+            scout.resumed = start.is_none();
+            let mut last = None;
+            while let Some((count, found)) = scout.run_to(end, points)? {
+                if count <= latest {
+                    last = Some(Hit {
+                        count,
+                        found,
+                        cycle: scout.robot.cycles(),
+                    });
+                }
+            }
+            if last.is_some() {
+                return Ok(last);
+            }
+            end = from;
+        }
+        Ok(None)
+    }
+
+    /// The host's actions, done and ahead.
+    fn events(&self) -> Vec<Done> {
+        self.done.iter().chain(self.ahead.iter()).cloned().collect()
+    }
+
+    /// The robot built again at power-up, to replay from.
     fn replayer(&self) -> Result<Replayer, Error> {
         Ok(Replayer {
             robot: (self.make)()?,
-            events: self.done.iter().chain(self.ahead.iter()).cloned().collect(),
+            events: self.events(),
             next: 0,
+            resumed: true,
         })
     }
 
-    /// Builds the robot again and runs it to `target` instructions.
+    /// The robot as checkpoint `at` has it, to replay from (`None` if it
+    /// cannot be copied again).
+    fn replayer_at(&self, at: &Checkpoint) -> Option<Replayer> {
+        Some(Replayer {
+            robot: at.robot.snapshot()?,
+            events: self.events(),
+            next: at.events,
+            resumed: true,
+        })
+    }
+
+    /// Runs the robot to `target` instructions from the newest checkpoint
+    /// before it (or from power-up).
     fn rerun_to(&mut self, target: u64) -> Result<(), Error> {
-        let mut replay = self.replayer()?;
+        let from = self.checkpoints.before(target);
+        let mut replay = match from.and_then(|c| self.replayer_at(c)) {
+            Some(replay) => replay,
+            None => self.replayer()?,
+        };
         let points = Points {
             breakpoints: &[],
             watches: &[],
@@ -655,12 +739,22 @@ pub struct LastWrite {
     pub cycle: u64,
 }
 
+/// A hit found by a re-run: the instruction count and cycle at it.
+struct Hit {
+    count: u64,
+    found: Found,
+    cycle: u64,
+}
+
 /// The robot built again, and the host's actions to do again on it.
 struct Replayer {
     robot: VirtualScorpion,
     events: Vec<Done>,
     /// The next event to do.
     next: usize,
+    /// The next run resumes from a stop: no breakpoint at its first
+    /// instruction.
+    resumed: bool,
 }
 
 impl Replayer {
@@ -689,9 +783,13 @@ impl Replayer {
                 at_count: Some(target),
                 ..Goal::default()
             };
-            match run_hooked(&mut self.robot, None, points, until, goal)? {
+            let first = std::mem::replace(&mut self.resumed, false);
+            match run_hooked(&mut self.robot, None, points, until, goal, first)? {
                 None | Some(Found::Count) => {}
-                Some(found) => return Ok(Some((self.robot.robot().cpu.instructions(), found))),
+                Some(found) => {
+                    self.resumed = true;
+                    return Ok(Some((self.robot.robot().cpu.instructions(), found)));
+                }
             }
         }
     }
@@ -718,13 +816,16 @@ struct Points<'a> {
     arrival: Arrival,
 }
 
-/// One run under the hooks, to `until` (a cycle) or a stop.
+/// One run under the hooks, to `until` (a cycle) or a stop; `first`: no
+/// breakpoint stops its first instruction (the run resumes from a stop
+/// there).
 fn run_hooked(
     robot: &mut VirtualScorpion,
     trace: Option<&mut Tracer<Box<dyn Write + Send>>>,
     points: Points<'_>,
     until: u64,
     goal: Goal,
+    first: bool,
 ) -> Result<Option<Found>, Error> {
     let idle = goal.at_count.is_none()
         && goal.returning_to.is_none()
@@ -748,6 +849,18 @@ fn run_hooked(
         };
     }
     let hit = Cell::new(None);
+    let watched = Watched::new(points.watches);
+    if goal.returning_to.is_none() && goal.finish_at.is_none() && trace.is_none() {
+        return run_lean(
+            robot,
+            points,
+            until,
+            goal.at_count,
+            first,
+            &places,
+            &watched,
+        );
+    }
     let matches = |cpu: &Cpu, peek: &dyn Fn(u16) -> u8| {
         points.breakpoints.iter().position(|point| {
             point
@@ -762,15 +875,19 @@ fn run_hooked(
         returning_to: goal.returning_to,
         finish_at: goal.finish_at,
         hit: &hit,
-        first: true,
+        first,
         last_pc: 0,
         found: None,
     };
+    let (reads, writes) = watched.kinds();
     let mut trace = trace;
     robot.run_until_with(until, |robot, to| {
         let mut bus = WatchBus {
             board: &mut robot.bus,
             watches: points.watches,
+            watched: &watched,
+            reads,
+            writes,
             hit: &hit,
         };
         match trace.as_deref_mut() {
@@ -778,7 +895,104 @@ fn run_hooked(
             None => robot.cpu.run(&mut bus, to, &mut look),
         }
     })?;
+    // A watch the run's last instruction hit, though the run ended before
+    // the next one looked: it stops here, not in the next run.
+    if look.found.is_none()
+        && let Some(access) = hit.take()
+    {
+        look.found = Some(Found::Watch {
+            access,
+            pc: look.last_pc,
+        });
+    }
     Ok(look.found)
+}
+
+/// [`run_hooked`] for a run only breakpoints, watchpoints and a count
+/// stop ([`Lean`]): on the board itself when nothing is watched. A
+/// breakpoint's PC reached, the breakpoint itself (a command's count and
+/// letter) is asked there, and the run goes on if it says no.
+fn run_lean(
+    robot: &mut VirtualScorpion,
+    points: Points<'_>,
+    until: u64,
+    at_count: Option<u64>,
+    first: bool,
+    places: &emulator::Breakpoints,
+    watched: &Watched,
+) -> Result<Option<Found>, Error> {
+    let hit = Cell::new(None);
+    let (reads, writes) = watched.kinds();
+    let mut start = if first {
+        robot.robot().cpu.instructions()
+    } else {
+        u64::MAX
+    };
+    loop {
+        let stopped = if reads || writes {
+            let mut lean = Lean::<true> {
+                places,
+                start,
+                stop_at: at_count.unwrap_or(u64::MAX),
+                hit: &hit,
+                last_pc: robot.robot().cpu.pc,
+                stopped: None,
+            };
+            robot.run_until_with(until, |robot, to| {
+                let mut bus = WatchBus {
+                    board: &mut robot.bus,
+                    watches: points.watches,
+                    watched,
+                    reads,
+                    writes,
+                    hit: &hit,
+                };
+                robot.cpu.run(&mut bus, to, &mut lean)
+            })?;
+            // A watch the run's last instruction hit, though the run
+            // ended before the next one looked: it stops here, not in
+            // the next run.
+            match (lean.stopped, hit.take()) {
+                (None, Some(access)) => Some(LeanStop::Watch {
+                    access,
+                    pc: lean.last_pc,
+                }),
+                (stopped, _) => stopped,
+            }
+        } else {
+            let mut lean = Lean::<false> {
+                places,
+                start,
+                stop_at: at_count.unwrap_or(u64::MAX),
+                hit: &hit,
+                last_pc: 0,
+                stopped: None,
+            };
+            robot.run_until_with(until, |robot, to| {
+                robot.cpu.run(&mut robot.bus, to, &mut lean)
+            })?;
+            lean.stopped
+        };
+        match stopped {
+            None => return Ok(None),
+            Some(LeanStop::Count) => return Ok(Some(Found::Count)),
+            Some(LeanStop::Watch { access, pc }) => return Ok(Some(Found::Watch { access, pc })),
+            Some(LeanStop::Place) => {
+                let (cpu, bus) = (&robot.robot().cpu, &robot.robot().bus);
+                let peek = |address| emulator::Bus::peek(bus, address);
+                let found = points.breakpoints.iter().position(|point| {
+                    point
+                        .as_ref()
+                        .is_some_and(|point| breakpoint_hits(point, cpu.pc, &points.arrival, &peek))
+                });
+                if let Some(index) = found {
+                    return Ok(Some(Found::Breakpoint(index)));
+                }
+                // Not this time (another command): on from here.
+                start = cpu.instructions();
+            }
+        }
+    }
 }
 
 fn signed(count: u64) -> i64 {

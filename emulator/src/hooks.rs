@@ -30,6 +30,30 @@ pub trait Hooks {
     /// trace or stop must see every instruction, so the default is false.
     const PASSIVE: bool = false;
 
+    /// True for hooks that, though they look at every instruction, let an
+    /// idle loop be skipped ([`Cpu::set_idle_skip`]): their
+    /// [`Hooks::before_instruction`] answers from the registers, the flags
+    /// and memory alone (and from what the bus they watch noted), never
+    /// from the cycle or instruction counters (beyond
+    /// [`Hooks::instruction_bound`]) or a count of their own. A lap of the
+    /// loop they let run would then be let run every time again, since
+    /// every lap sees the same registers and memory: the probe that finds
+    /// the loop runs under the hooks, asks them once more at the lap's end,
+    /// and skips. Breakpoints and their conditions qualify; hit counts and
+    /// tracing do not. Answered once per run.
+    #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        Self::PASSIVE
+    }
+
+    /// The instruction count a skip of idle-loop iterations must not pass
+    /// (the hooks stop at a count): the skip leaves
+    /// [`Cpu::instructions`] at most this.
+    #[inline(always)]
+    fn instruction_bound(&self) -> u64 {
+        u64::MAX
+    }
+
     /// Before each instruction, with the registers as the instruction will
     /// see them. [`Control::Stop`] ends the run before it executes.
     #[inline(always)]
@@ -79,6 +103,16 @@ impl<H: Hooks + ?Sized> Hooks for &mut H {
     const PASSIVE: bool = H::PASSIVE;
 
     #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        (**self).may_skip_idle()
+    }
+
+    #[inline(always)]
+    fn instruction_bound(&self) -> u64 {
+        (**self).instruction_bound()
+    }
+
+    #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
         (**self).before_instruction(cpu, bus)
     }
@@ -97,6 +131,16 @@ impl<H: Hooks + ?Sized> Hooks for &mut H {
 /// Both hooks, the first one first; either can stop the run.
 impl<H1: Hooks, H2: Hooks> Hooks for (H1, H2) {
     const PASSIVE: bool = H1::PASSIVE && H2::PASSIVE;
+
+    #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        self.0.may_skip_idle() && self.1.may_skip_idle()
+    }
+
+    #[inline(always)]
+    fn instruction_bound(&self) -> u64 {
+        self.0.instruction_bound().min(self.1.instruction_bound())
+    }
 
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
@@ -199,6 +243,13 @@ impl core::fmt::Debug for Breakpoints {
 }
 
 impl Hooks for Breakpoints {
+    /// A bit test of the PC: an idle loop that passes no marked address
+    /// may be skipped.
+    #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        true
+    }
+
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, _bus: &B) -> Control {
         if self.contains(cpu.pc) {

@@ -319,6 +319,85 @@ fn a_loop_polling_a_stable_card_register_is_skipped_to_the_cards_events() {
     assert!(skipped.cpu.skipped_cycles() > 40_000);
 }
 
+/// Breakpoints look at every instruction, yet a loop that passes none of
+/// them is skipped as without them, and the run stops where running every
+/// cycle stops: at the breakpoint after the loop, in the same state.
+#[test]
+fn breakpoints_elsewhere_let_the_loop_be_skipped_and_stop_where_running_stops() {
+    // The loop of the test above; $F007 is its STA $0300, after the loop.
+    let mut rom = vec![0xEA; 4096];
+    rom[..13].copy_from_slice(&[
+        0xAD, 0x00, 0x80, 0xC9, 0x05, 0xD0, 0xF9, 0x8D, 0x00, 0x03, 0x4C, 0x0A, 0xF0,
+    ]);
+    rom[0xFFC..].copy_from_slice(&0xF000u16.to_le_bytes().repeat(2));
+    let robots = [true, false].map(|skip| {
+        let mut robot = Scorpion::scorpion(&rom).expect("4 KiB");
+        robot.cpu.set_idle_skip(skip);
+        robot
+            .map_kim(0x8000, 0x8000, Box::new(TickCard::default()))
+            .expect("free KIM-bus space");
+        let mut points = emulator::Breakpoints::new();
+        points.insert(0xF007);
+        points.insert(0x0300);
+        let stop = robot.run_with(80_000, &mut points);
+        assert_eq!(stop, Stop::Hook { pc: 0xF007 });
+        robot
+    });
+    let [skipped, run] = robots;
+    assert_eq!(skipped.cpu, run.cpu);
+    assert_eq!(skipped.board().memory(), run.board().memory());
+    assert!(skipped.cpu.cycles() >= 5 * TICK);
+    assert!(
+        skipped.cpu.skipped_cycles() > 40_000,
+        "skipped {}",
+        skipped.cpu.skipped_cycles()
+    );
+}
+
+/// A count the hooks stop at bounds the skip: the run stops before the
+/// instruction with that count, as running every cycle does.
+#[test]
+fn a_count_to_stop_at_bounds_the_skip() {
+    /// Stops before the instruction with count `0`.
+    struct AtCount(u64);
+    impl emulator::Hooks for AtCount {
+        fn may_skip_idle(&self) -> bool {
+            true
+        }
+        fn instruction_bound(&self) -> u64 {
+            self.0
+        }
+        fn before_instruction<B: Bus>(
+            &mut self,
+            cpu: &emulator::Cpu,
+            _bus: &B,
+        ) -> emulator::Control {
+            if cpu.instructions() >= self.0 {
+                emulator::Control::Stop
+            } else {
+                emulator::Control::Continue
+            }
+        }
+    }
+    let program = [
+        0xA6, 0x10, 0xE8, 0xCA, 0xE4, 0x11, 0xD0, 0xF8, 0x4C, 0x00, 0x04,
+    ];
+    let machines = [true, false].map(|skip| {
+        let mut ram = Ram::new();
+        ram.load(0x0400, &program).expect("fits");
+        let mut machine = Machine::new(ram);
+        machine.cpu.pc = 0x0400;
+        machine.cpu.set_idle_skip(skip);
+        let stop = machine.run_with(u64::MAX, &mut AtCount(100_003));
+        assert!(matches!(stop, Stop::Hook { .. }), "{stop:?}");
+        machine
+    });
+    let [skipped, run] = machines;
+    assert_eq!(skipped.cpu, run.cpu);
+    assert_eq!(skipped.cpu.instructions(), 100_003);
+    assert!(skipped.cpu.skipped_cycles() > 0);
+}
+
 /// `program` at $0400 on the plain RAM machine, run to `until` with idle
 /// skipping and without: [skipped, run].
 fn both_ways(program: &[u8], until: u64) -> [emulator::RamMachine; 2] {

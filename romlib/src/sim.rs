@@ -126,6 +126,13 @@ pub trait Surroundings: std::fmt::Debug + Send {
         now: u64,
         robot: &mut Scorpion,
     ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>>;
+
+    /// A copy of the surroundings as they are now, which go on exactly as
+    /// these would (for a debugger's checkpoints). `None`, the default,
+    /// for surroundings that cannot be copied.
+    fn snapshot(&self) -> Option<Box<dyn Surroundings>> {
+        None
+    }
 }
 
 impl Default for VirtualScorpion {
@@ -282,6 +289,28 @@ impl VirtualScorpion {
         run: impl FnMut(&mut Scorpion, u64) -> Stop,
     ) -> Result<Stop, Error> {
         self.advance_with(until, run)
+    }
+
+    /// A copy of the robot as it is now: the board and its CPU, the
+    /// cards, the surroundings and what the host knows of the ROM
+    /// ([`emulator::board::Scorpion::snapshot`], [`Surroundings::snapshot`]).
+    /// The copy runs on exactly as this one would. `None` if a card or the
+    /// surroundings cannot be copied.
+    #[must_use]
+    pub fn snapshot(&self) -> Option<VirtualScorpion> {
+        let world = match &self.world {
+            Some(world) => Some(world.snapshot()?),
+            None => None,
+        };
+        Some(VirtualScorpion {
+            robot: self.robot.snapshot()?,
+            hooks: self.hooks,
+            table: self.table,
+            user: self.user.clone(),
+            labels: self.labels.clone(),
+            reference_rom: self.reference_rom,
+            world,
+        })
     }
 
     /// Every label the robot knows (the ROM's, a ROM profile's, every

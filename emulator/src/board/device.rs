@@ -66,6 +66,15 @@ pub trait Device: Any + std::fmt::Debug + Send {
         None
     }
 
+    /// A copy of the device as it is now, which goes on exactly as this
+    /// one would (for a debugger's checkpoints: the robot copied, later
+    /// run again from there). `None`, the default, for a device that cannot
+    /// be copied: whoever wanted the copy does without (a debugger builds
+    /// the robot again from power-up instead).
+    fn snapshot(&self) -> Option<Box<dyn Device>> {
+        None
+    }
+
     /// The device as [`Any`], so that its owner can get its concrete type
     /// back (`board.kim_device::<MyCard>()`).
     fn as_any(&self) -> &dyn Any;

@@ -264,6 +264,57 @@ impl Board {
         self.refresh(cycle);
     }
 
+    /// A copy of the board as it is now (memory, chips, latches, motors,
+    /// scene, mapped devices, what the host has not taken yet), which runs
+    /// on exactly as this one would; `None` if a mapped device cannot be
+    /// copied ([`Device::snapshot`]).
+    #[must_use]
+    pub fn snapshot(&self) -> Option<Board> {
+        let kim = self
+            .kim
+            .iter()
+            .map(|slot| {
+                Some(KimSlot {
+                    start: slot.start,
+                    end: slot.end,
+                    device: slot.device.snapshot()?,
+                    line: slot.line,
+                })
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some(Board {
+            memory: self.memory.clone(),
+            pages: self.pages,
+            via: self.via.clone(),
+            acia: self.acia.clone(),
+            acia_next: self.acia_next,
+            acia_host_due: self.acia_host_due,
+            acia_stale: self.acia_stale,
+            drive: self.drive,
+            sense: self.sense,
+            switches: self.switches,
+            bumpers: self.bumpers,
+            scene: self.scene.clone(),
+            motors: self.motors.clone(),
+            port_b: self.port_b,
+            kim,
+            inbox: self.inbox.clone(),
+            via_line: self.via_line,
+            acia_line: self.acia_line,
+            irq: self.irq,
+            next_event: self.next_event,
+            attention: self.attention,
+            irq_changed_at: self.irq_changed_at,
+            host_watch: self.host_watch,
+            host_due: self.host_due,
+            host_arrived: self.host_arrived,
+            last_poll: self.last_poll,
+            slow_start: self.slow_start,
+            slow_span: self.slow_span,
+            rom_writes: self.rom_writes,
+        })
+    }
+
     /// Copies `bytes` into RAM (the card's or the KIM bus's) at `address`,
     /// as a loader or a test fixture does.
     ///
@@ -912,6 +963,16 @@ impl Bus for Board {
 pub type Scorpion = Machine<Board>;
 
 impl Machine<Board> {
+    /// A copy of the robot as it is now, CPU and board
+    /// ([`Board::snapshot`]); `None` if a mapped device cannot be copied.
+    #[must_use]
+    pub fn snapshot(&self) -> Option<Scorpion> {
+        Some(Machine {
+            cpu: self.cpu.clone(),
+            bus: self.bus.snapshot()?,
+        })
+    }
+
     /// A powered-up Scorpion running `rom` (4 KiB, loaded at `$F000`).
     ///
     /// # Errors

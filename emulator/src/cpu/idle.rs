@@ -26,8 +26,16 @@
 //! after `k` skipped iterations is then the state now with `k * C` more
 //! cycles and `k * I` more instructions, which is what the skip produces.
 //!
-//! Skipping is off with any hook that is not [`Hooks::PASSIVE`](crate::Hooks)
-//! (tracing and breakpoints see every instruction), off in [`Cpu::step`],
+//! Skipping is off with any hook that is not [`Hooks::PASSIVE`] (tracing
+//! sees every instruction) unless the hooks answer from the registers and
+//! memory alone ([`Hooks::may_skip_idle`]: breakpoints, a debugger's
+//! watchpoints). Such hooks are asked before every instruction the probe
+//! runs, as the run would ask them, and once more at the lap's end (a
+//! watchpoint the lap's last access hit stops there); a lap they let run
+//! they would let run every time, since every lap sees the same registers
+//! and memory, so skipping it changes nothing they would have seen. The
+//! skip also stops short of the hooks' [`Hooks::instruction_bound`]. It is
+//! off in [`Cpu::step`],
 //! off for a bus that does not vouch for its memory (the default), and can
 //! be switched off with [`Cpu::set_idle_skip`] (the equivalence test runs a
 //! whole session both ways and compares everything).
@@ -44,8 +52,9 @@
 //! counter with the earlier of the run's limit and the next probe, a
 //! comparison it makes anyway, and leaves its inner loop at an RTI.
 
-use super::{Cpu, JAM, POLLED};
+use super::{Cpu, JAM, POLLED, Stop, TRAP};
 use crate::bus::{Bus, Interrupts};
+use crate::hooks::{Control, Hooks};
 
 /// Cycles from a success (or a skip) to the next probe.
 const MIN_GAP: u64 = 128;
@@ -219,19 +228,25 @@ impl Cpu {
 
     /// Runs instructions (at most [`BUDGET`], and not past `until` or an
     /// interrupt) looking for an idle loop, and skips the iterations it may
-    /// when one is found. Returns the last instruction's flow bits (`JAM`
-    /// ends the run). Never inlined, and called on a copy of the run's CPU,
-    /// so that the run loop keeps its registers.
+    /// when one is found. Returns the stop that ends the run (a JAM, or
+    /// the hooks'), if any. Never inlined, and called on a copy of the
+    /// run's CPU, so that the run loop keeps its registers.
     ///
     /// After an RTI (`returned`) it looks only if the RTI went back into
     /// the idle loop last found, where an interrupt-driven program waits
     /// again once its handler is done; a failure then does not slow the
     /// probes down.
     #[inline(never)]
-    pub(super) fn probe_idle<B: Bus>(&mut self, bus: &mut B, until: u64, returned: bool) -> u8 {
+    pub(super) fn probe_idle<B: Bus, H: Hooks>(
+        &mut self,
+        bus: &mut B,
+        until: u64,
+        returned: bool,
+        hooks: &mut H,
+    ) -> Option<Stop> {
         if returned {
             if !self.idle.returns_to_loop(self.pc) {
-                return 0;
+                return None;
             }
             self.idle.woken = true;
         }
@@ -239,21 +254,29 @@ impl Cpu {
             // Code outside plain memory (or a bus that vouches for none):
             // no lap can be clean.
             self.idle.missed(self.cycles);
-            return 0;
+            return None;
         }
         let mut probe = ProbeBus { bus, clean: true };
         let mut start = (self.loop_state(), self.cycles, self.instructions);
         let mut lap = [0; MAX_LOOP];
         lap[0] = self.pc;
         let mut window = 0;
-        let mut flow = 0;
         for _ in 0..BUDGET {
             if self.cycles >= until || self.nmi_pending || self.irq_pending {
                 break;
             }
-            flow = self.instruction(&mut probe);
+            if !H::PASSIVE && hooks.before_instruction(self, &*probe.bus) == Control::Stop {
+                return Some(Stop::Hook { pc: self.pc });
+            }
+            let flow = self.instruction(&mut probe);
             if flow & JAM != 0 {
-                break;
+                return Some(Stop::Jam {
+                    pc: self.pc,
+                    opcode: probe.bus.peek(self.pc),
+                });
+            }
+            if !H::PASSIVE && flow & TRAP != 0 && hooks.trap(self, &*probe.bus) == Control::Stop {
+                return Some(Stop::Trap { pc: self.pc });
             }
             if flow & POLLED != 0
                 && (self.nmi_pending || self.irq_pending || probe.bus.stop_requested())
@@ -267,11 +290,17 @@ impl Cpu {
             }
             window += 1;
             if self.pc == start.0.pc && self.loop_state() == start.0 {
+                // The hooks once more, before the lap repeats: a watch the
+                // lap's last access hit stops here, not laps later.
+                if !H::PASSIVE && hooks.before_instruction(self, &*probe.bus) == Control::Stop {
+                    return Some(Stop::Hook { pc: self.pc });
+                }
                 let cycles = self.cycles - start.1;
                 let instructions = self.instructions - start.2;
                 (self.idle.lap, self.idle.lap_len) = (lap, window);
-                self.skip_iterations(probe.bus, until, cycles, instructions);
-                return flow;
+                let until_count = hooks.instruction_bound();
+                self.skip_iterations(probe.bus, until, until_count, cycles, instructions);
+                return None;
             }
             if self.pc == start.0.pc || window == MAX_LOOP {
                 // Back with other registers (the first lap after entering
@@ -284,17 +313,26 @@ impl Cpu {
             }
         }
         self.idle.missed(self.cycles);
-        flow
+        None
     }
 
     /// Advances as many whole `cycles`-long iterations as end before
-    /// `until` and no later than the bus's quiet horizon.
-    fn skip_iterations<B: Bus>(&mut self, bus: &B, until: u64, cycles: u64, instructions: u64) {
+    /// `until` and no later than the bus's quiet horizon, leaving the
+    /// instruction count at most `until_count`.
+    fn skip_iterations<B: Bus>(
+        &mut self,
+        bus: &B,
+        until: u64,
+        until_count: u64,
+        cycles: u64,
+        instructions: u64,
+    ) {
         let last_end = until
             .saturating_sub(1)
             .min(bus.quiet_until())
             .min(CYCLE_CAP);
-        let laps = last_end.saturating_sub(self.cycles) / cycles;
+        let by_count = until_count.saturating_sub(self.instructions) / instructions.max(1);
+        let laps = (last_end.saturating_sub(self.cycles) / cycles).min(by_count);
         if laps == 0 {
             self.idle.missed(self.cycles);
             return;

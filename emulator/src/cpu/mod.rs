@@ -274,7 +274,10 @@ impl Cpu {
     /// their cycles and instructions as if it had run them: the state
     /// afterwards is exactly the state running them would leave. It only
     /// happens with hooks that observe nothing ([`Hooks::PASSIVE`]) and a
-    /// bus that vouches for its memory ([`Bus::is_plain_memory`]).
+    /// bus that vouches for its memory ([`Bus::is_plain_memory`]), or with
+    /// hooks whose answers repeat with the loop's laps
+    /// ([`Hooks::may_skip_idle`]: breakpoints), which then see the probe's
+    /// instructions and stop it as they would the run.
     pub fn set_idle_skip(&mut self, allowed: bool) {
         self.idle.enabled = allowed;
     }
@@ -436,8 +439,9 @@ impl Cpu {
 
     #[inline(always)]
     fn run_local<B: Bus, H: Hooks>(&mut self, bus: &mut B, until: u64, hooks: &mut H) -> Stop {
-        // A constant `false` unless the hooks observe nothing.
-        let probing = H::PASSIVE && self.idle.enabled;
+        // A constant `false` unless the hooks observe nothing or say
+        // their answers repeat with an idle loop's laps.
+        let probing = self.idle.enabled && (H::PASSIVE || hooks.may_skip_idle());
         // The inner loop ended on an RTI (only with passive hooks).
         let mut returned = false;
         loop {
@@ -459,14 +463,11 @@ impl Cpu {
                 // On a copy, so that this loop's CPU never has its address
                 // taken and stays in machine registers.
                 let mut cpu = self.clone();
-                let flow = cpu.probe_idle(bus, until, returned);
+                let stop = cpu.probe_idle(bus, until, returned, hooks);
                 *self = cpu;
                 returned = false;
-                if flow & JAM != 0 {
-                    return Stop::Jam {
-                        pc: self.pc,
-                        opcode: bus.peek(self.pc),
-                    };
+                if let Some(stop) = stop {
+                    return stop;
                 }
                 continue;
             }
@@ -514,7 +515,7 @@ impl Cpu {
                             interrupted =
                                 self.nmi_pending || self.irq_pending || bus.stop_requested();
                         }
-                        if H::PASSIVE {
+                        if probing {
                             // Maybe back into the idle loop last found:
                             // the probe decides, out of this loop.
                             break true;

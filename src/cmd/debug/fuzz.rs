@@ -118,7 +118,7 @@ fn line() -> impl Strategy<Value = String> {
 fn any_command_line_is_answered_within_its_bounds() {
     let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
     let args = Args {
-        baud: crate::cmd::ports::DEFAULT_BAUD,
+        baud: None,
         ..Args::default()
     };
     let (make, images, root) = recipe(&args, &adc).expect("the ADC example builds");
