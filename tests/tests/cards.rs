@@ -184,3 +184,72 @@ fn the_docs_wall_closes_the_bumper_where_the_robot_meets_it() {
         "the bumper closed at {met} steps"
     );
 }
+
+/// Surroundings that change the robot's inputs at irregular times and
+/// print what they see.
+const RESTLESS_WORLD: &str = r#"
+fn init() { this.n = 0; wake_at(ms(1)); }
+fn wake(now) {
+    this.n += 1;
+    bumpers(if this.n % 3 == 0 { 0x10 } else { 0 });
+    tracker(this.n % 2 == 0, true);
+    print(`${now} ${left_position()} ${right_position()}`);
+    wake_at(now + 137 * (this.n % 5 + 1));
+}
+"#;
+
+/// The robot after every instruction: registers, cycle, the zero page.
+type Trace = Vec<(emulator::Cpu, u64, [u8; 256])>;
+
+/// A project with a card and surroundings, run: the robot's state at
+/// every instruction of 0.2 s between two questions, the answers, and
+/// what the surroundings printed.
+fn rigged_run() -> (Trace, Vec<String>, Vec<String>) {
+    let mut s = with_card("rangefinder.rhai", &script("rangefinder/rangefinder.rhai"));
+    let world = ScriptWorld::load("restless.rhai", RESTLESS_WORLD).expect("loads");
+    let printed = world.printed();
+    s.robot.set_surroundings(Box::new(world));
+    upload(
+        &mut s,
+        &build(
+            &[examples_dir().join("rangefinder/rangefinder.s")],
+            "scorpion-ext",
+        ),
+    );
+    let mut answers = vec![s.ask("/1U")];
+    let mut trace = Trace::new();
+    let until = s.robot.cycles() + 200_000;
+    s.robot
+        .run_until_with(until, |robot, to| {
+            while robot.now() < to {
+                let _ = robot.step();
+                let mut zero_page = [0; 256];
+                zero_page.copy_from_slice(&robot.board().memory()[..256]);
+                trace.push((robot.cpu.clone(), robot.now(), zero_page));
+            }
+            emulator::Stop::Limit
+        })
+        .expect("runs");
+    answers.push(s.ask("/1U"));
+    (trace, answers, printed.take())
+}
+
+/// Issue 23: nothing a script does depends on the host (its clock, its
+/// randomness, its speed): the same project run twice is the same robot
+/// at every instruction, which step back in the debugger rests on.
+#[test]
+fn a_project_with_scripts_runs_the_same_twice_instruction_for_instruction() {
+    let (first, first_answers, first_printed) = rigged_run();
+    let (second, second_answers, second_printed) = rigged_run();
+    assert_eq!(first_answers, ["U0123\r", "U0123\r"]);
+    assert_eq!(first_answers, second_answers);
+    assert!(
+        first_printed.len() > 50,
+        "the world woke: {first_printed:?}"
+    );
+    assert_eq!(first_printed, second_printed);
+    assert!(first.len() > 10_000, "{} instructions", first.len());
+    assert_eq!(first.len(), second.len());
+    let differs = first.iter().zip(&second).position(|(a, b)| a != b);
+    assert_eq!(differs, None, "the runs part at that instruction");
+}
