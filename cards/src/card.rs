@@ -413,14 +413,15 @@ impl Device for ScriptCard {
         if self.fault.is_some() {
             return None;
         }
-        let printed = Arc::new(Mutex::new(Vec::new()));
+        let host = Arc::new(self.script.host().fork()?);
         let shared = Arc::new(Mutex::new(self.shared.lock().ok()?.clone()));
-        let mut engine = engine(&printed);
+        let mut engine = engine(&host);
         register(&mut engine, &shared);
         Some(Box::new(ScriptCard {
-            script: self.script.fork(engine, printed)?,
+            script: self.script.fork(engine, host)?,
             shared,
             view: self.view.clone(),
+            wake: self.wake,
             plain: self.plain.clone(),
             has_write: self.has_write,
             has_wake: self.has_wake,

@@ -14,7 +14,7 @@ use crate::sandbox::{HostError, OPERATION_BUDGET};
 pub const OPERATIONS_PER_MICROSECOND: u64 = 100;
 
 /// The wake-up a script asked for.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(crate) struct Alarm {
     /// The robot time of the running call; `None` in `init` and the top
     /// level, which run before robot time starts for the script.
@@ -63,7 +63,7 @@ impl Alarm {
 
 /// The operations a script may still take: [`OPERATION_BUDGET`] at most,
 /// earned at [`OPERATIONS_PER_MICROSECOND`] of robot time.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct Budget {
     credit: u64,
     /// The robot time the credit was last earned up to.

@@ -70,6 +70,21 @@ pub(crate) struct Host {
     pub(crate) crowded: AtomicBool,
 }
 
+impl Host {
+    /// The host of a copy of the script (a debugger's checkpoint): the
+    /// wake-up asked for copied, what the copy prints its own. `None` if a
+    /// lock is poisoned.
+    pub(crate) fn fork(&self) -> Option<Host> {
+        Some(Host {
+            printed: Printed::default(),
+            alarm: Mutex::new(self.alarm.lock().ok()?.clone()),
+            allowance: AtomicU64::new(self.allowance.load(Ordering::Relaxed)),
+            spent: AtomicU64::new(self.spent.load(Ordering::Relaxed)),
+            crowded: AtomicBool::new(self.crowded.load(Ordering::Relaxed)),
+        })
+    }
+}
+
 /// A failure of a host function a script called, with what to do.
 #[derive(Debug, Clone)]
 pub(crate) struct HostError {

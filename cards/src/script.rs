@@ -76,13 +76,14 @@ impl Script {
     }
 
     /// A copy of the script as it is now, on `engine` (an engine like
-    /// this one's, with the host's functions bound to the copy's own
-    /// state), printing into `printed`: the compiled script and its
-    /// constants shared, `this` copied. The engine keeps no state between
-    /// calls (its limits are per call), so the copy goes on as this script
+    /// this one's, made for `host` from [`Host::fork`] and with the
+    /// card's or surroundings' functions bound to the copy's own state):
+    /// the compiled script and its constants shared, `this` and the
+    /// robot-time budget copied. The engine keeps no state between calls
+    /// (its limits are per call), so the copy goes on as this script
     /// would. `None` if part of `this` is shared (a closure's captured
     /// variable), which a copy could not keep apart from the original.
-    pub(crate) fn fork(&self, engine: Engine, printed: Arc<Mutex<Vec<String>>>) -> Option<Script> {
+    pub(crate) fn fork(&self, engine: Engine, host: Arc<Host>) -> Option<Script> {
         if has_shared(&self.this) {
             return None;
         }
@@ -93,8 +94,14 @@ impl Script {
             this: self.this.clone(),
             name: self.name.clone(),
             text: self.text.clone(),
-            printed,
+            host,
+            budget: self.budget.clone(),
         })
+    }
+
+    /// The host the script's functions reach.
+    pub(crate) fn host(&self) -> &Host {
+        &self.host
     }
 
     /// Whether the script defines `name` with `params` parameters.

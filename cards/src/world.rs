@@ -114,12 +114,12 @@ impl Surroundings for ScriptWorld {
     /// [`ScriptWorld::printed`]. `None` if the script's state shares a
     /// closure's variable.
     fn snapshot(&self) -> Option<Box<dyn Surroundings>> {
-        let printed = Arc::new(Mutex::new(Vec::new()));
+        let host = Arc::new(self.script.host().fork()?);
         let shared = Arc::new(Mutex::new(self.shared.lock().ok()?.clone()));
-        let mut engine = engine(&printed);
+        let mut engine = engine(&host);
         register(&mut engine, &shared);
         Some(Box::new(ScriptWorld {
-            script: self.script.fork(engine, printed)?,
+            script: self.script.fork(engine, host)?,
             shared,
             has_wake: self.has_wake,
             pending: self.pending,
