@@ -352,7 +352,7 @@ fn a_builtin_include_can_be_left_out_of_the_listing() {
     let listing = |list_builtin_includes| {
         let options = Options {
             list_builtin_includes,
-            ..options()
+            ..options(Path::new("main.s"))
         };
         assembler::assemble(&source, Path::new("main.s"), &options)
             .expect("it assembles")
