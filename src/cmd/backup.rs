@@ -36,7 +36,7 @@ pub(crate) struct RestoreArgs {
 }
 
 pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
-    let transport = ports::open_resolved(&args.line.resolve()?, &[])?;
+    let transport = args.line.open()?;
     let profile = uploader::RomProfile::reference();
     let mut client = uploader::client(transport, &profile);
     client.probe()?;
@@ -55,7 +55,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
 
 pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
     let backup = read_backup(&args.file)?;
-    let transport = ports::open_resolved(&args.line.resolve()?, &[])?;
+    let transport = args.line.open()?;
     restore_into(transport, &backup, &args.file)
 }
 

@@ -61,7 +61,7 @@ fn run_read(args: &ReadArgs) -> miette::Result<ExitCode> {
             linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?,
         ),
     };
-    let transport = ports::open_resolved(&args.line.resolve()?, &[])?;
+    let transport = args.line.open()?;
     let profile = uploader::RomProfile::reference();
     let mut client = uploader::client(transport, &profile);
     client.probe()?;
