@@ -2,7 +2,6 @@
 
 pub(crate) mod ask;
 pub(crate) mod asm;
-pub(crate) mod backup;
 pub(crate) mod build;
 pub(crate) mod config;
 pub(crate) mod dap;
@@ -16,7 +15,6 @@ pub(crate) mod new;
 pub(crate) mod ports;
 pub(crate) mod read;
 pub(crate) mod rig;
-pub(crate) mod rom;
 pub(crate) mod sim;
 pub(crate) mod test;
 pub(crate) mod upload;

@@ -16,7 +16,6 @@ mod journeys;
 mod link;
 mod project;
 mod read;
-mod robot;
 mod search_order;
 mod sim;
 mod sim_line;
