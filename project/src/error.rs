@@ -161,6 +161,22 @@ pub enum Error {
         user: String,
     },
 
+    /// The project's ROM profile cannot be read.
+    #[error("{file}: [robot] rom = \"{rom}\": cannot read the ROM profile")]
+    #[diagnostic(
+        code(scorpion::project::rom_unreadable),
+        help("`rom` names a ROM's linked image (ELF), relative to the project; `scorpion config` shows where it is looked for")
+    )]
+    RomUnreadable {
+        /// The project file.
+        file: String,
+        /// The profile as written.
+        rom: String,
+        /// Why.
+        #[source]
+        source: hostfs::Error,
+    },
+
     /// The project's ROM profile is not a ROM's linked image.
     #[error("{file}: [robot] rom = \"{rom}\" is not a linked ROM image")]
     #[diagnostic(code(scorpion::project::rom))]

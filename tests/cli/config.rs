@@ -516,3 +516,35 @@ fn the_world_comes_from_the_project_or_the_flag_and_keeps_the_projects_cards() {
         );
     }
 }
+
+/// A `[robot] rom` that cannot be read is named as the ROM profile, with
+/// the project file's key, by every command that reads it (found by a
+/// new user: `test`, `build` and `read --port emu` said only
+/// "nosuch.elf: no such file").
+#[test]
+fn a_missing_rom_profile_is_named_by_every_command() {
+    let adc = Adc::new();
+    let toml = adc.project().join("Scorpion.toml");
+    let original = std::fs::read_to_string(&toml).expect("the project");
+    std::fs::write(
+        &toml,
+        original.replace("[robot]\n", "[robot]\nrom = \"nosuch.elf\"\n"),
+    )
+    .expect("write");
+    let runs: [&[&str]; 5] = [
+        &["test"],
+        &["build"],
+        &["sim"],
+        &["ask", "--port", "emu", "/1X"],
+        &["read", "--port", "emu", "0x0400", "1"],
+    ];
+    for args in runs {
+        let output = adc.run(&adc.project(), args, &[]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?} exits 0:\n{stderr}");
+        assert!(
+            stderr.contains("ROM profile") && stderr.contains("nosuch.elf"),
+            "{args:?} does not name the ROM profile:\n{stderr}"
+        );
+    }
+}
