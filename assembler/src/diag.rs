@@ -37,51 +37,77 @@ pub(crate) fn did_you_mean<'a>(
         .map(|(_, candidate)| candidate)
 }
 
-/// The optimal-string-alignment distance of `a` and `b` (strsim's
-/// `osa_distance` on bytes) if it is at most `limit`: rows of the table
-/// stop as soon as every cell exceeds the limit, and short names need no
-/// allocation, so rejecting a candidate costs a few dozen steps.
+/// A name prepared for [`Pattern::distance`]: for each byte, the bit mask
+/// of the positions where the name has it.
+struct Pattern {
+    masks: Box<[u64; 256]>,
+    len: usize,
+}
+
+impl Pattern {
+    /// `name` (lowercased), or `None` if it is too long for one word
+    /// (then [`osa_within`] answers).
+    fn new(name: &[u8]) -> Option<Pattern> {
+        if name.is_empty() || name.len() > 64 {
+            return None;
+        }
+        let mut masks = Box::new([0u64; 256]);
+        for (i, &byte) in name.iter().enumerate() {
+            masks[usize::from(byte)] |= 1 << i;
+        }
+        Some(Pattern {
+            masks,
+            len: name.len(),
+        })
+    }
+
+    /// The optimal-string-alignment distance (strsim's `osa_distance`)
+    /// from the pattern to `text`, by Hyyrö's bit-parallel algorithm
+    /// (2003): one step of a few word operations per byte of `text`, so a
+    /// comparison costs about as much as reading the name.
+    fn distance(&self, text: &[u8]) -> usize {
+        let last = 1u64 << (self.len - 1);
+        let mut vp = if self.len == 64 {
+            u64::MAX
+        } else {
+            (1u64 << self.len) - 1
+        };
+        let mut vn = 0u64;
+        let mut d0_before = 0u64;
+        let mut pm_before = 0u64;
+        let mut score = self.len;
+        for &byte in text {
+            let pm = self.masks[usize::from(byte)];
+            let tr = (((!d0_before) & pm) << 1) & pm_before;
+            let d0 = ((((pm & vp).wrapping_add(vp)) ^ vp) | pm | vn) | tr;
+            let hp = vn | !(d0 | vp);
+            let hn = d0 & vp;
+            if hp & last != 0 {
+                score += 1;
+            } else if hn & last != 0 {
+                score -= 1;
+            }
+            let hp = (hp << 1) | 1;
+            let hn = hn << 1;
+            vp = hn | !(d0 | hp);
+            vn = hp & d0;
+            d0_before = d0;
+            pm_before = pm;
+        }
+        score
+    }
+}
+
+/// The optimal-string-alignment distance of `a` and `b` if it is at most
+/// `limit` (strsim's, for names too long for [`Pattern`]).
 fn osa_within(a: &[u8], b: &[u8], limit: usize) -> Option<usize> {
-    const MAX: usize = 64;
     if a.len().abs_diff(b.len()) > limit {
         return None;
     }
-    if a.len() >= MAX || b.len() >= MAX {
-        let distance =
-            strsim::osa_distance(&String::from_utf8_lossy(a), &String::from_utf8_lossy(b));
-        return (distance <= limit).then_some(distance);
-    }
-    // Three rows of the table, used in turn: two back (for
-    // transpositions), one back, and the one being filled. Cells are
-    // bytes: names this short have distances below 64.
-    let mut rows = [[0u8; MAX]; 3];
-    for (j, cell) in rows[0].iter_mut().enumerate().take(b.len() + 1) {
-        *cell = j as u8;
-    }
-    let mut previous_min = 0;
-    for i in 1..=a.len() {
-        let (cur, prev, before) = (i % 3, (i + 2) % 3, (i + 1) % 3);
-        rows[cur][0] = i as u8;
-        let mut row_min = i;
-        for j in 1..=b.len() {
-            let cost = u8::from(a[i - 1] != b[j - 1]);
-            let mut value = (rows[prev][j] + 1)
-                .min(rows[cur][j - 1] + 1)
-                .min(rows[prev][j - 1] + cost);
-            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                value = value.min(rows[before][j - 2] + 1);
-            }
-            rows[cur][j] = value;
-            row_min = row_min.min(usize::from(value));
-        }
-        // A later cell comes from this row or (a transposition, plus
-        // one) the row before: past the limit in both, it stays past.
-        if row_min > limit && previous_min >= limit {
-            return None;
-        }
-        previous_min = row_min;
-    }
-    let distance = usize::from(rows[a.len() % 3][b.len()]);
+    let distance = match Pattern::new(a) {
+        Some(pattern) => pattern.distance(b),
+        None => strsim::osa_distance(&String::from_utf8_lossy(a), &String::from_utf8_lossy(b)),
+    };
     (distance <= limit).then_some(distance)
 }
 
@@ -119,14 +145,18 @@ impl Suggestions {
     pub(crate) fn suggest(&self, name: &str) -> Option<&str> {
         let wanted = name.to_ascii_lowercase();
         let limit = suggestion_limit(name);
+        let pattern = Pattern::new(wanted.as_bytes());
         let lengths = name.len().saturating_sub(limit)..=name.len() + limit;
         lengths
             .filter_map(|len| self.by_len.get(len))
             .flatten()
             .filter(|(_, written)| written != name)
             .filter_map(|(lower, written)| {
-                let distance = osa_within(wanted.as_bytes(), lower.as_bytes(), limit)?;
-                Some((distance, written.as_str()))
+                let distance = match &pattern {
+                    Some(pattern) => pattern.distance(lower.as_bytes()),
+                    None => osa_within(wanted.as_bytes(), lower.as_bytes(), limit)?,
+                };
+                (distance <= limit).then_some((distance, written.as_str()))
             })
             .min()
             .map(|(_, written)| written)
@@ -675,6 +705,31 @@ mod tests {
                         "{a} {b} {limit}"
                     );
                 }
+            }
+        }
+    }
+
+    /// Every pair of strings over three letters up to five long: the
+    /// bit-parallel distance is strsim's.
+    #[test]
+    fn bit_parallel_distance_is_strsims_exhaustively() {
+        let mut words = vec![String::new()];
+        let mut last = vec![String::new()];
+        for _ in 0..5 {
+            last = last
+                .iter()
+                .flat_map(|w| ["a", "b", "c"].map(|c| format!("{w}{c}")))
+                .collect();
+            words.extend(last.iter().cloned());
+        }
+        for a in &words {
+            for b in &words {
+                let exact = strsim::osa_distance(a, b);
+                assert_eq!(
+                    osa_within(a.as_bytes(), b.as_bytes(), 99),
+                    Some(exact),
+                    "{a} {b}"
+                );
             }
         }
     }
