@@ -165,7 +165,9 @@ pub enum Error {
     #[error("{file}: [robot] rom = \"{rom}\": cannot read the ROM profile")]
     #[diagnostic(
         code(scorpion::project::rom_unreadable),
-        help("`rom` names a ROM's linked image (ELF), relative to the project; `scorpion config` shows where it is looked for")
+        help(
+            "`rom` names a ROM's linked image (ELF), relative to the project; `scorpion config` shows where it is looked for"
+        )
     )]
     RomUnreadable {
         /// The project file.

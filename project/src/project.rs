@@ -145,12 +145,11 @@ impl Project {
             return Ok(None);
         };
         let path = self.root.join(rom);
-        let bytes =
-            hostfs::read(&path, hostfs::BINARY).map_err(|source| Error::RomUnreadable {
-                file: self.shown.clone(),
-                rom: rom.clone(),
-                source,
-            })?;
+        let bytes = hostfs::read(&path, hostfs::BINARY).map_err(|source| Error::RomUnreadable {
+            file: self.shown.clone(),
+            rom: rom.clone(),
+            source,
+        })?;
         let image = linker::Image::parse(rom, &bytes).map_err(|source| Error::Rom {
             file: self.shown.clone(),
             rom: rom.clone(),
