@@ -9,6 +9,7 @@ mod args;
 mod cmd;
 mod project;
 
+use std::io::Write as _;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -84,10 +85,9 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(report) => {
             // The only place errors reach the user: render them with miette.
-            #[allow(clippy::print_stderr, reason = "the CLI reports errors")]
-            {
-                eprintln!("{report:?}");
-            }
+            // A closed stderr (`2>&1 | head`) must not turn an error into
+            // a panic: what cannot be written is dropped.
+            let _ = writeln!(std::io::stderr(), "{report:?}");
             ExitCode::FAILURE
         }
     }

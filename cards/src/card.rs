@@ -17,7 +17,7 @@ use std::sync::{Arc, Mutex};
 use emulator::board::Device;
 
 use crate::error::ScriptError;
-use crate::sandbox::{Host, engine};
+use crate::sandbox::{Host, HostError, engine};
 use crate::script::Script;
 
 /// What the script changes through the host's functions.
@@ -287,29 +287,61 @@ fn as_int(cycle: u64) -> i64 {
 }
 
 /// The host's functions a card script calls.
+/// `register` as an index of the card's table, or the error `function`
+/// (`set`, `get`) throws at the call: a register the card does not have
+/// is a mistake, not a write to nowhere or a read of `$FF`.
+fn checked_register(
+    shared: &Shared,
+    function: &str,
+    register: i64,
+) -> Result<usize, Box<rhai::EvalAltResult>> {
+    let size = shared.table.len();
+    usize::try_from(register)
+        .ok()
+        .filter(|r| *r < size)
+        .ok_or_else(|| {
+            HostError {
+                message: format!(
+                    "`{function}({register}, ...)`: the card has registers 0 to {}",
+                    size.saturating_sub(1)
+                ),
+                help: "a register is 0 to SIZE - 1, counted from the card's BASE".into(),
+            }
+            .thrown()
+        })
+}
+
 fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
     let state = Arc::clone(shared);
-    engine.register_fn("set", move |register: i64, value: i64| {
-        if let Ok(mut shared) = state.lock()
-            && let Some(slot) = usize::try_from(register)
-                .ok()
-                .and_then(|r| shared.table.get_mut(r))
-        {
-            *slot = (value & 0xFF) as u8;
-        }
-    });
+    engine.register_fn(
+        "set",
+        move |register: i64, value: i64| -> Result<(), Box<rhai::EvalAltResult>> {
+            let Ok(mut shared) = state.lock() else {
+                return Ok(());
+            };
+            let slot = checked_register(&shared, "set", register)?;
+            if !(0..=0xFF).contains(&value) {
+                return Err(HostError {
+                    message: format!("`set({register}, {value})`: a register holds 0 to 255"),
+                    help: "give a byte: `value & 0xFF` keeps the low eight bits".into(),
+                }
+                .thrown());
+            }
+            shared.table[slot] = value as u8;
+            Ok(())
+        },
+    );
     let state = Arc::clone(shared);
-    engine.register_fn("get", move |register: i64| -> i64 {
-        state
-            .lock()
-            .ok()
-            .and_then(|shared| {
-                usize::try_from(register)
-                    .ok()
-                    .and_then(|r| shared.table.get(r).copied())
-            })
-            .map_or(0xFF, i64::from)
-    });
+    engine.register_fn(
+        "get",
+        move |register: i64| -> Result<i64, Box<rhai::EvalAltResult>> {
+            let Ok(shared) = state.lock() else {
+                return Ok(0xFF);
+            };
+            let slot = checked_register(&shared, "get", register)?;
+            Ok(i64::from(shared.table[slot]))
+        },
+    );
     let state = Arc::clone(shared);
     engine.register_fn("irq", move |on: bool| {
         if let Ok(mut shared) = state.lock() {

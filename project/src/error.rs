@@ -133,6 +133,23 @@ pub enum Error {
         why: String,
     },
 
+    /// A setting whose value cannot be used, with where it came from.
+    #[error("{what} = {value:?} ({origin}) is not {expected}")]
+    #[diagnostic(
+        code(scorpion::project::setting),
+        help("`scorpion config` shows every setting and where it came from")
+    )]
+    Setting {
+        /// The setting's name.
+        what: &'static str,
+        /// Its value, as given.
+        value: String,
+        /// Where it came from (flag, variable, file and line).
+        origin: String,
+        /// What it must be.
+        expected: &'static str,
+    },
+
     /// An environment variable whose value cannot be used.
     #[error("{name}={value} is not {expected}")]
     #[diagnostic(

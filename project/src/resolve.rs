@@ -271,6 +271,25 @@ impl Resolved {
             }
         };
 
+        // An empty port or a rate of 0 is a slip wherever it was written,
+        // said where it was, not when a command first opens the line.
+        if let Some(port) = port.as_ref().filter(|p| p.value.trim().is_empty()) {
+            return Err(Error::Setting {
+                what: "port",
+                value: port.value.clone(),
+                origin: port.origin.to_string(),
+                expected: "a serial port (/dev/ttyUSB0) or `emu`",
+            });
+        }
+        if baud.value == 0 {
+            return Err(Error::Setting {
+                what: "baud",
+                value: baud.value.to_string(),
+                origin: baud.origin.to_string(),
+                expected: "a baud rate (9600)",
+            });
+        }
+
         let cards = if !flags.cards.is_empty() {
             Sourced {
                 value: flags.cards.clone(),

@@ -27,6 +27,9 @@ fn bad_name(name: &str) -> Option<&'static str> {
     if std::path::Path::new(name).is_absolute() || name.starts_with('/') {
         return Some("an image's name is an absolute path");
     }
+    if name.ends_with('.') {
+        return Some("an image's name ends with `.` (its files would read `NAME..elf`)");
+    }
     if name.contains(['/', '\\']) {
         return Some("an image's name holds a path separator");
     }
@@ -45,7 +48,7 @@ pub(crate) fn check(shown: &str, text: &str, file: &ProjectFile) -> crate::Resul
     let at = |index: usize, pick: fn(&crate::spans::ImageSpans) -> std::ops::Range<usize>| {
         spans.image.get(index).map(pick).unwrap_or(0..0)
     };
-    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut seen: BTreeMap<String, usize> = BTreeMap::new();
     for (index, image) in file.images.iter().enumerate() {
         let name_at = at(index, |s| span(&s.name));
         if let Some(why) = bad_name(&image.name) {
@@ -58,7 +61,8 @@ pub(crate) fn check(shown: &str, text: &str, file: &ProjectFile) -> crate::Resul
             )
             .into());
         }
-        if let Some(first) = seen.insert(&image.name, index) {
+        // Names that differ only in case are one file on some systems.
+        if let Some(first) = seen.insert(image.name.to_ascii_lowercase(), index) {
             return Err(Located::new(
                 shown,
                 text,

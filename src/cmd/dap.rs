@@ -48,13 +48,22 @@ pub(crate) struct Args {}
 /// that asks to be woken at the same instant again and again) meets it.
 const STUCK: Duration = Duration::from_secs(5);
 
+/// The robot thread's stack (only what is touched is committed).
+const ROBOT_STACK: usize = 64 << 20;
+
 pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
     let outbox = Arc::new(Outbox::new(Box::new(BufWriter::new(std::io::stdout()))));
     let busy = Arc::new(Busy::default());
     let (to_robot, requests) = mpsc::channel();
     let robot = {
         let session = Session::new(Arc::clone(&outbox), Arc::clone(&busy));
-        std::thread::spawn(move || robot_thread(session, &requests))
+        // Scripts (Rhai) recurse deeply in a debug build: the robot's
+        // thread gets the stack a script's deepest allowed call needs.
+        std::thread::Builder::new()
+            .name("robot".into())
+            .stack_size(ROBOT_STACK)
+            .spawn(move || robot_thread(session, &requests))
+            .into_diagnostic()?
     };
     let mut reader = framing::FrameReader::new(BufReader::new(std::io::stdin()));
     loop {

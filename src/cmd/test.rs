@@ -11,7 +11,7 @@
 //! whose name contains NAME, as `cargo test NAME` does.
 
 use std::fmt::Write as _;
-use std::io::{BufRead as _, Write as _};
+use std::io::{BufRead as _, Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -33,6 +33,9 @@ use crate::project::{FILE, Project};
 /// A new or changed snapshot fails with its diff, its new text left beside
 /// the accepted one as `NAME.snap.new` (what `cargo insta review` shows
 /// too), until `--accept` or `--review` takes it.
+
+/// The longest answer `--review` reads from a line.
+const ANSWER_MAX: u64 = 256;
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     /// Only the tests whose name contains NAME: an image's (`probe`), one
@@ -154,11 +157,22 @@ impl Tally {
             );
             let _ = self.out.flush();
             let mut line = String::new();
-            let read = std::io::stdin()
-                .lock()
+            let mut input = std::io::stdin().lock();
+            // An answer is a word: a longer line is read no further than
+            // this (and the rest of it skipped), whatever is piped in.
+            let read = (&mut input)
+                .take(ANSWER_MAX)
                 .read_line(&mut line)
                 .into_diagnostic()
                 .wrap_err("cannot read the answer")?;
+            if read as u64 == ANSWER_MAX && !line.ends_with('\n') {
+                input
+                    .skip_until(b'\n')
+                    .into_diagnostic()
+                    .wrap_err("cannot read the answer")?;
+                line.clear();
+                line.push('?');
+            }
             if read == 0 {
                 let _ = writeln!(self.out);
                 return Ok(Decision::Skip);

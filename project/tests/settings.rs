@@ -1,0 +1,36 @@
+//! Settings that cannot be used are refused where they were written, by
+//! the resolution itself (found by a hostile tester: `SCORPION_BAUD=0` and
+//! an empty `port` in the per-user file passed `scorpion config`).
+
+use scorpion_project::{Environment, Error, Flags, Resolved};
+
+fn resolve(baud: Option<&str>, user: &str) -> Result<Resolved, Error> {
+    let dir = tempfile::tempdir().expect("a directory");
+    let user_file = dir.path().join("config.toml");
+    std::fs::write(&user_file, user).expect("write");
+    let env = Environment {
+        port: None,
+        baud: baud.map(str::to_owned),
+        user_file: Some(user_file),
+    };
+    Resolved::resolve(&Flags::default(), &env, dir.path())
+}
+
+#[test]
+fn a_rate_of_zero_is_refused_where_it_was_written() {
+    let error = resolve(Some("0"), "").expect_err("a rate of 0");
+    let said = error.to_string();
+    assert!(said.contains("baud") && said.contains("SCORPION_BAUD"), "{said}");
+    let error = resolve(None, "[robot]\nbaud = 0\n").expect_err("a rate of 0");
+    let said = error.to_string();
+    assert!(said.contains("baud") && said.contains("config.toml"), "{said}");
+    assert!(resolve(Some("9600"), "").is_ok());
+}
+
+#[test]
+fn an_empty_port_is_refused_where_it_was_written() {
+    let error = resolve(None, "[robot]\nport = \"\"\n").expect_err("an empty port");
+    let said = error.to_string();
+    assert!(said.contains("port") && said.contains("config.toml"), "{said}");
+    assert!(resolve(None, "[robot]\nport = \"emu\"\n").is_ok());
+}
