@@ -11,6 +11,7 @@ mod debug;
 mod disasm;
 mod emu;
 mod hostile_files;
+mod hostile_terminal;
 mod journeys;
 mod layouts;
 mod link;
