@@ -9,10 +9,10 @@ use std::process::{Command, Stdio};
 use crate::scorpion;
 
 /// Address space for the review run: far less than the piped line.
-const MEMORY_KIB: u64 = 400_000;
+const MEMORY_KIB: u64 = 700_000;
 
 /// A line this long, without a newline, then `s` to skip.
-const LINE: usize = 600 << 20;
+const LINE: usize = 800 << 20;
 
 #[test]
 fn a_huge_answer_to_review_is_read_no_further_than_an_answer() {
