@@ -540,11 +540,16 @@ fn a_missing_rom_profile_is_named_by_every_command() {
     ];
     for args in runs {
         let output = adc.run(&adc.project(), args, &[]);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(!output.status.success(), "{args:?} exits 0:\n{stderr}");
+        // `test` reports on stdout, as a test's failure; the others on stderr.
+        let said = format!(
+            "{}{}",
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(!output.status.success(), "{args:?} exits 0:\n{said}");
         assert!(
-            stderr.contains("ROM profile") && stderr.contains("nosuch.elf"),
-            "{args:?} does not name the ROM profile:\n{stderr}"
+            said.contains("ROM profile") && said.contains("nosuch.elf"),
+            "{args:?} does not name the ROM profile:\n{said}"
         );
     }
 }

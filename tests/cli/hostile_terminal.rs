@@ -22,7 +22,9 @@ fn a_huge_answer_to_review_is_read_no_further_than_an_answer() {
     assert!(scorpion(&project, &["test", "--accept"]).status.success());
     let source = project.join("src/big.s");
     let text = std::fs::read_to_string(&source).expect("the source");
-    std::fs::write(&source, text.replacen("lda #$01", "lda #$02", 1)).expect("write");
+    let planted = text.replacen("lda #VERSION", "lda #VERSION + 1", 1);
+    assert_ne!(planted, text, "the planted change");
+    std::fs::write(&source, planted).expect("write");
     let mut child = Command::new("sh")
         .arg("-c")
         .arg(format!("ulimit -v {MEMORY_KIB} && exec \"$0\" \"$@\""))
