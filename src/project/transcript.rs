@@ -12,7 +12,8 @@ use uploader::{Expectations, Mismatch};
 
 /// Reads the transcript at `path`, shown to the user as `shown`.
 pub(crate) fn read(path: &Path, shown: &str) -> miette::Result<Expectations> {
-    let text = hostfs::read_text(path, hostfs::TEXT).wrap_err_with(|| format!("cannot read {shown}"))?;
+    let text =
+        hostfs::read_text(path, hostfs::TEXT).wrap_err_with(|| format!("cannot read {shown}"))?;
     Expectations::parse(&text).map_err(|error| match error {
         uploader::Error::BadExpectations { line, reason } => miette::miette!(
             code = "uploader::bad_expectations",
