@@ -180,9 +180,12 @@ pub enum Error {
         base: u16,
         /// The failure, in one line.
         message: String,
-        /// The failure, located in the card's script.
-        #[diagnostic_source]
-        fault: Box<dyn miette::Diagnostic + Send + Sync>,
+        /// The failure, located in the card's script: one diagnostic,
+        /// related rather than a source so that its place and snippet
+        /// are shown through the callers' `wrap_err` (which keeps only a
+        /// cause's text).
+        #[related]
+        fault: [ScriptFault; 1],
     },
 
     /// The script of the robot's surroundings failed.
@@ -191,8 +194,54 @@ pub enum Error {
     Surroundings {
         /// The failure, in one line.
         message: String,
-        /// The failure, located in the script.
-        #[diagnostic_source]
-        fault: Box<dyn miette::Diagnostic + Send + Sync>,
+        /// The failure, located in the script: one diagnostic, related
+        /// for the reason [`Error::Card`]'s is.
+        #[related]
+        fault: [ScriptFault; 1],
     },
+}
+
+/// A card's or the surroundings' script failure as the script's host
+/// located it (file:line:col, snippet, help), shown in full as a related
+/// diagnostic of [`Error::Card`] and [`Error::Surroundings`].
+#[derive(Debug)]
+pub struct ScriptFault(pub Box<dyn miette::Diagnostic + Send + Sync>);
+
+impl std::fmt::Display for ScriptFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for ScriptFault {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
+impl miette::Diagnostic for ScriptFault {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.0.code()
+    }
+    fn severity(&self) -> Option<miette::Severity> {
+        self.0.severity()
+    }
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.0.help()
+    }
+    fn url<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.0.url()
+    }
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        self.0.source_code()
+    }
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        self.0.labels()
+    }
+    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
+        self.0.related()
+    }
+    fn diagnostic_source(&self) -> Option<&dyn miette::Diagnostic> {
+        self.0.diagnostic_source()
+    }
 }

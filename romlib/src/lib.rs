@@ -20,7 +20,7 @@ pub mod protocol;
 pub mod sim;
 pub mod symbols;
 
-pub use error::Error;
+pub use error::{Error, ScriptFault};
 pub use sim::{InstalledHook, Surroundings, VirtualScorpion};
 
 /// The reference ROM image, `$F000-$FFFF`.

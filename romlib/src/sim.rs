@@ -270,7 +270,7 @@ impl VirtualScorpion {
                 .wake(now, &mut self.robot)
                 .map_err(|fault| Error::Surroundings {
                     message: fault.to_string(),
-                    fault,
+                    fault: [crate::error::ScriptFault(fault)],
                 })?;
         }
     }
@@ -331,7 +331,7 @@ impl VirtualScorpion {
             return Err(Error::Card {
                 base,
                 message: fault.to_string(),
-                fault,
+                fault: [crate::error::ScriptFault(fault)],
             });
         }
         check(stop)

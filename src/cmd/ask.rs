@@ -44,27 +44,39 @@ fn command(text: &str) -> Result<Command, String> {
 
 /// One robot: the virtual one or a serial line.
 enum Robot {
-    Virtual(Box<VirtualScorpion>),
+    /// The virtual robot, and what its scripts print (shown after each
+    /// command, and on the way out when one fails).
+    Virtual(Box<VirtualScorpion>, ports::Shown),
     Serial(Client<Box<dyn uploader::Transport>>),
 }
 
 impl Robot {
+    /// [`Robot::exchange`] with the virtual robot.
+    fn exchange_virtual(
+        robot: &mut VirtualScorpion,
+        command: &Command,
+        timeout: Duration,
+        extension: bool,
+    ) -> miette::Result<Option<Answer>> {
+        if !extension {
+            return Ok(robot.exchange(command)?);
+        }
+        let cycles = u64::try_from(timeout.as_micros()).unwrap_or(u64::MAX);
+        match robot.transact(&command.encode(), cycles) {
+            Ok(raw) => Ok(Some(command.parse_answer(&raw)?)),
+            Err(romlib::Error::NoAnswer { received, .. }) if received.is_empty() => Ok(None),
+            Err(error) => Err(error.into()),
+        }
+    }
+
     /// Sends `command`; returns its answer, if it has one.
     fn exchange(&mut self, command: &Command, timeout: Duration) -> miette::Result<Option<Answer>> {
         let extension = matches!(command, Command::Extension(_));
         match self {
-            Robot::Virtual(robot) => {
-                if !extension {
-                    return Ok(robot.exchange(command)?);
-                }
-                let cycles = u64::try_from(timeout.as_micros()).unwrap_or(u64::MAX);
-                match robot.transact(&command.encode(), cycles) {
-                    Ok(raw) => Ok(Some(command.parse_answer(&raw)?)),
-                    Err(romlib::Error::NoAnswer { received, .. }) if received.is_empty() => {
-                        Ok(None)
-                    }
-                    Err(error) => Err(error.into()),
-                }
+            Robot::Virtual(robot, shown) => {
+                let answer = Self::exchange_virtual(robot, command, timeout, extension);
+                shown.show();
+                answer
             }
             Robot::Serial(client) => {
                 if command.is_question() {
@@ -99,12 +111,13 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         // The project's virtual robot: its cards, world, ROM and images.
         let rom = crate::cmd::config::rom(&resolved)?;
         let images = crate::cmd::config::images(&resolved, &args.images)?;
-        Robot::Virtual(Box::new(sim::robot_only(
+        let (robot, printed) = sim::robot(
             resolved.baud.value,
             rom.as_ref(),
             &crate::cmd::config::rig(&resolved),
             &images,
-        )?))
+        )?;
+        Robot::Virtual(Box::new(robot), ports::Shown(printed))
     } else {
         if !args.images.is_empty() {
             miette::bail!(

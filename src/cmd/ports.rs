@@ -2,6 +2,7 @@
 //! place the CLI turns a `--port` value into a transport.
 
 use std::process::ExitCode;
+use std::time::Duration;
 
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
@@ -74,7 +75,7 @@ pub(crate) fn open_resolved(
     let port = resolved.port()?;
     if port.value == EMU {
         let rom = crate::cmd::config::rom(resolved)?;
-        let mut robot = virtual_robot(
+        let (mut robot, shown) = virtual_robot(
             resolved.baud.value,
             rom.as_ref(),
             &crate::cmd::config::rig(resolved),
@@ -84,7 +85,7 @@ pub(crate) fn open_resolved(
                 .load_image(image)
                 .wrap_err_with(|| format!("cannot load {name}"))?;
         }
-        return Ok(Box::new(VirtualTransport::new(robot)));
+        return Ok(Box::new(Showing::new(VirtualTransport::new(robot), shown)));
     }
     Ok(Box::new(SerialTransport::open(
         &port.value,
@@ -97,12 +98,13 @@ pub(crate) const EMU: &str = "emu";
 
 /// A fresh virtual Scorpion whose DIP switches and host line are at `baud`,
 /// with the cards and surroundings of `rig`, running the ROM profile `rom`
-/// (its name and linked image) or the reference ROM.
+/// (its name and linked image) or the reference ROM; and what its scripts
+/// print, to be shown while it runs.
 pub(crate) fn virtual_robot(
     baud: u32,
     rom: Option<&(String, linker::Image)>,
     rig: &crate::cmd::rig::Rig,
-) -> miette::Result<VirtualScorpion> {
+) -> miette::Result<(VirtualScorpion, Shown)> {
     let mut robot = match rom {
         Some((name, image)) => VirtualScorpion::with_rom(name, image)?,
         None => VirtualScorpion::new(),
@@ -114,9 +116,8 @@ pub(crate) fn virtual_robot(
             "the Scorpion's 6551 has no {baud} baud rate"
         );
     }
-    // What their scripts print is shown by `scorpion sim` only.
-    let _printed = rig.apply(&mut robot)?;
-    Ok(robot)
+    let printed = rig.apply(&mut robot)?;
+    Ok((robot, Shown(printed)))
 }
 
 /// [`virtual_robot`] without the cards' and surroundings' scripts.
@@ -124,7 +125,7 @@ pub(crate) fn bare_robot(
     baud: u32,
     rom: Option<&(String, linker::Image)>,
 ) -> miette::Result<VirtualScorpion> {
-    virtual_robot(baud, rom, &crate::cmd::rig::Rig::default())
+    virtual_robot(baud, rom, &crate::cmd::rig::Rig::default()).map(|(robot, _)| robot)
 }
 
 /// Opens `port`: a serial device path, or `emu` for a fresh virtual
@@ -137,9 +138,75 @@ pub(crate) fn open(
     rig: &crate::cmd::rig::Rig,
 ) -> miette::Result<Box<dyn Transport>> {
     if port == EMU {
-        return Ok(Box::new(VirtualTransport::new(virtual_robot(
-            baud, None, rig,
-        )?)));
+        let (robot, shown) = virtual_robot(baud, None, rig)?;
+        return Ok(Box::new(Showing::new(VirtualTransport::new(robot), shown)));
     }
     Ok(Box::new(SerialTransport::open(port, baud)?))
+}
+
+/// What the virtual robot's scripts print, shown on stderr (`NAME: line`,
+/// as `scorpion sim` shows it) when asked and when dropped, so that no
+/// command that runs the scripts keeps their output to itself.
+pub(crate) struct Shown(pub(crate) Vec<(String, cards::Printed)>);
+
+impl Shown {
+    /// Shows what the scripts printed since the last look.
+    pub(crate) fn show(&self) {
+        crate::cmd::rig::show_printed(&self.0);
+    }
+}
+
+impl Drop for Shown {
+    fn drop(&mut self) {
+        self.show();
+    }
+}
+
+/// A line to the virtual robot that shows what its scripts print after
+/// every exchange on it.
+pub(crate) struct Showing<T> {
+    inner: T,
+    shown: Shown,
+}
+
+impl<T> Showing<T> {
+    /// `inner`, showing `shown` as it runs.
+    pub(crate) fn new(inner: T, shown: Shown) -> Self {
+        Showing { inner, shown }
+    }
+}
+
+impl<T: Transport> Transport for Showing<T> {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        let result = self.inner.send(bytes);
+        self.shown.show();
+        result
+    }
+    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
+        let result = self.inner.receive(into, timeout);
+        self.shown.show();
+        result
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn set_baud(&mut self, baud: u32) -> uploader::Result<()> {
+        self.inner.set_baud(baud)
+    }
+    fn now(&self) -> Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        let result = self.inner.clear_input();
+        self.shown.show();
+        result
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+    fn diagnose_silence(&mut self) -> uploader::Result<()> {
+        let result = self.inner.diagnose_silence();
+        self.shown.show();
+        result
+    }
 }

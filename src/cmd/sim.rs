@@ -57,17 +57,6 @@ fn bumper_mask(text: &str) -> Result<u8, String> {
         .map_err(|_| format!("`{text}` is not a hex byte (write 05 or $80: a bit per bumper)"))
 }
 
-/// The virtual robot as the options describe it, powered up, without the
-/// handles to what its scripts print.
-pub(crate) fn robot_only(
-    baud: u32,
-    rom: Option<&(String, linker::Image)>,
-    rig: &crate::cmd::rig::Rig,
-    images: &crate::cmd::config::Images,
-) -> miette::Result<VirtualScorpion> {
-    robot(baud, rom, rig, images).map(|(robot, _)| robot)
-}
-
 /// The virtual robot as the options describe it, powered up, and what
 /// each of its scripts prints.
 pub(crate) fn robot(

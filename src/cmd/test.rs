@@ -415,14 +415,16 @@ impl Setup {
     }
 
     /// A fresh robot with the images loaded as an upload leaves them.
-    fn robot(&self, built: &[Built]) -> miette::Result<romlib::VirtualScorpion> {
-        let mut robot = ports::virtual_robot(self.baud, self.rom.as_ref(), &self.rig)?;
+    /// What its scripts print is shown as it runs and when the
+    /// [`ports::Shown`] is dropped.
+    fn robot(&self, built: &[Built]) -> miette::Result<(romlib::VirtualScorpion, ports::Shown)> {
+        let (mut robot, shown) = ports::virtual_robot(self.baud, self.rom.as_ref(), &self.rig)?;
         for image in built {
             robot
                 .load_image(&image.linked.image)
                 .wrap_err_with(|| format!("cannot load {}", image.name))?;
         }
-        Ok(robot)
+        Ok((robot, shown))
     }
 }
 
@@ -463,7 +465,7 @@ fn routine_calls(
             let result = setup
                 .robot(built)
                 .map_err(|e| format!("{e:?}"))
-                .and_then(|mut robot| crate::project::calls::run(&call, &mut robot));
+                .and_then(|(mut robot, _shown)| crate::project::calls::run(&call, &mut robot));
             tally.record(
                 &name,
                 result.map(|()| "ok").map_err(|why| format!("  {why}")),
@@ -488,8 +490,8 @@ fn virtual_transcripts(
             continue;
         }
         let result = match setup.robot(built) {
-            Ok(robot) => {
-                let mut client = client(VirtualTransport::new(robot));
+            Ok((robot, shown)) => {
+                let mut client = client(ports::Showing::new(VirtualTransport::new(robot), shown));
                 let result = run_transcript(project, &path, &mut client, Clock::Robot);
                 robot_time += client.transport().now();
                 result

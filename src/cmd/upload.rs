@@ -316,10 +316,11 @@ fn upload_file(
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let mut robot = ports::virtual_robot(baud, rom.as_ref(), &rig)?;
+        let (mut robot, shown) = ports::virtual_robot(baud, rom.as_ref(), &rig)?;
         // A handler that hangs in the rehearsal is named by its label.
         robot.add_labels(&linked);
-        let mut client = args.client(VirtualTransport::new(robot), profile);
+        let transport = ports::Showing::new(VirtualTransport::new(robot), shown);
+        let mut client = args.client(transport, profile);
         let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
             "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot",
         )?;

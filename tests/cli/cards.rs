@@ -234,3 +234,96 @@ fn what_a_card_script_prints_shows_on_stderr_in_sim() {
     assert_eq!(code, 0, "{text}");
     assert!(text.contains("chatty.rhai: written 66 at "), "{text}");
 }
+
+#[test]
+fn what_the_scripts_print_shows_on_stderr_in_ask_and_read() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("talk.rhai"),
+        "fn init() { print(\"hello\"); wake_at(ms(1)); }\nfn wake(now) { print(`awake at ${now}`); }\n",
+    )
+    .expect("write the world");
+    std::fs::write(
+        dir.path().join("chatty.rhai"),
+        "const SIZE = 1;\nconst BASE = 0x9000;\nfn read(reg, now) { print(`read at ${now}`); 0x42 }\nfn write(reg, value, now) { print(`written ${value} at ${now}`); }\n",
+    )
+    .expect("write the card");
+    // `ask` runs the virtual robot itself.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "ask",
+            "--port",
+            "emu",
+            "--world",
+            "talk.rhai",
+            "--card",
+            "chatty.rhai",
+            "/7W900042",
+            "/1X",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("talk.rhai: hello\n"), "{stderr}");
+    assert!(stderr.contains("talk.rhai: awake at "), "{stderr}");
+    assert!(stderr.contains("chatty.rhai: written 66 at "), "{stderr}");
+    // `read` opens it as a line, as upload, installed and test do.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "read",
+            "--port",
+            "emu",
+            "--card",
+            "chatty.rhai",
+            "0x9000",
+            "1",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("chatty.rhai: read at "), "{stderr}");
+}
+
+#[test]
+fn a_world_or_card_fault_in_ask_is_shown_at_its_place() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("spin.rhai"),
+        "fn init() { wake_at(0); }\nfn wake(now) { wake_at(now); }\n",
+    )
+    .expect("write the world");
+    let output = scorpion(
+        dir.path(),
+        &["ask", "--port", "emu", "--world", "spin.rhai", "/1U"],
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("the surroundings failed"), "{stderr}");
+    assert!(stderr.contains("spin.rhai:2:16"), "{stderr}");
+    // The snippet and the help, not only the one-line message.
+    assert!(
+        stderr.contains(" 2 │ fn wake(now) { wake_at(now); }"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("help: robot time stands still"), "{stderr}");
+
+    std::fs::write(
+        dir.path().join("broken.rhai"),
+        "const SIZE = 1;\nconst BASE = 0x9000;\nfn write(reg, value, now) {\n    throw `no register ${reg}`;\n}\n",
+    )
+    .expect("write the card");
+    let output = scorpion(
+        dir.path(),
+        &["ask", "--port", "emu", "--card", "broken.rhai", "/7W900042"],
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("the card at $9000 failed"), "{stderr}");
+    assert!(stderr.contains("broken.rhai:4:5"), "{stderr}");
+    assert!(
+        stderr.contains(" 4 │     throw `no register ${reg}`;"),
+        "{stderr}"
+    );
+}
