@@ -42,8 +42,20 @@ fn value() -> impl Strategy<Value = String> {
 /// A line of a project file: a table header, a key with a value, or noise.
 fn line() -> impl Strategy<Value = String> {
     let keys = prop::sample::select(vec![
-        "name", "sources", "target", "include", "defines", "port", "baud", "cards", "world",
-        "rom", "transcripts", "builtin_listing", "members", "bogus",
+        "name",
+        "sources",
+        "target",
+        "include",
+        "defines",
+        "port",
+        "baud",
+        "cards",
+        "world",
+        "rom",
+        "transcripts",
+        "builtin_listing",
+        "members",
+        "bogus",
     ]);
     prop_oneof![
         3 => (keys, value()).prop_map(|(k, v)| format!("{k} = {v}")),

@@ -20,10 +20,16 @@ fn resolve(baud: Option<&str>, user: &str) -> Result<Resolved, Error> {
 fn a_rate_of_zero_is_refused_where_it_was_written() {
     let error = resolve(Some("0"), "").expect_err("a rate of 0");
     let said = error.to_string();
-    assert!(said.contains("baud") && said.contains("SCORPION_BAUD"), "{said}");
+    assert!(
+        said.contains("baud") && said.contains("SCORPION_BAUD"),
+        "{said}"
+    );
     let error = resolve(None, "[robot]\nbaud = 0\n").expect_err("a rate of 0");
     let said = error.to_string();
-    assert!(said.contains("baud") && said.contains("config.toml"), "{said}");
+    assert!(
+        said.contains("baud") && said.contains("config.toml"),
+        "{said}"
+    );
     assert!(resolve(Some("9600"), "").is_ok());
 }
 
@@ -31,6 +37,9 @@ fn a_rate_of_zero_is_refused_where_it_was_written() {
 fn an_empty_port_is_refused_where_it_was_written() {
     let error = resolve(None, "[robot]\nport = \"\"\n").expect_err("an empty port");
     let said = error.to_string();
-    assert!(said.contains("port") && said.contains("config.toml"), "{said}");
+    assert!(
+        said.contains("port") && said.contains("config.toml"),
+        "{said}"
+    );
     assert!(resolve(None, "[robot]\nport = \"emu\"\n").is_ok());
 }

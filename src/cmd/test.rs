@@ -26,6 +26,9 @@ use crate::project::snapshot::{self, Outcome};
 use crate::project::transcript::{self, Clock};
 use crate::project::{FILE, Project};
 
+/// The longest answer `--review` reads from a line.
+const ANSWER_MAX: u64 = 256;
+
 /// Run the project's tests: snapshots of the assembled output and
 /// transcripts on the virtual Scorpion.
 ///
@@ -34,8 +37,6 @@ use crate::project::{FILE, Project};
 /// the accepted one as `NAME.snap.new` (what `cargo insta review` shows
 /// too), until `--accept` or `--review` takes it.
 
-/// The longest answer `--review` reads from a line.
-const ANSWER_MAX: u64 = 256;
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     /// Only the tests whose name contains NAME: an image's (`probe`), one

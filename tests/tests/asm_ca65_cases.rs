@@ -116,9 +116,12 @@ fn cases() -> Vec<Case> {
         .collect()
 }
 
-/// Our assembler and linker on the case: the image, the warnings and the
+/// What a toolchain made of a case: the image, the warnings and the
 /// `.out` lines.
-fn ours(case: &Case) -> Result<(Vec<u8>, Vec<String>, Vec<String>), String> {
+type Made = (Vec<u8>, Vec<String>, Vec<String>);
+
+/// Our assembler and linker on the case.
+fn ours(case: &Case) -> Result<Made, String> {
     let dir = tempfile::tempdir().expect("a temporary directory");
     for (name, text) in &case.files {
         std::fs::write(dir.path().join(name), text).expect("write a case file");
