@@ -278,7 +278,7 @@ impl Program {
         use Value::{Addr, Byte, Chunk, Const};
         let not_yet = |v: &Value| matches!(v, Chunk { .. });
         match (op, left, right) {
-            (_, Const(a), Const(b)) => op.apply(a, b).map(Const).map_err(|_| EvalErr::DivZero),
+            (_, Const(a), Const(b)) => op.apply_ca65(a, b).map(Const).map_err(|_| EvalErr::DivZero),
             (BinaryOp::Add, Addr { base, off }, Const(k))
             | (BinaryOp::Add, Const(k), Addr { base, off }) => Ok(Addr {
                 base,

@@ -152,7 +152,7 @@ impl Asm<'_> {
         if let (Some(Node::Const(a)), Some(Node::Const(b))) = (
             self.prog.nodes.get(left as usize).copied(),
             self.prog.nodes.get(right as usize).copied(),
-        ) && let Ok(value) = op.apply(a, b)
+        ) && let Ok(value) = op.apply_ca65(a, b)
         {
             return self.prog.node(Node::Const(value));
         }

@@ -171,6 +171,26 @@ fn shift_right(value: i64, count: i64) -> i64 {
     }
 }
 
+/// ca65's `<<` on constants it folds: cc65's `shl_l`, the count taken as
+/// C's `unsigned` (its low 32 bits), counts past 63 shifting everything out.
+fn ca65_shift_left(value: i64, count: i64) -> i64 {
+    match count as u32 {
+        count @ 0..64 => value.wrapping_shl(count),
+        _ => 0,
+    }
+}
+
+/// ca65's `>>` on constants it folds: cc65's `shr_l`, a *logical* shift (a
+/// negative number's sign bits are not copied in), the count taken as C's
+/// `unsigned`. ld65 computes what reaches it with C's arithmetic `>>`
+/// instead, which [`BinaryOp::apply`] follows.
+fn ca65_shift_right(value: i64, count: i64) -> i64 {
+    match count as u32 {
+        count @ 0..64 => ((value as u64) >> count) as i64,
+        _ => 0,
+    }
+}
+
 impl UnaryOp {
     /// Applies the operator.
     #[must_use]
@@ -223,6 +243,22 @@ impl BinaryOp {
             BinaryOp::LogOr => truth(left != 0 || right != 0),
             BinaryOp::LogXor => truth((left != 0) != (right != 0)),
         })
+    }
+
+    /// Applies the operator as ca65 does when it folds constants while
+    /// assembling: as [`BinaryOp::apply`] (ld65's arithmetic, for what
+    /// the linker finishes) but for the shifts, which ca65 makes logical
+    /// with an unsigned 32-bit count (`(-16 >> 60) & $FF` is `$0F` in ca65
+    /// and `$FF` in ld65).
+    ///
+    /// # Errors
+    /// [`EvalError::DivisionByZero`] for `/` or `.mod` by zero.
+    pub fn apply_ca65(self, left: i64, right: i64) -> Result<i64, EvalError> {
+        match self {
+            BinaryOp::Shl => Ok(ca65_shift_left(left, right)),
+            BinaryOp::Shr => Ok(ca65_shift_right(left, right)),
+            _ => self.apply(left, right),
+        }
     }
 }
 
@@ -476,6 +512,23 @@ mod tests {
         assert_eq!(BinaryOp::Shl.apply(16, -4), Ok(1));
         assert_eq!(BinaryOp::Shr.apply(-16, 2), Ok(-4));
         assert_eq!(BinaryOp::Shr.apply(-16, 200), Ok(-1));
+        // ca65 2.19's folding, as it assembled `.byte <(...)` of each.
+        assert_eq!(BinaryOp::Shr.apply_ca65(-16, 60), Ok(0x0F));
+        assert_eq!(BinaryOp::Shr.apply_ca65(-16, 64), Ok(0));
+        assert_eq!(
+            BinaryOp::Shr.apply_ca65(-256, 4).map(|v| v & 0xFF),
+            Ok(0xF0)
+        );
+        assert_eq!(
+            BinaryOp::Shr
+                .apply_ca65(-1, (1 << 32) + 4)
+                .map(|v| v & 0xFF),
+            Ok(0xFF)
+        );
+        assert_eq!(BinaryOp::Shl.apply_ca65(1, (1 << 32) + 1), Ok(2));
+        assert_eq!(BinaryOp::Shl.apply_ca65(-16, -4), Ok(0));
+        assert_eq!(BinaryOp::Shr.apply_ca65(16, -2), Ok(0));
+        assert_eq!(BinaryOp::Shr.apply_ca65(1 << 63, 56), Ok(0x80));
         assert_eq!(BinaryOp::LogXor.apply(3, 0), Ok(1));
         assert_eq!(BinaryOp::LogXor.apply(3, 4), Ok(0));
         assert_eq!(UnaryOp::HiByte.apply(0x12345), 0x23);
