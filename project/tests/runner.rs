@@ -1,0 +1,291 @@
+//! The runner as a library, with no CLI process: a new project made in a
+//! temporary directory, its snapshots and transcripts run by
+//! `run_tests`, the report checked (counts, a planted change failing with
+//! its diff, its transcript mismatch and a pending `.snap.new`), the
+//! events a progress recorder receives in order, and the decisions about
+//! one pending snapshot at a time.
+
+use std::path::Path;
+
+use romlib::VirtualScorpion;
+use scorpion_project::runner::{
+    self, Decision, Mode, Options, Outcome, Passed, Progress, Question, SNAPSHOT_KINDS,
+};
+use scorpion_project::template::{self, Kind};
+use scorpion_project::{Environment, Found, Project};
+
+/// What a run told its progress, in order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Event {
+    Started(String),
+    Finished(String, bool),
+    RobotReady(String),
+    RobotDone(String),
+    Review(String),
+}
+
+/// Records every event; answers reviews with `answer`.
+#[derive(Default)]
+struct Recorder {
+    events: Vec<Event>,
+    answer: Option<Decision>,
+}
+
+impl Progress for Recorder {
+    fn test_started(&mut self, name: &str) {
+        self.events.push(Event::Started(name.to_owned()));
+    }
+    fn test_finished(&mut self, name: &str, outcome: &Outcome) {
+        self.events
+            .push(Event::Finished(name.to_owned(), !outcome.failed()));
+    }
+    fn robot_ready(&mut self, test: &str, _robot: &mut VirtualScorpion) {
+        self.events.push(Event::RobotReady(test.to_owned()));
+    }
+    fn robot_done(&mut self, test: &str, _robot: &mut VirtualScorpion) {
+        self.events.push(Event::RobotDone(test.to_owned()));
+    }
+    fn review(&mut self, question: &Question<'_>) -> miette::Result<Decision> {
+        self.events.push(Event::Review(question.name.to_owned()));
+        Ok(self.answer.unwrap_or(Decision::Skip))
+    }
+}
+
+/// A project's tests run with `options` (no user file, no environment).
+fn run(project: &Project, options: Options, recorder: &mut Recorder) -> runner::Report {
+    let found = Found::Project(project.clone());
+    runner::run_tests(&found, &options, recorder).expect("the run itself ends")
+}
+
+fn options() -> Options {
+    Options {
+        environment: Environment::default(),
+        ..Options::default()
+    }
+}
+
+fn new_project(dir: &Path) -> Project {
+    template::create(&dir.join("probe"), "probe", Kind::Extension).expect("a new project")
+}
+
+/// The tests a new project has, in the order they run: its image's
+/// snapshots, then its transcript.
+fn expected_names() -> Vec<String> {
+    let mut names: Vec<String> = SNAPSHOT_KINDS
+        .iter()
+        .map(|kind| format!("probe/{kind}"))
+        .collect();
+    names.push("transcript tests/probe.expect".to_owned());
+    names
+}
+
+#[test]
+fn a_new_project_passes_and_the_progress_hears_each_test_in_order() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let mut recorder = Recorder::default();
+    let report = run(&project, options(), &mut recorder);
+
+    let names = expected_names();
+    assert_eq!(report.passed, names.len(), "{report:#?}");
+    assert_eq!(report.failed, 0, "{report:#?}");
+    assert_eq!(report.filtered_out, 0);
+    assert!(report.success());
+    let ran: Vec<&str> = report.tests.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(ran, names);
+    assert!(report.robot_time > std::time::Duration::ZERO);
+
+    let transcript = names.last().expect("a transcript").clone();
+    let mut expected = Vec::new();
+    for name in &names {
+        expected.push(Event::Started(name.clone()));
+        if *name == transcript {
+            expected.push(Event::RobotReady(name.clone()));
+            expected.push(Event::RobotDone(name.clone()));
+        }
+        expected.push(Event::Finished(name.clone(), true));
+    }
+    assert_eq!(recorder.events, expected);
+}
+
+#[test]
+fn a_planted_change_fails_with_its_diff_its_mismatch_and_a_pending_snapshot() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let source = project.root.join("src").join("probe.s");
+    let text = std::fs::read_to_string(&source).expect("the new source");
+    assert!(text.contains("VERSION = $01"), "{text}");
+    std::fs::write(&source, text.replace("VERSION = $01", "VERSION = $02"))
+        .expect("the planted change");
+
+    let mut recorder = Recorder::default();
+    let report = run(&project, options(), &mut recorder);
+    assert!(!report.success());
+    assert_eq!(report.passed + report.failed, expected_names().len());
+
+    // The bytes hold the version: a diff from the old byte to the new,
+    // and the new text pending beside the accepted one.
+    let bytes = report.test("probe/bytes").expect("the bytes' snapshot ran");
+    let Outcome::Failed(failure) = &bytes.outcome else {
+        panic!("the changed bytes passed: {bytes:#?}");
+    };
+    let diff = failure.diff.as_deref().expect("a changed snapshot's diff");
+    assert!(
+        diff.lines()
+            .any(|l| l.starts_with("- ") && l.contains(" 01")),
+        "{diff}"
+    );
+    assert!(
+        diff.lines()
+            .any(|l| l.starts_with("+ ") && l.contains(" 02")),
+        "{diff}"
+    );
+    let pending = failure.pending.as_deref().expect("a pending snapshot");
+    assert_eq!(
+        pending,
+        project
+            .snapshot_path("probe", "bytes")
+            .with_extension("snap.new")
+    );
+    let written = std::fs::read_to_string(pending).expect("the pending file was written");
+    assert!(written.starts_with("---\nsource: Scorpion.toml\nexpression: probe/bytes\n---\n"));
+
+    // The transcript says the line, the command, both answers.
+    let transcript = report
+        .test("transcript tests/probe.expect")
+        .expect("the transcript ran");
+    let Outcome::Failed(failure) = &transcript.outcome else {
+        panic!("the transcript passed: {transcript:#?}");
+    };
+    let line = std::fs::read_to_string(project.root.join("tests").join("probe.expect"))
+        .expect("the transcript")
+        .lines()
+        .position(|l| l.starts_with("/1V"))
+        .expect("a /1V line")
+        + 1;
+    assert!(
+        failure.text.contains(&format!(
+            "tests/probe.expect:{line}: `/1V` answered `V02`, expected `V01`"
+        )),
+        "{}",
+        failure.text
+    );
+
+    // Every failure the report holds was told to the progress, as failed.
+    for test in &report.tests {
+        assert!(
+            recorder
+                .events
+                .contains(&Event::Finished(test.name.clone(), !test.outcome.failed())),
+            "{}",
+            test.name
+        );
+    }
+}
+
+#[test]
+fn one_pending_snapshot_at_a_time_is_accepted_rejected_or_reviewed() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let source = project.root.join("src").join("probe.s");
+    let text = std::fs::read_to_string(&source).expect("the new source");
+    std::fs::write(&source, text.replace("VERSION = $01", "VERSION = $02"))
+        .expect("the planted change");
+    let report = run(&project, options(), &mut Recorder::default());
+    let failed_snapshots: Vec<String> = report
+        .tests
+        .iter()
+        .filter(|t| t.outcome.failed() && t.name.starts_with("probe/"))
+        .map(|t| t.name.clone())
+        .collect();
+    let pending = runner::review::pending(&project);
+    assert_eq!(pending.len(), failed_snapshots.len(), "{pending:#?}");
+
+    // Accept the bytes' alone: its test passes, the others still fail.
+    let bytes = project.snapshot_path("probe", "bytes");
+    let one = pending
+        .iter()
+        .find(|p| p.accepted == bytes)
+        .expect("the bytes are pending");
+    assert!(one.diff().expect("readable").is_some());
+    one.accept().expect("accepted");
+    assert!(!one.pending.exists());
+    let again = run(
+        &project,
+        Options {
+            filter: Some("probe/".to_owned()),
+            ..options()
+        },
+        &mut Recorder::default(),
+    );
+    assert_eq!(
+        again.test("probe/bytes").map(|t| &t.outcome),
+        Some(&Outcome::Passed(Passed::Ok))
+    );
+    assert_eq!(again.failed, failed_snapshots.len() - 1);
+
+    // Reject the listing's: the pending file goes, the accepted stays.
+    let listing = project.snapshot_path("probe", "listing");
+    let accepted_text = std::fs::read_to_string(&listing).expect("accepted listing");
+    let pending = runner::review::pending(&project);
+    let one = pending
+        .iter()
+        .find(|p| p.accepted == listing)
+        .expect("the listing is pending");
+    one.reject().expect("rejected");
+    assert!(!one.pending.exists());
+    assert_eq!(
+        std::fs::read_to_string(&listing).expect("accepted listing"),
+        accepted_text
+    );
+
+    // A review answered `accept` takes what is left, each asked once.
+    let mut reviewer = Recorder {
+        answer: Some(Decision::Accept),
+        ..Recorder::default()
+    };
+    let reviewed = run(
+        &project,
+        Options {
+            filter: Some("probe/".to_owned()),
+            mode: Mode::Review,
+            ..options()
+        },
+        &mut reviewer,
+    );
+    assert_eq!(reviewed.failed, 0, "{reviewed:#?}");
+    let asked: Vec<&Event> = reviewer
+        .events
+        .iter()
+        .filter(|e| matches!(e, Event::Review(_)))
+        .collect();
+    assert_eq!(asked.len(), failed_snapshots.len() - 1, "{asked:?}");
+    assert!(runner::review::pending(&project).is_empty());
+}
+
+#[test]
+fn with_a_port_the_images_are_uploaded_and_the_transcripts_run_there() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let mut recorder = Recorder::default();
+    let report = run(
+        &project,
+        Options {
+            port: Some(runner::EMU.to_owned()),
+            ..options()
+        },
+        &mut recorder,
+    );
+    let ran: Vec<&str> = report.tests.iter().map(|t| t.name.as_str()).collect();
+    // The rehearsal on the virtual robot, the upload, the transcript on
+    // the robot the port names; no snapshots.
+    assert_eq!(
+        ran,
+        [
+            "transcript tests/probe.expect",
+            "upload probe",
+            "transcript tests/probe.expect"
+        ]
+    );
+    assert!(report.success(), "{report:#?}");
+}
