@@ -22,6 +22,8 @@ enum Event {
     RobotReady(String),
     RobotDone(String),
     Review(String),
+    CardMapped(String, u16, u16),
+    ScriptPrinted(String, String),
 }
 
 /// Records every event; answers reviews with `answer`.
@@ -44,6 +46,14 @@ impl Progress for Recorder {
     }
     fn robot_done(&mut self, test: &str, _robot: &mut VirtualScorpion) {
         self.events.push(Event::RobotDone(test.to_owned()));
+    }
+    fn card_mapped(&mut self, card: &str, start: u16, end: u16) {
+        self.events
+            .push(Event::CardMapped(card.to_owned(), start, end));
+    }
+    fn script_printed(&mut self, script: &str, line: &str) {
+        self.events
+            .push(Event::ScriptPrinted(script.to_owned(), line.to_owned()));
     }
     fn review(&mut self, question: &Question<'_>) -> miette::Result<Decision> {
         self.events.push(Event::Review(question.name.to_owned()));
@@ -288,4 +298,72 @@ fn with_a_port_the_images_are_uploaded_and_the_transcripts_run_there() {
         ]
     );
     assert!(report.success(), "{report:#?}");
+}
+
+#[test]
+fn a_projects_card_is_on_each_transcripts_robot_and_what_it_prints_is_told() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let card = "cards/hello.rhai";
+    let path = project.root.join(card);
+    std::fs::create_dir_all(path.parent().expect("a directory")).expect("cards/");
+    std::fs::write(
+        &path,
+        "const SIZE = 2;\nconst BASE = 0x9100;\nfn init() { print(\"hello from the card\"); }\n",
+    )
+    .expect("the card");
+    let file = project.root.join("Scorpion.toml");
+    let text = std::fs::read_to_string(&file).expect("the project file");
+    assert!(text.contains("cards = []"), "{text}");
+    std::fs::write(
+        &file,
+        text.replace("cards = []", &format!("cards = [\"{card}\"]")),
+    )
+    .expect("the card in the project");
+    let project = Project::load(&project.root).expect("the project with its card");
+
+    let mut recorder = Recorder::default();
+    let report = run(&project, options(), &mut recorder);
+    assert!(report.success(), "{report:#?}");
+
+    // The transcript's events, from its start to its end: the card mapped
+    // on its fresh robot before the robot is ready, what the card printed
+    // while it ran, the robot done before the test is.
+    let transcript = "transcript tests/probe.expect".to_owned();
+    let events = &recorder.events;
+    let from = events
+        .iter()
+        .position(|e| *e == Event::Started(transcript.clone()))
+        .expect("the transcript started");
+    let to = events
+        .iter()
+        .position(|e| *e == Event::Finished(transcript.clone(), true))
+        .expect("the transcript passed");
+    let during = &events[from..=to];
+    let at = |wanted: &Event| {
+        during
+            .iter()
+            .position(|e| e == wanted)
+            .unwrap_or_else(|| panic!("{wanted:?} not in {during:#?}"))
+    };
+    let mapped = at(&Event::CardMapped(card.to_owned(), 0x9100, 0x9101));
+    let ready = at(&Event::RobotReady(transcript.clone()));
+    let printed = at(&Event::ScriptPrinted(
+        card.to_owned(),
+        "hello from the card".to_owned(),
+    ));
+    let done = at(&Event::RobotDone(transcript.clone()));
+    assert!(
+        mapped < ready && ready < printed && printed < done,
+        "{during:#?}"
+    );
+    // Snapshots run no robot.
+    assert_eq!(
+        events
+            .iter()
+            .filter(|e| matches!(e, Event::CardMapped(..)))
+            .count(),
+        1,
+        "{events:#?}"
+    );
 }
