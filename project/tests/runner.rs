@@ -367,3 +367,52 @@ fn a_projects_card_is_on_each_transcripts_robot_and_what_it_prints_is_told() {
         "{events:#?}"
     );
 }
+
+#[test]
+fn each_routine_call_has_its_own_robot_and_its_failure_says_what_differs() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let source = project.root.join("src").join("probe.s");
+    let mut text = std::fs::read_to_string(&source).expect("the new source");
+    text.push_str("\ndouble: asl a\n        rts\n");
+    std::fs::write(&source, text).expect("a routine");
+    std::fs::write(
+        project.root.join("tests").join("probe.calls"),
+        "call double A=$21 => A=$42 C=0\ncall double A=$81 => A=$02 C=0\n",
+    )
+    .expect("the calls");
+
+    let mut recorder = Recorder::default();
+    let only_calls = Options {
+        filter: Some("call ".to_owned()),
+        ..options()
+    };
+    let report = run(&project, only_calls, &mut recorder);
+    let first = "call tests/probe.calls:1 double".to_owned();
+    let second = "call tests/probe.calls:2 double".to_owned();
+    let ran: Vec<&str> = report.tests.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(ran, [first.as_str(), second.as_str()]);
+    assert_eq!(
+        report.test(&first).map(|t| &t.outcome),
+        Some(&Outcome::Passed(Passed::Ok))
+    );
+    let Some(Outcome::Failed(failure)) = report.test(&second).map(|t| &t.outcome) else {
+        panic!("$81 doubled leaves the carry set: {report:#?}");
+    };
+    assert!(
+        failure.text.contains("C=$01, expected $00"),
+        "{}",
+        failure.text
+    );
+    // The snapshots and the transcript are filtered out, not run.
+    assert_eq!(report.filtered_out, expected_names().len());
+
+    let mut expected = Vec::new();
+    for (name, passed) in [(&first, true), (&second, false)] {
+        expected.push(Event::Started(name.clone()));
+        expected.push(Event::RobotReady(name.clone()));
+        expected.push(Event::RobotDone(name.clone()));
+        expected.push(Event::Finished(name.clone(), passed));
+    }
+    assert_eq!(recorder.events, expected);
+}
