@@ -21,18 +21,7 @@ pub(crate) struct Args {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    let resolved = args.line.resolve()?;
-    // `--port emu` is the project's virtual robot, its images installed.
-    let images = if resolved.port()?.value == ports::EMU {
-        crate::cmd::config::images(&resolved, &[])?.images
-    } else {
-        crate::cmd::config::note_unused_rig(&resolved);
-        Vec::new()
-    };
-    let transport = ports::open_resolved(&resolved, &images)?;
-    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
-    let mut client = uploader::client(transport, &profile);
-    client.probe()?;
+    let (mut client, profile) = ports::probed(&args.line)?;
     let everyone = uploader::read_installed(&mut client, &profile)?;
     let mut chains = Vec::new();
     for kind in HookKind::ALL {

@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
-use uploader::Transport;
 use uploader::transport::{SerialTransport, VirtualTransport, list_ports};
+use uploader::{RomProfile, Transport};
 
 /// List the serial ports of this machine.
 #[derive(Debug, clap::Args)]
@@ -91,6 +91,27 @@ pub(crate) fn open_resolved(
         &port.value,
         resolved.baud.value,
     )?))
+}
+
+/// The robot `line` names, probed, for commands that only look at it
+/// (`read`, `installed`): on `emu` the project's images installed as an
+/// upload leaves them (else nothing would be there to look at), on a real
+/// port the robot as it is (a note if cards or a world would go unused).
+pub(crate) fn probed(
+    line: &Line,
+) -> miette::Result<(uploader::Client<Box<dyn Transport>>, RomProfile)> {
+    let resolved = line.resolve()?;
+    let images = if resolved.port()?.value == EMU {
+        crate::cmd::config::images(&resolved, &[])?.images
+    } else {
+        crate::cmd::config::note_unused_rig(&resolved);
+        Vec::new()
+    };
+    let transport = open_resolved(&resolved, &images)?;
+    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
+    let mut client = uploader::client(transport, &profile);
+    client.probe()?;
+    Ok((client, profile))
 }
 
 /// The `--port` value that names the in-process virtual Scorpion.

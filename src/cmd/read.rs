@@ -34,18 +34,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             args.address
         );
     }
-    let resolved = args.line.resolve()?;
-    // `--port emu` is the project's virtual robot, its images installed.
-    let images = if resolved.port()?.value == ports::EMU {
-        crate::cmd::config::images(&resolved, &[])?.images
-    } else {
-        crate::cmd::config::note_unused_rig(&resolved);
-        Vec::new()
-    };
-    let transport = ports::open_resolved(&resolved, &images)?;
-    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
-    let mut client = uploader::client(transport, &profile);
-    client.probe()?;
+    let (mut client, _) = ports::probed(&args.line)?;
     let bytes = client.read_memory(args.address, args.length as usize)?;
     match &args.output {
         Some(path) => std::fs::write(path, &bytes)
