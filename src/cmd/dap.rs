@@ -23,6 +23,7 @@ use miette::IntoDiagnostic;
 mod framing;
 #[cfg(test)]
 mod fuzz;
+mod line;
 mod protocol;
 mod session;
 
