@@ -606,7 +606,8 @@ impl Debugger {
 
     /// The last write to `address` before now: the writing instruction's
     /// count (instructions run before it), its PC and the byte written.
-    /// `None` if nothing has written it since power-up.
+    /// `None` if no instruction has written it since the session began
+    /// (an image's bytes are loaded before it).
     ///
     /// # Errors
     /// As [`Debugger::back`].

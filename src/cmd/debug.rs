@@ -404,7 +404,9 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
                     write.instruction,
                     place(d, write.pc)
                 ),
-                None => format!("nothing has written ${address:04X} since power-up\n"),
+                None => format!(
+                    "no instruction has written ${address:04X} since the session began (images are loaded before it)\n"
+                ),
             }
         }
         "regs" | "r" => format!("{}\n", registers(d)),

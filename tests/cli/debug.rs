@@ -250,3 +250,33 @@ fn a_trace_that_cannot_be_written_says_so() {
         );
     }
 }
+
+/// `who-wrote` and `back` say what is true of the session: the image's
+/// install (and the ROM's power-up) ran before it began, so nothing in the
+/// session wrote the handler's code and nothing ran before its first
+/// instruction. The old monitor said "since power-up" for both.
+#[test]
+fn who_wrote_and_back_speak_of_the_session() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        "who-wrote read_channel\nback 1\nstep 2\nback 3\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(!text.contains("power-up\n"), "{text}");
+    assert!(
+        text.contains("no instruction has written $") && text.contains("since the session began"),
+        "{text}"
+    );
+    assert!(
+        text.contains("cannot go back 1 instructions: only 0 have run since the session began"),
+        "{text}"
+    );
+    assert!(
+        text.contains("cannot go back 3 instructions: only 2 have run since the session began"),
+        "{text}"
+    );
+}
+
