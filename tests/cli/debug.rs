@@ -280,3 +280,36 @@ fn who_wrote_and_back_speak_of_the_session() {
     );
 }
 
+/// A trace's failed write is said by the command whose run wrote it: the
+/// old monitor buffered a `step`'s lines, so `/dev/full` failed only at
+/// the next command that flushed (`trace off`, or the session's end).
+#[test]
+fn a_trace_write_that_fails_is_said_by_the_command_that_ran() {
+    if !Path::new("/dev/full").exists() {
+        scorpion_tests::tools::skipped(
+            "a_trace_write_that_fails_is_said_by_the_command_that_ran",
+            "no /dev/full here",
+        );
+        return;
+    }
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = debug_bounded(
+        &adc,
+        &["debug"],
+        "trace /dev/full\nstep 3\nregs\ntrace off\n",
+        std::time::Duration::from_secs(60),
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    let replies: Vec<&str> = text.split("(scorpion) ").skip(1).collect();
+    let reply = |command: &str| {
+        replies
+            .iter()
+            .find(|r| r.starts_with(&format!("{command}\n")))
+            .copied()
+            .unwrap_or_else(|| panic!("no reply to {command}: {text}"))
+    };
+    let failed = "error: cannot write the trace to /dev/full: No space left on device";
+    assert!(reply("step 3").contains(failed), "{text}");
+    assert!(!reply("trace off").contains("error"), "{text}");
+}
