@@ -23,7 +23,6 @@ use miette::IntoDiagnostic;
 mod framing;
 #[cfg(test)]
 mod fuzz;
-mod line;
 mod protocol;
 mod session;
 

@@ -313,3 +313,41 @@ fn a_trace_write_that_fails_is_said_by_the_command_that_ran() {
     assert!(reply("step 3").contains(failed), "{text}");
     assert!(!reply("trace off").contains("error"), "{text}");
 }
+
+/// The monitor sends only what the ROM reads as one command (11
+/// characters at most, docs/PROTOCOL.md): a 100 kB line starting with `/`
+/// was queued whole, minutes of line time ahead of everything after it
+/// (the hostile sweep after issue 23). Refused, saying why; the session
+/// goes on and the next command is answered.
+#[test]
+fn the_monitor_sends_only_commands_the_rom_can_read() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let long = format!("/2A1{}", "1".repeat(100_000));
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        &format!("{long}\nsend /1E/1B\n/2A1\ncontinue 200000\n"),
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        text.contains(
+            "is 100004 bytes: a command is `/`, a count 1-9 and that many characters, 11 at most"
+        ),
+        "{}",
+        &text[text.len().saturating_sub(2000)..]
+    );
+    assert!(
+        text.contains("expected exactly 1 characters after `/1`"),
+        "{text:.2000}"
+    );
+    assert!(
+        !text.contains("sent /2A11111"),
+        "the long line was not sent"
+    );
+    assert!(text.contains("sent /2A1\n"), "{text:.2000}");
+    assert!(
+        text.contains("< A57\\r"),
+        "only /2A1 was on the line: {text:.3000}"
+    );
+}

@@ -185,7 +185,7 @@ impl Session {
                 )?;
                 let stop_on_entry = args.boolean("stopOnEntry")?.unwrap_or(false);
                 let commands = args.strings("commands")?.unwrap_or_default();
-                super::line::commands(&commands).map_err(|e| format!("launch: {e}"))?;
+                debug::line::commands(&commands).map_err(|e| format!("launch: {e}"))?;
                 let cwd = args.string("cwd")?.map(PathBuf::from);
                 self.launch(Path::new(program), cwd)
                     .map_err(|e| format!("{e:?}"))?;
@@ -258,7 +258,7 @@ impl Session {
                     .ok_or("evaluate needs `expression`")?
                     .trim();
                 let result = if expression.starts_with('/') {
-                    super::line::command(expression)?;
+                    debug::line::command(expression)?;
                     debugger.send(expression.as_bytes());
                     format!("sent {expression}")
                 } else {

@@ -1,12 +1,12 @@
-//! What a client may put on the robot's line: `launch`'s `commands` and a
+//! What the debuggers put on the robot's line: the monitor's `/...` and
+//! `send` lines, and under `scorpion dap` `launch`'s `commands` and a
 //! debug-console line starting with `/` (`evaluate`). Each is one command
 //! as the ROM reads it (docs/PROTOCOL.md, section 1: `/`, a count N of 1
 //! to 9, then N characters), so the longest is 11 characters; and
 //! `launch` sends no more in all than a serial port holds
-//! ([`crate::cmd::host_line::HOLDS`]). A request is otherwise limited only
-//! by the framing's 4 MiB: sent as it came, 100 kB of "command" would
-//! queue about 48 bytes of memory a byte and minutes of line time ahead of
-//! everything after it.
+//! ([`crate::cmd::host_line::HOLDS`]). Sent as it came, 100 kB of
+//! "command" queued about 48 bytes of memory a byte and minutes of line
+//! time ahead of everything after it.
 
 use romlib::protocol::{Command, EXTENSION_MAX_LEN};
 
