@@ -657,3 +657,26 @@ fn a_command_longer_than_the_rom_reads_is_refused() {
     assert_eq!(c.request("disconnect", json!({}))["success"], true);
     assert!(c.ends());
 }
+
+/// `launch`'s `program` names a linked image or a project's directory: a
+/// directory with no Scorpion.toml in it or above launched the bare ROM
+/// without a word (the hostile sweep after issue 23). Refused, saying so.
+#[test]
+fn a_directory_that_is_no_project_is_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let mut c = Client::start();
+    c.request("initialize", json!({"adapterID": "scorpion"}));
+    let refused = c.request(
+        "launch",
+        json!({"program": dir.path().display().to_string()}),
+    );
+    assert_eq!(refused["success"], false, "{refused}");
+    assert!(
+        refused["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("is a directory with no Scorpion.toml in it or above")),
+        "{refused}"
+    );
+    assert_eq!(c.request("disconnect", json!({}))["success"], true);
+    assert!(c.ends());
+}

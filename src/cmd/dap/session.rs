@@ -403,6 +403,21 @@ impl Session {
     /// `launch`: the robot with `program` (an image, or a project's
     /// directory).
     fn launch(&mut self, program: &Path, cwd: Option<PathBuf>) -> miette::Result<()> {
+        // A directory that is no project's would launch the bare ROM
+        // without a word: most likely a slip in the editor's settings.
+        if program.is_dir()
+            && !std::path::absolute(program).is_ok_and(|dir| {
+                dir.ancestors()
+                    .any(|dir| dir.join(crate::project::FILE).is_file())
+            })
+        {
+            miette::bail!(
+                help = "`program` is a linked image (ELF) or a project's directory (with a Scorpion.toml in it or above)",
+                "{} is a directory with no {} in it or above",
+                program.display(),
+                crate::project::FILE
+            );
+        }
         let (here, images) = if program.is_dir() {
             (program.to_path_buf(), Vec::new())
         } else {
