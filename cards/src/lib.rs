@@ -13,7 +13,8 @@
 //! Scripts are untrusted input: they reach no file, network or process
 //! and see no clock but robot time; each call into one has an operation
 //! budget ([`OPERATION_BUDGET`]) and a script earns
-//! [`OPERATIONS_PER_MICROSECOND`] of robot time; wake-ups move forward;
+//! [`OPERATIONS_PER_MICROSECOND`] of robot time, each call paying
+//! [`CALL_COST`] for itself; wake-ups move forward;
 //! what it prints is bounded ([`Printed`]); every failure is a
 //! [`ScriptError`] located in the script. Cards in Rust
 //! implement the same `Device` trait (`examples/adc_in_rust.rs`).
@@ -27,7 +28,7 @@ mod script;
 mod world;
 
 pub use card::ScriptCard;
-pub use clock::OPERATIONS_PER_MICROSECOND;
+pub use clock::{CALL_COST, OPERATIONS_PER_MICROSECOND};
 pub use error::{Located, ScriptError};
 pub use printed::{MAX_PRINTED_BYTES, MAX_PRINTED_LINES, Printed};
 pub use sandbox::{MAX_FUNCTIONS, MAX_VARIABLES, OPERATION_BUDGET};

@@ -102,6 +102,11 @@ impl HostError {
     }
 }
 
+/// The error of a call stopped (or refused) for its share of robot time.
+pub(crate) fn robot_time_spent() -> EvalAltResult {
+    EvalAltResult::ErrorTerminated(Dynamic::from(ROBOT_TIME), rhai::Position::NONE)
+}
+
 /// Whether Rhai's `error` is a call stopped for its share of robot time.
 pub(crate) fn is_robot_time(error: &EvalAltResult) -> bool {
     matches!(error, EvalAltResult::ErrorTerminated(token, _)

@@ -8,11 +8,12 @@ use std::sync::atomic::Ordering;
 use miette::{NamedSource, SourceSpan};
 use rhai::{AST, CallFnOptions, Dynamic, Engine, EvalAltResult, ParseError, Position, Scope};
 
-use crate::clock::{Budget, OPERATIONS_PER_MICROSECOND};
+use crate::clock::{Budget, CALL_COST, OPERATIONS_PER_MICROSECOND};
 use crate::error::{Located, ScriptError, offset_of};
 use crate::printed::Printed;
 use crate::sandbox::{
     Host, HostError, MAX_CALL_LEVELS, MAX_VARIABLES, OPERATION_BUDGET, is_robot_time,
+    robot_time_spent,
 };
 
 /// A loaded script.
@@ -68,7 +69,8 @@ impl Script {
             budget: Budget::default(),
         };
         let mut scope = Scope::new();
-        script.start(None);
+        // Before robot time starts a call always has its full budget.
+        let _ = script.start(None);
         let result = script.engine.run_ast_with_scope(&mut scope, &script.ast);
         result.map_err(|error| script.runtime_error_in(&error, None))?;
         script.scope = scope;
@@ -124,7 +126,10 @@ impl Script {
         now: Option<u64>,
         args: impl rhai::FuncArgs,
     ) -> Result<Dynamic, ScriptError> {
-        self.start(now);
+        if !self.start(now) {
+            // Not even the call itself is covered: refused before it runs.
+            return Err(self.runtime_error_in(&robot_time_spent(), Some(function)));
+        }
         let options = CallFnOptions::new()
             .eval_ast(true)
             .rewind_scope(true)
@@ -142,14 +147,18 @@ impl Script {
     }
 
     /// Gets the host ready for a call at `now`: its robot time, its share
-    /// of operations.
-    fn start(&mut self, now: Option<u64>) {
+    /// of operations. `false` if the script's credit does not cover the
+    /// call itself ([`CALL_COST`]).
+    fn start(&mut self, now: Option<u64>) -> bool {
         if let Ok(mut alarm) = self.host.alarm.lock() {
             alarm.set_now(now);
         }
-        let allowance = self.budget.allowance(now);
+        let Some(allowance) = self.budget.allowance(now) else {
+            return false;
+        };
         self.host.allowance.store(allowance, Ordering::Relaxed);
         self.host.spent.store(0, Ordering::Relaxed);
+        true
     }
 
     /// The wake-up the script asked for.
@@ -180,7 +189,10 @@ impl Script {
             within = Some(name.clone());
             inner = next;
         }
-        let (line, column) = if inner.position().is_none() {
+        // Robot time runs out wherever the count happens to be (at a
+        // call's first statement, the script's top level is run again):
+        // the function called is the place to change.
+        let (line, column) = if inner.position().is_none() || is_robot_time(inner) {
             within.as_deref().map_or((1, 1), |name| self.fn_line(name))
         } else {
             place(inner.position())
@@ -197,7 +209,8 @@ impl Script {
                     "the script took more than its share of robot time ({OPERATIONS_PER_MICROSECOND} operations per microsecond)"
                 ),
                 Some(format!(
-                    "a call may take {OPERATION_BUDGET} operations, earned back at {OPERATIONS_PER_MICROSECOND} per microsecond of robot time: wake less often (`wake_at(now + ms(1))`), do less per call, or serve registers the program polls from `PLAIN`"
+                    "a call may take {OPERATION_BUDGET} operations, earned back at {OPERATIONS_PER_MICROSECOND} per microsecond of robot time, and each call counts {CALL_COST} for itself (at most one every {} microseconds on average): wake less often (`wake_at(now + ms(1))`), do less per call, or serve registers the program polls from `PLAIN`",
+                    CALL_COST / OPERATIONS_PER_MICROSECOND
                 )),
             ),
             EvalAltResult::ErrorStackOverflow(_) => (

@@ -6,7 +6,9 @@
 //! previous `wake`), and `wake(now)` then sets the inputs: `bumpers(mask)`
 //! (a bit per microswitch, 1 = closed), `tracker(left_lit, right_lit)`,
 //! `scene(value)` (every scanner position reads `value`) and `scene_at(h, v,
-//! value)`. It reads the drive motors' positions in steps with
+//! value)`; a mask or reading past a byte, or a position past the scene's
+//! edge, is an error at the call (the script's mistake, not eight bits of
+//! it or the nearest edge). It reads the drive motors' positions in steps with
 //! `left_position()` and `right_position()` (forward counts up).
 
 use std::sync::{Arc, Mutex};
@@ -15,7 +17,7 @@ use emulator::board::{Motor, Scorpion};
 use romlib::Surroundings;
 
 use crate::error::ScriptError;
-use crate::sandbox::{Host, engine};
+use crate::sandbox::{Host, HostError, engine};
 use crate::script::Script;
 
 /// One change to the robot's inputs a script asked for.
@@ -76,6 +78,41 @@ impl ScriptWorld {
     }
 }
 
+/// The scanner's positions each way: a scene is 256 by 256 readings,
+/// centre at (0, 0).
+const SCENE_STEPS: std::ops::RangeInclusive<i64> = -128..=127;
+
+/// `value` as a byte, or the error `call` (`bumpers(...)`, written as the
+/// script wrote it) throws at the call: a value past a byte is a mistake,
+/// not eight bits of it.
+fn checked_byte(value: i64, call: &str, what: &str) -> Result<u8, Box<rhai::EvalAltResult>> {
+    u8::try_from(value).map_err(|_| {
+        HostError {
+            message: format!("`{call}`: {what} is 0 to 255, not {value}"),
+            help: "give a byte: `value & 0xFF` keeps the low eight bits".into(),
+        }
+        .thrown()
+    })
+}
+
+/// A scanner position, or the error `call` throws: the scene has no
+/// readings past its edge, so a position there is a mistake.
+fn checked_step(step: i64, call: &str, axis: &str) -> Result<i64, Box<rhai::EvalAltResult>> {
+    if SCENE_STEPS.contains(&step) {
+        return Ok(step);
+    }
+    Err(HostError {
+        message: format!(
+            "`{call}`: {axis} is {step}, outside the scene ({} to {})",
+            SCENE_STEPS.start(),
+            SCENE_STEPS.end()
+        ),
+        help: "positions count scanner steps from the centre, (0, 0); a scan reaches 99 each side"
+            .into(),
+    }
+    .thrown())
+}
+
 fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
     let push = |shared: &Arc<Mutex<Shared>>, change: Change| {
         if let Ok(mut s) = shared.lock() {
@@ -83,21 +120,39 @@ fn register(engine: &mut rhai::Engine, shared: &Arc<Mutex<Shared>>) {
         }
     };
     let state = Arc::clone(shared);
-    engine.register_fn("bumpers", move |mask: i64| {
-        push(&state, Change::Bumpers((mask & 0xFF) as u8));
-    });
+    engine.register_fn(
+        "bumpers",
+        move |mask: i64| -> Result<(), Box<rhai::EvalAltResult>> {
+            let mask = checked_byte(mask, &format!("bumpers({mask})"), "the mask")?;
+            push(&state, Change::Bumpers(mask));
+            Ok(())
+        },
+    );
     let state = Arc::clone(shared);
     engine.register_fn("tracker", move |left: bool, right: bool| {
         push(&state, Change::Tracker { left, right });
     });
     let state = Arc::clone(shared);
-    engine.register_fn("scene", move |value: i64| {
-        push(&state, Change::Scene((value & 0xFF) as u8));
-    });
+    engine.register_fn(
+        "scene",
+        move |value: i64| -> Result<(), Box<rhai::EvalAltResult>> {
+            let value = checked_byte(value, &format!("scene({value})"), "a reading")?;
+            push(&state, Change::Scene(value));
+            Ok(())
+        },
+    );
     let state = Arc::clone(shared);
-    engine.register_fn("scene_at", move |h: i64, v: i64, value: i64| {
-        push(&state, Change::SceneAt(h, v, (value & 0xFF) as u8));
-    });
+    engine.register_fn(
+        "scene_at",
+        move |h: i64, v: i64, value: i64| -> Result<(), Box<rhai::EvalAltResult>> {
+            let call = format!("scene_at({h}, {v}, {value})");
+            let h = checked_step(h, &call, "h")?;
+            let v = checked_step(v, &call, "v")?;
+            let value = checked_byte(value, &call, "a reading")?;
+            push(&state, Change::SceneAt(h, v, value));
+            Ok(())
+        },
+    );
     let state = Arc::clone(shared);
     engine.register_fn("left_position", move || -> i64 {
         state.lock().map_or(0, |s| s.positions.0)

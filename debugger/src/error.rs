@@ -29,8 +29,12 @@ pub enum Error {
         /// Why it does not evaluate.
         reason: String,
     },
-    /// A step back further than the robot has run.
-    #[error("cannot go back {asked} instructions: only {ran} have run since power-up")]
+    /// A step back further than the robot has run in the session. (Its
+    /// power-up and the images' install ran before the session began and
+    /// cannot be stepped back into.)
+    #[error(
+        "cannot go back {asked} instructions: only {ran} have run since the session began (power-up and the images' install come before it)"
+    )]
     #[diagnostic(code(debugger::history))]
     BeforePowerUp {
         /// Instructions asked for.

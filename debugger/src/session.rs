@@ -505,6 +505,12 @@ impl Debugger {
                 std::mem::replace(&mut first, false),
             )?;
             received.extend(self.robot.receive());
+            if let Some(trace) = self.trace.as_mut() {
+                // What this run traced is written out before it answers:
+                // a writer that cannot take it fails this run, not the
+                // next (its error is noted for the check below).
+                let _ = trace.tracer.flush();
+            }
             // A failed write stops the tracer's run at once, each time.
             if let Some(error) = self.trace_failure() {
                 return Err(error);
@@ -606,7 +612,8 @@ impl Debugger {
 
     /// The last write to `address` before now: the writing instruction's
     /// count (instructions run before it), its PC and the byte written.
-    /// `None` if nothing has written it since power-up.
+    /// `None` if no instruction has written it since the session began
+    /// (an image's bytes are loaded before it).
     ///
     /// # Errors
     /// As [`Debugger::back`].

@@ -85,7 +85,7 @@ impl Symbols {
     /// value outside `$0000-$FFFF`.
     pub fn address(&self, text: &str) -> Result<u16, Error> {
         let bad = |reason: String| Error::Address {
-            text: text.to_owned(),
+            text: shown(text),
             reason,
         };
         let mut total: i64 = 0;
@@ -147,6 +147,17 @@ impl Symbols {
     }
 }
 
+/// The most characters of an expression an error repeats.
+const SHOWN: usize = 64;
+
+/// `text` as an error repeats it: a 50 kB expression is cut, not echoed.
+fn shown(text: &str) -> String {
+    match text.char_indices().nth(SHOWN) {
+        Some((at, _)) => format!("{}... ({} bytes)", &text[..at], text.len()),
+        None => text.to_owned(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,6 +177,10 @@ mod tests {
         );
         assert!(symbols.address("$10000").is_err());
         assert!(symbols.address("1+").is_err());
+        // A long expression is cut in the error, not repeated whole.
+        let long = "CMDBUF+1+".repeat(5000) + "1";
+        let said = symbols.address(&long).expect_err("past $FFFF").to_string();
+        assert!(said.len() < 200 && said.contains("(45001 bytes)"), "{said}");
         let dispatch = symbols.get("dispatch").expect("the ROM's dispatch label");
         assert_eq!(symbols.place(dispatch).as_deref(), Some("dispatch"));
         assert_eq!(symbols.place(dispatch + 2), Some("dispatch+$2".into()));

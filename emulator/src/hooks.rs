@@ -282,6 +282,25 @@ impl<W: Write> Tracer<W> {
         Tracer { out, error: None }
     }
 
+    /// Flushes what was traced so far (a debugger does as each run ends,
+    /// so that a writer that cannot take it fails at that run, not at a
+    /// later one or at [`Tracer::finish`]). A failure counts as the first
+    /// write error: the trace's next instruction stops the run again.
+    ///
+    /// # Errors
+    /// The first error `out` returned, now or before (its kind and text).
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        if self.error.is_none()
+            && let Err(error) = self.out.flush()
+        {
+            self.error = Some(error);
+        }
+        match &self.error {
+            Some(error) => Err(std::io::Error::new(error.kind(), error.to_string())),
+            None => Ok(()),
+        }
+    }
+
     /// Flushes and returns the writer, or the first write error.
     ///
     /// # Errors

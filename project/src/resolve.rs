@@ -102,19 +102,32 @@ pub struct Environment {
 
 impl Environment {
     /// The process's environment. An empty variable counts as unset.
-    #[must_use]
-    pub fn from_process() -> Environment {
+    ///
+    /// # Errors
+    /// [`Error::Environment`] for a `SCORPION_*` variable that is not
+    /// text (UTF-8): treated as unset, a port given that way would be
+    /// replaced by another without a word.
+    pub fn from_process() -> Result<Environment, Error> {
         let [port, baud, xdg, home] = VARIABLES;
-        let var = |name: &str| std::env::var(name).ok().filter(|v| !v.is_empty());
+        let var = |name: &'static str| match std::env::var(name) {
+            Ok(value) => Ok(Some(value).filter(|v| !v.is_empty())),
+            Err(std::env::VarError::NotPresent) => Ok(None),
+            Err(std::env::VarError::NotUnicode(value)) => Err(Error::Environment {
+                name,
+                value: value.to_string_lossy().into_owned(),
+                expected: "text (UTF-8)",
+            }),
+        };
+        // The per-user file's directory is a path, which need not be text.
         let base = std::env::var_os(xdg)
             .filter(|v| !v.is_empty())
             .map(PathBuf::from)
             .or_else(|| std::env::var_os(home).map(|h| PathBuf::from(h).join(".config")));
-        Environment {
-            port: var(port),
-            baud: var(baud),
+        Ok(Environment {
+            port: var(port)?,
+            baud: var(baud)?,
             user_file: base.map(|base| base.join("scorpion").join("config.toml")),
-        }
+        })
     }
 }
 

@@ -14,7 +14,15 @@ use toml::Spanned;
 #[derive(Debug, Default, Deserialize)]
 pub(crate) struct FileSpans {
     #[serde(default)]
+    pub(crate) project: Option<MetaSpans>,
+    #[serde(default)]
     pub(crate) image: Vec<ImageSpans>,
+}
+
+/// `[project]`'s spans.
+#[derive(Debug, Deserialize)]
+pub(crate) struct MetaSpans {
+    pub(crate) name: Option<Spanned<toml::Value>>,
 }
 
 /// One `[[image]]`'s spans.

@@ -1,7 +1,8 @@
 //! Checks serde cannot make: an image's name becomes file names
 //! (`target/scorpion/NAME.elf`, `tests/snapshots/NAME__KIND.snap`), so it
 //! must be a plain, unique file name; an image needs a source; a define's
-//! value must be one the assembler holds. Each refusal is at its line.
+//! value must be one the assembler holds; the project needs a name. Each
+//! refusal is at its line.
 
 use std::collections::BTreeMap;
 
@@ -48,6 +49,39 @@ pub(crate) fn check(shown: &str, text: &str, file: &ProjectFile) -> crate::Resul
     let at = |index: usize, pick: fn(&crate::spans::ImageSpans) -> std::ops::Range<usize>| {
         spans.image.get(index).map(pick).unwrap_or(0..0)
     };
+    // The name heads every report and the new project's files: a blank
+    // one reads as a missing one.
+    let control = file.project.name.chars().find(|c| c.is_control());
+    if let Some(c) = control {
+        let name_at = spans
+            .project
+            .as_ref()
+            .and_then(|p| p.name.as_ref())
+            .map_or(0..0, span);
+        return Err(Located::new(
+            shown,
+            text,
+            name_at,
+            format!("the project's name holds a control character ({c:?}): it heads every report"),
+            "name the project with printable characters: [project] name = \"probe\"",
+        )
+        .into());
+    }
+    if file.project.name.trim().is_empty() {
+        let name_at = spans
+            .project
+            .as_ref()
+            .and_then(|p| p.name.as_ref())
+            .map_or(0..0, span);
+        return Err(Located::new(
+            shown,
+            text,
+            name_at,
+            format!("the project's name is empty: `{}`", file.project.name),
+            "name the project: [project] name = \"probe\"",
+        )
+        .into());
+    }
     let mut seen: BTreeMap<String, usize> = BTreeMap::new();
     for (index, image) in file.images.iter().enumerate() {
         let name_at = at(index, |s| span(&s.name));

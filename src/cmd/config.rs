@@ -97,7 +97,7 @@ pub(crate) fn resolve(flags: &Flags) -> miette::Result<Resolved> {
 pub(crate) fn resolve_in(flags: &Flags, here: &Path) -> miette::Result<Resolved> {
     Ok(Resolved::resolve(
         flags,
-        &Environment::from_process(),
+        &Environment::from_process()?,
         here,
     )?)
 }

@@ -16,6 +16,7 @@ use crate::cmd::ports;
 mod counts;
 #[cfg(test)]
 mod fuzz;
+pub(crate) mod line;
 
 use counts::{BACK_COUNT, CONTINUE_CYCLES, DIS_COUNT, MEM_LEN, STEP_COUNT};
 
@@ -260,11 +261,13 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
         "help" | "h" | "?" => format!("{HELP}\n"),
         "quit" | "q" | "exit" => return Ok(Reply::Quit),
         _ if verb.starts_with('/') => {
+            line::command(line).map_err(Failure::Usage)?;
             d.send(line.as_bytes());
             format!("sent {line}\n")
         }
         "send" => {
             let what = line.trim_start_matches("send").trim();
+            line::command(what).map_err(Failure::Usage)?;
             d.send(what.as_bytes());
             format!("sent {what}\n")
         }
@@ -404,7 +407,9 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
                     write.instruction,
                     place(d, write.pc)
                 ),
-                None => format!("nothing has written ${address:04X} since power-up\n"),
+                None => format!(
+                    "no instruction has written ${address:04X} since the session began (images are loaded before it)\n"
+                ),
             }
         }
         "regs" | "r" => format!("{}\n", registers(d)),

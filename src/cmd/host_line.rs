@@ -1,6 +1,7 @@
-//! The host's end of the virtual robot's line under `scorpion sim --pty`:
-//! what clients write to the pseudo-terminal goes down the 6551's line at
-//! the baud rate, and no more of it waits than a real serial port holds.
+//! The host's end of the virtual robot's line under `scorpion sim` (the
+//! pseudo-terminal with `--pty`, stdin without): what clients write goes
+//! down the 6551's line at the baud rate, and no more of it waits than a
+//! real serial port holds.
 //!
 //! A pseudo-terminal has no baud rate: a client can write a megabyte in a
 //! moment. Putting every byte on the emulated wire at once would queue it
@@ -69,6 +70,11 @@ impl HostLine {
     #[cfg(test)]
     fn waiting(&self) -> usize {
         self.waiting.len()
+    }
+
+    /// Whether no byte waits for the line.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.waiting.is_empty()
     }
 
     /// Bytes dropped since the last call, the count then reset.

@@ -1,7 +1,7 @@
 //! `scorpion sim`: the virtual Scorpion, serving a pseudo-terminal or the
 //! terminal it runs in, at the baud rate's pace.
 
-use std::io::{BufRead, Write};
+use std::io::{Read, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::mpsc;
@@ -20,6 +20,11 @@ use crate::cmd::host_line::{self, HostLine};
 /// line on stdout and serves it until interrupted: point a terminal program
 /// or `scorpion upload --port PATH` at it. Without, it reads commands from
 /// stdin and prints the answers, one per line, until stdin ends.
+///
+/// Either way the line is a real one's: bytes go to the robot at the baud
+/// rate, at most 4 KiB wait for it (a serial port's buffer), and what is
+/// written faster than that is dropped and said on stderr, as are
+/// characters the 6551 overran.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     /// Serve a pseudo-terminal instead of stdin and stdout.
@@ -140,7 +145,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     if args.pty {
         serve_pty(&mut robot, resolved.baud.value, &printed)
     } else {
-        serve_stdio(&mut robot, &printed)
+        serve_stdio(&mut robot, resolved.baud.value, &printed)
     }
 }
 
@@ -168,10 +173,6 @@ impl Pace {
         self.first_cycle + cycles(self.started.elapsed())
     }
 
-    fn catch_up(&self, robot: &mut VirtualScorpion) -> miette::Result<()> {
-        self.run_to(robot, self.target())
-    }
-
     fn run_to(&self, robot: &mut VirtualScorpion, target: u64) -> miette::Result<()> {
         let behind = target.saturating_sub(robot.cycles());
         robot.run_for(behind)?;
@@ -185,8 +186,6 @@ fn serve_pty(
     baud: u32,
     printed: &[(String, cards::Printed)],
 ) -> miette::Result<ExitCode> {
-    use std::io::Read;
-
     use serialport::{SerialPort, TTYPort};
 
     let (mut master, slave) = TTYPort::pair()
@@ -272,8 +271,8 @@ fn write_answer(master: &mut impl Write, answer: &[u8]) -> miette::Result<u64> {
 /// host's end dropped (a client writing faster than the baud rate
 /// carries, more than a port holds), characters the 6551 lost to overrun
 /// (its receive register still full: the ROM or an extension did not
-/// read it in time), and answers the clients did not read.
-#[cfg(unix)]
+/// read it in time), and answers the clients did not read. Both modes
+/// say them: the pseudo-terminal and stdin.
 struct Overruns {
     /// The 6551's count when last looked at.
     seen: u64,
@@ -289,7 +288,6 @@ struct Overruns {
     pending_since: Option<Instant>,
 }
 
-#[cfg(unix)]
 impl Overruns {
     fn new(robot: &VirtualScorpion) -> Overruns {
         Overruns {
@@ -316,6 +314,15 @@ impl Overruns {
                 .said_at
                 .is_some_and(|at| at.elapsed() < Duration::from_secs(1))
         {
+            return;
+        }
+        self.say(baud);
+    }
+
+    /// Says what was lost and not said yet, now (also as stdin's mode
+    /// ends, before the quarter second a burst is summed over is up).
+    fn say(&mut self, baud: u32) {
+        if self.dropped + self.overrun + self.unread == 0 {
             return;
         }
         self.said_at = Some(Instant::now());
@@ -372,51 +379,83 @@ fn serve_pty(
 /// Robot time the stdin mode waits after the last command for answers.
 const QUIET_TIME: u64 = CPU_HZ / 5;
 
+/// Chunks of stdin read ahead of the robot: with the host line's
+/// [`host_line::HOLDS`], all the stdin mode ever holds (a pipe's writer
+/// waits on the kernel beyond that).
+const CHUNKS_AHEAD: usize = 4;
+
 /// Commands from stdin (line ends and all: the ROM ignores bytes outside
 /// commands), answers to stdout with their carriage returns as line ends.
+/// Stdin is the host's end of the line as the pseudo-terminal is under
+/// `--pty`: read as fast as it comes, at most [`host_line::HOLDS`] bytes
+/// waiting for the line, which carries them at the baud rate; the rest is
+/// dropped, and drops and 6551 overruns are said on stderr. (Queued whole,
+/// a flood on stdin grew memory by about 48 bytes a byte until the
+/// process was killed.)
 fn serve_stdio(
     robot: &mut VirtualScorpion,
+    baud: u32,
     printed: &[(String, cards::Printed)],
 ) -> miette::Result<ExitCode> {
-    let (sender, lines) = mpsc::channel::<Option<Vec<u8>>>();
+    let (sender, chunks) = mpsc::sync_channel::<Option<Vec<u8>>>(CHUNKS_AHEAD);
     std::thread::spawn(move || {
         let stdin = std::io::stdin();
         let mut input = stdin.lock();
+        let mut buffer = vec![0u8; host_line::HOLDS];
         loop {
-            let mut line = Vec::new();
-            match input.read_until(b'\n', &mut line) {
-                Ok(0) | Err(_) => {
+            match input.read(&mut buffer) {
+                Ok(0) => {
                     let _ = sender.send(None);
                     return;
                 }
-                Ok(_) => {
-                    if sender.send(Some(line)).is_err() {
+                Ok(count) => {
+                    if sender.send(Some(buffer[..count].to_vec())).is_err() {
                         return;
                     }
+                }
+                Err(error) if error.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(_) => {
+                    let _ = sender.send(None);
+                    return;
                 }
             }
         }
     });
     let pace = Pace::new(robot);
+    let mut line = HostLine::new(host_line::HOLDS);
+    let mut overruns = Overruns::new(robot);
     let mut out = std::io::stdout().lock();
     let mut ended = false;
     let mut quiet_since = robot.cycles();
     loop {
-        match lines.recv_timeout(Duration::from_millis(2)) {
-            Ok(Some(line)) => {
-                robot.send(&line);
-                quiet_since = robot.cycles();
+        // Everything stdin has given, without waiting once there is some.
+        let mut next = chunks.recv_timeout(Duration::from_millis(2));
+        loop {
+            match next {
+                Ok(Some(bytes)) => line.accept(&bytes),
+                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => ended = true,
+                Err(mpsc::RecvTimeoutError::Timeout) => break,
             }
-            Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => ended = true,
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            if ended {
+                break;
+            }
+            next = chunks
+                .try_recv()
+                .map_err(|_| mpsc::RecvTimeoutError::Timeout);
         }
-        if ended {
-            // No more input: no need to wait for the wall clock.
-            robot.run_for(1000)?;
+        // No more input: no need to wait for the wall clock.
+        let target = if ended {
+            robot.cycles() + 1000
         } else {
-            pace.catch_up(robot)?;
+            pace.target()
+        };
+        if !line.is_empty() {
+            quiet_since = robot.cycles();
         }
+        line.feed(robot, target);
+        pace.run_to(robot, target)?;
         crate::cmd::rig::show_printed(printed);
+        overruns.report(robot, line.take_dropped(), baud);
         let answer = robot.receive();
         if !answer.is_empty() {
             quiet_since = robot.cycles();
@@ -427,8 +466,9 @@ fn serve_stdio(
             out.write_all(&text).into_diagnostic()?;
             out.flush().into_diagnostic()?;
         }
-        let line_idle = robot.line_idle();
+        let line_idle = line.is_empty() && robot.line_idle();
         if ended && line_idle && robot.cycles() >= quiet_since + QUIET_TIME {
+            overruns.say(baud);
             // The answers so far are out; a robot whose loop stopped (a
             // handler that never returns) fails the run, saying where.
             robot.check_loop(romlib::sim::LOOP_WATCH)?;

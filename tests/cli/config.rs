@@ -320,6 +320,40 @@ fn a_variable_that_is_not_a_rate_is_refused_by_name() {
     );
 }
 
+/// A `SCORPION_*` variable that is not text (a byte past UTF-8) is
+/// refused, naming it; it was taken as unset, so the port from the
+/// per-user file or the project was used without a word.
+#[cfg(unix)]
+#[test]
+fn a_variable_that_is_not_text_is_refused_by_name() {
+    use std::os::unix::ffi::OsStrExt as _;
+    let adc = Adc::new();
+    for (name, command) in [
+        ("SCORPION_PORT", &["config"][..]),
+        ("SCORPION_PORT", &["ask", "/1E"][..]),
+        ("SCORPION_BAUD", &["config"][..]),
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(command)
+            .current_dir(adc.project())
+            .env_remove("RUST_BACKTRACE")
+            .env_remove("SCORPION_PORT")
+            .env_remove("SCORPION_BAUD")
+            .env("XDG_CONFIG_HOME", adc.xdg())
+            .env("NO_COLOR", "1")
+            .env(name, std::ffi::OsStr::from_bytes(b"/dev/tty\xFF"))
+            .output()
+            .expect("the scorpion binary runs");
+        assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+        assert!(
+            String::from_utf8_lossy(&output.stderr)
+                .contains(&format!("{name}=/dev/tty\u{FFFD} is not text (UTF-8)")),
+            "{name} {command:?}: {}",
+            transcript(&output)
+        );
+    }
+}
+
 /// The matrix for cards: each command that runs the virtual robot takes
 /// them from the project, or from `--card` instead. `ask --port emu` and
 /// `upload --port emu` loaded neither the project's images nor its cards.

@@ -604,3 +604,79 @@ fn a_card_that_never_lets_time_move_does_not_silence_the_adapter() {
         start.elapsed()
     );
 }
+
+/// A debug-console line starting with `/` goes down the robot's line, and
+/// so do `launch`'s `commands`: each must be one command as the ROM reads
+/// it (11 characters at most, docs/PROTOCOL.md), `commands` no more in all
+/// than a serial port holds. The old adapter sent a 100 kB "command" as it
+/// came (minutes of line time and megabytes queued ahead of the next);
+/// now it is refused, saying so, and the session goes on: the next command
+/// is answered at once.
+#[test]
+fn a_command_longer_than_the_rom_reads_is_refused() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let mut c = Client::start();
+    c.request("initialize", json!({"adapterID": "scorpion"}));
+    let flood = vec!["/2A1"; 2000];
+    let refused = c.request(
+        "launch",
+        json!({"program": adc.display().to_string(), "stopOnEntry": true, "commands": flood}),
+    );
+    assert_eq!(refused["success"], false, "{refused}");
+    assert!(
+        refused["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("`commands` holds 8000 bytes")),
+        "{refused}"
+    );
+    let launch = c.request(
+        "launch",
+        json!({"program": adc.display().to_string(), "stopOnEntry": true}),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    c.request("configurationDone", json!({}));
+    assert_eq!(c.event("stopped")["body"]["reason"], "entry");
+    let long = format!("/2A1{}", "1".repeat(100_000));
+    let refused = c.request("evaluate", json!({"expression": long, "context": "repl"}));
+    assert_eq!(refused["success"], false, "{refused}");
+    let message = refused["message"].as_str().unwrap_or_default().to_owned();
+    assert!(
+        message.contains("100004 bytes") && message.contains("11 at most"),
+        "{message}"
+    );
+    assert!(message.len() < 300, "the command is not echoed whole");
+    let sent = c.request("evaluate", json!({"expression": "/2A1", "context": "repl"}));
+    assert_eq!(sent["success"], true, "{sent}");
+    assert_eq!(
+        c.request("continue", json!({"threadId": 1}))["success"],
+        true
+    );
+    // Only /2A1's answer is on the line: nothing of the refused flood.
+    let output = c.event("output");
+    assert_eq!(output["body"]["output"], "A57\n", "{output}");
+    assert_eq!(c.request("disconnect", json!({}))["success"], true);
+    assert!(c.ends());
+}
+
+/// `launch`'s `program` names a linked image or a project's directory: a
+/// directory with no Scorpion.toml in it or above launched the bare ROM
+/// without a word (the hostile sweep after issue 23). Refused, saying so.
+#[test]
+fn a_directory_that_is_no_project_is_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let mut c = Client::start();
+    c.request("initialize", json!({"adapterID": "scorpion"}));
+    let refused = c.request(
+        "launch",
+        json!({"program": dir.path().display().to_string()}),
+    );
+    assert_eq!(refused["success"], false, "{refused}");
+    assert!(
+        refused["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("is a directory with no Scorpion.toml in it or above")),
+        "{refused}"
+    );
+    assert_eq!(c.request("disconnect", json!({}))["success"], true);
+    assert!(c.ends());
+}

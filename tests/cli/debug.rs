@@ -250,3 +250,104 @@ fn a_trace_that_cannot_be_written_says_so() {
         );
     }
 }
+
+/// `who-wrote` and `back` say what is true of the session: the image's
+/// install (and the ROM's power-up) ran before it began, so nothing in the
+/// session wrote the handler's code and nothing ran before its first
+/// instruction. The old monitor said "since power-up" for both.
+#[test]
+fn who_wrote_and_back_speak_of_the_session() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        "who-wrote read_channel\nback 1\nstep 2\nback 3\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(!text.contains("power-up\n"), "{text}");
+    assert!(
+        text.contains("no instruction has written $") && text.contains("since the session began"),
+        "{text}"
+    );
+    assert!(
+        text.contains("cannot go back 1 instructions: only 0 have run since the session began"),
+        "{text}"
+    );
+    assert!(
+        text.contains("cannot go back 3 instructions: only 2 have run since the session began"),
+        "{text}"
+    );
+}
+
+/// A trace's failed write is said by the command whose run wrote it: the
+/// old monitor buffered a `step`'s lines, so `/dev/full` failed only at
+/// the next command that flushed (`trace off`, or the session's end).
+#[test]
+fn a_trace_write_that_fails_is_said_by_the_command_that_ran() {
+    if !Path::new("/dev/full").exists() {
+        scorpion_tests::tools::skipped(
+            "a_trace_write_that_fails_is_said_by_the_command_that_ran",
+            "no /dev/full here",
+        );
+        return;
+    }
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = debug_bounded(
+        &adc,
+        &["debug"],
+        "trace /dev/full\nstep 3\nregs\ntrace off\n",
+        std::time::Duration::from_secs(60),
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    let replies: Vec<&str> = text.split("(scorpion) ").skip(1).collect();
+    let reply = |command: &str| {
+        replies
+            .iter()
+            .find(|r| r.starts_with(&format!("{command}\n")))
+            .copied()
+            .unwrap_or_else(|| panic!("no reply to {command}: {text}"))
+    };
+    let failed = "error: cannot write the trace to /dev/full: No space left on device";
+    assert!(reply("step 3").contains(failed), "{text}");
+    assert!(!reply("trace off").contains("error"), "{text}");
+}
+
+/// The monitor sends only what the ROM reads as one command (11
+/// characters at most, docs/PROTOCOL.md): a 100 kB line starting with `/`
+/// was queued whole, minutes of line time ahead of everything after it
+/// (the hostile sweep after issue 23). Refused, saying why; the session
+/// goes on and the next command is answered.
+#[test]
+fn the_monitor_sends_only_commands_the_rom_can_read() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let long = format!("/2A1{}", "1".repeat(100_000));
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        &format!("{long}\nsend /1E/1B\n/2A1\ncontinue 200000\n"),
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        text.contains(
+            "is 100004 bytes: a command is `/`, a count 1-9 and that many characters, 11 at most"
+        ),
+        "{}",
+        &text[text.len().saturating_sub(2000)..]
+    );
+    assert!(
+        text.contains("expected exactly 1 characters after `/1`"),
+        "{text:.2000}"
+    );
+    assert!(
+        !text.contains("sent /2A11111"),
+        "the long line was not sent"
+    );
+    assert!(text.contains("sent /2A1\n"), "{text:.2000}");
+    assert!(
+        text.contains("< A57\\r"),
+        "only /2A1 was on the line: {text:.3000}"
+    );
+}

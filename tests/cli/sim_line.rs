@@ -228,3 +228,80 @@ fn characters_the_6551_overran_are_lost_and_said() {
     let (answer, _) = ask(&mut *port, b"/1E", Duration::from_secs(5));
     assert_eq!(answer, "E0\r");
 }
+
+/// `scorpion sim` without `--pty` takes stdin as the pty's line is taken:
+/// 64 MiB written at once keeps the simulator's memory small (the old one
+/// read it as one line and queued it all, about 48 bytes a byte, until
+/// the memory limit killed it), the drop is said, and a command written
+/// once the line has carried what it holds is answered.
+#[test]
+fn a_flood_on_stdin_keeps_memory_small_and_is_said() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {MEMORY_KIB} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_scorpion"))
+        .arg("sim")
+        .current_dir(dir.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the scorpion binary runs");
+    let mut stdin = child.stdin.take().expect("stdin is piped");
+    stdin.write_all(b"/1E\n").expect("the first command");
+    std::thread::sleep(Duration::from_secs(1));
+    let peak = |pid: u32| -> Option<u64> {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+        status
+            .lines()
+            .find_map(|line| line.strip_prefix("VmHWM:"))
+            .and_then(|rest| rest.trim().trim_end_matches("kB").trim().parse().ok())
+    };
+    let before = peak(child.id()).expect("the simulator runs");
+    let chunk = vec![b'x'; 64 << 10];
+    let started = Instant::now();
+    let mut written = 0usize;
+    while written < 64 << 20 && started.elapsed() < Duration::from_secs(120) {
+        match stdin.write(&chunk) {
+            Ok(count) => written += count,
+            Err(_) => break,
+        }
+    }
+    assert_eq!(written, 64 << 20, "the flood was taken");
+    // What a port holds (4 KiB) takes 4.3 s at 9600 baud; then the line
+    // has room for the next command.
+    std::thread::sleep(Duration::from_secs(6));
+    let grown = peak(child.id())
+        .expect("the simulator still runs")
+        .saturating_sub(before);
+    stdin.write_all(b"/1E\n").expect("the last command");
+    drop(stdin);
+    let started = Instant::now();
+    while child.try_wait().expect("waitable").is_none() {
+        if started.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("the simulator did not end a minute after stdin did");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let output = child.wait_with_output().expect("the output");
+    let said = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "{said}");
+    assert!(grown < 16 << 10, "the simulator grew by {grown} KiB");
+    assert_eq!(
+        String::from_utf8_lossy(&output.stdout),
+        "E0\nE0\n",
+        "{said}"
+    );
+    let dropped: u64 = said
+        .lines()
+        .filter_map(|line| line.strip_prefix("line full: "))
+        .filter_map(|rest| rest.split(' ').next()?.parse::<u64>().ok())
+        .sum();
+    // Everything but what the line carried or held.
+    assert!(
+        dropped > (64 << 20) - (64 << 10),
+        "{dropped} dropped: {said}"
+    );
+}

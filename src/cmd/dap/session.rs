@@ -185,6 +185,7 @@ impl Session {
                 )?;
                 let stop_on_entry = args.boolean("stopOnEntry")?.unwrap_or(false);
                 let commands = args.strings("commands")?.unwrap_or_default();
+                debug::line::commands(&commands).map_err(|e| format!("launch: {e}"))?;
                 let cwd = args.string("cwd")?.map(PathBuf::from);
                 self.launch(Path::new(program), cwd)
                     .map_err(|e| format!("{e:?}"))?;
@@ -257,6 +258,7 @@ impl Session {
                     .ok_or("evaluate needs `expression`")?
                     .trim();
                 let result = if expression.starts_with('/') {
+                    debug::line::command(expression)?;
                     debugger.send(expression.as_bytes());
                     format!("sent {expression}")
                 } else {
@@ -401,6 +403,21 @@ impl Session {
     /// `launch`: the robot with `program` (an image, or a project's
     /// directory).
     fn launch(&mut self, program: &Path, cwd: Option<PathBuf>) -> miette::Result<()> {
+        // A directory that is no project's would launch the bare ROM
+        // without a word: most likely a slip in the editor's settings.
+        if program.is_dir()
+            && !std::path::absolute(program).is_ok_and(|dir| {
+                dir.ancestors()
+                    .any(|dir| dir.join(crate::project::FILE).is_file())
+            })
+        {
+            miette::bail!(
+                help = "`program` is a linked image (ELF) or a project's directory (with a Scorpion.toml in it or above)",
+                "{} is a directory with no {} in it or above",
+                program.display(),
+                crate::project::FILE
+            );
+        }
         let (here, images) = if program.is_dir() {
             (program.to_path_buf(), Vec::new())
         } else {
