@@ -66,10 +66,19 @@ pub(crate) fn define(text: &str) -> Result<(String, i64), String> {
     } else {
         (digits, 10)
     };
-    let number = i64::from_str_radix(digits, radix)
-        .ok()
-        .filter(|n| (0..=i64::from(u32::MAX)).contains(n))
-        .ok_or_else(|| format!("`{value}` is not a number (write 42, $2A, 0x2A or %101010)"))?;
+    let number = match u128::from_str_radix(digits, radix) {
+        Ok(n) if n <= u128::from(u32::MAX) => n as i64,
+        Ok(_) => {
+            return Err(format!(
+                "`{value}` is out of range: a define is a 32-bit value (at most $FFFFFFFF)"
+            ));
+        }
+        Err(_) => {
+            return Err(format!(
+                "`{value}` is not a number (write 42, $2A, 0x2A or %101010)"
+            ));
+        }
+    };
     Ok((name.to_owned(), if negative { -number } else { number }))
 }
 

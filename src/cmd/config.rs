@@ -182,8 +182,13 @@ pub(crate) fn note_unused_rig(resolved: &Resolved) {
     }
     let _ = writeln!(
         std::io::stderr(),
-        "note: {} belong to the virtual Scorpion (`--port emu`, `sim`, an upload's rehearsal); the robot on {} has its own",
+        "note: {} {} to the virtual Scorpion (`--port emu`, `sim`, an upload's rehearsal); the robot on {} has its own",
         unused.join(" and "),
+        if unused.len() == 1 {
+            "belongs"
+        } else {
+            "belong"
+        },
         resolved
             .port
             .as_ref()

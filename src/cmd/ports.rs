@@ -87,10 +87,18 @@ pub(crate) fn open_resolved(
         }
         return Ok(Box::new(Showing::new(VirtualTransport::new(robot), shown)));
     }
-    Ok(Box::new(SerialTransport::open(
-        &port.value,
-        resolved.baud.value,
-    )?))
+    // A port that came from a file or the environment is named with
+    // where it came from: a stale one is otherwise a mystery.
+    let origin = &port.origin;
+    let opened = SerialTransport::open(&port.value, resolved.baud.value);
+    match origin {
+        scorpion_project::Origin::Flag(_) => Ok(Box::new(opened?)),
+        _ => Ok(Box::new(
+            opened
+                .map_err(miette::Report::new)
+                .wrap_err_with(|| format!("the port {} is from the {origin}", port.value))?,
+        )),
+    }
 }
 
 /// The robot `line` names, probed, for commands that only look at it

@@ -171,7 +171,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         filter: filter.clone(),
         mode: args.mode(),
         port: args.port.clone(),
-        environment: Environment::from_process(),
+        environment: Environment::from_process()?,
     };
     let mut printer = Printer {
         out: std::io::stdout().lock(),

@@ -159,7 +159,7 @@ fn cards_and_surroundings_never_stop_work_on_a_real_port() {
         transcript(&output)
     );
     assert!(
-        stderr.contains("note: --card belong to the virtual Scorpion"),
+        stderr.contains("note: --card belongs to the virtual Scorpion"),
         "{}",
         transcript(&output)
     );

@@ -587,3 +587,30 @@ fn a_missing_rom_profile_is_named_by_every_command() {
         );
     }
 }
+
+/// A port that does not open says where it was configured (a stale one in
+/// the per-user file, the environment or the project), and a define out of
+/// 32 bits says it is out of range, not that it is no number.
+#[test]
+fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
+    let adc = Adc::new();
+    let project = adc.project();
+    for (source, origin) in [
+        (Source::UserFile, "user file"),
+        (Source::Env, "environment SCORPION_PORT"),
+        (Source::Project, "project"),
+    ] {
+        let (_, env) = adc.port_from(source, "/dev/no-such-scorpion-port");
+        let output = adc.run(&project, &["ask", "/1X"], &env);
+        assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("/dev/no-such-scorpion-port is from the ") && stderr.contains(origin),
+            "{source:?}: {stderr}"
+        );
+    }
+    let output = adc.run(&project, &["build", "-D", "BIG=99999999999"], &[]);
+    assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("`99999999999` is out of range"), "{stderr}");
+}

@@ -408,14 +408,14 @@ impl Session {
         if program.is_dir()
             && !std::path::absolute(program).is_ok_and(|dir| {
                 dir.ancestors()
-                    .any(|dir| dir.join(crate::project::FILE).is_file())
+                    .any(|dir| dir.join(scorpion_project::FILE).is_file())
             })
         {
             miette::bail!(
                 help = "`program` is a linked image (ELF) or a project's directory (with a Scorpion.toml in it or above)",
                 "{} is a directory with no {} in it or above",
                 program.display(),
-                crate::project::FILE
+                scorpion_project::FILE
             );
         }
         let (here, images) = if program.is_dir() {
