@@ -416,3 +416,58 @@ fn each_routine_call_has_its_own_robot_and_its_failure_says_what_differs() {
     }
     assert_eq!(recorder.events, expected);
 }
+
+/// A failure that stops a build or a run is a [`runner::Error`] whose
+/// variant a caller can act on, keeping the place: the source file the
+/// assembler could not read; the layout, its area and addresses outside
+/// the memory an upload may write; the transcript that cannot be read.
+#[test]
+fn what_stops_a_build_or_a_run_is_a_variant_with_its_place() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = new_project(dir.path());
+    let spec = &project.file.images[0];
+
+    // A source that is not there.
+    let missing = scorpion_project::ImageSpec {
+        sources: vec!["src/gone.s".to_owned()],
+        ..spec.clone()
+    };
+    match runner::build::build(&project, &missing) {
+        Err(runner::Error::Assemble(assembler::Error::Read { path, .. })) => {
+            assert_eq!(path, Path::new("src/gone.s"));
+        }
+        other => panic!("a missing source: {other:?}"),
+    }
+
+    // A layout whose RAM runs over the ROM's INJECT queue ($0F40-).
+    std::fs::write(
+        project.root.join("wide.toml"),
+        "name = \"wide\"\n\n[[area]]\nname = \"RAM\"\nstart = \"$0C00\"\nend = \"$0FFF\"\n\n\
+         [[segment]]\nname = \"CODE\"\nload = \"RAM\"\n",
+    )
+    .expect("write the layout");
+    let wide = scorpion_project::ImageSpec {
+        target: "wide.toml".to_owned(),
+        ..spec.clone()
+    };
+    match runner::build::build(&project, &wide) {
+        Err(runner::Error::LayoutOutsideRam(outside)) => {
+            assert_eq!(
+                (outside.layout.as_str(), outside.area.as_str()),
+                ("wide.toml", "RAM")
+            );
+            assert_eq!((outside.start, outside.last), (0x0C00, 0x0FFF));
+            assert!(outside.help.contains("$0F3F"), "{}", outside.help);
+        }
+        other => panic!("a layout outside user RAM: {other:?}"),
+    }
+
+    // A transcript that is not there.
+    let gone = project.root.join("tests/gone.expect");
+    match runner::transcript::read(&gone, "tests/gone.expect") {
+        Err(runner::Error::Read { shown, path, .. }) => {
+            assert_eq!((shown.as_str(), path), ("tests/gone.expect", gone));
+        }
+        other => panic!("a transcript that cannot be read: {other:?}"),
+    }
+}

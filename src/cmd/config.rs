@@ -110,7 +110,7 @@ pub(crate) fn rig(resolved: &Resolved) -> Rig {
 
 /// The ROM profile the virtual robot runs: its name and linked image.
 pub(crate) fn rom(resolved: &Resolved) -> miette::Result<Option<(String, linker::Image)>> {
-    scorpion_project::runner::rig::rom(resolved)
+    Ok(scorpion_project::runner::rig::rom(resolved)?)
 }
 
 /// The uploader's profile of the ROM the robot runs: the project's ROM

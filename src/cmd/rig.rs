@@ -59,7 +59,7 @@ impl Rig {
         robot: &mut VirtualScorpion,
         mapped: &mut dyn FnMut(&str, u16, u16),
     ) -> miette::Result<Vec<(String, Printed)>> {
-        self.plain().attach(robot, mapped)
+        Ok(self.plain().attach(robot, mapped)?)
     }
 }
 

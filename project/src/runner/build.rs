@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use linker::{Image, Linked, SourceProvider, Target};
 
+use super::error::{Error, LayoutUnreadable, Result};
 use crate::{ImageSpec, Project};
 
 /// Files read relative to the project's root.
@@ -53,7 +54,7 @@ pub struct Built {
 }
 
 /// Assembles and links `spec`.
-pub fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built> {
+pub fn build(project: &Project, spec: &ImageSpec) -> Result<Built> {
     build_with(project, spec, &assembler::Options::default())
 }
 
@@ -65,7 +66,7 @@ pub fn build_with(
     project: &Project,
     spec: &ImageSpec,
     given: &assembler::Options,
-) -> miette::Result<Built> {
+) -> Result<Built> {
     let source = Rooted(&project.root);
     let mut defines: Vec<(String, i64)> = spec
         .defines
@@ -101,22 +102,10 @@ pub fn build_with(
         objects.push((path.clone(), assembly.object));
     }
     let target = if spec.target.ends_with(".toml") {
-        let text = hostfs::read_text(project.path(&spec.target), hostfs::TEXT).map_err(|e| {
-            miette::miette!(
-                "image {}: cannot read the layout {}: {e}",
-                spec.name,
-                spec.target
-            )
-        })?;
+        let text = read_layout(project, spec, "layout")?;
         Target::Custom(linker::Layout::from_toml(&spec.target, &text)?)
     } else if spec.target.ends_with(".cfg") {
-        let text = hostfs::read_text(project.path(&spec.target), hostfs::TEXT).map_err(|e| {
-            miette::miette!(
-                "image {}: cannot read the ld65 configuration {}: {e}",
-                spec.name,
-                spec.target
-            )
-        })?;
+        let text = read_layout(project, spec, "ld65 configuration")?;
         Target::Custom(linker::Layout::from_ld65(&spec.target, &text, None)?)
     } else {
         Target::builtin(&spec.target, None)?
@@ -126,8 +115,7 @@ pub fn build_with(
             Some((name, image)) => uploader::RomProfile::from_rom_image(&name, &image)?,
             None => uploader::RomProfile::reference(),
         };
-        super::memory::check(&spec.name, &spec.target, layout, &profile.writable)
-            .map_err(|outside| miette::Report::new(*outside))?;
+        super::memory::check(&spec.name, &spec.target, layout, &profile.writable)?;
     }
     let rom = match project.rom()? {
         Some(profile) => profile,
@@ -151,7 +139,7 @@ pub fn build_with(
 /// Builds `spec` and writes `NAME.elf`, `NAME.lst` and `NAME.map` into
 /// the project's `target/scorpion/`; returns the build and the image's
 /// path.
-pub fn build_to_target(project: &Project, spec: &ImageSpec) -> miette::Result<(Built, PathBuf)> {
+pub fn build_to_target(project: &Project, spec: &ImageSpec) -> Result<(Built, PathBuf)> {
     build_to_target_with(project, spec, &assembler::Options::default())
 }
 
@@ -161,11 +149,13 @@ pub fn build_to_target_with(
     project: &Project,
     spec: &ImageSpec,
     given: &assembler::Options,
-) -> miette::Result<(Built, PathBuf)> {
+) -> Result<(Built, PathBuf)> {
     let built = build_with(project, spec, given)?;
     let dir = project.target_dir();
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| miette::miette!("cannot create {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(|error| Error::CreateDir {
+        path: dir.clone(),
+        error,
+    })?;
     let elf = linker::Format::Elf.write(&built.linked.image)?;
     for (ext, bytes) in [
         ("elf", elf),
@@ -173,11 +163,26 @@ pub fn build_to_target_with(
         ("map", built.linked.map().into_bytes()),
     ] {
         let path = dir.join(format!("{}.{ext}", built.name));
-        std::fs::write(&path, bytes)
-            .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
+        std::fs::write(&path, bytes).map_err(|error| Error::WriteTarget {
+            path: path.clone(),
+            error,
+        })?;
     }
     let path = dir.join(format!("{}.elf", built.name));
     Ok((built, path))
+}
+
+/// The text of `spec`'s own layout, a `kind` of file (`layout`, `ld65
+/// configuration`).
+fn read_layout(project: &Project, spec: &ImageSpec, kind: &'static str) -> Result<String> {
+    hostfs::read_text(project.path(&spec.target), hostfs::TEXT).map_err(|error| {
+        Error::LayoutUnreadable(Box::new(LayoutUnreadable {
+            image: spec.name.clone(),
+            layout: spec.target.clone(),
+            kind,
+            error,
+        }))
+    })
 }
 
 impl Built {

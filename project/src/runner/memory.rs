@@ -13,13 +13,20 @@ use std::ops::RangeInclusive;
 #[error("image {image}: the layout {layout} puts area `{area}` at ${start:04X}-${last:04X}, {why}")]
 #[diagnostic(code(scorpion::project::layout_outside_ram), help("{help}"))]
 pub struct OutsideMemory {
-    image: String,
-    layout: String,
-    area: String,
-    start: u64,
-    last: u64,
-    why: String,
-    help: String,
+    /// The image's name in the project.
+    pub image: String,
+    /// The layout file, as `target` names it.
+    pub layout: String,
+    /// The area of the layout that leaves the writable memory.
+    pub area: String,
+    /// The area's first address.
+    pub start: u64,
+    /// Its last address.
+    pub last: u64,
+    /// Where it leaves the writable memory.
+    pub why: String,
+    /// What to write in the layout instead.
+    pub help: String,
 }
 
 fn ranges_text(writable: &[RangeInclusive<u16>]) -> String {

@@ -2,6 +2,7 @@
 //! front end: everything `scorpion build` and `scorpion test` do but the
 //! printing and the questions to a terminal.
 //!
+//! - [`error`]: what stops a build or a run ([`Error`]), with its place.
 //! - [`build`]: an image built in memory, with its listing, map, symbols
 //!   and bytes (and written into the project's `target/scorpion/`).
 //! - [`toolchain`]: the built-in include files and the link step every
@@ -24,6 +25,7 @@
 
 pub mod build;
 pub mod calls;
+pub mod error;
 pub mod memory;
 pub mod report;
 pub mod review;
@@ -34,6 +36,7 @@ pub mod toolchain;
 pub mod transcript;
 
 pub use build::{Built, SNAPSHOT_KINDS};
+pub use error::{Error, Result};
 pub use report::{
     Failure, MemberReport, NoProgress, Outcome, Passed, Progress, Question, Report, TestResult,
 };

@@ -6,8 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use miette::{Context, IntoDiagnostic};
-
+use super::error::{Error, Result};
 use super::snapshot;
 use crate::Project;
 
@@ -37,22 +36,27 @@ pub enum Decision {
 }
 
 /// Deletes `path` if it is there.
-pub(crate) fn remove(path: &Path) -> miette::Result<()> {
+pub(crate) fn remove(path: &Path) -> Result<()> {
     match std::fs::remove_file(path) {
-        Err(error) if error.kind() != std::io::ErrorKind::NotFound => Err(error)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("cannot delete {}", path.display())),
+        Err(source) if source.kind() != std::io::ErrorKind::NotFound => Err(Error::Delete {
+            path: path.to_path_buf(),
+            source,
+        }),
         _ => Ok(()),
     }
 }
 
-fn write_file(path: &Path, text: &str) -> miette::Result<()> {
+fn write_file(path: &Path, text: &str) -> Result<()> {
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).into_diagnostic()?;
+        std::fs::create_dir_all(dir).map_err(|error| Error::CreateDir {
+            path: dir.to_path_buf(),
+            error,
+        })?;
     }
-    std::fs::write(path, text)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot write {}", path.display()))
+    std::fs::write(path, text).map_err(|source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// Carries out `decision` about the snapshot accepted at `accepted`
@@ -62,7 +66,7 @@ fn write_file(path: &Path, text: &str) -> miette::Result<()> {
 ///
 /// # Errors
 /// A file that cannot be written or deleted.
-pub fn decide(decision: Decision, accepted: &Path, rendered: &str) -> miette::Result<()> {
+pub fn decide(decision: Decision, accepted: &Path, rendered: &str) -> Result<()> {
     let pending = snapshot::pending_path(accepted);
     match decision {
         Decision::Accept => {
@@ -89,9 +93,12 @@ impl Pending {
     ///
     /// # Errors
     /// The pending file cannot be read.
-    pub fn diff(&self) -> miette::Result<Option<String>> {
-        let new = hostfs::read_text(&self.pending, hostfs::TEXT)
-            .wrap_err_with(|| format!("cannot read {}", self.pending.display()))?;
+    pub fn diff(&self) -> Result<Option<String>> {
+        let new = hostfs::read_text(&self.pending, hostfs::TEXT).map_err(|source| Error::Read {
+            shown: self.pending.display().to_string(),
+            path: self.pending.clone(),
+            source,
+        })?;
         let new = snapshot::content(&new).unwrap_or(&new).to_owned();
         Ok(match snapshot::compare(&self.accepted, &new) {
             snapshot::Compared::Same => None,
@@ -104,23 +111,19 @@ impl Pending {
     ///
     /// # Errors
     /// The file cannot be moved.
-    pub fn accept(&self) -> miette::Result<()> {
-        std::fs::rename(&self.pending, &self.accepted)
-            .into_diagnostic()
-            .wrap_err_with(|| {
-                format!(
-                    "cannot move {} to {}",
-                    self.pending.display(),
-                    self.accepted.display()
-                )
-            })
+    pub fn accept(&self) -> Result<()> {
+        std::fs::rename(&self.pending, &self.accepted).map_err(|source| Error::Move {
+            from: self.pending.clone(),
+            to: self.accepted.clone(),
+            source,
+        })
     }
 
     /// Deletes the pending text; the accepted snapshot stays as it was.
     ///
     /// # Errors
     /// The file cannot be deleted.
-    pub fn reject(&self) -> miette::Result<()> {
+    pub fn reject(&self) -> Result<()> {
         remove(&self.pending)
     }
 }

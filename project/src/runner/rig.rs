@@ -6,8 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
-use miette::Context;
 use romlib::VirtualScorpion;
+
+use super::error::{Baud, Error, Result};
 
 use crate::{Origin, Resolved};
 
@@ -34,10 +35,12 @@ pub struct Rig {
 /// What each script of a robot prints, by the script's name.
 pub type Scripts = Vec<(String, Printed)>;
 
-fn read(root: Option<&Path>, path: &Path) -> miette::Result<String> {
+fn read(root: Option<&Path>, path: &Path) -> Result<String> {
     let full = root.map_or_else(|| path.to_path_buf(), |root| root.join(path));
-    hostfs::read_text(&full, hostfs::TEXT)
-        .wrap_err_with(|| format!("cannot read the script {}", path.display()))
+    hostfs::read_text(&full, hostfs::TEXT).map_err(|source| Error::ScriptUnreadable {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 impl Rig {
@@ -64,7 +67,7 @@ impl Rig {
         &self,
         robot: &mut VirtualScorpion,
         mapped: &mut dyn FnMut(&str, u16, u16),
-    ) -> miette::Result<Scripts> {
+    ) -> Result<Scripts> {
         let mut printed = Vec::new();
         for card in &self.cards {
             let name = card.path.display().to_string();
@@ -74,8 +77,11 @@ impl Rig {
             printed.push((name.clone(), script.printed()));
             robot
                 .map_card(start, end, Box::new(script))
-                .wrap_err_with(|| {
-                    format!("cannot put the card {name} at ${start:04X}-${end:04X}")
+                .map_err(|source| Error::CardPlacement {
+                    card: name.clone(),
+                    start,
+                    end,
+                    source,
                 })?;
             mapped(&name, start, end);
         }
@@ -99,17 +105,14 @@ pub fn virtual_robot(
     rom: Option<&(String, linker::Image)>,
     rig: &Rig,
     mapped: &mut dyn FnMut(&str, u16, u16),
-) -> miette::Result<(VirtualScorpion, Scripts)> {
+) -> Result<(VirtualScorpion, Scripts)> {
     let mut robot = match rom {
         Some((name, image)) => VirtualScorpion::with_rom(name, image)?,
         None => VirtualScorpion::new(),
     };
     // A fresh robot runs at the reference rate already: no second boot.
     if robot.host_baud() != baud && !robot.set_baud(baud) {
-        miette::bail!(
-            help = "the 6551 runs at 50 to 19200 baud; the reference ROM's rate is 9600",
-            "the Scorpion's 6551 has no {baud} baud rate"
-        );
+        return Err(Error::Baud(Box::new(Baud { baud })));
     }
     let printed = rig.attach(&mut robot, mapped)?;
     Ok((robot, printed))
@@ -117,17 +120,16 @@ pub fn virtual_robot(
 
 /// The ROM profile the virtual robot runs, as `resolved` names it: its
 /// name and linked image (`None`: the reference ROM).
-pub fn rom(resolved: &Resolved) -> miette::Result<Option<(String, linker::Image)>> {
+pub fn rom(resolved: &Resolved) -> Result<Option<(String, linker::Image)>> {
     let Some(rom) = &resolved.rom else {
         return Ok(None);
     };
-    let bytes = hostfs::read(&rom.value, hostfs::BINARY).wrap_err_with(|| {
-        format!(
-            "cannot read the ROM profile {} ({})",
-            rom.value.display(),
-            rom.origin
-        )
-    })?;
+    let bytes =
+        hostfs::read(&rom.value, hostfs::BINARY).map_err(|source| Error::RomUnreadable {
+            path: rom.value.clone(),
+            origin: rom.origin.to_string(),
+            source,
+        })?;
     let name = match &rom.origin {
         // The project's profile is named as its file writes it.
         Origin::Project { .. } => resolved

@@ -18,13 +18,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use miette::Context;
 use romlib::VirtualScorpion;
 use uploader::transport::{SerialTransport, VirtualTransport};
 use uploader::{Client, ClientConfig, RomProfile, Transport, UploadImage};
 
 use super::build::{Built, SNAPSHOT_KINDS, build};
 use super::calls;
+use super::error::{Error, FrontEnd, Result, WorkspacePort};
 use super::report::{Failure, MemberReport, Outcome, Passed, Progress, Question, Report};
 use super::review::{self, Decision, Mode};
 use super::rig::{EMU, Rig, Scripts, rom, virtual_robot};
@@ -57,11 +57,7 @@ pub struct Options {
 /// What stops the run: a configuration that does not resolve, a snapshot
 /// that cannot be written, a robot that cannot be reached. A test that
 /// fails is in the report, not an error.
-pub fn run_tests(
-    found: &Found,
-    options: &Options,
-    progress: &mut dyn Progress,
-) -> miette::Result<Report> {
+pub fn run_tests(found: &Found, options: &Options, progress: &mut dyn Progress) -> Result<Report> {
     let progress = RefCell::new(progress);
     let mut run = Run {
         report: Report::default(),
@@ -74,10 +70,9 @@ pub fn run_tests(
         Found::Project(project) => run.project(project)?,
         Found::Workspace(workspace) => {
             if options.port.is_some() {
-                miette::bail!(
-                    help = "a workspace's members may not fit on one robot together: run `scorpion test --port` in each member's directory",
-                    "--port tests one project on the robot, and {FILE} here is a workspace"
-                );
+                return Err(Error::WorkspacePort(Box::new(WorkspacePort {
+                    root: workspace.root.clone(),
+                })));
             }
             // One run for every member: what is set up once (the scripting
             // engine's library, the ROM's symbols) serves all.
@@ -87,7 +82,7 @@ pub fn run_tests(
                 if let Err(error) = run.project(&project) {
                     run.record(
                         &format!("project {name}"),
-                        Outcome::Failed(Failure::text(format!("{error:?}"))),
+                        Outcome::Failed(Failure::text(rendered(error))),
                     );
                 }
                 let member = MemberReport {
@@ -167,7 +162,7 @@ impl Run<'_, '_, '_> {
     }
 
     /// One project's tests.
-    fn project(&mut self, project: &Project) -> miette::Result<()> {
+    fn project(&mut self, project: &Project) -> Result<()> {
         // Failures of this project only (a workspace runs several).
         let failed_before = self.report.failed;
         let mut built = Vec::new();
@@ -183,7 +178,7 @@ impl Run<'_, '_, '_> {
                     built.push(image);
                 }
                 Err(error) => {
-                    self.record_result(&format!("build {}", spec.name), Err(format!("{error:?}")))
+                    self.record_result(&format!("build {}", spec.name), Err(rendered(error)))
                 }
             }
         }
@@ -225,18 +220,14 @@ impl Run<'_, '_, '_> {
     }
 
     /// What [`Progress::review`] decides about the snapshot `name`.
-    fn ask(&mut self, name: &str, why: &str, accept: &str) -> miette::Result<Decision> {
+    fn ask(&mut self, name: &str, why: &str, accept: &str) -> Result<Decision> {
         self.progress
             .borrow_mut()
             .review(&Question { name, why, accept })
+            .map_err(|error| Error::Review(FrontEnd(error)))
     }
 
-    fn check_snapshots(
-        &mut self,
-        project: &Project,
-        built: &Built,
-        mode: Mode,
-    ) -> miette::Result<()> {
+    fn check_snapshots(&mut self, project: &Project, built: &Built, mode: Mode) -> Result<()> {
         for (kind, content) in built.snapshots() {
             let name = format!("{}/{kind}", built.name);
             if !self.selects(&name) {
@@ -304,7 +295,7 @@ impl Run<'_, '_, '_> {
     /// Snapshot files no image and kind of the project makes (an image
     /// renamed or removed): a failure, or deleted with [`Mode::Accept`]
     /// (pending ones with [`Mode::Reject`] too).
-    fn stale_snapshots(&mut self, project: &Project, mode: Mode) -> miette::Result<()> {
+    fn stale_snapshots(&mut self, project: &Project, mode: Mode) -> Result<()> {
         let dir = project.root.join("tests").join("snapshots");
         let Ok(entries) = std::fs::read_dir(&dir) else {
             return Ok(());
@@ -370,7 +361,7 @@ impl Run<'_, '_, '_> {
         setup: &Setup,
         built: &[Built],
         name: &str,
-    ) -> miette::Result<(VirtualScorpion, Scripts)> {
+    ) -> Result<(VirtualScorpion, Scripts)> {
         let progress = self.progress;
         let mut progress = progress.borrow_mut();
         let (mut robot, scripts) = virtual_robot(
@@ -384,19 +375,17 @@ impl Run<'_, '_, '_> {
         for image in built {
             robot
                 .load_image(&image.linked.image)
-                .wrap_err_with(|| format!("cannot load {}", image.name))?;
+                .map_err(|source| Error::Load {
+                    image: image.name.clone(),
+                    source,
+                })?;
         }
         progress.robot_ready(name, &mut robot);
         Ok((robot, scripts))
     }
 
     /// Every `tests/*.calls` file: each call on a fresh virtual Scorpion.
-    fn routine_calls(
-        &mut self,
-        project: &Project,
-        setup: &Setup,
-        built: &[Built],
-    ) -> miette::Result<()> {
+    fn routine_calls(&mut self, project: &Project, setup: &Setup, built: &[Built]) -> Result<()> {
         let mut symbols = HashMap::new();
         for image in built {
             for symbol in &image.linked.image.symbols {
@@ -407,8 +396,11 @@ impl Run<'_, '_, '_> {
         }
         for path in project.test_files("calls") {
             let shown = relative(project, &path);
-            let text = hostfs::read_text(&path, hostfs::TEXT)
-                .wrap_err_with(|| format!("cannot read {shown}"))?;
+            let text = hostfs::read_text(&path, hostfs::TEXT).map_err(|source| Error::Read {
+                shown: shown.clone(),
+                path: path.clone(),
+                source,
+            })?;
             let calls = match calls::parse(&text, &symbols) {
                 Ok(calls) => calls,
                 Err(why) => {
@@ -433,7 +425,7 @@ impl Run<'_, '_, '_> {
                         progress.robot_done(&name, &mut robot);
                         result
                     }
-                    Err(error) => Err(format!("{error:?}")),
+                    Err(error) => Err(rendered(error)),
                 };
                 self.record_result(
                     &name,
@@ -452,7 +444,7 @@ impl Run<'_, '_, '_> {
         project: &Project,
         setup: &Setup,
         built: &[Built],
-    ) -> miette::Result<()> {
+    ) -> Result<()> {
         let mut robot_time = Duration::ZERO;
         let started = Instant::now();
         for path in project.transcripts() {
@@ -474,7 +466,7 @@ impl Run<'_, '_, '_> {
                     client.transport().done(&name);
                     result
                 }
-                Err(error) => Err(indent(&format!("{error:?}"))),
+                Err(error) => Err(indent(&rendered(error))),
             };
             self.record_result(&name, result.map(|()| Passed::Ok));
         }
@@ -491,7 +483,7 @@ impl Run<'_, '_, '_> {
         setup: &Setup,
         built: &[Built],
         port: &str,
-    ) -> miette::Result<()> {
+    ) -> Result<()> {
         // On `emu` the robot is the virtual one with the project's parts; a
         // real robot has its own cards, and is opened without them.
         let progress = self.progress;
@@ -519,7 +511,10 @@ impl Run<'_, '_, '_> {
                 &uploader::UploadOptions::default(),
                 &mut uploader::NoProgress,
             )
-            .wrap_err_with(|| format!("cannot upload {}", image.name))?;
+            .map_err(|source| Error::UploadImage {
+                image: image.name.clone(),
+                source: Box::new(source),
+            })?;
             self.record_result(&format!("upload {}", image.name), Ok(Passed::Ok));
         }
         let clock = if port == EMU {
@@ -538,6 +533,12 @@ impl Run<'_, '_, '_> {
         }
         Ok(())
     }
+}
+
+/// `error` as the front end's miette handler renders it, for a test's
+/// failure.
+fn rendered(error: Error) -> String {
+    format!("{:?}", miette::Report::new(error))
 }
 
 fn indent(text: &str) -> String {
@@ -564,7 +565,7 @@ fn run_transcript<T: Transport>(
     clock: Clock,
 ) -> Result<(), String> {
     let shown = relative(project, path);
-    let expectations = transcript::read(path, &shown).map_err(|e| indent(&format!("{e:?}")))?;
+    let expectations = transcript::read(path, &shown).map_err(|e| indent(&rendered(e)))?;
     let checked = expectations
         .check_all(client)
         .map_err(|e| indent(&format!("{:?}", miette::Report::new(e))))?;
@@ -607,7 +608,7 @@ impl Setup {
         project: &Project,
         port: Option<&str>,
         environment: &Environment,
-    ) -> miette::Result<(Setup, Option<String>)> {
+    ) -> Result<(Setup, Option<String>)> {
         let flags = Flags {
             port: port.filter(|p| !p.is_empty()).map(str::to_owned),
             ..Flags::default()

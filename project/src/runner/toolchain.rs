@@ -30,7 +30,7 @@ pub fn link_objects(
     target: &Target,
     symbol_images: &[(String, Image)],
     sources: &dyn SourceProvider,
-) -> miette::Result<Linked> {
+) -> super::Result<Linked> {
     let symbol_files: Vec<SymbolFile<'_>> = symbol_images
         .iter()
         .map(|(name, image)| SymbolFile { name, image })

@@ -7,20 +7,33 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Duration;
 
-use miette::Context;
 use uploader::{Expectations, Mismatch};
 
+use super::error::{BadTranscript, Error, Result};
+
 /// Reads the transcript at `path`, shown to the user as `shown`.
-pub fn read(path: &Path, shown: &str) -> miette::Result<Expectations> {
-    let text =
-        hostfs::read_text(path, hostfs::TEXT).wrap_err_with(|| format!("cannot read {shown}"))?;
+///
+/// # Errors
+/// [`Error::Read`] if the file cannot be read, [`Error::BadTranscript`]
+/// at the first line that is not a transcript's.
+pub fn read(path: &Path, shown: &str) -> Result<Expectations> {
+    let text = hostfs::read_text(path, hostfs::TEXT).map_err(|source| Error::Read {
+        shown: shown.to_owned(),
+        path: path.to_path_buf(),
+        source,
+    })?;
     Expectations::parse(&text).map_err(|error| match error {
-        uploader::Error::BadExpectations { line, reason } => miette::miette!(
-            code = "uploader::bad_expectations",
-            help = "each line is `COMMAND` or `COMMAND => ANSWER`; `#` starts a comment",
-            "{shown}:{line}: {reason}"
-        ),
-        other => miette::Report::new(other).wrap_err(format!("in {shown}")),
+        uploader::Error::BadExpectations { line, reason } => {
+            Error::BadTranscript(Box::new(BadTranscript {
+                shown: shown.to_owned(),
+                line,
+                reason,
+            }))
+        }
+        source => Error::Transcript {
+            shown: shown.to_owned(),
+            source: Box::new(source),
+        },
     })
 }
 
