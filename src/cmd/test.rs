@@ -58,6 +58,11 @@ pub(crate) struct Args {
     /// [robot] port.
     #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
     port: Option<String>,
+    /// With --port: replace what the robot has installed where the images
+    /// go (an earlier build of them, most often), as `scorpion upload
+    /// --replace` does; without it such an upload fails the test.
+    #[arg(long, requires = "port")]
+    replace: bool,
     /// Also print the robot time the transcripts stood for and the wall
     /// time they took (left out otherwise: the output stays the same from
     /// run to run).
@@ -171,6 +176,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         filter: filter.clone(),
         mode: args.mode(),
         port: args.port.clone(),
+        replace: args.replace,
         environment: Environment::from_process()?,
     };
     let mut printer = Printer {

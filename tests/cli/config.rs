@@ -614,3 +614,32 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("`99999999999` is out of range"), "{stderr}");
 }
+
+/// The loop of a user with a robot: `test --port`, change the source,
+/// `test --port` again. The robot holds the earlier build where the new
+/// one goes: without `--replace` that is a failed test said like the
+/// others (with the summary and exit 1), with it the new build replaces
+/// the old and the transcripts pass.
+#[test]
+fn test_on_a_port_replaces_an_earlier_build_only_when_asked() {
+    let adc = Adc::new();
+    let project = adc.project();
+    let robot = Pty::with_adc_card();
+    let (_, env) = adc.port_from(Source::Env, &robot.path);
+    let first = adc.run(&project, &["test", "--port"], &env);
+    assert_eq!(first.status.code(), Some(0), "{}", transcript(&first));
+    let source = project.join("adc.s");
+    let text = std::fs::read_to_string(&source).expect("the source");
+    std::fs::write(&source, format!("{text}\n        .byte $5A ; a change\n")).expect("write");
+    let refused = adc.run(&project, &["test", "--port"], &env);
+    assert_eq!(refused.status.code(), Some(1), "{}", transcript(&refused));
+    let out = stdout(&refused);
+    assert!(out.contains("test upload adc ... FAILED"), "{out}");
+    assert!(out.contains("--replace"), "{out}");
+    assert!(out.ends_with(" 1 failed\n"), "{out}");
+    let replaced = adc.run(&project, &["test", "--port", "--replace"], &env);
+    assert_eq!(replaced.status.code(), Some(0), "{}", transcript(&replaced));
+    let out = stdout(&replaced);
+    assert!(out.contains("test upload adc ... ok"), "{out}");
+    assert!(out.ends_with(" 0 failed\n"), "{out}");
+}

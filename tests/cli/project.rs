@@ -404,6 +404,19 @@ fn routine_calls_check_registers_memory_and_cycles() {
         "{}",
         transcript(&slow)
     );
+    // A hook handler ends in the ROM (`jmp CMD_DONE`): the failure says
+    // why it never comes back.
+    std::fs::write(
+        project.join("tests/calls.calls"),
+        "call handler A=$56 X=$01 => A=$56\n",
+    )
+    .expect("write");
+    let handler = scorpion(&project, &["test"]);
+    assert!(
+        stdout(&handler).contains("it is in the ROM, and a routine that ends by jumping there"),
+        "{}",
+        transcript(&handler)
+    );
 }
 
 #[test]

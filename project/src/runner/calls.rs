@@ -256,9 +256,19 @@ pub fn run(call: &Call, robot: &mut VirtualScorpion) -> Result<(), String> {
             return Err(format!("the CPU jammed at ${pc:04X} (${opcode:02X})"));
         }
         _ => {
+            let pc = machine.cpu.pc;
+            // A hook handler ends by jumping into the ROM (`jmp CMD_DONE`),
+            // never with an `RTS` back to its caller: say so where it is.
+            let why = if pc >= platform::map::ROM_START {
+                ": it is in the ROM, and a routine that ends by jumping there \
+                 (a handler's `jmp CMD_DONE`) never returns to a `call`; call \
+                 the subroutines it uses, or test the handler with a transcript"
+            } else {
+                ""
+            };
             return Err(format!(
-                "`{}` did not return within {limit} cycles (PC ${:04X})",
-                call.routine, machine.cpu.pc
+                "`{}` did not return within {limit} cycles (PC ${pc:04X}{why})",
+                call.routine
             ));
         }
     }

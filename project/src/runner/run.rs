@@ -45,6 +45,10 @@ pub struct Options {
     /// the virtual one, and an upload of the images) instead of the
     /// snapshots: `Some("")` for the port the configuration names.
     pub port: Option<String>,
+    /// With a port: replace what the robot has installed where the images
+    /// go (an earlier build of the same images, most often), as `scorpion
+    /// upload --replace` does, instead of refusing the upload.
+    pub replace: bool,
     /// The environment the configuration is resolved with (the line's
     /// rate, the port, the per-user file).
     pub environment: Environment,
@@ -503,19 +507,33 @@ impl Run<'_, '_, '_> {
             Box::new(SerialTransport::open(port, setup.baud)?)
         };
         let mut client = client(transport);
+        let options = uploader::UploadOptions {
+            replace: self.options.replace,
+            ..uploader::UploadOptions::default()
+        };
         for image in built {
+            let name = format!("upload {}", image.name);
+            self.start(&name);
             let upload = UploadImage::try_from(&image.linked.image)?;
-            uploader::upload(
-                &mut client,
-                &upload,
-                &uploader::UploadOptions::default(),
-                &mut uploader::NoProgress,
-            )
-            .map_err(|source| Error::UploadImage {
-                image: image.name.clone(),
-                source: Box::new(source),
-            })?;
-            self.record_result(&format!("upload {}", image.name), Ok(Passed::Ok));
+            let uploaded =
+                uploader::upload(&mut client, &upload, &options, &mut uploader::NoProgress)
+                    .map_err(|source| Error::UploadImage {
+                        image: image.name.clone(),
+                        source: Box::new(source),
+                    });
+            if let Err(error) = uploaded {
+                // A failed upload is a failed test, said like the others;
+                // the transcripts would only test what the robot had.
+                let mut why = indent(&rendered(error));
+                if !self.options.replace {
+                    why.push_str(
+                        "    (`scorpion test --port --replace` replaces what the robot has there)\n",
+                    );
+                }
+                self.record_result(&name, Err(why));
+                return Ok(());
+            }
+            self.record_result(&name, Ok(Passed::Ok));
         }
         let clock = if port == EMU {
             Clock::Robot
