@@ -86,6 +86,18 @@ pub struct VirtualScorpion {
     reference_rom: bool,
     /// What changes the robot's inputs over time, if anything.
     world: Option<Box<dyn Surroundings>>,
+    /// The host's own run of the CPU, if it set one (a profiler).
+    runner: Option<Box<dyn Runner>>,
+}
+
+/// A run of the robot's CPU that every run of a [`VirtualScorpion`] goes
+/// through once set ([`VirtualScorpion::set_runner`]): a profiler or a
+/// coverage count watching every exchange of a test, with its own hooks.
+pub trait Runner: std::fmt::Debug + Send {
+    /// Runs `robot` to robot time `until` or an earlier stop, as
+    /// [`emulator::Machine::run`] does (with hooks that never stop it, the
+    /// same run).
+    fn run(&mut self, robot: &mut Scorpion, until: u64) -> Stop;
 }
 
 /// An image's labels: its symbols that lie in a section (not constants).
@@ -162,6 +174,7 @@ impl VirtualScorpion {
             labels: Vec::new(),
             reference_rom: true,
             world: None,
+            runner: None,
         };
         scorpion.boot();
         scorpion
@@ -220,6 +233,7 @@ impl VirtualScorpion {
             labels: Vec::new(),
             reference_rom: false,
             world: None,
+            runner: None,
         };
         scorpion.add_labels(rom);
         scorpion.boot();
@@ -235,8 +249,20 @@ impl VirtualScorpion {
     /// line, until a byte reaches it): the surroundings woken when they
     /// asked to be, then a jammed CPU or a failed card reported.
     fn advance(&mut self, until: u64) -> Result<(), Error> {
-        self.advance_with(until, |robot, to| robot.run(to))
-            .map(|_| ())
+        let mut runner = self.runner.take();
+        let result = self.advance_with(until, |robot, to| match runner.as_mut() {
+            Some(runner) => runner.run(robot, to),
+            None => robot.run(to),
+        });
+        self.runner = runner;
+        result.map(|_| ())
+    }
+
+    /// Every run from now on (the host's exchanges, settling, waiting for
+    /// answers) goes through `runner` instead of the plain run; `None`
+    /// goes back to the plain run. Returns the runner there was.
+    pub fn set_runner(&mut self, runner: Option<Box<dyn Runner>>) -> Option<Box<dyn Runner>> {
+        std::mem::replace(&mut self.runner, runner)
     }
 
     /// [`VirtualScorpion::advance`] with the caller's own run of the CPU
@@ -310,6 +336,9 @@ impl VirtualScorpion {
             labels: self.labels.clone(),
             reference_rom: self.reference_rom,
             world,
+            // The copy runs plainly: the host watches the robot it set
+            // its run on.
+            runner: None,
         })
     }
 
