@@ -17,7 +17,7 @@
 //! [`RING`] instructions) are counted that many times more, to their
 //! addresses, lines, routines and branches.
 
-use emulator::{Bus, Control, Cpu, Hooks, Interrupt};
+use emulator::{Breakpoints, Bus, Control, Cpu, Hooks, Interrupt};
 
 use crate::flow::{self, Flow};
 use crate::stack::{Routine, Stack};
@@ -178,6 +178,10 @@ pub struct Profiler {
     pub(crate) stack: Stack,
     pub(crate) labels: Labels,
     places: Places,
+    /// Every address of `places`: one bit test per instruction.
+    watched: Breakpoints,
+    /// Calls, commands and stacks counted too (not for coverage alone).
+    calls: bool,
     pub(crate) commands: Vec<CommandRun>,
     /// Cycles counted (instructions and interrupt sequences).
     pub(crate) total: u64,
@@ -190,7 +194,18 @@ impl Profiler {
     /// ([`romlib::VirtualScorpion::labels`]) and whose ROM has `places`.
     #[must_use]
     pub fn new(labels: &[(u16, String)], places: Places) -> Profiler {
+        let mut watched = Breakpoints::new();
+        for &at in places
+            .arrival
+            .iter()
+            .chain(&places.done)
+            .chain(places.main_loop.iter())
+        {
+            watched.insert(at);
+        }
         Profiler {
+            watched,
+            calls: true,
             flows: flow::table(),
             counts: vec![0; 0x1_0000],
             cycles: vec![0; 0x1_0000],
@@ -213,6 +228,15 @@ impl Profiler {
     #[must_use]
     pub fn for_robot(robot: &romlib::VirtualScorpion) -> Profiler {
         Profiler::new(&robot.labels(), Places::of(robot))
+    }
+
+    /// Counts by address and branch only, for coverage: no call stack,
+    /// no commands (faster).
+    #[must_use]
+    pub fn coverage_only(mut self) -> Profiler {
+        self.calls = false;
+        self.watched = Breakpoints::new();
+        self
     }
 
     /// Counts the instruction still pending, which ended at the CPU's
@@ -247,6 +271,9 @@ impl Profiler {
         self.total
     }
 
+    // Out of line: the CPU's run loop keeps its registers (inlined, this
+    // would crowd them out of machine registers on every instruction).
+    #[inline(never)]
     fn count_pending(&mut self, pending: Pending, end: u64, next_pc: u16, s_after: u8) {
         let ran = Ran {
             pc: pending.pc,
@@ -270,16 +297,20 @@ impl Profiler {
         self.counts[at] += times;
         self.cycles[at] += cycles;
         self.total += cycles;
-        self.stack.charge(self.labels.of(ran.pc), cycles);
-        match self.flows[usize::from(ran.opcode)] {
-            Flow::Plain => {}
-            Flow::Branch => {
-                if ran.next_pc == ran.pc.wrapping_add(2) {
-                    self.not_taken[at] += times;
-                } else {
-                    self.taken[at] += times;
-                }
+        let flow = self.flows[usize::from(ran.opcode)];
+        if flow == Flow::Branch {
+            if ran.next_pc == ran.pc.wrapping_add(2) {
+                self.not_taken[at] += times;
+            } else {
+                self.taken[at] += times;
             }
+        }
+        if !self.calls {
+            return;
+        }
+        self.stack.charge(self.labels.of(ran.pc), cycles);
+        match flow {
+            Flow::Plain | Flow::Branch => {}
             Flow::Call => self.stack.call(ran.next_pc, ran.s_before, end, times),
             Flow::Return => self.stack.unwind(ran.s_after, false, end),
             Flow::ReturnFromInterrupt | Flow::SetStack => {
@@ -291,7 +322,8 @@ impl Profiler {
 
     /// A new instruction at `pc` is about to run at cycle `now`: a
     /// command arriving or done.
-    #[inline(always)]
+    #[cold]
+    #[inline(never)]
     fn look<B: Bus>(&mut self, pc: u16, now: u64, bus: &B) {
         if self.places.arrival == Some(pc) {
             self.arrive(now, bus);
@@ -396,7 +428,9 @@ impl Hooks for Profiler {
             }
             self.count_pending(pending, cpu.cycles(), cpu.pc, cpu.s);
         }
-        self.look(cpu.pc, cpu.cycles(), bus);
+        if self.watched.contains(cpu.pc) {
+            self.look(cpu.pc, cpu.cycles(), bus);
+        }
         self.pending = Some(Pending {
             pc: cpu.pc,
             opcode: bus.peek(cpu.pc),
@@ -424,10 +458,12 @@ impl Hooks for Profiler {
             Interrupt::Irq => Routine::Irq,
             Interrupt::Nmi => Routine::Nmi,
         };
-        self.stack.interrupt(routine, s_before, began);
-        // The sequence's own seven cycles are the handler's.
-        self.stack.charge(u32::MAX, 7);
         self.total += 7;
+        if self.calls {
+            self.stack.interrupt(routine, s_before, began);
+            // The sequence's own seven cycles are the handler's.
+            self.stack.charge(u32::MAX, 7);
+        }
     }
 
     fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, _cycles: u64) {

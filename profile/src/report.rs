@@ -165,14 +165,28 @@ pub fn hot_lines(profile: &Profile, lines: &LineTable) -> Vec<HotLine> {
     hot
 }
 
-/// The hot lines as a table, at most `limit`.
+/// The hot source lines as a table, at most `limit` (code without a line
+/// table, the ROM's, is summed on a line of its own: the routines and
+/// the flame graph name it).
 #[must_use]
 pub fn hot_lines_table(profile: &Profile, lines: &LineTable, limit: usize) -> String {
     let mut text = format!(
         "{:<40} {:>10} {:>12} {:>7}\n",
         "line", "runs", "cycles", "share"
     );
-    for line in hot_lines(profile, lines).into_iter().take(limit) {
+    let (sourced, unsourced): (Vec<HotLine>, Vec<HotLine>) = hot_lines(profile, lines)
+        .into_iter()
+        .partition(|line| !line.place.ends_with("(no source)"));
+    let elsewhere: u64 = unsourced.iter().map(|line| line.cycles).sum();
+    let _ = writeln!(
+        text,
+        "{:<40} {:>10} {:>12} {:>6.2}%",
+        "(the ROM and code without source)",
+        "",
+        elsewhere,
+        100.0 * elsewhere as f64 / profile.total.max(1) as f64
+    );
+    for line in sourced.into_iter().take(limit) {
         let share = 100.0 * line.cycles as f64 / profile.total.max(1) as f64;
         let _ = writeln!(
             text,

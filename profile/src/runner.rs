@@ -4,8 +4,8 @@
 
 use std::sync::{Arc, Mutex, PoisonError};
 
-use emulator::Stop;
 use emulator::board::Scorpion;
+use emulator::{Breakpoints, Stop};
 
 use crate::engine::Profiler;
 
@@ -20,8 +20,14 @@ impl Recorder {
     /// Sets a fresh profiler on `robot` (its ROM and the images loaded
     /// so far named) and returns the host's handle to it.
     pub fn attach(robot: &mut romlib::VirtualScorpion) -> Recorder {
+        let profiler = Profiler::for_robot(robot);
+        Recorder::attach_profiler(robot, profiler)
+    }
+
+    /// Sets `profiler` on `robot` (a [`Profiler::coverage_only`] one).
+    pub fn attach_profiler(robot: &mut romlib::VirtualScorpion, profiler: Profiler) -> Recorder {
         let recorder = Recorder {
-            profiler: Arc::new(Mutex::new(Profiler::for_robot(robot))),
+            profiler: Arc::new(Mutex::new(profiler)),
         };
         robot.set_runner(Some(Box::new(recorder.clone())));
         recorder
@@ -54,6 +60,13 @@ impl romlib::Runner for Recorder {
     fn run(&mut self, robot: &mut Scorpion, until: u64) -> Stop {
         let mut profiler = self.profiler.lock().unwrap_or_else(PoisonError::into_inner);
         let stop = robot.run_with(until, &mut *profiler);
+        profiler.end_run(&robot.cpu);
+        stop
+    }
+
+    fn run_to(&mut self, robot: &mut Scorpion, until: u64, stops: &mut Breakpoints) -> Stop {
+        let mut profiler = self.profiler.lock().unwrap_or_else(PoisonError::into_inner);
+        let stop = robot.run_with(until, &mut (&mut *profiler, stops));
         profiler.end_run(&robot.cpu);
         stop
     }

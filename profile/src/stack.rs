@@ -101,6 +101,9 @@ pub(crate) struct Stack {
     cell_ids: FxHashMap<(u32, u32), u32>,
     frames: Vec<Frame>,
     main: u32,
+    /// The node code runs in now (the top frame's, or `main`'s).
+    top: u32,
+    /// The last cell charged: its node, label and index.
     current: (u32, u32, u32),
     /// The command running now (an index into the commands seen).
     pub(crate) command: Option<u32>,
@@ -122,11 +125,13 @@ impl Stack {
             cell_ids: FxHashMap::default(),
             frames: Vec::new(),
             main: TOP,
+            top: TOP,
             current: (u32::MAX, u32::MAX, 0),
             command: None,
         };
         let main = stack.routine_id(Routine::Main);
         stack.main = stack.child(TOP, main);
+        stack.top = stack.main;
         stack.calls[main as usize].calls = 1;
         stack.current = (stack.main, u32::MAX, 0);
         let cell = stack.cell(stack.main, u32::MAX);
@@ -162,7 +167,11 @@ impl Stack {
 
     /// The node code runs in now.
     fn node(&self) -> u32 {
-        self.frames.last().map_or(self.main, |frame| frame.node)
+        self.top
+    }
+
+    fn frames_changed(&mut self) {
+        self.top = self.frames.last().map_or(self.main, |frame| frame.node);
     }
 
     /// Counts `cycles` spent at an address labelled `label`, in the
@@ -170,10 +179,10 @@ impl Stack {
     #[inline(always)]
     pub(crate) fn charge(&mut self, label: u32, cycles: u64) {
         let (node, at, cell) = self.current;
-        let cell = if at == label && node == self.node() {
+        let cell = if at == label && node == self.top {
             cell
         } else {
-            let node = self.node();
+            let node = self.top;
             let cell = self.cell(node, label);
             self.current = (node, label, cell);
             cell
@@ -196,12 +205,14 @@ impl Stack {
             ends,
             times,
         });
+        self.frames_changed();
     }
 
     fn pop(&mut self, now: u64) {
         let Some(frame) = self.frames.pop() else {
             return;
         };
+        self.frames_changed();
         let cost = now.saturating_sub(frame.entry);
         let calls = &mut self.calls[frame.routine as usize];
         if calls.ended == 0 || cost < calls.min {

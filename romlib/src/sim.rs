@@ -10,8 +10,8 @@
 //! [`VirtualScorpion::exchange`] sends a [`Command`] through the emulated
 //! 6551 at the line's baud rate and parses the answer.
 
-use emulator::Stop;
 use emulator::board::{CPU_HZ, Scorpion};
+use emulator::{Breakpoints, Stop};
 use isa::objfmt::HookKind;
 use linker::Image;
 use platform::map::{self, KIM_BUS};
@@ -98,6 +98,13 @@ pub trait Runner: std::fmt::Debug + Send {
     /// [`emulator::Machine::run`] does (with hooks that never stop it, the
     /// same run).
     fn run(&mut self, robot: &mut Scorpion, until: u64) -> Stop;
+
+    /// Runs `robot` to robot time `until` or to the first instruction at
+    /// an address of `stops`, as [`emulator::Machine::run_with`] with
+    /// `stops` does (a routine-level test's run to its return).
+    fn run_to(&mut self, robot: &mut Scorpion, until: u64, stops: &mut Breakpoints) -> Stop {
+        robot.run_with(until, stops)
+    }
 }
 
 /// An image's labels: its symbols that lie in a section (not constants).
@@ -256,6 +263,17 @@ impl VirtualScorpion {
         });
         self.runner = runner;
         result.map(|_| ())
+    }
+
+    /// Runs the CPU alone (no surroundings woken, no host) to robot time
+    /// `until` or to the first instruction at an address of `stops`,
+    /// through the runner if one is set: a routine called directly, run
+    /// to its return.
+    pub fn run_to(&mut self, until: u64, stops: &mut Breakpoints) -> Stop {
+        match self.runner.as_mut() {
+            Some(runner) => runner.run_to(&mut self.robot, until, stops),
+            None => self.robot.run_with(until, stops),
+        }
     }
 
     /// Every run from now on (the host's exchanges, settling, waiting for
