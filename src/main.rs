@@ -7,7 +7,6 @@
 
 mod args;
 mod cmd;
-mod project;
 
 use std::io::Write as _;
 use std::process::ExitCode;

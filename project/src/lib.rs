@@ -8,14 +8,22 @@
 //! - [`resolve`]: flags, then the environment, then the per-user file,
 //!   then the project, then defaults, each value with where it came from.
 //! - [`error`]: what can go wrong, located in the file that says it.
+//! - [`runner`]: the project's builds and tests (snapshots, transcripts,
+//!   routine calls, on the virtual Scorpion or a robot), reported as they
+//!   go through a [`runner::Progress`] and at the end as a
+//!   [`runner::Report`].
+//! - [`template`]: a new project, as `scorpion new` makes it.
 //!
-//! Nothing here prints or exits: callers show [`Error`]s with miette.
+//! Nothing here prints or exits: callers show [`Error`]s and the runner's
+//! reports with miette.
 
 pub mod error;
 pub mod file;
 pub mod project;
 pub mod resolve;
+pub mod runner;
 mod spans;
+pub mod template;
 mod validate;
 
 pub use error::{Error, Located};

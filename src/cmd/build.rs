@@ -53,9 +53,9 @@ fn project(args: &Args) -> miette::Result<ExitCode> {
     {
         *dir = here.join(&*dir);
     }
-    match crate::project::config::Found::here()? {
-        crate::project::config::Found::Project(project) => build_project(&project, "", &given),
-        crate::project::config::Found::Workspace(workspace) => {
+    match scorpion_project::Found::here()? {
+        scorpion_project::Found::Project(project) => build_project(&project, "", &given),
+        scorpion_project::Found::Workspace(workspace) => {
             for (name, project) in workspace.projects()? {
                 build_project(&project, &format!("{name}/"), &given)?;
             }
@@ -67,12 +67,13 @@ fn project(args: &Args) -> miette::Result<ExitCode> {
 
 /// Builds `project`'s images; `at` is its directory as printed.
 fn build_project(
-    project: &crate::project::Project,
+    project: &scorpion_project::Project,
     at: &str,
     given: &assembler::Options,
 ) -> miette::Result<()> {
     for spec in &project.file.images {
-        let (built, _) = crate::project::build::build_to_target_with(project, spec, given)?;
+        let (built, _) =
+            scorpion_project::runner::build::build_to_target_with(project, spec, given)?;
         for warning in &built.warnings {
             #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
             {

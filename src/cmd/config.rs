@@ -105,41 +105,12 @@ pub(crate) fn resolve_in(flags: &Flags, here: &Path) -> miette::Result<Resolved>
 /// The virtual robot's cards and surroundings, each read from where its
 /// source says.
 pub(crate) fn rig(resolved: &Resolved) -> Rig {
-    Rig {
-        cards: resolved.cards.value.clone(),
-        world: resolved.world.as_ref().map(|w| w.value.clone()),
-        root: resolved.base(&resolved.cards.origin).map(Path::to_path_buf),
-        world_root: resolved
-            .world
-            .as_ref()
-            .and_then(|w| resolved.base(&w.origin))
-            .map(Path::to_path_buf),
-    }
+    Rig::from(scorpion_project::runner::Rig::of(resolved))
 }
 
 /// The ROM profile the virtual robot runs: its name and linked image.
 pub(crate) fn rom(resolved: &Resolved) -> miette::Result<Option<(String, linker::Image)>> {
-    let Some(rom) = &resolved.rom else {
-        return Ok(None);
-    };
-    let bytes = hostfs::read(&rom.value, hostfs::BINARY).wrap_err_with(|| {
-        format!(
-            "cannot read the ROM profile {} ({})",
-            rom.value.display(),
-            rom.origin
-        )
-    })?;
-    let name = match &rom.origin {
-        // The project's profile is named as its file writes it.
-        Origin::Project { .. } => resolved
-            .project
-            .as_ref()
-            .and_then(|p| p.file.robot.rom.clone())
-            .unwrap_or_else(|| rom.value.display().to_string()),
-        _ => rom.value.display().to_string(),
-    };
-    let image = linker::Image::parse(&name, &bytes)?;
-    Ok(Some((name, image)))
+    scorpion_project::runner::rig::rom(resolved)
 }
 
 /// The uploader's profile of the ROM the robot runs: the project's ROM
@@ -181,7 +152,7 @@ pub(crate) fn images(resolved: &Resolved, given: &[PathBuf]) -> miette::Result<I
     }
     if let Some(project) = &resolved.project {
         for spec in &project.file.images {
-            let built = crate::project::build::build(project, spec)?;
+            let built = scorpion_project::runner::build::build(project, spec)?;
             images.push((built.name.clone(), built.linked.image));
         }
     }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use linker::{Format, Image, Input, LinkOptions, Linked, SourceProvider, SymbolFile, Target};
+use linker::{Format, Image, Linked, SourceProvider, Target};
 use miette::{Context, IntoDiagnostic};
 
 use crate::args;
@@ -131,32 +131,6 @@ fn target(args: &LinkArgs) -> miette::Result<Target> {
     Ok(Target::builtin(name, start)?)
 }
 
-/// Links named objects for `target` against the named symbol images
-/// (`--just-symbols`, the ROM).
-pub(crate) fn link_objects(
-    objects: &[(String, Vec<u8>)],
-    target: &Target,
-    symbol_images: &[(String, Image)],
-    sources: &dyn SourceProvider,
-) -> miette::Result<Linked> {
-    let symbol_files: Vec<SymbolFile<'_>> = symbol_images
-        .iter()
-        .map(|(name, image)| SymbolFile { name, image })
-        .collect();
-    let inputs: Vec<Input<'_>> = objects
-        .iter()
-        .map(|(name, bytes)| Input { name, bytes })
-        .collect();
-    Ok(linker::link(
-        &inputs,
-        &LinkOptions {
-            target,
-            just_symbols: &symbol_files,
-            sources,
-        },
-    )?)
-}
-
 /// Links named objects with `args` and writes everything asked for.
 pub(crate) fn link_and_write(
     objects: &[(String, Vec<u8>)],
@@ -183,7 +157,8 @@ pub(crate) fn link_and_write(
         let image = Image::parse(&name, romlib::ROM_ELF)?;
         symbol_images.push((name, image));
     }
-    let mut linked = link_objects(objects, &target, &symbol_images, sources)?;
+    let mut linked =
+        scorpion_project::runner::link_objects(objects, &target, &symbol_images, sources)?;
     report_warnings(&mut linked);
     let bytes = linked.write(args.format())?;
     write(output, &bytes)?;

@@ -94,29 +94,24 @@ pub(crate) fn open_resolved(
 }
 
 /// The `--port` value that names the in-process virtual Scorpion.
-pub(crate) const EMU: &str = "emu";
+pub(crate) const EMU: &str = scorpion_project::runner::EMU;
 
 /// A fresh virtual Scorpion whose DIP switches and host line are at `baud`,
-/// with the cards and surroundings of `rig`, running the ROM profile `rom`
-/// (its name and linked image) or the reference ROM; and what its scripts
-/// print, to be shown while it runs.
+/// with the cards and surroundings of `rig` (where each card went said on
+/// stderr), running the ROM profile `rom` (its name and linked image) or
+/// the reference ROM; and what its scripts print, to be shown while it
+/// runs.
 pub(crate) fn virtual_robot(
     baud: u32,
     rom: Option<&(String, linker::Image)>,
     rig: &crate::cmd::rig::Rig,
 ) -> miette::Result<(VirtualScorpion, Shown)> {
-    let mut robot = match rom {
-        Some((name, image)) => VirtualScorpion::with_rom(name, image)?,
-        None => VirtualScorpion::new(),
-    };
-    // A fresh robot runs at the reference rate already: no second boot.
-    if robot.host_baud() != baud && !robot.set_baud(baud) {
-        miette::bail!(
-            help = "the 6551 runs at 50 to 19200 baud; the reference ROM's rate is 9600",
-            "the Scorpion's 6551 has no {baud} baud rate"
-        );
-    }
-    let printed = rig.apply(&mut robot)?;
+    let (robot, printed) = scorpion_project::runner::rig::virtual_robot(
+        baud,
+        rom,
+        &rig.plain(),
+        &mut crate::cmd::rig::say_mapped,
+    )?;
     Ok((robot, Shown(printed)))
 }
 
@@ -126,22 +121,6 @@ pub(crate) fn bare_robot(
     rom: Option<&(String, linker::Image)>,
 ) -> miette::Result<VirtualScorpion> {
     virtual_robot(baud, rom, &crate::cmd::rig::Rig::default()).map(|(robot, _)| robot)
-}
-
-/// Opens `port`: a serial device path, or `emu` for a fresh virtual
-/// Scorpion in this process (the transport's clock is then its emulated
-/// time) with the cards and surroundings of `rig`. The rig is the virtual
-/// robot's: a real one has its own, and is opened without it.
-pub(crate) fn open(
-    port: &str,
-    baud: u32,
-    rig: &crate::cmd::rig::Rig,
-) -> miette::Result<Box<dyn Transport>> {
-    if port == EMU {
-        let (robot, shown) = virtual_robot(baud, None, rig)?;
-        return Ok(Box::new(Showing::new(VirtualTransport::new(robot), shown)));
-    }
-    Ok(Box::new(SerialTransport::open(port, baud)?))
 }
 
 /// What the virtual robot's scripts print, shown on stderr (`NAME: line`,

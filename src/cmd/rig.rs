@@ -1,12 +1,12 @@
 //! `--card FILE[@ADDR]` and `--world FILE`: what the virtual Scorpion has
 //! around it besides the ROM and the images (KIM-bus cards and the
-//! surroundings, as scripts), for every command that runs it.
+//! surroundings, as scripts), for every command that runs it; the flags of
+//! the library's [`scorpion_project::runner::Rig`], which loads them.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
-use miette::Context;
+use cards::{CardArg, Printed};
 use romlib::VirtualScorpion;
 
 /// Cards and surroundings of the virtual Scorpion.
@@ -30,13 +30,17 @@ pub(crate) struct Rig {
     pub(crate) world_root: Option<PathBuf>,
 }
 
-fn read(root: Option<&Path>, path: &Path) -> miette::Result<String> {
-    let full = root.map_or_else(|| path.to_path_buf(), |root| root.join(path));
-    hostfs::read_text(&full, hostfs::TEXT)
-        .wrap_err_with(|| format!("cannot read the script {}", path.display()))
-}
-
 impl Rig {
+    /// The library's rig: the same cards, world and directories.
+    pub(crate) fn plain(&self) -> scorpion_project::runner::Rig {
+        scorpion_project::runner::Rig {
+            cards: self.cards.clone(),
+            world: self.world.clone(),
+            root: self.root.clone(),
+            world_root: self.world_root.clone(),
+        }
+    }
+
     /// Maps the cards into `robot`'s KIM bus and gives it the
     /// surroundings, saying on stderr where each card went. Returns each
     /// script's name and what it prints.
@@ -44,9 +48,7 @@ impl Rig {
         &self,
         robot: &mut VirtualScorpion,
     ) -> miette::Result<Vec<(String, Printed)>> {
-        self.attach(robot, &mut |name, start, end| {
-            let _ = writeln!(std::io::stderr(), "card {name}: ${start:04X}-${end:04X}");
-        })
+        self.attach(robot, &mut say_mapped)
     }
 
     /// [`Rig::apply`], telling `mapped` (name, first and last address)
@@ -57,29 +59,24 @@ impl Rig {
         robot: &mut VirtualScorpion,
         mapped: &mut dyn FnMut(&str, u16, u16),
     ) -> miette::Result<Vec<(String, Printed)>> {
-        let mut printed = Vec::new();
-        for card in &self.cards {
-            let name = card.path.display().to_string();
-            let text = read(self.root.as_deref(), &card.path)?;
-            let script = ScriptCard::load(&name, &text, card.base)?;
-            let (start, end) = script.window();
-            printed.push((name.clone(), script.printed()));
-            robot
-                .map_card(start, end, Box::new(script))
-                .wrap_err_with(|| {
-                    format!("cannot put the card {name} at ${start:04X}-${end:04X}")
-                })?;
-            mapped(&name, start, end);
-        }
-        if let Some(path) = &self.world {
-            let name = path.display().to_string();
-            let text = read(self.world_root.as_deref(), path)?;
-            let world = ScriptWorld::load(&name, &text)?;
-            printed.push((name, world.printed()));
-            robot.set_surroundings(Box::new(world));
-        }
-        Ok(printed)
+        self.plain().attach(robot, mapped)
     }
+}
+
+impl From<scorpion_project::runner::Rig> for Rig {
+    fn from(rig: scorpion_project::runner::Rig) -> Rig {
+        Rig {
+            cards: rig.cards,
+            world: rig.world,
+            root: rig.root,
+            world_root: rig.world_root,
+        }
+    }
+}
+
+/// Says on stderr where a card went.
+pub(crate) fn say_mapped(name: &str, start: u16, end: u16) {
+    let _ = writeln!(std::io::stderr(), "card {name}: ${start:04X}-${end:04X}");
 }
 
 /// Shows on stderr what the scripts printed, a line each, after the

@@ -87,7 +87,7 @@ pub(crate) fn robot(
             .wrap_err_with(|| format!("cannot load {name}"))?;
         let mut err = std::io::stderr().lock();
         if images.from_project {
-            writeln!(err, "loaded {name} from {}", crate::project::FILE).into_diagnostic()?;
+            writeln!(err, "loaded {name} from {}", scorpion_project::FILE).into_diagnostic()?;
             continue;
         }
         for area in &image.areas {

@@ -16,7 +16,7 @@ use uploader::{
 };
 
 use crate::cmd::ports;
-use crate::project::transcript::{self, Clock, TranscriptFailed};
+use scorpion_project::runner::transcript::{self, Clock, TranscriptFailed};
 
 /// Upload a linked image (`scorpion link` or `scorpion build` output) into
 /// the robot with its own RAM-write commands: every byte verified with
@@ -277,11 +277,11 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         None => {
             let Some(project) = &resolved.project else {
                 // None here, or a workspace: the error says which.
-                crate::project::Project::here()?;
+                scorpion_project::Project::here()?;
                 miette::bail!("no project here");
             };
             for spec in &project.file.images {
-                let (_, path) = crate::project::build::build_to_target(project, spec)?;
+                let (_, path) = scorpion_project::runner::build::build_to_target(project, spec)?;
                 let code = upload_file(args, &resolved, &path)?;
                 if code != ExitCode::SUCCESS {
                     return Ok(code);

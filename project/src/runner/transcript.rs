@@ -11,7 +11,7 @@ use miette::Context;
 use uploader::{Expectations, Mismatch};
 
 /// Reads the transcript at `path`, shown to the user as `shown`.
-pub(crate) fn read(path: &Path, shown: &str) -> miette::Result<Expectations> {
+pub fn read(path: &Path, shown: &str) -> miette::Result<Expectations> {
     let text =
         hostfs::read_text(path, hostfs::TEXT).wrap_err_with(|| format!("cannot read {shown}"))?;
     Expectations::parse(&text).map_err(|error| match error {
@@ -26,7 +26,7 @@ pub(crate) fn read(path: &Path, shown: &str) -> miette::Result<Expectations> {
 
 /// What the times of a check are measured in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Clock {
+pub enum Clock {
     /// The virtual Scorpion's emulated time.
     Robot,
     /// Time on a real line, as this computer measured it.
@@ -43,7 +43,7 @@ fn time(at: Duration, clock: Clock) -> String {
 }
 
 /// A line per mismatch, each `FILE:LINE: ...`, in the file's order.
-pub(crate) fn describe(shown: &str, mismatches: &[Mismatch], clock: Clock) -> String {
+pub fn describe(shown: &str, mismatches: &[Mismatch], clock: Clock) -> String {
     let mut text = String::new();
     for mismatch in mismatches {
         let _ = writeln!(
@@ -65,7 +65,7 @@ pub(crate) fn describe(shown: &str, mismatches: &[Mismatch], clock: Clock) -> St
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[error("{shown}: {count} of {lines} lines not answered as they require")]
 #[diagnostic(code(scorpion::transcript_failed))]
-pub(crate) struct TranscriptFailed {
+pub struct TranscriptFailed {
     shown: String,
     count: usize,
     lines: usize,
@@ -76,7 +76,7 @@ pub(crate) struct TranscriptFailed {
 impl TranscriptFailed {
     /// The failure of `expectations`, read from `shown`, if any line
     /// differed.
-    pub(crate) fn of(
+    pub fn of(
         shown: &str,
         expectations: &Expectations,
         mismatches: &[Mismatch],

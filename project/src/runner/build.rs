@@ -9,8 +9,7 @@ use std::path::{Path, PathBuf};
 
 use linker::{Image, Linked, SourceProvider, Target};
 
-use super::Project;
-use scorpion_project::ImageSpec;
+use crate::{ImageSpec, Project};
 
 /// Files read relative to the project's root.
 struct Rooted<'a>(&'a Path);
@@ -38,23 +37,23 @@ impl SourceProvider for Rooted<'_> {
 }
 
 /// What `scorpion test` snapshots of every image.
-pub(crate) const SNAPSHOT_KINDS: [&str; 4] = ["listing", "map", "symbols", "bytes"];
+pub const SNAPSHOT_KINDS: [&str; 4] = ["listing", "map", "symbols", "bytes"];
 
 /// A built image and what it is made of.
 #[derive(Debug)]
-pub(crate) struct Built {
+pub struct Built {
     /// The image's name in the project.
-    pub(crate) name: String,
+    pub name: String,
     /// The link's result.
-    pub(crate) linked: Linked,
+    pub linked: Linked,
     /// The listings of its sources, one after the other.
-    pub(crate) listing: String,
+    pub listing: String,
     /// Warnings of the assembler and the linker, rendered.
-    pub(crate) warnings: Vec<miette::Report>,
+    pub warnings: Vec<miette::Report>,
 }
 
 /// Assembles and links `spec`.
-pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built> {
+pub fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built> {
     build_with(project, spec, &assembler::Options::default())
 }
 
@@ -62,7 +61,7 @@ pub(crate) fn build(project: &Project, spec: &ImageSpec) -> miette::Result<Built
 /// `given` (`scorpion build -D`, `-I`...) on top of the image's own: its
 /// include directories first, then the given ones; its defines, each
 /// replaced by a given one of the same name.
-pub(crate) fn build_with(
+pub fn build_with(
     project: &Project,
     spec: &ImageSpec,
     given: &assembler::Options,
@@ -85,7 +84,7 @@ pub(crate) fn build_with(
         defines,
         listing: true,
         list_builtin_includes: project.file.tests.builtin_listing,
-        builtin_includes: crate::cmd::asm::builtin_includes(),
+        builtin_includes: super::toolchain::builtin_includes(),
         ..given.clone()
     };
     let mut objects = Vec::new();
@@ -137,7 +136,7 @@ pub(crate) fn build_with(
             Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?,
         ),
     };
-    let mut linked = crate::cmd::link::link_objects(&objects, &target, &[rom], &source)?;
+    let mut linked = super::toolchain::link_objects(&objects, &target, &[rom], &source)?;
     for warning in std::mem::take(&mut linked.warnings) {
         warnings.push(miette::Report::new(warning));
     }
@@ -152,16 +151,13 @@ pub(crate) fn build_with(
 /// Builds `spec` and writes `NAME.elf`, `NAME.lst` and `NAME.map` into
 /// the project's `target/scorpion/`; returns the build and the image's
 /// path.
-pub(crate) fn build_to_target(
-    project: &Project,
-    spec: &ImageSpec,
-) -> miette::Result<(Built, PathBuf)> {
+pub fn build_to_target(project: &Project, spec: &ImageSpec) -> miette::Result<(Built, PathBuf)> {
     build_to_target_with(project, spec, &assembler::Options::default())
 }
 
 /// [`build_to_target`] with the command line's assembler options (see
 /// [`build_with`]).
-pub(crate) fn build_to_target_with(
+pub fn build_to_target_with(
     project: &Project,
     spec: &ImageSpec,
     given: &assembler::Options,
@@ -186,7 +182,7 @@ pub(crate) fn build_to_target_with(
 
 impl Built {
     /// The texts its snapshots hold, by kind ([`SNAPSHOT_KINDS`]).
-    pub(crate) fn snapshots(&self) -> [(&'static str, String); 4] {
+    pub fn snapshots(&self) -> [(&'static str, String); 4] {
         [
             (SNAPSHOT_KINDS[0], self.listing.clone()),
             (SNAPSHOT_KINDS[1], self.linked.map()),
@@ -197,7 +193,7 @@ impl Built {
 
     /// The image's own symbols (not the ROM's it linked against), a line
     /// each, by address then name.
-    pub(crate) fn symbols(&self) -> String {
+    pub fn symbols(&self) -> String {
         let rom = |name: &str, value: u32| {
             romlib::symbols::find(name).is_some_and(|s| u32::from(s.value) == value)
         };
@@ -223,7 +219,7 @@ impl Built {
     }
 
     /// The loaded bytes as a hex dump, 16 a line, each line at its address.
-    pub(crate) fn bytes(&self) -> String {
+    pub fn bytes(&self) -> String {
         let mut text = String::new();
         for area in &self.linked.image.areas {
             for (index, chunk) in area.bytes.chunks(16).enumerate() {

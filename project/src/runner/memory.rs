@@ -12,7 +12,7 @@ use std::ops::RangeInclusive;
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[error("image {image}: the layout {layout} puts area `{area}` at ${start:04X}-${last:04X}, {why}")]
 #[diagnostic(code(scorpion::project::layout_outside_ram), help("{help}"))]
-pub(crate) struct OutsideMemory {
+pub struct OutsideMemory {
     image: String,
     layout: String,
     area: String,
@@ -32,7 +32,7 @@ fn ranges_text(writable: &[RangeInclusive<u16>]) -> String {
 
 /// Checks every area of `layout` (the file `layout_file`) against
 /// `writable`.
-pub(crate) fn check(
+pub fn check(
     image: &str,
     layout_file: &str,
     layout: &linker::Layout,

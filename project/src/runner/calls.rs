@@ -41,11 +41,11 @@ enum Reg {
 
 /// One line.
 #[derive(Debug, Clone)]
-pub(crate) struct Call {
+pub struct Call {
     /// 1-based line.
-    pub(crate) line: usize,
+    pub line: usize,
     /// The routine as written.
-    pub(crate) routine: String,
+    pub routine: String,
     address: u16,
     set_regs: Vec<(Reg, u8)>,
     set_mem: Vec<(u16, Vec<u8>)>,
@@ -76,7 +76,7 @@ fn number(text: &str) -> Option<u32> {
 }
 
 /// Parses a calls file against the images' symbols.
-pub(crate) fn parse(text: &str, symbols: &HashMap<String, u16>) -> Result<Vec<Call>, String> {
+pub fn parse(text: &str, symbols: &HashMap<String, u16>) -> Result<Vec<Call>, String> {
     let mut calls = Vec::new();
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
@@ -203,7 +203,7 @@ fn flag(p: u8, r: Reg) -> u8 {
 }
 
 /// Runs one call on `robot` (a fresh one, images loaded).
-pub(crate) fn run(call: &Call, robot: &mut VirtualScorpion) -> Result<(), String> {
+pub fn run(call: &Call, robot: &mut VirtualScorpion) -> Result<(), String> {
     let machine = robot.robot_mut();
     for (at, bytes) in &call.set_mem {
         machine

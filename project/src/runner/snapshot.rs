@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// A snapshot file's text for `content`.
-pub(crate) fn render(source: &str, expression: &str, content: &str) -> String {
+pub fn render(source: &str, expression: &str, content: &str) -> String {
     format!(
         "---\nsource: {}\nexpression: {}\n---\n{}\n",
         yaml_string(source),
@@ -43,7 +43,7 @@ fn yaml_string(text: &str) -> String {
 }
 
 /// The content of a snapshot file (after its header), if it has one.
-pub(crate) fn content(file: &str) -> Option<&str> {
+pub fn content(file: &str) -> Option<&str> {
     let rest = file.strip_prefix("---\n")?;
     let end = rest.find("\n---\n")?;
     Some(&rest[end + 5..])
@@ -51,21 +51,21 @@ pub(crate) fn content(file: &str) -> Option<&str> {
 
 /// Where the pending (new, not yet accepted) text of the snapshot at
 /// `path` goes: `NAME.snap.new`, as insta names it.
-pub(crate) fn pending_path(path: &Path) -> PathBuf {
+pub fn pending_path(path: &Path) -> PathBuf {
     let mut name = path.as_os_str().to_owned();
     name.push(".new");
     PathBuf::from(name)
 }
 
 /// The accepted snapshot a pending file `NAME.snap.new` stands beside.
-pub(crate) fn accepted_path(pending: &Path) -> Option<PathBuf> {
+pub fn accepted_path(pending: &Path) -> Option<PathBuf> {
     let text = pending.to_str()?;
     text.strip_suffix(".new").map(PathBuf::from)
 }
 
 /// How a snapshot compares.
 #[derive(Debug, PartialEq, Eq)]
-pub(crate) enum Outcome {
+pub enum Compared {
     /// The same.
     Same,
     /// There was none.
@@ -75,20 +75,20 @@ pub(crate) enum Outcome {
 }
 
 /// Compares `content` with the snapshot at `path`.
-pub(crate) fn compare(path: &Path, content: &str) -> Outcome {
+pub fn compare(path: &Path, content: &str) -> Compared {
     let Ok(old) = hostfs::read_text(path, hostfs::TEXT) else {
-        return Outcome::New;
+        return Compared::New;
     };
     let old = self::content(&old).unwrap_or(&old);
     match diff(old, content) {
-        None => Outcome::Same,
-        Some(diff) => Outcome::Changed(diff),
+        None => Compared::Same,
+        Some(diff) => Compared::Changed(diff),
     }
 }
 
 /// The `-`/`+` lines that differ between `old` and `new` (two lines of
 /// context), or `None` if they are the same as insta compares them.
-pub(crate) fn diff(old: &str, new: &str) -> Option<String> {
+pub fn diff(old: &str, new: &str) -> Option<String> {
     let (old, new) = (old.trim_end(), new.trim_end());
     if old == new {
         return None;

@@ -1,0 +1,703 @@
+//! [`run_tests`]: a project's (or a workspace's members') tests. For every
+//! image, snapshots of the assembled output (listing, map, symbols, bytes:
+//! nothing of the machine, no times); then every transcript
+//! (`tests/*.expect`) on the virtual Scorpion with the images loaded as an
+//! upload leaves them and the project's cards and surroundings, and every
+//! routine call (`tests/*.calls`); with a port, the transcripts on a real
+//! robot after a rehearsal on the virtual one and an upload of the images,
+//! and no snapshots.
+//!
+//! A snapshot that fails leaves its new text beside the accepted one
+//! (`NAME.snap.new`, as insta's assertions do) unless the [`Mode`] says
+//! otherwise. A filter runs the tests whose name contains it, as `cargo
+//! test NAME` does.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use miette::Context;
+use romlib::VirtualScorpion;
+use uploader::transport::{SerialTransport, VirtualTransport};
+use uploader::{Client, ClientConfig, RomProfile, Transport, UploadImage};
+
+use super::build::{Built, SNAPSHOT_KINDS, build};
+use super::calls;
+use super::report::{Failure, MemberReport, Outcome, Passed, Progress, Question, Report};
+use super::review::{self, Decision, Mode};
+use super::rig::{EMU, Rig, Scripts, rom, virtual_robot};
+use super::snapshot::{self, Compared};
+use super::transcript::{self, Clock};
+use crate::{Environment, FILE, Flags, Found, Project, Resolved};
+
+/// What to run, and how.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// Only the tests whose name contains this: an image's (`probe`), one
+    /// snapshot (`probe/listing`), one file's (`probe.expect`,
+    /// `tests/io.calls`). Empty: all.
+    pub filter: Option<String>,
+    /// What to do with snapshots that differ.
+    pub mode: Mode,
+    /// Run the transcripts on the robot on this port (after a rehearsal on
+    /// the virtual one, and an upload of the images) instead of the
+    /// snapshots: `Some("")` for the port the configuration names.
+    pub port: Option<String>,
+    /// The environment the configuration is resolved with (the line's
+    /// rate, the port, the per-user file).
+    pub environment: Environment,
+}
+
+/// Runs the tests of `found` (a project, or every member of a workspace),
+/// telling `progress` of each as it goes.
+///
+/// # Errors
+/// What stops the run: a configuration that does not resolve, a snapshot
+/// that cannot be written, a robot that cannot be reached. A test that
+/// fails is in the report, not an error.
+pub fn run_tests(
+    found: &Found,
+    options: &Options,
+    progress: &mut dyn Progress,
+) -> miette::Result<Report> {
+    let progress = RefCell::new(progress);
+    let mut run = Run {
+        report: Report::default(),
+        filter: options.filter.clone().filter(|f| !f.is_empty()),
+        options,
+        progress: &progress,
+        started: None,
+    };
+    match found {
+        Found::Project(project) => run.project(project)?,
+        Found::Workspace(workspace) => {
+            if options.port.is_some() {
+                miette::bail!(
+                    help = "a workspace's members may not fit on one robot together: run `scorpion test --port` in each member's directory",
+                    "--port tests one project on the robot, and {FILE} here is a workspace"
+                );
+            }
+            // One run for every member: what is set up once (the scripting
+            // engine's library, the ROM's symbols) serves all.
+            for (name, project) in workspace.projects()? {
+                progress.borrow_mut().member_started(&name);
+                let (passed, failed) = (run.report.passed, run.report.failed);
+                if let Err(error) = run.project(&project) {
+                    run.record(
+                        &format!("project {name}"),
+                        Outcome::Failed(Failure::text(format!("{error:?}"))),
+                    );
+                }
+                let member = MemberReport {
+                    name,
+                    passed: run.report.passed - passed,
+                    failed: run.report.failed - failed,
+                };
+                progress.borrow_mut().member_finished(&member);
+                run.report.members.push(member);
+            }
+        }
+    }
+    Ok(run.report)
+}
+
+/// The progress, shared between the run and the lines it opens (a line
+/// tells what the scripts print as it runs; the run, between exchanges,
+/// what passed).
+type Shared<'r, 'p> = &'r RefCell<&'p mut dyn Progress>;
+
+/// A run under way.
+struct Run<'r, 'p, 'o> {
+    report: Report,
+    /// The filter, if not empty.
+    filter: Option<String>,
+    options: &'o Options,
+    progress: Shared<'r, 'p>,
+    /// The test [`Progress::test_started`] was told of last.
+    started: Option<String>,
+}
+
+impl Run<'_, '_, '_> {
+    /// Records how the test `name` ended.
+    fn record(&mut self, name: &str, outcome: Outcome) {
+        let progress = self.progress;
+        let mut progress = progress.borrow_mut();
+        if self.started.take().as_deref() != Some(name) {
+            progress.test_started(name);
+        }
+        if outcome.failed() {
+            self.report.failed += 1;
+        } else {
+            self.report.passed += 1;
+        }
+        progress.test_finished(name, &outcome);
+        self.report.tests.push(super::report::TestResult {
+            name: name.to_owned(),
+            outcome,
+        });
+    }
+
+    /// [`Run::record`] of a pass or a failure's text.
+    fn record_result(&mut self, name: &str, result: Result<Passed, String>) {
+        let outcome = match result {
+            Ok(passed) => Outcome::Passed(passed),
+            Err(why) => Outcome::Failed(Failure::text(why)),
+        };
+        self.record(name, outcome);
+    }
+
+    /// Whether the test `name` runs; counted as filtered out if not.
+    fn selects(&mut self, name: &str) -> bool {
+        let selected = self
+            .filter
+            .as_deref()
+            .is_none_or(|filter| name.contains(filter));
+        if !selected {
+            self.report.filtered_out += 1;
+        }
+        selected
+    }
+
+    /// Tells the progress that the test `name` begins.
+    fn start(&mut self, name: &str) {
+        self.progress.borrow_mut().test_started(name);
+        self.started = Some(name.to_owned());
+    }
+
+    /// One project's tests.
+    fn project(&mut self, project: &Project) -> miette::Result<()> {
+        // Failures of this project only (a workspace runs several).
+        let failed_before = self.report.failed;
+        let mut built = Vec::new();
+        for spec in &project.file.images {
+            match build(project, spec) {
+                Ok(image) => {
+                    for warning in &image.warnings {
+                        self.progress
+                            .borrow_mut()
+                            .build_warning(&image.name, warning);
+                    }
+                    self.progress.borrow_mut().image_built(&image);
+                    built.push(image);
+                }
+                Err(error) => {
+                    self.record_result(&format!("build {}", spec.name), Err(format!("{error:?}")))
+                }
+            }
+        }
+        match &self.options.port {
+            Some(port) => {
+                let (setup, port) = Setup::of(project, Some(port), &self.options.environment)?;
+                let port = port.unwrap_or_default();
+                if self.report.failed == failed_before {
+                    // The rehearsal: every transcript on the virtual robot
+                    // with the project's cards and world first; the robot
+                    // is touched only if they all pass.
+                    self.virtual_transcripts(project, &setup, &built)?;
+                }
+                if self.report.failed == failed_before {
+                    self.robot_transcripts(project, &setup, &built, &port)?;
+                } else {
+                    self.record_result(
+                        &format!("upload to {port}"),
+                        Err("  the rehearsal on the virtual Scorpion failed; nothing was sent to the robot".to_owned()),
+                    );
+                }
+            }
+            None => {
+                let mode = self.options.mode;
+                for image in &built {
+                    self.check_snapshots(project, image, mode)?;
+                }
+                if built.len() == project.file.images.len() {
+                    self.stale_snapshots(project, mode)?;
+                }
+                if self.report.failed == failed_before || built.len() == project.file.images.len() {
+                    let (setup, _) = Setup::of(project, None, &self.options.environment)?;
+                    self.virtual_transcripts(project, &setup, &built)?;
+                    self.routine_calls(project, &setup, &built)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// What [`Progress::review`] decides about the snapshot `name`.
+    fn ask(&mut self, name: &str, why: &str, accept: &str) -> miette::Result<Decision> {
+        self.progress
+            .borrow_mut()
+            .review(&Question { name, why, accept })
+    }
+
+    fn check_snapshots(
+        &mut self,
+        project: &Project,
+        built: &Built,
+        mode: Mode,
+    ) -> miette::Result<()> {
+        for (kind, content) in built.snapshots() {
+            let name = format!("{}/{kind}", built.name);
+            if !self.selects(&name) {
+                continue;
+            }
+            self.start(&name);
+            let path = project.snapshot_path(&built.name, kind);
+            let pending = snapshot::pending_path(&path);
+            let compared = snapshot::compare(&path, &content);
+            if compared == Compared::Same {
+                // A pending text from an earlier failure is out of date.
+                review::remove(&pending)?;
+                self.record_result(&name, Ok(Passed::Ok));
+                continue;
+            }
+            let shown = relative(project, &path);
+            let (why, diff) = match &compared {
+                Compared::New => (
+                    format!("  no snapshot {shown} yet:\n{}", indent(&content)),
+                    None,
+                ),
+                Compared::Changed(diff) => (
+                    format!("  {shown} differs (- snapshot, + now):\n{}", indent(diff)),
+                    Some(diff.clone()),
+                ),
+                Compared::Same => (String::new(), None),
+            };
+            let decision = match mode {
+                Mode::Accept => Decision::Accept,
+                Mode::Reject => Decision::Reject,
+                Mode::Fail => Decision::Skip,
+                Mode::Review => self.ask(&name, &why, "accept")?,
+            };
+            let rendered = snapshot::render(FILE, &name, &content);
+            review::decide(decision, &path, &rendered)?;
+            // The review showed the diff already.
+            let why = if mode == Mode::Review {
+                String::new()
+            } else {
+                why
+            };
+            let outcome = match decision {
+                Decision::Accept => Outcome::Passed(Passed::Accepted),
+                Decision::Reject => Outcome::Failed(Failure {
+                    text: format!("{why}  rejected: the snapshot stays as it was\n"),
+                    diff,
+                    pending: None,
+                }),
+                Decision::Skip => {
+                    let shown = relative(project, &pending);
+                    Outcome::Failed(Failure {
+                        text: format!(
+                            "{why}  the new one is in {shown}: `scorpion test {name} --accept` takes it, `scorpion test --review` (or `cargo insta review`) asks\n"
+                        ),
+                        diff,
+                        pending: Some(pending),
+                    })
+                }
+            };
+            self.record(&name, outcome);
+        }
+        Ok(())
+    }
+
+    /// Snapshot files no image and kind of the project makes (an image
+    /// renamed or removed): a failure, or deleted with [`Mode::Accept`]
+    /// (pending ones with [`Mode::Reject`] too).
+    fn stale_snapshots(&mut self, project: &Project, mode: Mode) -> miette::Result<()> {
+        let dir = project.root.join("tests").join("snapshots");
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return Ok(());
+        };
+        let wanted: Vec<PathBuf> = project
+            .file
+            .images
+            .iter()
+            .flat_map(|image| SNAPSHOT_KINDS.map(|kind| project.snapshot_path(&image.name, kind)))
+            .collect();
+        let mut stale: Vec<PathBuf> = entries
+            .filter_map(Result::ok)
+            .map(|entry| entry.path())
+            .filter(|path| {
+                let accepted = snapshot::accepted_path(path).unwrap_or_default();
+                let snap = path.extension().is_some_and(|ext| ext == "snap");
+                let pending = path.extension().is_some_and(|ext| ext == "new")
+                    && accepted.extension().is_some_and(|ext| ext == "snap");
+                (snap && !wanted.contains(path)) || (pending && !wanted.contains(&accepted))
+            })
+            .collect();
+        stale.sort();
+        for path in stale {
+            let shown = relative(project, &path);
+            let name = format!("stale {shown}");
+            if !self.selects(&name) {
+                continue;
+            }
+            let pending = path.extension().is_some_and(|ext| ext == "new");
+            let why = format!("  no image of {FILE} makes {shown}\n");
+            let decision = match mode {
+                Mode::Accept => Decision::Accept,
+                Mode::Reject if pending => Decision::Accept,
+                Mode::Reject | Mode::Fail => Decision::Skip,
+                Mode::Review if pending => Decision::Skip,
+                Mode::Review => {
+                    self.start(&name);
+                    self.ask(&name, &why, "delete it")?
+                }
+            };
+            match decision {
+                Decision::Accept => {
+                    review::remove(&path)?;
+                    self.record_result(&name, Ok(Passed::Deleted));
+                }
+                // A pending text nothing makes is left for whoever made it.
+                Decision::Reject | Decision::Skip if pending => {}
+                Decision::Reject | Decision::Skip => self.record_result(
+                    &name,
+                    Err(format!(
+                        "{why}  `scorpion test --accept` deletes it, `scorpion test --review` asks\n"
+                    )),
+                ),
+            }
+        }
+        Ok(())
+    }
+
+    /// A fresh robot of `setup` with the images loaded as an upload
+    /// leaves them, ready for the test `name`.
+    fn robot(
+        &mut self,
+        setup: &Setup,
+        built: &[Built],
+        name: &str,
+    ) -> miette::Result<(VirtualScorpion, Scripts)> {
+        let progress = self.progress;
+        let mut progress = progress.borrow_mut();
+        let (mut robot, scripts) = virtual_robot(
+            setup.baud,
+            setup.rom.as_ref(),
+            &setup.rig,
+            &mut |card, start, end| {
+                progress.card_mapped(card, start, end);
+            },
+        )?;
+        for image in built {
+            robot
+                .load_image(&image.linked.image)
+                .wrap_err_with(|| format!("cannot load {}", image.name))?;
+        }
+        progress.robot_ready(name, &mut robot);
+        Ok((robot, scripts))
+    }
+
+    /// Every `tests/*.calls` file: each call on a fresh virtual Scorpion.
+    fn routine_calls(
+        &mut self,
+        project: &Project,
+        setup: &Setup,
+        built: &[Built],
+    ) -> miette::Result<()> {
+        let mut symbols = HashMap::new();
+        for image in built {
+            for symbol in &image.linked.image.symbols {
+                if let Ok(value) = u16::try_from(symbol.value) {
+                    symbols.entry(symbol.name.clone()).or_insert(value);
+                }
+            }
+        }
+        for path in project.test_files("calls") {
+            let shown = relative(project, &path);
+            let text = hostfs::read_text(&path, hostfs::TEXT)
+                .wrap_err_with(|| format!("cannot read {shown}"))?;
+            let calls = match calls::parse(&text, &symbols) {
+                Ok(calls) => calls,
+                Err(why) => {
+                    let name = format!("calls {shown}");
+                    if self.selects(&name) {
+                        self.record_result(&name, Err(format!("  {shown}: {why}")));
+                    }
+                    continue;
+                }
+            };
+            for call in calls {
+                let name = format!("call {shown}:{} {}", call.line, call.routine);
+                if !self.selects(&name) {
+                    continue;
+                }
+                self.start(&name);
+                let result = match self.robot(setup, built, &name) {
+                    Ok((mut robot, scripts)) => {
+                        let result = calls::run(&call, &mut robot);
+                        let mut progress = self.progress.borrow_mut();
+                        show(&scripts, &mut **progress);
+                        progress.robot_done(&name, &mut robot);
+                        result
+                    }
+                    Err(error) => Err(format!("{error:?}")),
+                };
+                self.record_result(
+                    &name,
+                    result
+                        .map(|()| Passed::Ok)
+                        .map_err(|why| format!("  {why}")),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Every transcript on a fresh virtual Scorpion with the images loaded.
+    fn virtual_transcripts(
+        &mut self,
+        project: &Project,
+        setup: &Setup,
+        built: &[Built],
+    ) -> miette::Result<()> {
+        let mut robot_time = Duration::ZERO;
+        let started = Instant::now();
+        for path in project.transcripts() {
+            let name = format!("transcript {}", relative(project, &path));
+            if !self.selects(&name) {
+                continue;
+            }
+            self.start(&name);
+            let result = match self.robot(setup, built, &name) {
+                Ok((robot, scripts)) => {
+                    let line = Showing {
+                        inner: VirtualTransport::new(robot),
+                        scripts,
+                        progress: self.progress,
+                    };
+                    let mut client = client(line);
+                    let result = run_transcript(project, &path, &mut client, Clock::Robot);
+                    robot_time += client.transport().now();
+                    client.transport().done(&name);
+                    result
+                }
+                Err(error) => Err(indent(&format!("{error:?}"))),
+            };
+            self.record_result(&name, result.map(|()| Passed::Ok));
+        }
+        self.report.robot_time += robot_time;
+        self.report.wall_time += started.elapsed();
+        Ok(())
+    }
+
+    /// Uploads the images to the robot on `port`, then runs the
+    /// transcripts.
+    fn robot_transcripts(
+        &mut self,
+        project: &Project,
+        setup: &Setup,
+        built: &[Built],
+        port: &str,
+    ) -> miette::Result<()> {
+        // On `emu` the robot is the virtual one with the project's parts; a
+        // real robot has its own cards, and is opened without them.
+        let progress = self.progress;
+        let transport: Box<dyn Transport + '_> = if port == EMU {
+            let (robot, scripts) = {
+                let mut progress = progress.borrow_mut();
+                virtual_robot(setup.baud, None, &setup.rig, &mut |card, start, end| {
+                    progress.card_mapped(card, start, end);
+                })?
+            };
+            Box::new(Showing {
+                inner: VirtualTransport::new(robot),
+                scripts,
+                progress,
+            })
+        } else {
+            Box::new(SerialTransport::open(port, setup.baud)?)
+        };
+        let mut client = client(transport);
+        for image in built {
+            let upload = UploadImage::try_from(&image.linked.image)?;
+            uploader::upload(
+                &mut client,
+                &upload,
+                &uploader::UploadOptions::default(),
+                &mut uploader::NoProgress,
+            )
+            .wrap_err_with(|| format!("cannot upload {}", image.name))?;
+            self.record_result(&format!("upload {}", image.name), Ok(Passed::Ok));
+        }
+        let clock = if port == EMU {
+            Clock::Robot
+        } else {
+            Clock::Line
+        };
+        for path in project.transcripts() {
+            let name = format!("transcript {}", relative(project, &path));
+            if !self.selects(&name) {
+                continue;
+            }
+            self.start(&name);
+            let result = run_transcript(project, &path, &mut client, clock);
+            self.record_result(&name, result.map(|()| Passed::Ok));
+        }
+        Ok(())
+    }
+}
+
+fn indent(text: &str) -> String {
+    text.lines().fold(String::new(), |mut out, line| {
+        let _ = writeln!(out, "    {line}");
+        out
+    })
+}
+
+/// `path` as shown to the user: relative to the project's root.
+fn relative(project: &Project, path: &Path) -> String {
+    path.strip_prefix(&project.root)
+        .unwrap_or(path)
+        .display()
+        .to_string()
+}
+
+/// Runs the transcript at `path` on `client`: every line that differs is
+/// a line of the failure.
+fn run_transcript<T: Transport>(
+    project: &Project,
+    path: &Path,
+    client: &mut Client<T>,
+    clock: Clock,
+) -> Result<(), String> {
+    let shown = relative(project, path);
+    let expectations = transcript::read(path, &shown).map_err(|e| indent(&format!("{e:?}")))?;
+    let checked = expectations
+        .check_all(client)
+        .map_err(|e| indent(&format!("{:?}", miette::Report::new(e))))?;
+    if checked.mismatches.is_empty() {
+        Ok(())
+    } else {
+        Err(transcript::describe(&shown, &checked.mismatches, clock)
+            .lines()
+            .fold(String::new(), |mut out, line| {
+                let _ = writeln!(out, "  {line}");
+                out
+            }))
+    }
+}
+
+fn client<T: Transport>(transport: T) -> Client<T> {
+    Client::new(
+        transport,
+        ClientConfig {
+            window: RomProfile::reference().window(),
+            ..ClientConfig::default()
+        },
+    )
+}
+
+/// What every virtual robot of a run is made of, read once: the line's
+/// rate, the project's ROM profile, its cards and surroundings.
+struct Setup {
+    baud: u32,
+    rom: Option<(String, linker::Image)>,
+    rig: Rig,
+}
+
+impl Setup {
+    /// The virtual robot the one resolution gives `project` (its cards,
+    /// world and ROM profile; the rate from the environment, the per-user
+    /// file or the project), and the port, if `port` asks for one
+    /// (`Some("")`: the configured one).
+    fn of(
+        project: &Project,
+        port: Option<&str>,
+        environment: &Environment,
+    ) -> miette::Result<(Setup, Option<String>)> {
+        let flags = Flags {
+            port: port.filter(|p| !p.is_empty()).map(str::to_owned),
+            ..Flags::default()
+        };
+        let resolved = Resolved::resolve(&flags, environment, &project.root)?;
+        let port = match port {
+            Some(_) => Some(resolved.port()?.value.clone()),
+            None => None,
+        };
+        Ok((
+            Setup {
+                baud: resolved.baud.value,
+                rom: rom(&resolved)?,
+                rig: Rig::of(&resolved),
+            },
+            port,
+        ))
+    }
+}
+
+/// Tells `progress` what the scripts printed since the last look.
+fn show(scripts: &Scripts, progress: &mut dyn Progress) {
+    for (name, printed) in scripts {
+        for line in printed.take() {
+            progress.script_printed(name, &line);
+        }
+    }
+}
+
+/// A line to the virtual robot that tells what its scripts print after
+/// every exchange on it, and when it is dropped.
+struct Showing<'r, 'p, T> {
+    inner: T,
+    scripts: Scripts,
+    progress: Shared<'r, 'p>,
+}
+
+impl<T> Showing<'_, '_, T> {
+    fn show(&self) {
+        show(&self.scripts, &mut **self.progress.borrow_mut());
+    }
+}
+
+impl Showing<'_, '_, VirtualTransport> {
+    /// The test `name` is done with the robot.
+    fn done(&mut self, name: &str) {
+        self.show();
+        self.progress
+            .borrow_mut()
+            .robot_done(name, self.inner.robot_mut());
+    }
+}
+
+impl<T> Drop for Showing<'_, '_, T> {
+    fn drop(&mut self) {
+        self.show();
+    }
+}
+
+impl<T: Transport> Transport for Showing<'_, '_, T> {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        let result = self.inner.send(bytes);
+        self.show();
+        result
+    }
+    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
+        let result = self.inner.receive(into, timeout);
+        self.show();
+        result
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn set_baud(&mut self, baud: u32) -> uploader::Result<()> {
+        self.inner.set_baud(baud)
+    }
+    fn now(&self) -> Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        let result = self.inner.clear_input();
+        self.show();
+        result
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+    fn diagnose_silence(&mut self) -> uploader::Result<()> {
+        let result = self.inner.diagnose_silence();
+        self.show();
+        result
+    }
+}
