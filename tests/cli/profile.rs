@@ -122,3 +122,187 @@ fn a_workspace_is_profiled_member_by_member() {
         transcript(&output)
     );
 }
+
+/// Copies the directory `from` into `to` (an example, so that its tests
+/// write into a temporary directory, not the repository).
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for entry in std::fs::read_dir(from).expect("the example").flatten() {
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            if entry.file_name() != "target" {
+                copy_dir(&entry.path(), &target);
+            }
+        } else {
+            std::fs::copy(entry.path(), &target).expect("a copy");
+        }
+    }
+}
+
+/// The 1-based numbers of the lines of `text` that contain `what`.
+fn lines_with(text: &str, what: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| line.contains(what))
+        .map(|(index, _)| index + 1)
+        .collect()
+}
+
+fn stdout(output: &std::process::Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// A new project's transcript sends only `/1V`: its handler's two
+/// `bne not_mine` are never taken, and coverage says so, line by line,
+/// in the summary, the LCOV file and the HTML page. Two more transcript
+/// lines (a `/2V` and a `/1W`, neither the extension's) take both, and
+/// coverage is whole.
+#[test]
+fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let created = scorpion(dir.path(), &["new", "myext"]);
+    assert!(created.status.success(), "{}", transcript(&created));
+    let project = dir.path().join("myext");
+    let source = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let branches = lines_with(&source, "bne not_mine");
+    assert_eq!(branches.len(), 2, "{source}");
+
+    let first = scorpion(&project, &["test", "--coverage"]);
+    assert!(first.status.success(), "{}", transcript(&first));
+    let text = stdout(&first);
+    for line in &branches {
+        assert!(
+            text.contains(&format!("  branch never taken: src/myext.s:{line}\n")),
+            "{text}"
+        );
+    }
+    assert!(!text.contains("never run:"), "/1V runs every line: {text}");
+    assert!(text.contains("branches (50.0%)"), "{text}");
+    let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
+        .expect("lcov.info");
+    let sf = project.join("src/myext.s");
+    assert!(lcov.contains(&format!("SF:{}\n", sf.display())), "{lcov}");
+    for line in &branches {
+        assert!(
+            lcov.contains(&format!("BRDA:{line},0,0,0\n")),
+            "never taken: {lcov}"
+        );
+        assert!(
+            lcov.contains(&format!("BRDA:{line},0,1,1\n")),
+            "not taken once: {lcov}"
+        );
+        assert!(lcov.contains(&format!("DA:{line},1\n")), "{lcov}");
+    }
+    assert!(
+        lcov.contains("BRF:4\nBRH:2\n") && lcov.ends_with("end_of_record\n"),
+        "{lcov}"
+    );
+    let html = std::fs::read_to_string(project.join("target/scorpion/coverage/index.html"))
+        .expect("index.html");
+    assert!(
+        html.contains("never taken") && html.contains("cmp #'V'"),
+        "the page shows the source and the branch: {html}"
+    );
+
+    // genhtml, the LCOV tool, reads the file.
+    if let Some(genhtml) = scorpion_tests::tools::require(
+        "genhtml",
+        "a_branch_never_taken_is_named_until_a_transcript_takes_it",
+    ) {
+        let out = dir.path().join("genhtml");
+        let read = std::process::Command::new(genhtml)
+            .args(["--branch-coverage", "--output-directory"])
+            .arg(&out)
+            .arg(project.join("target/scorpion/coverage/lcov.info"))
+            .output()
+            .expect("genhtml runs");
+        assert!(read.status.success(), "{}", transcript(&read));
+        assert!(out.join("index.html").is_file());
+    }
+
+    let expect = project.join("tests/myext.expect");
+    let mut transcript_text = std::fs::read_to_string(&expect).expect("the transcript");
+    transcript_text.push_str("/2V => nothing            # not /1V: on down the chain\n");
+    transcript_text.push_str("/1W => nothing            # not V either\n");
+    std::fs::write(&expect, transcript_text).expect("write");
+    let second = scorpion(&project, &["test", "--coverage"]);
+    assert!(second.status.success(), "{}", transcript(&second));
+    let text = stdout(&second);
+    assert!(
+        text.contains("lines (100.0%), 4 of 4 branches (100.0%)"),
+        "{text}"
+    );
+    assert!(!text.contains("branch never taken"), "{text}");
+}
+
+/// The examples' projects covered: each one's LCOV names its source with
+/// lines run, and its HTML page shows the source.
+#[test]
+fn the_examples_projects_covered() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for (name, source) in [
+        ("adc", "adc.s"),
+        ("patrol", "patrol.s"),
+        ("checksum", "checksum.s"),
+    ] {
+        let project = dir.path().join(name);
+        copy_dir(&example(name), &project);
+        let output = scorpion(&project, &["test", "--coverage"]);
+        assert!(output.status.success(), "{}", transcript(&output));
+        assert!(
+            stdout(&output).contains("coverage: "),
+            "{}",
+            transcript(&output)
+        );
+        let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
+            .expect("lcov.info");
+        assert!(
+            lcov.contains(&format!("SF:{}\n", project.join(source).display())),
+            "{lcov}"
+        );
+        let hit: usize = lcov
+            .lines()
+            .find_map(|l| l.strip_prefix("LH:"))
+            .and_then(|n| n.parse().ok())
+            .expect("LH");
+        assert!(hit > 0, "{name}: no line run:\n{lcov}");
+        let html = std::fs::read_to_string(project.join("target/scorpion/coverage/index.html"))
+            .expect("index.html");
+        assert!(
+            html.contains(source) && html.contains("class=\"run\""),
+            "{name}"
+        );
+    }
+}
+
+/// A budget in the project file fails the test run when a command goes
+/// over it, naming the transcript line and the stack; a generous one
+/// passes.
+#[test]
+fn a_command_over_its_budget_fails_the_tests() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = dir.path().join("adc");
+    copy_dir(&example("adc"), &project);
+    let file = project.join("Scorpion.toml");
+    let original = std::fs::read_to_string(&file).expect("the project file");
+    std::fs::write(
+        &file,
+        format!("{original}\n[budgets]\n\"/2A\" = 100\nPUTHEX = 100000\n"),
+    )
+    .expect("write");
+    let over = scorpion(&project, &["test"]);
+    assert!(!over.status.success(), "{}", transcript(&over));
+    let text = stdout(&over);
+    assert!(text.contains("test budget /2A ... FAILED"), "{text}");
+    assert!(
+        text.contains("over its budget of 100 at adc.expect:"),
+        "{text}"
+    );
+    assert!(text.contains("(stack: main;/2A"), "{text}");
+    assert!(text.contains("test budget PUTHEX ... ok"), "{text}");
+
+    std::fs::write(&file, format!("{original}\n[budgets]\n\"/2A\" = 100000\n")).expect("write");
+    let within = scorpion(&project, &["test"]);
+    assert!(within.status.success(), "{}", transcript(&within));
+    assert!(stdout(&within).contains("test budget /2A ... ok"));
+}
