@@ -155,7 +155,7 @@ fn stdout(output: &std::process::Output) -> String {
 /// A new project's transcript sends only `/1V`: its handler's two
 /// `bne not_mine` are never taken, and coverage says so, line by line,
 /// in the summary, the LCOV file and the HTML page. Two more transcript
-/// lines (a `/2V` and a `/1W`, neither the extension's) take both, and
+/// lines (a `/2V0` and a `/1W`, neither the extension's) take both, and
 /// coverage is whole.
 #[test]
 fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
@@ -222,7 +222,7 @@ fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
 
     let expect = project.join("tests/myext.expect");
     let mut transcript_text = std::fs::read_to_string(&expect).expect("the transcript");
-    transcript_text.push_str("/2V => nothing            # not /1V: on down the chain\n");
+    transcript_text.push_str("/2V0 => nothing           # not /1V: on down the chain\n");
     transcript_text.push_str("/1W => nothing            # not V either\n");
     std::fs::write(&expect, transcript_text).expect("write");
     let second = scorpion(&project, &["test", "--coverage"]);
@@ -305,4 +305,52 @@ fn a_command_over_its_budget_fails_the_tests() {
     let within = scorpion(&project, &["test"]);
     assert!(within.status.success(), "{}", transcript(&within));
     assert!(stdout(&within).contains("test budget /2A ... ok"));
+}
+
+/// README's profiling section, run as written: every line its output
+/// block shows comes out, and the flame graph and the coverage report are
+/// there with what they show.
+#[test]
+fn the_readmes_profiling_section_runs_as_written() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let heading = "## Where the cycles go";
+    let script = crate::readme_block(heading, "sh");
+    let output = std::process::Command::new("sh")
+        .arg("-e")
+        .arg("-c")
+        .arg(format!("exec 2>&1\n{script}"))
+        .current_dir(dir.path())
+        .env("PATH", crate::path_with_scorpion())
+        .env("NO_COLOR", "1")
+        .env_remove("SCORPION_PORT")
+        .env_remove("SCORPION_BAUD")
+        .output()
+        .expect("sh runs");
+    assert!(output.status.success(), "{}", transcript(&output));
+    let text = stdout(&output);
+    for line in crate::readme_block(heading, "text").lines() {
+        assert!(
+            text.contains(line),
+            "README.md's profiling section is stale: `{line}` is not in\n{text}"
+        );
+    }
+    let project = dir.path().join("myext");
+    let svg = std::fs::read_to_string(project.join("target/scorpion/flamegraph.svg"))
+        .expect("the flame graph");
+    assert!(
+        svg.contains("<svg") && svg.contains("/1V"),
+        "the command's box"
+    );
+    let folded = std::fs::read_to_string(project.join("target/scorpion/profile.folded"))
+        .expect("the folded stacks");
+    assert!(
+        folded.lines().any(|l| l.starts_with("main;/1V;PUTHEX")),
+        "{folded}"
+    );
+    let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
+        .expect("lcov.info");
+    assert!(lcov.contains("myext.s") && lcov.contains("BRDA:"), "{lcov}");
+    let html = std::fs::read_to_string(project.join("target/scorpion/coverage/index.html"))
+        .expect("index.html");
+    assert!(html.contains("jsr PUTCH"), "the page shows the source");
 }
