@@ -155,3 +155,24 @@ impl LineTable {
         Some((file.as_str(), *line))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::is_instruction;
+
+    #[test]
+    fn instructions_are_mnemonics_after_an_optional_label() {
+        assert!(is_instruction("        lda #1"));
+        assert!(is_instruction("loop:   dex"));
+        assert!(is_instruction(
+            "@wait:  bit ADC_STATUS          ; bit 6 into V"
+        ));
+        assert!(is_instruction("x:inx"));
+        assert!(!is_instruction("        .byte 1, 'R'"));
+        assert!(!is_instruction("table:  .addr soft_reset"));
+        assert!(!is_instruction("; lda #1"));
+        assert!(!is_instruction("label:"));
+        assert!(!is_instruction("        SCORPION_CHAIN_UNKNOWN"));
+        assert!(!is_instruction("VERSION = $01"));
+    }
+}
