@@ -50,6 +50,9 @@ enum Command {
     New(cmd::new::Args),
     /// Run a project's tests: snapshots and transcripts.
     Test(cmd::test::Args),
+    /// Profile a project's tests on the virtual Scorpion: cycles per
+    /// routine, robot command and source line, and a flame graph.
+    Profile(cmd::profile::Args),
     /// Debug a program on the virtual Scorpion: breakpoints, stepping,
     /// back in time.
     Debug(cmd::debug::Args),
@@ -76,6 +79,7 @@ fn main() -> ExitCode {
         Command::Ask(args) => cmd::ask::run(&args),
         Command::New(args) => cmd::new::run(&args),
         Command::Test(args) => cmd::test::run(&args),
+        Command::Profile(args) => cmd::profile::run(&args),
         Command::Debug(args) => cmd::debug::run(&args),
         Command::Dap(args) => cmd::dap::run(&args),
         Command::Config(args) => cmd::config::run(&args),

@@ -69,6 +69,18 @@ pub trait Hooks {
         let _ = (cpu, bus, kind);
     }
 
+    /// After the run skipped `laps` iterations of an idle loop instead of
+    /// running them (only with hooks that [`Hooks::may_skip_idle`]): one
+    /// lap is the last `instructions` instructions these hooks were shown
+    /// (the probe ran it under them, and asked them once more at its start
+    /// again, the PC now), and took `cycles` cycles. Hooks that count what
+    /// runs (a profiler) count the skipped laps here, as if they had seen
+    /// them; the CPU's counters have already moved past them.
+    #[inline(always)]
+    fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, cycles: u64) {
+        let _ = (cpu, laps, instructions, cycles);
+    }
+
     /// After an instruction that jumped or branched to itself (`JMP *`,
     /// `BNE *`, the way test programs and idle loops stop).
     /// [`Control::Stop`] ends the run with [`crate::Stop::Trap`].
@@ -123,6 +135,11 @@ impl<H: Hooks + ?Sized> Hooks for &mut H {
     }
 
     #[inline(always)]
+    fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, cycles: u64) {
+        (**self).idle_skipped(cpu, laps, instructions, cycles);
+    }
+
+    #[inline(always)]
     fn trap<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
         (**self).trap(cpu, bus)
     }
@@ -154,6 +171,12 @@ impl<H1: Hooks, H2: Hooks> Hooks for (H1, H2) {
     fn interrupt<B: Bus>(&mut self, cpu: &Cpu, bus: &B, kind: Interrupt) {
         self.0.interrupt(cpu, bus, kind);
         self.1.interrupt(cpu, bus, kind);
+    }
+
+    #[inline(always)]
+    fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, cycles: u64) {
+        self.0.idle_skipped(cpu, laps, instructions, cycles);
+        self.1.idle_skipped(cpu, laps, instructions, cycles);
     }
 
     #[inline(always)]

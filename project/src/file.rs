@@ -21,6 +21,11 @@ pub struct ProjectFile {
     /// `[tests]`.
     #[serde(default)]
     pub tests: TestsSpec,
+    /// `[budgets]`: the most a robot command (`"/2A"`, from its arrival
+    /// to `CMD_DONE`) or a routine (its label, from its entry to its
+    /// `RTS`) may cost, in cycles, anywhere in the tests.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub budgets: BTreeMap<String, u64>,
 }
 
 /// A workspace's file: `[workspace]` only.

@@ -26,7 +26,7 @@ fn block(doc: &str, heading: &str) -> String {
 }
 
 /// Keys whose tables are the user's names (defines), not the schema's.
-const MAPS: [&str; 1] = ["defines"];
+const MAPS: [&str; 2] = ["defines", "budgets"];
 
 /// Every key path of `value` (`image.name`), into the first element of
 /// arrays of tables.
@@ -92,6 +92,7 @@ fn everything() -> ProjectFile {
             transcripts: vec!["t.expect".into()],
             builtin_listing: true,
         },
+        budgets: BTreeMap::from([("/2A".into(), 3000)]),
     }
 }
 

@@ -21,7 +21,7 @@ pub mod sim;
 pub mod symbols;
 
 pub use error::{Error, ScriptFault};
-pub use sim::{InstalledHook, Surroundings, VirtualScorpion};
+pub use sim::{InstalledHook, Runner, Surroundings, VirtualScorpion};
 
 /// The reference ROM image, `$F000-$FFFF`.
 pub const ROM: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/scorpion-rom.bin"));

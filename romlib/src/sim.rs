@@ -10,8 +10,8 @@
 //! [`VirtualScorpion::exchange`] sends a [`Command`] through the emulated
 //! 6551 at the line's baud rate and parses the answer.
 
-use emulator::Stop;
 use emulator::board::{CPU_HZ, Scorpion};
+use emulator::{Breakpoints, Stop};
 use isa::objfmt::HookKind;
 use linker::Image;
 use platform::map::{self, KIM_BUS};
@@ -86,6 +86,25 @@ pub struct VirtualScorpion {
     reference_rom: bool,
     /// What changes the robot's inputs over time, if anything.
     world: Option<Box<dyn Surroundings>>,
+    /// The host's own run of the CPU, if it set one (a profiler).
+    runner: Option<Box<dyn Runner>>,
+}
+
+/// A run of the robot's CPU that every run of a [`VirtualScorpion`] goes
+/// through once set ([`VirtualScorpion::set_runner`]): a profiler or a
+/// coverage count watching every exchange of a test, with its own hooks.
+pub trait Runner: std::fmt::Debug + Send {
+    /// Runs `robot` to robot time `until` or an earlier stop, as
+    /// [`emulator::Machine::run`] does (with hooks that never stop it, the
+    /// same run).
+    fn run(&mut self, robot: &mut Scorpion, until: u64) -> Stop;
+
+    /// Runs `robot` to robot time `until` or to the first instruction at
+    /// an address of `stops`, as [`emulator::Machine::run_with`] with
+    /// `stops` does (a routine-level test's run to its return).
+    fn run_to(&mut self, robot: &mut Scorpion, until: u64, stops: &mut Breakpoints) -> Stop {
+        robot.run_with(until, stops)
+    }
 }
 
 /// An image's labels: its symbols that lie in a section (not constants).
@@ -162,6 +181,7 @@ impl VirtualScorpion {
             labels: Vec::new(),
             reference_rom: true,
             world: None,
+            runner: None,
         };
         scorpion.boot();
         scorpion
@@ -220,6 +240,7 @@ impl VirtualScorpion {
             labels: Vec::new(),
             reference_rom: false,
             world: None,
+            runner: None,
         };
         scorpion.add_labels(rom);
         scorpion.boot();
@@ -235,8 +256,31 @@ impl VirtualScorpion {
     /// line, until a byte reaches it): the surroundings woken when they
     /// asked to be, then a jammed CPU or a failed card reported.
     fn advance(&mut self, until: u64) -> Result<(), Error> {
-        self.advance_with(until, |robot, to| robot.run(to))
-            .map(|_| ())
+        let mut runner = self.runner.take();
+        let result = self.advance_with(until, |robot, to| match runner.as_mut() {
+            Some(runner) => runner.run(robot, to),
+            None => robot.run(to),
+        });
+        self.runner = runner;
+        result.map(|_| ())
+    }
+
+    /// Runs the CPU alone (no surroundings woken, no host) to robot time
+    /// `until` or to the first instruction at an address of `stops`,
+    /// through the runner if one is set: a routine called directly, run
+    /// to its return.
+    pub fn run_to(&mut self, until: u64, stops: &mut Breakpoints) -> Stop {
+        match self.runner.as_mut() {
+            Some(runner) => runner.run_to(&mut self.robot, until, stops),
+            None => self.robot.run_with(until, stops),
+        }
+    }
+
+    /// Every run from now on (the host's exchanges, settling, waiting for
+    /// answers) goes through `runner` instead of the plain run; `None`
+    /// goes back to the plain run. Returns the runner there was.
+    pub fn set_runner(&mut self, runner: Option<Box<dyn Runner>>) -> Option<Box<dyn Runner>> {
+        std::mem::replace(&mut self.runner, runner)
     }
 
     /// [`VirtualScorpion::advance`] with the caller's own run of the CPU
@@ -310,6 +354,9 @@ impl VirtualScorpion {
             labels: self.labels.clone(),
             reference_rom: self.reference_rom,
             world,
+            // The copy runs plainly: the host watches the robot it set
+            // its run on.
+            runner: None,
         })
     }
 

@@ -13,6 +13,7 @@ pub(crate) mod installed;
 pub(crate) mod link;
 pub(crate) mod new;
 pub(crate) mod ports;
+pub(crate) mod profile;
 pub(crate) mod read;
 pub(crate) mod rig;
 pub(crate) mod sim;

@@ -68,6 +68,13 @@ pub(crate) struct Args {
     /// run to run).
     #[arg(long)]
     timing: bool,
+    /// Count which lines of the project's own sources the transcripts and
+    /// `.calls` tests ran, and each conditional branch taken and not
+    /// taken: the lines never run are named, and
+    /// `target/scorpion/coverage/` gets `lcov.info` (LCOV) and
+    /// `index.html`.
+    #[arg(long, conflicts_with = "port")]
+    coverage: bool,
 }
 
 impl Args {
@@ -88,11 +95,35 @@ impl Args {
 /// virtual robot's scripts print and where its cards went on stderr.
 struct Printer {
     out: std::io::StdoutLock<'static>,
+    /// The profiler on every test's robot, for `--coverage` and the
+    /// project's `[budgets]`.
+    watch: Option<crate::cmd::profile::Watch>,
 }
 
 impl Progress for Printer {
+    fn image_built(&mut self, built: &runner::Built) {
+        if let Some(watch) = &mut self.watch {
+            watch.image_built(built);
+        }
+    }
+
+    fn robot_ready(&mut self, _test: &str, robot: &mut romlib::VirtualScorpion) {
+        if let Some(watch) = &mut self.watch {
+            watch.robot_ready(robot);
+        }
+    }
+
+    fn robot_done(&mut self, test: &str, robot: &mut romlib::VirtualScorpion) {
+        if let Some(watch) = &mut self.watch {
+            watch.robot_done(test, robot);
+        }
+    }
+
     fn member_started(&mut self, name: &str) {
         let _ = writeln!(self.out, "== {name}");
+        if let Some(watch) = &mut self.watch {
+            watch.member_started(name);
+        }
     }
 
     fn member_finished(&mut self, member: &MemberReport) {
@@ -179,11 +210,40 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         replace: args.replace,
         environment: Environment::from_process()?,
     };
+    // Budgets need the whole profiler; coverage alone, the counts.
+    let budgets = args.port.is_none() && crate::cmd::profile::Watch::needed(&found)?;
+    let watch = if args.coverage || budgets {
+        Some(crate::cmd::profile::Watch::new(&found, !budgets)?)
+    } else {
+        None
+    };
     let mut printer = Printer {
         out: std::io::stdout().lock(),
+        watch,
     };
-    let report = runner::run_tests(&found, &options, &mut printer)?;
+    let mut report = runner::run_tests(&found, &options, &mut printer)?;
     let out = &mut printer.out;
+    if let Some(watch) = &printer.watch {
+        let name = match &found {
+            Found::Project(project) => project.file.project.name.clone(),
+            Found::Workspace(_) => String::new(),
+        };
+        for member in &watch.members {
+            if budgets && !member.budgets.is_empty() && member.tests > 0 {
+                let (passed, failed) = member.check_budgets(out);
+                report.passed += passed;
+                report.failed += failed;
+            }
+            if args.coverage {
+                let name = if name.is_empty() {
+                    member.root.display().to_string()
+                } else {
+                    name.clone()
+                };
+                member.write_coverage(&name, out)?;
+            }
+        }
+    }
     if args.timing {
         let _ = writeln!(
             out,

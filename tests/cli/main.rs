@@ -15,6 +15,7 @@ mod hostile_terminal;
 mod journeys;
 mod layouts;
 mod link;
+mod profile;
 mod project;
 mod read;
 mod search_order;

@@ -34,7 +34,10 @@
 //! watchpoint the lap's last access hit stops there); a lap they let run
 //! they would let run every time, since every lap sees the same registers
 //! and memory, so skipping it changes nothing they would have seen. The
-//! skip also stops short of the hooks' [`Hooks::instruction_bound`]. It is
+//! skip also stops short of the hooks' [`Hooks::instruction_bound`], and
+//! is told to them ([`Hooks::idle_skipped`]: the laps skipped, each the
+//! lap they just saw), so hooks that count (a profiler) count every lap.
+//! It is
 //! off in [`Cpu::step`],
 //! off for a bus that does not vouch for its memory (the default), and can
 //! be switched off with [`Cpu::set_idle_skip`] (the equivalence test runs a
@@ -299,7 +302,11 @@ impl Cpu {
                 let instructions = self.instructions - start.2;
                 (self.idle.lap, self.idle.lap_len) = (lap, window);
                 let until_count = hooks.instruction_bound();
-                self.skip_iterations(probe.bus, until, until_count, cycles, instructions);
+                let laps =
+                    self.skip_iterations(probe.bus, until, until_count, cycles, instructions);
+                if !H::PASSIVE && laps > 0 {
+                    hooks.idle_skipped(self, laps, instructions, cycles);
+                }
                 return None;
             }
             if self.pc == start.0.pc || window == MAX_LOOP {
@@ -318,7 +325,8 @@ impl Cpu {
 
     /// Advances as many whole `cycles`-long iterations as end before
     /// `until` and no later than the bus's quiet horizon, leaving the
-    /// instruction count at most `until_count`.
+    /// instruction count at most `until_count`. Returns how many it
+    /// advanced.
     fn skip_iterations<B: Bus>(
         &mut self,
         bus: &B,
@@ -326,7 +334,7 @@ impl Cpu {
         until_count: u64,
         cycles: u64,
         instructions: u64,
-    ) {
+    ) -> u64 {
         let last_end = until
             .saturating_sub(1)
             .min(bus.quiet_until())
@@ -335,11 +343,12 @@ impl Cpu {
         let laps = (last_end.saturating_sub(self.cycles) / cycles).min(by_count);
         if laps == 0 {
             self.idle.missed(self.cycles);
-            return;
+            return 0;
         }
         self.cycles += laps * cycles;
         self.instructions += laps * instructions;
         self.idle.skipped_cycles += laps * cycles;
         self.idle.found(self.cycles);
+        laps
     }
 }

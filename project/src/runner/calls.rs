@@ -248,7 +248,10 @@ pub fn run(call: &Call, robot: &mut VirtualScorpion) -> Result<(), String> {
     let limit = call.within.unwrap_or(DEFAULT_LIMIT);
     let mut stop_at = Breakpoints::new();
     stop_at.insert(RETURN);
-    let stop = machine.run_with(start + limit + 1, &mut stop_at);
+    // Through the robot's runner: a profiler or a coverage count set on
+    // it sees the call.
+    let stop = robot.run_to(start + limit + 1, &mut stop_at);
+    let machine = robot.robot_mut();
     let took = machine.now() - start;
     match stop {
         Stop::Hook { pc } if pc == RETURN => {}

@@ -1,0 +1,472 @@
+//! The hooks that count: every instruction's cycles by address, each
+//! conditional branch taken and not taken, the shadow call stack, and each
+//! robot command from its arrival to `CMD_DONE`.
+//!
+//! An instruction's cycles are only known once it has run: they are the
+//! cycle counter's advance from the hooks' look before it to their look
+//! before the next one (or to the start of the interrupt sequence that
+//! follows it, or to the end of the run). So the profiler keeps the
+//! instruction it last let run as pending and counts it at the next look,
+//! when it also sees where it went (a branch taken or not, a call made) and
+//! what it left S at.
+//!
+//! An idle loop the emulator skips is counted as if it had run: the probe
+//! that found it ran one lap under these hooks, and
+//! [`Hooks::idle_skipped`] says how many more laps the skip stands for,
+//! so the last lap's instructions (kept in a ring of the last
+//! [`RING`] instructions) are counted that many times more, to their
+//! addresses, lines, routines and branches.
+
+use emulator::{Breakpoints, Bus, Control, Cpu, Hooks, Interrupt};
+
+use crate::flow::{self, Flow};
+use crate::stack::{Routine, Stack};
+
+/// The longest idle loop the emulator skips is 32 instructions.
+const RING: usize = 64;
+
+/// Addresses of the ROM the profiler watches for.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Places {
+    /// Where a whole command has arrived and the ROM looks for its
+    /// handler (the reference ROM's `dispatch`).
+    pub arrival: Option<u16>,
+    /// Where a command is done (`CMD_DONE`, and the ROM's own
+    /// `cmd_done` its built-in commands jump to).
+    pub done: Vec<u16>,
+    /// The control loop's hook (`HOOK_LOOP`): a command that comes back
+    /// to it without passing `CMD_DONE` (`/1R`) ends there.
+    pub main_loop: Option<u16>,
+    /// The command's length and buffer (`CMDLEN`, `CMDBUF`).
+    pub command_length: u16,
+    /// The command's letter and arguments.
+    pub command_buffer: u16,
+}
+
+impl Places {
+    /// The places of the ROM `robot` runs: its labels `dispatch`,
+    /// `CMD_DONE` and `cmd_done`, its loop hook, and the reference ROM's
+    /// command buffer.
+    #[must_use]
+    pub fn of(robot: &romlib::VirtualScorpion) -> Places {
+        let labels = robot.labels();
+        let find = |name: &str| labels.iter().find(|(_, n)| n == name).map(|(at, _)| *at);
+        let mut done: Vec<u16> = ["CMD_DONE", "cmd_done"]
+            .iter()
+            .filter_map(|name| find(name))
+            .collect();
+        if done.is_empty() {
+            done.push(romlib::symbols::CMD_DONE);
+        }
+        Places {
+            arrival: find("dispatch"),
+            done,
+            main_loop: Some(robot.hook_address(isa::objfmt::HookKind::Loop)),
+            command_length: romlib::symbols::CMDLEN,
+            command_buffer: romlib::symbols::CMDBUF,
+        }
+    }
+}
+
+/// Names for addresses: which label each address is under.
+#[derive(Debug, Clone)]
+pub(crate) struct Labels {
+    /// The index into `names` of the label at or below each address, or
+    /// `u32::MAX` for none.
+    by_address: Vec<u32>,
+    pub(crate) names: Vec<(u16, String)>,
+}
+
+impl Labels {
+    /// `labels`: (address, name), in any order; the first name at an
+    /// address wins, names starting `__` (the toolchain's) last.
+    pub(crate) fn new(labels: &[(u16, String)]) -> Labels {
+        let mut names: Vec<(u16, String)> = labels.to_vec();
+        names.sort_by_key(|(at, name)| (*at, name.starts_with("__"), name.clone()));
+        names.dedup_by_key(|(at, _)| *at);
+        let mut by_address = vec![u32::MAX; 0x1_0000];
+        for (index, window) in names.iter().enumerate() {
+            let start = usize::from(window.0);
+            let end = names
+                .get(index + 1)
+                .map_or(0x1_0000, |(next, _)| usize::from(*next));
+            let index = u32::try_from(index).unwrap_or(u32::MAX);
+            for slot in &mut by_address[start..end] {
+                *slot = index;
+            }
+        }
+        Labels { by_address, names }
+    }
+
+    #[inline(always)]
+    pub(crate) fn of(&self, address: u16) -> u32 {
+        self.by_address[usize::from(address)]
+    }
+
+    /// `address` named: `label`, `label+$offset`, or `$ADDR`.
+    pub(crate) fn name(&self, address: u16) -> String {
+        match self.names.get(self.of(address) as usize) {
+            Some((at, name)) if *at == address => name.clone(),
+            Some((at, name)) => format!("{name}+${:X}", address - at),
+            None => format!("${address:04X}"),
+        }
+    }
+
+    /// The label with index `label`.
+    pub(crate) fn label(&self, label: u32) -> Option<&str> {
+        self.names
+            .get(label as usize)
+            .map(|(_, name)| name.as_str())
+    }
+}
+
+/// One robot command, from its arrival.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CommandRun {
+    /// As sent: `/2A1`.
+    pub text: String,
+    /// The cycle it arrived at (the robot's time).
+    pub arrival: u64,
+    /// Cycles from its arrival to `CMD_DONE`; `None` if it never got
+    /// there (`/1R`, or the run ended first).
+    pub cycles: Option<u64>,
+    /// Where it came from (a transcript's `file:line`), if the host said.
+    pub origin: Option<String>,
+}
+
+/// An instruction that ran, as the ring keeps it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Ran {
+    pc: u16,
+    opcode: u8,
+    cycles: u64,
+    next_pc: u16,
+    s_before: u8,
+    s_after: u8,
+}
+
+/// The instruction let run and not yet counted.
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    pc: u16,
+    opcode: u8,
+    s: u8,
+    /// Instructions run before it.
+    count: u64,
+    /// The cycle it began at.
+    start: u64,
+}
+
+/// The profiler: [`Hooks`] that never stop a run and let idle loops be
+/// skipped, counting everything. Turn it into a [`crate::Profile`] with
+/// [`Profiler::finish`].
+#[derive(Debug, Clone)]
+pub struct Profiler {
+    flows: [Flow; 256],
+    /// Executions by address.
+    pub(crate) counts: Vec<u64>,
+    /// Cycles by address.
+    pub(crate) cycles: Vec<u64>,
+    /// Conditional branches taken, by address.
+    pub(crate) taken: Vec<u64>,
+    /// Conditional branches not taken, by address.
+    pub(crate) not_taken: Vec<u64>,
+    pending: Option<Pending>,
+    ring: [Ran; RING],
+    ring_next: usize,
+    ring_len: usize,
+    pub(crate) stack: Stack,
+    pub(crate) labels: Labels,
+    places: Places,
+    /// Every address of `places`: one bit test per instruction.
+    watched: Breakpoints,
+    /// Calls, commands and stacks counted too (not for coverage alone).
+    calls: bool,
+    pub(crate) commands: Vec<CommandRun>,
+    /// Cycles counted (instructions and interrupt sequences).
+    pub(crate) total: u64,
+    /// Laps of idle loops counted without running.
+    pub(crate) skipped_laps: u64,
+}
+
+impl Profiler {
+    /// A profiler for a robot whose ROM and images have `labels`
+    /// ([`romlib::VirtualScorpion::labels`]) and whose ROM has `places`.
+    #[must_use]
+    pub fn new(labels: &[(u16, String)], places: Places) -> Profiler {
+        let mut watched = Breakpoints::new();
+        for &at in places
+            .arrival
+            .iter()
+            .chain(&places.done)
+            .chain(places.main_loop.iter())
+        {
+            watched.insert(at);
+        }
+        Profiler {
+            watched,
+            calls: true,
+            flows: flow::table(),
+            counts: vec![0; 0x1_0000],
+            cycles: vec![0; 0x1_0000],
+            taken: vec![0; 0x1_0000],
+            not_taken: vec![0; 0x1_0000],
+            pending: None,
+            ring: [Ran::default(); RING],
+            ring_next: 0,
+            ring_len: 0,
+            stack: Stack::new(),
+            labels: Labels::new(labels),
+            places,
+            commands: Vec::new(),
+            total: 0,
+            skipped_laps: 0,
+        }
+    }
+
+    /// A profiler for `robot` as it is now (its ROM and loaded images).
+    #[must_use]
+    pub fn for_robot(robot: &romlib::VirtualScorpion) -> Profiler {
+        Profiler::new(&robot.labels(), Places::of(robot))
+    }
+
+    /// Counts by address and branch only, for coverage: no call stack,
+    /// no commands (faster).
+    #[must_use]
+    pub fn coverage_only(mut self) -> Profiler {
+        self.calls = false;
+        self.watched = Breakpoints::new();
+        self
+    }
+
+    /// Counts the instruction still pending, which ended at the CPU's
+    /// cycle now: call after a run of the CPU the hooks saw, before
+    /// anything else runs it (the runner does).
+    pub fn end_run(&mut self, cpu: &Cpu) {
+        if let Some(pending) = self.pending {
+            if cpu.instructions() == pending.count + 1 {
+                self.count_pending(pending, cpu.cycles(), cpu.pc, cpu.s);
+            }
+        }
+        self.pending = None;
+    }
+
+    /// Says where the `index`th command seen came from (a transcript's
+    /// `file:line`).
+    pub fn set_origin(&mut self, index: usize, origin: String) {
+        if let Some(run) = self.commands.get_mut(index) {
+            run.origin = Some(origin);
+        }
+    }
+
+    /// The commands seen so far.
+    #[must_use]
+    pub fn commands(&self) -> &[CommandRun] {
+        &self.commands
+    }
+
+    /// Cycles counted so far.
+    #[must_use]
+    pub fn total_cycles(&self) -> u64 {
+        self.total
+    }
+
+    // Out of line: the CPU's run loop keeps its registers (inlined, this
+    // would crowd them out of machine registers on every instruction).
+    #[inline(never)]
+    fn count_pending(&mut self, pending: Pending, end: u64, next_pc: u16, s_after: u8) {
+        let ran = Ran {
+            pc: pending.pc,
+            opcode: pending.opcode,
+            cycles: end.saturating_sub(pending.start),
+            next_pc,
+            s_before: pending.s,
+            s_after,
+        };
+        self.count(ran, 1, end);
+        self.ring[self.ring_next] = ran;
+        self.ring_next = (self.ring_next + 1) % RING;
+        self.ring_len = (self.ring_len + 1).min(RING);
+    }
+
+    /// Counts `ran`, `times` times over, the last one ending at `end`.
+    #[inline(always)]
+    fn count(&mut self, ran: Ran, times: u64, end: u64) {
+        let at = usize::from(ran.pc);
+        let cycles = ran.cycles * times;
+        self.counts[at] += times;
+        self.cycles[at] += cycles;
+        self.total += cycles;
+        let flow = self.flows[usize::from(ran.opcode)];
+        if flow == Flow::Branch {
+            if ran.next_pc == ran.pc.wrapping_add(2) {
+                self.not_taken[at] += times;
+            } else {
+                self.taken[at] += times;
+            }
+        }
+        if !self.calls {
+            return;
+        }
+        self.stack.charge(self.labels.of(ran.pc), cycles);
+        match flow {
+            Flow::Plain | Flow::Branch => {}
+            Flow::Call => self.stack.call(ran.next_pc, ran.s_before, end, times),
+            Flow::Return => self.stack.unwind(ran.s_after, false, end),
+            Flow::ReturnFromInterrupt | Flow::SetStack => {
+                self.stack.unwind(ran.s_after, true, end);
+            }
+            Flow::Break => self.stack.interrupt(Routine::Brk, ran.s_before, end),
+        }
+    }
+
+    /// A new instruction at `pc` is about to run at cycle `now`: a
+    /// command arriving or done.
+    #[cold]
+    #[inline(never)]
+    fn look<B: Bus>(&mut self, pc: u16, now: u64, bus: &B) {
+        if self.places.arrival == Some(pc) {
+            self.arrive(now, bus);
+        } else if self.places.done.contains(&pc) {
+            self.done(now, true);
+        } else if self.places.main_loop == Some(pc) && self.stack.command.is_some() {
+            self.done(now, false);
+        }
+    }
+
+    #[cold]
+    fn arrive<B: Bus>(&mut self, now: u64, bus: &B) {
+        self.done(now, false);
+        let count = bus.peek(self.places.command_length);
+        let mut text = format!("/{count}");
+        for offset in 0..u16::from(count.min(9)) {
+            let byte = bus.peek(self.places.command_buffer.wrapping_add(offset));
+            text.push(if byte.is_ascii_graphic() {
+                char::from(byte)
+            } else {
+                '?'
+            });
+        }
+        let index = u32::try_from(self.commands.len()).unwrap_or(u32::MAX);
+        self.stack.command_begins(&text, index, now);
+        self.commands.push(CommandRun {
+            text,
+            arrival: now,
+            cycles: None,
+            origin: None,
+        });
+    }
+
+    #[cold]
+    fn done(&mut self, now: u64, finished: bool) {
+        if let Some(index) = self.stack.command {
+            if let Some(run) = self.commands.get_mut(index as usize) {
+                if finished {
+                    run.cycles = Some(now.saturating_sub(run.arrival));
+                }
+            }
+            self.stack.command_ends(now);
+        }
+    }
+
+    /// Counts `laps` more laps of the last `instructions` instructions.
+    #[cold]
+    fn replay(&mut self, cpu: &Cpu, laps: u64, instructions: u64) {
+        let len = usize::try_from(instructions).unwrap_or(usize::MAX);
+        if len == 0 || len > self.ring_len {
+            // Not a lap these hooks saw (cannot happen with the
+            // emulator's probe): the cycles still count, at the PC.
+            if let Some(pending) = &mut self.pending {
+                pending.start = cpu.cycles();
+                pending.count = cpu.instructions();
+            }
+            return;
+        }
+        let first = (self.ring_next + RING - len) % RING;
+        let lap: Vec<Ran> = (0..len).map(|i| self.ring[(first + i) % RING]).collect();
+        let lap_cycles: u64 = lap.iter().map(|ran| ran.cycles).sum();
+        // Calls made and ended within the lap cost a lap's share; the
+        // clock they see starts where the skipped laps began.
+        let mut clock = cpu.cycles().saturating_sub(laps * lap_cycles);
+        for ran in lap {
+            clock += ran.cycles;
+            self.count(ran, laps, clock);
+        }
+        self.skipped_laps += laps;
+        // The instruction the probe asked about last is the lap's first
+        // again, now after the skipped laps.
+        if let Some(pending) = &mut self.pending {
+            pending.start = cpu.cycles();
+            pending.count = cpu.instructions();
+        }
+    }
+
+    /// Ends every frame still open and turns the counts into a profile.
+    #[must_use]
+    pub fn finish(mut self, now: u64) -> crate::Profile {
+        self.stack.close(now);
+        crate::Profile::from_profiler(&self)
+    }
+}
+
+impl Hooks for Profiler {
+    // It never stops a run, and counts the laps of a skipped idle loop
+    // when told of them.
+    #[inline(always)]
+    fn may_skip_idle(&self) -> bool {
+        true
+    }
+
+    #[inline(always)]
+    fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
+        let count = cpu.instructions();
+        if let Some(pending) = self.pending {
+            if pending.count == count && pending.pc == cpu.pc {
+                // Asked again before it ran (the idle probe's look at a
+                // lap's end).
+                return Control::Continue;
+            }
+            self.count_pending(pending, cpu.cycles(), cpu.pc, cpu.s);
+        }
+        if self.watched.contains(cpu.pc) {
+            self.look(cpu.pc, cpu.cycles(), bus);
+        }
+        self.pending = Some(Pending {
+            pc: cpu.pc,
+            opcode: bus.peek(cpu.pc),
+            s: cpu.s,
+            count,
+            start: cpu.cycles(),
+        });
+        Control::Continue
+    }
+
+    fn interrupt<B: Bus>(&mut self, cpu: &Cpu, bus: &B, kind: Interrupt) {
+        let began = cpu.cycles().saturating_sub(7);
+        let s_before = cpu.s.wrapping_add(3);
+        if let Some(pending) = self.pending.take() {
+            // The instruction before the sequence went where the sequence
+            // pushed as the return address.
+            let lo = bus.peek(0x0100 | u16::from(cpu.s.wrapping_add(2)));
+            let hi = bus.peek(0x0100 | u16::from(s_before));
+            let next_pc = u16::from_le_bytes([lo, hi]);
+            if cpu.instructions() == pending.count + 1 {
+                self.count_pending(pending, began, next_pc, s_before);
+            }
+        }
+        let routine = match kind {
+            Interrupt::Irq => Routine::Irq,
+            Interrupt::Nmi => Routine::Nmi,
+        };
+        self.total += 7;
+        if self.calls {
+            self.stack.interrupt(routine, s_before, began);
+            // The sequence's own seven cycles are the handler's.
+            self.stack.charge(u32::MAX, 7);
+        }
+    }
+
+    fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, _cycles: u64) {
+        self.replay(cpu, laps, instructions);
+    }
+}

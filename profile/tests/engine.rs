@@ -1,0 +1,221 @@
+//! The profiler's counts, exact: a routine counted by hand, idle loops the
+//! emulator skips counted as if run, a command timed from its arrival to
+//! `CMD_DONE` against breakpoints, interrupts as roots of their own.
+
+use std::collections::BTreeMap;
+
+use emulator::{Breakpoints, Machine, StopAtTrap};
+use romlib::VirtualScorpion;
+use scorpion_profile::{Places, Profile, Profiler, Recorder};
+
+/// A place the profiler watches nothing at (a plain RAM machine).
+fn no_places() -> Places {
+    Places {
+        arrival: None,
+        done: Vec::new(),
+        main_loop: None,
+        command_length: 0,
+        command_buffer: 0,
+    }
+}
+
+/// `routine` at $04F8: an indexed load that crosses a page and a taken
+/// branch to the next page, counted by hand from the datasheet:
+///
+/// ```text
+/// 04F8  BD F0 10  LDA $10F0,X   4 + 1 ($10F0 + $20 = $1110: page crossed)
+/// 04FB  D0 03     BNE $0500     2 + 1 (taken) + 1 ($04FD -> $0500: page crossed)
+/// 0500  CA        DEX           2
+/// 0501  60        RTS           6
+/// ```
+///
+/// 5 + 4 + 2 + 6 = 17 cycles from its first instruction to the end of
+/// its RTS (the JSR is the caller's).
+#[test]
+fn a_routine_counted_by_hand_costs_what_the_profile_says() {
+    let mut machine =
+        Machine::with_image(0x0400, &[0xA2, 0x20, 0x20, 0xF8, 0x04, 0x4C, 0x05, 0x04])
+            .expect("the caller fits");
+    machine
+        .bus
+        .load(
+            0x04F8,
+            &[0xBD, 0xF0, 0x10, 0xD0, 0x03, 0xEA, 0xEA, 0xEA, 0xCA, 0x60],
+        )
+        .expect("the routine fits");
+    machine.bus.bytes_mut()[0x1110] = 1;
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "start".to_owned()), (0x04F8, "routine".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    let stop = machine.run_with(10_000, &mut (&mut profiler, StopAtTrap));
+    assert!(matches!(stop, emulator::Stop::Trap { .. }), "{stop:?}");
+    profiler.end_run(&machine.cpu);
+    let profile = profiler.finish(machine.cpu.cycles());
+
+    let routine = &profile.routines["routine"];
+    assert_eq!((routine.calls, routine.ended), (1, 1));
+    assert_eq!(routine.inclusive, 17, "the hand count");
+    assert_eq!((routine.min, routine.max), (17, 17));
+    assert_eq!(routine.exclusive, 17, "it calls nothing");
+    assert_eq!(profile.cycles[0x04F8], 5, "LDA abs,X across a page");
+    assert_eq!(profile.cycles[0x04FB], 4, "BNE taken across a page");
+    assert_eq!((profile.taken[0x04FB], profile.not_taken[0x04FB]), (1, 0));
+    assert_eq!(profile.counts[0x04FD], 0, "the NOPs are jumped over");
+    assert_eq!(routine.worst_path, "main;routine");
+    // LDX 2 + JSR 6 + the routine + JMP 3 (the trap, counted once).
+    assert_eq!(profile.total, 2 + 6 + 17 + 3);
+    assert_eq!(
+        profile.total,
+        machine.cpu.cycles(),
+        "every cycle of the run"
+    );
+}
+
+/// `/1Q` answers `Q` and a byte from a table: a handler that loops, calls
+/// ROM services, and is reached from the ROM's dispatch.
+const SOURCE: &str = "
+        .include \"scorpion.inc\"
+        .code
+        SCORPION_UNKNOWN_HANDLER
+handler:
+        cpx #1
+        bne not_mine
+        cmp #'Q'
+        bne not_mine
+        ldy #0
+count:  iny
+        cpy #20
+        bne count
+        lda #'Q'
+        jsr PUTCH
+        tya
+        jsr PUTHEX
+        jsr PUTEOL
+        jmp CMD_DONE
+not_mine:
+        SCORPION_CHAIN_UNKNOWN
+";
+
+fn image() -> linker::Image {
+    let files = assembler::MemorySource::new().with("q.s", SOURCE);
+    let options = assembler::Options {
+        builtin_includes: BTreeMap::from([(
+            "scorpion.inc".to_owned(),
+            romlib::SCORPION_INC.as_bytes().to_vec(),
+        )]),
+        ..assembler::Options::default()
+    };
+    let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
+        .expect("the handler assembles");
+    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
+}
+
+fn robot() -> VirtualScorpion {
+    let mut robot = VirtualScorpion::new();
+    robot.load_image(&image()).expect("the image loads");
+    robot
+}
+
+/// A session with the host: questions, the extension, waits between.
+fn session(robot: &mut VirtualScorpion) {
+    for command in [&b"/1Q"[..], b"/1X", b"/1Q", b"/1P"] {
+        robot.transact(command, 1_000_000).expect("answered");
+        robot.run_for(50_000).expect("runs");
+    }
+}
+
+fn profiled(idle_skip: bool) -> Profile {
+    let mut robot = robot();
+    robot.robot_mut().cpu.set_idle_skip(idle_skip);
+    let recorder = Recorder::attach(&mut robot);
+    session(&mut robot);
+    recorder.finish(&mut robot)
+}
+
+#[test]
+fn idle_laps_the_emulator_skips_count_as_if_run() {
+    let skipped = profiled(true);
+    let run = profiled(false);
+    assert!(
+        skipped.skipped_laps > 1000,
+        "the idle loop was skipped: {}",
+        skipped.skipped_laps
+    );
+    assert_eq!(run.skipped_laps, 0);
+    assert_eq!(skipped.total, run.total);
+    assert!(skipped.counts == run.counts, "executions by address differ");
+    assert!(skipped.cycles == run.cycles, "cycles by address differ");
+    assert!(skipped.taken == run.taken && skipped.not_taken == run.not_taken);
+    assert_eq!(skipped.routines, run.routines);
+    assert_eq!(skipped.stacks, run.stacks);
+    assert_eq!(skipped.commands, run.commands);
+}
+
+#[test]
+fn a_command_costs_what_breakpoints_at_dispatch_and_cmd_done_measure() {
+    let profile = profiled(true);
+    let q: Vec<_> = profile
+        .commands
+        .iter()
+        .filter(|run| run.text == "/1Q")
+        .collect();
+    assert_eq!(q.len(), 2);
+    let cycles = q[0].cycles.expect("/1Q reaches CMD_DONE");
+
+    // The same command, timed by stopping at the ROM's dispatch and at
+    // CMD_DONE.
+    let mut robot = robot();
+    let places = Places::of(&robot);
+    let dispatch = places.arrival.expect("the reference ROM's dispatch");
+    let mut at_dispatch = Breakpoints::new();
+    at_dispatch.insert(dispatch);
+    robot.send(b"/1Q");
+    let until = robot.cycles() + 1_000_000;
+    robot
+        .run_until_with(until, |r, to| r.run_with(to, &mut at_dispatch))
+        .expect("runs");
+    assert_eq!(robot.robot().cpu.pc, dispatch);
+    let arrived = robot.cycles();
+    let mut at_done = Breakpoints::new();
+    for &done in &places.done {
+        at_done.insert(done);
+    }
+    // Off the dispatch first, then to the first of CMD_DONE / cmd_done.
+    robot.robot_mut().step();
+    let until = robot.cycles() + 1_000_000;
+    robot
+        .run_until_with(until, |r, to| r.run_with(to, &mut at_done))
+        .expect("runs");
+    assert!(places.done.contains(&robot.robot().cpu.pc));
+    assert_eq!(cycles, robot.cycles() - arrived);
+
+    let cost = &profile.routines["/1Q"];
+    assert_eq!(cost.calls, 2);
+    assert!(cost.max >= cycles);
+}
+
+#[test]
+fn interrupts_are_roots_of_their_own() {
+    let profile = profiled(true);
+    let irq = &profile.routines["IRQ"];
+    // Every byte the host sends interrupts (the 6551's receive IRQ).
+    assert!(irq.calls >= 4 * 3, "{irq:?}");
+    assert_eq!(irq.calls, irq.ended);
+    assert!(profile.stacks.keys().any(|stack| stack.starts_with("IRQ")));
+    assert!(
+        !profile.stacks.keys().any(|stack| stack.contains(";IRQ")),
+        "an interrupt is nobody's callee"
+    );
+    // The handler's calls into the ROM hang under the command.
+    assert!(
+        profile
+            .stacks
+            .keys()
+            .any(|stack| stack.starts_with("main;/1Q;")),
+        "{:?}",
+        profile.stacks.keys().collect::<Vec<_>>()
+    );
+    // Everything counted once: the stacks add up to the total.
+    assert_eq!(profile.stacks.values().sum::<u64>(), profile.total);
+}

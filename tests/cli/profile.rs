@@ -1,0 +1,356 @@
+//! `scorpion profile` on the examples' projects: the tables name their
+//! routines and commands, and the folded stacks and the flame graph hold
+//! them (checked for content, not only for existence).
+
+use std::path::Path;
+
+use crate::{scorpion, transcript};
+
+fn example(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name)
+}
+
+/// Profiles `examples/NAME` into `out`: the report, the folded stacks,
+/// the SVG.
+fn profile(name: &str, out: &Path) -> (String, String, String) {
+    let folded = out.join(format!("{name}.folded"));
+    let svg = out.join(format!("{name}.svg"));
+    let output = scorpion(
+        &example(name),
+        &[
+            "profile",
+            "--folded",
+            folded.to_str().expect("UTF-8"),
+            "--flamegraph",
+            svg.to_str().expect("UTF-8"),
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    (
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        std::fs::read_to_string(&folded).expect("the folded stacks"),
+        std::fs::read_to_string(&svg).expect("the flame graph"),
+    )
+}
+
+#[test]
+fn the_adc_extension_profiled_by_routine_command_and_line() {
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let (report, folded, svg) = profile("adc", out.path());
+    // Its transcript sends /2A three times (two channels, one refused)
+    // and the ROM's /1X once.
+    let row = |key: &str| {
+        report
+            .lines()
+            .find(|line| line.starts_with(key))
+            .unwrap_or_else(|| panic!("no `{key}` row in:\n{report}"))
+            .to_owned()
+    };
+    let a = row("/2A ");
+    let fields: Vec<&str> = a.split_whitespace().collect();
+    assert_eq!(fields[1], "3", "three /2A runs: {a}");
+    assert!(a.contains("adc.expect:"), "the worst run's line: {a}");
+    assert!(row("/1X ").split_whitespace().nth(1) == Some("1"));
+    assert!(
+        report.contains("one character at 9600 baud: 1041 cycles"),
+        "{report}"
+    );
+    // The ROM's services the handler calls are routines; IRQ a root.
+    for routine in ["PUTCH", "PUTHEX", "IRQ", "main"] {
+        assert!(
+            report.lines().any(|l| l.starts_with(routine)),
+            "no {routine} in:\n{report}"
+        );
+    }
+    // The busy wait on the card's status (`@wait: bit ADC_STATUS`, 15
+    // laps a conversion) is the hottest line of adc.s.
+    let hot = report
+        .lines()
+        .find(|line| line.starts_with("adc.s:"))
+        .unwrap_or_else(|| panic!("no adc.s line in:\n{report}"));
+    assert!(hot.starts_with("adc.s:42 "), "{hot}");
+    let runs: u64 = hot
+        .split_whitespace()
+        .nth(1)
+        .and_then(|n| n.parse().ok())
+        .expect("runs");
+    assert_eq!(runs % 2, 0, "two conversions, the same laps each: {hot}");
+    // The stacks: a command's frame under the loop, its calls under it.
+    assert!(
+        folded.lines().any(|l| l.starts_with("main;/2A0;PUTHEX")),
+        "{folded}"
+    );
+    assert!(folded.lines().any(|l| l.starts_with("IRQ")), "{folded}");
+    let total: u64 = folded
+        .lines()
+        .map(|l| {
+            l.rsplit(' ')
+                .next()
+                .and_then(|n| n.parse::<u64>().ok())
+                .expect("a count")
+        })
+        .sum();
+    assert!(
+        report.starts_with(&format!("{total} cycles of robot time profiled")),
+        "{report}"
+    );
+    assert!(svg.starts_with("<?xml") && svg.contains("<svg"), "an SVG");
+    assert!(
+        svg.contains("/2A0") && svg.contains("PUTHEX"),
+        "the flame graph names the stacks"
+    );
+}
+
+#[test]
+fn the_patrol_operating_system_profiled() {
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let (report, folded, svg) = profile("patrol", out.path());
+    assert!(report.contains("/2A "), "{report}");
+    assert!(folded.contains("main;/2A1"), "{folded}");
+    assert!(svg.contains("<svg"));
+}
+
+#[test]
+fn a_workspace_is_profiled_member_by_member() {
+    let output = scorpion(&example(""), &["profile"]);
+    assert!(!output.status.success());
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("members run on robots of their own"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+/// Copies the directory `from` into `to` (an example, so that its tests
+/// write into a temporary directory, not the repository).
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for entry in std::fs::read_dir(from).expect("the example").flatten() {
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            if entry.file_name() != "target" {
+                copy_dir(&entry.path(), &target);
+            }
+        } else {
+            std::fs::copy(entry.path(), &target).expect("a copy");
+        }
+    }
+}
+
+/// The 1-based numbers of the lines of `text` that contain `what`.
+fn lines_with(text: &str, what: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| line.contains(what))
+        .map(|(index, _)| index + 1)
+        .collect()
+}
+
+fn stdout(output: &std::process::Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// A new project's transcript sends only `/1V`: its handler's two
+/// `bne not_mine` are never taken, and coverage says so, line by line,
+/// in the summary, the LCOV file and the HTML page. Two more transcript
+/// lines (a `/2V0` and a `/1W`, neither the extension's) take both, and
+/// coverage is whole.
+#[test]
+fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let created = scorpion(dir.path(), &["new", "myext"]);
+    assert!(created.status.success(), "{}", transcript(&created));
+    let project = dir.path().join("myext");
+    let source = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let branches = lines_with(&source, "bne not_mine");
+    assert_eq!(branches.len(), 2, "{source}");
+
+    let first = scorpion(&project, &["test", "--coverage"]);
+    assert!(first.status.success(), "{}", transcript(&first));
+    let text = stdout(&first);
+    for line in &branches {
+        assert!(
+            text.contains(&format!("  branch never taken: src/myext.s:{line}\n")),
+            "{text}"
+        );
+    }
+    assert!(!text.contains("never run:"), "/1V runs every line: {text}");
+    assert!(text.contains("branches (50.0%)"), "{text}");
+    let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
+        .expect("lcov.info");
+    let sf = project.join("src/myext.s");
+    assert!(lcov.contains(&format!("SF:{}\n", sf.display())), "{lcov}");
+    for line in &branches {
+        assert!(
+            lcov.contains(&format!("BRDA:{line},0,0,0\n")),
+            "never taken: {lcov}"
+        );
+        assert!(
+            lcov.contains(&format!("BRDA:{line},0,1,1\n")),
+            "not taken once: {lcov}"
+        );
+        assert!(lcov.contains(&format!("DA:{line},1\n")), "{lcov}");
+    }
+    assert!(
+        lcov.contains("BRF:4\nBRH:2\n") && lcov.ends_with("end_of_record\n"),
+        "{lcov}"
+    );
+    let html = std::fs::read_to_string(project.join("target/scorpion/coverage/index.html"))
+        .expect("index.html");
+    assert!(
+        html.contains("never taken") && html.contains("cmp #'V'"),
+        "the page shows the source and the branch: {html}"
+    );
+
+    // genhtml, the LCOV tool, reads the file.
+    if let Some(genhtml) = scorpion_tests::tools::require(
+        "genhtml",
+        "a_branch_never_taken_is_named_until_a_transcript_takes_it",
+    ) {
+        let out = dir.path().join("genhtml");
+        let read = std::process::Command::new(genhtml)
+            .args(["--branch-coverage", "--output-directory"])
+            .arg(&out)
+            .arg(project.join("target/scorpion/coverage/lcov.info"))
+            .output()
+            .expect("genhtml runs");
+        assert!(read.status.success(), "{}", transcript(&read));
+        assert!(out.join("index.html").is_file());
+    }
+
+    let expect = project.join("tests/myext.expect");
+    let mut transcript_text = std::fs::read_to_string(&expect).expect("the transcript");
+    transcript_text.push_str("/2V0 => nothing           # not /1V: on down the chain\n");
+    transcript_text.push_str("/1W => nothing            # not V either\n");
+    std::fs::write(&expect, transcript_text).expect("write");
+    let second = scorpion(&project, &["test", "--coverage"]);
+    assert!(second.status.success(), "{}", transcript(&second));
+    let text = stdout(&second);
+    assert!(
+        text.contains("lines (100.0%), 4 of 4 branches (100.0%)"),
+        "{text}"
+    );
+    assert!(!text.contains("branch never taken"), "{text}");
+}
+
+/// The examples' projects covered: each one's LCOV names its source with
+/// lines run, and its HTML page shows the source.
+#[test]
+fn the_examples_projects_covered() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for (name, source) in [
+        ("adc", "adc.s"),
+        ("patrol", "patrol.s"),
+        ("checksum", "checksum.s"),
+    ] {
+        let project = dir.path().join(name);
+        copy_dir(&example(name), &project);
+        let output = scorpion(&project, &["test", "--coverage"]);
+        assert!(output.status.success(), "{}", transcript(&output));
+        assert!(
+            stdout(&output).contains("coverage: "),
+            "{}",
+            transcript(&output)
+        );
+        let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
+            .expect("lcov.info");
+        assert!(
+            lcov.contains(&format!("SF:{}\n", project.join(source).display())),
+            "{lcov}"
+        );
+        let hit: usize = lcov
+            .lines()
+            .find_map(|l| l.strip_prefix("LH:"))
+            .and_then(|n| n.parse().ok())
+            .expect("LH");
+        assert!(hit > 0, "{name}: no line run:\n{lcov}");
+        let html = std::fs::read_to_string(project.join("target/scorpion/coverage/index.html"))
+            .expect("index.html");
+        assert!(
+            html.contains(source) && html.contains("class=\"run\""),
+            "{name}"
+        );
+    }
+}
+
+/// A budget in the project file fails the test run when a command goes
+/// over it, naming the transcript line and the stack; a generous one
+/// passes.
+#[test]
+fn a_command_over_its_budget_fails_the_tests() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = dir.path().join("adc");
+    copy_dir(&example("adc"), &project);
+    let file = project.join("Scorpion.toml");
+    let original = std::fs::read_to_string(&file).expect("the project file");
+    std::fs::write(
+        &file,
+        format!("{original}\n[budgets]\n\"/2A\" = 100\nPUTHEX = 100000\n"),
+    )
+    .expect("write");
+    let over = scorpion(&project, &["test"]);
+    assert!(!over.status.success(), "{}", transcript(&over));
+    let text = stdout(&over);
+    assert!(text.contains("test budget /2A ... FAILED"), "{text}");
+    assert!(
+        text.contains("over its budget of 100 at adc.expect:"),
+        "{text}"
+    );
+    assert!(text.contains("(stack: main;/2A"), "{text}");
+    assert!(text.contains("test budget PUTHEX ... ok"), "{text}");
+
+    std::fs::write(&file, format!("{original}\n[budgets]\n\"/2A\" = 100000\n")).expect("write");
+    let within = scorpion(&project, &["test"]);
+    assert!(within.status.success(), "{}", transcript(&within));
+    assert!(stdout(&within).contains("test budget /2A ... ok"));
+}
+
+/// README's profiling section, run as written: every line its output
+/// block shows comes out, and the flame graph and the coverage report are
+/// there with what they show.
+#[test]
+fn the_readmes_profiling_section_runs_as_written() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let heading = "## Where the cycles go";
+    let script = crate::readme_block(heading, "sh");
+    let output = std::process::Command::new("sh")
+        .arg("-e")
+        .arg("-c")
+        .arg(format!("exec 2>&1\n{script}"))
+        .current_dir(dir.path())
+        .env("PATH", crate::path_with_scorpion())
+        .env("NO_COLOR", "1")
+        .env_remove("SCORPION_PORT")
+        .env_remove("SCORPION_BAUD")
+        .output()
+        .expect("sh runs");
+    assert!(output.status.success(), "{}", transcript(&output));
+    let text = stdout(&output);
+    for line in crate::readme_block(heading, "text").lines() {
+        assert!(
+            text.contains(line),
+            "README.md's profiling section is stale: `{line}` is not in\n{text}"
+        );
+    }
+    let project = dir.path().join("myext");
+    let svg = std::fs::read_to_string(project.join("target/scorpion/flamegraph.svg"))
+        .expect("the flame graph");
+    assert!(
+        svg.contains("<svg") && svg.contains("/1V"),
+        "the command's box"
+    );
+    let folded = std::fs::read_to_string(project.join("target/scorpion/profile.folded"))
+        .expect("the folded stacks");
+    assert!(
+        folded.lines().any(|l| l.starts_with("main;/1V;PUTHEX")),
+        "{folded}"
+    );
+    let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
+        .expect("lcov.info");
+    assert!(lcov.contains("myext.s") && lcov.contains("BRDA:"), "{lcov}");
+    let html = std::fs::read_to_string(project.join("target/scorpion/coverage/index.html"))
+        .expect("index.html");
+    assert!(html.contains("jsr PUTCH"), "the page shows the source");
+}
