@@ -293,7 +293,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         filter: args.filter.clone().filter(|f| !f.is_empty()),
         mode: Mode::Fail,
         port: None,
-        environment: Environment::from_process(),
+        replace: false,
+        environment: Environment::from_process()?,
     };
     let report = runner::run_tests(&found, &options, &mut Quiet { watch: &mut watch })?;
     let mut out = std::io::stdout().lock();
