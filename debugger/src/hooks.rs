@@ -119,6 +119,14 @@ impl WatchBus<'_> {
 }
 
 impl Bus for WatchBus<'_> {
+    // The instruction stream is not the program reading data: a read
+    // watch stops at a load from its bytes, not at running code there
+    // (and the opcode fetch, every instruction's, costs no test).
+    #[inline(always)]
+    fn fetch(&mut self, address: u16, cycle: u64) -> u8 {
+        self.board.fetch(address, cycle)
+    }
+
     #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
         let value = self.board.read(address, cycle);
@@ -212,11 +220,14 @@ pub(crate) enum LeanStop {
 }
 
 /// The hooks of a run that only breakpoints, watchpoints (with `WATCH`)
-/// and a count can stop: a bit test of the PC and a comparison of the
-/// count per instruction (and a look at the bus's note, with `WATCH`),
-/// nothing else. A run to a breakpoint, a step back's re-run, a search
-/// for a hit all run here; `next`, `finish` and tracing use [`Look`].
-pub(crate) struct Lean<'a, const WATCH: bool> {
+/// and a count (with `COUNT`) can stop: a bit test of the PC per
+/// instruction (and a comparison of the count, with `COUNT`, and a look
+/// at the bus's note, with `WATCH`), nothing else. A run to a breakpoint,
+/// a step back's re-run, a search for a hit all run here; `next`,
+/// `finish` and tracing use [`Look`]. A run with no count to stop at
+/// (`continue`) makes no comparison: its idle skip and its end are bound
+/// by the cycle the run is given.
+pub(crate) struct Lean<'a, const WATCH: bool, const COUNT: bool> {
     /// Every PC a breakpoint may stop at.
     pub(crate) places: &'a Breakpoints,
     /// The count of the run's first instruction: a breakpoint there is
@@ -230,19 +241,22 @@ pub(crate) struct Lean<'a, const WATCH: bool> {
     pub(crate) last_pc: u16,
     /// Why it stopped.
     pub(crate) stopped: Option<LeanStop>,
+    /// No breakpoint counts its hits or logs: an idle loop may be skipped.
+    pub(crate) skip_idle: bool,
 }
 
-impl<const WATCH: bool> Hooks for Lean<'_, WATCH> {
+impl<const WATCH: bool, const COUNT: bool> Hooks for Lean<'_, WATCH, COUNT> {
     // Every answer comes from the PC, memory and the bus's note, except
-    // the count, which bounds the skip.
+    // the count, which bounds the skip, and a breakpoint's hits, which
+    // forbid it.
     #[inline(always)]
     fn may_skip_idle(&self) -> bool {
-        true
+        self.skip_idle
     }
 
     #[inline(always)]
     fn instruction_bound(&self) -> u64 {
-        self.stop_at
+        if COUNT { self.stop_at } else { u64::MAX }
     }
 
     #[inline(always)]
@@ -258,7 +272,7 @@ impl<const WATCH: bool> Hooks for Lean<'_, WATCH> {
             }
             self.last_pc = cpu.pc;
         }
-        if cpu.instructions() >= self.stop_at {
+        if COUNT && cpu.instructions() >= self.stop_at {
             self.stopped = Some(LeanStop::Count);
             return Control::Stop;
         }
@@ -295,16 +309,18 @@ pub(crate) struct Look<'a, M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> {
     pub(crate) last_pc: u16,
     /// What was found.
     pub(crate) found: Option<Found>,
+    /// No breakpoint counts its hits or logs: an idle loop may be skipped.
+    pub(crate) skip_idle: bool,
 }
 
 impl<M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> Hooks for Look<'_, M> {
     // Every answer comes from the PC, S, memory and the watch the bus
     // noted (all the same on every lap of an idle loop), except the count
     // to stop at, which bounds the skip. A point with a count of its own
-    // (a hit count) would have to say no here.
+    // (a hit count, a log point) says no here.
     #[inline(always)]
     fn may_skip_idle(&self) -> bool {
-        true
+        self.skip_idle
     }
 
     #[inline(always)]
