@@ -108,18 +108,20 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let (make, images, root) = recipe(args, &here)?;
     let mut debugger = Debugger::new(make, &images)?;
     let terminal = std::io::stdin().is_terminal();
+    let completion = completion_words(&debugger, &images);
+    let mut input = Input::new(terminal, completion, prompt::history_file(&root));
     let interrupt = Arc::new(AtomicBool::new(false));
-    if terminal {
+    if input.is_terminal() {
         // Ctrl-C while the robot runs pauses it (the run looks at the flag
         // between slices); at the prompt rustyline reads it as a key.
+        // Registered after the editor is made, which sets a SIGINT handler
+        // of its own: signal-hook's runs first, then calls rustyline's.
         signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&interrupt))
             .into_diagnostic()?;
         debugger.set_interrupt(Arc::clone(&interrupt));
     }
-    let completion = completion_words(&debugger, &images);
-    let mut input = Input::new(terminal, completion, prompt::history_file(&root));
     let mut monitor = Monitor::new(Sources::new(root));
-    monitor.pausable = terminal;
+    monitor.pausable = input.is_terminal();
     let mut out = std::io::stdout().lock();
     writeln!(
         out,

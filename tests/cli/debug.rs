@@ -206,7 +206,7 @@ fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
     for (command, reply) in script.lines().zip(&replies[1..]) {
         let reply = reply.strip_prefix(command).unwrap_or(reply);
         let expected = match command {
-            "mem $FFF8 24" => "\nFFF8: FF FF 3B F6 00 F0 3C F6 ",
+            "mem $FFF8 24" => "\n$FFF8: FF FF 3B F6 00 F0 3C F6 ",
             "regs" => "\nPC=",
             "list adc.s:4294967295" => "adc.s has no line 4294967295",
             _ if command.contains(" -") => " is a number of ",
@@ -215,8 +215,8 @@ fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
         };
         assert!(reply.contains(expected), "{command}: {reply}");
     }
-    assert!(text.contains("\n0000: 00 00"), "{text}");
-    assert!(!text.contains("\n10000:"), "{text}");
+    assert!(text.contains("\n$0000: 00 00"), "{text}");
+    assert!(!text.contains("\n$10000:"), "{text}");
     let regs: Vec<&str> = text.lines().filter(|l| l.starts_with("PC=")).collect();
     assert_eq!(regs.len(), 2, "{text}");
     assert_eq!(regs[0], regs[1], "nothing ran: {text}");
