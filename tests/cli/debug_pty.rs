@@ -11,9 +11,13 @@ use std::time::{Duration, Instant};
 
 use scorpion_tests::tools;
 
+const PROMPT: &str = "(scorpion) ";
+
 /// A tmux server of this test's own, killed when dropped.
 struct Tmux {
     socket: String,
+    /// The session typed into and read.
+    target: std::cell::RefCell<String>,
 }
 
 impl Tmux {
@@ -28,7 +32,15 @@ impl Tmux {
 
     /// Everything the pane has shown (its scrollback too).
     fn screen(&self) -> String {
-        self.run(&["capture-pane", "-p", "-J", "-S", "-", "-t", "monitor"])
+        self.run(&[
+            "capture-pane",
+            "-p",
+            "-J",
+            "-S",
+            "-",
+            "-t",
+            &self.target.borrow(),
+        ])
     }
 
     /// Waits until `wanted` shows `times` times in all (or 20 s pass,
@@ -48,16 +60,25 @@ impl Tmux {
         }
     }
 
-    /// Types `keys` literally, then Enter.
+    /// Types `keys` literally, then Enter, and waits for the next prompt
+    /// (keys typed while a command runs could be lost when the editor
+    /// takes the terminal back).
     fn type_line(&self, keys: &str) {
+        let prompts = self.screen().matches(PROMPT).count();
+        self.type_only(keys);
+        self.wait_for(PROMPT, prompts + 1);
+    }
+
+    /// Types `keys` literally, then Enter.
+    fn type_only(&self, keys: &str) {
         if !keys.is_empty() {
-            self.run(&["send-keys", "-t", "monitor", "-l", keys]);
+            self.run(&["send-keys", "-t", &self.target.borrow(), "-l", keys]);
         }
-        self.run(&["send-keys", "-t", "monitor", "Enter"]);
+        self.run(&["send-keys", "-t", &self.target.borrow(), "Enter"]);
     }
 
     fn key(&self, key: &str) {
-        self.run(&["send-keys", "-t", "monitor", key]);
+        self.run(&["send-keys", "-t", &self.target.borrow(), key]);
     }
 
     /// Starts `scorpion debug` in `dir` in a new session's window.
@@ -71,14 +92,20 @@ impl Tmux {
             "new-session",
             "-d",
             "-s",
-            "monitor",
+            &self.target.borrow(),
             "-x",
             "250",
             "-y",
             "50",
             &command,
         ]);
-        self.run(&["set-option", "-t", "monitor", "history-limit", "10000"]);
+        self.run(&[
+            "set-option",
+            "-t",
+            &self.target.borrow(),
+            "history-limit",
+            "10000",
+        ]);
     }
 }
 
@@ -108,6 +135,7 @@ fn a_monitor_session_at_a_terminal() {
     let project = adc_project();
     let tmux = Tmux {
         socket: format!("scorpion-debug-{}", std::process::id()),
+        target: std::cell::RefCell::new("monitor".to_owned()),
     };
     tmux.start(project.path());
     tmux.wait_for("(scorpion) ", 1);
@@ -160,7 +188,7 @@ fn a_monitor_session_at_a_terminal() {
     tmux.type_line("print A + 1");
     tmux.wait_for("A + 1 = $", 1);
     // Ctrl-C during a continue of an hour of robot time pauses it.
-    tmux.type_line("continue 3600000000");
+    tmux.type_only("continue 3600000000");
     std::thread::sleep(Duration::from_millis(700));
     tmux.key("C-c");
     let screen = tmux.wait_for("paused (Ctrl-C): ", 1);
@@ -168,14 +196,25 @@ fn a_monitor_session_at_a_terminal() {
     assert!(!after.contains("still running"), "{screen}");
     tmux.type_line("regs");
     tmux.wait_for("\nPC=$", 3);
-    tmux.type_line("quit");
+    tmux.type_only("quit");
 
     // The next session in this project remembers: Up, Up is the long
     // continue.
+    // The file is written again after each line: read it once `quit` is
+    // in it.
     let history = project.path().join("target/debug-history");
-    let kept = std::fs::read_to_string(&history).expect("the project's history file");
+    let start = Instant::now();
+    let kept = loop {
+        let kept = std::fs::read_to_string(&history).unwrap_or_default();
+        if kept.contains("quit") || start.elapsed() > Duration::from_secs(10) {
+            break kept;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
     assert!(kept.contains("continue 3600000000"), "{kept}");
-    tmux.run(&["kill-session", "-t", "monitor"]);
+    // A second session beside the first (whose window waits), so that
+    // the tmux server stays up.
+    tmux.target.replace("again".to_owned());
     tmux.start(project.path());
     tmux.wait_for("(scorpion) ", 1);
     tmux.key("Up");
