@@ -150,10 +150,11 @@ mod tests {
             got,
             [
                 ("if", "A == 1 && [CMDBUF] == $2F", 18),
-                ("hits", "3", 50),
-                ("log", "A={A} if", 56),
+                ("hits", "3", 49),
+                ("log", "A={A} if", 55),
             ]
         );
         assert_eq!(&line[18..19], "A");
+        assert_eq!(&line[49..50], "3");
     }
 }
