@@ -28,22 +28,50 @@ pub(crate) struct Watched {
     reads: Breakpoints,
     /// Addresses some watch stops writes of.
     writes: Breakpoints,
+    /// The blocks of `reads` ([`block`]).
+    read_blocks: u64,
+    /// The blocks of `writes`.
+    write_blocks: u64,
+}
+
+/// The 1 KiB block of `address`, as a bit of a block mask: a mask of the
+/// blocks that hold a marked address is tested (in a register) before the
+/// bitmap itself, so that an address far from every point costs a shift
+/// and a test, no load.
+#[inline(always)]
+pub(crate) fn block(address: u16) -> u64 {
+    1 << (address >> 10)
+}
+
+/// Whether `address`'s block is in `blocks`.
+#[inline(always)]
+pub(crate) fn in_blocks(blocks: u64, address: u16) -> bool {
+    blocks & (1 << (address >> 10)) != 0
 }
 
 impl Watched {
+    /// The blocks of the addresses watched for reads, and for writes.
+    pub(crate) fn blocks(&self) -> (u64, u64) {
+        (self.read_blocks, self.write_blocks)
+    }
+
     /// The tables of `watches`.
     pub(crate) fn new(watches: &[Option<Watch>]) -> Watched {
         let mut table = Watched {
             reads: Breakpoints::new(),
             writes: Breakpoints::new(),
+            read_blocks: 0,
+            write_blocks: 0,
         };
         for watch in watches.iter().flatten() {
             for address in watch.start..=watch.end {
                 if watch.kind.covers(false) {
                     table.reads.insert(address);
+                    table.read_blocks |= block(address);
                 }
                 if watch.kind.covers(true) {
                     table.writes.insert(address);
+                    table.write_blocks |= block(address);
                 }
             }
         }
@@ -75,24 +103,24 @@ pub(crate) struct WatchBus<'a> {
     pub(crate) watches: &'a [Option<Watch>],
     /// Where they are: only an access the tables mark looks further.
     pub(crate) watched: &'a Watched,
-    /// Some watch covers reads (else reads are not looked at).
-    pub(crate) reads: bool,
-    /// Some watch covers writes.
-    pub(crate) writes: bool,
     pub(crate) hit: &'a Cell<Option<Access>>,
+    /// The blocks holding an address watched for reads ([`blocks`]).
+    pub(crate) read_blocks: u64,
+    /// The blocks holding an address watched for writes.
+    pub(crate) write_blocks: u64,
 }
 
 impl WatchBus<'_> {
     #[inline(always)]
     fn read_seen(&self, address: u16, value: u8) {
-        if self.reads && self.watched.reads.contains(address) {
+        if in_blocks(self.read_blocks, address) && self.watched.reads.contains(address) {
             self.note(address, value, false);
         }
     }
 
     #[inline(always)]
     fn write_seen(&self, address: u16, value: u8) {
-        if self.writes && self.watched.writes.contains(address) {
+        if in_blocks(self.write_blocks, address) && self.watched.writes.contains(address) {
             self.note(address, value, true);
         }
     }
@@ -230,6 +258,8 @@ pub(crate) enum LeanStop {
 pub(crate) struct Lean<'a, const WATCH: bool, const COUNT: bool> {
     /// Every PC a breakpoint may stop at.
     pub(crate) places: &'a Breakpoints,
+    /// The blocks that hold one ([`blocks`]): tested first.
+    pub(crate) place_blocks: u64,
     /// The count of the run's first instruction: a breakpoint there is
     /// where the last stop was, so it does not stop again.
     pub(crate) start: u64,
@@ -276,7 +306,10 @@ impl<const WATCH: bool, const COUNT: bool> Hooks for Lean<'_, WATCH, COUNT> {
             self.stopped = Some(LeanStop::Count);
             return Control::Stop;
         }
-        if self.places.contains(cpu.pc) && cpu.instructions() != self.start {
+        if in_blocks(self.place_blocks, cpu.pc)
+            && self.places.contains(cpu.pc)
+            && cpu.instructions() != self.start
+        {
             self.stopped = Some(LeanStop::Place);
             return Control::Stop;
         }

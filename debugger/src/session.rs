@@ -1096,14 +1096,15 @@ fn run_hooked(
         return Ok(None);
     }
     let mut places = emulator::Breakpoints::new();
+    let mut place_blocks = 0;
     for point in points.breakpoints.iter().flatten() {
-        match point {
-            Breakpoint::At(address) => places.insert(*address),
-            Breakpoint::UnknownHook => places.insert(points.arrival.unknown),
-            Breakpoint::Command { .. } => {
-                places.insert(points.arrival.dispatch.unwrap_or(points.arrival.unknown))
-            }
+        let at = match point {
+            Breakpoint::At(address) => *address,
+            Breakpoint::UnknownHook => points.arrival.unknown,
+            Breakpoint::Command { .. } => points.arrival.dispatch.unwrap_or(points.arrival.unknown),
         };
+        places.insert(at);
+        place_blocks |= crate::hooks::block(at);
     }
     let hit = Cell::new(None);
     let watched = Watched::new(points.watches);
@@ -1114,7 +1115,7 @@ fn run_hooked(
             until,
             goal.at_count,
             first,
-            &places,
+            (&places, place_blocks),
             &watched,
         );
     }
@@ -1131,16 +1132,16 @@ fn run_hooked(
         found: None,
         skip_idle: !points.counting(),
     };
-    let (reads, writes) = watched.kinds();
+    let (read_blocks, write_blocks) = watched.blocks();
     let mut trace = trace;
     robot.run_until_with(until, |robot, to| {
         let mut bus = WatchBus {
             board: &mut robot.bus,
             watches: points.watches,
             watched: &watched,
-            reads,
-            writes,
             hit: &hit,
+            read_blocks,
+            write_blocks,
         };
         match trace.as_deref_mut() {
             Some(tracer) => robot.cpu.run(&mut bus, to, &mut (&mut look, tracer)),
@@ -1170,7 +1171,7 @@ fn run_lean(
     until: u64,
     at_count: Option<u64>,
     first: bool,
-    places: &emulator::Breakpoints,
+    (places, place_blocks): (&emulator::Breakpoints, u64),
     watched: &Watched,
 ) -> Result<Option<Found>, Error> {
     let (reads, writes) = watched.kinds();
@@ -1186,6 +1187,7 @@ fn run_lean(
         until,
         stop_at,
         places,
+        place_blocks,
         watched,
         skip_idle,
     };
@@ -1221,6 +1223,7 @@ struct Leaning<'a> {
     until: u64,
     stop_at: u64,
     places: &'a emulator::Breakpoints,
+    place_blocks: u64,
     watched: &'a Watched,
     skip_idle: bool,
 }
@@ -1235,6 +1238,7 @@ impl Leaning<'_> {
         let hit = Cell::new(None);
         let mut lean = Lean::<WATCH, COUNT> {
             places: self.places,
+            place_blocks: self.place_blocks,
             start,
             stop_at: self.stop_at,
             hit: &hit,
@@ -1248,15 +1252,15 @@ impl Leaning<'_> {
             })?;
             return Ok(lean.stopped);
         }
-        let (reads, writes) = self.watched.kinds();
+        let (read_blocks, write_blocks) = self.watched.blocks();
         robot.run_until_with(self.until, |robot, to| {
             let mut bus = WatchBus {
                 board: &mut robot.bus,
                 watches: self.points.watches,
                 watched: self.watched,
-                reads,
-                writes,
                 hit: &hit,
+                read_blocks,
+                write_blocks,
             };
             robot.cpu.run(&mut bus, to, &mut lean)
         })?;
