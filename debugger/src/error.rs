@@ -69,4 +69,36 @@ pub enum Error {
         /// The write's error.
         message: String,
     },
+    /// A value a register or flag does not hold.
+    #[error("{what} holds 0 to {max}, not {value}")]
+    #[diagnostic(code(debugger::value))]
+    Value {
+        /// The register or flag.
+        what: String,
+        /// The value given.
+        value: i64,
+        /// The largest it holds.
+        max: u16,
+    },
+    /// Bytes to write that would land outside RAM.
+    #[error(
+        "${address:04X} is not RAM: only RAM can be written (not the ROM, the I/O page or a card's registers)"
+    )]
+    #[diagnostic(code(debugger::not_ram))]
+    NotRam {
+        /// The first address that is not RAM.
+        address: u16,
+    },
+    /// An expression that does not parse.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Parse(#[from] crate::expr::ParseError),
+    /// An expression that cannot be evaluated.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Eval(#[from] crate::expr::EvalError),
+    /// A hit count that does not read.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Hits(#[from] crate::points::HitsError),
 }

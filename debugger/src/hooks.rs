@@ -28,22 +28,50 @@ pub(crate) struct Watched {
     reads: Breakpoints,
     /// Addresses some watch stops writes of.
     writes: Breakpoints,
+    /// The blocks of `reads` ([`block`]).
+    read_blocks: u64,
+    /// The blocks of `writes`.
+    write_blocks: u64,
+}
+
+/// The 1 KiB block of `address`, as a bit of a block mask: a mask of the
+/// blocks that hold a marked address is tested (in a register) before the
+/// bitmap itself, so that an address far from every point costs a shift
+/// and a test, no load.
+#[inline(always)]
+pub(crate) fn block(address: u16) -> u64 {
+    1 << (address >> 10)
+}
+
+/// Whether `address`'s block is in `blocks`.
+#[inline(always)]
+pub(crate) fn in_blocks(blocks: u64, address: u16) -> bool {
+    blocks & (1 << (address >> 10)) != 0
 }
 
 impl Watched {
+    /// The blocks of the addresses watched for reads, and for writes.
+    pub(crate) fn blocks(&self) -> (u64, u64) {
+        (self.read_blocks, self.write_blocks)
+    }
+
     /// The tables of `watches`.
     pub(crate) fn new(watches: &[Option<Watch>]) -> Watched {
         let mut table = Watched {
             reads: Breakpoints::new(),
             writes: Breakpoints::new(),
+            read_blocks: 0,
+            write_blocks: 0,
         };
         for watch in watches.iter().flatten() {
             for address in watch.start..=watch.end {
                 if watch.kind.covers(false) {
                     table.reads.insert(address);
+                    table.read_blocks |= block(address);
                 }
                 if watch.kind.covers(true) {
                     table.writes.insert(address);
+                    table.write_blocks |= block(address);
                 }
             }
         }
@@ -75,24 +103,24 @@ pub(crate) struct WatchBus<'a> {
     pub(crate) watches: &'a [Option<Watch>],
     /// Where they are: only an access the tables mark looks further.
     pub(crate) watched: &'a Watched,
-    /// Some watch covers reads (else reads are not looked at).
-    pub(crate) reads: bool,
-    /// Some watch covers writes.
-    pub(crate) writes: bool,
     pub(crate) hit: &'a Cell<Option<Access>>,
+    /// The blocks holding an address watched for reads ([`blocks`]).
+    pub(crate) read_blocks: u64,
+    /// The blocks holding an address watched for writes.
+    pub(crate) write_blocks: u64,
 }
 
 impl WatchBus<'_> {
     #[inline(always)]
     fn read_seen(&self, address: u16, value: u8) {
-        if self.reads && self.watched.reads.contains(address) {
+        if in_blocks(self.read_blocks, address) && self.watched.reads.contains(address) {
             self.note(address, value, false);
         }
     }
 
     #[inline(always)]
     fn write_seen(&self, address: u16, value: u8) {
-        if self.writes && self.watched.writes.contains(address) {
+        if in_blocks(self.write_blocks, address) && self.watched.writes.contains(address) {
             self.note(address, value, true);
         }
     }
@@ -119,6 +147,14 @@ impl WatchBus<'_> {
 }
 
 impl Bus for WatchBus<'_> {
+    // The instruction stream is not the program reading data: a read
+    // watch stops at a load from its bytes, not at running code there
+    // (and the opcode fetch, every instruction's, costs no test).
+    #[inline(always)]
+    fn fetch(&mut self, address: u16, cycle: u64) -> u8 {
+        self.board.fetch(address, cycle)
+    }
+
     #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
         let value = self.board.read(address, cycle);
@@ -212,13 +248,18 @@ pub(crate) enum LeanStop {
 }
 
 /// The hooks of a run that only breakpoints, watchpoints (with `WATCH`)
-/// and a count can stop: a bit test of the PC and a comparison of the
-/// count per instruction (and a look at the bus's note, with `WATCH`),
-/// nothing else. A run to a breakpoint, a step back's re-run, a search
-/// for a hit all run here; `next`, `finish` and tracing use [`Look`].
-pub(crate) struct Lean<'a, const WATCH: bool> {
+/// and a count (with `COUNT`) can stop: a bit test of the PC per
+/// instruction (and a comparison of the count, with `COUNT`, and a look
+/// at the bus's note, with `WATCH`), nothing else. A run to a breakpoint,
+/// a step back's re-run, a search for a hit all run here; `next`,
+/// `finish` and tracing use [`Look`]. A run with no count to stop at
+/// (`continue`) makes no comparison: its idle skip and its end are bound
+/// by the cycle the run is given.
+pub(crate) struct Lean<'a, const WATCH: bool, const COUNT: bool> {
     /// Every PC a breakpoint may stop at.
     pub(crate) places: &'a Breakpoints,
+    /// The blocks that hold one ([`blocks`]): tested first.
+    pub(crate) place_blocks: u64,
     /// The count of the run's first instruction: a breakpoint there is
     /// where the last stop was, so it does not stop again.
     pub(crate) start: u64,
@@ -230,19 +271,22 @@ pub(crate) struct Lean<'a, const WATCH: bool> {
     pub(crate) last_pc: u16,
     /// Why it stopped.
     pub(crate) stopped: Option<LeanStop>,
+    /// No breakpoint counts its hits or logs: an idle loop may be skipped.
+    pub(crate) skip_idle: bool,
 }
 
-impl<const WATCH: bool> Hooks for Lean<'_, WATCH> {
+impl<const WATCH: bool, const COUNT: bool> Hooks for Lean<'_, WATCH, COUNT> {
     // Every answer comes from the PC, memory and the bus's note, except
-    // the count, which bounds the skip.
+    // the count, which bounds the skip, and a breakpoint's hits, which
+    // forbid it.
     #[inline(always)]
     fn may_skip_idle(&self) -> bool {
-        true
+        self.skip_idle
     }
 
     #[inline(always)]
     fn instruction_bound(&self) -> u64 {
-        self.stop_at
+        if COUNT { self.stop_at } else { u64::MAX }
     }
 
     #[inline(always)]
@@ -258,11 +302,14 @@ impl<const WATCH: bool> Hooks for Lean<'_, WATCH> {
             }
             self.last_pc = cpu.pc;
         }
-        if cpu.instructions() >= self.stop_at {
+        if COUNT && cpu.instructions() >= self.stop_at {
             self.stopped = Some(LeanStop::Count);
             return Control::Stop;
         }
-        if self.places.contains(cpu.pc) && cpu.instructions() != self.start {
+        if in_blocks(self.place_blocks, cpu.pc)
+            && self.places.contains(cpu.pc)
+            && cpu.instructions() != self.start
+        {
             self.stopped = Some(LeanStop::Place);
             return Control::Stop;
         }
@@ -295,16 +342,18 @@ pub(crate) struct Look<'a, M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> {
     pub(crate) last_pc: u16,
     /// What was found.
     pub(crate) found: Option<Found>,
+    /// No breakpoint counts its hits or logs: an idle loop may be skipped.
+    pub(crate) skip_idle: bool,
 }
 
 impl<M: Fn(&Cpu, &dyn Fn(u16) -> u8) -> Option<usize>> Hooks for Look<'_, M> {
     // Every answer comes from the PC, S, memory and the watch the bus
     // noted (all the same on every lap of an idle loop), except the count
     // to stop at, which bounds the skip. A point with a count of its own
-    // (a hit count) would have to say no here.
+    // (a hit count, a log point) says no here.
     #[inline(always)]
     fn may_skip_idle(&self) -> bool {
-        true
+        self.skip_idle
     }
 
     #[inline(always)]

@@ -11,6 +11,9 @@
 //! - [`hooks`]: the CPU hooks and the watching bus that find them;
 //! - [`symbols`]: labels for addresses, addresses for expressions
 //!   (`CMDBUF+1`, `handler`, `$8001`);
+//! - [`expr`]: the expression language of conditions, log points, `set`
+//!   and `display` (`A == 1 && [CMDBUF] == $2F`), shared by the monitor
+//!   and the DAP server;
 //! - [`session`]: run, step, next (over `JSR`), finish (to the `RTS`),
 //!   and back in time;
 //! - [`checkpoints`]: copies of the robot taken as it runs, to go back
@@ -38,7 +41,8 @@
 //! # What points cost
 //!
 //! Breakpoints are a bitmap of the PCs where one may stop, tested once per
-//! instruction; watchpoints a bitmap of the addresses read or written that
+//! instruction (a breakpoint's condition and hit count are asked only at a
+//! PC whose bit is set); watchpoints a bitmap of the addresses read or written that
 //! one covers, tested on those accesses only ([`hooks`]). Both answer from
 //! registers and memory alone, so an idle loop that none of them touches
 //! is skipped as the plain run skips it.
@@ -47,6 +51,7 @@
 
 pub mod checkpoints;
 pub mod error;
+pub mod expr;
 pub mod hooks;
 pub mod points;
 pub mod session;
@@ -54,6 +59,7 @@ pub mod symbols;
 
 pub use checkpoints::{CHECKPOINT_EVERY, MAX_CHECKPOINTS};
 pub use error::Error;
-pub use points::{Breakpoint, Watch, WatchKind};
-pub use session::{Debugger, Event, MakeRobot, Stopped, Why};
+pub use expr::{Expr, Register, Template};
+pub use points::{Breakpoint, HitCondition, PointOptions, Watch, WatchKind};
+pub use session::{Debugger, Event, Logged, MakeRobot, Stopped, Why};
 pub use symbols::Symbols;

@@ -1,9 +1,10 @@
 //! The debugging session: the robot, the host's actions on it, and the
 //! ways to run it.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::collections::VecDeque;
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use emulator::{Cpu, Tracer};
@@ -12,8 +13,9 @@ use romlib::VirtualScorpion;
 
 use crate::Error;
 use crate::checkpoints::{Checkpoint, Checkpoints};
+use crate::expr::{Peeking, Register};
 use crate::hooks::{Access, Found, Lean, LeanStop, Look, WatchBus, Watched};
-use crate::points::{Breakpoint, Watch};
+use crate::points::{Breakpoint, PointOptions, Watch};
 use crate::symbols::Symbols;
 
 /// Builds the robot as it is at power-up with everything loaded: called
@@ -28,6 +30,15 @@ pub enum Event {
     Send(Vec<u8>),
     /// The bumpers set (a bit per closed bumper).
     Bumpers(u8),
+    /// A register or flag set by the user.
+    Set(Register, u16),
+    /// Bytes of RAM written by the user.
+    Poke {
+        /// Where the first goes.
+        address: u16,
+        /// The bytes.
+        bytes: Vec<u8>,
+    },
 }
 
 /// An event and where in the run it happened.
@@ -68,6 +79,8 @@ pub enum Why {
     Budget,
     /// Back in time, at the instruction asked for.
     Back,
+    /// Paused by the user (Ctrl-C in the monitor) while it ran.
+    Paused,
 }
 
 /// Where a run ended.
@@ -93,6 +106,14 @@ pub struct Debugger {
     /// The loaded images, for their source lines.
     images: Vec<linker::Image>,
     breakpoints: Vec<Option<Breakpoint>>,
+    /// Each breakpoint's condition, hit count and log message.
+    options: Vec<PointOptions>,
+    /// Each breakpoint's hits so far (where its condition held).
+    hits: Vec<Cell<u64>>,
+    /// What log points logged since the last look.
+    logs: RefCell<Logs>,
+    /// Set (by a signal handler) to pause a run between its slices.
+    interrupt: Option<Arc<AtomicBool>>,
     watches: Vec<Option<Watch>>,
     /// What the host did, in order, up to now.
     done: Vec<Done>,
@@ -160,6 +181,17 @@ impl std::fmt::Debug for Debugger {
     }
 }
 
+/// Expressions read the session's robot as it is now.
+impl crate::expr::Machine for Debugger {
+    fn cpu(&self) -> &Cpu {
+        self.cpu()
+    }
+
+    fn peek(&self, address: u16) -> u8 {
+        emulator::Bus::peek(&self.robot.robot().bus, address)
+    }
+}
+
 /// A line of disassembly.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Line {
@@ -193,6 +225,10 @@ impl Debugger {
             symbols,
             images: images.to_vec(),
             breakpoints: Vec::new(),
+            options: Vec::new(),
+            hits: Vec::new(),
+            logs: RefCell::new(Logs::default()),
+            interrupt: None,
             watches: Vec::new(),
             done: Vec::new(),
             ahead: VecDeque::new(),
@@ -342,8 +378,102 @@ impl Debugger {
 
     /// Adds a breakpoint; returns its number.
     pub fn add_breakpoint(&mut self, point: Breakpoint) -> usize {
+        self.add_breakpoint_with(point, PointOptions::default())
+    }
+
+    /// Adds a breakpoint with a condition, a hit count or a log message;
+    /// returns its number.
+    pub fn add_breakpoint_with(&mut self, point: Breakpoint, options: PointOptions) -> usize {
         self.breakpoints.push(Some(point));
+        self.options.push(options);
+        self.hits.push(Cell::new(0));
         self.breakpoints.len()
+    }
+
+    /// Breakpoint `id`'s condition, hit count and log message, and its hits
+    /// so far.
+    #[must_use]
+    pub fn breakpoint_options(&self, id: usize) -> Option<(&PointOptions, u64)> {
+        let index = id.checked_sub(1)?;
+        self.breakpoints.get(index)?.as_ref()?;
+        Some((self.options.get(index)?, self.hits.get(index)?.get()))
+    }
+
+    /// What log points logged since the last call (the oldest first), and
+    /// how many lines were dropped beyond [`MAX_LOGS`] kept.
+    pub fn take_logs(&mut self) -> (Vec<Logged>, u64) {
+        let logs = std::mem::take(self.logs.get_mut());
+        (logs.lines, logs.dropped)
+    }
+
+    /// Pauses a run (`continue`, `next`, `finish`, `until`) between slices
+    /// of [`SLICE`] robot cycles once `flag` is set: the run ends with
+    /// [`Why::Paused`] and clears it. Safe to set from a signal handler.
+    pub fn set_interrupt(&mut self, flag: Arc<AtomicBool>) {
+        self.interrupt = Some(flag);
+    }
+
+    /// Sets a register or flag, as a host action done again on every
+    /// re-run from before now (so a step back and forward sees it).
+    ///
+    /// # Errors
+    /// [`Error::Value`] for a value the register does not hold.
+    pub fn set_register(&mut self, register: Register, value: i64) -> Result<(), Error> {
+        let value = u16::try_from(value)
+            .ok()
+            .filter(|&v| v <= register.max())
+            .ok_or_else(|| Error::Value {
+                what: register.to_string(),
+                value,
+                max: register.max(),
+            })?;
+        self.act(Event::Set(register, value));
+        Ok(())
+    }
+
+    /// Writes `bytes` into RAM from `address` (as a host action, done
+    /// again on every re-run).
+    ///
+    /// # Errors
+    /// [`Error::NotRam`]: a byte would land outside RAM (the ROM, the I/O
+    /// page, a card's registers, past $FFFF); nothing is written.
+    pub fn poke(&mut self, address: u16, bytes: &[u8]) -> Result<(), Error> {
+        let bus = &self.robot.robot().bus;
+        for offset in 0..bytes.len() {
+            let at = u16::try_from(usize::from(address) + offset)
+                .ok()
+                .filter(|&at| bus.is_ram(at));
+            if at.is_none() {
+                return Err(Error::NotRam {
+                    address: u16::try_from(usize::from(address) + offset).unwrap_or(0xFFFF),
+                });
+            }
+        }
+        self.act(Event::Poke {
+            address,
+            bytes: bytes.to_vec(),
+        });
+        Ok(())
+    }
+
+    /// Runs until the PC reaches `address` (or a breakpoint or watchpoint
+    /// stops it first, or `budget` cycles run out).
+    ///
+    /// # Errors
+    /// As [`Debugger::run`].
+    pub fn until(&mut self, address: u16, budget: u64) -> Result<Stopped, Error> {
+        let kept = self.breakpoints.len();
+        let id = self.add_breakpoint(Breakpoint::At(address));
+        let until = self.robot.cycles().saturating_add(budget);
+        let stopped = self.go(until, Goal::default());
+        self.breakpoints.truncate(kept);
+        self.options.truncate(kept);
+        self.hits.truncate(kept);
+        let mut stopped = stopped?;
+        if matches!(stopped.why, Why::Breakpoint { id: hit, .. } if hit == id) {
+            stopped.why = Why::Stepped;
+        }
+        Ok(stopped)
     }
 
     /// Adds a watchpoint; returns its number.
@@ -488,15 +618,23 @@ impl Debugger {
                     self.done.push(done);
                 }
             }
+            let slice = if self.interrupt.is_some() {
+                self.robot.cycles().saturating_add(SLICE)
+            } else {
+                u64::MAX
+            };
             let to = until
                 .min(self.ahead.front().map_or(u64::MAX, |d| d.cycle))
-                .min(self.checkpoints.next_due());
+                .min(self.checkpoints.next_due())
+                .min(slice);
             let arrival = self.arrival();
             let found = run_hooked(
                 &mut self.robot,
                 self.trace.as_mut().map(|trace| &mut trace.tracer),
                 Points {
                     breakpoints: &self.breakpoints,
+                    options: &self.options,
+                    live: Some((self.hits.as_slice(), &self.logs)),
                     watches: &self.watches,
                     arrival,
                 },
@@ -517,6 +655,13 @@ impl Debugger {
             }
             if self.robot.cycles() >= self.checkpoints.next_due() {
                 self.checkpoints.take(&self.robot, self.done.len());
+            }
+            let paused = self
+                .interrupt
+                .as_ref()
+                .is_some_and(|flag| flag.swap(false, Ordering::Relaxed));
+            if found.is_none() && paused {
+                return Ok(self.stopped(Why::Paused, received));
             }
             if found.is_none() && self.robot.cycles() < until {
                 continue;
@@ -594,8 +739,12 @@ impl Debugger {
     pub fn reverse_continue(&mut self) -> Result<Option<Stopped>, Error> {
         let now = self.cpu().instructions();
         let arrival = self.arrival();
+        // Conditions hold on a re-run as they did; counts and logs are
+        // the live run's (a log point never stops).
         let points = Points {
             breakpoints: &self.breakpoints,
+            options: &self.options,
+            live: None,
             watches: &self.watches,
             arrival,
         };
@@ -626,6 +775,8 @@ impl Debugger {
         })];
         let points = Points {
             breakpoints: &[],
+            options: &[],
+            live: None,
             watches: &watches,
             arrival: self.arrival(),
         };
@@ -720,6 +871,8 @@ impl Debugger {
         };
         let points = Points {
             breakpoints: &[],
+            options: &[],
+            live: None,
             watches: &[],
             arrival: self.arrival(),
         };
@@ -819,8 +972,112 @@ fn check_place(robot: &VirtualScorpion, done: &Done) -> Result<(), Error> {
 #[derive(Clone, Copy)]
 struct Points<'a> {
     breakpoints: &'a [Option<Breakpoint>],
+    /// Beside each breakpoint (none past the end: plain breakpoints).
+    options: &'a [PointOptions],
+    /// The live run's hit counts and logs; `None` on a re-run, which
+    /// only tests conditions.
+    live: Option<(&'a [Cell<u64>], &'a RefCell<Logs>)>,
     watches: &'a [Option<Watch>],
     arrival: Arrival,
+}
+
+impl Points<'_> {
+    /// Whether a hit must be counted or logged (no idle loop skipped).
+    fn counting(&self) -> bool {
+        self.live.is_some()
+            && self
+                .breakpoints
+                .iter()
+                .zip(self.options)
+                .any(|(point, options)| point.is_some() && options.counts())
+    }
+
+    /// Which breakpoint stops at `cpu`'s PC, if any: each one there is
+    /// asked in turn (its place, its condition, its count; a log point
+    /// logs and does not stop). Asked only where a PC bit is set.
+    fn stop_at(&self, cpu: &Cpu, peek: &dyn Fn(u16) -> u8) -> Option<usize> {
+        let mut stop = None;
+        for (index, point) in self.breakpoints.iter().enumerate() {
+            let Some(point) = point else { continue };
+            if !breakpoint_hits(point, cpu.pc, &self.arrival, peek) {
+                continue;
+            }
+            let Some(options) = self.options.get(index) else {
+                stop = stop.or(Some(index));
+                continue;
+            };
+            let machine = Peeking { cpu, peek };
+            if options
+                .condition
+                .as_ref()
+                .is_some_and(|condition| !condition.holds(&machine))
+            {
+                continue;
+            }
+            let Some((hits, logs)) = self.live else {
+                // A re-run: conditions only.
+                if options.log.is_none() {
+                    stop = stop.or(Some(index));
+                }
+                continue;
+            };
+            if let Some(hit_condition) = options.hits {
+                let count = hits.get(index).map_or(1, |hits| {
+                    let count = hits.get().saturating_add(1);
+                    hits.set(count);
+                    count
+                });
+                if !hit_condition.stops(count) {
+                    continue;
+                }
+            }
+            match &options.log {
+                Some(template) => logs.borrow_mut().push(Logged {
+                    id: index + 1,
+                    pc: cpu.pc,
+                    text: template.render(&machine),
+                }),
+                None => stop = stop.or(Some(index)),
+            }
+        }
+        stop
+    }
+}
+
+/// A run's slice when it may be paused: a tenth of a second of robot
+/// time, well under a millisecond of ours.
+pub const SLICE: u64 = 100_000;
+
+/// Log lines kept between looks ([`Debugger::take_logs`]); more are
+/// counted, not kept.
+pub const MAX_LOGS: usize = 10_000;
+
+/// A line a log point logged.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Logged {
+    /// The breakpoint's number.
+    pub id: usize,
+    /// The PC it logged at.
+    pub pc: u16,
+    /// Its message, values filled in.
+    pub text: String,
+}
+
+/// The lines logged since the last look, bounded.
+#[derive(Debug, Default)]
+struct Logs {
+    lines: Vec<Logged>,
+    dropped: u64,
+}
+
+impl Logs {
+    fn push(&mut self, line: Logged) {
+        if self.lines.len() < MAX_LOGS {
+            self.lines.push(line);
+        } else {
+            self.dropped += 1;
+        }
+    }
 }
 
 /// One run under the hooks, to `until` (a cycle) or a stop; `first`: no
@@ -846,14 +1103,15 @@ fn run_hooked(
         return Ok(None);
     }
     let mut places = emulator::Breakpoints::new();
+    let mut place_blocks = 0;
     for point in points.breakpoints.iter().flatten() {
-        match point {
-            Breakpoint::At(address) => places.insert(*address),
-            Breakpoint::UnknownHook => places.insert(points.arrival.unknown),
-            Breakpoint::Command { .. } => {
-                places.insert(points.arrival.dispatch.unwrap_or(points.arrival.unknown))
-            }
+        let at = match point {
+            Breakpoint::At(address) => *address,
+            Breakpoint::UnknownHook => points.arrival.unknown,
+            Breakpoint::Command { .. } => points.arrival.dispatch.unwrap_or(points.arrival.unknown),
         };
+        places.insert(at);
+        place_blocks |= crate::hooks::block(at);
     }
     let hit = Cell::new(None);
     let watched = Watched::new(points.watches);
@@ -864,17 +1122,11 @@ fn run_hooked(
             until,
             goal.at_count,
             first,
-            &places,
+            (&places, place_blocks),
             &watched,
         );
     }
-    let matches = |cpu: &Cpu, peek: &dyn Fn(u16) -> u8| {
-        points.breakpoints.iter().position(|point| {
-            point
-                .as_ref()
-                .is_some_and(|point| breakpoint_hits(point, cpu.pc, &points.arrival, peek))
-        })
-    };
+    let matches = |cpu: &Cpu, peek: &dyn Fn(u16) -> u8| points.stop_at(cpu, peek);
     let mut look = Look {
         places: &places,
         breakpoint: matches,
@@ -885,17 +1137,18 @@ fn run_hooked(
         first,
         last_pc: 0,
         found: None,
+        skip_idle: !points.counting(),
     };
-    let (reads, writes) = watched.kinds();
+    let (read_blocks, write_blocks) = watched.blocks();
     let mut trace = trace;
     robot.run_until_with(until, |robot, to| {
         let mut bus = WatchBus {
             board: &mut robot.bus,
             watches: points.watches,
             watched: &watched,
-            reads,
-            writes,
             hit: &hit,
+            read_blocks,
+            write_blocks,
         };
         match trace.as_deref_mut() {
             Some(tracer) => robot.cpu.run(&mut bus, to, &mut (&mut look, tracer)),
@@ -925,60 +1178,33 @@ fn run_lean(
     until: u64,
     at_count: Option<u64>,
     first: bool,
-    places: &emulator::Breakpoints,
+    (places, place_blocks): (&emulator::Breakpoints, u64),
     watched: &Watched,
 ) -> Result<Option<Found>, Error> {
-    let hit = Cell::new(None);
     let (reads, writes) = watched.kinds();
+    let skip_idle = !points.counting();
     let mut start = if first {
         robot.robot().cpu.instructions()
     } else {
         u64::MAX
     };
+    let stop_at = at_count.unwrap_or(u64::MAX);
+    let lean = Leaning {
+        points,
+        until,
+        stop_at,
+        places,
+        place_blocks,
+        watched,
+        skip_idle,
+    };
     loop {
-        let stopped = if reads || writes {
-            let mut lean = Lean::<true> {
-                places,
-                start,
-                stop_at: at_count.unwrap_or(u64::MAX),
-                hit: &hit,
-                last_pc: robot.robot().cpu.pc,
-                stopped: None,
-            };
-            robot.run_until_with(until, |robot, to| {
-                let mut bus = WatchBus {
-                    board: &mut robot.bus,
-                    watches: points.watches,
-                    watched,
-                    reads,
-                    writes,
-                    hit: &hit,
-                };
-                robot.cpu.run(&mut bus, to, &mut lean)
-            })?;
-            // A watch the run's last instruction hit, though the run
-            // ended before the next one looked: it stops here, not in
-            // the next run.
-            match (lean.stopped, hit.take()) {
-                (None, Some(access)) => Some(LeanStop::Watch {
-                    access,
-                    pc: lean.last_pc,
-                }),
-                (stopped, _) => stopped,
-            }
-        } else {
-            let mut lean = Lean::<false> {
-                places,
-                start,
-                stop_at: at_count.unwrap_or(u64::MAX),
-                hit: &hit,
-                last_pc: 0,
-                stopped: None,
-            };
-            robot.run_until_with(until, |robot, to| {
-                robot.cpu.run(&mut robot.bus, to, &mut lean)
-            })?;
-            lean.stopped
+        // Four runs, one per kind: each tests only what it needs.
+        let stopped = match (reads || writes, at_count.is_some()) {
+            (true, true) => lean.run::<true, true>(robot, start)?,
+            (true, false) => lean.run::<true, false>(robot, start)?,
+            (false, true) => lean.run::<false, true>(robot, start)?,
+            (false, false) => lean.run::<false, false>(robot, start)?,
         };
         match stopped {
             None => return Ok(None),
@@ -987,11 +1213,7 @@ fn run_lean(
             Some(LeanStop::Place) => {
                 let (cpu, bus) = (&robot.robot().cpu, &robot.robot().bus);
                 let peek = |address| emulator::Bus::peek(bus, address);
-                let found = points.breakpoints.iter().position(|point| {
-                    point
-                        .as_ref()
-                        .is_some_and(|point| breakpoint_hits(point, cpu.pc, &points.arrival, &peek))
-                });
+                let found = points.stop_at(cpu, &peek);
                 if let Some(index) = found {
                     return Ok(Some(Found::Breakpoint(index)));
                 }
@@ -999,6 +1221,65 @@ fn run_lean(
                 start = cpu.instructions();
             }
         }
+    }
+}
+
+/// What a lean run is given.
+struct Leaning<'a> {
+    points: Points<'a>,
+    until: u64,
+    stop_at: u64,
+    places: &'a emulator::Breakpoints,
+    place_blocks: u64,
+    watched: &'a Watched,
+    skip_idle: bool,
+}
+
+impl Leaning<'_> {
+    /// One run under [`Lean`]: why it stopped (`None`: at `until`).
+    fn run<const WATCH: bool, const COUNT: bool>(
+        &self,
+        robot: &mut VirtualScorpion,
+        start: u64,
+    ) -> Result<Option<LeanStop>, Error> {
+        let hit = Cell::new(None);
+        let mut lean = Lean::<WATCH, COUNT> {
+            places: self.places,
+            place_blocks: self.place_blocks,
+            start,
+            stop_at: self.stop_at,
+            hit: &hit,
+            last_pc: robot.robot().cpu.pc,
+            stopped: None,
+            skip_idle: self.skip_idle,
+        };
+        if !WATCH {
+            robot.run_until_with(self.until, |robot, to| {
+                robot.cpu.run(&mut robot.bus, to, &mut lean)
+            })?;
+            return Ok(lean.stopped);
+        }
+        let (read_blocks, write_blocks) = self.watched.blocks();
+        robot.run_until_with(self.until, |robot, to| {
+            let mut bus = WatchBus {
+                board: &mut robot.bus,
+                watches: self.points.watches,
+                watched: self.watched,
+                hit: &hit,
+                read_blocks,
+                write_blocks,
+            };
+            robot.cpu.run(&mut bus, to, &mut lean)
+        })?;
+        // A watch the run's last instruction hit, though the run ended
+        // before the next one looked: it stops here, not in the next run.
+        Ok(match (lean.stopped, hit.take()) {
+            (None, Some(access)) => Some(LeanStop::Watch {
+                access,
+                pc: lean.last_pc,
+            }),
+            (stopped, _) => stopped,
+        })
     }
 }
 
@@ -1043,6 +1324,11 @@ fn apply(robot: &mut VirtualScorpion, event: &Event) {
     match event {
         Event::Send(bytes) => robot.send(bytes),
         Event::Bumpers(closed) => robot.set_bumpers(*closed),
+        Event::Set(register, value) => register.write(&mut robot.robot_mut().cpu, *value),
+        Event::Poke { address, bytes } => {
+            // Checked when done: RAM all the way ([`Debugger::poke`]).
+            let _ = robot.robot_mut().bus.load(*address, bytes);
+        }
     }
 }
 

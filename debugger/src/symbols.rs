@@ -124,26 +124,37 @@ impl Symbols {
         if term.starts_with(|c: char| c.is_ascii_digit()) {
             return number(term, 10);
         }
-        self.get(term).map(i64::from).ok_or_else(|| {
-            // The nearest name, a letter or two away (or only in case).
-            let near = self
-                .by_name
-                .keys()
-                .map(|name| {
-                    let distance = if name.eq_ignore_ascii_case(term) {
-                        0
-                    } else {
-                        strsim::levenshtein(name, term)
-                    };
-                    (distance, name)
-                })
-                .filter(|(distance, _)| *distance <= 2)
-                .min();
-            match near {
-                Some((_, name)) => format!("no label `{term}` (did you mean `{name}`?)"),
-                None => format!("no label `{term}`"),
-            }
-        })
+        self.get(term)
+            .map(i64::from)
+            .ok_or_else(|| self.unknown(term))
+    }
+
+    /// What to say of `term`, which is no name known: the nearest name a
+    /// letter or two away (or only in case), if there is one.
+    #[must_use]
+    pub fn unknown(&self, term: &str) -> String {
+        let near = self
+            .by_name
+            .keys()
+            .map(|name| {
+                let distance = if name.eq_ignore_ascii_case(term) {
+                    0
+                } else {
+                    strsim::levenshtein(name, term)
+                };
+                (distance, name)
+            })
+            .filter(|(distance, _)| *distance <= 2)
+            .min();
+        match near {
+            Some((_, name)) => format!("no label `{term}` (did you mean `{name}`?)"),
+            None => format!("no label `{term}`"),
+        }
+    }
+
+    /// Every name known, for completion.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.by_name.keys().map(String::as_str)
     }
 }
 

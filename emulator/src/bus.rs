@@ -109,6 +109,15 @@ pub trait Bus {
     /// Writes `value` to `address` during bus cycle `cycle`.
     fn write(&mut self, address: u16, value: u8, cycle: u64);
 
+    /// A read of the instruction stream at the PC (an opcode or an operand
+    /// byte): the same access as [`Bus::read`], which the default calls.
+    /// A debugger's watching bus tells it apart from the program's reads
+    /// of data, and leaves it unwatched.
+    #[inline(always)]
+    fn fetch(&mut self, address: u16, cycle: u64) -> u8 {
+        self.read(address, cycle)
+    }
+
     /// A read of `address` during bus cycle `cycle` whose value the CPU
     /// ignores (see the [module documentation](self)). Its side effects are
     /// those of [`Bus::read`]; a bus may skip the rest.
@@ -196,6 +205,11 @@ pub trait Bus {
 }
 
 impl<B: Bus + ?Sized> Bus for &mut B {
+    #[inline(always)]
+    fn fetch(&mut self, address: u16, cycle: u64) -> u8 {
+        (**self).fetch(address, cycle)
+    }
+
     #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
         (**self).read(address, cycle)

@@ -3,22 +3,31 @@
 //! in the spirit of VICE's monitor read from stdin (typed, or a script),
 //! the robot's serial line driven from the same prompt.
 
-use std::io::{BufRead, IsTerminal, Write};
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use debugger::session::{Line, Stopped};
-use debugger::{Breakpoint, Debugger, Watch, WatchKind, Why};
+use debugger::{Breakpoint, Debugger, Expr, Watch, WatchKind, Why};
 use miette::IntoDiagnostic;
 
 use crate::cmd::ports;
 
+mod breaks;
 mod counts;
+mod edit;
 #[cfg(test)]
 mod fuzz;
 pub(crate) mod line;
+mod prompt;
 
-use counts::{BACK_COUNT, CONTINUE_CYCLES, DIS_COUNT, MEM_LEN, STEP_COUNT};
+use prompt::{Input, Read};
+
+use counts::{
+    BACK_COUNT, CONTINUE_CYCLES, CONTINUE_CYCLES_PAUSABLE, DIS_COUNT, MEM_LEN, STEP_COUNT,
+};
 
 /// Debug a program on the virtual Scorpion: breakpoints (an address, a
 /// label, a robot command arriving), watchpoints, step, next, finish, and
@@ -51,28 +60,44 @@ pub(crate) struct Args {
 const BUDGET: u64 = 1_000_000;
 
 const HELP: &str = "\
-commands (addresses: $C011, 49152, %1010, a label, sums: CMDBUF+1)
+commands (addresses and values are expressions: $C011, 49152, %1010, 'A', a label,
+CMDBUF+1, registers A X Y S P PC, flags C Z I D V N, [ADDR] a byte, {ADDR} a word,
+== != < <= > >= && || & | ^ << >> + - * / ! ~, < and > the low and high byte)
   /1P                  send a command down the serial line (any line starting with /)
   send TEXT            send TEXT as it is
   bumpers HEX          close the bumpers whose bits are set ($00 opens them all)
-  break ADDR | FILE:LINE | /3A | unknown
+  break ADDR | FILE:LINE | /3A | unknown [if COND] [hits N] [log MESSAGE]
                        stop before the instruction at ADDR or from FILE:LINE, when the ROM
-                       has command /3A,
-                       or when it jumps through HOOK_UNKNOWN                    (b)
+                       has command /3A, or when it jumps through HOOK_UNKNOWN;
+                       only when COND holds (A == 1 && [CMDBUF] == $2F), from the Nth
+                       hit (hits 3, hits == 3, hits % 3); a log point prints MESSAGE
+                       ({A}, {[CMDBUF]} filled in) and goes on                   (b)
   watch [read|write|access] ADDR[..ADDR]
                        stop after an instruction that reads or writes there       (w)
   delete N | delete watch N
                        remove breakpoint N or watchpoint N
   info                 list the breakpoints and watchpoints
-  continue [CYCLES]    run until a stop, at most CYCLES (1 s; 60000000 at most)   (c)
+  continue [CYCLES]    run until a stop, at most CYCLES (1 s; 60000000 at most);
+                       Ctrl-C pauses it                                          (c)
   step [N]             run N instructions (1; 10000000 at most)                   (s)
   next                 one instruction, a JSR with its whole subroutine            (n)
   finish               run until the current subroutine returns                   (f)
+  until [ADDR|FILE:LINE]
+                       run until the PC reaches there (alone: the next instruction
+                       in memory, out of a loop)                                  (u)
+  (an empty line at a terminal repeats the last step, next or back)
   back [N]             go back N instructions (1), exactly                        (bs)
   reverse-continue     go back to the last breakpoint or watchpoint hit           (rc)
   who-wrote ADDR       the last instruction that wrote ADDR, and the byte
   regs                 the registers                                              (r)
+  set REG VALUE        set A X Y S P PC or a flag C Z I D V N: set A $05, set C 1,
+                       set PC label (also regs A=$05)
   mem ADDR [LEN]       bytes from ADDR (16; 65536 at most)                        (m)
+  mem ADDR BYTE BYTE...| mem ADDR = BYTE... | poke ADDR BYTE...
+                       write RAM (each BYTE an expression)
+  print EXPR           an expression's value                                      (p)
+  display [EXPR]       show EXPR at each stop (alone: show them now); undisplay N
+  bt                   the call chain, from the return addresses on the stack
   dis [ADDR] [N]       N instructions from ADDR (the PC; 8; 65536 at most)        (d)
   trace FILE | trace off
                        write every instruction run to FILE
@@ -83,9 +108,21 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let here = std::env::current_dir().into_diagnostic()?;
     let (make, images, root) = recipe(args, &here)?;
     let mut debugger = Debugger::new(make, &images)?;
-    let mut sources = Sources::new(root);
-    let stdin = std::io::stdin();
-    let interactive = stdin.is_terminal();
+    let terminal = std::io::stdin().is_terminal();
+    let completion = completion_words(&debugger, &images);
+    let mut input = Input::new(terminal, completion, prompt::history_file(&root));
+    let interrupt = Arc::new(AtomicBool::new(false));
+    if input.is_terminal() {
+        // Ctrl-C while the robot runs pauses it (the run looks at the flag
+        // between slices); at the prompt rustyline reads it as a key.
+        // Registered after the editor is made, which sets a SIGINT handler
+        // of its own: signal-hook's runs first, then calls rustyline's.
+        signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&interrupt))
+            .into_diagnostic()?;
+        debugger.set_interrupt(Arc::clone(&interrupt));
+    }
+    let mut monitor = Monitor::new(Sources::new(root));
+    monitor.pausable = input.is_terminal();
     let mut out = std::io::stdout().lock();
     writeln!(
         out,
@@ -94,20 +131,40 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     )
     .into_diagnostic()?;
     let mut broken = false;
-    let mut lines = stdin.lock().lines();
+    // What an empty line repeats (at a terminal): the last step or next.
+    let mut repeat: Option<String> = None;
     loop {
-        write!(out, "(scorpion) ").into_diagnostic()?;
+        if !input.is_terminal() {
+            // rustyline writes its own.
+            write!(out, "{PROMPT}").into_diagnostic()?;
+        }
         out.flush().into_diagnostic()?;
-        let Some(line) = lines.next() else {
-            writeln!(out).into_diagnostic()?;
-            break;
+        let read = input.read(PROMPT).into_diagnostic()?;
+        let mut line = match read {
+            Read::Line(line) => line,
+            Read::Interrupted => {
+                writeln!(out, "(Ctrl-C: `quit` or Ctrl-D leaves)").into_diagnostic()?;
+                continue;
+            }
+            Read::End => {
+                writeln!(out).into_diagnostic()?;
+                break;
+            }
         };
-        let line = line.into_diagnostic()?;
-        if !interactive {
+        if !input.is_terminal() {
             // A script's session reads as a transcript.
             writeln!(out, "{line}").into_diagnostic()?;
+        } else if line.trim().is_empty()
+            && let Some(last) = &repeat
+        {
+            line.clone_from(last);
         }
-        match command(&mut debugger, &mut sources, line.trim()) {
+        if is_repeatable(&line) {
+            repeat = Some(line.trim().to_owned());
+        }
+        // A Ctrl-C pressed since the last run pauses nothing now.
+        interrupt.store(false, Ordering::Relaxed);
+        match command(&mut debugger, &mut monitor, line.trim()) {
             Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,
             Ok(Reply::Quit) => break,
             Err(error) => {
@@ -129,6 +186,59 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+const PROMPT: &str = "(scorpion) ";
+
+/// Whether an empty line after `line` runs it again: the steps.
+fn is_repeatable(line: &str) -> bool {
+    let verb = line.split_whitespace().next().unwrap_or_default();
+    matches!(
+        verb,
+        "step" | "s" | "stepi" | "si" | "next" | "n" | "back" | "bs" | "reverse-step"
+    )
+}
+
+/// What Tab completes: the symbols, the registers, and every source line
+/// that made code.
+fn completion_words(d: &Debugger, images: &[linker::Image]) -> prompt::Completion {
+    let mut completion = prompt::Completion::default();
+    completion
+        .names
+        .extend(d.symbols().names().map(str::to_owned));
+    completion
+        .names
+        .extend(["A", "X", "Y", "S", "P", "PC", "C", "Z", "I", "D", "V", "N"].map(str::to_owned));
+    for image in images {
+        for entry in &image.lines.entries {
+            if let Some(file) = image.lines.file_name(entry.loc) {
+                completion
+                    .places
+                    .insert(format!("{file}:{}", entry.loc.line));
+            }
+        }
+    }
+    completion
+}
+
+/// What the monitor keeps between commands besides the debugger: the
+/// sources it shows and the expressions shown at each stop.
+pub(crate) struct Monitor {
+    pub(crate) sources: Sources,
+    /// `display`'s expressions, by number (from 1; deleted ones `None`).
+    displays: Vec<Option<Expr>>,
+    /// Ctrl-C pauses a run (at a terminal): a run may be longer.
+    pausable: bool,
+}
+
+impl Monitor {
+    pub(crate) fn new(sources: Sources) -> Monitor {
+        Monitor {
+            sources,
+            displays: Vec::new(),
+            pausable: false,
+        }
+    }
 }
 
 /// The source files the images name, read when shown: relative to the
@@ -238,9 +348,13 @@ impl Failure {
 impl From<debugger::Error> for Failure {
     fn from(error: debugger::Error) -> Failure {
         match error {
-            debugger::Error::Address { .. } | debugger::Error::BeforePowerUp { .. } => {
-                Failure::Usage(error.to_string())
-            }
+            debugger::Error::Address { .. }
+            | debugger::Error::BeforePowerUp { .. }
+            | debugger::Error::Value { .. }
+            | debugger::Error::NotRam { .. }
+            | debugger::Error::Parse(_)
+            | debugger::Error::Eval(_)
+            | debugger::Error::Hits(_) => Failure::Usage(error.to_string()),
             other => Failure::Robot(other),
         }
     }
@@ -251,12 +365,14 @@ fn usage(text: &str) -> Failure {
 }
 
 /// Runs one monitor command.
-fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply, Failure> {
+fn command(d: &mut Debugger, m: &mut Monitor, line: &str) -> Result<Reply, Failure> {
     let mut words = line.split_whitespace();
     let Some(verb) = words.next() else {
         return Ok(Reply::Text(String::new()));
     };
     let rest: Vec<&str> = words.collect();
+    // The line after the verb, as typed.
+    let after = line[verb.len()..].trim();
     let text = match verb {
         "help" | "h" | "?" => format!("{HELP}\n"),
         "quit" | "q" | "exit" => return Ok(Reply::Quit),
@@ -266,10 +382,9 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
             format!("sent {line}\n")
         }
         "send" => {
-            let what = line.trim_start_matches("send").trim();
-            line::command(what).map_err(Failure::Usage)?;
-            d.send(what.as_bytes());
-            format!("sent {what}\n")
+            line::command(after).map_err(Failure::Usage)?;
+            d.send(after.as_bytes());
+            format!("sent {after}\n")
         }
         "bumpers" => {
             let mask = rest
@@ -279,28 +394,7 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
             d.set_bumpers(mask);
             format!("bumpers ${mask:02X}\n")
         }
-        "break" | "b" => {
-            let what = rest
-                .first()
-                .ok_or_else(|| usage("break ADDR, break /3A or break unknown"))?;
-            let point = if *what == "unknown" {
-                Breakpoint::UnknownHook
-            } else if what.starts_with('/') {
-                Breakpoint::command(what).ok_or_else(|| {
-                    usage("a command breakpoint is /, a count 1-9 and a letter: /3A")
-                })?
-            } else if let Some((file, line)) = file_line(what) {
-                Breakpoint::At(
-                    d.address_of_line(file, line)
-                        .ok_or_else(|| usage(&format!("no code came from {file}:{line}")))?,
-                )
-            } else {
-                Breakpoint::At(d.symbols().address(&rest.join(" "))?)
-            };
-            let shown = describe(d, &point);
-            let id = d.add_breakpoint(point);
-            format!("breakpoint {id}: {shown}\n")
-        }
+        "break" | "b" => breaks::add(d, line, verb.len())?,
         "watch" | "w" => {
             let (kind, range) = match rest.first().copied() {
                 Some("read") => (WatchKind::Read, &rest[1..]),
@@ -313,9 +407,9 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
                 return Err(usage("watch [read|write|access] ADDR[..ADDR]"));
             }
             let (start, end) = match range.split_once("..") {
-                Some((a, b)) => (d.symbols().address(a)?, d.symbols().address(b)?),
+                Some((a, b)) => (address(d, a)?, address(d, b)?),
                 None => {
-                    let a = d.symbols().address(&range)?;
+                    let a = address(d, &range)?;
                     (a, a)
                 }
             };
@@ -349,7 +443,14 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
         "info" => {
             let mut text = String::new();
             for (id, point) in d.breakpoints() {
-                text.push_str(&format!("breakpoint {id}: {}\n", describe(d, &point)));
+                text.push_str(&format!("breakpoint {id}: {}", describe(d, &point)));
+                if let Some((options, hits)) = d.breakpoint_options(id) {
+                    text.push_str(&options.describe());
+                    if hits > 0 {
+                        text.push_str(&format!(" (hit {hits} time{})", plural(hits)));
+                    }
+                }
+                text.push('\n');
             }
             for (id, watch) in d.watches() {
                 text.push_str(&format!(
@@ -358,96 +459,153 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
                     range_text(watch.start, watch.end)
                 ));
             }
+            for (id, shown) in m.displays.iter().enumerate() {
+                if let Some(shown) = shown {
+                    text.push_str(&format!("display {}: {shown}\n", id + 1));
+                }
+            }
             if text.is_empty() {
                 text = "no breakpoints or watchpoints\n".into();
             }
             text
         }
         "continue" | "c" | "run" => {
-            let budget = CONTINUE_CYCLES
-                .or(rest.first(), BUDGET)
-                .map_err(Failure::Usage)?;
-            {
-                let stop = d.run(budget)?;
-                stop_report(d, sources, &stop)
-            }
+            let count = if m.pausable {
+                CONTINUE_CYCLES_PAUSABLE
+            } else {
+                CONTINUE_CYCLES
+            };
+            let budget = count.or(rest.first(), BUDGET).map_err(Failure::Usage)?;
+            let stop = d.run(budget)?;
+            stop_report(d, m, &stop)
         }
         "step" | "s" | "stepi" | "si" => {
             let n = STEP_COUNT.or(rest.first(), 1).map_err(Failure::Usage)?;
-            {
-                let stop = d.step(n)?;
-                stop_report(d, sources, &stop)
-            }
+            let stop = d.step(n)?;
+            stop_report(d, m, &stop)
         }
         "next" | "n" => {
             let stop = d.next(BUDGET)?;
-            stop_report(d, sources, &stop)
+            stop_report(d, m, &stop)
         }
         "finish" | "f" => {
             let stop = d.finish(BUDGET)?;
-            stop_report(d, sources, &stop)
+            stop_report(d, m, &stop)
+        }
+        "until" | "u" => {
+            let target = if after.is_empty() {
+                // The instruction after this one in memory: out of a loop
+                // whose branch back is here.
+                let pc = d.cpu().pc;
+                let len = d.disassemble(pc, 1).first().map_or(1, |l| l.bytes.len());
+                pc.wrapping_add(u16::try_from(len).unwrap_or(1))
+            } else if let Some((file, n)) = file_line(after) {
+                d.address_of_line(file, n)
+                    .ok_or_else(|| usage(&format!("no code came from {file}:{n}")))?
+            } else {
+                address(d, after)?
+            };
+            let stop = d.until(target, BUDGET)?;
+            stop_report(d, m, &stop)
         }
         "back" | "bs" | "reverse-step" => {
             let n = BACK_COUNT.or(rest.first(), 1).map_err(Failure::Usage)?;
-            {
-                let stop = d.back(n)?;
-                stop_report(d, sources, &stop)
-            }
+            let stop = d.back(n)?;
+            stop_report(d, m, &stop)
         }
         "reverse-continue" | "rc" => match d.reverse_continue()? {
-            Some(stopped) => stop_report(d, sources, &stopped),
+            Some(stopped) => stop_report(d, m, &stopped),
             None => "no breakpoint or watchpoint was hit before here\n".into(),
         },
         "who-wrote" => {
-            let address = d.symbols().address(&rest.join(" "))?;
+            let address = address(d, after)?;
             match d.who_wrote(address)? {
-                Some(write) => format!(
-                    "${address:04X} was last written ${:02X} by instruction {} at {}\n",
-                    write.value,
-                    write.instruction,
-                    place(d, write.pc)
-                ),
+                Some(write) => {
+                    let mut text = format!(
+                        "${address:04X} was last written ${:02X} by instruction {} at {}\n",
+                        write.value,
+                        write.instruction,
+                        place(d, write.pc)
+                    );
+                    text.push_str(&source_line(d, &mut m.sources, write.pc));
+                    text
+                }
                 None => format!(
                     "no instruction has written ${address:04X} since the session began (images are loaded before it)\n"
                 ),
             }
         }
-        "regs" | "r" => format!("{}\n", registers(d)),
+        "regs" | "r" if rest.is_empty() => format!("{}\n", registers(d)),
+        // `r A=$05 X=1`: each set in turn.
+        "regs" | "r" => {
+            let mut text = String::new();
+            for word in &rest {
+                edit::set(d, word)?;
+            }
+            text.push_str(&format!("{}\n", registers(d)));
+            text
+        }
+        "set" => edit::set(d, after)?,
+        "mem" | "m" => match rest.as_slice() {
+            [] => return Err(usage("mem ADDR [LEN], or mem ADDR BYTE BYTE... to write")),
+            [a] => memory(d, address(d, a)?, 16),
+            [a, "=", bytes @ ..] => edit::poke(d, a, bytes)?,
+            [a, n] => memory(d, address(d, a)?, MEM_LEN.parse(n).map_err(Failure::Usage)?),
+            [a, bytes @ ..] => edit::poke(d, a, bytes)?,
+        },
+        "poke" => match rest.as_slice() {
+            [a, bytes @ ..] if !bytes.is_empty() => edit::poke(d, a, bytes)?,
+            _ => return Err(usage("poke ADDR BYTE...")),
+        },
+        "print" | "p" => {
+            let value = evaluate(d, after)?;
+            format!("{} = {}\n", after, shown_value(value))
+        }
+        "display" => {
+            if after.is_empty() {
+                displays(d, m)
+            } else {
+                let shown = expression(d, after, 0)?;
+                let value = shown_expression(d, &shown);
+                m.displays.push(Some(shown));
+                format!("display {}: {after} = {value}\n", m.displays.len())
+            }
+        }
+        "undisplay" => {
+            let id: usize = after.parse().map_err(|_| usage("undisplay N"))?;
+            let taken = id
+                .checked_sub(1)
+                .and_then(|i| m.displays.get_mut(i))
+                .and_then(Option::take);
+            if taken.is_none() {
+                return Err(usage(&format!("no display {id}")));
+            }
+            format!("display {id} removed\n")
+        }
+        "bt" | "backtrace" | "where" => backtrace(d, &mut m.sources),
         "list" | "l" => {
             let (file, line) = match rest.first() {
                 Some(place) => match file_line(place) {
                     Some((file, line)) => (file.to_owned(), line),
                     None => d
-                        .source_of(d.symbols().address(place)?)
+                        .source_of(address(d, place)?)
                         .ok_or_else(|| usage(&format!("no source line for {place}")))?,
                 },
                 None => d.source_of(d.cpu().pc).ok_or_else(|| {
                     usage("no source line for the PC (the ROM, or an image without a source map)")
                 })?,
             };
-            listing(sources, &file, line)
-        }
-        "mem" | "m" => {
-            let (address, len) = match rest.as_slice() {
-                [] => return Err(usage("mem ADDR [LEN]")),
-                [a] => (d.symbols().address(a)?, 16),
-                [a, n] => (
-                    d.symbols().address(a)?,
-                    MEM_LEN.parse(n).map_err(Failure::Usage)?,
-                ),
-                _ => return Err(usage("mem ADDR [LEN]")),
-            };
-            memory(d, address, len)
+            listing(&mut m.sources, &file, line)
         }
         "dis" | "d" => {
             let address = match rest.first() {
-                Some(a) => d.symbols().address(a)?,
+                Some(a) => address(d, a)?,
                 None => d.cpu().pc,
             };
             let n = DIS_COUNT.or(rest.get(1), 8).map_err(Failure::Usage)?;
             d.disassemble(address, usize::try_from(n).unwrap_or(usize::MAX))
                 .iter()
-                .map(|l| line_text(d, l))
+                .map(|l| line_text(d, &mut m.sources, l))
                 .collect()
         }
         "trace" => match rest.first() {
@@ -468,6 +626,110 @@ fn command(d: &mut Debugger, sources: &mut Sources, line: &str) -> Result<Reply,
         }
     };
     Ok(Reply::Text(text))
+}
+
+fn plural(n: u64) -> &'static str {
+    if n == 1 { "" } else { "s" }
+}
+
+/// `text` (which starts `offset` characters into the command line) as an
+/// expression; a parse error points at its column in the line.
+fn expression(d: &Debugger, text: &str, offset: usize) -> Result<Expr, Failure> {
+    Expr::parse(text, d.symbols()).map_err(|error| Failure::Usage(pointed(&error, offset)))
+}
+
+/// A parse error's message and its place under the expression.
+fn pointed(error: &debugger::expr::ParseError, offset: usize) -> String {
+    format!(
+        "column {}: {}\n{}",
+        error.column + offset,
+        error.reason,
+        error.pointed()
+    )
+}
+
+/// The value of the expression `text` now.
+fn evaluate(d: &Debugger, text: &str) -> Result<i64, Failure> {
+    let parsed = expression(d, text, 0)?;
+    parsed
+        .eval(d)
+        .map_err(|error| Failure::Usage(error.to_string()))
+}
+
+/// The address the expression `text` gives now.
+fn address(d: &Debugger, text: &str) -> Result<u16, Failure> {
+    let parsed = expression(d, text, 0)?;
+    parsed
+        .address(d)
+        .map_err(|error| Failure::Usage(error.to_string()))
+}
+
+/// `$2F (47)`: a value in hexadecimal and decimal.
+fn shown_value(value: i64) -> String {
+    let hex = debugger::expr::show(value);
+    if hex.starts_with('$') {
+        format!("{hex} ({value})")
+    } else {
+        hex
+    }
+}
+
+/// An expression's value now, or why it has none.
+fn shown_expression(d: &Debugger, shown: &Expr) -> String {
+    match shown.eval(d) {
+        Ok(value) => shown_value(value),
+        Err(error) => format!("<{}>", error.reason),
+    }
+}
+
+/// The `display` expressions with their values now.
+fn displays(d: &Debugger, m: &Monitor) -> String {
+    let mut text = String::new();
+    for (id, shown) in m.displays.iter().enumerate() {
+        let Some(shown) = shown else { continue };
+        let value = shown_expression(d, shown);
+        text.push_str(&format!("  {}: {shown} = {value}\n", id + 1));
+    }
+    if text.is_empty() && m.displays.iter().all(Option::is_none) {
+        text = "nothing displayed; `display EXPR` shows EXPR at each stop\n".into();
+    }
+    text
+}
+
+/// The call chain: the PC, then each return address found on the stack
+/// (the instruction after its `JSR`), with its place and source line.
+fn backtrace(d: &Debugger, sources: &mut Sources) -> String {
+    let mut text = String::new();
+    for (depth, pc) in d.backtrace().into_iter().enumerate() {
+        let at = if depth == 0 {
+            pc
+        } else {
+            // The frame is at its JSR: three bytes before the return.
+            pc.wrapping_sub(3)
+        };
+        text.push_str(&format!("#{depth} {}", place(d, at)));
+        if let Some((file, n)) = d.source_of(at) {
+            let source = sources
+                .line(&file, n)
+                .map(|s| format!(": {}", s.trim()))
+                .unwrap_or_default();
+            text.push_str(&format!("  {file}:{n}{source}"));
+        }
+        text.push('\n');
+    }
+    text
+}
+
+/// `  adc.s:42: @wait: bit ADC_STATUS` for `address`, if its source is
+/// known.
+fn source_line(d: &Debugger, sources: &mut Sources, address: u16) -> String {
+    match d.source_of(address) {
+        Some((file, n)) => match sources.line(&file, n) {
+            Some(source) => format!("  {file}:{n}: {}\n", source.trim_end()),
+            None => format!("  {file}:{n}\n"),
+        },
+        None => String::new(),
+    }
 }
 
 fn kind_name(kind: WatchKind) -> &'static str {
@@ -533,10 +795,14 @@ fn memory(d: &Debugger, address: u16, len: u64) -> String {
         // As `scorpion read` shows a robot's memory.
         let _ = crate::cmd::read::write_dump(&mut text, start, &bytes);
     }
-    String::from_utf8_lossy(&text).into_owned()
+    // Addresses as everywhere else in the monitor: `$00F4:`.
+    String::from_utf8_lossy(&text)
+        .lines()
+        .map(|row| format!("${row}\n"))
+        .collect()
 }
 
-fn line_text(d: &Debugger, line: &Line) -> String {
+fn line_text(d: &Debugger, sources: &mut Sources, line: &Line) -> String {
     let bytes: Vec<String> = line.bytes.iter().map(|b| format!("{b:02X}")).collect();
     let label = line
         .label
@@ -544,9 +810,10 @@ fn line_text(d: &Debugger, line: &Line) -> String {
         .or_else(|| d.symbols().place(line.address))
         .unwrap_or_default();
     let marker = if line.address == d.cpu().pc { '>' } else { ' ' };
+    let instruction = named_instruction(d, sources, line);
     let text = match &line.source {
-        Some((file, n)) => format!("{:<30} {file}:{n}", line.text),
-        None => line.text.clone(),
+        Some((file, n)) => format!("{instruction:<30} {file}:{n}"),
+        None => instruction,
     };
     format!(
         "{marker} ${:04X}  {:<8}  {:<20} {}\n",
@@ -557,7 +824,131 @@ fn line_text(d: &Debugger, line: &Line) -> String {
     )
 }
 
-fn stop_report(d: &Debugger, sources: &mut Sources, stop: &Stopped) -> String {
+/// The instruction with its target named as the source names it: a
+/// label, a cheap local (`@wait`), an unnamed label (`:+`, `:--`), the
+/// address kept beside it; as decoded where nothing names it.
+fn named_instruction(d: &Debugger, sources: &mut Sources, line: &Line) -> String {
+    let bus = &d.robot().robot().bus;
+    let peek = |at: u16| emulator::Bus::peek(bus, at);
+    let instruction = isa::Instruction::decode_with(line.address, peek);
+    let plain = instruction.to_string();
+    let Some(target) = instruction.target() else {
+        return plain;
+    };
+    // Page zero and immediate operands are data more often than places.
+    if target < 0x100 && !plain.starts_with('B') && !plain.starts_with('J') {
+        return plain;
+    }
+    let name = d
+        .symbols()
+        .label(target)
+        .map(str::to_owned)
+        .or_else(|| source_label(d, sources, line.address, target));
+    match name {
+        Some(name) => {
+            let named = instruction
+                .display_with(|at| (at == target).then_some(name.as_str()))
+                .to_string();
+            if named == plain {
+                plain
+            } else {
+                format!("{named:<14} ; ${target:04X}")
+            }
+        }
+        None => plain,
+    }
+}
+
+/// The label the source wrote on the line that made `target`, as the
+/// instruction at `from` would name it: `@wait`, or `:+`/`:-` (one sign per
+/// unnamed label passed) for an unnamed one.
+fn source_label(d: &Debugger, sources: &mut Sources, from: u16, target: u16) -> Option<String> {
+    let (file, n) = d.source_of(target)?;
+    // Only a line whose bytes begin at the target is labelled there.
+    if d.address_of_line(&file, n) != Some(target) {
+        return None;
+    }
+    // The label on the line itself, or alone on a line just above it.
+    let mut n = n;
+    let mut text = sources.line(&file, n)?;
+    for above in (n.saturating_sub(4).max(1)..n).rev() {
+        if label_of(&text).is_some() {
+            break;
+        }
+        let Some(line) = sources.line(&file, above) else {
+            break;
+        };
+        let bare = line.split(';').next().unwrap_or_default().trim();
+        if bare.is_empty() {
+            continue;
+        }
+        let only_label = label_of(&line)
+            .is_some_and(|(_, rest)| rest.split(';').next().unwrap_or_default().trim().is_empty());
+        if !only_label {
+            break;
+        }
+        (n, text) = (above, line);
+    }
+    let trimmed = text.trim_start();
+    if let Some(after) = trimmed.strip_prefix(':')
+        && (after.is_empty() || after.starts_with(char::is_whitespace))
+    {
+        let (from_file, from_line) = d.source_of(from)?;
+        if from_file != file {
+            return None;
+        }
+        let unnamed = |sources: &mut Sources, lines: std::ops::RangeInclusive<u32>| {
+            lines
+                .filter(|&k| {
+                    sources.line(&file, k).is_some_and(|l| {
+                        let l = l.trim_start();
+                        l.strip_prefix(':')
+                            .is_some_and(|a| a.is_empty() || a.starts_with(char::is_whitespace))
+                    })
+                })
+                .count()
+        };
+        let (sign, count) = if n > from_line {
+            ('+', unnamed(sources, from_line + 1..=n))
+        } else {
+            ('-', unnamed(sources, n..=from_line))
+        };
+        return (count > 0).then(|| format!(":{}", sign.to_string().repeat(count)));
+    }
+    label_of(&text)
+        .map(|(name, _)| name.to_owned())
+        .filter(|name| !name.is_empty())
+}
+
+/// The label a source line starts with (`@wait:`, `loop:`, `:` for an
+/// unnamed one, as ""), and what follows it.
+fn label_of(line: &str) -> Option<(&str, &str)> {
+    let trimmed = line.trim_start();
+    let end = trimmed
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '@'))
+        .unwrap_or(trimmed.len());
+    let rest = trimmed[end..].strip_prefix(':')?;
+    // `::` is a scope, not a label's end.
+    (!rest.starts_with(':')).then_some((&trimmed[..end], rest))
+}
+
+fn stop_report(d: &mut Debugger, m: &mut Monitor, stop: &Stopped) -> String {
+    let mut text = String::new();
+    let (logs, dropped) = d.take_logs();
+    for logged in logs {
+        text.push_str(&format!(
+            "log {} at {}: {}\n",
+            logged.id,
+            place(d, logged.pc),
+            logged.text
+        ));
+    }
+    if dropped > 0 {
+        text.push_str(&format!(
+            "({dropped} more log lines dropped: at most {} between stops)\n",
+            debugger::session::MAX_LOGS
+        ));
+    }
     let why = match &stop.why {
         Why::Breakpoint { id, point } => format!("breakpoint {id} ({})", describe(d, point)),
         Why::Watch { id, access, pc } => format!(
@@ -572,8 +963,8 @@ fn stop_report(d: &Debugger, sources: &mut Sources, stop: &Stopped) -> String {
         Why::Finished => "returned".into(),
         Why::Budget => "still running (no stop in the cycles given)".into(),
         Why::Back => "back".into(),
+        Why::Paused => "paused (Ctrl-C)".into(),
     };
-    let mut text = String::new();
     if !stop.received.is_empty() {
         let answer = String::from_utf8_lossy(&stop.received).replace('\r', "\\r");
         text.push_str(&format!("< {answer}\n"));
@@ -588,14 +979,17 @@ fn stop_report(d: &Debugger, sources: &mut Sources, stop: &Stopped) -> String {
         plural(stop.instructions)
     ));
     if let Some(line) = d.disassemble(d.cpu().pc, 1).first() {
-        text.push_str(&line_text(d, line));
+        text.push_str(&line_text(d, &mut m.sources, line));
         if let Some((file, n)) = &line.source
-            && let Some(source) = sources.line(file, *n)
+            && let Some(source) = m.sources.line(file, *n)
         {
             text.push_str(&format!("  {file}:{n}: {}\n", source.trim_end()));
         }
     }
     text.push_str(&format!("  {}\n", registers(d)));
+    if m.displays.iter().any(Option::is_some) {
+        text.push_str(&displays(d, m));
+    }
     text
 }
 

@@ -206,7 +206,7 @@ fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
     for (command, reply) in script.lines().zip(&replies[1..]) {
         let reply = reply.strip_prefix(command).unwrap_or(reply);
         let expected = match command {
-            "mem $FFF8 24" => "\nFFF8: FF FF 3B F6 00 F0 3C F6 ",
+            "mem $FFF8 24" => "\n$FFF8: FF FF 3B F6 00 F0 3C F6 ",
             "regs" => "\nPC=",
             "list adc.s:4294967295" => "adc.s has no line 4294967295",
             _ if command.contains(" -") => " is a number of ",
@@ -215,8 +215,8 @@ fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
         };
         assert!(reply.contains(expected), "{command}: {reply}");
     }
-    assert!(text.contains("\n0000: 00 00"), "{text}");
-    assert!(!text.contains("\n10000:"), "{text}");
+    assert!(text.contains("\n$0000: 00 00"), "{text}");
+    assert!(!text.contains("\n$10000:"), "{text}");
     let regs: Vec<&str> = text.lines().filter(|l| l.starts_with("PC=")).collect();
     assert_eq!(regs.len(), 2, "{text}");
     assert_eq!(regs[0], regs[1], "nothing ran: {text}");
@@ -350,4 +350,59 @@ fn the_monitor_sends_only_commands_the_rom_can_read() {
         text.contains("< A57\\r"),
         "only /2A1 was on the line: {text:.3000}"
     );
+}
+
+/// The fenced block of `kind` that follows `heading` in docs/DEBUGGING.md.
+fn guide_block(heading: &str, kind: &str) -> String {
+    let guide =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/DEBUGGING.md"))
+            .expect("docs/DEBUGGING.md");
+    let section = &guide[guide.find(heading).expect("the section")..];
+    let fence = format!("```{kind}\n");
+    let start = section.find(&fence).expect("the block") + fence.len();
+    let end = start + section[start..].find("```").expect("the block's end");
+    section[start..end].to_string()
+}
+
+/// The planted-bug hunt of docs/DEBUGGING.md, run as written: its output
+/// is the guide's.
+#[test]
+fn the_debugging_guides_bug_hunt_runs_as_written() {
+    let tmp = tempfile::tempdir().expect("a temporary directory");
+    let heading = "## A bug hunt in the monitor";
+    let script = guide_block(heading, "sh");
+    let output = std::process::Command::new("sh")
+        .arg("-e")
+        .arg("-c")
+        .arg(format!("exec 2>&1\n{script}"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("PATH", crate::path_with_scorpion())
+        .env("TMPDIR", tmp.path())
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("sh runs");
+    assert!(output.status.success(), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        text.contains("< K0203\\r") && text.contains("< K0003\\r"),
+        "{text}"
+    );
+    assert_eq!(
+        text,
+        guide_block(heading, "text"),
+        "docs/DEBUGGING.md's bug hunt is stale"
+    );
+}
+
+/// New commands at the prompt from a script: a conditional breakpoint, a
+/// hit count, a log point, set, mem writes, print, display, bt, until,
+/// and their mistakes (a condition that does not parse, with its column;
+/// a count of 2^64; a register's value out of range; ROM written).
+#[test]
+fn conditions_counts_logs_sets_and_their_mistakes() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(Some(&adc), &["debug"], &session("new_commands.txt"));
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    insta::assert_snapshot!(text);
 }

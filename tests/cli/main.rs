@@ -8,6 +8,7 @@ mod cards;
 mod config;
 mod dap;
 mod debug;
+mod debug_pty;
 mod disasm;
 mod emu;
 mod hostile_files;

@@ -45,10 +45,12 @@ impl Cpu {
         self.cycles += 1;
     }
 
-    /// Reads the byte at PC and steps past it.
+    /// Reads the byte at PC (as an instruction fetch, [`Bus::fetch`]) and
+    /// steps past it.
     #[inline(always)]
     pub(super) fn fetch<B: Bus>(&mut self, bus: &mut B) -> u8 {
-        let value = self.read(bus, self.pc);
+        let value = bus.fetch(self.pc, self.cycles);
+        self.cycles += 1;
         self.pc = self.pc.wrapping_add(1);
         value
     }

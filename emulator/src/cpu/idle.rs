@@ -159,6 +159,12 @@ impl<B: Bus> ProbeBus<'_, B> {
 
 impl<B: Bus> Bus for ProbeBus<'_, B> {
     #[inline(always)]
+    fn fetch(&mut self, address: u16, cycle: u64) -> u8 {
+        self.clean &= self.bus.is_plain_memory(address);
+        self.bus.fetch(address, cycle)
+    }
+
+    #[inline(always)]
     fn read(&mut self, address: u16, cycle: u64) -> u8 {
         self.clean &= self.bus.is_plain_memory(address);
         self.bus.read(address, cycle)

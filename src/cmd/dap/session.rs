@@ -366,6 +366,7 @@ impl Session {
             Why::Watch { id, .. } => ("data breakpoint", Some(format!("watchpoint {id}"))),
             Why::Stepped | Why::Finished | Why::Back => ("step", None),
             Why::Budget => ("pause", Some("the step ran out of robot time".into())),
+            Why::Paused => ("pause", None),
         };
         self.stopped(reason, description)
     }

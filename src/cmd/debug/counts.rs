@@ -75,6 +75,17 @@ pub(crate) const CONTINUE_CYCLES: Count = Count {
     why: "a minute of robot time: nothing can stop a run once it goes; continue again to go on",
 };
 
+/// `continue [CYCLES]` at a terminal, where Ctrl-C pauses the run: an
+/// hour of robot time.
+pub(crate) const CONTINUE_CYCLES_PAUSABLE: Count = Count {
+    usage: "continue [CYCLES]",
+    name: "CYCLES",
+    unit: "cycles",
+    min: 1,
+    max: 3_600_000_000,
+    why: "an hour of robot time; Ctrl-C pauses a run",
+};
+
 impl Count {
     /// `text` as this count, or what is wrong with it.
     pub(crate) fn parse(&self, text: &str) -> Result<u64, String> {

@@ -10,7 +10,7 @@ use std::path::Path;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-use super::{Args, Reply, Sources, command, recipe};
+use super::{Args, Monitor, Reply, Sources, command, recipe};
 
 /// Numbers as typed: small, at and around the bounds of u32 and u64,
 /// negative, in other bases, not numbers. (Numbers between a bound's tenth
@@ -86,6 +86,16 @@ fn line() -> impl Strategy<Value = String> {
         "trace",
         "help",
         "frob",
+        "set",
+        "poke",
+        "print",
+        "display",
+        "undisplay",
+        "until",
+        "bt",
+        "break read_channel if",
+        "break read_channel hits",
+        "break read_channel log",
     ]);
     let word = prop_oneof![
         number(),
@@ -98,6 +108,16 @@ fn line() -> impl Strategy<Value = String> {
         Just("/dev/full".to_owned()),
         Just("/nonexistent/dir/trace.txt".to_owned()),
         Just("/9Z".to_owned()),
+        Just("A".to_owned()),
+        Just("PC".to_owned()),
+        Just("=".to_owned()),
+        Just("[CMDBUF]".to_owned()),
+        Just("{A}".to_owned()),
+        Just("((((".to_owned()),
+        Just("A==1&&".to_owned()),
+        Just("1/0".to_owned()),
+        Just(">=".to_owned()),
+        Just("%".to_owned()),
     ];
     (verb, prop::collection::vec(word, 0..4)).prop_map(|(verb, words)| {
         if verb == "trace" {
@@ -124,13 +144,13 @@ fn any_command_line_is_answered_within_its_bounds() {
     let (make, images, root) = recipe(&args, &adc).expect("the ADC example builds");
     let session = RefCell::new((
         debugger::Debugger::new(make, &images).expect("the robot builds"),
-        Sources::new(root),
+        Monitor::new(Sources::new(root)),
     ));
     let mut runner = TestRunner::new(Config::with_cases(400));
     let outcome = runner.run(&line(), |line| {
         let mut session = session.borrow_mut();
-        let (debugger, sources) = &mut *session;
-        if let Ok(Reply::Text(text)) = command(debugger, sources, &line) {
+        let (debugger, monitor) = &mut *session;
+        if let Ok(Reply::Text(text)) = command(debugger, monitor, &line) {
             // Output bounded: a whole address space's dump or listing.
             prop_assert!(text.len() < 8 << 20, "{line}: {} bytes", text.len());
         }
