@@ -94,9 +94,9 @@ pub fn require_npm_packages(
     } else {
         missing(
             &format!(
-                "the npm packages {} in {} (`npm ci` there)",
-                absent.join(", "),
-                dir.display()
+                "the node_modules of {} (`npm ci` there; wanted: {})",
+                dir.display(),
+                absent.join(", ")
             ),
             test,
         );
