@@ -273,3 +273,95 @@ fn the_extension_packages_into_a_vsix_with_its_files() {
         assert!(stdout.lines().any(|l| l == entry), "{entry} in {stdout}");
     }
 }
+
+/// A Lua value as docs/DEBUGGING.md's Neovim block writes them: a quoted
+/// string, a boolean, or a list of strings `{ 'a', 'b' }`.
+fn lua_value(text: &str) -> Value {
+    let text = text.trim();
+    let unquote = |s: &str| s.trim().trim_matches('\'').trim_matches('"').to_owned();
+    match text {
+        "true" => Value::Bool(true),
+        "false" => Value::Bool(false),
+        list if list.starts_with('{') => Value::Array(
+            list.trim_start_matches('{')
+                .trim_end_matches('}')
+                .split(',')
+                .filter(|item| !item.trim().is_empty())
+                .map(|item| Value::String(unquote(item)))
+                .collect(),
+        ),
+        quoted => Value::String(unquote(quoted)),
+    }
+}
+
+#[test]
+fn a_dap_session_through_the_neovim_adapter_definition_in_debugging_md() {
+    let test = "a_dap_session_through_the_neovim_adapter_definition_in_debugging_md";
+    let Some(node) = node(test) else { return };
+    let docs =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/DEBUGGING.md"))
+            .expect("docs/DEBUGGING.md");
+    let section = &docs[docs.find("### Neovim").expect("the Neovim section")..];
+    let start = section.find("```lua\n").expect("its Lua block") + "```lua\n".len();
+    let block = &section[start..start + section[start..].find("```").expect("the block's end")];
+
+    // `dap.adapters.scorpion = { type = 'executable', command = ..., args = { ... } }`
+    let adapter = block
+        .lines()
+        .find(|l| l.contains("dap.adapters.scorpion"))
+        .expect("the adapter definition");
+    let field = |name: &str| {
+        let at = adapter.find(&format!("{name} = ")).expect(name) + name.len() + 3;
+        let rest = &adapter[at..];
+        let end = if rest.starts_with('{') {
+            rest.find('}').expect("a list's end") + 1
+        } else {
+            rest.find(',').expect("a field's end")
+        };
+        lua_value(&rest[..end])
+    };
+    assert_eq!(field("command"), "scorpion", "{adapter}");
+    // The configuration: one `key = value,` a line, comments dropped.
+    let mut launch = serde_json::Map::new();
+    let configuration = &block[block.find("dap.configurations").expect("a configuration")..];
+    for line in configuration.lines().skip(2) {
+        let code = line.split("--").next().unwrap_or_default().trim();
+        let Some((key, value)) = code.split_once(" = ") else {
+            continue;
+        };
+        launch.insert(
+            key.trim().to_owned(),
+            lua_value(value.trim_end_matches(',')),
+        );
+    }
+    assert_eq!(launch["type"], "scorpion", "{launch:?}");
+    let definition = serde_json::json!({"args": field("args"), "launch": launch});
+    let dir = tempfile::tempdir().expect("a scratch directory");
+    let file = dir.path().join("neovim.json");
+    std::fs::write(&file, definition.to_string()).expect("the definition written");
+
+    let adc = examples().join("adc");
+    let output = run_script(
+        &node,
+        "dap.js",
+        &[
+            env!("CARGO_BIN_EXE_scorpion"),
+            adc.to_str().expect("UTF-8"),
+            file.to_str().expect("UTF-8"),
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{definition}\n{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for step in [
+        "dap: hit adc.s:",
+        "dap: registers: ",
+        "dap: stepped to adc.s:",
+        "dap: disconnected",
+    ] {
+        assert!(stdout.contains(step), "{step:?} in {stdout}");
+    }
+}

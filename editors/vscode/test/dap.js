@@ -3,14 +3,17 @@
 // the adapter is started exactly as package.json tells VS Code to (its
 // `program`, the `scorpion` binary given here, with its `args`), launched
 // with the contribution's first configuration snippet on the ADC example.
-// Usage: node test/dap.js SCORPION_BINARY EXAMPLE_DIR
+// Usage: node test/dap.js SCORPION_BINARY EXAMPLE_DIR [ADAPTER_JSON]
+// With ADAPTER_JSON ({"args": [...], "launch": {...}}, another editor's
+// adapter definition and launch configuration, `${workspaceFolder}` left
+// as written), the session runs through that instead of package.json.
 'use strict';
 const assert = require('assert');
 const fs = require('fs');
 const path = require('path');
 const { DebugClient } = require('@vscode/debugadapter-testsupport');
 
-const [scorpion, example] = process.argv.slice(2);
+const [scorpion, example, other] = process.argv.slice(2);
 if (!scorpion || !example) throw new Error('usage: node test/dap.js SCORPION_BINARY EXAMPLE_DIR');
 
 const manifest = JSON.parse(fs.readFileSync(path.join(__dirname, '..', 'package.json'), 'utf8'));
@@ -28,7 +31,12 @@ function fromSnippet(snippet, workspaceFolder) {
     .replace(/\$\{\d+:([^}]*)\}/g, '$1');
   return JSON.parse(text);
 }
-const launch = fromSnippet(debuggerContribution.configurationSnippets[0], example);
+const otherEditor = other ? JSON.parse(fs.readFileSync(other, 'utf8')) : null;
+const adapterArgs = otherEditor ? otherEditor.args : debuggerContribution.args;
+assert.deepEqual(adapterArgs, ['dap'], 'the adapter is `scorpion dap`');
+const launch = otherEditor
+  ? JSON.parse(JSON.stringify(otherEditor.launch).split('${workspaceFolder}').join(example))
+  : fromSnippet(debuggerContribution.configurationSnippets[0], example);
 assert.equal(launch.type, debuggerContribution.type);
 assert.equal(launch.request, 'launch');
 assert.equal(launch.program, example, 'the snippet launches the workspace folder');
@@ -36,7 +44,8 @@ for (const key of Object.keys(launch).filter((k) => !['type', 'request', 'name']
   assert.ok(key in debuggerContribution.configurationAttributes.launch.properties, `${key} is a declared attribute`);
 }
 // The ADC example answers `/2A1`; the launch types it to the robot.
-launch.commands = ['/2A1'];
+if (!otherEditor) launch.commands = ['/2A1'];
+assert.deepEqual(launch.commands, ['/2A1'], 'the launch types /2A1 to the robot');
 
 const source = path.join(example, 'adc.s');
 const lines = fs.readFileSync(source, 'utf8').split('\n');
@@ -51,7 +60,7 @@ const sec = lineOf('sec');
 const log = (what) => console.log(`dap: ${what}`);
 
 (async () => {
-  const dc = new DebugClient(scorpion, debuggerContribution.args[0], debuggerContribution.type, {}, true);
+  const dc = new DebugClient(scorpion, adapterArgs[0], debuggerContribution.type, {}, true);
   dc.defaultTimeout = 30000;
   await dc.start();
   try {
@@ -69,13 +78,17 @@ const log = (what) => console.log(`dap: ${what}`);
     assert.equal(set.body.breakpoints[0].verified, true, JSON.stringify(set.body));
     log(`breakpoint at adc.s:${sec} verified`);
 
-    const entry = dc.assertStoppedLocation('entry', {});
-    await dc.configurationDoneRequest();
-    await entry;
-    log('stopped on entry');
+    if (launch.stopOnEntry) {
+      const entry = dc.assertStoppedLocation('entry', {});
+      await dc.configurationDoneRequest();
+      await entry;
+      log('stopped on entry');
+    } else {
+      await dc.configurationDoneRequest();
+    }
 
     const hit = dc.assertStoppedLocation('breakpoint', { path: source, line: sec });
-    await dc.continueRequest({ threadId: 1 });
+    if (launch.stopOnEntry) await dc.continueRequest({ threadId: 1 });
     const trace = await hit;
     const frame = trace.body.stackFrames[0];
     log(`hit ${path.basename(frame.source.path)}:${frame.line} in ${frame.name}`);
