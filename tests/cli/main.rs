@@ -24,6 +24,7 @@ mod sim;
 mod sim_line;
 mod terminal;
 mod upload;
+mod vscode;
 
 use std::process::{Command, Output};
 

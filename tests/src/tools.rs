@@ -67,3 +67,39 @@ pub fn require_python_module(module: &str, test: &str) -> Option<PathBuf> {
     }
     usable
 }
+
+/// Node.js, if it is on `PATH` and `dir` (a package with a committed
+/// `package-lock.json`) has each of `packages` installed in its
+/// `node_modules` (`npm ci` there), or `None` after printing why `test` is
+/// skipped. Panics when either is missing under `CI=true`.
+#[must_use]
+pub fn require_npm_packages(
+    dir: &std::path::Path,
+    packages: &[&str],
+    test: &str,
+) -> Option<PathBuf> {
+    let node = require("node", test)?;
+    let absent: Vec<&str> = packages
+        .iter()
+        .copied()
+        .filter(|package| {
+            !dir.join("node_modules")
+                .join(package)
+                .join("package.json")
+                .is_file()
+        })
+        .collect();
+    if absent.is_empty() {
+        Some(node)
+    } else {
+        missing(
+            &format!(
+                "the node_modules of {} (`npm ci` there; wanted: {})",
+                dir.display(),
+                absent.join(", ")
+            ),
+            test,
+        );
+        None
+    }
+}
