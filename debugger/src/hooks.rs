@@ -128,7 +128,13 @@ impl WatchBus<'_> {
     #[cold]
     #[inline(never)]
     fn note(&self, address: u16, value: u8, write: bool) {
-        if self.hit.get().is_some() {
+        if let Some(hit) = self.hit.get() {
+            // A read-modify-write instruction (INC, ASL...) writes the byte
+            // it read, then the result: the byte it leaves is the one to
+            // tell, not the NMOS 6502's dummy first write.
+            if write && hit.write && hit.address == address {
+                self.hit.set(Some(Access { value, ..hit }));
+            }
             return;
         }
         let found = self
