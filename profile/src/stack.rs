@@ -227,8 +227,30 @@ impl Stack {
         calls.inclusive += cost * frame.times;
     }
 
+    /// Ends the frames whose return slots a push at S = `s_before`
+    /// writes over (the 6502 stack is 256 bytes and wraps), or
+    /// whose slots lie above S (an address pulled and discarded): they can
+    /// never be returned from, and left open the shadow stack would grow
+    /// without bound under a `JSR` that never returns.
+    fn overwritten(&mut self, s_before: u8, now: u64) {
+        while let Some(frame) = self.frames.last() {
+            let (return_s, slot) = match frame.ends {
+                Ends::Return { return_s } => (return_s, 2),
+                Ends::Interrupt { return_s } => (return_s, 3),
+                Ends::Command => break,
+            };
+            // The frame's slot runs from return_s down by `slot` bytes; a
+            // push that starts below it leaves it whole.
+            if u16::from(s_before) + slot <= u16::from(return_s) {
+                break;
+            }
+            self.pop(now);
+        }
+    }
+
     /// A `JSR` to `target` with S at `s_before` before it, ending at `now`.
     pub(crate) fn call(&mut self, target: u16, s_before: u8, now: u64, times: u64) {
+        self.overwritten(s_before, now);
         self.push(
             Routine::Sub(target),
             Ends::Return { return_s: s_before },
@@ -240,6 +262,7 @@ impl Stack {
     /// An IRQ, NMI or BRK whose sequence began at `entry`, with S at
     /// `s_before` before its pushes.
     pub(crate) fn interrupt(&mut self, routine: Routine, s_before: u8, entry: u64) {
+        self.overwritten(s_before, entry);
         self.push(routine, Ends::Interrupt { return_s: s_before }, entry, 1);
     }
 

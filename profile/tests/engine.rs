@@ -219,3 +219,33 @@ fn interrupts_are_roots_of_their_own() {
     // Everything counted once: the stacks add up to the total.
     assert_eq!(profile.stacks.values().sum::<u64>(), profile.total);
 }
+
+/// `rec: JSR rec` never returns: the 6502 stack wraps every 128 calls and
+/// overwrites the oldest return addresses, so the shadow stack (and every
+/// folded path) stays as deep as the real stack can hold, not as deep as
+/// the number of calls.
+#[test]
+fn a_call_that_never_returns_keeps_the_stack_as_deep_as_the_6502s() {
+    let mut machine = Machine::with_image(0x0400, &[0x20, 0x00, 0x04]).expect("the loop fits");
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "rec".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    // 1000 calls: almost eight times round the stack.
+    let _ = machine.run_with(6_000, &mut (&mut profiler, StopAtTrap));
+    profiler.end_run(&machine.cpu);
+    let profile = profiler.finish(machine.cpu.cycles());
+
+    let deepest = profile
+        .stacks
+        .keys()
+        .map(|path| path.split(';').count())
+        .max()
+        .expect("some stack");
+    assert!(
+        (100..=130).contains(&deepest),
+        "deepest path {deepest} frames"
+    );
+    assert_eq!(profile.routines["rec"].calls, 1000);
+    assert_eq!(profile.total, machine.cpu.cycles(), "every cycle counted");
+}
