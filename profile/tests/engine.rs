@@ -249,3 +249,25 @@ fn a_call_that_never_returns_keeps_the_stack_as_deep_as_the_6502s() {
     assert_eq!(profile.routines["rec"].calls, 1000);
     assert_eq!(profile.total, machine.cpu.cycles(), "every cycle counted");
 }
+
+/// A run that ends stuck (`JSR sp` / `sp: JMP sp`) and whose clock moved on
+/// past the last instruction counted (the robot's stuck window): a frame
+/// still open is closed at the last instruction counted, so its inclusive
+/// cycles are no more than the run's.
+#[test]
+fn a_frame_open_at_the_end_closes_at_the_last_instruction_counted() {
+    let mut machine =
+        Machine::with_image(0x0400, &[0x20, 0x03, 0x04, 0x4C, 0x03, 0x04]).expect("it fits");
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "start".to_owned()), (0x0403, "sp".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    let _ = machine.run_with(3_000, &mut (&mut profiler, StopAtTrap));
+    profiler.end_run(&machine.cpu);
+    let stuck_window = 100_000;
+    let profile = profiler.finish(machine.cpu.cycles() + stuck_window);
+
+    let sp = &profile.routines["sp"];
+    assert_eq!(sp.inclusive, profile.total - 6, "all but the JSR");
+    assert_eq!(sp.inclusive, sp.exclusive);
+}
