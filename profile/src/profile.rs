@@ -15,7 +15,8 @@ pub struct RoutineCost {
     /// Calls that ended before the run did.
     pub ended: u64,
     /// From entry to exit, summed over the calls that ended (a call's
-    /// `RTS` is its own, the `JSR` its caller's).
+    /// `RTS` is its own, the `JSR` its caller's); a recursive routine's
+    /// outermost calls only, since the inner ones are inside them.
     pub inclusive: u64,
     /// Spent in its own instructions (not in routines it called, nor in
     /// interrupts, which are roots of their own).

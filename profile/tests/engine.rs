@@ -271,3 +271,42 @@ fn a_frame_open_at_the_end_closes_at_the_last_instruction_counted() {
     assert_eq!(sp.inclusive, profile.total - 6, "all but the JSR");
     assert_eq!(sp.inclusive, sp.exclusive);
 }
+
+/// `down` calls itself ten deep: its inclusive cycles are those of its
+/// outermost call (every cycle but the caller's), not the sum over the
+/// ten nested calls, each of which holds the ones inside it.
+///
+/// ```text
+/// 0400  A2 0A     LDX #10
+/// 0402  20 08 04  JSR down
+/// 0405  4C 05 04  JMP *        (the trap)
+/// 0408  CA        down: DEX
+/// 0409  F0 03     BEQ out
+/// 040B  20 08 04  JSR down
+/// 040E  60        out: RTS
+/// ```
+#[test]
+fn a_recursive_routine_counts_its_outermost_call_only() {
+    let mut machine = Machine::with_image(
+        0x0400,
+        &[
+            0xA2, 0x0A, 0x20, 0x08, 0x04, 0x4C, 0x05, 0x04, 0xCA, 0xF0, 0x03, 0x20, 0x08, 0x04,
+            0x60,
+        ],
+    )
+    .expect("it fits");
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "start".to_owned()), (0x0408, "down".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    let stop = machine.run_with(10_000, &mut (&mut profiler, StopAtTrap));
+    assert!(matches!(stop, emulator::Stop::Trap { .. }), "{stop:?}");
+    profiler.end_run(&machine.cpu);
+    let profile = profiler.finish(machine.cpu.cycles());
+
+    let down = &profile.routines["down"];
+    assert_eq!((down.calls, down.ended), (10, 10));
+    // LDX 2 + JSR 6 + JMP 3 are the caller's.
+    assert_eq!(down.inclusive, profile.total - 11);
+    assert_eq!(down.inclusive, down.exclusive, "it calls only itself");
+}
