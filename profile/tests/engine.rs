@@ -310,3 +310,32 @@ fn a_recursive_routine_counts_its_outermost_call_only() {
     assert_eq!(down.inclusive, profile.total - 11);
     assert_eq!(down.inclusive, down.exclusive, "it calls only itself");
 }
+
+/// A `;` command letter (`/1;`) would split its frame in two in the folded
+/// stacks (`main;/1;;dispatch`), where `;` parts frames: it is replaced.
+#[test]
+fn a_semicolon_in_a_command_does_not_split_its_frame() {
+    let mut robot = robot();
+    let recorder = Recorder::attach(&mut robot);
+    // Nothing answers it; it runs all the same.
+    let _ = robot.transact(b"/1;", 1_000_000);
+    robot.run_for(50_000).expect("runs");
+    let profile = recorder.finish(&mut robot);
+
+    let command: Vec<_> = profile
+        .stacks
+        .keys()
+        .filter(|path| path.contains("/1"))
+        .collect();
+    assert!(
+        !command.is_empty(),
+        "the command shows: {:?}",
+        profile.stacks
+    );
+    for path in command {
+        assert!(
+            path.split(';').all(|frame| !frame.is_empty()),
+            "an empty frame in {path}"
+        );
+    }
+}
