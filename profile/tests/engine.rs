@@ -339,3 +339,26 @@ fn a_semicolon_in_a_command_does_not_split_its_frame() {
         );
     }
 }
+
+/// A command that never reaches `CMD_DONE` (`spin: jmp spin`) has no
+/// finished run to hold against its budget: it is over it, not passed.
+#[test]
+fn a_command_that_never_finishes_is_over_its_budget() {
+    let profile = Profile {
+        commands: vec![scorpion_profile::CommandRun {
+            text: "/1Q".to_owned(),
+            arrival: 1000,
+            cycles: None,
+            origin: Some("t.expect:1".to_owned()),
+        }],
+        ..Profile::default()
+    };
+    let budgets = [scorpion_profile::budget::Budget::new("/1Q", 10)];
+    let (overruns, unused) = scorpion_profile::budget::check(&profile, &budgets);
+    assert!(unused.is_empty(), "{unused:?}");
+    assert_eq!(overruns.len(), 1, "the budget fails");
+    assert_eq!(overruns[0].unfinished, 1);
+    let said = overruns[0].to_string();
+    assert!(said.contains("never finished"), "{said}");
+    assert!(said.contains("t.expect:1"), "{said}");
+}
