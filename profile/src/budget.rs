@@ -42,8 +42,11 @@ impl Budget {
 pub struct Overrun {
     /// The budget.
     pub budget: Budget,
-    /// The worst case's cycles.
+    /// The worst case's cycles (of the runs that finished).
     pub worst: u64,
+    /// Runs of a command that never reached `CMD_DONE`: over any budget,
+    /// since they never finished within it.
+    pub unfinished: u64,
     /// Where the worst case came from (a transcript's `file:line`, the
     /// command's text), if known.
     pub origin: Option<String>,
@@ -58,11 +61,19 @@ impl std::fmt::Display for Overrun {
             Subject::Command(command) => format!("command {command}"),
             Subject::Routine(routine) => format!("routine {routine}"),
         };
-        write!(
-            f,
-            "{what} took {} cycles, over its budget of {}",
-            self.worst, self.budget.cycles
-        )?;
+        if self.unfinished > 0 {
+            write!(
+                f,
+                "{what} never finished ({} run(s) never reached CMD_DONE), over its budget of {}",
+                self.unfinished, self.budget.cycles
+            )?;
+        } else {
+            write!(
+                f,
+                "{what} took {} cycles, over its budget of {}",
+                self.worst, self.budget.cycles
+            )?;
+        }
         if let Some(origin) = &self.origin {
             write!(f, " at {origin}")?;
         }
@@ -93,11 +104,23 @@ pub fn check(profile: &Profile, budgets: &[Budget]) -> (Vec<Overrun>, Vec<Unused
                     });
                     continue;
                 };
-                if cost.runs > 0 && cost.worst > budget.cycles {
-                    let run = profile.commands.get(cost.worst_run);
+                let unfinished = cost.unfinished;
+                if unfinished > 0 || (cost.runs > 0 && cost.worst > budget.cycles) {
+                    // The run to point at: the first that never finished,
+                    // else the dearest.
+                    let index = if unfinished > 0 {
+                        profile.commands.iter().position(|run| {
+                            run.cycles.is_none()
+                                && run.text.chars().take(3).collect::<String>() == *key
+                        })
+                    } else {
+                        Some(cost.worst_run)
+                    };
+                    let run = index.and_then(|i| profile.commands.get(i));
                     overruns.push(Overrun {
                         budget: budget.clone(),
                         worst: cost.worst,
+                        unfinished,
                         origin: run.map(origin_of),
                         path: run.map_or_else(String::new, |run| format!("main;{}", run.text)),
                     });
@@ -115,6 +138,7 @@ pub fn check(profile: &Profile, budgets: &[Budget]) -> (Vec<Overrun>, Vec<Unused
                     overruns.push(Overrun {
                         budget: budget.clone(),
                         worst: cost.max,
+                        unfinished: 0,
                         origin: run.map(origin_of),
                         path: cost.worst_path.clone(),
                     });

@@ -187,6 +187,10 @@ pub struct Profiler {
     pub(crate) total: u64,
     /// Laps of idle loops counted without running.
     pub(crate) skipped_laps: u64,
+    /// The cycle the last instruction or interrupt sequence counted ended
+    /// at: frames still open at the end close there, not at a later time
+    /// the machine idled or was stuck through without being counted.
+    last_end: Option<u64>,
 }
 
 impl Profiler {
@@ -221,6 +225,7 @@ impl Profiler {
             commands: Vec::new(),
             total: 0,
             skipped_laps: 0,
+            last_end: None,
         }
     }
 
@@ -294,6 +299,7 @@ impl Profiler {
     fn count(&mut self, ran: Ran, times: u64, end: u64) {
         let at = usize::from(ran.pc);
         let cycles = ran.cycles * times;
+        self.last_end = Some(end);
         self.counts[at] += times;
         self.cycles[at] += cycles;
         self.total += cycles;
@@ -404,7 +410,8 @@ impl Profiler {
     /// Ends every frame still open and turns the counts into a profile.
     #[must_use]
     pub fn finish(mut self, now: u64) -> crate::Profile {
-        self.stack.close(now);
+        let end = self.last_end.map_or(now, |end| end.min(now));
+        self.stack.close(end);
         crate::Profile::from_profiler(&self)
     }
 }
@@ -459,6 +466,7 @@ impl Hooks for Profiler {
             Interrupt::Nmi => Routine::Nmi,
         };
         self.total += 7;
+        self.last_end = Some(began + 7);
         if self.calls {
             self.stack.interrupt(routine, s_before, began);
             // The sequence's own seven cycles are the handler's.

@@ -15,7 +15,8 @@ pub struct RoutineCost {
     /// Calls that ended before the run did.
     pub ended: u64,
     /// From entry to exit, summed over the calls that ended (a call's
-    /// `RTS` is its own, the `JSR` its caller's).
+    /// `RTS` is its own, the `JSR` its caller's); a recursive routine's
+    /// outermost calls only, since the inner ones are inside them.
     pub inclusive: u64,
     /// Spent in its own instructions (not in routines it called, nor in
     /// interrupts, which are roots of their own).
@@ -90,11 +91,12 @@ impl Profile {
             Routine::Command(text) => text.clone(),
         };
         let names: Vec<String> = stack.routines.iter().map(routine_name).collect();
+        let frame_names: Vec<String> = names.iter().map(|name| frame_name(name)).collect();
         let path_of = |node: u32| -> String {
             stack
                 .path(node)
                 .iter()
-                .map(|&routine| names[routine as usize].as_str())
+                .map(|&routine| frame_names[routine as usize].as_str())
                 .collect::<Vec<_>>()
                 .join(";")
         };
@@ -121,7 +123,7 @@ impl Profile {
             if let Some(name) = labels.label(label) {
                 if name != names[routine as usize] {
                     folded.push(';');
-                    folded.push_str(name);
+                    folded.push_str(&frame_name(name));
                 }
             }
             *stacks.entry(folded).or_default() += cycles;
@@ -229,6 +231,12 @@ impl Profile {
         }
         text
     }
+}
+
+/// `name` as a frame of a folded stack, where `;` parts frames: a `;` in
+/// it (a command letter, `/1;`) becomes the fullwidth semicolon U+FF1B.
+fn frame_name(name: &str) -> String {
+    name.replace(';', "\u{FF1B}")
 }
 
 /// Adds `theirs` into `mine`; `offset` shifts the command index.

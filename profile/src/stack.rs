@@ -93,6 +93,9 @@ pub(crate) struct Stack {
     pub(crate) routines: Vec<Routine>,
     routine_ids: FxHashMap<Routine, u32>,
     pub(crate) calls: Vec<Calls>,
+    /// Open frames of each routine: only the outermost one's cycles count
+    /// as its inclusive (a recursive routine's inner calls are inside it).
+    active: Vec<u32>,
     pub(crate) nodes: Vec<Node>,
     node_ids: FxHashMap<(u32, u32), u32>,
     /// Cycles by cell; a cell is a node and a label.
@@ -115,6 +118,7 @@ impl Stack {
             routines: Vec::new(),
             routine_ids: FxHashMap::default(),
             calls: Vec::new(),
+            active: Vec::new(),
             nodes: vec![Node {
                 parent: TOP,
                 routine: u32::MAX,
@@ -147,6 +151,7 @@ impl Stack {
         self.routines.push(routine.clone());
         self.routine_ids.insert(routine, id);
         self.calls.push(Calls::default());
+        self.active.push(0);
         id
     }
 
@@ -198,6 +203,7 @@ impl Stack {
         };
         let node = self.child(parent, routine);
         self.calls[routine as usize].calls += times;
+        self.active[routine as usize] += 1;
         self.frames.push(Frame {
             node,
             routine,
@@ -214,6 +220,9 @@ impl Stack {
         };
         self.frames_changed();
         let cost = now.saturating_sub(frame.entry);
+        let active = &mut self.active[frame.routine as usize];
+        *active = active.saturating_sub(1);
+        let outermost = *active == 0;
         let calls = &mut self.calls[frame.routine as usize];
         if calls.ended == 0 || cost < calls.min {
             calls.min = cost;
@@ -224,11 +233,35 @@ impl Stack {
             calls.worst_command = self.command;
         }
         calls.ended += frame.times;
-        calls.inclusive += cost * frame.times;
+        if outermost {
+            calls.inclusive += cost * frame.times;
+        }
+    }
+
+    /// Ends the frames whose return slots a push at S = `s_before`
+    /// writes over (the 6502 stack is 256 bytes and wraps), or
+    /// whose slots lie above S (an address pulled and discarded): they can
+    /// never be returned from, and left open the shadow stack would grow
+    /// without bound under a `JSR` that never returns.
+    fn overwritten(&mut self, s_before: u8, now: u64) {
+        while let Some(frame) = self.frames.last() {
+            let (return_s, slot) = match frame.ends {
+                Ends::Return { return_s } => (return_s, 2),
+                Ends::Interrupt { return_s } => (return_s, 3),
+                Ends::Command => break,
+            };
+            // The frame's slot runs from return_s down by `slot` bytes; a
+            // push that starts below it leaves it whole.
+            if u16::from(s_before) + slot <= u16::from(return_s) {
+                break;
+            }
+            self.pop(now);
+        }
     }
 
     /// A `JSR` to `target` with S at `s_before` before it, ending at `now`.
     pub(crate) fn call(&mut self, target: u16, s_before: u8, now: u64, times: u64) {
+        self.overwritten(s_before, now);
         self.push(
             Routine::Sub(target),
             Ends::Return { return_s: s_before },
@@ -240,6 +273,7 @@ impl Stack {
     /// An IRQ, NMI or BRK whose sequence began at `entry`, with S at
     /// `s_before` before its pushes.
     pub(crate) fn interrupt(&mut self, routine: Routine, s_before: u8, entry: u64) {
+        self.overwritten(s_before, entry);
         self.push(routine, Ends::Interrupt { return_s: s_before }, entry, 1);
     }
 

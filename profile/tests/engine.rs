@@ -219,3 +219,146 @@ fn interrupts_are_roots_of_their_own() {
     // Everything counted once: the stacks add up to the total.
     assert_eq!(profile.stacks.values().sum::<u64>(), profile.total);
 }
+
+/// `rec: JSR rec` never returns: the 6502 stack wraps every 128 calls and
+/// overwrites the oldest return addresses, so the shadow stack (and every
+/// folded path) stays as deep as the real stack can hold, not as deep as
+/// the number of calls.
+#[test]
+fn a_call_that_never_returns_keeps_the_stack_as_deep_as_the_6502s() {
+    let mut machine = Machine::with_image(0x0400, &[0x20, 0x00, 0x04]).expect("the loop fits");
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "rec".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    // 1000 calls: almost eight times round the stack.
+    let _ = machine.run_with(6_000, &mut (&mut profiler, StopAtTrap));
+    profiler.end_run(&machine.cpu);
+    let profile = profiler.finish(machine.cpu.cycles());
+
+    let deepest = profile
+        .stacks
+        .keys()
+        .map(|path| path.split(';').count())
+        .max()
+        .expect("some stack");
+    assert!(
+        (100..=130).contains(&deepest),
+        "deepest path {deepest} frames"
+    );
+    assert_eq!(profile.routines["rec"].calls, 1000);
+    assert_eq!(profile.total, machine.cpu.cycles(), "every cycle counted");
+}
+
+/// A run that ends stuck (`JSR sp` / `sp: JMP sp`) and whose clock moved on
+/// past the last instruction counted (the robot's stuck window): a frame
+/// still open is closed at the last instruction counted, so its inclusive
+/// cycles are no more than the run's.
+#[test]
+fn a_frame_open_at_the_end_closes_at_the_last_instruction_counted() {
+    let mut machine =
+        Machine::with_image(0x0400, &[0x20, 0x03, 0x04, 0x4C, 0x03, 0x04]).expect("it fits");
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "start".to_owned()), (0x0403, "sp".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    let _ = machine.run_with(3_000, &mut (&mut profiler, StopAtTrap));
+    profiler.end_run(&machine.cpu);
+    let stuck_window = 100_000;
+    let profile = profiler.finish(machine.cpu.cycles() + stuck_window);
+
+    let sp = &profile.routines["sp"];
+    assert_eq!(sp.inclusive, profile.total - 6, "all but the JSR");
+    assert_eq!(sp.inclusive, sp.exclusive);
+}
+
+/// `down` calls itself ten deep: its inclusive cycles are those of its
+/// outermost call (every cycle but the caller's), not the sum over the
+/// ten nested calls, each of which holds the ones inside it.
+///
+/// ```text
+/// 0400  A2 0A     LDX #10
+/// 0402  20 08 04  JSR down
+/// 0405  4C 05 04  JMP *        (the trap)
+/// 0408  CA        down: DEX
+/// 0409  F0 03     BEQ out
+/// 040B  20 08 04  JSR down
+/// 040E  60        out: RTS
+/// ```
+#[test]
+fn a_recursive_routine_counts_its_outermost_call_only() {
+    let mut machine = Machine::with_image(
+        0x0400,
+        &[
+            0xA2, 0x0A, 0x20, 0x08, 0x04, 0x4C, 0x05, 0x04, 0xCA, 0xF0, 0x03, 0x20, 0x08, 0x04,
+            0x60,
+        ],
+    )
+    .expect("it fits");
+    machine.cpu.pc = 0x0400;
+    machine.cpu.s = 0xFF;
+    let labels = [(0x0400, "start".to_owned()), (0x0408, "down".to_owned())];
+    let mut profiler = Profiler::new(&labels, no_places());
+    let stop = machine.run_with(10_000, &mut (&mut profiler, StopAtTrap));
+    assert!(matches!(stop, emulator::Stop::Trap { .. }), "{stop:?}");
+    profiler.end_run(&machine.cpu);
+    let profile = profiler.finish(machine.cpu.cycles());
+
+    let down = &profile.routines["down"];
+    assert_eq!((down.calls, down.ended), (10, 10));
+    // LDX 2 + JSR 6 + JMP 3 are the caller's.
+    assert_eq!(down.inclusive, profile.total - 11);
+    assert_eq!(down.inclusive, down.exclusive, "it calls only itself");
+}
+
+/// A `;` command letter (`/1;`) would split its frame in two in the folded
+/// stacks (`main;/1;;dispatch`), where `;` parts frames: it is replaced.
+#[test]
+fn a_semicolon_in_a_command_does_not_split_its_frame() {
+    let mut robot = robot();
+    let recorder = Recorder::attach(&mut robot);
+    // Nothing answers it; it runs all the same.
+    let _ = robot.transact(b"/1;", 1_000_000);
+    robot.run_for(50_000).expect("runs");
+    let profile = recorder.finish(&mut robot);
+
+    let command: Vec<_> = profile
+        .stacks
+        .keys()
+        .filter(|path| path.contains("/1"))
+        .collect();
+    assert!(
+        !command.is_empty(),
+        "the command shows: {:?}",
+        profile.stacks
+    );
+    for path in command {
+        assert!(
+            path.split(';').all(|frame| !frame.is_empty()),
+            "an empty frame in {path}"
+        );
+    }
+}
+
+/// A command that never reaches `CMD_DONE` (`spin: jmp spin`) has no
+/// finished run to hold against its budget: it is over it, not passed.
+#[test]
+fn a_command_that_never_finishes_is_over_its_budget() {
+    let profile = Profile {
+        commands: vec![scorpion_profile::CommandRun {
+            text: "/1Q".to_owned(),
+            arrival: 1000,
+            cycles: None,
+            origin: Some("t.expect:1".to_owned()),
+        }],
+        ..Profile::default()
+    };
+    let budgets = [scorpion_profile::budget::Budget::new("/1Q", 10)];
+    let (overruns, unused) = scorpion_profile::budget::check(&profile, &budgets);
+    assert!(unused.is_empty(), "{unused:?}");
+    assert_eq!(overruns.len(), 1, "the budget fails");
+    assert_eq!(overruns[0].unfinished, 1);
+    let said = overruns[0].to_string();
+    assert!(said.contains("never finished"), "{said}");
+    assert!(said.contains("t.expect:1"), "{said}");
+}

@@ -8,7 +8,7 @@ use crate::FILE;
 use crate::error::{Error, Located};
 use crate::file::{ProjectFile, WorkspaceFile};
 
-const KEYS_HELP: &str = "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts, builtin_listing (or, for a workspace, [workspace] members alone); docs/PROJECT.md has them all";
+const KEYS_HELP: &str = "the keys: [project] name; [[image]] name, sources, target, include, defines; [robot] port, baud, cards, world, rom; [tests] transcripts, builtin_listing; [budgets] \"/2A\" or a routine's label = cycles (or, for a workspace, [workspace] members alone); docs/PROJECT.md has them all";
 
 /// A project: its root directory and its file.
 #[derive(Debug, Clone)]

@@ -111,6 +111,16 @@ impl Member {
             scorpion_profile::coverage::Coverage::new(&self.profile, &self.lines(), &|file| {
                 read_source(&self.root, file).is_some()
             });
+        let (lines, _) = coverage.line_counts();
+        if lines == 0 {
+            // An lcov.info without a record is one genhtml and lcov reject,
+            // and 0 of 0 lines is no percentage.
+            let _ = writeln!(
+                out,
+                "coverage: nothing to cover (no code line of the project's sources ran or was built); no report written"
+            );
+            return Ok(());
+        }
         let dir = self.root.join("target/scorpion/coverage");
         let lcov = dir.join("lcov.info");
         let html = dir.join("index.html");
@@ -281,6 +291,16 @@ impl Progress for Quiet<'_> {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    if let (Some(folded), Some(svg)) = (&args.folded, &args.flamegraph) {
+        // One would overwrite the other: refuse before running anything.
+        if std::path::absolute(folded).ok() == std::path::absolute(svg).ok() {
+            miette::bail!(
+                help = "give --folded and --flamegraph different files",
+                "--folded and --flamegraph name the same file, {}: the flame graph would overwrite the folded stacks",
+                folded.display()
+            );
+        }
+    }
     let found = Found::here()?;
     let Found::Project(project) = &found else {
         miette::bail!(

@@ -354,3 +354,62 @@ fn the_readmes_profiling_section_runs_as_written() {
         .expect("index.html");
     assert!(html.contains("jsr PUTCH"), "the page shows the source");
 }
+
+/// `--folded F --flamegraph F`: the SVG would overwrite the folded stacks
+/// silently; the same path twice is refused, before anything runs.
+#[test]
+fn the_same_file_for_folded_stacks_and_flame_graph_is_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let same = dir.path().join("out");
+    let same = same.to_str().expect("UTF-8");
+    let output = scorpion(
+        &example("adc"),
+        &["profile", "--folded", same, "--flamegraph", same],
+    );
+    assert!(!output.status.success(), "{}", transcript(&output));
+    let said = transcript(&output);
+    assert!(said.contains("name the same file"), "{said}");
+    assert!(!dir.path().join("out").exists(), "nothing written");
+}
+
+/// Coverage of a project with no code line: no lcov.info without records
+/// (genhtml rejects it) and no "0 of 0 lines (100%)".
+#[test]
+fn coverage_of_a_project_with_no_code_says_there_is_nothing_to_cover() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = dir.path().join("empty");
+    std::fs::create_dir_all(project.join("src")).expect("src");
+    std::fs::create_dir_all(project.join("tests")).expect("tests");
+    std::fs::write(
+        project.join("Scorpion.toml"),
+        "[project]\nname = \"empty\"\n\n[[image]]\nname = \"empty\"\nsources = [\"src/main.s\"]\n",
+    )
+    .expect("write");
+    std::fs::write(project.join("src/main.s"), "; nothing\n").expect("write");
+    std::fs::write(project.join("tests/t.expect"), "/1X => X00\n").expect("write");
+    let output = scorpion(&project, &["test", "--coverage"]);
+    let said = transcript(&output);
+    assert!(said.contains("nothing to cover"), "{said}");
+    assert!(!said.contains("0 of 0 lines"), "{said}");
+    assert!(
+        !project.join("target/scorpion/coverage/lcov.info").exists(),
+        "no lcov.info without records"
+    );
+}
+
+/// The help for an unknown Scorpion.toml key lists every table, `[budgets]`
+/// among them.
+#[test]
+fn the_project_files_key_list_names_budgets() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("Scorpion.toml"),
+        "[project]\nname = \"k\"\nbudget = 3\n",
+    )
+    .expect("write");
+    let output = scorpion(dir.path(), &["test"]);
+    assert!(!output.status.success(), "{}", transcript(&output));
+    let said = transcript(&output);
+    assert!(said.contains("[robot]"), "the key list is shown: {said}");
+    assert!(said.contains("[budgets]"), "{said}");
+}
