@@ -267,6 +267,7 @@ impl Expr {
             chars: text.char_indices().collect(),
             at: 0,
             symbols,
+            operators: 0,
         };
         parser.blank();
         if parser.at == parser.chars.len() {
@@ -435,11 +436,18 @@ struct Parser<'a> {
     /// Index into `chars`.
     at: usize,
     symbols: &'a Symbols,
+    /// Binary operators read so far (see [`MAX_OPERATORS`]).
+    operators: usize,
 }
 
 /// Nesting deeper than this is refused (a hostile line of brackets must
 /// not overflow the stack).
 const MAX_DEPTH: usize = 64;
+
+/// More binary operators than this are refused: a long flat chain
+/// (`1+1+1...`) builds a tree as deep as it is long, which evaluating or
+/// dropping would walk on the stack.
+const MAX_OPERATORS: usize = 1000;
 
 impl Parser<'_> {
     fn peek(&self) -> Option<char> {
@@ -531,6 +539,12 @@ impl Parser<'_> {
             let Some(&(_, _, op)) = found else {
                 return Ok(left);
             };
+            self.operators += 1;
+            if self.operators > MAX_OPERATORS {
+                return Err(self.error_here(&format!(
+                    "too long: an expression has at most {MAX_OPERATORS} operators"
+                )));
+            }
             let right = self.binary_level(level + 1, depth)?;
             left = Node::Binary(op, Box::new(left), Box::new(right));
             if !chains {

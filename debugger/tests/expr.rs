@@ -95,6 +95,16 @@ fn bad_expressions_say_what_at_their_column() {
     }
     let deep = "(".repeat(10_000);
     assert!(Expr::parse(&deep, &symbols()).is_err(), "no stack overflow");
+    // A long flat chain builds a tree as deep as it is long: 100,000
+    // terms overflowed the stack when evaluated or dropped (the monitor's
+    // `print`, `display`, `break ... if`). Bounded, said at its place.
+    let flat = format!("{}1", "1+".repeat(100_000));
+    let error = Expr::parse(&flat, &symbols()).expect_err("too long");
+    assert!(error.reason.contains("at most 1000 operators"), "{error}");
+    assert_eq!(error.column, 2003, "{error}");
+    let most = format!("{}1", "1+".repeat(1000));
+    let expr = Expr::parse(&most, &symbols()).expect("1000 operators");
+    assert_eq!(expr.eval(&machine()).expect("evaluates"), 1001);
 }
 
 #[test]

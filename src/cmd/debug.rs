@@ -59,6 +59,9 @@ pub(crate) struct Args {
 /// unless given: one second of the robot's time.
 const BUDGET: u64 = 1_000_000;
 
+/// The most `display` expressions shown at each stop.
+const DISPLAYS_MAX: usize = 64;
+
 const HELP: &str = "\
 commands (addresses and values are expressions: $C011, 49152, %1010, 'A', a label,
 CMDBUF+1, registers A X Y S P PC, flags C Z I D V N, [ADDR] a byte, {ADDR} a word,
@@ -149,6 +152,10 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             Read::End => {
                 writeln!(out).into_diagnostic()?;
                 break;
+            }
+            Read::Invalid(why) => {
+                writeln!(out, "error: {why}").into_diagnostic()?;
+                continue;
             }
         };
         if !input.is_terminal() {
@@ -565,6 +572,11 @@ fn command(d: &mut Debugger, m: &mut Monitor, line: &str) -> Result<Reply, Failu
             if after.is_empty() {
                 displays(d, m)
             } else {
+                if m.displays.iter().flatten().count() >= DISPLAYS_MAX {
+                    return Err(Failure::Usage(format!(
+                        "at most {DISPLAYS_MAX} expressions are displayed at once; `undisplay N` one first"
+                    )));
+                }
                 let shown = expression(d, after, 0)?;
                 let value = shown_expression(d, &shown);
                 m.displays.push(Some(shown));

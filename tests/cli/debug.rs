@@ -143,7 +143,12 @@ fn breaks_at_a_source_line_and_lists_the_source_there() {
 /// does, but under a memory limit (1 GB of address space, through the
 /// shell's `ulimit`) and a time limit: a command that allocates gigabytes
 /// or runs for ever fails the test instead of the machine.
-fn debug_bounded(dir: &Path, args: &[&str], input: &str, limit: std::time::Duration) -> Output {
+fn debug_bounded(
+    dir: &Path,
+    args: &[&str],
+    input: impl AsRef<[u8]>,
+    limit: std::time::Duration,
+) -> Output {
     use std::io::Write as _;
     use std::process::{Command, Stdio};
     let mut child = Command::new("sh")
@@ -160,11 +165,11 @@ fn debug_bounded(dir: &Path, args: &[&str], input: &str, limit: std::time::Durat
         .spawn()
         .expect("sh runs");
     let mut stdin = child.stdin.take().expect("stdin is piped");
-    let input = input.to_owned();
+    let input = input.as_ref().to_vec();
     // Written on a thread of its own: a monitor stuck in a command stops
     // reading, and the write must not stall the clock below.
     let writer = std::thread::spawn(move || {
-        let _ = stdin.write_all(input.as_bytes());
+        let _ = stdin.write_all(&input);
     });
     let start = std::time::Instant::now();
     while child.try_wait().expect("the child's status").is_none() {
@@ -197,7 +202,7 @@ fn counts_beyond_their_bounds_are_refused_and_the_session_goes_on() {
     let output = debug_bounded(
         &adc,
         &["debug"],
-        &format!("regs\n{script}"),
+        format!("regs\n{script}"),
         std::time::Duration::from_secs(60),
     );
     assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
@@ -405,4 +410,34 @@ fn conditions_counts_logs_sets_and_their_mistakes() {
     assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
     let text = String::from_utf8_lossy(&output.stdout).into_owned();
     insta::assert_snapshot!(text);
+}
+
+/// Found by a fresh-eyes tester of the new monitor: a line that is not
+/// UTF-8 ended the whole session (exit 1, the robot lost), a long flat
+/// expression (`1+1+...`, 100,000 terms) overflowed the stack, and
+/// `display` took any number of expressions. Each is refused alone now;
+/// the session goes on and ends well.
+#[test]
+fn a_bad_line_a_long_expression_and_many_displays_are_refused_alone() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let mut input = b"print 1\nprint \xff\xfe A\nprint 2\n".to_vec();
+    input.extend(format!("print {}1\n", "1+".repeat(5_000)).bytes());
+    input.extend("display A\n".repeat(70).bytes());
+    input.extend(b"print 3\nquit\n");
+    let output = debug_bounded(&adc, &["debug"], input, std::time::Duration::from_secs(60));
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        text.contains("error: that line is not UTF-8 text; it was skipped"),
+        "{text:.3000}"
+    );
+    assert!(text.contains("print 2\n2 = $02"), "{text:.3000}");
+    assert!(text.contains("at most 1000 operators"), "{text:.3000}");
+    assert!(text.contains("display 64: A = "), "{text:.3000}");
+    assert!(!text.contains("display 65:"), "{text:.3000}");
+    assert!(
+        text.contains("at most 64 expressions are displayed at once"),
+        "{text:.3000}"
+    );
+    assert!(text.contains("print 3\n3 = $03"), "{text:.3000}");
 }

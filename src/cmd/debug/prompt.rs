@@ -9,7 +9,7 @@
 //! event loop this REPL has no use for.
 
 use std::collections::BTreeSet;
-use std::io::BufRead;
+use std::io::{BufRead, Read as _};
 use std::path::{Path, PathBuf};
 
 use rustyline::completion::Completer;
@@ -58,7 +58,14 @@ pub(crate) enum Read {
     Interrupted,
     /// The end of the input (Ctrl-D, the script's end).
     End,
+    /// A line that cannot be a command (not UTF-8 text, or longer than
+    /// [`LINE_MAX`]): said, and the session goes on.
+    Invalid(String),
 }
+
+/// The longest line read from a script or a pipe; the rest of a longer
+/// line is skipped.
+pub(crate) const LINE_MAX: u64 = 1 << 20;
 
 /// The monitor's input.
 pub(crate) enum Input {
@@ -68,7 +75,7 @@ pub(crate) enum Input {
         history: Option<PathBuf>,
     },
     /// Plain lines (a script, a pipe).
-    Plain(std::io::Lines<std::io::StdinLock<'static>>),
+    Plain(std::io::StdinLock<'static>),
 }
 
 impl Input {
@@ -97,7 +104,7 @@ impl Input {
                 };
             }
         }
-        Input::Plain(std::io::stdin().lock().lines())
+        Input::Plain(std::io::stdin().lock())
     }
 
     /// Whether lines come from a terminal (else they are echoed, so that
@@ -128,15 +135,58 @@ impl Input {
                 }
                 Err(ReadlineError::Interrupted) => Ok(Read::Interrupted),
                 Err(ReadlineError::Eof) => Ok(Read::End),
-                Err(ReadlineError::Io(error)) => Err(error),
-                Err(other) => Err(std::io::Error::other(other.to_string())),
+                Err(ReadlineError::Io(error))
+                    if error.kind() != std::io::ErrorKind::InvalidData =>
+                {
+                    Err(error)
+                }
+                // A byte that is no UTF-8 typed at the prompt is one bad
+                // line, not the end of the session and its robot.
+                Err(other) => Ok(Read::Invalid(format!(
+                    "that line could not be read: {other}"
+                ))),
             },
-            Input::Plain(lines) => lines.next().transpose().map(|line| match line {
-                Some(line) => Read::Line(line),
-                None => Read::End,
-            }),
+            Input::Plain(stdin) => plain_line(stdin),
         }
     }
+}
+
+/// The next line of a script or a pipe, as bytes first: a line that is
+/// not UTF-8, or longer than [`LINE_MAX`], is refused alone.
+fn plain_line(stdin: &mut impl BufRead) -> std::io::Result<Read> {
+    let mut bytes = Vec::new();
+    let read = stdin
+        .by_ref()
+        .take(LINE_MAX)
+        .read_until(b'\n', &mut bytes)?;
+    if read == 0 {
+        return Ok(Read::End);
+    }
+    if bytes.last() != Some(&b'\n') && read as u64 == LINE_MAX {
+        // Skip the rest of the line, however long, without keeping it.
+        loop {
+            let buffer = stdin.fill_buf()?;
+            if buffer.is_empty() {
+                break;
+            }
+            if let Some(end) = buffer.iter().position(|&b| b == b'\n') {
+                stdin.consume(end + 1);
+                break;
+            }
+            let all = buffer.len();
+            stdin.consume(all);
+        }
+        return Ok(Read::Invalid(format!(
+            "a line longer than {LINE_MAX} bytes was skipped"
+        )));
+    }
+    while matches!(bytes.last(), Some(b'\n' | b'\r')) {
+        bytes.pop();
+    }
+    Ok(match String::from_utf8(bytes) {
+        Ok(line) => Read::Line(line),
+        Err(_) => Read::Invalid("that line is not UTF-8 text; it was skipped".to_owned()),
+    })
 }
 
 /// Where the history of a session in `root` is kept: the project's
