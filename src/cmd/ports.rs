@@ -2,7 +2,6 @@
 //! place the CLI turns a `--port` value into a transport.
 
 use std::process::ExitCode;
-use std::time::Duration;
 
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
@@ -172,49 +171,10 @@ impl Drop for Shown {
 
 /// A line to the virtual robot that shows what its scripts print after
 /// every exchange on it.
-pub(crate) struct Showing<T> {
-    inner: T,
-    shown: Shown,
-}
+pub(crate) type Showing<T> = uploader::transport::Observed<T, Shown>;
 
-impl<T> Showing<T> {
-    /// `inner`, showing `shown` as it runs.
-    pub(crate) fn new(inner: T, shown: Shown) -> Self {
-        Showing { inner, shown }
-    }
-}
-
-impl<T: Transport> Transport for Showing<T> {
-    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
-        let result = self.inner.send(bytes);
-        self.shown.show();
-        result
-    }
-    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
-        let result = self.inner.receive(into, timeout);
-        self.shown.show();
-        result
-    }
-    fn baud(&self) -> u32 {
-        self.inner.baud()
-    }
-    fn set_baud(&mut self, baud: u32) -> uploader::Result<()> {
-        self.inner.set_baud(baud)
-    }
-    fn now(&self) -> Duration {
-        self.inner.now()
-    }
-    fn clear_input(&mut self) -> uploader::Result<()> {
-        let result = self.inner.clear_input();
-        self.shown.show();
-        result
-    }
-    fn name(&self) -> String {
-        self.inner.name()
-    }
-    fn diagnose_silence(&mut self) -> uploader::Result<()> {
-        let result = self.inner.diagnose_silence();
-        self.shown.show();
-        result
+impl uploader::transport::Exchanged for Shown {
+    fn exchanged(&mut self) {
+        self.show();
     }
 }

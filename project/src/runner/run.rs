@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use romlib::VirtualScorpion;
-use uploader::transport::{SerialTransport, VirtualTransport};
+use uploader::transport::{Exchanged, Observed, SerialTransport, VirtualTransport};
 use uploader::{Client, ClientConfig, RomProfile, Transport, UploadImage};
 
 use super::build::{Built, SNAPSHOT_KINDS, build};
@@ -459,15 +459,17 @@ impl Run<'_, '_, '_> {
             self.start(&name);
             let result = match self.robot(setup, built, &name) {
                 Ok((robot, scripts)) => {
-                    let line = Showing {
-                        inner: VirtualTransport::new(robot),
-                        scripts,
-                        progress: self.progress,
-                    };
+                    let line = Showing::new(
+                        VirtualTransport::new(robot),
+                        Tell {
+                            scripts,
+                            progress: self.progress,
+                        },
+                    );
                     let mut client = client(line);
                     let result = run_transcript(project, &path, &mut client, Clock::Robot);
                     robot_time += client.transport().now();
-                    client.transport().done(&name);
+                    done(client.transport(), &name);
                     result
                 }
                 Err(error) => Err(indent(&rendered(error))),
@@ -498,11 +500,10 @@ impl Run<'_, '_, '_> {
                     progress.card_mapped(card, start, end);
                 })?
             };
-            Box::new(Showing {
-                inner: VirtualTransport::new(robot),
-                scripts,
-                progress,
-            })
+            Box::new(Showing::new(
+                VirtualTransport::new(robot),
+                Tell { scripts, progress },
+            ))
         } else {
             Box::new(SerialTransport::open(port, setup.baud)?)
         };
@@ -656,67 +657,39 @@ fn show(scripts: &Scripts, progress: &mut dyn Progress) {
     }
 }
 
-/// A line to the virtual robot that tells what its scripts print after
-/// every exchange on it, and when it is dropped.
-struct Showing<'r, 'p, T> {
-    inner: T,
+/// What a virtual robot's scripts print, told to the progress after
+/// every exchange on its line and when dropped.
+struct Tell<'r, 'p> {
     scripts: Scripts,
     progress: Shared<'r, 'p>,
 }
 
-impl<T> Showing<'_, '_, T> {
+impl Tell<'_, '_> {
     fn show(&self) {
         show(&self.scripts, &mut **self.progress.borrow_mut());
     }
 }
 
-impl Showing<'_, '_, VirtualTransport> {
-    /// The test `name` is done with the robot.
-    fn done(&mut self, name: &str) {
+impl Exchanged for Tell<'_, '_> {
+    fn exchanged(&mut self) {
         self.show();
-        self.progress
-            .borrow_mut()
-            .robot_done(name, self.inner.robot_mut());
     }
 }
 
-impl<T> Drop for Showing<'_, '_, T> {
+impl Drop for Tell<'_, '_> {
     fn drop(&mut self) {
         self.show();
     }
 }
 
-impl<T: Transport> Transport for Showing<'_, '_, T> {
-    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
-        let result = self.inner.send(bytes);
-        self.show();
-        result
-    }
-    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
-        let result = self.inner.receive(into, timeout);
-        self.show();
-        result
-    }
-    fn baud(&self) -> u32 {
-        self.inner.baud()
-    }
-    fn set_baud(&mut self, baud: u32) -> uploader::Result<()> {
-        self.inner.set_baud(baud)
-    }
-    fn now(&self) -> Duration {
-        self.inner.now()
-    }
-    fn clear_input(&mut self) -> uploader::Result<()> {
-        let result = self.inner.clear_input();
-        self.show();
-        result
-    }
-    fn name(&self) -> String {
-        self.inner.name()
-    }
-    fn diagnose_silence(&mut self) -> uploader::Result<()> {
-        let result = self.inner.diagnose_silence();
-        self.show();
-        result
-    }
+/// A line to the virtual robot that tells what its scripts print.
+type Showing<'r, 'p, T> = Observed<T, Tell<'r, 'p>>;
+
+/// The test `name` is done with the robot on `line`.
+fn done(line: &mut Showing<'_, '_, VirtualTransport>, name: &str) {
+    let (inner, tell) = line.parts_mut();
+    tell.show();
+    tell.progress
+        .borrow_mut()
+        .robot_done(name, inner.robot_mut());
 }

@@ -7,12 +7,14 @@
 //! baud rate means the same on both, and the benchmark reads device time.
 
 mod faults;
+mod observed;
 mod serial;
 mod sim;
 
 use std::time::Duration;
 
 pub use faults::{FaultConfig, FaultStats, FaultyTransport};
+pub use observed::{Exchanged, Observed};
 pub use serial::{PortInfo, SerialTransport, list_ports};
 pub use sim::VirtualTransport;
 
