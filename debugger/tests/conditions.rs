@@ -4,7 +4,8 @@
 //! actions so that a step back and forward again sees them. Also `until`
 //! and a run paused by its interrupt flag (Ctrl-C in the monitor).
 
-use std::collections::BTreeMap;
+mod build;
+
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
@@ -35,18 +36,7 @@ not_mine:
 ";
 
 fn debugger() -> Debugger {
-    let files = assembler::MemorySource::new().with("q.s", SOURCE);
-    let options = assembler::Options {
-        builtin_includes: BTreeMap::from([(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]),
-        ..assembler::Options::default()
-    };
-    let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
-        .expect("the handler assembles");
-    let image = romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext")
-        .expect("the handler links");
+    let image = build::extension("q.s", SOURCE);
     let loaded = image.clone();
     let make = Box::new(move || {
         let mut robot = VirtualScorpion::new();

@@ -6,6 +6,8 @@
 //! state seen there (registers, cycle, every byte of memory), and a
 //! second debugger doing the same actions must see the same states.
 
+mod build;
+
 use std::any::Any;
 use std::collections::BTreeMap;
 
@@ -60,17 +62,7 @@ impl Device for Counter {
 }
 
 fn image() -> linker::Image {
-    let files = assembler::MemorySource::new().with("q.s", SOURCE);
-    let options = assembler::Options {
-        builtin_includes: BTreeMap::from([(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]),
-        ..assembler::Options::default()
-    };
-    let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
-        .expect("the handler assembles");
-    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
+    build::extension("q.s", SOURCE)
 }
 
 fn debugger(image: &linker::Image) -> Debugger {

@@ -3,7 +3,7 @@
 //! `who-wrote` must tell the byte the instruction left, not the first,
 //! dummy write of the old value.
 
-use std::collections::BTreeMap;
+mod build;
 
 use debugger::{Debugger, Watch, WatchKind, Why};
 use romlib::VirtualScorpion;
@@ -30,18 +30,7 @@ not_mine:
 ";
 
 fn debugger() -> Debugger {
-    let files = assembler::MemorySource::new().with("p.s", SOURCE);
-    let options = assembler::Options {
-        builtin_includes: BTreeMap::from([(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]),
-        ..assembler::Options::default()
-    };
-    let assembly = assembler::assemble(&files, std::path::Path::new("p.s"), &options)
-        .expect("the handler assembles");
-    let image = romlib::link_against_rom("p.s", &assembly.object, "scorpion-ext")
-        .expect("the handler links");
+    let image = build::extension("p.s", SOURCE);
     let loaded = image.clone();
     let make = Box::new(move || {
         let mut robot = VirtualScorpion::new();

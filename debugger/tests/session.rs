@@ -3,8 +3,9 @@
 //! register, step back and see the earlier registers, find who wrote a
 //! byte, go back to the last breakpoint, and continue to the answer.
 
+mod build;
+
 use std::any::Any;
-use std::collections::BTreeMap;
 
 use debugger::{Breakpoint, Debugger, Watch, WatchKind, Why};
 use emulator::board::Device;
@@ -58,17 +59,7 @@ impl Device for Card {
 }
 
 fn image() -> linker::Image {
-    let files = assembler::MemorySource::new().with("q.s", SOURCE);
-    let options = assembler::Options {
-        builtin_includes: BTreeMap::from([(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]),
-        ..assembler::Options::default()
-    };
-    let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
-        .expect("the handler assembles");
-    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
+    build::extension("q.s", SOURCE)
 }
 
 fn debugger() -> Debugger {
