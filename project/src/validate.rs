@@ -51,13 +51,13 @@ pub(crate) fn check(shown: &str, text: &str, file: &ProjectFile) -> crate::Resul
     };
     // The name heads every report and the new project's files: a blank
     // one reads as a missing one.
+    let name_at = spans
+        .project
+        .as_ref()
+        .and_then(|p| p.name.as_ref())
+        .map_or(0..0, span);
     let control = file.project.name.chars().find(|c| c.is_control());
     if let Some(c) = control {
-        let name_at = spans
-            .project
-            .as_ref()
-            .and_then(|p| p.name.as_ref())
-            .map_or(0..0, span);
         return Err(Located::new(
             shown,
             text,
@@ -68,11 +68,6 @@ pub(crate) fn check(shown: &str, text: &str, file: &ProjectFile) -> crate::Resul
         .into());
     }
     if file.project.name.trim().is_empty() {
-        let name_at = spans
-            .project
-            .as_ref()
-            .and_then(|p| p.name.as_ref())
-            .map_or(0..0, span);
         return Err(Located::new(
             shown,
             text,
