@@ -22,12 +22,16 @@
     reason = "a counting allocator: GlobalAlloc is an unsafe trait; it only forwards to System"
 )]
 
+#[path = "common/clock.rs"]
+mod clock;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
+use clock::Clock;
 use debugger::{Breakpoint, Debugger, Watch, WatchKind};
 use romlib::VirtualScorpion;
 
@@ -103,35 +107,6 @@ fn debugger(image: &linker::Image, setup: impl Fn(&mut Debugger)) -> Debugger {
     setup(&mut d);
     d.send(b"/2A1");
     d
-}
-
-/// A clock of this thread's time on a CPU: the machine is shared with
-/// other work, whose turns a wall clock would count. The scheduler's own
-/// account (`/proc/thread-self/schedstat`, nanoseconds), or the wall clock
-/// where there is none.
-#[derive(Clone, Copy)]
-enum Clock {
-    Cpu(u64),
-    Wall(Instant),
-}
-
-impl Clock {
-    fn start() -> Clock {
-        let on_cpu = std::fs::read_to_string("/proc/thread-self/schedstat")
-            .ok()
-            .and_then(|text| text.split_whitespace().next()?.parse().ok());
-        match on_cpu {
-            Some(ns) => Clock::Cpu(ns),
-            None => Clock::Wall(Instant::now()),
-        }
-    }
-
-    fn elapsed(self) -> Duration {
-        match (self, Clock::start()) {
-            (Clock::Cpu(then), Clock::Cpu(now)) => Duration::from_nanos(now - then),
-            (Clock::Wall(then), _) | (_, Clock::Wall(then)) => then.elapsed(),
-        }
-    }
 }
 
 /// Robot cycles per second of one run.

@@ -17,10 +17,13 @@
 //! `cargo bench -p scorpion-profile`.
 #![allow(clippy::print_stdout, reason = "a benchmark reports on stdout")]
 
+#[path = "../../debugger/benches/common/clock.rs"]
+mod clock;
+
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::time::{Duration, Instant};
 
+use clock::Clock;
 use romlib::VirtualScorpion;
 use scorpion_profile::Recorder;
 use scorpion_profile::coverage::Coverage;
@@ -65,32 +68,6 @@ fn minute(robot: &mut VirtualScorpion) -> u64 {
         robot.run_for(ASK_EVERY).expect("runs");
     }
     robot.cycles() - start
-}
-
-/// A clock of this thread's time on a CPU (see the debugger's bench).
-#[derive(Clone, Copy)]
-enum Clock {
-    Cpu(u64),
-    Wall(Instant),
-}
-
-impl Clock {
-    fn start() -> Clock {
-        let on_cpu = std::fs::read_to_string("/proc/thread-self/schedstat")
-            .ok()
-            .and_then(|text| text.split_whitespace().next()?.parse().ok());
-        match on_cpu {
-            Some(ns) => Clock::Cpu(ns),
-            None => Clock::Wall(Instant::now()),
-        }
-    }
-
-    fn elapsed(self) -> Duration {
-        match (self, Clock::start()) {
-            (Clock::Cpu(then), Clock::Cpu(now)) => Duration::from_nanos(now - then),
-            (Clock::Wall(then), _) | (_, Clock::Wall(then)) => then.elapsed(),
-        }
-    }
 }
 
 /// Robot cycles per second of one run.
