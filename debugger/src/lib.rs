@@ -19,6 +19,15 @@
 //! - [`checkpoints`]: copies of the robot taken as it runs, to go back
 //!   from.
 //!
+//! And its two front ends, one interpreter of conditions, expressions and
+//! requests under both:
+//!
+//! - [`monitor`]: the monitor's command language (`scorpion debug`), each
+//!   line answered as text;
+//! - [`dap`]: the Debug Adapter Protocol server (`scorpion dap`);
+//! - [`sources`] and [`line`], which both use: the source lines they show,
+//!   and the commands they put on the robot's serial line.
+//!
 //! # Back in time
 //!
 //! The emulator is exact and deterministic, so the debugger keeps what
@@ -47,14 +56,19 @@
 //! registers and memory alone, so an idle loop that none of them touches
 //! is skipped as the plain run skips it.
 //!
-//! Nothing here prints: the monitor (`scorpion debug`) does.
+//! Nothing here prints: the monitor's interpreter returns text for the CLI
+//! to print, and the DAP server writes its messages where it is told.
 
 pub mod checkpoints;
+pub mod dap;
 pub mod error;
 pub mod expr;
 pub mod hooks;
+pub mod line;
+pub mod monitor;
 pub mod points;
 pub mod session;
+pub mod sources;
 pub mod symbols;
 
 pub use checkpoints::{CHECKPOINT_EVERY, MAX_CHECKPOINTS};
@@ -62,4 +76,5 @@ pub use error::Error;
 pub use expr::{Expr, Register, Template};
 pub use points::{Breakpoint, HitCondition, PointOptions, Watch, WatchKind};
 pub use session::{Debugger, Event, Logged, MakeRobot, Stopped, Why};
+pub use sources::Sources;
 pub use symbols::Symbols;

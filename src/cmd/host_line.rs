@@ -25,7 +25,7 @@ use romlib::VirtualScorpion;
 /// driver's transmit buffer (`UART_XMIT_SIZE`, a page). At 9600 baud the
 /// line carries them in 4.3 s, so a flood delays the command after it by
 /// no more than that, as on a real port.
-pub(crate) const HOLDS: usize = 4096;
+pub(crate) const HOLDS: usize = debugger::line::HOLDS;
 
 /// Bytes waiting for the line, and how many were dropped.
 #[derive(Debug)]

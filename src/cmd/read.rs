@@ -1,6 +1,5 @@
 //! `scorpion read`: dump robot memory with `/7R` questions.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -42,46 +41,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             .wrap_err_with(|| format!("cannot write {}", path.display()))?,
         None => {
             let mut out = std::io::stdout().lock();
-            write_dump(&mut out, args.address, &bytes).into_diagnostic()?;
+            debugger::monitor::write_dump(&mut out, args.address, &bytes).into_diagnostic()?;
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Sixteen bytes a line: address, hex, and the printable characters.
-pub(crate) fn write_dump(out: &mut impl Write, address: u16, bytes: &[u8]) -> std::io::Result<()> {
-    for (row, chunk) in bytes.chunks(16).enumerate() {
-        let at = usize::from(address) + row * 16;
-        write!(out, "{at:04X}:")?;
-        for byte in chunk {
-            write!(out, " {byte:02X}")?;
-        }
-        let pad = 3 * (16 - chunk.len());
-        let text: String = chunk
-            .iter()
-            .map(|&b| {
-                if (0x20..0x7F).contains(&b) {
-                    char::from(b)
-                } else {
-                    '.'
-                }
-            })
-            .collect();
-        writeln!(out, "{:pad$}  {text}", "")?;
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn dump_layout() {
-        let mut out = Vec::new();
-        super::write_dump(&mut out, 0x0400, b"HELLO, SCORPION!\x4C\x00").expect("in memory");
-        assert_eq!(
-            String::from_utf8(out).expect("ASCII"),
-            "0400: 48 45 4C 4C 4F 2C 20 53 43 4F 52 50 49 4F 4E 21  HELLO, SCORPION!\n\
-             0410: 4C 00                                            L.\n"
-        );
-    }
 }

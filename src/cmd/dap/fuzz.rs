@@ -2,7 +2,7 @@
 //! not, with arguments of any shape (missing, of the wrong type, huge,
 //! negative), before and after `launch`, is answered and the session
 //! goes on; never a panic. The framing's own fuzzing is in
-//! [`super::framing`], the messages' in [`super::protocol`].
+//! `debugger::dap::framing`, the messages' in `debugger::dap::protocol`.
 
 use std::cell::RefCell;
 use std::path::Path;
@@ -12,8 +12,8 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use serde_json::{Map, Value, json};
 
-use super::protocol::{Outbox, Request};
-use super::session::{Busy, Session};
+use debugger::dap::protocol::{Outbox, Request};
+use debugger::dap::session::{Busy, Session};
 
 /// Values of every JSON type, and the extremes of integers.
 fn value() -> impl Strategy<Value = Value> {
@@ -116,7 +116,10 @@ fn fuzz(session: &RefCell<(Session, i64)>) {
 #[test]
 fn any_request_is_answered_and_the_session_goes_on() {
     let outbox = Arc::new(Outbox::new(Box::new(std::io::sink())));
-    let session = RefCell::new((Session::new(outbox, Arc::new(Busy::default())), 0));
+    let session = RefCell::new((
+        Session::new(outbox, Arc::new(Busy::default()), Box::new(super::launch)),
+        0,
+    ));
     // Before launch, then after.
     fuzz(&session);
     let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");

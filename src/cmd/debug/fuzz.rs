@@ -2,7 +2,7 @@
 //! monitor's own verbs and the numbers, addresses and words a careless or
 //! hostile user types, is answered (text or an error) on the ADC example;
 //! never a panic, and never a run or an output beyond the bounds
-//! ([`super::counts`]).
+//! (`debugger::monitor`'s counts).
 
 use std::cell::RefCell;
 use std::path::Path;
@@ -10,7 +10,10 @@ use std::path::Path;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-use super::{Args, Monitor, Reply, Sources, command, recipe};
+use debugger::monitor::{Monitor, Reply};
+use debugger::sources::Sources;
+
+use super::{Args, recipe};
 
 /// Numbers as typed: small, at and around the bounds of u32 and u64,
 /// negative, in other bases, not numbers. (Numbers between a bound's tenth
@@ -150,7 +153,7 @@ fn any_command_line_is_answered_within_its_bounds() {
     let outcome = runner.run(&line(), |line| {
         let mut session = session.borrow_mut();
         let (debugger, monitor) = &mut *session;
-        if let Ok(Reply::Text(text)) = command(debugger, monitor, &line) {
+        if let Ok(Reply::Text(text)) = monitor.command(debugger, &line) {
             // Output bounded: a whole address space's dump or listing.
             prop_assert!(text.len() < 8 << 20, "{line}: {} bytes", text.len());
         }

@@ -1,9 +1,9 @@
 //! `break PLACE [if CONDITION] [hits COUNT] [log MESSAGE]`: a breakpoint
 //! with what it asks before it stops. The condition, the count and the
-//! message are the debugger crate's ([`debugger::PointOptions`]), shared
+//! message are the debugger crate's ([`crate::PointOptions`]), shared
 //! with the DAP server; this reads the monitor's words for them.
 
-use debugger::{Breakpoint, Debugger, Expr, HitCondition, PointOptions, Template};
+use crate::{Breakpoint, Debugger, Expr, HitCondition, PointOptions, Template};
 
 use super::{Failure, address, describe, file_line, pointed, usage};
 
@@ -97,19 +97,7 @@ pub(super) fn add(d: &mut Debugger, line: &str, verb: usize) -> Result<String, F
             }
         }
     }
-    let point = if what == "unknown" {
-        Breakpoint::UnknownHook
-    } else if what.starts_with('/') {
-        Breakpoint::command(what)
-            .ok_or_else(|| usage("a command breakpoint is /, a count 1-9 and a letter: /3A"))?
-    } else if let Some((file, n)) = file_line(what) {
-        Breakpoint::At(
-            d.address_of_line(file, n)
-                .ok_or_else(|| usage(&format!("no code came from {file}:{n}")))?,
-        )
-    } else {
-        Breakpoint::At(address(d, what)?)
-    };
+    let point = place(d, what)?;
     let shown = describe(d, &point);
     let extra = options.describe();
     let kind = if options.log.is_some() {
@@ -121,10 +109,33 @@ pub(super) fn add(d: &mut Debugger, line: &str, verb: usize) -> Result<String, F
     Ok(format!("{kind} {id}: {shown}{extra}\n"))
 }
 
+/// Where `what` stops, as `break` (and the DAP server's function
+/// breakpoints) take it: `unknown` (the unknown-command hook), a robot
+/// command `/3A`, `FILE:LINE`, or an address expression (`checksum`,
+/// `$0403`, `CMDBUF+1`).
+///
+/// # Errors
+/// [`Failure::Usage`]: none of those.
+pub(crate) fn place(d: &Debugger, what: &str) -> Result<Breakpoint, Failure> {
+    Ok(if what == "unknown" {
+        Breakpoint::UnknownHook
+    } else if what.starts_with('/') {
+        Breakpoint::command(what)
+            .ok_or_else(|| usage("a command breakpoint is /, a count 1-9 and a letter: /3A"))?
+    } else if let Some((file, n)) = file_line(what) {
+        Breakpoint::At(
+            d.address_of_line(file, n)
+                .ok_or_else(|| usage(&format!("no code came from {file}:{n}")))?,
+        )
+    } else {
+        Breakpoint::At(address(d, what)?)
+    })
+}
+
 /// A parse error in a clause, its column counted in the whole line and
 /// pointed at under it.
-fn at_line(error: &debugger::expr::ParseError, line: &str, column: usize) -> String {
-    let whole = debugger::expr::ParseError {
+fn at_line(error: &crate::expr::ParseError, line: &str, column: usize) -> String {
+    let whole = crate::expr::ParseError {
         text: line.to_owned(),
         column: error.column + column,
         reason: error.reason.clone(),

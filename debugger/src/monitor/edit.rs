@@ -3,7 +3,7 @@
 //! change is a host action the debugger records, so that a step back and
 //! forward again sees it at the same instruction.
 
-use debugger::{Debugger, Register};
+use crate::{Debugger, Register};
 
 use super::{Failure, address, expression, registers, usage};
 
@@ -27,7 +27,7 @@ pub(super) fn set(d: &mut Debugger, text: &str) -> Result<String, Failure> {
     d.set_register(register, value)?;
     Ok(format!(
         "{register} = {}\n  {}\n",
-        debugger::expr::show(value),
+        crate::expr::show(value),
         registers(d)
     ))
 }

@@ -13,11 +13,11 @@
 use std::io::{BufRead, Read, Write};
 
 /// The longest header line taken, in bytes (without its line end).
-pub(crate) const MAX_HEADER_LINE: usize = 1024;
+pub const MAX_HEADER_LINE: usize = 1024;
 
 /// The largest body taken, in bytes: far above any request an editor
 /// sends (breakpoints for a whole file fit in a few kilobytes).
-pub(crate) const MAX_BODY: u64 = 4 << 20;
+pub const MAX_BODY: u64 = 4 << 20;
 
 /// The largest body skipped to keep in step with the messages after it;
 /// a larger length is taken as a lie (or garbage), and the reader looks
@@ -29,7 +29,7 @@ const CONTENT_LENGTH: &[u8] = b"Content-Length:";
 
 /// Why a message could not be read; the reader has gone past it.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub(crate) enum FrameError {
+pub enum FrameError {
     /// A header line longer than [`MAX_HEADER_LINE`].
     #[error("a header line longer than {MAX_HEADER_LINE} bytes")]
     HeaderTooLong,
@@ -72,7 +72,7 @@ enum HeaderLine {
 
 /// Reads messages from a stream of the base protocol.
 #[derive(Debug)]
-pub(crate) struct FrameReader<R> {
+pub struct FrameReader<R> {
     input: R,
     /// After an error that lost the message's bounds: look for the next
     /// `Content-Length:` before anything else.
@@ -85,7 +85,7 @@ pub(crate) struct FrameReader<R> {
 
 impl<R: BufRead> FrameReader<R> {
     /// Reads messages from `input`.
-    pub(crate) fn new(input: R) -> FrameReader<R> {
+    pub fn new(input: R) -> FrameReader<R> {
         FrameReader {
             input,
             lost: false,
@@ -100,7 +100,7 @@ impl<R: BufRead> FrameReader<R> {
     ///
     /// # Errors
     /// The input's own read errors.
-    pub(crate) fn next_message(&mut self) -> std::io::Result<Option<Result<Vec<u8>, FrameError>>> {
+    pub fn next_message(&mut self) -> std::io::Result<Option<Result<Vec<u8>, FrameError>>> {
         if self.ended {
             return Ok(None);
         }
@@ -269,7 +269,7 @@ impl<R: BufRead> FrameReader<R> {
 ///
 /// # Errors
 /// The output's write errors.
-pub(crate) fn write_message(out: &mut impl Write, body: &[u8]) -> std::io::Result<()> {
+pub fn write_message(out: &mut impl Write, body: &[u8]) -> std::io::Result<()> {
     write!(out, "Content-Length: {}\r\n\r\n", body.len())?;
     out.write_all(body)?;
     out.flush()

@@ -17,30 +17,30 @@ use super::framing;
 
 /// A request from the client.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Request {
+pub struct Request {
     /// Its sequence number.
-    pub(crate) seq: i64,
+    pub seq: i64,
     /// Its command: `launch`, `next`...
-    pub(crate) command: String,
+    pub command: String,
     /// Its arguments (an empty object when it had none).
-    pub(crate) arguments: Map<String, Value>,
+    pub arguments: Map<String, Value>,
 }
 
 /// A message that is not a request this adapter can take: what is known
 /// of it, to answer it.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Refused {
+pub struct Refused {
     /// Its `seq`, if one could be found.
-    pub(crate) seq: Option<i64>,
+    pub seq: Option<i64>,
     /// Its `command`, if one could be found.
-    pub(crate) command: Option<String>,
+    pub command: Option<String>,
     /// Why it is refused.
-    pub(crate) why: String,
+    pub why: String,
 }
 
 /// What a message's body is.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Incoming {
+pub enum Incoming {
     /// A request.
     Request(Request),
     /// Something else a client may send (a response to a reverse request:
@@ -51,7 +51,7 @@ pub(crate) enum Incoming {
 }
 
 /// A message's body as a request, or why it is not one.
-pub(crate) fn parse(body: &[u8]) -> Incoming {
+pub fn parse(body: &[u8]) -> Incoming {
     let value: Value = match serde_json::from_slice(body) {
         Ok(value) => value,
         Err(error) => {
@@ -135,7 +135,7 @@ fn salvage(body: &[u8]) -> (Option<i64>, Option<String>) {
 /// answers `pause` and `disconnect` when the robot does not come back):
 /// the first answer to a request [`Outbox::watch`]ed goes out, a later
 /// one does not.
-pub(crate) struct Outbox {
+pub struct Outbox {
     state: Mutex<State>,
     answered: Condvar,
 }
@@ -156,7 +156,7 @@ struct State {
 
 impl Outbox {
     /// Messages into `out`.
-    pub(crate) fn new(out: Box<dyn Write + Send>) -> Outbox {
+    pub fn new(out: Box<dyn Write + Send>) -> Outbox {
         Outbox {
             state: Mutex::new(State {
                 out,
@@ -186,7 +186,7 @@ impl Outbox {
     ///
     /// # Errors
     /// The output's write errors.
-    pub(crate) fn respond(
+    pub fn respond(
         &self,
         request_seq: i64,
         command: &str,
@@ -224,7 +224,7 @@ impl Outbox {
     ///
     /// # Errors
     /// The output's write errors.
-    pub(crate) fn event(&self, event: &str, body: Option<Value>) -> std::io::Result<()> {
+    pub fn event(&self, event: &str, body: Option<Value>) -> std::io::Result<()> {
         let mut state = self.lock()?;
         let mut message = Map::new();
         message.insert("type".into(), json!("event"));
@@ -240,7 +240,7 @@ impl Outbox {
     ///
     /// # Errors
     /// The output's write errors.
-    pub(crate) fn output(&self, category: &str, text: &str) -> std::io::Result<()> {
+    pub fn output(&self, category: &str, text: &str) -> std::io::Result<()> {
         self.event(
             "output",
             Some(json!({"category": category, "output": text})),
@@ -249,7 +249,7 @@ impl Outbox {
 
     /// Notes that request `seq` is to be answered once only: whoever
     /// answers first.
-    pub(crate) fn watch(&self, seq: i64) {
+    pub fn watch(&self, seq: i64) {
         if let Ok(mut state) = self.state.lock() {
             state.watched.insert(seq, false);
         }
@@ -257,7 +257,7 @@ impl Outbox {
 
     /// Waits up to `wait` for request `seq` (watched) to be answered;
     /// true if it was.
-    pub(crate) fn wait_answered(&self, seq: i64, wait: Duration) -> bool {
+    pub fn wait_answered(&self, seq: i64, wait: Duration) -> bool {
         let deadline = Instant::now() + wait;
         let Ok(mut state) = self.state.lock() else {
             return false;

@@ -3,8 +3,7 @@
 //! debug-console line starting with `/` (`evaluate`). Each is one command
 //! as the ROM reads it (docs/PROTOCOL.md, section 1: `/`, a count N of 1
 //! to 9, then N characters), so the longest is 11 characters; and
-//! `launch` sends no more in all than a serial port holds
-//! ([`crate::cmd::host_line::HOLDS`]). Sent as it came, 100 kB of
+//! `launch` sends no more in all than a serial port holds ([`HOLDS`]). Sent as it came, 100 kB of
 //! "command" queued about 48 bytes of memory a byte and minutes of line
 //! time ahead of everything after it.
 
@@ -12,10 +11,18 @@ use romlib::protocol::{Command, EXTENSION_MAX_LEN};
 
 /// The longest command: `/`, the count, and the most characters a count
 /// says.
-pub(crate) const MAX_COMMAND: usize = 2 + EXTENSION_MAX_LEN;
+pub const MAX_COMMAND: usize = 2 + EXTENSION_MAX_LEN;
+
+/// The most bytes a serial port holds on their way out: Linux's serial
+/// driver's transmit buffer (`UART_XMIT_SIZE`, a page), the bound the
+/// simulator's host line keeps too.
+pub const HOLDS: usize = 4096;
 
 /// `text` as a command to send, or why it is not one.
-pub(crate) fn command(text: &str) -> Result<Command, String> {
+///
+/// # Errors
+/// Why it is not one command as the ROM reads it.
+pub fn command(text: &str) -> Result<Command, String> {
     if text.len() > MAX_COMMAND {
         let shown: String = text.chars().take(MAX_COMMAND).collect();
         return Err(format!(
@@ -28,12 +35,15 @@ pub(crate) fn command(text: &str) -> Result<Command, String> {
 
 /// Checks `launch`'s `commands`: each a command, and no more in all than a
 /// serial port holds.
-pub(crate) fn commands(texts: &[String]) -> Result<(), String> {
+///
+/// # Errors
+/// A list longer than [`HOLDS`], or the first that is not a command.
+pub fn commands(texts: &[String]) -> Result<(), String> {
     let total: usize = texts.iter().map(String::len).sum();
-    if total > crate::cmd::host_line::HOLDS {
+    if total > HOLDS {
         return Err(format!(
             "`commands` holds {total} bytes: at most {} go down the line at once (what a serial port holds); send the rest from the debug console",
-            crate::cmd::host_line::HOLDS
+            HOLDS
         ));
     }
     texts.iter().try_for_each(|text| command(text).map(drop))

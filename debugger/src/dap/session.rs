@@ -8,14 +8,15 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use base64::Engine as _;
-use debugger::{Breakpoint, Debugger, Stopped, Why};
 use serde_json::{Map, Value, json};
 
+use super::Launcher;
 use super::protocol::{Outbox, Request};
-use crate::cmd::debug::{self, Sources};
+use crate::sources::Sources;
+use crate::{Breakpoint, Debugger, Stopped, Why};
 
 /// Robot time a running robot gets between looks for requests (10 ms).
-pub(crate) const SLICE: u64 = 10_000;
+pub const SLICE: u64 = 10_000;
 /// The only thread: the 6502.
 const THREAD: i64 = 1;
 /// `variablesReference` of the registers and of the flags.
@@ -31,7 +32,7 @@ const NOT_LAUNCHED: &str = "launch a program first";
 /// What the robot's thread is doing, for the one that answers when it
 /// does not come back: since when, and what.
 #[derive(Debug, Default)]
-pub(crate) struct Busy(Mutex<Option<(Instant, String)>>);
+pub struct Busy(Mutex<Option<(Instant, String)>>);
 
 impl Busy {
     fn start(&self, what: String) {
@@ -47,7 +48,7 @@ impl Busy {
     }
 
     /// What it has been doing, and for how long; `None` when idle.
-    pub(crate) fn describe(&self) -> Option<String> {
+    pub fn describe(&self) -> Option<String> {
         let busy = self.0.lock().ok()?;
         let (since, what) = busy.as_ref()?;
         Some(format!("{what} for {:.1} s", since.elapsed().as_secs_f64()))
@@ -55,8 +56,9 @@ impl Busy {
 }
 
 /// The session's state.
-pub(crate) struct Session {
+pub struct Session {
     outbox: Arc<Outbox>,
+    launcher: Launcher,
     busy: Arc<Busy>,
     debugger: Option<Debugger>,
     sources: Sources,
@@ -66,6 +68,15 @@ pub(crate) struct Session {
     stop_on_entry: bool,
     commands: Vec<String>,
     running: bool,
+}
+
+impl std::fmt::Debug for Session {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session")
+            .field("debugger", &self.debugger)
+            .field("running", &self.running)
+            .finish_non_exhaustive()
+    }
 }
 
 /// What happens after a response.
@@ -86,9 +97,11 @@ type Answer = Result<(Option<Value>, Then), String>;
 
 impl Session {
     /// A session, not launched, answering through `outbox`.
-    pub(crate) fn new(outbox: Arc<Outbox>, busy: Arc<Busy>) -> Session {
+    #[must_use]
+    pub fn new(outbox: Arc<Outbox>, busy: Arc<Busy>, launcher: Launcher) -> Session {
         Session {
             outbox,
+            launcher,
             busy,
             debugger: None,
             sources: Sources::new(PathBuf::from(".")),
@@ -100,13 +113,13 @@ impl Session {
     }
 
     /// The robot runs (between requests).
-    pub(crate) fn running(&self) -> bool {
+    pub fn running(&self) -> bool {
         self.running
     }
 
     /// A program is launched.
-    #[cfg(test)]
-    pub(crate) fn launched(&self) -> bool {
+    #[must_use]
+    pub fn launched(&self) -> bool {
         self.debugger.is_some()
     }
 
@@ -131,7 +144,7 @@ impl Session {
     ///
     /// # Errors
     /// The output's write errors.
-    pub(crate) fn handle(&mut self, request: &Request) -> std::io::Result<bool> {
+    pub fn handle(&mut self, request: &Request) -> std::io::Result<bool> {
         self.busy.start(format!("answering `{}`", request.command));
         let answer = self.answer(request);
         self.busy.end();
@@ -185,7 +198,7 @@ impl Session {
                 )?;
                 let stop_on_entry = args.boolean("stopOnEntry")?.unwrap_or(false);
                 let commands = args.strings("commands")?.unwrap_or_default();
-                debug::line::commands(&commands).map_err(|e| format!("launch: {e}"))?;
+                crate::line::commands(&commands).map_err(|e| format!("launch: {e}"))?;
                 let cwd = args.string("cwd")?.map(PathBuf::from);
                 self.launch(Path::new(program), cwd)
                     .map_err(|e| format!("{e:?}"))?;
@@ -258,7 +271,7 @@ impl Session {
                     .ok_or("evaluate needs `expression`")?
                     .trim();
                 let result = if expression.starts_with('/') {
-                    debug::line::command(expression)?;
+                    crate::line::command(expression)?;
                     debugger.send(expression.as_bytes());
                     format!("sent {expression}")
                 } else {
@@ -351,7 +364,7 @@ impl Session {
     /// response.
     fn step_by(
         &mut self,
-        step: impl FnOnce(&mut Debugger) -> Result<Stopped, debugger::Error>,
+        step: impl FnOnce(&mut Debugger) -> Result<Stopped, crate::Error>,
     ) -> Answer {
         let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
         let stop = step(debugger).map_err(|e| e.to_string())?;
@@ -376,7 +389,7 @@ impl Session {
     ///
     /// # Errors
     /// The output's write errors.
-    pub(crate) fn run_slice(&mut self) -> std::io::Result<()> {
+    pub fn run_slice(&mut self) -> std::io::Result<()> {
         let Some(debugger) = self.debugger.as_mut() else {
             self.running = false;
             return Ok(());
@@ -404,35 +417,7 @@ impl Session {
     /// `launch`: the robot with `program` (an image, or a project's
     /// directory).
     fn launch(&mut self, program: &Path, cwd: Option<PathBuf>) -> miette::Result<()> {
-        // A directory that is no project's would launch the bare ROM
-        // without a word: most likely a slip in the editor's settings.
-        if program.is_dir()
-            && !std::path::absolute(program).is_ok_and(|dir| {
-                dir.ancestors()
-                    .any(|dir| dir.join(scorpion_project::FILE).is_file())
-            })
-        {
-            miette::bail!(
-                help = "`program` is a linked image (ELF) or a project's directory (with a Scorpion.toml in it or above)",
-                "{} is a directory with no {} in it or above",
-                program.display(),
-                scorpion_project::FILE
-            );
-        }
-        let (here, images) = if program.is_dir() {
-            (program.to_path_buf(), Vec::new())
-        } else {
-            let dir = program
-                .parent()
-                .filter(|p| !p.as_os_str().is_empty())
-                .unwrap_or(Path::new("."));
-            (dir.to_path_buf(), vec![program.to_path_buf()])
-        };
-        let args = debug::Args {
-            images,
-            ..debug::Args::default()
-        };
-        let (make, images, root) = debug::recipe(&args, &here)?;
+        let super::Launched { make, images, root } = (self.launcher)(program)?;
         self.debugger = Some(Debugger::new(make, &images)?);
         self.by_source.clear();
         self.running = false;
