@@ -21,14 +21,14 @@ use serde_json::{Value, json};
 /// How long a message may take to come (a loaded machine's margin).
 const PATIENCE: Duration = Duration::from_secs(30);
 
-struct Client {
+pub(crate) struct Client {
     child: Child,
     input: ChildStdin,
     /// Messages as the reader thread framed them, or why it could not.
     messages: Receiver<Result<Value, String>>,
     seq: i64,
     /// Events read while waiting for responses.
-    events: Vec<Value>,
+    pub(crate) events: Vec<Value>,
 }
 
 /// One message read exactly as the protocol frames it: `Content-Length: `,
@@ -67,7 +67,7 @@ fn read_exactly(output: &mut impl Read) -> Result<Option<Value>, String> {
 }
 
 impl Client {
-    fn start() -> Client {
+    pub(crate) fn start() -> Client {
         let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
             .arg("dap")
             .stdin(Stdio::piped())
@@ -103,7 +103,7 @@ impl Client {
         }
     }
 
-    fn read(&mut self) -> Value {
+    pub(crate) fn read(&mut self) -> Value {
         match self.messages.recv_timeout(PATIENCE) {
             Ok(Ok(message)) => message,
             Ok(Err(why)) => panic!("the adapter's output is not framed exactly: {why}"),
@@ -115,13 +115,13 @@ impl Client {
     }
 
     /// Sends `bytes` as they are (a hostile client's framing).
-    fn send_raw(&mut self, bytes: &[u8]) {
+    pub(crate) fn send_raw(&mut self, bytes: &[u8]) {
         self.input.write_all(bytes).expect("write");
         self.input.flush().expect("flush");
     }
 
     /// The response to request `seq` (events meanwhile are kept).
-    fn response_to(&mut self, seq: i64) -> Value {
+    pub(crate) fn response_to(&mut self, seq: i64) -> Value {
         loop {
             let message = self.read();
             if message["type"] == "response" && message["request_seq"] == seq {
@@ -132,7 +132,7 @@ impl Client {
     }
 
     /// Waits for the adapter to end, at most `PATIENCE`; its success.
-    fn ends(&mut self) -> bool {
+    pub(crate) fn ends(&mut self) -> bool {
         let start = Instant::now();
         loop {
             if let Some(status) = self.child.try_wait().expect("the adapter's status") {
@@ -147,7 +147,7 @@ impl Client {
     }
 
     /// Sends a request; returns its response (events meanwhile are kept).
-    fn request(&mut self, command: &str, arguments: Value) -> Value {
+    pub(crate) fn request(&mut self, command: &str, arguments: Value) -> Value {
         self.seq += 1;
         let message =
             json!({"seq": self.seq, "type": "request", "command": command, "arguments": arguments});
@@ -157,7 +157,7 @@ impl Client {
     }
 
     /// The next event named `name` (kept ones first).
-    fn event(&mut self, name: &str) -> Value {
+    pub(crate) fn event(&mut self, name: &str) -> Value {
         if let Some(index) = self.events.iter().position(|e| e["event"] == name) {
             return self.events.remove(index);
         }
@@ -170,13 +170,13 @@ impl Client {
         }
     }
 
-    fn top_frame(&mut self) -> Value {
+    pub(crate) fn top_frame(&mut self) -> Value {
         let trace = self.request("stackTrace", json!({"threadId": 1}));
         assert_eq!(trace["success"], true, "{trace}");
         trace["body"]["stackFrames"][0].clone()
     }
 
-    fn register(&mut self, name: &str) -> String {
+    pub(crate) fn register(&mut self, name: &str) -> String {
         let variables = self.request("variables", json!({"variablesReference": 1}));
         variables["body"]["variables"]
             .as_array()

@@ -7,6 +7,7 @@ mod build;
 mod cards;
 mod config;
 mod dap;
+mod dap_requests;
 mod debug;
 mod debug_pty;
 mod disasm;

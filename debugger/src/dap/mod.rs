@@ -8,7 +8,9 @@
 //! Three parts, each with its own types: [`framing`] reads and writes the
 //! base protocol with bounded lengths; [`protocol`] takes requests from
 //! messages and numbers the responses and events; [`session`] answers
-//! requests on the robot. [`serve`] runs them on two threads: the caller's
+//! requests on the robot, with a module for each family of them
+//! (`breakpoints` and the `points` they set, `exceptions`, `memory` with
+//! the registers, `disassemble`; `arguments` reads them typed). [`serve`] runs them on two threads: the caller's
 //! reads the requests and answers what cannot wait (a message that is not
 //! a request; `pause` and `disconnect` when the robot does not come back),
 //! the robot's thread answers the rest and runs the robot in slices of
@@ -20,7 +22,13 @@ use std::sync::Arc;
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
+mod arguments;
+mod breakpoints;
+mod disassemble;
+mod exceptions;
 pub mod framing;
+mod memory;
+mod points;
 pub mod protocol;
 pub mod session;
 

@@ -2,30 +2,29 @@
 //! debugger, and a running robot run in slices of robot time between
 //! looks for the next request.
 
-use std::collections::HashMap;
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use base64::Engine as _;
-use serde_json::{Map, Value, json};
+use serde_json::{Value, json};
 
 use super::Launcher;
+use super::arguments::Arguments;
+use super::exceptions::{self, Exception};
+use super::memory::{self, FLAGS, REGISTERS};
+use super::points::{Kind, Points};
 use super::protocol::{Outbox, Request};
+use super::{breakpoints, disassemble};
 use crate::sources::Sources;
-use crate::{Breakpoint, Debugger, Stopped, Why};
+use crate::{Debugger, Stopped, Why};
 
 /// Robot time a running robot gets between looks for requests (10 ms).
 pub const SLICE: u64 = 10_000;
 /// The only thread: the 6502.
 const THREAD: i64 = 1;
-/// `variablesReference` of the registers and of the flags.
-const REGISTERS: i64 = 1;
-const FLAGS: i64 = 2;
 /// Robot time a `next` or `stepOut` may take (a second).
 const STEP_BUDGET: u64 = 1_000_000;
-/// The most bytes one `readMemory` answers: the address space.
-const MAX_READ: i64 = 0x1_0000;
 
 const NOT_LAUNCHED: &str = "launch a program first";
 
@@ -62,9 +61,16 @@ pub struct Session {
     busy: Arc<Busy>,
     debugger: Option<Debugger>,
     sources: Sources,
-    /// Breakpoint numbers by source path (`setBreakpoints` replaces a
-    /// source's set).
-    by_source: HashMap<String, Vec<usize>>,
+    /// The breakpoints of every kind, by the client's numbers.
+    points: Points,
+    /// The exception filters on.
+    filters: Vec<&'static str>,
+    /// The exception the robot is stopped at, for `exceptionInfo`.
+    exception: Option<Exception>,
+    /// `launch`'s `program` and `cwd`, for `restart`.
+    launched_with: Option<(PathBuf, Option<PathBuf>)>,
+    /// The source files the images' line tables name (`loadedSources`).
+    files: BTreeSet<String>,
     stop_on_entry: bool,
     commands: Vec<String>,
     running: bool,
@@ -105,7 +111,11 @@ impl Session {
             busy,
             debugger: None,
             sources: Sources::new(PathBuf::from(".")),
-            by_source: HashMap::new(),
+            points: Points::default(),
+            filters: exceptions::defaults(),
+            exception: None,
+            launched_with: None,
+            files: BTreeSet::new(),
             stop_on_entry: false,
             commands: Vec::new(),
             running: false,
@@ -124,11 +134,46 @@ impl Session {
     }
 
     fn stopped(&self, reason: &str, description: Option<String>) -> std::io::Result<()> {
+        self.stopped_at(reason, description, &[])
+    }
+
+    /// The `stopped` event, naming the breakpoints hit.
+    fn stopped_at(
+        &self,
+        reason: &str,
+        description: Option<String>,
+        hit: &[i64],
+    ) -> std::io::Result<()> {
         let mut body = json!({"reason": reason, "threadId": THREAD, "allThreadsStopped": true});
         if let Some(description) = description {
+            if reason == "exception" {
+                body["text"] = json!(description);
+            }
             body["description"] = json!(description);
         }
+        if !hit.is_empty() {
+            body["hitBreakpointIds"] = json!(hit);
+        }
         self.outbox.event("stopped", Some(body))
+    }
+
+    /// What log points logged, as console output.
+    fn show_logs(&mut self) -> std::io::Result<()> {
+        let Some(debugger) = self.debugger.as_mut() else {
+            return Ok(());
+        };
+        let (logs, dropped) = debugger.take_logs();
+        let mut text: String = logs.into_iter().map(|l| l.text + "\n").collect();
+        if dropped > 0 {
+            text.push_str(&format!(
+                "({dropped} more log lines dropped: at most {} between stops)\n",
+                crate::session::MAX_LOGS
+            ));
+        }
+        if text.is_empty() {
+            return Ok(());
+        }
+        self.outbox.output("console", &text)
     }
 
     /// What the robot sent, as console output.
@@ -183,15 +228,7 @@ impl Session {
             map: &request.arguments,
         };
         let body = match request.command.as_str() {
-            "initialize" => {
-                let capabilities = json!({
-                    "supportsConfigurationDoneRequest": true,
-                    "supportsStepBack": true,
-                    "supportsReadMemoryRequest": true,
-                    "supportsTerminateRequest": true,
-                });
-                return Ok((Some(capabilities), Then::Initialized));
-            }
+            "initialize" => return Ok((Some(capabilities()), Then::Initialized)),
             "launch" => {
                 let program = args.string("program")?.ok_or(
                     "launch needs `program`: a linked image (ELF) or a project's directory",
@@ -206,8 +243,45 @@ impl Session {
                 self.commands = commands;
                 None
             }
-            "setBreakpoints" => return self.set_breakpoints(&args),
-            "setExceptionBreakpoints" => None,
+            "restart" => return self.restart(&args),
+            "setBreakpoints" => {
+                let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+                Some(breakpoints::set_source(&mut self.points, debugger, &args)?)
+            }
+            "setFunctionBreakpoints" => {
+                let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+                Some(breakpoints::set_functions(
+                    &mut self.points,
+                    debugger,
+                    &args,
+                )?)
+            }
+            "setInstructionBreakpoints" => {
+                let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+                Some(breakpoints::set_instructions(
+                    &mut self.points,
+                    debugger,
+                    &args,
+                )?)
+            }
+            "dataBreakpointInfo" => {
+                let debugger = self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
+                let scope = args.integer("variablesReference")?.unwrap_or(0);
+                let registers = scope == REGISTERS || scope == FLAGS;
+                Some(breakpoints::data_info(debugger, &args, registers)?)
+            }
+            "setDataBreakpoints" => {
+                let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+                Some(breakpoints::set_data(&mut self.points, debugger, &args)?)
+            }
+            "setExceptionBreakpoints" => Some(self.set_exceptions(&args)?),
+            "exceptionInfo" => {
+                let exception = self
+                    .exception
+                    .as_ref()
+                    .ok_or("the robot is not stopped at an exception")?;
+                Some(exception.info())
+            }
             "configurationDone" => {
                 let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
                 for command in &self.commands {
@@ -233,36 +307,48 @@ impl Session {
             "variables" => {
                 let debugger = self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
                 let reference = args.integer("variablesReference")?.unwrap_or(0);
-                Some(json!({"variables": variables(debugger, reference)}))
+                Some(json!({"variables": memory::variables(debugger, reference)}))
+            }
+            "setVariable" => {
+                let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+                Some(memory::set(debugger, &args)?)
             }
             "readMemory" => {
                 let debugger = self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
+                Some(memory::read(debugger, &args)?)
+            }
+            "writeMemory" => {
+                let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+                Some(memory::write(debugger, &args)?)
+            }
+            "disassemble" => {
+                let debugger = self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
                 let reference = args
                     .string("memoryReference")?
-                    .ok_or("readMemory needs `memoryReference`")?
-                    .replace("0x", "$");
-                let base = debugger
-                    .symbols()
-                    .address(&reference)
-                    .map_err(|e| e.to_string())?;
+                    .ok_or("disassemble needs `memoryReference`")?;
+                let base = memory::address(debugger, reference, 0)?;
                 let offset = args.integer("offset")?.unwrap_or(0);
-                let count = args.integer("count")?.unwrap_or(0).clamp(0, MAX_READ);
-                let start = i64::from(base).saturating_add(offset);
-                let end = start.saturating_add(count).min(MAX_READ);
-                let bytes: Vec<u8> = (start.max(0)..end)
-                    .filter_map(|at| u16::try_from(at).ok())
-                    .map(|at| emulator::Bus::peek(&debugger.robot().robot().bus, at))
+                let instruction_offset = args.integer("instructionOffset")?.unwrap_or(0);
+                let count = args
+                    .integer("instructionCount")?
+                    .ok_or("disassemble needs `instructionCount`, an integer")?;
+                let instructions = disassemble::instructions(
+                    debugger,
+                    &mut self.sources,
+                    i64::from(base).saturating_add(offset),
+                    instruction_offset,
+                    count,
+                );
+                Some(json!({ "instructions": instructions }))
+            }
+            "loadedSources" => {
+                self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
+                let sources: Vec<Value> = self
+                    .files
+                    .iter()
+                    .map(|file| disassemble::source(&self.sources.root, file))
                     .collect();
-                let unreadable = count - i64::try_from(bytes.len()).unwrap_or(count);
-                let mut body = json!({
-                    "address": format!("0x{:04X}", start.clamp(0, MAX_READ)),
-                    "data": base64::engine::general_purpose::STANDARD.encode(bytes),
-                });
-                if unreadable > 0 {
-                    // Outside the 6502's addresses.
-                    body["unreadableBytes"] = json!(unreadable);
-                }
-                Some(body)
+                Some(json!({ "sources": sources }))
             }
             "evaluate" => {
                 let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
@@ -286,6 +372,7 @@ impl Session {
             }
             "continue" => {
                 self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
+                self.exception = None;
                 return Ok((Some(json!({"allThreadsContinued": true})), Then::Run));
             }
             "pause" => {
@@ -307,57 +394,93 @@ impl Session {
         Ok((body, Then::Nothing))
     }
 
-    fn set_breakpoints(&mut self, args: &Arguments<'_>) -> Answer {
-        let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
-        let source = match args.map.get("source") {
-            Some(Value::Object(source)) => source.clone(),
-            _ => return Err("setBreakpoints needs `source`, an object with a `path`".into()),
-        };
-        let path = source
-            .get("path")
-            .and_then(Value::as_str)
-            .unwrap_or_default()
-            .to_owned();
-        let wanted = match args.map.get("breakpoints") {
-            None | Some(Value::Null) => Vec::new(),
-            Some(Value::Array(wanted)) => wanted.clone(),
-            Some(_) => return Err("setBreakpoints: `breakpoints` is a list".into()),
-        };
-        // Checked before the old set goes: a refused request changes nothing.
-        let mut lines = Vec::with_capacity(wanted.len());
-        for breakpoint in &wanted {
-            let line = breakpoint.get("line").and_then(Value::as_i64).ok_or(
-                "setBreakpoints: each of `breakpoints` is an object with a `line`, a number",
-            )?;
-            lines.push(line);
+    /// `setExceptionBreakpoints`: the filters on (`jam`, `brk`, `card`);
+    /// kept before `launch` too, and set on each robot launched.
+    fn set_exceptions(&mut self, args: &Arguments<'_>) -> Result<Value, String> {
+        let names = args.strings("filters")?.unwrap_or_default();
+        let mut filters = Vec::new();
+        for name in &names {
+            let filter = exceptions::named(name).ok_or_else(|| {
+                format!("setExceptionBreakpoints: no filter `{name}`; they are jam, brk and card")
+            })?;
+            filters.push(filter);
         }
-        for id in self.by_source.remove(&path).unwrap_or_default() {
-            debugger.delete_breakpoint(id);
+        // `filterOptions` (conditions on filters) are not offered.
+        if let Some(options) = args.objects("filterOptions")?.first() {
+            let filter = args.of(options).string("filterId")?.unwrap_or_default();
+            return Err(format!(
+                "setExceptionBreakpoints: the filters take no conditions (`filterOptions` for `{filter}`)"
+            ));
         }
-        let mut ids = Vec::new();
-        let mut answers = Vec::new();
-        for line in lines {
-            let address = u32::try_from(line)
-                .ok()
-                .and_then(|line| debugger.address_of_line(&path, line));
-            let mut answer = json!({
-                "verified": address.is_some(),
-                "line": line,
-                "source": Value::Object(source.clone()),
-            });
-            match address {
-                Some(address) => {
-                    let id = debugger.add_breakpoint(Breakpoint::At(address));
-                    ids.push(id);
-                    answer["id"] = json!(id);
-                    answer["instructionReference"] = json!(format!("0x{address:04X}"));
-                }
-                None => answer["message"] = json!(format!("no code came from line {line}")),
+        self.filters = filters;
+        self.install_brk()?;
+        let answers: Vec<Value> = names.iter().map(|_| json!({"verified": true})).collect();
+        Ok(json!({ "breakpoints": answers }))
+    }
+
+    /// The BRK filter's breakpoint, set or removed as the filters say.
+    fn install_brk(&mut self) -> Result<(), String> {
+        let Some(debugger) = self.debugger.as_mut() else {
+            return Ok(());
+        };
+        let kind = Kind::Exception("brk");
+        let wanted = self.filters.contains(&"brk");
+        if wanted == self.points.has(&kind) {
+            return Ok(());
+        }
+        self.points.clear(debugger, &kind);
+        if wanted {
+            let point = exceptions::brk_point(debugger)?;
+            self.points.add(debugger, kind, point);
+        }
+        Ok(())
+    }
+
+    /// `restart`: the robot built again from power-up (with the
+    /// arguments' new launch configuration, if given), every breakpoint
+    /// set again, the launch's commands sent again; stopped on entry or
+    /// running as `launch` said.
+    fn restart(&mut self, args: &Arguments<'_>) -> Answer {
+        let (old_program, old_cwd) = self.launched_with.clone().ok_or(NOT_LAUNCHED)?;
+        let new = match args.map.get("arguments") {
+            None | Some(Value::Null) => None,
+            Some(Value::Object(map)) => Some(args.of(map)),
+            Some(_) => return Err(args.wrong("arguments", "an object (a launch configuration)")),
+        };
+        let (program, cwd, stop_on_entry, commands) = match &new {
+            Some(new) => {
+                let commands = new.strings("commands")?.unwrap_or_default();
+                crate::line::commands(&commands).map_err(|e| format!("restart: {e}"))?;
+                (
+                    new.string("program")?.map_or(old_program, PathBuf::from),
+                    new.string("cwd")?.map(PathBuf::from).or(old_cwd),
+                    new.boolean("stopOnEntry")?.unwrap_or(false),
+                    commands,
+                )
             }
-            answers.push(answer);
+            None => (
+                old_program,
+                old_cwd,
+                self.stop_on_entry,
+                self.commands.clone(),
+            ),
+        };
+        let super::Launched { make, images, root } =
+            (self.launcher)(&program).map_err(|e| format!("{e:?}"))?;
+        let mut debugger = Debugger::new(make, &images).map_err(|e| e.to_string())?;
+        self.points.install_all(&mut debugger);
+        for command in &commands {
+            debugger.send(command.as_bytes());
         }
-        self.by_source.insert(path, ids);
-        Ok((Some(json!({"breakpoints": answers})), Then::Nothing))
+        self.debugger = Some(debugger);
+        self.files = files(&images);
+        self.sources = Sources::new(cwd.clone().unwrap_or(root));
+        self.launched_with = Some((program, cwd));
+        self.stop_on_entry = stop_on_entry;
+        self.commands = commands;
+        self.exception = None;
+        self.running = false;
+        Ok((None, Then::Configured))
     }
 
     /// A stepping request: done at once, its stop reported after the
@@ -367,25 +490,51 @@ impl Session {
         step: impl FnOnce(&mut Debugger) -> Result<Stopped, crate::Error>,
     ) -> Answer {
         let debugger = self.debugger.as_mut().ok_or(NOT_LAUNCHED)?;
+        self.exception = None;
         let stop = step(debugger).map_err(|e| e.to_string())?;
         Ok((None, Then::Report(stop)))
     }
 
-    /// Says where the robot stopped, after what it sent.
-    fn report(&self, stop: &Stopped) -> std::io::Result<()> {
+    /// Says where the robot stopped, after what it sent and logged.
+    fn report(&mut self, stop: &Stopped) -> std::io::Result<()> {
+        self.show_logs()?;
         self.show_received(&stop.received)?;
+        let Some(debugger) = self.debugger.as_ref() else {
+            return Ok(());
+        };
+        let mut hit = Vec::new();
         let (reason, description) = match &stop.why {
-            Why::Breakpoint { .. } => ("breakpoint", None),
-            Why::Watch { id, .. } => ("data breakpoint", Some(format!("watchpoint {id}"))),
+            Why::Breakpoint { id, .. } => match self.points.breakpoint(*id) {
+                Some((_, Kind::Exception(_))) => {
+                    let exception = Exception::brk(debugger);
+                    let description = exception.description.clone();
+                    self.exception = Some(exception);
+                    ("exception", Some(description))
+                }
+                Some((number, kind)) => {
+                    hit.push(number);
+                    (kind.reason(), None)
+                }
+                None => ("breakpoint", None),
+            },
+            Why::Watch { id, access, pc } => {
+                hit.extend(self.points.watch(*id));
+                (
+                    "data breakpoint",
+                    Some(breakpoints::watch_text(debugger, access, *pc)),
+                )
+            }
             Why::Stepped | Why::Finished | Why::Back => ("step", None),
             Why::Budget => ("pause", Some("the step ran out of robot time".into())),
             Why::Paused => ("pause", None),
         };
-        self.stopped(reason, description)
+        self.stopped_at(reason, description, &hit)
     }
 
     /// One slice of a running robot: a stop is reported, and the robot's
-    /// answers shown as they come.
+    /// answers and log points' lines shown as they come. A run that fails
+    /// (a JAM, a card's fault) stops at an exception if its filter is on;
+    /// otherwise the program has ended.
     ///
     /// # Errors
     /// The output's write errors.
@@ -401,15 +550,31 @@ impl Session {
         let run = debugger.run(SLICE);
         self.busy.end();
         match run {
-            Ok(stop) if stop.why == Why::Budget => self.show_received(&stop.received),
+            Ok(stop) if stop.why == Why::Budget => {
+                // The log points' lines first, as the monitor shows them:
+                // most were logged before the robot answered.
+                self.show_logs()?;
+                self.show_received(&stop.received)
+            }
             Ok(stop) => {
                 self.running = false;
                 self.report(&stop)
             }
             Err(error) => {
                 self.running = false;
-                self.outbox.output("stderr", &format!("{error}\n"))?;
-                self.stopped("exception", Some(error.to_string()))
+                self.show_logs()?;
+                let exception = Exception::from_error(&error);
+                self.outbox
+                    .output("stderr", &format!("{}\n", exception.details))?;
+                if exception.id == "error" || self.filters.contains(&exception.id) {
+                    let description = exception.description.clone();
+                    self.exception = Some(exception);
+                    self.stopped("exception", Some(description))
+                } else {
+                    // The robot cannot go on, and nobody asked to stop
+                    // there: the program has ended.
+                    self.outbox.event("terminated", None)
+                }
             }
         }
     }
@@ -419,64 +584,55 @@ impl Session {
     fn launch(&mut self, program: &Path, cwd: Option<PathBuf>) -> miette::Result<()> {
         let super::Launched { make, images, root } = (self.launcher)(program)?;
         self.debugger = Some(Debugger::new(make, &images)?);
-        self.by_source.clear();
+        self.points.forget();
+        self.files = files(&images);
+        self.exception = None;
         self.running = false;
         // An image's source paths are as its build was given them: `cwd`
         // says from where.
-        self.sources = Sources::new(cwd.unwrap_or(root));
+        self.sources = Sources::new(cwd.clone().unwrap_or(root));
+        self.launched_with = Some((program.to_path_buf(), cwd));
+        self.install_brk().map_err(|e| miette::miette!("{e}"))?;
         Ok(())
     }
 }
 
-/// A request's arguments, read with their types checked.
-struct Arguments<'a> {
-    command: &'a str,
-    map: &'a Map<String, Value>,
+/// What `initialize` answers: exactly what this adapter does.
+fn capabilities() -> Value {
+    json!({
+        "supportsConfigurationDoneRequest": true,
+        "supportsStepBack": true,
+        "supportsReadMemoryRequest": true,
+        "supportsWriteMemoryRequest": true,
+        "supportsTerminateRequest": true,
+        "supportsRestartRequest": true,
+        "supportsConditionalBreakpoints": true,
+        "supportsHitConditionalBreakpoints": true,
+        "supportsLogPoints": true,
+        "supportsFunctionBreakpoints": true,
+        "supportsDataBreakpoints": true,
+        "supportsDataBreakpointBytes": true,
+        "supportsInstructionBreakpoints": true,
+        "supportsDisassembleRequest": true,
+        "supportsSetVariable": true,
+        "supportsExceptionInfoRequest": true,
+        "supportsLoadedSourcesRequest": true,
+        "exceptionBreakpointFilters": exceptions::capabilities(),
+    })
 }
 
-impl<'a> Arguments<'a> {
-    fn wrong(&self, name: &str, kind: &str) -> String {
-        format!("{}: `{name}` is {kind}", self.command)
-    }
-
-    fn string(&self, name: &str) -> Result<Option<&'a str>, String> {
-        match self.map.get(name) {
-            None | Some(Value::Null) => Ok(None),
-            Some(Value::String(text)) => Ok(Some(text)),
-            Some(_) => Err(self.wrong(name, "a string")),
-        }
-    }
-
-    fn boolean(&self, name: &str) -> Result<Option<bool>, String> {
-        match self.map.get(name) {
-            None | Some(Value::Null) => Ok(None),
-            Some(Value::Bool(value)) => Ok(Some(*value)),
-            Some(_) => Err(self.wrong(name, "true or false")),
-        }
-    }
-
-    fn integer(&self, name: &str) -> Result<Option<i64>, String> {
-        match self.map.get(name) {
-            None | Some(Value::Null) => Ok(None),
-            Some(value) => value
-                .as_i64()
-                .map(Some)
-                .ok_or_else(|| self.wrong(name, "an integer")),
-        }
-    }
-
-    fn strings(&self, name: &str) -> Result<Option<Vec<String>>, String> {
-        match self.map.get(name) {
-            None | Some(Value::Null) => Ok(None),
-            Some(Value::Array(items)) => items
+/// The source files the images' line tables name.
+fn files(images: &[linker::Image]) -> BTreeSet<String> {
+    images
+        .iter()
+        .flat_map(|image| {
+            image
+                .lines
+                .entries
                 .iter()
-                .map(|item| item.as_str().map(str::to_owned))
-                .collect::<Option<Vec<_>>>()
-                .map(Some)
-                .ok_or_else(|| self.wrong(name, "a list of strings")),
-            Some(_) => Err(self.wrong(name, "a list of strings")),
-        }
-    }
+                .filter_map(|entry| image.lines.file_name(entry.loc).map(str::to_owned))
+        })
+        .collect()
 }
 
 /// Frame `index` of the call chain, at `pc`, with its source line.
@@ -494,41 +650,7 @@ fn frame(root: &Path, debugger: &Debugger, index: usize, pc: u16) -> Value {
     });
     if let Some((file, line)) = debugger.source_of(pc) {
         frame["line"] = json!(line);
-        frame["source"] = json!({
-            "name": Path::new(&file).file_name().map(|n| n.to_string_lossy().into_owned()),
-            "path": root.join(&file).display().to_string(),
-        });
+        frame["source"] = disassemble::source(root, &file);
     }
     frame
-}
-
-/// The registers (`REGISTERS`) or the flags (`FLAGS`).
-fn variables(debugger: &Debugger, reference: i64) -> Vec<Value> {
-    let cpu = debugger.cpu();
-    let variable =
-        |name: &str, value: String| json!({"name": name, "value": value, "variablesReference": 0});
-    if reference == FLAGS {
-        let p = cpu.p();
-        return "NV-BDIZC"
-            .chars()
-            .enumerate()
-            .filter(|(_, name)| *name != '-')
-            .map(|(bit, name)| {
-                let set = p & (0x80 >> bit) != 0;
-                variable(&name.to_string(), u8::from(set).to_string())
-            })
-            .collect();
-    }
-    if reference != REGISTERS {
-        return Vec::new();
-    }
-    vec![
-        variable("PC", format!("${:04X}", cpu.pc)),
-        variable("A", format!("${:02X}", cpu.a)),
-        variable("X", format!("${:02X}", cpu.x)),
-        variable("Y", format!("${:02X}", cpu.y)),
-        variable("S", format!("${:02X}", cpu.s)),
-        variable("P", format!("${:02X}", cpu.p())),
-        variable("cycles", debugger.robot().cycles().to_string()),
-    ]
 }

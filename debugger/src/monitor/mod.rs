@@ -10,7 +10,7 @@ use crate::session::{Line, Stopped};
 use crate::sources::Sources;
 use crate::{Breakpoint, Debugger, Expr, Watch, WatchKind, Why};
 
-mod breaks;
+pub(crate) mod breaks;
 mod counts;
 mod edit;
 
@@ -640,7 +640,7 @@ fn line_text(d: &Debugger, sources: &mut Sources, line: &Line) -> String {
 /// The instruction with its target named as the source names it: a
 /// label, a cheap local (`@wait`), an unnamed label (`:+`, `:--`), the
 /// address kept beside it; as decoded where nothing names it.
-fn named_instruction(d: &Debugger, sources: &mut Sources, line: &Line) -> String {
+pub(crate) fn named_instruction(d: &Debugger, sources: &mut Sources, line: &Line) -> String {
     let bus = &d.robot().robot().bus;
     let peek = |at: u16| emulator::Bus::peek(bus, at);
     let instruction = isa::Instruction::decode_with(line.address, peek);

@@ -112,6 +112,117 @@ const log = (what) => console.log(`dap: ${what}`);
     await stepped;
     log(`stepped to adc.s:${sec + 1}`);
 
+    // Issue 25, point 2: each request an assembly debugger answers, as VS
+    // Code sends them from its views (breakpoints, variables, memory,
+    // disassembly, exceptions, loaded scripts, the restart button).
+    for (const capability of [
+      'supportsConditionalBreakpoints', 'supportsHitConditionalBreakpoints', 'supportsLogPoints',
+      'supportsFunctionBreakpoints', 'supportsDataBreakpoints', 'supportsInstructionBreakpoints',
+      'supportsDisassembleRequest', 'supportsSetVariable', 'supportsWriteMemoryRequest',
+      'supportsReadMemoryRequest', 'supportsRestartRequest', 'supportsExceptionInfoRequest',
+      'supportsLoadedSourcesRequest',
+    ]) assert.equal(init.body[capability], true, capability);
+    assert.deepEqual(init.body.exceptionBreakpointFilters.map((f) => f.filter), ['jam', 'brk', 'card']);
+
+    const loaded = await dc.send('loadedSources', {});
+    assert.ok(loaded.body.sources.some((s) => s.path === source), JSON.stringify(loaded.body));
+    log('loadedSources: adc.s');
+
+    const here = (await dc.stackTraceRequest({ threadId: 1 })).body.stackFrames[0];
+    const listing = await dc.send('disassemble', {
+      memoryReference: here.instructionPointerReference, instructionOffset: -2, instructionCount: 6,
+    });
+    const at = listing.body.instructions[2];
+    assert.equal(at.address, here.instructionPointerReference);
+    assert.equal(at.line, sec + 1);
+    log(`disassemble: ${at.address} ${at.instruction}`);
+
+    // A = $32: the channel digit '2', so the robot reads channel 2.
+    const setA = await dc.send('setVariable', { variablesReference: registers.variablesReference, name: 'A', value: '$32' });
+    assert.equal(setA.body.value, '$32');
+    log('setVariable A = $32');
+
+    await dc.send('writeMemory', { memoryReference: '0x0300', data: 'ASNF' });
+    const read = await dc.send('readMemory', { memoryReference: '0x0300', count: 3 });
+    assert.equal(read.body.data, 'ASNF');
+    log('writeMemory and readMemory at $0300');
+
+    const info = await dc.send('dataBreakpointInfo', { name: 'ADC_CONTROL' });
+    assert.equal(info.body.dataId, '0x9000');
+    await dc.send('setDataBreakpoints', { breakpoints: [{ dataId: info.body.dataId, accessType: 'write' }] });
+    const watched = dc.waitForEvent('stopped');
+    await dc.continueRequest({ threadId: 1 });
+    const wrote = (await watched).body;
+    assert.equal(wrote.reason, 'data breakpoint');
+    assert.ok(wrote.description.startsWith('wrote $82 to $9000'), wrote.description);
+    log(`data breakpoint: ${wrote.description}`);
+    await dc.send('setDataBreakpoints', { breakpoints: [] });
+
+    const fn = await dc.send('setFunctionBreakpoints', { breakpoints: [{ name: 'PUTHEX' }] });
+    assert.equal(fn.body.breakpoints[0].verified, true);
+    const called = dc.waitForEvent('stopped');
+    await dc.continueRequest({ threadId: 1 });
+    assert.equal((await called).body.reason, 'function breakpoint');
+    log('function breakpoint at PUTHEX');
+    await dc.send('setFunctionBreakpoints', { breakpoints: [] });
+
+    // /2A3 stops at `sec` only when A holds its digit; the wait loop logs.
+    const wait = lineOf('@wait:');
+    await dc.setBreakpointsRequest({ source: { path: source }, breakpoints: [
+      { line: sec, condition: 'A == $33', hitCondition: '1' },
+      { line: wait, logMessage: 'status {[$9001]}' },
+    ] });
+    const conditional = dc.waitForEvent('stopped');
+    await dc.evaluateRequest({ expression: '/2A3', context: 'repl' });
+    await dc.continueRequest({ threadId: 1 });
+    assert.equal((await conditional).body.reason, 'breakpoint');
+    const third = (await dc.stackTraceRequest({ threadId: 1 })).body.stackFrames[0];
+    assert.equal(third.line, sec);
+    log(`conditional breakpoint at adc.s:${third.line}`);
+
+    const call = (await dc.send('disassemble', { memoryReference: third.instructionPointerReference, instructionCount: 12 }))
+      .body.instructions.find((i) => i.instruction.startsWith('JSR'));
+    await dc.send('setInstructionBreakpoints', { breakpoints: [{ instructionReference: call.address }] });
+    // The log point's lines, among the robot's own output.
+    const logged = new Promise((resolve) => {
+      const seen = (event) => {
+        if (event.body.category === 'console' && event.body.output.startsWith('status $')) {
+          dc.removeListener('output', seen);
+          resolve(event);
+        }
+      };
+      dc.on('output', seen);
+    });
+    const instruction = dc.waitForEvent('stopped');
+    await dc.continueRequest({ threadId: 1 });
+    await logged;
+    assert.equal((await instruction).body.reason, 'instruction breakpoint');
+    log(`log point and instruction breakpoint at ${call.address}`);
+
+    await dc.setExceptionBreakpointsRequest({ filters: ['brk'] });
+    await dc.send('writeMemory', { memoryReference: call.address, data: 'AA==' });
+    const brk = dc.waitForEvent('stopped');
+    await dc.continueRequest({ threadId: 1 });
+    assert.equal((await brk).body.reason, 'exception');
+    const exception = await dc.send('exceptionInfo', { threadId: 1 });
+    assert.equal(exception.body.exceptionId, 'brk');
+    log(`exception: ${exception.body.description}`);
+
+    // A new robot: the BRK planted is gone, the breakpoints stay, and the
+    // launch's /2A1 runs again to the instruction breakpoint.
+    const restarted = dc.waitForEvent('stopped');
+    await dc.send('restart', {});
+    if (launch.stopOnEntry) {
+      assert.equal((await restarted).body.reason, 'entry');
+      const again = dc.waitForEvent('stopped');
+      await dc.continueRequest({ threadId: 1 });
+      assert.equal((await again).body.reason, 'instruction breakpoint');
+    } else {
+      assert.equal((await restarted).body.reason, 'instruction breakpoint');
+    }
+    log('restarted');
+    await dc.send('setInstructionBreakpoints', { breakpoints: [] });
+
     await dc.setBreakpointsRequest({ source: { path: source }, breakpoints: [] });
     const ended = new Promise((resolve) => {
       dc.once('terminated', () => resolve('terminated'));

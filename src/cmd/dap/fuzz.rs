@@ -1,5 +1,5 @@
-//! Hostile requests for the DAP server (issue 23): any command, known or
-//! not, with arguments of any shape (missing, of the wrong type, huge,
+//! Hostile requests for the DAP server (issue 23; issue 25's requests
+//! too): any command, known or not, with arguments of any shape (missing, of the wrong type, huge,
 //! negative), before and after `launch`, is answered and the session
 //! goes on; never a panic. The framing's own fuzzing is in
 //! `debugger::dap::framing`, the messages' in `debugger::dap::protocol`.
@@ -34,6 +34,26 @@ fn value() -> impl Strategy<Value = Value> {
         Just(json!([{"line": 33}, {"line": -1}, {"line": 4294967296u64}, {}])),
         Just(json!({"path": "adc.s"})),
         Just(json!({})),
+        Just(json!("AAEC")),
+        Just(json!("not base64!")),
+        Just(json!("A == $31")),
+        Just(json!("((")),
+        Just(json!("== 2")),
+        Just(json!("% 0")),
+        Just(json!("A={A} [CMDBUF]={[CMDBUF]}")),
+        Just(json!("{")),
+        Just(json!(["jam", "brk", "card"])),
+        Just(json!(["frob"])),
+        Just(
+            json!([{"name": "read_channel", "condition": "A == 1"}, {"name": "/2A"}, {"name": "nowhere"}])
+        ),
+        Just(
+            json!([{"dataId": "0x0200..0x0201", "accessType": "write"}, {"dataId": "CMDBUF", "accessType": "sideways"}])
+        ),
+        Just(json!([{"instructionReference": "0x0400", "offset": -5, "hitCondition": "3"}])),
+        Just(json!([{"line": 33, "logMessage": "A={A}"}, {"line": 33, "condition": "[["}])),
+        Just(json!({"program": "/nonexistent", "stopOnEntry": "yes"})),
+        Just(json!([{"filterId": "jam", "condition": "1"}])),
     ]
 }
 
@@ -56,6 +76,16 @@ fn request() -> impl Strategy<Value = (String, Map<String, Value>)> {
         "stepOut",
         "stepBack",
         "reverseContinue",
+        "setFunctionBreakpoints",
+        "setInstructionBreakpoints",
+        "dataBreakpointInfo",
+        "setDataBreakpoints",
+        "disassemble",
+        "setVariable",
+        "writeMemory",
+        "restart",
+        "exceptionInfo",
+        "loadedSources",
         "attach",
         "frobnicate",
         "",
@@ -72,6 +102,19 @@ fn request() -> impl Strategy<Value = (String, Map<String, Value>)> {
         "frameId",
         "stopOnEntry",
         "commands",
+        "name",
+        "value",
+        "data",
+        "dataId",
+        "accessType",
+        "asAddress",
+        "bytes",
+        "instructionReference",
+        "instructionOffset",
+        "instructionCount",
+        "filters",
+        "filterOptions",
+        "arguments",
     ]);
     let arguments = prop::collection::btree_map(key, value(), 0..5).prop_map(|map| {
         map.into_iter()
