@@ -441,3 +441,27 @@ fn a_bad_line_a_long_expression_and_many_displays_are_refused_alone() {
     );
     assert!(text.contains("print 3\n3 = $03"), "{text:.3000}");
 }
+
+/// Issue 25's leftovers: `mem ADDR $10` (a length written in hex, as
+/// addresses are) was refused as "not a number"; a length is any
+/// expression now, within the same bounds.
+#[test]
+fn a_memory_length_may_be_written_in_hex() {
+    let adc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc");
+    let output = scorpion_with_input(
+        Some(&adc),
+        &["debug"],
+        "mem $0300 $10\nmem $0300 %11\nmem $0300 16\nmem $0300 $10001\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    let rows: Vec<&str> = text.lines().filter(|l| l.starts_with("$0300:")).collect();
+    assert_eq!(rows.len(), 3, "{text}");
+    assert_eq!(rows[0], rows[2], "$10 is 16 bytes: {text}");
+    assert_eq!(
+        rows[1].split_whitespace().count(),
+        1 + 3 + 1,
+        "%11 is 3 bytes (and their text): {text}"
+    );
+    assert!(text.contains("is at most 65536 bytes"), "{text}");
+}

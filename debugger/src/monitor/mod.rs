@@ -59,7 +59,7 @@ CMDBUF+1, registers A X Y S P PC, flags C Z I D V N, [ADDR] a byte, {ADDR} a wor
   regs                 the registers                                              (r)
   set REG VALUE        set A X Y S P PC or a flag C Z I D V N: set A $05, set C 1,
                        set PC label (also regs A=$05)
-  mem ADDR [LEN]       bytes from ADDR (16; 65536 at most)                        (m)
+  mem ADDR [LEN]       bytes from ADDR (16, or LEN: 32, $20; 65536 at most)       (m)
   mem ADDR BYTE BYTE...| mem ADDR = BYTE... | poke ADDR BYTE...
                        write RAM (each BYTE an expression)
   print EXPR           an expression's value                                      (p)
@@ -358,7 +358,7 @@ fn command(d: &mut Debugger, m: &mut Monitor, line: &str) -> Result<Reply, Failu
             [] => return Err(usage("mem ADDR [LEN], or mem ADDR BYTE BYTE... to write")),
             [a] => memory(d, address(d, a)?, 16),
             [a, "=", bytes @ ..] => edit::poke(d, a, bytes)?,
-            [a, n] => memory(d, address(d, a)?, MEM_LEN.parse(n).map_err(Failure::Usage)?),
+            [a, n] => memory(d, address(d, a)?, mem_len(d, n)?),
             [a, bytes @ ..] => edit::poke(d, a, bytes)?,
         },
         "poke" => match rest.as_slice() {
@@ -475,6 +475,16 @@ fn address(d: &Debugger, text: &str) -> Result<u16, Failure> {
     parsed
         .address(d)
         .map_err(|error| Failure::Usage(error.to_string()))
+}
+
+/// `mem`'s LEN: a count in decimal as every count is written, or any
+/// expression (`$10`, `%10000`, `END-START`), within the same bounds.
+fn mem_len(d: &Debugger, word: &str) -> Result<u64, Failure> {
+    if word.bytes().all(|b| b.is_ascii_digit()) {
+        return MEM_LEN.parse(word).map_err(Failure::Usage);
+    }
+    let value = evaluate(d, word)?;
+    MEM_LEN.parse(&value.to_string()).map_err(Failure::Usage)
 }
 
 /// `$2F (47)`: a value in hexadecimal and decimal.
