@@ -376,3 +376,58 @@ fn a_dap_session_through_the_neovim_adapter_definition_in_debugging_md() {
         assert!(stdout.contains(step), "{step:?} in {stdout}");
     }
 }
+
+/// docs/DEBUGGING.md's bug hunt in VS Code terms, run as the guide writes
+/// it: the planted bug (`bcc @carried` turned into `bcs @carried` in a copy
+/// of the checksum example) hunted through the extension's debugger
+/// contribution with VS Code's DAP test client, the same steps as the
+/// monitor's hunt; its transcript (each step with the DAP requests it
+/// made) is the guide's.
+#[test]
+fn the_debugging_guides_bug_hunt_runs_in_vs_code_as_written() {
+    let test = "the_debugging_guides_bug_hunt_runs_in_vs_code_as_written";
+    let Some(node) = node(test) else { return };
+    let dir = tempfile::tempdir().expect("a scratch directory");
+    let project = dir.path().join("checksum-bug");
+    std::fs::create_dir(&project).expect("the project's directory");
+    std::fs::copy(
+        examples().join("scorpion.inc"),
+        dir.path().join("scorpion.inc"),
+    )
+    .expect("scorpion.inc");
+    for entry in std::fs::read_dir(examples().join("checksum")).expect("examples/checksum") {
+        let path = entry.expect("an entry").path();
+        if path.is_file() {
+            std::fs::copy(&path, project.join(path.file_name().expect("a name"))).expect("a copy");
+        }
+    }
+    let source = std::fs::read_to_string(project.join("checksum.s")).expect("checksum.s");
+    let planted = source.replace("bcc @carried", "bcs @carried");
+    assert_ne!(planted, source, "the bug is planted");
+    std::fs::write(project.join("checksum.s"), planted).expect("the bug planted");
+
+    let output = run_script(
+        &node,
+        "hunt.js",
+        &[
+            env!("CARGO_BIN_EXE_scorpion"),
+            project.to_str().expect("UTF-8"),
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let guide =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/DEBUGGING.md"))
+            .expect("docs/DEBUGGING.md");
+    let section = &guide[guide.find("## A bug hunt in VS Code").expect("the section")..];
+    let start = section.find("```text\n").expect("its transcript") + "```text\n".len();
+    let block = &section[start..start + section[start..].find("```").expect("the block's end")];
+    assert_eq!(
+        stdout, block,
+        "docs/DEBUGGING.md's VS Code bug hunt is stale"
+    );
+}
