@@ -64,6 +64,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A diagnostic's message, help and causes each on one line (the
+    // terminal folds them): an editor's problem matcher (editors/vscode's
+    // `$scorpion`) reads the message on the line above its place, which a
+    // message wrapped at 80 columns split from it.
+    let _ = miette::set_hook(Box::new(|_| {
+        Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
+    }));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Asm(args) => cmd::asm::run(&args),

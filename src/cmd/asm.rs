@@ -111,7 +111,9 @@ pub(crate) fn report(assembly: &assembler::Assembly) {
     for warning in &assembly.warnings {
         #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
         {
-            eprintln!("{:?}", miette::Report::new(warning.clone()));
+            // "Warning: " as miette heads a related warning: the
+            // problem matcher reads a warning's severity there.
+            eprintln!("Warning: {:?}", miette::Report::new(warning.clone()));
         }
     }
     for message in &assembly.messages {

@@ -77,7 +77,9 @@ fn build_project(
         for warning in &built.warnings {
             #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
             {
-                eprintln!("{warning:?}");
+                // "Warning: " as miette heads a related warning: the
+                // problem matcher reads a warning's severity there.
+                eprintln!("Warning: {warning:?}");
             }
         }
         let bytes: usize = built.linked.image.areas.iter().map(|a| a.bytes.len()).sum();

@@ -189,7 +189,9 @@ fn report_warnings(linked: &mut Linked) {
     for warning in std::mem::take(&mut linked.warnings) {
         #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
         {
-            eprintln!("{:?}", miette::Report::new(warning));
+            // "Warning: " as miette heads a related warning: the
+            // problem matcher reads a warning's severity there.
+            eprintln!("Warning: {:?}", miette::Report::new(warning));
         }
     }
 }

@@ -135,7 +135,9 @@ impl Progress for Printer {
     }
 
     fn build_warning(&mut self, _image: &str, warning: &miette::Report) {
-        let _ = writeln!(std::io::stderr(), "{warning:?}");
+        // "Warning: " as miette heads a related warning: the
+        // problem matcher reads a warning's severity there.
+        let _ = writeln!(std::io::stderr(), "Warning: {warning:?}");
     }
 
     fn test_finished(&mut self, name: &str, outcome: &Outcome) {

@@ -431,3 +431,113 @@ fn the_debugging_guides_bug_hunt_runs_in_vs_code_as_written() {
         "docs/DEBUGGING.md's VS Code bug hunt is stale"
     );
 }
+
+/// Runs the `$scorpion` matcher (test/matcher.js) over what `output`
+/// printed; the problems it finds.
+fn problems(node: &Path, dir: &Path, output: &Output) -> Vec<Value> {
+    let printed = dir.join("printed.txt");
+    let mut text = output.stdout.clone();
+    text.extend(&output.stderr);
+    std::fs::write(&printed, &text).expect("the output saved");
+    let matched = run_script(node, "matcher.js", &[printed.to_str().expect("UTF-8")]);
+    assert!(
+        matched.status.success(),
+        "{}",
+        String::from_utf8_lossy(&matched.stderr)
+    );
+    let found: Value = serde_json::from_slice(&matched.stdout).expect("the problems as JSON");
+    found.as_array().expect("a list").clone()
+}
+
+/// Issue 25's leftover: the matcher missed warnings (`⚠`, on their own or
+/// beside errors) and messages miette wrapped over two lines (a long
+/// message's place was no longer right under its first line). Over real
+/// output of `scorpion asm` (warnings and an error; warnings alone) and
+/// `scorpion build` (a project file's long message), each is found at its
+/// place with its severity, code and whole message.
+#[test]
+fn the_problem_matcher_finds_warnings_and_long_messages() {
+    let test = "the_problem_matcher_finds_warnings_and_long_messages";
+    let Some(node) = node(test) else { return };
+    let dir = tempfile::tempdir().expect("a scratch directory");
+    std::fs::write(
+        dir.path().join("mixed.s"),
+        "        jmp ($02FF)\n        .warning \"check this\"\n        lda #300\n",
+    )
+    .expect("mixed.s");
+    std::fs::write(dir.path().join("warned.s"), "        jmp ($02FF)\n").expect("warned.s");
+    let mixed = super::scorpion(dir.path(), &["asm", "mixed.s", "-o", "mixed.o"]);
+    assert!(!mixed.status.success(), "{}", super::transcript(&mixed));
+    let found = problems(&node, dir.path(), &mixed);
+    let summary: Vec<(String, u64, String)> = found
+        .iter()
+        .map(|p| {
+            (
+                p["severity"].as_str().unwrap_or_default().to_owned(),
+                p["line"].as_u64().unwrap_or_default(),
+                p["code"].as_str().unwrap_or_default().to_owned(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        summary,
+        [
+            ("warning".to_owned(), 1, "asm::jmp-page-wrap".to_owned()),
+            ("warning".to_owned(), 2, "asm::user-warning".to_owned()),
+            ("error".to_owned(), 3, "asm::range".to_owned()),
+        ],
+        "{found:?}\n{}",
+        super::transcript(&mixed)
+    );
+    assert_eq!(found[1]["message"], "check this");
+
+    let warned = super::scorpion(dir.path(), &["asm", "warned.s", "-o", "warned.o"]);
+    assert!(warned.status.success(), "{}", super::transcript(&warned));
+    let found = problems(&node, dir.path(), &warned);
+    assert_eq!(found.len(), 1, "{found:?}\n{}", super::transcript(&warned));
+    assert_eq!(found[0]["severity"], "warning", "{found:?}");
+    assert_eq!(found[0]["file"], "warned.s", "{found:?}");
+    assert_eq!(
+        (found[0]["line"].clone(), found[0]["column"].clone()),
+        (1.into(), 13.into())
+    );
+
+    // A message longer than a line: miette wrapped it at 80 columns.
+    let project = dir.path().join("bad");
+    std::fs::create_dir(&project).expect("the project");
+    std::fs::write(
+        project.join("Scorpion.toml"),
+        "[project]\nname = \"bad\"\n\n[[image]]\nname = \"bad\"\nsourcse = [\"bad.s\"]\n",
+    )
+    .expect("Scorpion.toml");
+    let built = super::scorpion(&project, &["build"]);
+    assert!(!built.status.success(), "{}", super::transcript(&built));
+    let found = problems(&node, &project, &built);
+    assert_eq!(found.len(), 1, "{found:?}\n{}", super::transcript(&built));
+    let message = found[0]["message"].as_str().unwrap_or_default();
+    assert!(
+        message.contains("unknown field `sourcse`") && message.ends_with("`defines`"),
+        "the whole message: {found:?}"
+    );
+    assert_eq!(
+        (found[0]["line"].clone(), found[0]["column"].clone()),
+        (6.into(), 1.into())
+    );
+}
+
+/// Issue 25's leftover: the README's first launch configuration ("create a
+/// launch.json file" gives it) had a `commands` entry the extension does
+/// not generate. It is the extension's `initialConfigurations` now.
+#[test]
+fn the_readmes_first_launch_configuration_is_the_one_generated() {
+    let readme = std::fs::read_to_string(extension().join("README.md")).expect("README.md");
+    let section = &readme[readme
+        .find("## Debugging: launch.json")
+        .expect("the section")..];
+    let start = section.find("```json\n").expect("its block") + "```json\n".len();
+    let block = &section[start..start + section[start..].find("```").expect("the block's end")];
+    let shown: Value = serde_json::from_str(block).expect("the block is JSON");
+    let manifest = json(&extension().join("package.json"));
+    let generated = &manifest["contributes"]["debuggers"][0]["initialConfigurations"];
+    assert_eq!(&shown["configurations"], generated, "{block}");
+}
