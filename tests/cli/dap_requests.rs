@@ -274,6 +274,14 @@ fn function_data_and_instruction_breakpoints() {
     let info = ok(&c.request("dataBreakpointInfo", json!({"name": "ADC_CONTROL"}))).clone();
     assert_eq!(info["dataId"], "0x9000", "{info}");
     assert_eq!(info["accessTypes"], json!(["read", "write", "readWrite"]));
+    // An address and a length (supportsDataBreakpointBytes): the card's
+    // three registers.
+    let card = ok(&c.request(
+        "dataBreakpointInfo",
+        json!({"name": "0x9000", "asAddress": true, "bytes": 3}),
+    ))
+    .clone();
+    assert_eq!(card["dataId"], "0x9000..0x9002", "{card}");
     let set = c.request(
         "setDataBreakpoints",
         json!({"breakpoints": [{"dataId": info["dataId"], "accessType": "write"}]}),
