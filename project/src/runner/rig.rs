@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
+use cards::{CardArg, Printed, Room, ScriptCard, ScriptWorld};
 use romlib::VirtualScorpion;
 
 use super::error::{Baud, Error, Result};
@@ -21,8 +21,10 @@ pub struct Rig {
     /// KIM-bus cards, Rhai scripts (docs/CARDS.md), each at its script's
     /// `BASE` or the address given.
     pub cards: Vec<CardArg>,
-    /// The robot's surroundings, a Rhai script that closes bumpers and
-    /// lights the phototransistors over robot time (docs/CARDS.md).
+    /// The robot's surroundings: a Rhai script that closes bumpers and
+    /// lights the phototransistors over robot time (docs/CARDS.md), or a
+    /// world file (`.toml`: a room, docs/WORLD.md), which may name such a
+    /// script beside it.
     pub world: Option<PathBuf>,
     /// The directory the cards' relative paths are read from (a
     /// project's root); the paths are shown as given.
@@ -88,9 +90,23 @@ impl Rig {
         if let Some(path) = &self.world {
             let name = path.display().to_string();
             let text = read(self.world_root.as_deref(), path)?;
-            let world = ScriptWorld::load(&name, &text)?;
-            printed.push((name, world.printed()));
-            robot.set_surroundings(Box::new(world));
+            if path.extension().is_some_and(|e| e == "toml") {
+                let mut room = Room::load(&name, &text)?;
+                if let Some(script) = room.script_path() {
+                    // Written relative to the world file.
+                    let script = path.parent().unwrap_or(Path::new("")).join(script);
+                    let name = script.display().to_string();
+                    let text = read(self.world_root.as_deref(), &script)?;
+                    let world = ScriptWorld::load(&name, &text)?;
+                    printed.push((name, world.printed()));
+                    room.add(Box::new(world));
+                }
+                robot.set_surroundings(Box::new(room));
+            } else {
+                let world = ScriptWorld::load(&name, &text)?;
+                printed.push((name, world.printed()));
+                robot.set_surroundings(Box::new(world));
+            }
         }
         Ok(printed)
     }
