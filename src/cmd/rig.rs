@@ -28,6 +28,9 @@ pub(crate) struct Rig {
     /// may come from its own source (`--world` with the project's cards).
     #[arg(skip)]
     pub(crate) world_root: Option<PathBuf>,
+    /// The room of a world file, once a robot has it.
+    #[arg(skip)]
+    pub(crate) room: scorpion_project::runner::rig::RoomSlot,
 }
 
 impl Rig {
@@ -38,6 +41,7 @@ impl Rig {
             world: self.world.clone(),
             root: self.root.clone(),
             world_root: self.world_root.clone(),
+            room: self.room.clone(),
         }
     }
 
@@ -70,6 +74,7 @@ impl From<scorpion_project::runner::Rig> for Rig {
             world: rig.world,
             root: rig.root,
             world_root: rig.world_root,
+            room: rig.room,
         }
     }
 }

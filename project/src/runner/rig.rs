@@ -4,8 +4,9 @@
 //! them ([`Resolved`]).
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
-use cards::{CardArg, Printed, Room, ScriptCard, ScriptWorld};
+use cards::{CardArg, Printed, Room, RoomView, ScriptCard, ScriptWorld};
 use romlib::VirtualScorpion;
 
 use super::error::{Baud, Error, Result};
@@ -32,6 +33,27 @@ pub struct Rig {
     /// The directory the world's relative path is read from: each part
     /// may come from its own source (`--world` with the project's cards).
     pub world_root: Option<PathBuf>,
+    /// The room of the last robot given a world file, seen from the host
+    /// (its pose, trail and picture: `--path FILE.svg`).
+    pub room: RoomSlot,
+}
+
+/// Where the host sees the room of a world file from, once a robot has
+/// it: shared by the rig's copies.
+#[derive(Debug, Clone, Default)]
+pub struct RoomSlot(Arc<Mutex<Option<RoomView>>>);
+
+impl RoomSlot {
+    /// The room's view, if a robot was given a world file.
+    pub fn get(&self) -> Option<RoomView> {
+        self.0.lock().ok().and_then(|slot| slot.clone())
+    }
+
+    fn set(&self, view: RoomView) {
+        if let Ok(mut slot) = self.0.lock() {
+            *slot = Some(view);
+        }
+    }
 }
 
 /// What each script of a robot prints, by the script's name.
@@ -58,6 +80,7 @@ impl Rig {
                 .as_ref()
                 .and_then(|w| resolved.base(&w.origin))
                 .map(Path::to_path_buf),
+            room: RoomSlot::default(),
         }
     }
 
@@ -101,6 +124,7 @@ impl Rig {
                     printed.push((name, world.printed()));
                     room.add(Box::new(world));
                 }
+                self.room.set(room.view());
                 robot.set_surroundings(Box::new(room));
             } else {
                 let world = ScriptWorld::load(&name, &text)?;
