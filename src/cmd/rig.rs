@@ -16,8 +16,10 @@ pub(crate) struct Rig {
     /// `BASE` or at ADDR (hex); repeat for more cards.
     #[arg(long = "card", value_name = "FILE[@ADDR]")]
     pub(crate) cards: Vec<CardArg>,
-    /// The robot's surroundings, a Rhai script that closes bumpers and
-    /// lights the phototransistors over robot time (docs/CARDS.md).
+    /// The robot's surroundings: a Rhai script that closes bumpers and
+    /// lights the phototransistors over robot time (docs/CARDS.md), or a
+    /// world file (`.toml`: a room with obstacles and floor lines, the
+    /// robot's pose following its motors; docs/WORLD.md).
     #[arg(long = "world", value_name = "FILE")]
     pub(crate) world: Option<PathBuf>,
     /// The directory the cards' relative paths are read from (a

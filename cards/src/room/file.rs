@@ -315,3 +315,57 @@ fn located(
         help: Some(help.to_owned()),
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A world file's mistakes, each with the error it must give.
+    #[test]
+    fn mistakes_are_located() {
+        for (text, expected) in [
+            (
+                "wals = []\n",
+                "world.toml:1:1: unknown field `wals`, expected one of `walls`, `obstacle`, `line`, `robot`, `script`",
+            ),
+            (
+                "[[obstacle]]\ncircle = { x = 1, y = 2, radius = 0 }\n",
+                "world.toml:2:10: a circle at (1, 2) of radius 0",
+            ),
+            (
+                "[[obstacle]]\ncircle = { x = 1, y = 2, radius = 3 }\npolygon = [[0, 0], [1, 0], [1, 1]]\n",
+                "world.toml:1:1: an obstacle is either a `polygon` or a `circle`",
+            ),
+            (
+                "[[line]]\npoints = [[0, 0]]\n",
+                "world.toml:2:10: a line: 1 points, at least 2 needed",
+            ),
+            (
+                "[robot]\nstep = -1\n",
+                "world.toml:2:8: the step is -1; it must be more than 0",
+            ),
+            (
+                "[robot]\nbumpers = [0, 45, 90, 135, 180, 225, 270, 315, 360]\n",
+                "world.toml:2:11: 9 bumpers; the robot has eight microswitches at most, each an angle",
+            ),
+            ("[robot]\nx = nan\n", "world.toml:2:5: x is not a number"),
+            (
+                "walls = [[0, 0]",
+                "world.toml:1:16: unclosed array, expected `]`",
+            ),
+        ] {
+            let error = parse("world.toml", text).expect_err(text);
+            assert_eq!(error.to_string(), expected, "{text}");
+        }
+    }
+
+    #[test]
+    fn an_empty_file_is_an_open_floor_with_the_defaults() {
+        let layout = parse("world.toml", "").expect("empty is fine");
+        assert_eq!(layout.walls, None);
+        assert_eq!(layout.body.radius, defaults::RADIUS);
+        assert_eq!(layout.drive.step, defaults::STEP);
+        assert_eq!(layout.body.bumpers.len(), 8);
+        assert_eq!(layout.start.heading, 0.0);
+    }
+}
