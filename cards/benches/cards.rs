@@ -15,9 +15,10 @@
 //! emulator skips a loop whose reads cannot change: (a), (b) once their
 //! answer is kept, and (c), whose registers say they are stable) and with
 //! every instruction run (the idle skip off), where each read costs what
-//! it costs. Targets: (b) at least 0.5 of the Rust card and at least 200
-//! times the real robot's 1 MHz, as run; the ratio with every instruction
-//! run is printed beside it.
+//! it costs. Targets: (b) at least 0.5 of the Rust card with every
+//! instruction run (as run, both loops are skipped and a run takes
+//! microseconds, too short to compare), and at least 200 times the real
+//! robot's 1 MHz as run.
 //!
 //! Then the bound on hostile scripts (docs/CARDS.md): a card that spends
 //! all its share of robot time, (e) in calls (woken as often as
@@ -269,14 +270,17 @@ fn main() {
         per_call * 1e9
     );
     let verdict = |met: bool| if met { "met" } else { "MISSED" };
-    let kept = best[2][0] / best[1][0];
+    // The cost of a read against the Rust card's, every instruction run:
+    // as run, both loops are skipped and a run takes microseconds, too
+    // short to compare. How fast the robot runs is as it runs.
+    let kept = best[2][1] / best[1][1];
     let kept_robot = speed(best[1][0]);
     println!(
-        "  targets, a polled register read through `read` (b), as run: at least 0.5 of the Rust card ({kept:.2}: {}), at least 200x the robot ({kept_robot:.0}x: {}); every instruction run: {:.2} of the Rust card, {:.0}x the robot",
+        "  targets, a polled register read through `read` (b): at least 0.5 of the Rust card, every instruction run ({kept:.2}: {}); at least 200x the robot, as run ({kept_robot:.0}x: {}; every instruction run {:.0}x, the Rust card {:.0}x)",
         verdict(kept >= 0.5),
         verdict(kept_robot >= 200.0),
-        best[2][1] / best[1][1],
-        speed(best[1][1])
+        speed(best[1][1]),
+        speed(best[2][1])
     );
     println!(
         "  a card whose every read calls its script (e): {:.3} of the Rust card, {:.0}x the robot",
