@@ -9,7 +9,12 @@
 //! Registers listed in `PLAIN` (all of them when there is no `read`) are
 //! read from the card's register table without calling the script; the
 //! script fills the table with `set(reg, value)`, so a program that polls a
-//! status bit costs a table look-up per read. `irq(true)` pulls the bus's
+//! status bit costs a table look-up per read. Any other register's
+//! answer from `read` is kept and served again without calling the script
+//! until it can have changed: a write to the card, a wake-up, or a read of
+//! a register listed in `VOLATILE` (reads with effects, such as a data
+//! register that clears an interrupt, or answers that change with robot
+//! time alone), whose every read calls `read`. `irq(true)` pulls the bus's
 //! /IRQ line low until `irq(false)`.
 
 use std::sync::{Arc, Mutex};
@@ -42,6 +47,13 @@ pub struct ScriptCard {
     wake: Option<u64>,
     /// Registers read from the table without calling `read`.
     plain: Vec<bool>,
+    /// Registers whose reads the script declares have effects (or whose
+    /// answer changes with robot time alone): `read` is called for every
+    /// one.
+    volatile: Vec<bool>,
+    /// `read`'s last answer for each register, while it still holds: no
+    /// write, wake-up or read with effects since.
+    answers: Vec<Option<u8>>,
     has_write: bool,
     has_wake: bool,
     base: u16,
@@ -156,30 +168,12 @@ impl ScriptCard {
         let size = u16::try_from(size).unwrap_or(1);
         let has_read = script.has_fn("read", 2);
         let mut plain = vec![!has_read; usize::from(size)];
-        if let Some(list) = script.constant("PLAIN") {
-            let registers = list.into_array().map_err(|_| {
-                window(
-                    "`PLAIN` is not a list of registers".into(),
-                    "write `const PLAIN = [1, 2];`: the registers read from the table",
-                )
-            })?;
-            for register in registers {
-                let index = register
-                    .as_int()
-                    .ok()
-                    .and_then(|r| usize::try_from(r).ok())
-                    .filter(|&r| r < usize::from(size))
-                    .ok_or_else(|| {
-                        window(
-                            format!(
-                                "`PLAIN` lists {register}, not a register of 0 to {}",
-                                size - 1
-                            ),
-                            "registers are numbered from 0 to SIZE - 1",
-                        )
-                    })?;
-                plain[index] = true;
-            }
+        for index in registers(&script, name, "PLAIN", size)? {
+            plain[index] = true;
+        }
+        let mut volatile = vec![false; usize::from(size)];
+        for index in registers(&script, name, "VOLATILE", size)? {
+            volatile[index] = true;
         }
         if let Ok(mut shared) = shared.lock() {
             shared.table = vec![0; usize::from(size)];
@@ -192,6 +186,8 @@ impl ScriptCard {
             script,
             shared,
             plain,
+            volatile,
+            answers: vec![None; usize::from(size)],
             base,
             size,
             now: 0,
@@ -241,6 +237,12 @@ impl ScriptCard {
         result
     }
 
+    /// Forgets `read`'s answers: the script ran for something that can
+    /// change them.
+    fn forget(&mut self) {
+        self.answers.fill(None);
+    }
+
     /// Copies what the script left in `shared` into `view`.
     fn look(&mut self) {
         if let Ok(shared) = self.shared.lock() {
@@ -275,11 +277,55 @@ impl ScriptCard {
             if !self.has_wake {
                 continue;
             }
+            self.forget();
             if let Err(error) = self.call("wake", Some(due), (as_int(due),)) {
                 self.fail(error);
             }
         }
     }
+}
+
+/// The registers the script's constant `list` (`PLAIN`, `VOLATILE`)
+/// names, each checked to be one of the card's `size`.
+fn registers(
+    script: &Script,
+    name: &str,
+    list: &str,
+    size: u16,
+) -> Result<Vec<usize>, ScriptError> {
+    let window = |message: String, help: String| ScriptError::Window {
+        file: name.to_owned(),
+        message,
+        help: Some(help),
+    };
+    let Some(value) = script.constant(list) else {
+        return Ok(Vec::new());
+    };
+    let entries = value.into_array().map_err(|_| {
+        window(
+            format!("`{list}` is not a list of registers"),
+            format!("write `const {list} = [1, 2];`: a list of register numbers"),
+        )
+    })?;
+    entries
+        .into_iter()
+        .map(|register| {
+            register
+                .as_int()
+                .ok()
+                .and_then(|r| usize::try_from(r).ok())
+                .filter(|&r| r < usize::from(size))
+                .ok_or_else(|| {
+                    window(
+                        format!(
+                            "`{list}` lists {register}, not a register of 0 to {}",
+                            size - 1
+                        ),
+                        "registers are numbered from 0 to SIZE - 1".into(),
+                    )
+                })
+        })
+        .collect()
 }
 
 fn as_int(cycle: u64) -> i64 {
@@ -357,12 +403,27 @@ impl Device for ScriptCard {
             return 0xFF;
         }
         let register = offset % self.size;
-        if self.plain[usize::from(register)] {
+        let index = usize::from(register);
+        if self.plain[index] {
             return self.table(register);
         }
+        let volatile = self.volatile[index];
+        if !volatile && let Some(answer) = self.answers[index] {
+            return answer;
+        }
         let value = self.call("read", Some(cycle), (i64::from(register), as_int(cycle)));
+        if volatile {
+            // Its effects may change any register's answer.
+            self.forget();
+        }
         match value.map(|v| v.as_int()) {
-            Ok(Ok(value)) if (0..=0xFF).contains(&value) => value as u8,
+            Ok(Ok(value)) if (0..=0xFF).contains(&value) => {
+                let answer = value as u8;
+                if !volatile {
+                    self.answers[index] = Some(answer);
+                }
+                answer
+            }
             Ok(Ok(value)) => {
                 let error = self.script.error_at_fn(
                     "read",
@@ -394,6 +455,7 @@ impl Device for ScriptCard {
             return;
         }
         let register = offset % self.size;
+        self.forget();
         if !self.has_write {
             if let Ok(mut shared) = self.shared.lock()
                 && let Some(slot) = shared.table.get_mut(usize::from(register))
@@ -418,8 +480,10 @@ impl Device for ScriptCard {
 
     fn is_stable(&self, offset: u16) -> bool {
         // A plain register is the table, which only the script changes:
-        // at a wake-up (the card's next event) or a write.
-        self.failed || self.plain[usize::from(offset % self.size)]
+        // at a wake-up (the card's next event) or a write; an answer of
+        // `read` without effects holds until then too.
+        let index = usize::from(offset % self.size);
+        self.failed || self.plain[index] || (!self.volatile[index] && self.answers[index].is_some())
     }
 
     fn sync(&mut self, cycle: u64) {
@@ -455,6 +519,8 @@ impl Device for ScriptCard {
             view: self.view.clone(),
             wake: self.wake,
             plain: self.plain.clone(),
+            volatile: self.volatile.clone(),
+            answers: self.answers.clone(),
             has_write: self.has_write,
             has_wake: self.has_wake,
             base: self.base,

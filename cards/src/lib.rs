@@ -8,6 +8,10 @@
 //!   interface.
 //! - [`ScriptWorld`]: surroundings that change the robot's inputs over
 //!   robot time (a [`romlib::Surroundings`]).
+//! - [`Room`]: the robot in a room from a world file (`world.toml`:
+//!   walls, obstacles, floor lines, the robot's pose, drive and sensors;
+//!   docs/WORLD.md), its pose following the drive motors' steps, a world
+//!   script adding to it.
 //! - [`CardArg`]: the `--card FILE[@ADDR]` argument.
 //!
 //! Scripts are untrusted input: they reach no file, network or process
@@ -23,6 +27,7 @@ mod card;
 mod clock;
 mod error;
 mod printed;
+pub mod room;
 mod sandbox;
 mod script;
 mod world;
@@ -31,6 +36,7 @@ pub use card::ScriptCard;
 pub use clock::{CALL_COST, OPERATIONS_PER_MICROSECOND};
 pub use error::{Located, ScriptError};
 pub use printed::{MAX_PRINTED_BYTES, MAX_PRINTED_LINES, Printed};
+pub use room::{Room, RoomView};
 pub use sandbox::{MAX_FUNCTIONS, MAX_VARIABLES, OPERATION_BUDGET};
 pub use world::ScriptWorld;
 

@@ -16,11 +16,23 @@ use crate::sandbox::{
     robot_time_spent,
 };
 
+/// The namespace functions read the top level's constants from
+/// (`global::NAME`, Rhai's own name for them).
+const GLOBAL: &str = "global";
+
 /// A loaded script.
 pub(crate) struct Script {
     engine: Engine,
     ast: AST,
+    /// The top level's variables and constants, as it left them.
     scope: Scope<'static>,
+    /// The scope calls run in: empty (a function sees only its
+    /// parameters), kept so a call allocates none.
+    calls: Scope<'static>,
+    /// The top level's constants, which functions read as `global::NAME`:
+    /// a static module of the engine's, so a call need not run the top
+    /// level again to declare them.
+    constants: rhai::Shared<rhai::Module>,
     /// The state the script's functions see as `this`.
     this: Dynamic,
     name: String,
@@ -62,6 +74,8 @@ impl Script {
             engine,
             ast,
             scope: Scope::new(),
+            calls: Scope::new(),
+            constants: rhai::Module::new().into(),
             this: Dynamic::from_map(rhai::Map::new()),
             name: name.to_owned(),
             text: text.to_owned(),
@@ -73,6 +87,17 @@ impl Script {
         let _ = script.start(None);
         let result = script.engine.run_ast_with_scope(&mut scope, &script.ast);
         result.map_err(|error| script.runtime_error_in(&error, None))?;
+        let mut constants = rhai::Module::new();
+        for (name, constant, value) in scope.iter_raw() {
+            if constant {
+                constants.set_var(name, value.clone());
+            }
+        }
+        constants.build_index();
+        script.constants = constants.into();
+        script
+            .engine
+            .register_static_module(GLOBAL, script.constants.clone());
         script.scope = scope;
         Ok(script)
     }
@@ -85,14 +110,17 @@ impl Script {
     /// (its limits are per call), so the copy goes on as this script
     /// would. `None` if part of `this` is shared (a closure's captured
     /// variable), which a copy could not keep apart from the original.
-    pub(crate) fn fork(&self, engine: Engine, host: Arc<Host>) -> Option<Script> {
+    pub(crate) fn fork(&self, mut engine: Engine, host: Arc<Host>) -> Option<Script> {
         if has_shared(&self.this) {
             return None;
         }
+        engine.register_static_module(GLOBAL, self.constants.clone());
         Some(Script {
             engine,
             ast: self.ast.clone(),
             scope: self.scope.clone(),
+            calls: Scope::new(),
+            constants: self.constants.clone(),
             this: self.this.clone(),
             name: self.name.clone(),
             text: self.text.clone(),
@@ -130,13 +158,16 @@ impl Script {
             // Not even the call itself is covered: refused before it runs.
             return Err(self.runtime_error_in(&robot_time_spent(), Some(function)));
         }
+        // The top level ran once, at loading: its constants are the
+        // engine's `global` module, so the call goes straight to the
+        // function.
         let options = CallFnOptions::new()
-            .eval_ast(true)
+            .eval_ast(false)
             .rewind_scope(true)
             .bind_this_ptr(&mut self.this);
         let result = self.engine.call_fn_with_options::<Dynamic>(
             options,
-            &mut self.scope,
+            &mut self.calls,
             &self.ast,
             function,
             args,
@@ -190,8 +221,8 @@ impl Script {
             inner = next;
         }
         // Robot time runs out wherever the count happens to be (at a
-        // call's first statement, the script's top level is run again):
-        // the function called is the place to change.
+        // call's first statement, say): the function called is the place
+        // to change.
         let (line, column) = if inner.position().is_none() || is_robot_time(inner) {
             within.as_deref().map_or((1, 1), |name| self.fn_line(name))
         } else {

@@ -9,6 +9,8 @@ use romlib::Surroundings;
 const COUNTER: &str = r"
 const SIZE = 1;
 const BASE = 0x9000;
+// Every read counts: its effects are declared.
+const VOLATILE = [0];
 fn init() { this.count = 0; this.seen = []; }
 fn read(reg, now) { this.count += 1; this.seen.push(now); this.count }
 ";

@@ -16,8 +16,10 @@ pub(crate) struct Rig {
     /// `BASE` or at ADDR (hex); repeat for more cards.
     #[arg(long = "card", value_name = "FILE[@ADDR]")]
     pub(crate) cards: Vec<CardArg>,
-    /// The robot's surroundings, a Rhai script that closes bumpers and
-    /// lights the phototransistors over robot time (docs/CARDS.md).
+    /// The robot's surroundings: a Rhai script that closes bumpers and
+    /// lights the phototransistors over robot time (docs/CARDS.md), or a
+    /// world file (`.toml`: a room with obstacles and floor lines, the
+    /// robot's pose following its motors; docs/WORLD.md).
     #[arg(long = "world", value_name = "FILE")]
     pub(crate) world: Option<PathBuf>,
     /// The directory the cards' relative paths are read from (a
@@ -28,6 +30,9 @@ pub(crate) struct Rig {
     /// may come from its own source (`--world` with the project's cards).
     #[arg(skip)]
     pub(crate) world_root: Option<PathBuf>,
+    /// The room of a world file, once a robot has it.
+    #[arg(skip)]
+    pub(crate) room: scorpion_project::runner::rig::RoomSlot,
 }
 
 impl Rig {
@@ -38,6 +43,7 @@ impl Rig {
             world: self.world.clone(),
             root: self.root.clone(),
             world_root: self.world_root.clone(),
+            room: self.room.clone(),
         }
     }
 
@@ -70,6 +76,7 @@ impl From<scorpion_project::runner::Rig> for Rig {
             world: rig.world,
             root: rig.root,
             world_root: rig.world_root,
+            room: rig.room,
         }
     }
 }

@@ -49,6 +49,11 @@ pub(crate) struct Args {
     /// Cards on the KIM bus and the robot's surroundings.
     #[command(flatten)]
     rig: crate::cmd::rig::Rig,
+    /// Draw the robot's path in its room (a world file, `--world
+    /// room.toml`) to FILE.svg when the run ends: the room, the trail with
+    /// a mark every second, the bumps and the commands received.
+    #[arg(long, value_name = "FILE.svg")]
+    path: Option<PathBuf>,
 }
 
 /// A bumper mask in hex: `05`, `$05` or `0x05`.
@@ -133,20 +138,35 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     ))?;
     let rom = crate::cmd::config::rom(&resolved)?;
     let images = crate::cmd::config::images(&resolved, &args.images)?;
-    let (mut robot, printed) = robot(
-        resolved.baud.value,
-        rom.as_ref(),
-        &crate::cmd::config::rig(&resolved),
-        &images,
-    )?;
+    let rig = crate::cmd::config::rig(&resolved);
+    let (mut robot, printed) = robot(resolved.baud.value, rom.as_ref(), &rig, &images)?;
+    let room = match &args.path {
+        Some(path) => Some((
+            path,
+            rig.room.get().ok_or_else(|| {
+                miette::miette!(
+                    help = "give a world file: `--world room.toml` (docs/WORLD.md)",
+                    "--path draws the robot in its room, and the robot has none"
+                )
+            })?,
+        )),
+        None => None,
+    };
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }
-    if args.pty {
+    let mut commands = Vec::new();
+    let exit = if args.pty {
         serve_pty(&mut robot, resolved.baud.value, &printed)
     } else {
-        serve_stdio(&mut robot, resolved.baud.value, &printed)
+        serve_stdio(&mut robot, resolved.baud.value, &printed, &mut commands)
+    }?;
+    if let Some((path, view)) = room {
+        std::fs::write(path, view.svg(&commands))
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
     }
+    Ok(exit)
 }
 
 /// Emulated cycles for a wall-clock duration (the CPU runs at 1 MHz).
@@ -396,6 +416,7 @@ fn serve_stdio(
     robot: &mut VirtualScorpion,
     baud: u32,
     printed: &[(String, cards::Printed)],
+    commands: &mut Vec<(u64, String)>,
 ) -> miette::Result<ExitCode> {
     let (sender, chunks) = mpsc::sync_channel::<Option<Vec<u8>>>(CHUNKS_AHEAD);
     std::thread::spawn(move || {
@@ -432,7 +453,16 @@ fn serve_stdio(
         let mut next = chunks.recv_timeout(Duration::from_millis(2));
         loop {
             match next {
-                Ok(Some(bytes)) => line.accept(&bytes),
+                Ok(Some(bytes)) => {
+                    // For the picture of the path: what arrived, when.
+                    let text = String::from_utf8_lossy(&bytes);
+                    commands.extend(
+                        text.split(['\r', '\n'])
+                            .filter(|command| !command.is_empty())
+                            .map(|command| (robot.cycles(), command.to_owned())),
+                    );
+                    line.accept(&bytes);
+                }
                 Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => ended = true,
                 Err(mpsc::RecvTimeoutError::Timeout) => break,
             }

@@ -212,6 +212,55 @@ fn the_readmes_own_card_section_runs_as_written() {
 }
 
 #[test]
+fn the_readmes_room_section_runs_as_written() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::os::unix::fs::symlink(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples"),
+        dir.path().join("examples"),
+    )
+    .expect("link the examples");
+    let path = crate::path_with_scorpion();
+    let mut printed = String::new();
+    for line in readme_block("## Your robot in a room", "sh").lines() {
+        let output = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(line)
+            .current_dir(dir.path())
+            .env("PATH", &path)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("sh runs");
+        assert!(
+            output.status.success(),
+            "`{line}`:\n{}",
+            transcript(&output)
+        );
+        printed.push_str(&String::from_utf8_lossy(&output.stdout));
+    }
+    assert_eq!(
+        printed,
+        readme_block("## Your robot in a room", "text"),
+        "README.md's room section is stale"
+    );
+    let picture = std::fs::read_to_string(dir.path().join("path.svg")).expect("the picture");
+    assert!(picture.starts_with("<svg "), "{picture}");
+    assert!(picture.contains(">bump 10 at "), "{picture}");
+    assert!(picture.contains(">/4C+40 at "), "{picture}");
+}
+
+#[test]
+fn path_needs_a_room() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let (code, text) = sim_in(dir.path(), &["--path", "path.svg"], "/1B\n");
+    assert_eq!(code, 1, "{text}");
+    assert!(
+        text.contains("--path draws the robot in its room"),
+        "{text}"
+    );
+    assert!(!dir.path().join("path.svg").exists());
+}
+
+#[test]
 fn the_examples_readme_shows_the_same_card_commands() {
     let examples =
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/README.md"))

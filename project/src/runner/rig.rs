@@ -4,8 +4,9 @@
 //! them ([`Resolved`]).
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
-use cards::{CardArg, Printed, ScriptCard, ScriptWorld};
+use cards::{CardArg, Printed, Room, RoomView, ScriptCard, ScriptWorld};
 use romlib::VirtualScorpion;
 
 use super::error::{Baud, Error, Result};
@@ -21,8 +22,10 @@ pub struct Rig {
     /// KIM-bus cards, Rhai scripts (docs/CARDS.md), each at its script's
     /// `BASE` or the address given.
     pub cards: Vec<CardArg>,
-    /// The robot's surroundings, a Rhai script that closes bumpers and
-    /// lights the phototransistors over robot time (docs/CARDS.md).
+    /// The robot's surroundings: a Rhai script that closes bumpers and
+    /// lights the phototransistors over robot time (docs/CARDS.md), or a
+    /// world file (`.toml`: a room, docs/WORLD.md), which may name such a
+    /// script beside it.
     pub world: Option<PathBuf>,
     /// The directory the cards' relative paths are read from (a
     /// project's root); the paths are shown as given.
@@ -30,6 +33,27 @@ pub struct Rig {
     /// The directory the world's relative path is read from: each part
     /// may come from its own source (`--world` with the project's cards).
     pub world_root: Option<PathBuf>,
+    /// The room of the last robot given a world file, seen from the host
+    /// (its pose, trail and picture: `--path FILE.svg`).
+    pub room: RoomSlot,
+}
+
+/// Where the host sees the room of a world file from, once a robot has
+/// it: shared by the rig's copies.
+#[derive(Debug, Clone, Default)]
+pub struct RoomSlot(Arc<Mutex<Option<RoomView>>>);
+
+impl RoomSlot {
+    /// The room's view, if a robot was given a world file.
+    pub fn get(&self) -> Option<RoomView> {
+        self.0.lock().ok().and_then(|slot| slot.clone())
+    }
+
+    fn set(&self, view: RoomView) {
+        if let Ok(mut slot) = self.0.lock() {
+            *slot = Some(view);
+        }
+    }
 }
 
 /// What each script of a robot prints, by the script's name.
@@ -56,6 +80,7 @@ impl Rig {
                 .as_ref()
                 .and_then(|w| resolved.base(&w.origin))
                 .map(Path::to_path_buf),
+            room: RoomSlot::default(),
         }
     }
 
@@ -88,9 +113,24 @@ impl Rig {
         if let Some(path) = &self.world {
             let name = path.display().to_string();
             let text = read(self.world_root.as_deref(), path)?;
-            let world = ScriptWorld::load(&name, &text)?;
-            printed.push((name, world.printed()));
-            robot.set_surroundings(Box::new(world));
+            if path.extension().is_some_and(|e| e == "toml") {
+                let mut room = Room::load(&name, &text)?;
+                if let Some(script) = room.script_path() {
+                    // Written relative to the world file.
+                    let script = path.parent().unwrap_or(Path::new("")).join(script);
+                    let name = script.display().to_string();
+                    let text = read(self.world_root.as_deref(), &script)?;
+                    let world = ScriptWorld::load(&name, &text)?;
+                    printed.push((name, world.printed()));
+                    room.add(Box::new(world));
+                }
+                self.room.set(room.view());
+                robot.set_surroundings(Box::new(room));
+            } else {
+                let world = ScriptWorld::load(&name, &text)?;
+                printed.push((name, world.printed()));
+                robot.set_surroundings(Box::new(world));
+            }
         }
         Ok(printed)
     }

@@ -1,0 +1,283 @@
+//! The robot in a room: a world file ([`file`]) gives the walls,
+//! obstacles and floor lines, the robot's start pose, drive and sensors;
+//! [`Room`] follows the drive motors' steps to the robot's pose
+//! ([`drive`]) and closes a bumper while its part of the outline touches
+//! something, lights a ground-tracker phototransistor over a floor line
+//! while the lamps are on. A world script named by the file adds what
+//! the file cannot say. See docs/WORLD.md.
+
+pub mod drive;
+pub mod file;
+pub mod geometry;
+pub mod picture;
+
+use std::sync::{Arc, Mutex};
+
+use emulator::board::{Motor, Scorpion};
+use romlib::Surroundings;
+
+use crate::error::ScriptError;
+use drive::Pose;
+use file::Layout;
+use geometry::{Point, near_polyline, sin_cos};
+
+/// Robot time between two looks at the motors, cycles (1 ms): a drive
+/// steps at most 495 times a second (speed 99), so each look sees one
+/// step a wheel at most, and a bumper closes within a millisecond of the
+/// step that made the contact.
+pub const TICK: u64 = 1000;
+
+/// Points each bumper's part of the outline is felt at.
+const FEELERS: u32 = 9;
+
+/// Where the robot went, kept for the picture and the transcripts.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Trail {
+    /// The pose after each look at which the robot had moved, with the
+    /// robot time (cycles); the start pose at 0 first.
+    pub poses: Vec<(u64, Pose)>,
+    /// Each change of the bumpers the room closed, with the robot time.
+    pub bumps: Vec<(u64, u8)>,
+}
+
+/// The most poses a trail keeps: past that, the robot's later moves are
+/// not drawn (a run of hours), and the pose is still followed.
+pub const MAX_TRAIL: usize = 200_000;
+
+/// A handle on the room as the robot runs: its pose and trail, read by
+/// the host while the room itself belongs to the virtual robot.
+#[derive(Debug, Clone)]
+pub struct RoomView {
+    trail: Arc<Mutex<Trail>>,
+    layout: Arc<Layout>,
+}
+
+impl RoomView {
+    /// The robot's pose now.
+    #[must_use]
+    pub fn pose(&self) -> Option<Pose> {
+        self.trail
+            .lock()
+            .ok()
+            .and_then(|trail| trail.poses.last().map(|&(_, pose)| pose))
+    }
+
+    /// The trail so far.
+    #[must_use]
+    pub fn trail(&self) -> Trail {
+        self.trail.lock().map(|t| t.clone()).unwrap_or_default()
+    }
+
+    /// The path as a picture (SVG text, [`picture::svg`]), with
+    /// `commands` (robot time, text) placed along it.
+    #[must_use]
+    pub fn svg(&self, commands: &[(u64, String)]) -> String {
+        picture::svg(&self.layout, &self.trail(), commands)
+    }
+}
+
+/// The robot's surroundings from a world file.
+#[derive(Debug)]
+pub struct Room {
+    layout: Layout,
+    pose: Pose,
+    /// The drive motors' positions at the last look (`None`: no look
+    /// yet; the robot stands at its start pose whatever they read).
+    motors: Option<(i64, i64)>,
+    /// What the room last set: bumpers, phototransistors.
+    bumpers: u8,
+    sense: u8,
+    next_look: u64,
+    script: Option<Box<dyn Surroundings>>,
+    view: RoomView,
+}
+
+impl Room {
+    /// Reads the world file `text` (named `name` in errors).
+    ///
+    /// # Errors
+    /// [`ScriptError::Script`] at the place of a mistake in the file.
+    pub fn load(name: &str, text: &str) -> Result<Room, ScriptError> {
+        let layout = file::parse(name, text)?;
+        let pose = layout.start;
+        let view = RoomView {
+            trail: Arc::new(Mutex::new(Trail {
+                poses: vec![(0, pose)],
+                bumps: Vec::new(),
+            })),
+            layout: Arc::new(layout.clone()),
+        };
+        Ok(Room {
+            layout,
+            pose,
+            motors: None,
+            bumpers: 0,
+            sense: 0,
+            next_look: 0,
+            script: None,
+            view,
+        })
+    }
+
+    /// The world script the file names (`script = "..."`), as written:
+    /// relative to the file's folder.
+    #[must_use]
+    pub fn script_path(&self) -> Option<&str> {
+        self.layout.script.as_deref()
+    }
+
+    /// Adds surroundings (the world script) that run with the room.
+    pub fn add(&mut self, script: Box<dyn Surroundings>) {
+        self.script = Some(script);
+    }
+
+    /// The file as read, defaults filled in.
+    #[must_use]
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// A handle on the robot's pose and trail.
+    #[must_use]
+    pub fn view(&self) -> RoomView {
+        self.view.clone()
+    }
+
+    /// The robot's pose.
+    #[must_use]
+    pub fn pose(&self) -> Pose {
+        self.pose
+    }
+
+    /// Whether the floor point `point` is taken by a wall or an obstacle.
+    fn blocked(&self, point: Point) -> bool {
+        self.layout
+            .walls
+            .as_ref()
+            .is_some_and(|walls| !geometry::inside_polygon(walls, point))
+            || self.layout.obstacles.iter().any(|o| o.contains(point))
+    }
+
+    /// The bumpers closed at the robot's pose: a bit for each whose part
+    /// of the outline touches a wall or an obstacle.
+    #[must_use]
+    pub fn contacts(&self) -> u8 {
+        let body = &self.layout.body;
+        let mut closed = 0;
+        for (bit, &middle) in body.bumpers.iter().enumerate() {
+            let touches = (0..FEELERS).any(|k| {
+                let share = f64::from(k) / f64::from(FEELERS - 1) - 0.5;
+                let (sin, cos) = sin_cos(middle + share * body.bumper_arc);
+                self.blocked(self.pose.place(body.radius * cos, body.radius * sin))
+            });
+            if touches {
+                closed |= 1 << bit;
+            }
+        }
+        closed
+    }
+
+    /// The phototransistors (`SENSE` bits: 0 right, 1 left) at the
+    /// robot's pose with the lamps as `lamps` says.
+    #[must_use]
+    pub fn sees(&self, lamps: bool) -> u8 {
+        if !lamps {
+            return 0;
+        }
+        let body = &self.layout.body;
+        let over = |(forward, left): (f64, f64)| {
+            let point = self.pose.place(forward, left);
+            self.layout
+                .lines
+                .iter()
+                .any(|line| near_polyline(&line.points, line.width / 2.0, point))
+        };
+        u8::from(over(body.right_tracker)) | (u8::from(over(body.left_tracker)) << 1)
+    }
+
+    /// Follows the motors to `now` and sets the robot's inputs.
+    fn look(&mut self, now: u64, robot: &mut Scorpion) {
+        let board = robot.board();
+        let motors = (
+            board.motor(Motor::Left).position(),
+            board.motor(Motor::Right).position(),
+        );
+        let lamps = board.lamps();
+        let last = self.motors.unwrap_or(motors);
+        let (left, right) = (motors.0 - last.0, motors.1 - last.1);
+        self.motors = Some(motors);
+        let moved = left != 0 || right != 0;
+        if moved {
+            self.pose = self.layout.drive.moved(self.pose, left, right);
+        }
+        let closed = self.contacts();
+        if closed != self.bumpers {
+            self.bumpers = closed;
+            robot.set_bumpers(closed);
+        }
+        let sense = self.sees(lamps);
+        if sense != self.sense {
+            self.sense = sense;
+            robot.board_mut().set_phototransistors(sense);
+        }
+        if let Ok(mut trail) = self.view.trail.lock() {
+            if moved && trail.poses.len() < MAX_TRAIL {
+                trail.poses.push((now, self.pose));
+            }
+            if trail
+                .bumps
+                .last()
+                .map_or(closed != 0, |&(_, b)| b != closed)
+                && trail.bumps.len() < MAX_TRAIL
+            {
+                trail.bumps.push((now, closed));
+            }
+        }
+    }
+}
+
+impl Surroundings for Room {
+    fn next_wake(&self) -> Option<u64> {
+        let script = self.script.as_ref().and_then(|s| s.next_wake());
+        Some(script.map_or(self.next_look, |s| s.min(self.next_look)))
+    }
+
+    fn wake(
+        &mut self,
+        now: u64,
+        robot: &mut Scorpion,
+    ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>> {
+        if now >= self.next_look {
+            self.look(now, robot);
+            self.next_look = now + TICK;
+        }
+        if let Some(script) = &mut self.script
+            && script.next_wake().is_some_and(|at| at <= now)
+        {
+            script.wake(now, robot)?;
+        }
+        Ok(())
+    }
+
+    /// The room with its pose and script copied; the copy's trail goes on
+    /// from this one's in its own [`RoomView`].
+    fn snapshot(&self) -> Option<Box<dyn Surroundings>> {
+        let script = match &self.script {
+            Some(script) => Some(script.snapshot()?),
+            None => None,
+        };
+        Some(Box::new(Room {
+            layout: self.layout.clone(),
+            pose: self.pose,
+            motors: self.motors,
+            bumpers: self.bumpers,
+            sense: self.sense,
+            next_look: self.next_look,
+            script,
+            view: RoomView {
+                trail: Arc::new(Mutex::new(self.view.trail())),
+                layout: Arc::clone(&self.view.layout),
+            },
+        }))
+    }
+}
