@@ -1,9 +1,11 @@
 //! The CPU hooks that find where to stop, and the bus that watches memory.
 //!
 //! A watchpoint is found by [`WatchBus`], which passes every access on to
-//! the board and notes the first one a watchpoint covers; the hooks see
-//! the note before the next instruction and stop there, so a watch stops
-//! just after the instruction that made the access, with its effect seen.
+//! the board and notes the first one a watchpoint covers, and has the
+//! board end the run at that instruction's end
+//! ([`Board::request_stop`]): a watch stops just after the instruction
+//! that made the access, with its effect seen, and no hook looks for it
+//! before every instruction.
 //!
 //! Nothing that never stops costs more than a bit test where it could:
 //! breakpoints are a bitmap of the PCs they may stop at, tested once per
@@ -112,22 +114,25 @@ pub(crate) struct WatchBus<'a> {
 
 impl WatchBus<'_> {
     #[inline(always)]
-    fn read_seen(&self, address: u16, value: u8) {
+    fn read_seen(&mut self, address: u16, value: u8) {
         if in_blocks(self.read_blocks, address) && self.watched.reads.contains(address) {
             self.note(address, value, false);
         }
     }
 
     #[inline(always)]
-    fn write_seen(&self, address: u16, value: u8) {
+    fn write_seen(&mut self, address: u16, value: u8) {
         if in_blocks(self.write_blocks, address) && self.watched.writes.contains(address) {
             self.note(address, value, true);
         }
     }
 
+    /// Notes the first access a watch covers, and has the board end the
+    /// run at this instruction's end ([`Board::request_stop`]): the hooks
+    /// need not look for it before every instruction.
     #[cold]
     #[inline(never)]
-    fn note(&self, address: u16, value: u8, write: bool) {
+    fn note(&mut self, address: u16, value: u8, write: bool) {
         if let Some(hit) = self.hit.get() {
             // A read-modify-write instruction (INC, ASL...) writes the byte
             // it read, then the result: the byte it leaves is the one to
@@ -148,6 +153,7 @@ impl WatchBus<'_> {
                 value,
                 write,
             }));
+            self.board.request_stop();
         }
     }
 }
@@ -255,8 +261,9 @@ pub(crate) enum LeanStop {
 
 /// The hooks of a run that only breakpoints, watchpoints (with `WATCH`)
 /// and a count (with `COUNT`) can stop: a bit test of the PC per
-/// instruction (and a comparison of the count, with `COUNT`, and a look
-/// at the bus's note, with `WATCH`), nothing else. A run to a breakpoint,
+/// instruction (and a comparison of the count, with `COUNT`, and the PC
+/// noted, with `WATCH`: the watching bus ends the run itself, through the
+/// board), nothing else. A run to a breakpoint,
 /// a step back's re-run, a search for a hit all run here; `next`,
 /// `finish` and tracing use [`Look`]. A run with no count to stop at
 /// (`continue`) makes no comparison: its idle skip and its end are bound
@@ -271,8 +278,6 @@ pub(crate) struct Lean<'a, const WATCH: bool, const COUNT: bool> {
     pub(crate) start: u64,
     /// Stop before the instruction with this count.
     pub(crate) stop_at: u64,
-    /// The watchpoint hit the bus noted (with `WATCH`).
-    pub(crate) hit: &'a Cell<Option<Access>>,
     /// The PC of the instruction last let run (with `WATCH`).
     pub(crate) last_pc: u16,
     /// Why it stopped.
@@ -298,14 +303,8 @@ impl<const WATCH: bool, const COUNT: bool> Hooks for Lean<'_, WATCH, COUNT> {
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, _bus: &B) -> Control {
         if WATCH {
-            if let Some(access) = self.hit.get() {
-                self.hit.set(None);
-                self.stopped = Some(LeanStop::Watch {
-                    access,
-                    pc: self.last_pc,
-                });
-                return Control::Stop;
-            }
+            // A watch hit ends the run through the board, just after the
+            // instruction: its PC is the last one noted here.
             self.last_pc = cpu.pc;
         }
         if COUNT && cpu.instructions() >= self.stop_at {

@@ -1150,10 +1150,13 @@ fn run_hooked(
             read_blocks,
             write_blocks,
         };
-        match trace.as_deref_mut() {
+        let stop = match trace.as_deref_mut() {
             Some(tracer) => robot.cpu.run(&mut bus, to, &mut (&mut look, tracer)),
             None => robot.cpu.run(&mut bus, to, &mut look),
-        }
+        };
+        // A watch hit's stop is this run's: the next one goes on.
+        robot.bus.clear_stop_request();
+        stop
     })?;
     // A watch the run's last instruction hit, though the run ended before
     // the next one looked: it stops here, not in the next run.
@@ -1248,7 +1251,6 @@ impl Leaning<'_> {
             place_blocks: self.place_blocks,
             start,
             stop_at: self.stop_at,
-            hit: &hit,
             last_pc: robot.robot().cpu.pc,
             stopped: None,
             skip_idle: self.skip_idle,
@@ -1269,10 +1271,13 @@ impl Leaning<'_> {
                 read_blocks,
                 write_blocks,
             };
-            robot.cpu.run(&mut bus, to, &mut lean)
+            let stop = robot.cpu.run(&mut bus, to, &mut lean);
+            // The hit's stop is this run's: the next one goes on.
+            robot.bus.clear_stop_request();
+            stop
         })?;
-        // A watch the run's last instruction hit, though the run ended
-        // before the next one looked: it stops here, not in the next run.
+        // The run ended just after the instruction that made the access
+        // (or at its limit, if that came first): it stops here.
         Ok(match (lean.stopped, hit.take()) {
             (None, Some(access)) => Some(LeanStop::Watch {
                 access,

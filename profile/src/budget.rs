@@ -127,7 +127,7 @@ pub fn check(profile: &Profile, budgets: &[Budget]) -> (Vec<Overrun>, Vec<Unused
                 }
             }
             Subject::Routine(name) => {
-                let Some(cost) = profile.routines.get(name) else {
+                let Some(cost) = profile.routine(name) else {
                     unused.push(Unused {
                         budget: budget.clone(),
                     });

@@ -75,6 +75,9 @@ pub(crate) struct Labels {
     /// `u32::MAX` for none.
     by_address: Vec<u32>,
     pub(crate) names: Vec<(u16, String)>,
+    /// The other labels of an address `names` names once (`rec:` on the
+    /// line after `cmd_q:`): a budget may name a routine by any of them.
+    pub(crate) aliases: Vec<(u16, String)>,
 }
 
 impl Labels {
@@ -83,6 +86,18 @@ impl Labels {
     pub(crate) fn new(labels: &[(u16, String)]) -> Labels {
         let mut names: Vec<(u16, String)> = labels.to_vec();
         names.sort_by_key(|(at, name)| (*at, name.starts_with("__"), name.clone()));
+        let mut aliases: Vec<(u16, String)> = Vec::new();
+        let mut first: Option<&(u16, String)> = None;
+        for label in &names {
+            match first {
+                Some(kept) if kept.0 == label.0 => {
+                    if kept.1 != label.1 && !aliases.contains(label) {
+                        aliases.push(label.clone());
+                    }
+                }
+                _ => first = Some(label),
+            }
+        }
         names.dedup_by_key(|(at, _)| *at);
         let mut by_address = vec![u32::MAX; 0x1_0000];
         for (index, window) in names.iter().enumerate() {
@@ -95,7 +110,11 @@ impl Labels {
                 *slot = index;
             }
         }
-        Labels { by_address, names }
+        Labels {
+            by_address,
+            names,
+            aliases,
+        }
     }
 
     #[inline(always)]
@@ -254,6 +273,16 @@ impl Profiler {
             }
         }
         self.pending = None;
+    }
+
+    /// The host entered the routine at `target` as a `JSR` does, at cycle
+    /// `now`, S at `s_before` before the return address was pushed (a
+    /// routine-level test's call): its frame begins, a root of its own
+    /// (no code of the robot's called it), and ends at its `RTS`.
+    pub fn entered(&mut self, target: u16, s_before: u8, now: u64) {
+        if self.calls {
+            self.stack.entered(target, s_before, now);
+        }
     }
 
     /// Says where the `index`th command seen came from (a transcript's
@@ -465,12 +494,15 @@ impl Hooks for Profiler {
             Interrupt::Irq => Routine::Irq,
             Interrupt::Nmi => Routine::Nmi,
         };
+        // The sequence's own seven cycles are the handler's, counted at
+        // its first instruction (its address, so its line and label):
+        // cycles by address add up to the total, as routines' do.
         self.total += 7;
+        self.cycles[usize::from(cpu.pc)] += 7;
         self.last_end = Some(began + 7);
         if self.calls {
             self.stack.interrupt(routine, s_before, began);
-            // The sequence's own seven cycles are the handler's.
-            self.stack.charge(u32::MAX, 7);
+            self.stack.charge(self.labels.of(cpu.pc), 7);
         }
     }
 

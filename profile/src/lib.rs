@@ -14,6 +14,7 @@
 //!   are;
 //! - [`report`]: the tables a terminal shows, sorted by cost;
 //! - [`flame`]: the folded stacks as an SVG flame graph;
+//! - [`speedscope`]: the folded stacks as a speedscope file;
 //! - [`coverage`]: line and branch coverage, as LCOV and HTML;
 //! - [`budget`]: cycle budgets per command and per routine, checked.
 //!
@@ -29,6 +30,7 @@ pub mod lines;
 pub mod profile;
 pub mod report;
 pub mod runner;
+pub mod speedscope;
 mod stack;
 
 pub use engine::{CommandRun, Places, Profiler};

@@ -59,6 +59,10 @@ pub struct Profile {
     /// The labels of the robots profiled (ROM and images), to name
     /// addresses no source line covers.
     pub labels: Vec<(u16, String)>,
+    /// A routine's other labels (the same address under two names:
+    /// `cmd_q:` then `rec:`), each to the name [`Profile::routines`]
+    /// keeps it under.
+    pub aliases: BTreeMap<String, String>,
 }
 
 impl Default for Profile {
@@ -74,6 +78,7 @@ impl Default for Profile {
             total: 0,
             skipped_laps: 0,
             labels: Vec::new(),
+            aliases: BTreeMap::new(),
         }
     }
 }
@@ -158,7 +163,16 @@ impl Profile {
             }
             merge_cost(routines.entry(name.clone()).or_default(), &cost, 0);
         }
+        let mut aliases = BTreeMap::new();
+        for routine in &stack.routines {
+            if let Routine::Sub(address) = routine {
+                for (_, alias) in labels.aliases.iter().filter(|(at, _)| at == address) {
+                    aliases.insert(alias.clone(), labels.name(*address));
+                }
+            }
+        }
         Profile {
+            aliases,
             counts: profiler.counts.clone(),
             cycles: profiler.cycles.clone(),
             taken: profiler.taken.clone(),
@@ -192,6 +206,11 @@ impl Profile {
             *self.stacks.entry(stack.clone()).or_default() += cycles;
         }
         self.commands.extend(other.commands.iter().cloned());
+        for (alias, name) in &other.aliases {
+            self.aliases
+                .entry(alias.clone())
+                .or_insert_with(|| name.clone());
+        }
         self.total += other.total;
         self.skipped_laps += other.skipped_laps;
         if self.labels.is_empty() {
@@ -203,6 +222,17 @@ impl Profile {
             labels.dedup();
             self.labels = labels;
         }
+    }
+
+    /// The routine named `name`, by its shown name or another label of
+    /// its address.
+    #[must_use]
+    pub fn routine(&self, name: &str) -> Option<&RoutineCost> {
+        self.routines.get(name).or_else(|| {
+            self.aliases
+                .get(name)
+                .and_then(|shown| self.routines.get(shown))
+        })
     }
 
     /// `address` as `label` or `label+$offset`, or `$ADDR`.

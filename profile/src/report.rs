@@ -135,7 +135,9 @@ pub struct HotLine {
 pub fn hot_lines(profile: &Profile, lines: &LineTable) -> Vec<HotLine> {
     let mut by_place: BTreeMap<String, (u64, u64)> = BTreeMap::new();
     for (address, (&count, &cycles)) in profile.counts.iter().zip(&profile.cycles).enumerate() {
-        if count == 0 {
+        // An interrupt's entry counted at a handler the run ended before
+        // has cycles and no run.
+        if count == 0 && cycles == 0 {
             continue;
         }
         let Ok(address) = u16::try_from(address) else {

@@ -70,4 +70,9 @@ impl romlib::Runner for Recorder {
         profiler.end_run(&robot.cpu);
         stop
     }
+
+    fn entered(&mut self, robot: &Scorpion, target: u16, s_before: u8) {
+        let mut profiler = self.profiler.lock().unwrap_or_else(PoisonError::into_inner);
+        profiler.entered(target, s_before, robot.cpu.cycles());
+    }
 }

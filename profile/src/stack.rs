@@ -196,11 +196,15 @@ impl Stack {
     }
 
     fn push(&mut self, routine: Routine, ends: Ends, entry: u64, times: u64) {
-        let routine = self.routine_id(routine);
         let parent = match ends {
             Ends::Interrupt { .. } => TOP,
             Ends::Return { .. } | Ends::Command => self.node(),
         };
+        self.push_under(parent, routine, ends, entry, times);
+    }
+
+    fn push_under(&mut self, parent: u32, routine: Routine, ends: Ends, entry: u64, times: u64) {
+        let routine = self.routine_id(routine);
         let node = self.child(parent, routine);
         self.calls[routine as usize].calls += times;
         self.active[routine as usize] += 1;
@@ -267,6 +271,19 @@ impl Stack {
             Ends::Return { return_s: s_before },
             now,
             times,
+        );
+    }
+
+    /// The routine at `target` entered by the host as a `JSR` would (S at
+    /// `s_before` before the return address), at `now`: a root.
+    pub(crate) fn entered(&mut self, target: u16, s_before: u8, now: u64) {
+        self.overwritten(s_before, now);
+        self.push_under(
+            TOP,
+            Routine::Sub(target),
+            Ends::Return { return_s: s_before },
+            now,
+            1,
         );
     }
 

@@ -362,3 +362,45 @@ fn a_command_that_never_finishes_is_over_its_budget() {
     assert!(said.contains("never finished"), "{said}");
     assert!(said.contains("t.expect:1"), "{said}");
 }
+
+/// Each IRQ's seven-cycle entry sequence is counted at the handler's
+/// first instruction: cycles by address (hence by line, in the hot lines
+/// and the coverage report) add up to the profile's total, as the stacks
+/// do.
+#[test]
+fn an_interrupt_entry_is_counted_at_its_handler() {
+    let profile = profiled(true);
+    assert!(profile.routines["IRQ"].calls > 0, "the session interrupts");
+    assert_eq!(profile.cycles.iter().sum::<u64>(), profile.total);
+    let table = scorpion_profile::lines::LineTable::default();
+    let by_line: u64 = scorpion_profile::report::hot_lines(&profile, &table)
+        .iter()
+        .map(|line| line.cycles)
+        .sum();
+    assert_eq!(by_line, profile.total);
+}
+
+/// The speedscope file, read back as speedscope reads it (its "sampled"
+/// schema): every stack a sample, weighted by its cycles, adding up to
+/// the profile's total.
+#[test]
+fn the_speedscope_file_reads_back_to_the_profiles_totals() {
+    use scorpion_profile::speedscope;
+    let profile = profiled(true);
+    let text = speedscope::json(&profile, "q").expect("written");
+    let value: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(value["$schema"], speedscope::SCHEMA);
+    assert_eq!(value["profiles"][0]["type"], "sampled");
+    let file: speedscope::File = serde_json::from_str(&text).expect("the schema's fields");
+    let sampled = &file.profiles[0];
+    assert_eq!(sampled.samples.len(), sampled.weights.len());
+    assert_eq!(sampled.weights.iter().sum::<u64>(), profile.total);
+    assert_eq!(sampled.end_value, profile.total);
+    for (sample, weight) in sampled.samples.iter().zip(&sampled.weights) {
+        let stack: Vec<&str> = sample
+            .iter()
+            .map(|&frame| file.shared.frames[frame].name.as_str())
+            .collect();
+        assert_eq!(profile.stacks.get(&stack.join(";")), Some(weight));
+    }
+}

@@ -105,6 +105,14 @@ pub trait Runner: std::fmt::Debug + Send {
     fn run_to(&mut self, robot: &mut Scorpion, until: u64, stops: &mut Breakpoints) -> Stop {
         robot.run_with(until, stops)
     }
+
+    /// The host entered the routine at `target` as a `JSR` does, without
+    /// one (a routine-level test pushed a return address, S at
+    /// `s_before` before the push, and set the PC): a profiler starts the
+    /// routine's frame there. The default: nothing.
+    fn entered(&mut self, robot: &Scorpion, target: u16, s_before: u8) {
+        let _ = (robot, target, s_before);
+    }
 }
 
 /// An image's labels: its symbols that lie in a section (not constants).
@@ -263,6 +271,14 @@ impl VirtualScorpion {
         });
         self.runner = runner;
         result.map(|_| ())
+    }
+
+    /// Tells the runner, if one is set, that the host entered the
+    /// routine at `target` as a `JSR` does ([`Runner::entered`]).
+    pub fn entered(&mut self, target: u16, s_before: u8) {
+        if let Some(runner) = self.runner.as_mut() {
+            runner.entered(&self.robot, target, s_before);
+        }
     }
 
     /// Runs the CPU alone (no surroundings woken, no host) to robot time

@@ -20,7 +20,7 @@ use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 use scorpion_profile::lines::LineTable;
 use scorpion_profile::{Profile, Profiler, Recorder, report};
-use scorpion_project::runner::{self, Built, Mode, Progress};
+use scorpion_project::runner::{self, Built, Failure, Mode, Outcome, Passed, Progress};
 use scorpion_project::{Environment, Found};
 
 /// Profile the project's tests on the virtual Scorpion: cycles per
@@ -42,6 +42,10 @@ pub(crate) struct Args {
     /// `target/scorpion/flamegraph.svg`).
     #[arg(long, value_name = "FILE")]
     flamegraph: Option<PathBuf>,
+    /// Also write the stacks as a speedscope file (JSON, its "sampled"
+    /// profile; open it at https://www.speedscope.app).
+    #[arg(long, value_name = "FILE")]
+    speedscope: Option<PathBuf>,
 }
 
 /// One project's counts.
@@ -74,30 +78,35 @@ impl Member {
         }
     }
 
-    /// `scorpion test`'s lines for its budgets: (passed, failed).
-    pub(crate) fn check_budgets(&self, out: &mut dyn std::io::Write) -> (usize, usize) {
+    /// `scorpion test`'s tests of its budgets (`budget KEY`), over what
+    /// its tests ran; `filtered`: a filter left some tests out, so a
+    /// budget nothing ran is not run rather than failed. None if it has
+    /// no budget, or no test ran and none was filtered out.
+    pub(crate) fn budget_tests(&self, filtered: bool) -> Vec<(String, Outcome)> {
+        use scorpion_profile::budget::Subject;
+        if self.budgets.is_empty() || (self.tests == 0 && !filtered) {
+            return Vec::new();
+        }
         let (overruns, unused) = scorpion_profile::budget::check(&self.profile, &self.budgets);
-        let mut counts = (0, 0);
+        let mut tests = Vec::new();
         for budget in &self.budgets {
             let key = match &budget.subject {
-                scorpion_profile::budget::Subject::Command(key)
-                | scorpion_profile::budget::Subject::Routine(key) => key,
+                Subject::Command(key) | Subject::Routine(key) => key,
             };
-            if let Some(overrun) = overruns.iter().find(|o| &o.budget == budget) {
-                let _ = writeln!(out, "test budget {key} ... FAILED\n  {overrun}");
-                counts.1 += 1;
-            } else if unused.iter().any(|u| &u.budget == budget) {
-                let _ = writeln!(
-                    out,
-                    "test budget {key} ... FAILED\n  no command or routine the tests ran is named `{key}` (a command is `/2A`: its count and letter; a routine, a JSR target's label)"
-                );
-                counts.1 += 1;
+            let outcome = if let Some(overrun) = overruns.iter().find(|o| &o.budget == budget) {
+                Outcome::Failed(Failure::text(format!("  {overrun}")))
+            } else if !unused.iter().any(|u| &u.budget == budget) {
+                Outcome::Passed(Passed::Ok)
+            } else if filtered {
+                Outcome::Passed(Passed::NotRun)
             } else {
-                let _ = writeln!(out, "test budget {key} ... ok");
-                counts.0 += 1;
-            }
+                Outcome::Failed(Failure::text(format!(
+                    "  no command or routine the tests ran is named `{key}` (a command is `/2A`: its count and letter; a routine, a JSR target's label or a .calls test's routine)"
+                )))
+            };
+            tests.push((format!("budget {key}"), outcome));
         }
-        counts
+        tests
     }
 
     /// Writes `target/scorpion/coverage/lcov.info` and `index.html` and
@@ -248,6 +257,14 @@ impl Watch {
         }
     }
 
+    /// The project's budgets checked over what its tests ran.
+    pub(crate) fn budget_tests(&self, filtered: bool) -> Vec<(String, Outcome)> {
+        self.members
+            .last()
+            .map(|member| member.budget_tests(filtered))
+            .unwrap_or_default()
+    }
+
     /// Whether any project watched has budgets.
     pub(crate) fn needed(found: &Found) -> miette::Result<bool> {
         Ok(match found {
@@ -291,14 +308,24 @@ impl Progress for Quiet<'_> {
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
-    if let (Some(folded), Some(svg)) = (&args.folded, &args.flamegraph) {
-        // One would overwrite the other: refuse before running anything.
-        if std::path::absolute(folded).ok() == std::path::absolute(svg).ok() {
-            miette::bail!(
-                help = "give --folded and --flamegraph different files",
-                "--folded and --flamegraph name the same file, {}: the flame graph would overwrite the folded stacks",
-                folded.display()
-            );
+    let named = [
+        ("--folded", &args.folded),
+        ("--flamegraph", &args.flamegraph),
+        ("--speedscope", &args.speedscope),
+    ];
+    for (index, (first, one)) in named.iter().enumerate() {
+        for (second, other) in &named[index + 1..] {
+            let (Some(one), Some(other)) = (one, other) else {
+                continue;
+            };
+            // One would overwrite the other: refuse before running anything.
+            if std::path::absolute(one).ok() == std::path::absolute(other).ok() {
+                miette::bail!(
+                    help = format!("give {first} and {second} different files"),
+                    "{first} and {second} name the same file, {}: one would overwrite the other",
+                    one.display()
+                );
+            }
         }
     }
     let found = Found::here()?;
@@ -369,6 +396,13 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         shown(&project.root, &folded),
         shown(&project.root, &svg)
     );
+    if let Some(path) = &args.speedscope {
+        let json = scorpion_profile::speedscope::json(profile, &title)
+            .into_diagnostic()
+            .wrap_err("cannot write the speedscope file")?;
+        write(path, json.as_bytes())?;
+        let _ = writeln!(out, "speedscope: {}", shown(&project.root, path));
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -98,6 +98,29 @@ struct Printer {
     /// The profiler on every test's robot, for `--coverage` and the
     /// project's `[budgets]`.
     watch: Option<crate::cmd::profile::Watch>,
+    /// Budgets are checked (some project has them).
+    budgets: bool,
+    /// `--coverage`: each project's report written when its tests end.
+    coverage: bool,
+    /// The first coverage report that could not be written.
+    failed_write: Option<miette::Report>,
+}
+
+impl Printer {
+    /// Writes the coverage of the project whose tests ran last.
+    fn write_coverage(&mut self, name: &str) {
+        let Some(member) = self.watch.as_ref().and_then(|w| w.members.last()) else {
+            return;
+        };
+        let name = if name.is_empty() {
+            member.root.display().to_string()
+        } else {
+            name.to_owned()
+        };
+        if let Err(error) = member.write_coverage(&name, &mut self.out) {
+            self.failed_write.get_or_insert(error);
+        }
+    }
 }
 
 impl Progress for Printer {
@@ -126,7 +149,19 @@ impl Progress for Printer {
         }
     }
 
+    fn virtual_runs_done(&mut self, filtered: bool) -> Vec<(String, Outcome)> {
+        match &self.watch {
+            Some(watch) if self.budgets => watch.budget_tests(filtered),
+            _ => Vec::new(),
+        }
+    }
+
     fn member_finished(&mut self, member: &MemberReport) {
+        // A member's coverage before its summary, not after every
+        // member's.
+        if self.coverage {
+            self.write_coverage(&member.name);
+        }
         let _ = writeln!(
             self.out,
             "{}: {} passed, {} failed",
@@ -212,8 +247,10 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         replace: args.replace,
         environment: Environment::from_process()?,
     };
-    // Budgets need the whole profiler; coverage alone, the counts.
-    let budgets = args.port.is_none() && crate::cmd::profile::Watch::needed(&found)?;
+    // Budgets need the whole profiler; coverage alone, the counts. With
+    // a port, the rehearsal on the virtual Scorpion checks them, before
+    // anything is sent to the robot.
+    let budgets = crate::cmd::profile::Watch::needed(&found)?;
     let watch = if args.coverage || budgets {
         Some(crate::cmd::profile::Watch::new(&found, !budgets)?)
     } else {
@@ -222,30 +259,18 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let mut printer = Printer {
         out: std::io::stdout().lock(),
         watch,
+        budgets,
+        coverage: args.coverage,
+        failed_write: None,
     };
-    let mut report = runner::run_tests(&found, &options, &mut printer)?;
-    let out = &mut printer.out;
-    if let Some(watch) = &printer.watch {
-        let name = match &found {
-            Found::Project(project) => project.file.project.name.clone(),
-            Found::Workspace(_) => String::new(),
-        };
-        for member in &watch.members {
-            if budgets && !member.budgets.is_empty() && member.tests > 0 {
-                let (passed, failed) = member.check_budgets(out);
-                report.passed += passed;
-                report.failed += failed;
-            }
-            if args.coverage {
-                let name = if name.is_empty() {
-                    member.root.display().to_string()
-                } else {
-                    name.clone()
-                };
-                member.write_coverage(&name, out)?;
-            }
-        }
+    let report = runner::run_tests(&found, &options, &mut printer)?;
+    if let (true, Found::Project(project)) = (args.coverage, &found) {
+        printer.write_coverage(&project.file.project.name);
     }
+    if let Some(error) = printer.failed_write.take() {
+        return Err(error);
+    }
+    let out = &mut printer.out;
     if args.timing {
         let _ = writeln!(
             out,

@@ -413,3 +413,171 @@ fn the_project_files_key_list_names_budgets() {
     assert!(said.contains("[robot]"), "the key list is shown: {said}");
     assert!(said.contains("[budgets]"), "{said}");
 }
+
+/// `--speedscope FILE`: speedscope's "sampled" JSON, read back with
+/// serde: its weights add up to the cycles the report says it profiled,
+/// and its frames name the command and the routines.
+#[test]
+fn the_speedscope_file_holds_the_profiles_cycles() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let file = dir.path().join("adc.speedscope.json");
+    let output = scorpion(
+        &example("adc"),
+        &[
+            "profile",
+            "--folded",
+            dir.path().join("f").to_str().expect("UTF-8"),
+            "--flamegraph",
+            dir.path().join("s.svg").to_str().expect("UTF-8"),
+            "--speedscope",
+            file.to_str().expect("UTF-8"),
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let report = stdout(&output);
+    let total: u64 = report
+        .split_whitespace()
+        .next()
+        .and_then(|n| n.parse().ok())
+        .expect("N cycles of robot time profiled");
+    let text = std::fs::read_to_string(&file).expect("the speedscope file");
+    let read: scorpion_profile::speedscope::File =
+        serde_json::from_str(&text).expect("speedscope's schema");
+    let sampled = &read.profiles[0];
+    assert_eq!(sampled.kind, "sampled");
+    assert_eq!(sampled.weights.iter().sum::<u64>(), total);
+    let names: Vec<&str> = read.shared.frames.iter().map(|f| f.name.as_str()).collect();
+    for name in ["main", "/2A0", "PUTHEX", "IRQ"] {
+        assert!(names.contains(&name), "{names:?}");
+    }
+}
+
+/// The adc example copied into `dir/name` with `budgets` as its project
+/// file's `[budgets]` table.
+fn adc_with_budgets(dir: &Path, name: &str, budgets: &str) -> std::path::PathBuf {
+    let project = dir.join(name);
+    copy_dir(&example("adc"), &project);
+    let file = project.join("Scorpion.toml");
+    let original = std::fs::read_to_string(&file).expect("the project file");
+    let renamed = original.replace(
+        "name = \"adc\"\n\n[[image]]",
+        &format!("name = \"{name}\"\n\n[[image]]"),
+    );
+    std::fs::write(&file, format!("{renamed}\n[budgets]\n{budgets}\n")).expect("write");
+    project
+}
+
+/// `scorpion test --port` rehearses the transcripts on the virtual
+/// Scorpion: a command over its budget there fails the rehearsal, and
+/// nothing is sent to the robot (issue 26 F4).
+#[test]
+fn a_budget_fails_the_rehearsal_of_test_port() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = adc_with_budgets(dir.path(), "adc", "\"/2A\" = 100");
+    let output = scorpion(&project, &["test", "--port", "emu"]);
+    assert!(!output.status.success(), "{}", transcript(&output));
+    let text = stdout(&output);
+    assert!(text.contains("test budget /2A ... FAILED"), "{text}");
+    assert!(
+        text.contains("over its budget of 100 at adc.expect:"),
+        "{text}"
+    );
+    assert!(
+        text.contains("nothing was sent to the robot"),
+        "the upload is not attempted: {text}"
+    );
+}
+
+/// A routine that only a `.calls` test runs is a routine of the profile
+/// (a root: nothing of the robot's called it), so its budget is checked
+/// (issue 26 F5): `double` is `ASL A` (2) and `RTS` (6).
+#[test]
+fn a_routine_run_only_by_a_calls_test_is_budgeted() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "calls"]);
+    assert!(made.status.success(), "{}", transcript(&made));
+    let project = dir.path().join("calls");
+    let source = project.join("src/calls.s");
+    let mut text = std::fs::read_to_string(&source).expect("the source");
+    text.push_str("\ndouble: asl a\n        rts\n");
+    std::fs::write(&source, text).expect("edit");
+    std::fs::write(
+        project.join("tests/calls.calls"),
+        "call double A=$21 => A=$42\n",
+    )
+    .expect("write");
+    let file = project.join("Scorpion.toml");
+    let original = std::fs::read_to_string(&file).expect("the project file");
+    std::fs::write(&file, format!("{original}\n[budgets]\ndouble = 7\n")).expect("write");
+    let over = scorpion(&project, &["test", "--accept"]);
+    assert!(!over.status.success(), "{}", transcript(&over));
+    let said = stdout(&over);
+    assert!(said.contains("test budget double ... FAILED"), "{said}");
+    assert!(
+        said.contains("routine double took 8 cycles, over its budget of 7"),
+        "{said}"
+    );
+    assert!(said.contains("(stack: double)"), "a root: {said}");
+
+    std::fs::write(&file, format!("{original}\n[budgets]\ndouble = 8\n")).expect("write");
+    let within = scorpion(&project, &["test"]);
+    assert!(within.status.success(), "{}", transcript(&within));
+    assert!(stdout(&within).contains("test budget double ... ok"));
+}
+
+/// `scorpion test NAME` runs some tests only: a budget on what only the
+/// others run says so and does not fail (issue 26 F6); unfiltered, the
+/// same budget on nothing the tests run fails.
+#[test]
+fn a_filter_leaves_the_budgets_of_what_it_left_out_unchecked() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = adc_with_budgets(dir.path(), "adc", "\"/2A\" = 100000\nnowhere = 10");
+    let filtered = scorpion(&project, &["test", "adc/listing"]);
+    let said = stdout(&filtered);
+    assert!(filtered.status.success(), "{}", transcript(&filtered));
+    assert!(
+        said.contains("test budget /2A ... not run (the tests that would run it are filtered out)"),
+        "{said}"
+    );
+    assert!(said.contains("test budget nowhere ... not run"), "{said}");
+    assert!(said.contains("1 passed, 0 failed, "), "{said}");
+
+    let all = scorpion(&project, &["test"]);
+    let said = stdout(&all);
+    assert!(!all.status.success(), "{}", transcript(&all));
+    assert!(said.contains("test budget /2A ... ok"), "{said}");
+    assert!(said.contains("test budget nowhere ... FAILED"), "{said}");
+}
+
+/// In a workspace, each member's budgets and coverage come with its own
+/// tests, before its summary line, not after every member's (issue 26
+/// F7).
+#[test]
+fn a_workspaces_members_report_in_order() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for name in ["one", "two"] {
+        adc_with_budgets(dir.path(), name, "\"/2A\" = 100000");
+    }
+    std::fs::write(
+        dir.path().join("Scorpion.toml"),
+        "[workspace]\nmembers = [\"one\", \"two\"]\n",
+    )
+    .expect("write");
+    let output = scorpion(dir.path(), &["test", "--coverage"]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let said = stdout(&output);
+    let at = |what: &str, from: usize| {
+        said[from..]
+            .find(what)
+            .map(|i| i + from)
+            .unwrap_or_else(|| panic!("no `{what}` after {from} in:\n{said}"))
+    };
+    let one = at("== one", 0);
+    let one_budget = at("test budget /2A ... ok", one);
+    let one_coverage = at("coverage: ", one_budget);
+    let one_done = at("one: ", one_coverage);
+    let two = at("== two", one_done);
+    let two_budget = at("test budget /2A ... ok", two);
+    let two_coverage = at("coverage: ", two_budget);
+    at("two: ", two_coverage);
+}

@@ -174,6 +174,9 @@ pub struct Board {
     host_due: u64,
     /// A byte reached the watching host and it has not taken it yet.
     host_arrived: bool,
+    /// Something watching the bus asked the run to end at this
+    /// instruction's end ([`Board::request_stop`]).
+    stop_asked: bool,
     /// The cycle of the last poll.
     last_poll: u64,
     /// Addresses from here up to the ROM take the slow path (the I/O page,
@@ -242,6 +245,7 @@ impl Board {
             host_watch: false,
             host_due: u64::MAX,
             host_arrived: false,
+            stop_asked: false,
             last_poll: 0,
             slow_start: map::IO_START,
             slow_span: map::ROM_START - map::IO_START,
@@ -308,6 +312,7 @@ impl Board {
             host_watch: self.host_watch,
             host_due: self.host_due,
             host_arrived: self.host_arrived,
+            stop_asked: self.stop_asked,
             last_poll: self.last_poll,
             slow_start: self.slow_start,
             slow_span: self.slow_span,
@@ -605,6 +610,24 @@ impl Board {
         self.host_watch = watch;
         self.host_arrived = false;
         self.refresh_next_event();
+    }
+
+    /// Ends the CPU's run at the end of the instruction (or interrupt
+    /// sequence) under way, with [`crate::Stop::Bus`], as a byte reaching
+    /// a watching host does: for a bus wrapped around the board that saw
+    /// an access it watches for (a debugger's watchpoint), so that the
+    /// run needs no look of its own before every instruction. The next
+    /// poll is made (whatever the devices' quiet), and sees it. Ending a
+    /// run changes nothing in what the robot does. Stays asked until
+    /// [`Board::clear_stop_request`].
+    pub fn request_stop(&mut self) {
+        self.stop_asked = true;
+        self.attention = 0;
+    }
+
+    /// Forgets a [`Board::request_stop`]: runs go on.
+    pub fn clear_stop_request(&mut self) {
+        self.stop_asked = false;
     }
 
     /// Attempted writes to the ROM since power-up (they change nothing).
@@ -939,7 +962,7 @@ impl Bus for Board {
 
     #[inline(always)]
     fn stop_requested(&self) -> bool {
-        self.host_arrived
+        self.host_arrived | self.stop_asked
     }
 
     #[inline(always)]

@@ -55,7 +55,7 @@
 //! counter with the earlier of the run's limit and the next probe, a
 //! comparison it makes anyway, and leaves its inner loop at an RTI.
 
-use super::{Cpu, JAM, POLLED, Stop, TRAP};
+use super::{Cpu, JAM, NO_POLL, POLLED, Stop, TRAP};
 use crate::bus::{Bus, Interrupts};
 use crate::hooks::{Control, Hooks};
 
@@ -287,7 +287,8 @@ impl Cpu {
             if !H::PASSIVE && flow & TRAP != 0 && hooks.trap(self, &*probe.bus) == Control::Stop {
                 return Some(Stop::Trap { pc: self.pc });
             }
-            if flow & POLLED != 0
+            // BRK's sequence polled for itself (NO_POLL).
+            if flow & (POLLED | NO_POLL) != 0
                 && (self.nmi_pending || self.irq_pending || probe.bus.stop_requested())
             {
                 break;

@@ -508,7 +508,11 @@ impl Cpu {
                         };
                     }
                     self.instructions += 1;
-                    // BRK's sequence polled; RTI polls as usual.
+                    // BRK's sequence polled (a stop the bus asked during
+                    // it ends the run here); RTI polls as usual.
+                    if flow & NO_POLL != 0 {
+                        interrupted = bus.stop_requested();
+                    }
                     if flow & RETURNED != 0 {
                         if self.cycles > bus.quiet_until() {
                             self.poll_after(bus, flow);

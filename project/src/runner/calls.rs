@@ -245,6 +245,8 @@ pub fn run(call: &Call, robot: &mut VirtualScorpion) -> Result<(), String> {
         })
         .map_err(|e| format!("cannot push the return address: {e}"))?;
     machine.cpu.pc = call.address;
+    // A profiler set on the robot sees the call as a JSR's.
+    robot.entered(call.address, s);
     let limit = call.within.unwrap_or(DEFAULT_LIMIT);
     let mut stop_at = Breakpoints::new();
     stop_at.insert(RETURN);

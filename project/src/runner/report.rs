@@ -20,6 +20,10 @@ pub enum Passed {
     Accepted,
     /// A stale snapshot, deleted.
     Deleted,
+    /// Not checked: what it checks is what tests the filter left out
+    /// would have run (a cycle budget of a routine no selected test
+    /// called). Counted as filtered out, neither passed nor failed.
+    NotRun,
 }
 
 impl Passed {
@@ -29,6 +33,7 @@ impl Passed {
             Passed::Ok => "ok",
             Passed::Accepted => "accepted",
             Passed::Deleted => "deleted",
+            Passed::NotRun => "not run (the tests that would run it are filtered out)",
         }
     }
 }
@@ -172,6 +177,17 @@ pub trait Progress {
     /// The test `_test` is done with its virtual robot: where what an
     /// observer gathered is read back.
     fn robot_done(&mut self, _test: &str, _robot: &mut VirtualScorpion) {}
+
+    /// The project's runs on the virtual Scorpion are done (its
+    /// transcripts and routine calls; with a port, the rehearsal, before
+    /// anything is sent to the robot): the observer's own checks over
+    /// what they ran (the project's cycle budgets), each a test's name
+    /// and outcome, recorded as the project's tests (a failure, in a
+    /// rehearsal, keeps the robot untouched). `_filtered`: a filter left
+    /// some tests out. None unless overridden.
+    fn virtual_runs_done(&mut self, _filtered: bool) -> Vec<(String, Outcome)> {
+        Vec::new()
+    }
 
     /// A card or the world script `_script` printed `_line`.
     fn script_printed(&mut self, _script: &str, _line: &str) {}

@@ -126,10 +126,10 @@ impl Run<'_, '_, '_> {
         if self.started.take().as_deref() != Some(name) {
             progress.test_started(name);
         }
-        if outcome.failed() {
-            self.report.failed += 1;
-        } else {
-            self.report.passed += 1;
+        match &outcome {
+            Outcome::Failed(_) => self.report.failed += 1,
+            Outcome::Passed(Passed::NotRun) => self.report.filtered_out += 1,
+            Outcome::Passed(_) => self.report.passed += 1,
         }
         progress.test_finished(name, &outcome);
         self.report.tests.push(super::report::TestResult {
@@ -195,6 +195,7 @@ impl Run<'_, '_, '_> {
                     // with the project's cards and world first; the robot
                     // is touched only if they all pass.
                     self.virtual_transcripts(project, &setup, &built)?;
+                    self.virtual_checks();
                 }
                 if self.report.failed == failed_before {
                     self.robot_transcripts(project, &setup, &built, &port)?;
@@ -217,10 +218,21 @@ impl Run<'_, '_, '_> {
                     let (setup, _) = Setup::of(project, None, &self.options.environment)?;
                     self.virtual_transcripts(project, &setup, &built)?;
                     self.routine_calls(project, &setup, &built)?;
+                    self.virtual_checks();
                 }
             }
         }
         Ok(())
+    }
+
+    /// The observer's checks over the project's virtual runs
+    /// ([`Progress::virtual_runs_done`]), recorded as tests.
+    fn virtual_checks(&mut self) {
+        let filtered = self.filter.is_some();
+        let checks = self.progress.borrow_mut().virtual_runs_done(filtered);
+        for (name, outcome) in checks {
+            self.record(&name, outcome);
+        }
     }
 
     /// What [`Progress::review`] decides about the snapshot `name`.
