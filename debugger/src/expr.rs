@@ -148,14 +148,30 @@ pub struct ParseError {
 }
 
 impl ParseError {
-    /// The expression with a caret under the column: for a terminal.
+    /// The expression with a caret under the column: for a terminal. A
+    /// column past what an error repeats of the text gets no caret.
     #[must_use]
     pub fn pointed(&self) -> String {
+        if self.column > SHOWN {
+            return format!("  {}", self.text);
+        }
         format!(
             "  {}\n  {}^",
             self.text,
             " ".repeat(self.column.saturating_sub(1))
         )
+    }
+}
+
+/// The most characters of an expression an error repeats.
+const SHOWN: usize = 200;
+
+/// `text` as an error repeats it: an expression of a megabyte is cut, not
+/// echoed whole into a response or onto the terminal.
+fn clipped(text: &str) -> String {
+    match text.char_indices().nth(SHOWN) {
+        Some((at, _)) => format!("{}... ({} bytes)", &text[..at], text.len()),
+        None => text.to_owned(),
     }
 }
 
@@ -302,7 +318,7 @@ impl Expr {
     /// outside $0000-$FFFF.
     pub fn eval(&self, machine: &dyn Machine) -> Result<i64, EvalError> {
         eval(&self.node, machine).map_err(|reason| EvalError {
-            text: self.text.clone(),
+            text: clipped(&self.text),
             reason,
         })
     }
@@ -468,7 +484,7 @@ impl Parser<'_> {
         let offset = self.chars.get(index).map_or(self.text.len(), |&(o, _)| o);
         let len = self.chars.get(index).map_or(0, |&(_, c)| c.len_utf8());
         ParseError {
-            text: self.text.to_owned(),
+            text: clipped(self.text),
             column: index + 1,
             reason: reason.to_owned(),
             span: (offset, len).into(),

@@ -305,10 +305,11 @@ impl Debugger {
             .and_then(|address| u16::try_from(address).ok())
     }
 
-    /// The PC, then the return addresses on the 6502 stack, innermost
-    /// first: every pair of stack bytes above S that points just past a
-    /// `JSR` (the stack has no frames to walk; this is how 6502 monitors
-    /// show a call chain).
+    /// The PC, then the `JSR` of each call on the 6502 stack, innermost
+    /// first: every pair of stack bytes above S that points at the last
+    /// byte of a `JSR` (the stack has no frames to walk; this is how 6502
+    /// monitors show a call chain). A caller's frame is where it called,
+    /// as gdb and editors show it, not the line the call returns to.
     #[must_use]
     pub fn backtrace(&self) -> Vec<u16> {
         let bus = &self.robot.robot().bus;
@@ -319,7 +320,7 @@ impl Debugger {
             let pushed = u16::from_le_bytes([peek(0x0100 + s), peek(0x0100 + s + 1)]);
             let call = pushed.wrapping_sub(2);
             if peek(call) == 0x20 {
-                frames.push(pushed.wrapping_add(1));
+                frames.push(call);
                 s += 2;
             } else {
                 s += 1;
@@ -1007,12 +1008,27 @@ impl Points<'_> {
                 continue;
             };
             let machine = Peeking { cpu, peek };
-            if options
-                .condition
-                .as_ref()
-                .is_some_and(|condition| !condition.holds(&machine))
-            {
-                continue;
+            if let Some(condition) = &options.condition {
+                match condition.eval(&machine) {
+                    Ok(0) => continue,
+                    Ok(_) => {}
+                    // It stops, and says why, rather than stopping silently or
+                    // never: the user fixes the condition from what is said.
+                    Err(error) => {
+                        if let Some((_, logs)) = self.live {
+                            logs.borrow_mut().push(Logged {
+                                id: index + 1,
+                                pc: cpu.pc,
+                                text: format!(
+                                    "breakpoint {}: its condition cannot be evaluated here, so it stops: {error}",
+                                    index + 1
+                                ),
+                            });
+                        }
+                        stop = stop.or(Some(index));
+                        continue;
+                    }
+                }
             }
             let Some((hits, logs)) = self.live else {
                 // A re-run: conditions only.

@@ -133,9 +133,15 @@ impl Symbols {
     /// letter or two away (or only in case), if there is one.
     #[must_use]
     pub fn unknown(&self, term: &str) -> String {
+        // Names more than two letters longer or shorter cannot be within two
+        // edits; skipping them keeps a megabyte-long mistyped name from costing
+        // a Levenshtein table against every label (seconds, with the session
+        // unable to answer anything else meanwhile).
+        let length = term.chars().count();
         let near = self
             .by_name
             .keys()
+            .filter(|name| name.chars().count().abs_diff(length) <= 2)
             .map(|name| {
                 let distance = if name.eq_ignore_ascii_case(term) {
                     0
@@ -146,6 +152,7 @@ impl Symbols {
             })
             .filter(|(distance, _)| *distance <= 2)
             .min();
+        let term = shown(term);
         match near {
             Some((_, name)) => format!("no label `{term}` (did you mean `{name}`?)"),
             None => format!("no label `{term}`"),
@@ -192,6 +199,15 @@ mod tests {
         let long = "CMDBUF+1+".repeat(5000) + "1";
         let said = symbols.address(&long).expect_err("past $FFFF").to_string();
         assert!(said.len() < 200 && said.contains("(45001 bytes)"), "{said}");
+        // A megabyte of unknown name: said briefly, and without comparing it
+        // with every label letter by letter (that took 90 s and blocked the
+        // DAP session).
+        let huge = "a".repeat(1_000_000);
+        let said = symbols.unknown(&huge);
+        assert!(
+            said.len() < 200 && said.contains("(1000000 bytes)"),
+            "{said}"
+        );
         let dispatch = symbols.get("dispatch").expect("the ROM's dispatch label");
         assert_eq!(symbols.place(dispatch).as_deref(), Some("dispatch"));
         assert_eq!(symbols.place(dispatch + 2), Some("dispatch+$2".into()));

@@ -227,3 +227,37 @@ fn a_set_interrupt_flag_pauses_a_run_within_a_slice() {
     // Not set: the run goes its whole length.
     assert_eq!(d.run(1_000_000).expect("runs").why, Why::Budget);
 }
+
+#[test]
+fn a_condition_that_cannot_be_evaluated_stops_and_says_why() {
+    let mut d = debugger();
+    let handler = at(&d, "handler");
+    let id = d.add_breakpoint_with(Breakpoint::At(handler), when(&d, "1/(A-A) == 1"));
+    let stop = ask(&mut d, b"/1Q");
+    assert_eq!(
+        stop.why,
+        Why::Breakpoint {
+            id,
+            point: Breakpoint::At(handler)
+        }
+    );
+    let (logs, _) = d.take_logs();
+    let said: Vec<&str> = logs.iter().map(|l| l.text.as_str()).collect();
+    assert!(
+        said.len() == 1 && said[0].contains("cannot be evaluated") && said[0].contains("zero"),
+        "{said:?}"
+    );
+}
+
+#[test]
+fn a_megabyte_condition_is_not_echoed_whole() {
+    let d = debugger();
+    let long = "(".repeat(1_000_000);
+    let error = Expr::parse(&long, d.symbols()).expect_err("does not parse");
+    assert!(
+        error.to_string().len() < 1000,
+        "{} bytes",
+        error.to_string().len()
+    );
+    assert!(error.pointed().len() < 1000);
+}

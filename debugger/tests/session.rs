@@ -156,9 +156,10 @@ fn command_watch_next_and_finish() {
     assert_eq!(over.pc, before + 3);
     assert!(over.instructions > 1, "the whole of PUTCH ran");
     d.step(2).expect("into PUTHEX");
-    // The call chain: here, then where PUTHEX returns to.
+    // The call chain: here, then the JSR PUTHEX that called it (three
+    // bytes before where it returns to).
     let chain = d.backtrace();
-    assert_eq!(chain, vec![d.cpu().pc, before + 9], "{chain:04X?}");
+    assert_eq!(chain, vec![d.cpu().pc, before + 6], "{chain:04X?}");
     let finished = d.finish(100_000).expect("runs");
     assert_eq!(finished.why, Why::Finished);
     assert_eq!(finished.pc, before + 9, "back after the JSR PUTHEX");

@@ -519,17 +519,11 @@ fn displays(d: &Debugger, m: &Monitor) -> String {
     text
 }
 
-/// The call chain: the PC, then each return address found on the stack
-/// (the instruction after its `JSR`), with its place and source line.
+/// The call chain: the PC, then each caller's `JSR` found on the stack,
+/// with its place and source line.
 fn backtrace(d: &Debugger, sources: &mut Sources) -> String {
     let mut text = String::new();
-    for (depth, pc) in d.backtrace().into_iter().enumerate() {
-        let at = if depth == 0 {
-            pc
-        } else {
-            // The frame is at its JSR: three bytes before the return.
-            pc.wrapping_sub(3)
-        };
+    for (depth, at) in d.backtrace().into_iter().enumerate() {
         text.push_str(&format!("#{depth} {}", place(d, at)));
         if let Some((file, n)) = d.source_of(at) {
             let source = sources
