@@ -355,6 +355,61 @@ impl<T: Transport> Client<T> {
         Ok(())
     }
 
+    /// Sends `questions` (commands whose answers are `answer_len`
+    /// characters, the carriage return included) back to back, as many
+    /// ahead of their answers as the robot's receive buffer holds, and
+    /// returns the frames that came back, in order, once every question
+    /// is answered or the answers stop coming (`work` is the robot's time
+    /// per question besides the characters). Answers carry what they
+    /// answer (an address, say): the caller matches them, and asks again
+    /// for what is missing.
+    ///
+    /// # Errors
+    /// A line error.
+    pub(crate) fn batch(
+        &mut self,
+        questions: &[Vec<u8>],
+        answer_len: usize,
+        work: Duration,
+    ) -> Result<Vec<Vec<u8>>> {
+        self.drain()?;
+        let mut frames = Vec::new();
+        let mut next = 0;
+        // Characters of questions sent and not answered yet.
+        let mut ahead: VecDeque<usize> = VecDeque::new();
+        let mut deadline = self.transport.now();
+        while next < questions.len() || !ahead.is_empty() {
+            while next < questions.len()
+                && (ahead.is_empty()
+                    || ahead.iter().sum::<usize>() + questions[next].len() <= self.config.window)
+            {
+                let bytes = &questions[next];
+                self.send_raw(bytes)?;
+                let now = self.transport.now();
+                deadline = deadline.max(now) + self.chars(bytes.len() + answer_len) + work;
+                ahead.push_back(bytes.len());
+                next += 1;
+            }
+            if let Some(frame) = self.take_frame() {
+                frames.push(frame);
+                ahead.pop_front();
+                continue;
+            }
+            let now = self.transport.now();
+            let until = deadline + self.config.margin;
+            if now >= until {
+                // The rest are lost: the caller asks again.
+                self.stats.lost += ahead.len();
+                ahead.clear();
+                deadline = now;
+                continue;
+            }
+            self.fill(until - now)?;
+        }
+        self.rx.clear();
+        Ok(frames)
+    }
+
     /// Asks one question and waits for its answer (stop-and-wait), with a
     /// timeout from the baud rate and the configured retries.
     ///

@@ -15,7 +15,7 @@
 use std::time::Duration;
 
 use isa::objfmt::HookKind;
-use romlib::protocol::{Command, Extension};
+use romlib::protocol::{Answer, Command, Extension, ReadSpan};
 
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::Client;
@@ -78,9 +78,9 @@ impl Session {
         }
     }
 
-    /// Where `frames` runs: `HOOK_UNKNOWN`'s target while the loader is in.
+    /// Where `sums` runs: `HOOK_UNKNOWN`'s target while the loader is in.
     pub(crate) fn handler(&self) -> u16 {
-        self.loader.frames
+        self.loader.sums
     }
 
     /// The rate the transfer ran at.
@@ -109,7 +109,14 @@ impl Session {
             }
             client.transport().set_baud(now)?;
         }
-        let mut start = Start::Write;
+        // A loader left in RAM by an earlier upload at the same place (the
+        // usual case when an extension is uploaded again after an edit)
+        // only needs verifying: reading it back costs less than writing it.
+        let mut start = if self.resident(client)? {
+            Start::Verify
+        } else {
+            Start::Write
+        };
         loop {
             let error = match self.hook_loader(client, start) {
                 Ok(()) => break,
@@ -135,9 +142,29 @@ impl Session {
         Ok(())
     }
 
-    /// Verifies (or writes) the loader and hooks `frames`, switching the
-    /// line to the fast rate on the way if it is not there. The robot
-    /// answers at the host's rate when this starts.
+    /// Whether `rate` reads back as linked (one read; anything else, a lost
+    /// answer included, says no): the loader is probably in RAM already.
+    fn resident<T: Transport>(&self, client: &mut Client<T>) -> Result<bool> {
+        let rate = self.loader.rate_part()?;
+        let area = &rate.areas()[0];
+        let Ok(span) = ReadSpan::new(area.address, area.bytes.len() as u8) else {
+            return Ok(false);
+        };
+        match client.ask(&Command::ReadMemory(span)) {
+            Ok(Answer::Memory(bytes)) => Ok(bytes == area.bytes),
+            Ok(_) | Err(Error::Protocol(_) | Error::NoAnswer { .. } | Error::WrongBaud { .. }) => {
+                Ok(false)
+            }
+            Err(error) => Err(error),
+        }
+    }
+
+    /// Verifies (or writes) the loader and hooks it, switching the line
+    /// to the fast rate on the way if it is not there: `rate` and `frames`
+    /// through the ROM, `frames` hooked, `sums` through `frames`, `sums`
+    /// hooked. Each part is hooked only once it and every part it falls
+    /// into verified. The robot answers at the host's rate when this
+    /// starts.
     fn hook_loader<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
         match self.fast {
             Some(fast) if client.transport().baud() != fast => {
@@ -150,7 +177,7 @@ impl Session {
                 }
                 self.put(client, &self.loader.frames_part()?, start)?;
             }
-            _ => self.put(client, self.loader.whole(), start)?,
+            _ => self.put(client, &self.loader.rom_part()?, start)?,
         }
         self.target = client.transport().baud();
         switch_hook(
@@ -158,7 +185,38 @@ impl Session {
             self.hook,
             self.loader.frames,
             self.limits.max_writes,
-        )
+        )?;
+        self.put_framed(client, &self.loader.sums_part()?, start)?;
+        switch_hook(client, self.hook, self.loader.sums, self.limits.max_writes)
+    }
+
+    /// Puts loader bytes into the robot through `frames` (hooked),
+    /// verified.
+    fn put_framed<T: Transport>(
+        &self,
+        client: &mut Client<T>,
+        image: &UploadImage,
+        start: Start,
+    ) -> Result<()> {
+        let mut body = Body::new(image, Writer::Frames);
+        match start {
+            Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
+            Start::Verify => body.plan_reads(&mut NoProgress),
+        }
+        for _ in 0..3 {
+            match body.run(client, self.limits, &mut NoProgress)? {
+                RunEnd::Done => return Ok(()),
+                RunEnd::CheckLoader => body.interrupted(),
+            }
+        }
+        // Frames keep not landing: `frames` is gone (a reset). A recovery
+        // starts over from the ROM's commands.
+        Err(Error::NoAnswer {
+            port: client.transport().name(),
+            baud: client.transport().baud(),
+            question: "/1L".into(),
+            waited: Duration::ZERO,
+        })
     }
 
     /// Puts loader bytes into the robot through the ROM, verified.
@@ -242,7 +300,12 @@ impl Session {
         progress: &mut dyn Progress,
     ) -> Result<()> {
         let rate = self.find_rate(client)?;
-        let mut known = vec![self.loader.frames, self.loader.rate, self.original];
+        let mut known = vec![
+            self.loader.sums,
+            self.loader.frames,
+            self.loader.rate,
+            self.original,
+        ];
         known.extend(self.reset);
         // A hook that no longer holds a `JMP` (a `/9W` whose address noise
         // changed) is written whole again by `hook_loader`.
@@ -251,7 +314,7 @@ impl Session {
             Err(Error::NotAHook { .. }) => None,
             Err(error) => return Err(error),
         };
-        if current == Some(self.loader.frames) && rate == self.target {
+        if current == Some(self.loader.sums) && rate == self.target {
             return Ok(());
         }
         progress.event(&Event::LoaderRestored {

@@ -17,12 +17,15 @@ use std::time::Duration;
 use isa::objfmt::HookKind;
 use romlib::protocol::{Command, Extension};
 
+use crate::backup::{Backup, Keep, NoKeep, table_range};
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::{Client, ClientConfig};
+use crate::delta;
+use crate::fingerprint;
 use crate::hooks::{
     Wanted, read_hook, read_hooks, read_word, settle_hooks, switch_hook, write_word_verified,
 };
-use crate::image::{RomProfile, UploadImage};
+use crate::image::{Area, RomProfile, UploadImage};
 use crate::loader::{FAST_BAUD, Loader, loader_estimate, rom_only_estimate};
 use crate::progress::{Event, Phase, Progress};
 use crate::session::{Session, recoverable};
@@ -61,6 +64,10 @@ pub struct UploadOptions {
     /// Take an installed extension that overlaps the image out of its
     /// chains (and out of the table) instead of refusing the upload.
     pub replace: bool,
+    /// Through the loader, write only the ranges whose checksum on the
+    /// robot differs from the image's (see `delta`); `false` writes every
+    /// byte.
+    pub delta: bool,
 }
 
 impl Default for UploadOptions {
@@ -73,6 +80,7 @@ impl Default for UploadOptions {
             loader: LoaderChoice::Auto,
             fast_baud: Some(FAST_BAUD),
             replace: false,
+            delta: true,
         }
     }
 }
@@ -127,6 +135,9 @@ pub struct UploadReport {
     pub hooks: Vec<InstalledHook>,
     /// The RAM loader, if it carried the body.
     pub loader: Option<LoaderReport>,
+    /// The ranges written (address, length), the table entry's included:
+    /// with a delta upload, only those the robot did not hold.
+    pub written: Vec<(u16, usize)>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -230,6 +241,24 @@ pub fn upload<T: Transport>(
     options: &UploadOptions,
     progress: &mut dyn Progress,
 ) -> Result<UploadReport> {
+    upload_keeping(client, image, options, progress, &mut NoKeep)
+}
+
+/// [`upload`], keeping what it overwrites: before the image's bytes are
+/// written, `keep` receives what the robot held there (through the loader
+/// with [`UploadOptions::delta`], only the ranges that differ), the table
+/// of installed extensions and the hooks as the upload found them.
+/// Restoring that ([`crate::restore`]) undoes the upload.
+///
+/// # Errors
+/// As [`upload`].
+pub fn upload_keeping<T: Transport>(
+    client: &mut Client<T>,
+    image: &UploadImage,
+    options: &UploadOptions,
+    progress: &mut dyn Progress,
+    keep: &mut dyn Keep,
+) -> Result<UploadReport> {
     options.profile.check(image)?;
     let start = client.transport().now();
     let stats_before = client.stats();
@@ -245,6 +274,22 @@ pub fn upload<T: Transport>(
     let rates = (base, options.fast_baud.unwrap_or(base));
     let leftover = Loader::place(profile, image, rates)?;
     let (mut hooks_now, found_at) = connect(client, options)?;
+    // The right ROM, or no write: nothing has been written yet.
+    fingerprint::check_jump_table(client, profile)?;
+    let mut kept = None;
+    if keep.wanted() {
+        let mut before = Backup {
+            areas: Vec::new(),
+            hooks: hooks_now.clone(),
+        };
+        if let Some((address, len)) = table_range(profile) {
+            before.areas.push(Area {
+                address,
+                bytes: client.read_memory(address, len)?,
+            });
+        }
+        kept = Some(before);
+    }
     // What is installed: an overlap is refused (or, with `replace`, the old
     // extension leaves its chains first, which changes the hooks).
     let mut plan = table::prepare(client, profile, image, options.replace, options.max_writes)?;
@@ -255,7 +300,7 @@ pub fn upload<T: Transport>(
     for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
         let loader = leftover.as_ref().filter(|loader| {
-            kind == HookKind::Unknown && (target == loader.frames || target == loader.rate)
+            kind == HookKind::Unknown && [loader.sums, loader.frames, loader.rate].contains(&target)
         });
         if image.contains(target) || loader.is_some() {
             // An earlier copy of this image, probably: the hook goes back
@@ -322,7 +367,8 @@ pub fn upload<T: Transport>(
         });
     }
     let mut session = None;
-    let mut body;
+    let (mut rewrites, mut passes) = (0, 0);
+    let mut written = Vec::new();
     let mut hooks;
     if let Some(loader) = loader {
         let mut running = Session::new(
@@ -332,12 +378,28 @@ pub fn upload<T: Transport>(
             (base, options.fast_baud),
             limits,
         );
-        body = Body::new(&image, Writer::Frames);
         let result = running
             .install(client, progress)
             .and_then(|()| {
-                body.plan_writes(client.transport().baud(), progress);
-                running.transfer(client, &mut body, progress)
+                // The whole ROM is summed on the robot while the image's
+                // sums are on their way: all before anything of the image
+                // is written.
+                let rom = fingerprint::whole_rom(profile);
+                let first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
+                let (todo, found) = if options.delta {
+                    delta::differing_and(client, &first, &image)?
+                } else {
+                    let found = crate::sums::robot_sums(client, &first)?;
+                    (image.areas().to_vec(), found)
+                };
+                if let (Some((_, expected)), Some(&found)) = (rom, found.first()) {
+                    fingerprint::check_whole(profile, expected, found)?;
+                }
+                keep_old(client, kept.take(), &todo, keep)?;
+                written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
+                (rewrites, passes) =
+                    write_ranges(client, &mut running, &image, todo, options, progress)?;
+                Ok(())
             })
             .and_then(|()| write_flags(client, plan.as_mut(), options))
             .and_then(|()| {
@@ -380,7 +442,11 @@ pub fn upload<T: Transport>(
         }
         session = Some(running);
     } else {
+        keep_old(client, kept.take(), image.areas(), keep)?;
+        written = whole(&image);
+        let body;
         (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+        (rewrites, passes) = (body.rewrites, body.passes());
     }
     // Through the loader, a reset is found and recovered from while the
     // body goes in; one after its last check clears the entry's flags, and
@@ -390,7 +456,11 @@ pub fn upload<T: Transport>(
         if let Some(plan) = plan.as_mut() {
             plan.forget_flags();
         }
+        let body;
         (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+        rewrites += body.rewrites;
+        passes += body.passes();
+        written = whole(&image);
     }
 
     let stats = client.stats();
@@ -399,9 +469,9 @@ pub fn upload<T: Transport>(
         device_time: client.transport().now().saturating_sub(start),
         chars_sent: stats.sent - stats_before.sent,
         chars_received: stats.received - stats_before.received,
-        rewrites: body.rewrites,
+        rewrites,
         lost_answers: stats.lost - stats_before.lost,
-        final_passes: body.passes(),
+        final_passes: passes,
         hooks,
         loader: session.map(|session| {
             let (address, len) = session.placement();
@@ -412,6 +482,82 @@ pub fn upload<T: Transport>(
                 recoveries: session.recoveries,
             }
         }),
+        written,
+    })
+}
+
+/// Every area of `image` as (address, length).
+fn whole(image: &UploadImage) -> Vec<(u16, usize)> {
+    image
+        .areas()
+        .iter()
+        .map(|area| (area.address, area.bytes.len()))
+        .collect()
+}
+
+/// Reads what `areas` will overwrite (two answers agreeing for each span)
+/// and hands it, with the hooks and table read at the start, to `keep`.
+fn keep_old<T: Transport>(
+    client: &mut Client<T>,
+    kept: Option<Backup>,
+    areas: &[Area],
+    keep: &mut dyn Keep,
+) -> Result<()> {
+    let Some(mut kept) = kept else {
+        return Ok(());
+    };
+    for area in areas {
+        // The table entry: the whole table is kept already.
+        let covered = kept
+            .areas
+            .iter()
+            .any(|old| old.address <= area.address && area.end() <= old.end());
+        if covered {
+            continue;
+        }
+        let bytes = client.read_memory(area.address, area.bytes.len())?;
+        kept.areas.push(Area {
+            address: area.address,
+            bytes,
+        });
+    }
+    keep.keep(&kept);
+    Ok(())
+}
+
+/// Writes `todo` through the loader, verified; with a delta upload, a
+/// transfer that met faults (a write whose address noise changed may have
+/// landed on a range the sums passed) is followed by the sums again, and
+/// whatever differs now is written again.
+fn write_ranges<T: Transport>(
+    client: &mut Client<T>,
+    running: &mut Session,
+    image: &UploadImage,
+    mut todo: Vec<Area>,
+    options: &UploadOptions,
+    progress: &mut dyn Progress,
+) -> Result<(usize, u32)> {
+    let (mut rewrites, mut passes) = (0, 0);
+    for _ in 0..=options.max_passes {
+        if todo.is_empty() {
+            return Ok((rewrites, passes));
+        }
+        let part = UploadImage::new(todo, Vec::new())?;
+        let mut body = Body::new(&part, Writer::Frames);
+        body.plan_writes(client.transport().baud(), progress);
+        running.transfer(client, &mut body, progress)?;
+        rewrites += body.rewrites;
+        passes += body.passes();
+        if !options.delta || body.passes() == 0 {
+            return Ok((rewrites, passes));
+        }
+        todo = delta::differing(client, image)?;
+    }
+    Err(Error::LoaderUnavailable {
+        reason: format!(
+            "ranges kept differing after {} rounds of writes and sums",
+            options.max_passes
+        ),
     })
 }
 
