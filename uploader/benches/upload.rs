@@ -19,7 +19,7 @@
 use std::time::{Duration, Instant};
 
 use uploader::transport::{VirtualTransport, char_time};
-use uploader::{LoaderChoice, NoProgress, UploadOptions, UploadReport};
+use uploader::{Backup, Keep, LoaderChoice, NoProgress, UploadOptions, UploadReport};
 
 #[path = "../tests/common/image.rs"]
 mod image;
@@ -35,6 +35,17 @@ fn upload(options: &UploadOptions) -> (UploadReport, Duration) {
     let report = uploader::upload(&mut client, &extension(BYTES, 0), options, &mut NoProgress)
         .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
     (report, started.elapsed())
+}
+
+/// Keeps what an upload overwrote, as `scorpion upload` does for
+/// `--undo` (its file aside).
+#[derive(Default)]
+struct Undo(usize);
+
+impl Keep for Undo {
+    fn keep(&mut self, overwritten: &Backup) {
+        self.0 = overwritten.len();
+    }
 }
 
 fn main() {
@@ -120,6 +131,21 @@ fn main() {
     )
     .unwrap_or_else(|error| panic!("the one-byte upload failed: {error}"));
     let wall = started.elapsed();
+    // What `scorpion upload` does: the same upload keeping what it
+    // overwrites for `--undo`, into a fresh robot and as a one-byte change.
+    let mut client = uploader::client(VirtualTransport::default(), &options.profile);
+    let mut undo = Undo::default();
+    let kept_full =
+        uploader::upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut undo)
+            .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
+    let kept_delta = uploader::upload_keeping(
+        &mut client,
+        &one_byte_changed(&image, 1000),
+        &options,
+        &mut NoProgress,
+        &mut undo,
+    )
+    .unwrap_or_else(|error| panic!("the one-byte upload failed: {error}"));
     let full_ratio = full.device_time.as_secs_f64() / line_bound.as_secs_f64();
     let delta_ratio = delta.device_time.as_secs_f64() / 1.0;
     println!(
@@ -139,6 +165,21 @@ fn main() {
         delta.chars_sent + delta.chars_received,
         wall.as_millis()
     );
+    for (name, report, bound) in [
+        ("keeping for undo, full", &kept_full, &full),
+        ("keeping for undo, one byte", &kept_delta, &delta),
+    ] {
+        println!(
+            "  {name:<34} {:>9.3} {:>10} {:>10} {:>8}",
+            report.device_time.as_secs_f64(),
+            format!(
+                "{:.3}x",
+                report.device_time.as_secs_f64() / bound.device_time.as_secs_f64()
+            ),
+            "no keep",
+            report.chars_sent + report.chars_received,
+        );
+    }
     if full_ratio > 1.15 {
         missed.push(format!(
             "the full upload with default options: {full_ratio:.3}x, target 1.15x"

@@ -114,10 +114,21 @@ impl Backup {
         }
         let mut at = MAGIC.len();
         let mut backup = Backup::default();
+        // Where each hook's and each memory record started: a second
+        // record for the same hook or bytes would make a restore's result
+        // depend on the order it is read in.
+        let mut hooks_at: Vec<(HookKind, usize)> = Vec::new();
+        let mut areas_at: Vec<(u32, u32, usize)> = Vec::new();
         let take = |at: &mut usize, len: usize| -> Result<&[u8]> {
-            let slice = bytes
-                .get(*at..*at + len)
-                .ok_or_else(|| bad(*at, "it ends in the middle of a record"))?;
+            let slice = bytes.get(*at..*at + len).ok_or_else(|| {
+                bad(
+                    *at,
+                    &format!(
+                        "it ends in the middle of a record: expected {len} more bytes, found {}",
+                        bytes.len().saturating_sub(*at)
+                    ),
+                )
+            })?;
             *at += len;
             Ok(slice)
         };
@@ -129,9 +140,22 @@ impl Backup {
                     let head = take(&mut at, 4)?;
                     let address = u16::from_le_bytes([head[0], head[1]]);
                     let len = usize::from(u16::from_le_bytes([head[2], head[3]]));
-                    if u32::from(address) + len as u32 > 0x1_0000 {
+                    let end = u32::from(address) + len as u32;
+                    if end > 0x1_0000 {
                         return Err(bad(start, "a memory record runs past $FFFF"));
                     }
+                    if let Some(&(_, _, first)) = areas_at
+                        .iter()
+                        .find(|&&(from, to, _)| u32::from(address) < to && from < end)
+                    {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a memory record (${address:04X}, {len} bytes) overlaps the one at byte {first}"
+                            ),
+                        ));
+                    }
+                    areas_at.push((u32::from(address), end, start));
                     let data = take(&mut at, len)?.to_vec();
                     backup.areas.push(Area {
                         address,
@@ -143,8 +167,23 @@ impl Backup {
                     let kind = match record[0] {
                         0 => HookKind::Unknown,
                         1 => HookKind::Loop,
-                        _ => return Err(bad(start + 1, "an unknown hook (0 or 1 expected)")),
+                        found => {
+                            return Err(bad(
+                                start + 1,
+                                &format!("an unknown hook: expected 0 or 1, found {found}"),
+                            ));
+                        }
                     };
+                    if let Some(&(_, first)) = hooks_at.iter().find(|(k, _)| *k == kind) {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a second record for {} (the first is at byte {first})",
+                                kind.rom_symbol()
+                            ),
+                        ));
+                    }
+                    hooks_at.push((kind, start));
                     backup
                         .hooks
                         .push((kind, u16::from_le_bytes([record[1], record[2]])));
@@ -152,10 +191,13 @@ impl Backup {
                 b'E' => {
                     let sum = take(&mut at, 4)?;
                     let sum = u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]);
-                    if sum != fnv1a32(&bytes[..start]) {
+                    let computed = fnv1a32(&bytes[..start]);
+                    if sum != computed {
                         return Err(bad(
                             start,
-                            "its checksum does not match: the file is damaged",
+                            &format!(
+                                "its checksum does not match: the end record holds ${sum:08X}, the bytes before it sum to ${computed:08X} (the file is damaged)"
+                            ),
                         ));
                     }
                     if at != bytes.len() {
@@ -166,7 +208,7 @@ impl Backup {
                 other => {
                     return Err(bad(
                         start,
-                        &format!("an unknown record ${other:02X} (A, H or E expected)"),
+                        &format!("an unknown record: expected A, H or E, found ${other:02X}"),
                     ));
                 }
             }
@@ -251,7 +293,9 @@ pub fn restore<T: Transport>(
     progress: &mut dyn Progress,
 ) -> Result<Vec<UploadReport>> {
     let profile = &options.profile;
-    client.probe()?;
+    // A restore or upload that died at the loader's fast rate may have
+    // left the robot there: `connect` finds it and asks it back.
+    crate::upload::connect(client, options)?;
     fingerprint::check_jump_table(client, profile)?;
     for kind in HookKind::ALL {
         if let Some(to) = profile.reset_target(kind) {
@@ -408,6 +452,70 @@ mod tests {
             );
         }
         assert!(Backup::decode("b", &bytes[..bytes.len() - 1]).is_err());
+    }
+
+    /// A backup file with `backup`'s records and a good end record.
+    fn with_end(mut body: Vec<u8>) -> Vec<u8> {
+        let sum = fnv1a32(&body);
+        body.push(b'E');
+        body.extend_from_slice(&sum.to_le_bytes());
+        body
+    }
+
+    #[test]
+    fn a_second_record_for_one_hook_is_refused_at_its_place() {
+        let mut body = MAGIC.to_vec();
+        body.extend_from_slice(&[b'H', 0, 0x21, 0xFF]);
+        let second = body.len();
+        body.extend_from_slice(&[b'H', 0, 0x00, 0x04]);
+        let error = Backup::decode("twice.bak", &with_end(body)).expect_err("refused");
+        let text = error.to_string();
+        assert!(
+            matches!(&error, Error::BadBackup { offset, .. } if *offset == second),
+            "{error:?}"
+        );
+        assert!(text.contains("HOOK_UNKNOWN"), "{text}");
+        assert!(text.contains(&format!("byte {}", MAGIC.len())), "{text}");
+    }
+
+    #[test]
+    fn overlapping_memory_records_are_refused_at_their_place() {
+        let mut body = MAGIC.to_vec();
+        body.extend_from_slice(&[b'A', 0x00, 0x04, 4, 0, 1, 2, 3, 4]);
+        let second = body.len();
+        body.extend_from_slice(&[b'A', 0x02, 0x04, 1, 0, 9]);
+        let error = Backup::decode("overlap.bak", &with_end(body)).expect_err("refused");
+        assert!(
+            matches!(&error, Error::BadBackup { offset, .. } if *offset == second),
+            "{error:?}"
+        );
+        assert!(error.to_string().contains("$0402"), "{error}");
+    }
+
+    #[test]
+    fn a_truncated_or_damaged_file_says_where_and_what_was_expected() {
+        let bytes = sample().encode();
+        let cut = &bytes[..MAGIC.len() + 3];
+        let text = Backup::decode("cut.bak", cut)
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            text.contains(&format!("at byte {}", MAGIC.len() + 1)),
+            "{text}"
+        );
+        assert!(text.contains("expected 4 more bytes, found 2"), "{text}");
+
+        let mut damaged = bytes.clone();
+        let last = damaged.len() - 1;
+        damaged[last] ^= 0x40;
+        let text = Backup::decode("damaged.bak", &damaged)
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            text.contains(&format!("at byte {}", bytes.len() - 5)),
+            "{text}"
+        );
+        assert!(text.contains("the end record holds $"), "{text}");
     }
 
     #[test]

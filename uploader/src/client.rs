@@ -356,13 +356,16 @@ impl<T: Transport> Client<T> {
     }
 
     /// Sends `questions` (commands whose answers are `answer_len`
-    /// characters, the carriage return included) back to back, as many
-    /// ahead of their answers as the robot's receive buffer holds, and
-    /// returns the frames that came back, in order, once every question
-    /// is answered or the answers stop coming (`work` is the robot's time
-    /// per question besides the characters). Answers carry what they
-    /// answer (an address, say): the caller matches them, and asks again
-    /// for what is missing.
+    /// characters, the carriage return included) back to back and returns
+    /// the frames that came back, in order, once every question is
+    /// answered or the answers stop coming (`work` is the robot's time per
+    /// question besides the characters). A question may carry a loader
+    /// frame before it, which the loader takes as it arrives. As with
+    /// [`Client::room`], at most a window of characters goes out after a
+    /// question whose answer has not arrived: what the robot's receive
+    /// ring holds while it works on that question and answers it. Answers
+    /// carry what they answer (an address, say): the caller matches them,
+    /// and asks again for what is missing.
     ///
     /// # Errors
     /// A line error.
@@ -375,32 +378,33 @@ impl<T: Transport> Client<T> {
         self.drain()?;
         let mut frames = Vec::new();
         let mut next = 0;
-        // Characters of questions sent and not answered yet.
-        let mut ahead: VecDeque<usize> = VecDeque::new();
+        // The host's character count just after each unanswered question.
+        let mut marks: VecDeque<usize> = VecDeque::new();
         let mut deadline = self.transport.now();
-        while next < questions.len() || !ahead.is_empty() {
+        while next < questions.len() || !marks.is_empty() {
             while next < questions.len()
-                && (ahead.is_empty()
-                    || ahead.iter().sum::<usize>() + questions[next].len() <= self.config.window)
+                && marks.front().is_none_or(|&oldest| {
+                    self.sent + questions[next].len() <= oldest + self.config.window
+                })
             {
                 let bytes = &questions[next];
                 self.send_raw(bytes)?;
                 let now = self.transport.now();
                 deadline = deadline.max(now) + self.chars(bytes.len() + answer_len) + work;
-                ahead.push_back(bytes.len());
+                marks.push_back(self.sent);
                 next += 1;
             }
             if let Some(frame) = self.take_frame() {
                 frames.push(frame);
-                ahead.pop_front();
+                marks.pop_front();
                 continue;
             }
             let now = self.transport.now();
             let until = deadline + self.config.margin;
             if now >= until {
                 // The rest are lost: the caller asks again.
-                self.stats.lost += ahead.len();
-                ahead.clear();
+                self.stats.lost += marks.len();
+                marks.clear();
                 deadline = now;
                 continue;
             }

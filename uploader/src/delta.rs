@@ -42,7 +42,7 @@ fn differ<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     ranges: &[(Range, &[u8])],
-) -> Result<(Vec<usize>, Vec<u16>)> {
+) -> Result<(Vec<(usize, u16)>, Vec<u16>)> {
     let mut asked: Vec<Range> = first.to_vec();
     asked.extend(ranges.iter().map(|(range, _)| *range));
     let mut found = robot_sums(client, &asked)?;
@@ -52,10 +52,13 @@ fn differ<T: Transport>(
         .zip(rest)
         .enumerate()
         .filter(|(_, ((_, bytes), found))| fletcher16(bytes) != *found)
-        .map(|(i, _)| i)
+        .map(|(i, (_, found))| (i, found))
         .collect();
     Ok((wrong, found))
 }
+
+/// A range of the image and the robot's sum of what it holds there.
+pub(crate) type Held = (Area, u16);
 
 /// The ranges of `image` the robot does not hold, merged where they
 /// touch; empty when it holds every byte. The loader's `sums` must be
@@ -67,12 +70,14 @@ pub(crate) fn differing<T: Transport>(
     client: &mut Client<T>,
     image: &UploadImage,
 ) -> Result<Vec<Area>> {
-    Ok(differing_and(client, &[], image)?.0)
+    Ok(merged(&differing_and(client, &[], image)?.0))
 }
 
-/// [`differing`], with the robot's sums of `first` asked in the same
-/// batch as the coarse pass (the whole ROM's, say: the robot sums it while
-/// the other questions are on their way).
+/// The ranges of `image` the robot does not hold, each with the robot's
+/// sum of what it holds there (what an undo keeps is checked against
+/// it), and the robot's sums of `first`, asked in the same batch as the
+/// coarse pass (the whole ROM's, say: the robot sums it while the other
+/// questions are on their way).
 ///
 /// # Errors
 /// As [`differing`].
@@ -80,28 +85,74 @@ pub(crate) fn differing_and<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     image: &UploadImage,
-) -> Result<(Vec<Area>, Vec<u16>)> {
+) -> Result<(Vec<Held>, Vec<u16>)> {
     let coarse = split(image.areas(), COARSE);
     let (wrong, sums) = differ(client, first, &coarse)?;
-    let mut out: Vec<Area> = Vec::new();
+    let held = |range: &(Range, &[u8]), sum: u16| {
+        (
+            Area {
+                address: range.0.0,
+                bytes: range.1.to_vec(),
+            },
+            sum,
+        )
+    };
     if wrong.len() * 2 > coarse.len() {
-        for i in wrong {
-            push(&mut out, coarse[i].0.0, coarse[i].1);
-        }
+        let out = wrong
+            .iter()
+            .map(|&(i, sum)| held(&coarse[i], sum))
+            .collect();
         return Ok((out, sums));
     }
-    let pieces: Vec<Area> = wrong
+    let pieces: Vec<Area> = wrong.iter().map(|&(i, _)| held(&coarse[i], 0).0).collect();
+    let fine = split(&pieces, FINE);
+    let out = differ(client, &[], &fine)?
+        .0
         .iter()
-        .map(|&i| Area {
-            address: coarse[i].0.0,
-            bytes: coarse[i].1.to_vec(),
+        .map(|&(i, sum)| held(&fine[i], sum))
+        .collect();
+    Ok((out, sums))
+}
+
+/// Every range of `image` (coarse), each with the robot's sum of what it
+/// holds there, and the robot's sums of `first`: for an upload that
+/// writes every byte and keeps what it overwrites.
+///
+/// # Errors
+/// As [`differing`].
+pub(crate) fn all_and<T: Transport>(
+    client: &mut Client<T>,
+    first: &[Range],
+    image: &UploadImage,
+) -> Result<(Vec<Held>, Vec<u16>)> {
+    let coarse = split(image.areas(), COARSE);
+    let mut asked: Vec<Range> = first.to_vec();
+    asked.extend(coarse.iter().map(|(range, _)| *range));
+    let mut found = robot_sums(client, &asked)?;
+    let rest = found.split_off(first.len());
+    let out = coarse
+        .iter()
+        .zip(rest)
+        .map(|(((address, _), bytes), sum)| {
+            (
+                Area {
+                    address: *address,
+                    bytes: bytes.to_vec(),
+                },
+                sum,
+            )
         })
         .collect();
-    let fine = split(&pieces, FINE);
-    for i in differ(client, &[], &fine)?.0 {
-        push(&mut out, fine[i].0.0, fine[i].1);
+    Ok((out, found))
+}
+
+/// The ranges of `held`, merged where they touch.
+pub(crate) fn merged(held: &[Held]) -> Vec<Area> {
+    let mut out = Vec::new();
+    for (area, _) in held {
+        push(&mut out, area.address, &area.bytes);
     }
-    Ok((out, sums))
+    out
 }
 
 /// Appends a range, merged with the last one if it follows it.

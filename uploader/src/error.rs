@@ -32,6 +32,26 @@ pub enum Error {
         whole_sum: Option<(u16, u16)>,
     },
 
+    /// A range written through the loader kept summing otherwise on the
+    /// robot than the image's bytes do.
+    #[error(
+        "${address:04X} and the {len} bytes from it still differ on the robot after {attempts} writes (a checksum computed on the robot)"
+    )]
+    #[diagnostic(
+        code(uploader::sum_failed),
+        help(
+            "the line is very noisy or this memory does not hold what is written to it; `--full --loader never` writes and reads back each byte and names the first that will not hold"
+        )
+    )]
+    SumFailed {
+        /// The range's first address.
+        address: u16,
+        /// Its length.
+        len: usize,
+        /// Writes (or rounds) it took.
+        attempts: u32,
+    },
+
     /// A backup file that cannot be restored: nothing of it was written.
     #[error("{name} is not a backup this uploader can restore (at byte {offset}): {reason}")]
     #[diagnostic(

@@ -11,6 +11,7 @@
 
 use std::ops::RangeInclusive;
 
+use isa::objfmt::HookKind;
 use romlib::protocol::{Answer, Command, ReadSpan};
 
 use crate::client::{Client, spans};
@@ -75,8 +76,44 @@ pub(crate) fn check_jump_table<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
 ) -> Result<()> {
+    check_ranges(client, profile, &profile.jump_table)
+}
+
+/// The jump-table entries (`JMP`s) of the hooks' targets at reset, which
+/// an upload points hooks back at before its loader runs (an extension
+/// replaced, a hook disarmed): compared before those writes, the rest of
+/// the table once the loader runs at the fast rate.
+pub(crate) fn check_reset_entries<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+) -> Result<()> {
+    let mut ranges: Vec<RangeInclusive<u16>> = Vec::new();
+    let mut targets: Vec<u16> = HookKind::ALL
+        .into_iter()
+        .filter_map(|kind| profile.reset_target(kind))
+        .collect();
+    targets.sort_unstable();
+    for at in targets {
+        let entry = at..=at.saturating_add(2);
+        // Neighbouring entries are read in one span.
+        match ranges.last_mut() {
+            Some(last) if u32::from(*last.end()) + 1 >= u32::from(at) => {
+                *last = *last.start()..=(*last.end()).max(*entry.end());
+            }
+            _ => ranges.push(entry),
+        }
+    }
+    check_ranges(client, profile, &ranges)
+}
+
+/// [`check_jump_table`] over `ranges`.
+fn check_ranges<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    ranges: &[RangeInclusive<u16>],
+) -> Result<()> {
     let mut differences = Vec::new();
-    for range in &profile.jump_table {
+    for range in ranges {
         let Some(expected) = expected(profile, range) else {
             continue;
         };
@@ -108,6 +145,40 @@ pub(crate) fn check_jump_table<T: Transport>(
     }
 }
 
+/// The spans of the profile's jump table and vectors with their bytes,
+/// for a comparison that rides on another transfer (see
+/// `Body::add_checks`); empty for a profile without the ROM's bytes.
+pub(crate) fn table_checks(profile: &RomProfile) -> Vec<(ReadSpan, Vec<u8>)> {
+    let mut out = Vec::new();
+    for range in &profile.jump_table {
+        let Some(expected) = expected(profile, range) else {
+            continue;
+        };
+        for span in spans(*range.start(), expected.len()) {
+            let offset = usize::from(span.address() - range.start());
+            out.push((
+                span,
+                expected[offset..offset + usize::from(span.count())].to_vec(),
+            ));
+        }
+    }
+    out
+}
+
+/// CMD_DONE's entry of the jump table (its `JMP`) with its bytes: the one
+/// service the loader's `rate` calls, compared before `rate` is hooked.
+pub(crate) fn cmd_done_check(profile: &RomProfile) -> Vec<(ReadSpan, Vec<u8>)> {
+    let Some(services) = &profile.loader_services else {
+        return Vec::new();
+    };
+    let at = services.cmd_done;
+    let range = at..=at.saturating_add(2);
+    match (expected(profile, &range), ReadSpan::new(at, 3)) {
+        (Some(bytes), Ok(span)) => vec![(span, bytes)],
+        _ => Vec::new(),
+    }
+}
+
 /// One `/7R` answer, if it came and parsed.
 fn read_once<T: Transport>(client: &mut Client<T>, span: ReadSpan) -> Result<Option<Vec<u8>>> {
     match client.ask(&Command::ReadMemory(span)) {
@@ -117,6 +188,20 @@ fn read_once<T: Transport>(client: &mut Client<T>, span: ReadSpan) -> Result<Opt
         }
         Err(error) => Err(error),
     }
+}
+
+/// The jump table's and the vectors' ranges with the profile's sums of
+/// them, for a robot whose loader was found in RAM (see `upload`); empty
+/// for a profile without the ROM's bytes.
+pub(crate) fn table_sums(profile: &RomProfile) -> Vec<((u16, usize), u16)> {
+    profile
+        .jump_table
+        .iter()
+        .filter_map(|range| {
+            let bytes = expected(profile, range)?;
+            Some(((*range.start(), bytes.len()), fletcher16(&bytes)))
+        })
+        .collect()
 }
 
 /// The range of the profile's ROM the loader's `sums` checks, and its

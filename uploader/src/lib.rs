@@ -32,6 +32,7 @@ mod image;
 mod loader;
 mod progress;
 mod session;
+mod summed;
 mod sums;
 mod table;
 mod taper;

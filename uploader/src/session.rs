@@ -23,6 +23,7 @@ use crate::hooks::{read_hook, switch_hook};
 use crate::image::{RomProfile, UploadImage};
 use crate::loader::{Loader, rate_toggle};
 use crate::progress::{Event, NoProgress, Phase, Progress};
+use crate::summed::{Summed, write_summed};
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
 
@@ -52,6 +53,15 @@ pub(crate) struct Session {
     /// then runs at the base rate).
     fast: Option<u32>,
     limits: Limits,
+    /// Whether `sums` goes in and is hooked (an upload too small to gain
+    /// from it leaves it out: `frames` is then hooked).
+    with_sums: bool,
+    /// The profile whose jump table the robot's is compared with before
+    /// `frames` goes in, if the upload left that to the loader (at the
+    /// fast rate); `None` once it was.
+    rom_check: Option<RomProfile>,
+    /// Whether the loader was written (not found in RAM, verified).
+    wrote: bool,
     /// Times the loader was restored.
     pub(crate) recoveries: u32,
 }
@@ -64,6 +74,8 @@ impl Session {
         original: u16,
         (base, fast): (u32, Option<u32>),
         limits: Limits,
+        with_sums: bool,
+        rom_check: Option<RomProfile>,
     ) -> Self {
         Session {
             loader,
@@ -74,13 +86,38 @@ impl Session {
             target: base,
             fast: fast.filter(|&fast| fast != base && rate_toggle((base, fast)) != 0),
             limits,
+            with_sums,
+            rom_check,
+            wrote: false,
             recoveries: 0,
         }
     }
 
-    /// Where `sums` runs: `HOOK_UNKNOWN`'s target while the loader is in.
+    /// `HOOK_UNKNOWN`'s target while the loader is in: `sums`, or
+    /// `frames` without it.
     pub(crate) fn handler(&self) -> u16 {
-        self.loader.sums
+        if self.with_sums {
+            self.loader.sums
+        } else {
+            self.loader.frames
+        }
+    }
+
+    /// Whether the loader was written, rather than found in RAM from an
+    /// earlier upload and verified.
+    pub(crate) fn wrote_loader(&self) -> bool {
+        self.wrote
+    }
+
+    /// The profile whose jump table is still to be compared with the
+    /// robot's (a loader found in RAM leaves that to `sums`); taken.
+    pub(crate) fn take_rom_check(&mut self) -> Option<RomProfile> {
+        self.rom_check.take()
+    }
+
+    /// Whether `sums` is in (and hooked).
+    pub(crate) fn has_sums(&self) -> bool {
+        self.with_sums
     }
 
     /// The rate the transfer ran at.
@@ -88,9 +125,14 @@ impl Session {
         self.target
     }
 
-    /// The loader's first address and size.
+    /// The loader's first address and the size of what went in.
     pub(crate) fn placement(&self) -> (u16, usize) {
-        (self.loader.address(), self.loader.len())
+        let len = if self.with_sums {
+            self.loader.len()
+        } else {
+            usize::from(self.loader.sums - self.loader.address())
+        };
+        (self.loader.address(), len)
     }
 
     /// Installs the loader: `rate` at the base rate, the switch, `frames`
@@ -113,8 +155,9 @@ impl Session {
         // usual case when an extension is uploaded again after an edit)
         // only needs verifying: reading it back costs less than writing it.
         let mut start = if self.resident(client)? {
-            Start::Verify
+            Start::Resident
         } else {
+            self.wrote = true;
             Start::Write
         };
         loop {
@@ -168,16 +211,33 @@ impl Session {
     fn hook_loader<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
         match self.fast {
             Some(fast) if client.transport().baud() != fast => {
-                self.put(client, &self.loader.rate_part()?, start)?;
+                let checks = match &self.rom_check {
+                    Some(profile) => crate::fingerprint::cmd_done_check(profile),
+                    None => Vec::new(),
+                };
+                match start {
+                    // `rate` found in RAM was read whole already, and ran
+                    // on this robot before (see `Start::Resident`).
+                    Start::Resident => {}
+                    _ => {
+                        if !self.put_checked(client, &self.loader.rate_part()?, start, checks)? {
+                            self.check_rom(client)?;
+                        }
+                    }
+                }
                 switch_hook(client, self.hook, self.loader.rate, self.limits.max_writes)?;
                 if !self.switch_rate(client, fast)? {
                     // This robot does not follow: the transfer runs at the
                     // base rate, and no later recovery tries again.
                     self.fast = None;
                 }
-                self.put(client, &self.loader.frames_part()?, start)?;
+                let part = self.loader.frames_part()?;
+                self.put_then_check_rom(client, &part, start)?;
             }
-            _ => self.put(client, &self.loader.rom_part()?, start)?,
+            _ => {
+                let part = self.loader.rom_part()?;
+                self.put_then_check_rom(client, &part, start)?;
+            }
         }
         self.target = client.transport().baud();
         switch_hook(
@@ -186,8 +246,68 @@ impl Session {
             self.loader.frames,
             self.limits.max_writes,
         )?;
+        if !self.with_sums {
+            return Ok(());
+        }
         self.put_framed(client, &self.loader.sums_part()?, start)?;
         switch_hook(client, self.hook, self.loader.sums, self.limits.max_writes)
+    }
+
+    /// Puts a part of the loader in through the ROM's commands with the
+    /// robot's jump table compared on the way (its answers ride on the
+    /// return wire while the `/9W`s go out); the part is hooked only after
+    /// this returns. A comparison that did not pass (a lost answer, noise,
+    /// another ROM) is read again until two answers agree.
+    fn put_then_check_rom<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        part: &UploadImage,
+        start: Start,
+    ) -> Result<()> {
+        if start == Start::Resident && self.with_sums {
+            // `sums` compares the table, cheaper than reading it.
+            return self
+                .put_checked(client, part, start, Vec::new())
+                .map(|_| ());
+        }
+        let checks = match &self.rom_check {
+            Some(profile) => crate::fingerprint::table_checks(profile),
+            None => Vec::new(),
+        };
+        if self.put_checked(client, part, start, checks)? {
+            self.rom_check = None;
+        }
+        self.check_rom(client)
+    }
+
+    /// Puts loader bytes into the robot through the ROM, verified, with
+    /// read-only comparisons on the way; whether they passed.
+    fn put_checked<T: Transport>(
+        &self,
+        client: &mut Client<T>,
+        image: &UploadImage,
+        start: Start,
+        checks: Vec<(ReadSpan, Vec<u8>)>,
+    ) -> Result<bool> {
+        let mut body = Body::new(image, Writer::Rom);
+        match start {
+            Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
+            Start::Verify | Start::Resident => body.plan_reads(&mut NoProgress),
+        }
+        body.add_checks(checks);
+        match body.run(client, self.limits, &mut NoProgress)? {
+            RunEnd::Done | RunEnd::CheckLoader => Ok(body.checks_passed()),
+        }
+    }
+
+    /// The right ROM before `frames`, which calls into its jump table, is
+    /// hooked (once): the whole table read until two answers agree.
+    fn check_rom<T: Transport>(&mut self, client: &mut Client<T>) -> Result<()> {
+        if let Some(profile) = &self.rom_check {
+            crate::fingerprint::check_jump_table(client, profile)?;
+            self.rom_check = None;
+        }
+        Ok(())
     }
 
     /// Puts loader bytes into the robot through `frames` (hooked),
@@ -201,7 +321,7 @@ impl Session {
         let mut body = Body::new(image, Writer::Frames);
         match start {
             Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
-            Start::Verify => body.plan_reads(&mut NoProgress),
+            Start::Verify | Start::Resident => body.plan_reads(&mut NoProgress),
         }
         for _ in 0..3 {
             match body.run(client, self.limits, &mut NoProgress)? {
@@ -217,23 +337,6 @@ impl Session {
             question: "/1L".into(),
             waited: Duration::ZERO,
         })
-    }
-
-    /// Puts loader bytes into the robot through the ROM, verified.
-    fn put<T: Transport>(
-        &self,
-        client: &mut Client<T>,
-        image: &UploadImage,
-        start: Start,
-    ) -> Result<()> {
-        let mut body = Body::new(image, Writer::Rom);
-        match start {
-            Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
-            Start::Verify => body.plan_reads(&mut NoProgress),
-        }
-        match body.run(client, self.limits, &mut NoProgress)? {
-            RunEnd::Done | RunEnd::CheckLoader => Ok(()),
-        }
     }
 
     /// Sends `/1F` (`rate` toggles the line, reached directly or through
@@ -314,7 +417,7 @@ impl Session {
             Err(Error::NotAHook { .. }) => None,
             Err(error) => return Err(error),
         };
-        if current == Some(self.loader.sums) && rate == self.target {
+        if current == Some(self.handler()) && rate == self.target {
             return Ok(());
         }
         progress.event(&Event::LoaderRestored {
@@ -355,6 +458,60 @@ impl Session {
             }
             body.set_writer(Writer::Frames);
         }
+    }
+
+    /// Writes `areas` in frames verified by the robot's sums (`sums` must
+    /// be in), checking and restoring the loader when the sums stop
+    /// coming; after a restore the sums tell which ranges landed.
+    pub(crate) fn transfer_summed<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        areas: &[crate::image::Area],
+        progress: &mut dyn Progress,
+    ) -> Result<Summed> {
+        let mut held_maybe = false;
+        let mut total = Summed::default();
+        for _ in 0..=MAX_RECOVERIES {
+            match write_summed(client, areas, held_maybe, self.limits, progress) {
+                Ok(done) => {
+                    total.rewrites += done.rewrites;
+                    total.passes += done.passes;
+                    return Ok(total);
+                }
+                Err(error) if recoverable(&error) => {
+                    self.ensure(client, progress).map_err(|_| error)?;
+                    held_maybe = true;
+                    total.passes += 1;
+                }
+                Err(Error::SumFailed {
+                    address,
+                    len,
+                    attempts,
+                }) => {
+                    // A range that will not hold: written and read back
+                    // byte by byte, which names the byte (or, if noise was
+                    // all it was, ends verified).
+                    let part = areas_within(areas, address, len);
+                    let image = UploadImage::new(part, Vec::new())?;
+                    let mut body = Body::new(&image, Writer::Frames);
+                    body.plan_writes(client.transport().baud(), progress);
+                    let limits = self.limits;
+                    self.limits.max_writes = limits.max_writes.saturating_sub(attempts).max(1);
+                    let done = self.transfer(client, &mut body, progress);
+                    self.limits = limits;
+                    done?;
+                    total.rewrites += body.rewrites;
+                    total.passes += body.passes();
+                    held_maybe = true;
+                }
+                Err(error) => return Err(error),
+            }
+        }
+        Err(Error::LoaderUnavailable {
+            reason: format!(
+                "its sums stopped answering {MAX_RECOVERIES} times; the line is too noisy or the robot keeps resetting"
+            ),
+        })
     }
 
     /// Puts the line back on the base rate: `/1F` through the loader,
@@ -409,6 +566,16 @@ impl Session {
         Ok(())
     }
 
+    /// Checks the loader after an error a reset explains and restores it
+    /// (and the line's rate) if it has to.
+    pub(crate) fn recover<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        progress: &mut dyn Progress,
+    ) -> Result<()> {
+        self.ensure(client, progress)
+    }
+
     /// Finds the robot after an error a reset explains, and leaves the
     /// host at its rate.
     pub(crate) fn find<T: Transport>(&mut self, client: &mut Client<T>) -> Result<u32> {
@@ -429,6 +596,24 @@ fn send_toggle<T: Transport>(client: &mut Client<T>, to: u32) -> Result<()> {
     client.transport().clear_input()
 }
 
+/// The bytes of `areas` from `address` for `len` bytes.
+fn areas_within(areas: &[crate::image::Area], address: u16, len: usize) -> Vec<crate::image::Area> {
+    let (from, to) = (u32::from(address), u32::from(address) + len as u32);
+    areas
+        .iter()
+        .filter_map(|area| {
+            let start = from.max(u32::from(area.address));
+            let end = to.min(area.end());
+            (start < end).then(|| crate::image::Area {
+                address: start as u16,
+                bytes: area.bytes[(start - u32::from(area.address)) as usize
+                    ..(end - u32::from(area.address)) as usize]
+                    .to_vec(),
+            })
+        })
+        .collect()
+}
+
 /// Errors a reset or a passing line fault explains: the robot may answer
 /// again, at one of the two rates.
 pub(crate) fn recoverable(error: &Error) -> bool {
@@ -447,4 +632,11 @@ pub(crate) fn recoverable(error: &Error) -> bool {
 enum Start {
     Write,
     Verify,
+    /// `rate` read back as linked: the loader of an earlier upload,
+    /// which compared this robot's jump table and ROM with the profile's
+    /// before it hooked anything, and the robot has stayed powered since
+    /// (its RAM still holds the loader). The rest only needs verifying,
+    /// and the jump table is compared by `sums` (a read if the sums
+    /// differ).
+    Resident,
 }

@@ -21,7 +21,7 @@ const CYCLES_PER_BYTE: u64 = 24;
 
 /// Characters of an answer: `K`, four address digits, four sum digits,
 /// the carriage return.
-const ANSWER_LEN: usize = 10;
+pub(crate) const ANSWER_LEN: usize = 10;
 
 /// The most a range is asked again after its answer was lost.
 const ATTEMPTS: u32 = 6;
@@ -42,13 +42,13 @@ pub fn fletcher16(bytes: &[u8]) -> u16 {
 pub(crate) type Range = (u16, usize);
 
 /// The question for one range.
-fn question((address, len): Range) -> Vec<u8> {
+pub(crate) fn question((address, len): Range) -> Vec<u8> {
     // A length of $10000 cannot be asked; nothing asks for it.
     format!("/9K{address:04X}{:04X}", len.min(0xFFFF)).into_bytes()
 }
 
 /// An answer's address and sum, if it is one.
-fn parse(frame: &[u8]) -> Option<(u16, u16)> {
+pub(crate) fn parse(frame: &[u8]) -> Option<(u16, u16)> {
     let text = frame.strip_suffix(&[EOL])?.strip_prefix(b"K")?;
     if text.len() != 8 || !text.iter().all(u8::is_ascii_hexdigit) {
         return None;
@@ -57,6 +57,12 @@ fn parse(frame: &[u8]) -> Option<(u16, u16)> {
     let address = u16::from_str_radix(&text[..4], 16).ok()?;
     let sum = u16::from_str_radix(&text[4..], 16).ok()?;
     Some((address, sum))
+}
+
+/// The robot's time to answer one question over at most `longest` bytes,
+/// besides the characters.
+pub(crate) fn work(longest: usize) -> Duration {
+    Duration::from_micros(longest as u64 * CYCLES_PER_BYTE + 2_000)
 }
 
 /// The robot's checksums of `ranges` (distinct first addresses), asked
@@ -76,10 +82,9 @@ pub(crate) fn robot_sums<T: Transport>(
         if missing.is_empty() {
             break;
         }
-        let longest = missing.iter().map(|&i| ranges[i].1).max().unwrap_or(0) as u64;
-        let work = Duration::from_micros(longest * CYCLES_PER_BYTE + 2_000);
+        let longest = missing.iter().map(|&i| ranges[i].1).max().unwrap_or(0);
         let questions: Vec<Vec<u8>> = missing.iter().map(|&i| question(ranges[i])).collect();
-        let frames = client.batch(&questions, ANSWER_LEN, work)?;
+        let frames = client.batch(&questions, ANSWER_LEN, work(longest))?;
         for (address, sum) in frames.iter().filter_map(|frame| parse(frame)) {
             if let Some(&i) = missing.iter().find(|&&i| ranges[i].0 == address) {
                 found[i] = Some(sum);

@@ -17,9 +17,9 @@ use std::time::Duration;
 use isa::objfmt::HookKind;
 use romlib::protocol::{Command, Extension};
 
-use crate::backup::{Backup, Keep, NoKeep, table_range};
+use crate::backup::{Backup, Keep, NoKeep};
 use crate::body::{Body, Limits, RunEnd, Writer};
-use crate::client::{Client, ClientConfig};
+use crate::client::{Client, ClientConfig, spans};
 use crate::delta;
 use crate::fingerprint;
 use crate::hooks::{
@@ -29,9 +29,11 @@ use crate::image::{Area, RomProfile, UploadImage};
 use crate::loader::{FAST_BAUD, Loader, loader_estimate, rom_only_estimate};
 use crate::progress::{Event, Phase, Progress};
 use crate::session::{Session, recoverable};
+use crate::sums::fletcher16;
 use crate::table;
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
+use romlib::protocol::Answer;
 
 /// Whether the RAM loader carries the body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -147,7 +149,7 @@ pub struct UploadReport {
 /// hooked obeys, and anything else drops) asks it back. A robot that stays
 /// at the fast rate (a `/1R` there unhooked the loader) is read there: only
 /// the loader can bring it back.
-fn connect<T: Transport>(
+pub(crate) fn connect<T: Transport>(
     client: &mut Client<T>,
     options: &UploadOptions,
 ) -> Result<(Vec<(HookKind, u16)>, u32)> {
@@ -274,25 +276,34 @@ pub fn upload_keeping<T: Transport>(
     let rates = (base, options.fast_baud.unwrap_or(base));
     let leftover = Loader::place(profile, image, rates)?;
     let (mut hooks_now, found_at) = connect(client, options)?;
-    // The right ROM, or no write: nothing has been written yet.
-    fingerprint::check_jump_table(client, profile)?;
-    let mut kept = None;
-    if keep.wanted() {
-        let mut before = Backup {
-            areas: Vec::new(),
-            hooks: hooks_now.clone(),
-        };
-        if let Some((address, len)) = table_range(profile) {
-            before.areas.push(Area {
-                address,
-                bytes: client.read_memory(address, len)?,
-            });
-        }
-        kept = Some(before);
+    // The right ROM, or no write. Through the loader the jump table is
+    // read once the line runs at the fast rate, before `frames` (which
+    // calls GETCH and CHKCH) is hooked: only `rate`, which calls nothing
+    // but CMD_DONE (its entry read before `rate` is hooked) and obeys
+    // nothing but `/1F`, runs before. A write before the loader (a hook
+    // disarmed or an extension replaced points hooks back at the ROM's
+    // entries; a table entry freed) reads those entries first, at the base
+    // rate; an upload through the ROM's commands alone, the whole table.
+    let mut rom_checked = options.loader == LoaderChoice::Never;
+    if rom_checked {
+        fingerprint::check_jump_table(client, profile)?;
+    }
+    let mut entries_checked = rom_checked;
+    if options.replace && !entries_checked {
+        fingerprint::check_reset_entries(client, profile)?;
+        entries_checked = true;
     }
     // What is installed: an overlap is refused (or, with `replace`, the old
     // extension leaves its chains first, which changes the hooks).
     let mut plan = table::prepare(client, profile, image, options.replace, options.max_writes)?;
+    // What an undo puts back: the hooks and the table as found (the table
+    // as `prepare` read it, flags and the entries in use: no more reads).
+    let mut kept = keep.wanted().then(|| Backup {
+        areas: plan
+            .as_ref()
+            .map_or_else(Vec::new, |plan| plan.found.clone()),
+        hooks: hooks_now.clone(),
+    });
     if options.replace {
         hooks_now = read_hooks(client, profile)?;
     }
@@ -328,6 +339,7 @@ pub fn upload_keeping<T: Transport>(
                     target,
                 });
             };
+            check_entries_once(client, profile, &mut entries_checked)?;
             switch_hook(client, address, to, options.max_writes)?;
             progress.event(&Event::HookDisarmed {
                 kind,
@@ -354,6 +366,9 @@ pub fn upload_keeping<T: Transport>(
     // it; its flags, which make it count, once body and entry are in.
     let bytes = image.len();
     if let Some(plan) = plan.as_mut() {
+        if plan.frees_first() {
+            check_entries_once(client, profile, &mut entries_checked)?;
+        }
         plan.free_first(client, options.max_writes)?;
         image.push_area(plan.entry_area());
     }
@@ -377,25 +392,73 @@ pub fn upload_keeping<T: Transport>(
             before(HookKind::Unknown),
             (base, options.fast_baud),
             limits,
+            wants_sums(&image, keep.wanted()),
+            (!rom_checked).then(|| profile.clone()),
         );
         let result = running
             .install(client, progress)
             .and_then(|()| {
+                if !running.has_sums() {
+                    // A small image: written whole, read back byte by byte.
+                    keep_old(client, kept.take(), image.areas(), keep)?;
+                    written = whole(&image);
+                    let mut body = Body::new(&image, Writer::Frames);
+                    body.plan_writes(client.transport().baud(), progress);
+                    running.transfer(client, &mut body, progress)?;
+                    (rewrites, passes) = (body.rewrites, body.passes());
+                    return Ok(());
+                }
                 // The whole ROM is summed on the robot while the image's
                 // sums are on their way: all before anything of the image
-                // is written.
-                let rom = fingerprint::whole_rom(profile);
-                let first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
-                let (todo, found) = if options.delta {
-                    delta::differing_and(client, &first, &image)?
-                } else {
-                    let found = crate::sums::robot_sums(client, &first)?;
-                    (image.areas().to_vec(), found)
-                };
-                if let (Some((_, expected)), Some(&found)) = (rom, found.first()) {
-                    fingerprint::check_whole(profile, expected, found)?;
+                // is written. Not when the loader was found in RAM,
+                // verified: this robot has stayed powered since an upload
+                // put it there, which summed its ROM (the jump table is
+                // read each time).
+                let rom = fingerprint::whole_rom(profile).filter(|_| running.wrote_loader());
+                let mut first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
+                let table = running
+                    .take_rom_check()
+                    .map(|profile| (fingerprint::table_sums(&profile), profile));
+                if let Some((sums, _)) = &table {
+                    first.extend(sums.iter().map(|(range, _)| *range));
                 }
-                keep_old(client, kept.take(), &todo, keep)?;
+                // A reset while the sums are asked unhooks the loader: it
+                // is restored and they are asked again.
+                let mut tries = 0;
+                let (todo, found) = loop {
+                    let asked = if options.delta {
+                        delta::differing_and(client, &first, &image)
+                    } else if kept.is_some() {
+                        delta::all_and(client, &first, &image)
+                    } else {
+                        crate::sums::robot_sums(client, &first).map(|found| {
+                            let all = image.areas().iter().map(|area| (area.clone(), 0));
+                            (all.collect(), found)
+                        })
+                    };
+                    match asked {
+                        Ok(asked) => break asked,
+                        Err(error) if recoverable(&error) && tries < 3 => {
+                            tries += 1;
+                            running.recover(client, progress).map_err(|_| error)?;
+                        }
+                        Err(error) => return Err(error),
+                    }
+                };
+                let mut found = found.into_iter();
+                if let Some((_, expected)) = rom {
+                    fingerprint::check_whole(profile, expected, found.next().unwrap_or(0))?;
+                }
+                if let Some((sums, profile)) = table {
+                    let differ = sums.iter().any(|(_, sum)| found.next() != Some(*sum));
+                    if differ {
+                        // What differs, read until two answers agree (a
+                        // sum that noise changed passes here).
+                        fingerprint::check_jump_table(client, &profile)?;
+                    }
+                }
+                keep_summed(client, kept.take(), &todo, keep)?;
+                let todo = delta::merged(&todo);
                 written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
                 (rewrites, passes) =
                     write_ranges(client, &mut running, &image, todo, options, progress)?;
@@ -442,6 +505,7 @@ pub fn upload_keeping<T: Transport>(
         }
         session = Some(running);
     } else {
+        check_rom_once(client, profile, &mut rom_checked)?;
         keep_old(client, kept.take(), image.areas(), keep)?;
         written = whole(&image);
         let body;
@@ -486,6 +550,34 @@ pub fn upload_keeping<T: Transport>(
     })
 }
 
+/// Compares the robot's jump table with the profile's, unless that was
+/// done.
+fn check_rom_once<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    checked: &mut bool,
+) -> Result<()> {
+    if !*checked {
+        fingerprint::check_jump_table(client, profile)?;
+        *checked = true;
+    }
+    Ok(())
+}
+
+/// Compares the robot's jump-table entries of the hooks' reset targets
+/// with the profile's, unless that was done.
+fn check_entries_once<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    checked: &mut bool,
+) -> Result<()> {
+    if !*checked {
+        fingerprint::check_reset_entries(client, profile)?;
+        *checked = true;
+    }
+    Ok(())
+}
+
 /// Every area of `image` as (address, length).
 fn whole(image: &UploadImage) -> Vec<(u16, usize)> {
     image
@@ -525,7 +617,90 @@ fn keep_old<T: Transport>(
     Ok(())
 }
 
-/// Writes `todo` through the loader, verified; with a delta upload, a
+/// Hands `keep` what the ranges of `held` hold on the robot now (the
+/// ranges about to be written, each with the robot's sum of it), with the
+/// hooks and table read at the start. A range whose sum is that of zeros
+/// (RAM nothing was loaded into, on the virtual robot) is taken for zeros
+/// without a read, with the same trust a delta upload puts in a sum; any
+/// other is read once at the loader's rate and checked against its sum
+/// (read again, up to four times, if noise changed an answer).
+fn keep_summed<T: Transport>(
+    client: &mut Client<T>,
+    kept: Option<Backup>,
+    held: &[delta::Held],
+    keep: &mut dyn Keep,
+) -> Result<()> {
+    let Some(mut kept) = kept else {
+        return Ok(());
+    };
+    for (area, sum) in held {
+        let len = area.bytes.len();
+        let covered = kept
+            .areas
+            .iter()
+            .any(|old| old.address <= area.address && area.end() <= old.end());
+        if covered {
+            continue;
+        }
+        let zeros = vec![0; len];
+        let bytes = if fletcher16(&zeros) == *sum {
+            zeros
+        } else {
+            read_summed(client, area.address, len, *sum)?
+        };
+        kept.areas.push(Area {
+            address: area.address,
+            bytes,
+        });
+    }
+    keep.keep(&kept);
+    Ok(())
+}
+
+/// `len` bytes from `address`, read once and checked against `sum` (the
+/// robot's), again while they do not agree; then read until two answers
+/// agree.
+fn read_summed<T: Transport>(
+    client: &mut Client<T>,
+    address: u16,
+    len: usize,
+    sum: u16,
+) -> Result<Vec<u8>> {
+    for _ in 0..4 {
+        let mut bytes = Vec::with_capacity(len);
+        for span in spans(address, len) {
+            match client.ask(&Command::ReadMemory(span)) {
+                Ok(Answer::Memory(data)) if data.len() == usize::from(span.count()) => {
+                    bytes.extend(data);
+                }
+                Ok(_)
+                | Err(Error::Protocol(_) | Error::NoAnswer { .. } | Error::WrongBaud { .. }) => {
+                    break;
+                }
+                Err(error) => return Err(error),
+            }
+        }
+        if bytes.len() == len && fletcher16(&bytes) == sum {
+            return Ok(bytes);
+        }
+    }
+    client.read_memory(address, len)
+}
+
+/// Whether the loader's `sums` goes in: it costs about three characters
+/// a byte of it at the fast rate (written, read back), and pays for
+/// itself in an image large enough that its sums spare the return wire
+/// the `/7R` answers, or that the robot may hold already, and in an upload
+/// that keeps what it overwrites (a range of zeros is known by its sum).
+fn wants_sums(image: &UploadImage, keeping: bool) -> bool {
+    keeping || image.len() >= SUMS_PAY
+}
+
+/// The image size from which the loader's `sums` pays for itself.
+const SUMS_PAY: usize = 256;
+
+/// Writes `todo` through the loader, verified by the robot's sums; with a
+/// delta upload, a
 /// transfer that met faults (a write whose address noise changed may have
 /// landed on a range the sums passed) is followed by the sums again, and
 /// whatever differs now is written again.
@@ -542,16 +717,23 @@ fn write_ranges<T: Transport>(
         if todo.is_empty() {
             return Ok((rewrites, passes));
         }
-        let part = UploadImage::new(todo, Vec::new())?;
-        let mut body = Body::new(&part, Writer::Frames);
-        body.plan_writes(client.transport().baud(), progress);
-        running.transfer(client, &mut body, progress)?;
-        rewrites += body.rewrites;
-        passes += body.passes();
-        if !options.delta || body.passes() == 0 {
+        let done = running.transfer_summed(client, &todo, progress)?;
+        rewrites += done.rewrites;
+        passes += done.passes;
+        if !options.delta || done.passes == 0 {
             return Ok((rewrites, passes));
         }
-        todo = delta::differing(client, image)?;
+        let mut tries = 0;
+        todo = loop {
+            match delta::differing(client, image) {
+                Ok(todo) => break todo,
+                Err(error) if recoverable(&error) && tries < 3 => {
+                    tries += 1;
+                    running.recover(client, progress).map_err(|_| error)?;
+                }
+                Err(error) => return Err(error),
+            }
+        };
     }
     Err(Error::LoaderUnavailable {
         reason: format!(
