@@ -36,10 +36,7 @@ pub(crate) struct RestoreArgs {
 }
 
 pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
-    let transport = args.line.open()?;
-    let profile = uploader::RomProfile::reference();
-    let mut client = uploader::client(transport, &profile);
-    client.probe()?;
+    let (mut client, profile) = ports::probed(&args.line)?;
     let backup = uploader::backup(&mut client, &profile)?;
     std::fs::write(&args.output, backup.encode())
         .into_diagnostic()
@@ -55,17 +52,25 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
 
 pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
     let backup = read_backup(&args.file)?;
-    let transport = args.line.open()?;
-    restore_into(transport, &backup, &args.file)
+    let resolved = args.line.resolve()?;
+    let transport = ports::open_resolved(&resolved, &[])?;
+    let rom = crate::cmd::config::rom(&resolved)?;
+    let profile = crate::cmd::config::profile(rom.as_ref())?;
+    restore_into(transport, profile, &backup, &args.file)
 }
 
-/// Restores `backup` (from `file`) through `transport`, and says so.
+/// Restores `backup` (from `file`) through `transport` into a robot with
+/// `profile`'s ROM, and says so.
 pub(crate) fn restore_into(
     transport: Box<dyn uploader::Transport>,
+    profile: uploader::RomProfile,
     backup: &Backup,
     file: &Path,
 ) -> miette::Result<ExitCode> {
-    let options = UploadOptions::default();
+    let options = UploadOptions {
+        profile,
+        ..UploadOptions::default()
+    };
     let mut client = uploader::client(transport, &options.profile);
     let reports = uploader::restore(&mut client, backup, &options, &mut NoProgress)?;
     let written: usize = reports
@@ -81,11 +86,10 @@ pub(crate) fn restore_into(
     Ok(ExitCode::SUCCESS)
 }
 
-/// Reads and checks a backup file.
+/// Reads (through the bounded reader: a FIFO or `/dev/zero` is refused,
+/// not waited on) and checks a backup file.
 pub(crate) fn read_backup(path: &Path) -> miette::Result<Backup> {
-    let bytes = std::fs::read(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
+    let bytes = hostfs::read(path, hostfs::BACKUP)?;
     Ok(Backup::decode(&path.display().to_string(), &bytes)?)
 }
 

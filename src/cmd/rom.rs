@@ -1,6 +1,7 @@
 //! `scorpion rom read`: a robot's whole ROM, read over its line and
-//! verified, as a ROM profile (a linked ELF) that `build --rom`, `link
-//! --just-symbols`, `[robot] rom` and `scorpion sim --rom` use.
+//! verified, as a ROM profile (a linked ELF) that a project's `[robot]
+//! rom` (its `build`, `test`, `upload`, `sim`), `link --just-symbols` and
+//! `scorpion sim --rom` use.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -50,9 +51,7 @@ fn run_read(args: &ReadArgs) -> miette::Result<ExitCode> {
     let (base_name, base) = match &args.base {
         Some(path) => {
             let name = path.display().to_string();
-            let bytes = std::fs::read(path)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot read {name}"))?;
+            let bytes = hostfs::read(path, hostfs::BINARY)?;
             let image = linker::Image::parse(&name, &bytes)?;
             (name, image)
         }
@@ -61,10 +60,7 @@ fn run_read(args: &ReadArgs) -> miette::Result<ExitCode> {
             linker::Image::parse("scorpion-rom.elf", romlib::ROM_ELF)?,
         ),
     };
-    let transport = args.line.open()?;
-    let profile = uploader::RomProfile::reference();
-    let mut client = uploader::client(transport, &profile);
-    client.probe()?;
+    let (mut client, _) = ports::probed(&args.line)?;
     let start = platform::map::ROM_START;
     let bytes = client.read_memory(start, platform::map::ROM_SIZE)?;
     let (image, differences) = uploader::rom_profile_image(&base, start, &bytes);

@@ -73,7 +73,8 @@ pub(crate) struct Args {
     undo: bool,
     /// Where an upload keeps what it overwrites and `--undo` finds it
     /// [default: target/scorpion/last-upload.undo in a project, else
-    /// scorpion-last-upload.undo here].
+    /// scorpion-last-upload.undo here]. Not on `--port emu`, whose robot
+    /// lasts one command.
     #[arg(long, value_name = "FILE")]
     undo_file: Option<PathBuf>,
 }
@@ -105,7 +106,7 @@ impl Args {
         if let Some(path) = &self.undo_file {
             return path.clone();
         }
-        match crate::project::Project::here() {
+        match scorpion_project::Project::here() {
             Ok(project) => project
                 .root
                 .join("target")
@@ -339,7 +340,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let backup = crate::cmd::backup::read_backup(&path)
             .wrap_err("nothing to undo: no upload has kept what it overwrote there")?;
         let transport = ports::open_resolved(&resolved, &[])?;
-        return crate::cmd::backup::restore_into(transport, &backup, &path);
+        let rom = crate::cmd::config::rom(&resolved)?;
+        let profile = crate::cmd::config::profile(rom.as_ref())?;
+        return crate::cmd::backup::restore_into(transport, profile, &backup, &path);
     }
     match &args.image {
         Some(path) => upload_file(args, &resolved, path),
@@ -431,7 +434,13 @@ fn upload_file(
         path: args.undo_path(),
         failed: None,
     };
-    let result = uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo);
+    // `emu` is a fresh virtual Scorpion for each command: nothing of it
+    // outlives this one for an undo to put back.
+    let result = if emulated {
+        uploader::upload(&mut client, &image, &options, &mut bar)
+    } else {
+        uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
+    };
     bar.bar.finish_and_clear();
     let report = result?;
     if let Some(error) = undo.failed {
