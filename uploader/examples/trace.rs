@@ -8,6 +8,7 @@
 //! cargo run -p uploader --release --example trace -- 9600    # the loader at 9600 throughout
 //! cargo run -p uploader --release --example trace -- rom     # the ROM's commands only
 //! cargo run -p uploader --release --example trace -- delta   # one byte changed, once installed
+//! cargo run -p uploader --release --example trace -- small   # 109 bytes, as the README's main job
 //! ```
 //!
 //! The image is the benchmark's: a 2 KiB extension at `$0400`
@@ -107,7 +108,15 @@ fn main() -> uploader::Result<()> {
         entries: Vec::new(),
     };
     let mut client = uploader::client(log, &options.profile);
-    let mut image = extension(2048, 0);
+    // `small`: an image the size of the README's main job (109 bytes).
+    let mut image = extension(
+        if mode.as_deref() == Some("small") {
+            109
+        } else {
+            2048
+        },
+        0,
+    );
     if mode.as_deref() == Some("delta") {
         uploader::upload(&mut client, &image, &options, &mut NoProgress)?;
         client.transport().entries.clear();

@@ -36,13 +36,16 @@ fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
     out
 }
 
+/// A range's index and the robot's sum of it.
+type Differs = (usize, u16);
+
 /// The ranges of `ranges` whose robot sum differs from the host's, and
 /// the robot's sums of `first` (asked first, in the same batch).
 fn differ<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     ranges: &[(Range, &[u8])],
-) -> Result<(Vec<(usize, u16)>, Vec<u16>)> {
+) -> Result<(Vec<Differs>, Vec<u16>)> {
     let mut asked: Vec<Range> = first.to_vec();
     asked.extend(ranges.iter().map(|(range, _)| *range));
     let mut found = robot_sums(client, &asked)?;

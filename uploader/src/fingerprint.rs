@@ -165,20 +165,6 @@ pub(crate) fn table_checks(profile: &RomProfile) -> Vec<(ReadSpan, Vec<u8>)> {
     out
 }
 
-/// CMD_DONE's entry of the jump table (its `JMP`) with its bytes: the one
-/// service the loader's `rate` calls, compared before `rate` is hooked.
-pub(crate) fn cmd_done_check(profile: &RomProfile) -> Vec<(ReadSpan, Vec<u8>)> {
-    let Some(services) = &profile.loader_services else {
-        return Vec::new();
-    };
-    let at = services.cmd_done;
-    let range = at..=at.saturating_add(2);
-    match (expected(profile, &range), ReadSpan::new(at, 3)) {
-        (Some(bytes), Ok(span)) => vec![(span, bytes)],
-        _ => Vec::new(),
-    }
-}
-
 /// One `/7R` answer, if it came and parsed.
 fn read_once<T: Transport>(client: &mut Client<T>, span: ReadSpan) -> Result<Option<Vec<u8>>> {
     match client.ask(&Command::ReadMemory(span)) {

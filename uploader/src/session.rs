@@ -62,6 +62,9 @@ pub(crate) struct Session {
     rom_check: Option<RomProfile>,
     /// Whether the loader was written (not found in RAM, verified).
     wrote: bool,
+    /// Whether an earlier upload may have left the loader in RAM (the
+    /// robot's table lists an extension): only then is it looked for.
+    pub(crate) maybe_resident: bool,
     /// Times the loader was restored.
     pub(crate) recoveries: u32,
 }
@@ -89,6 +92,7 @@ impl Session {
             with_sums,
             rom_check,
             wrote: false,
+            maybe_resident: true,
             recoveries: 0,
         }
     }
@@ -154,7 +158,7 @@ impl Session {
         // A loader left in RAM by an earlier upload at the same place (the
         // usual case when an extension is uploaded again after an edit)
         // only needs verifying: reading it back costs less than writing it.
-        let mut start = if self.resident(client)? {
+        let mut start = if self.maybe_resident && self.resident(client)? {
             Start::Resident
         } else {
             self.wrote = true;
@@ -211,19 +215,14 @@ impl Session {
     fn hook_loader<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
         match self.fast {
             Some(fast) if client.transport().baud() != fast => {
-                let checks = match &self.rom_check {
-                    Some(profile) => crate::fingerprint::cmd_done_check(profile),
-                    None => Vec::new(),
-                };
-                match start {
-                    // `rate` found in RAM was read whole already, and ran
-                    // on this robot before (see `Start::Resident`).
-                    Start::Resident => {}
-                    _ => {
-                        if !self.put_checked(client, &self.loader.rate_part()?, start, checks)? {
-                            self.check_rom(client)?;
-                        }
-                    }
+                // `rate` found in RAM was read whole already, and ran on
+                // this robot before (see `Start::Resident`). `rate` is
+                // hooked before the jump table is compared: it obeys only
+                // `/1F` and calls only CMD_DONE, so on another ROM the worst
+                // it does is leave the robot for its reset button, with
+                // nothing of the image written.
+                if start != Start::Resident {
+                    self.put_checked(client, &self.loader.rate_part()?, start, Vec::new())?;
                 }
                 switch_hook(client, self.hook, self.loader.rate, self.limits.max_writes)?;
                 if !self.switch_rate(client, fast)? {

@@ -195,6 +195,7 @@ fn choose_loader(
     image: &UploadImage,
     initial: &[(HookKind, u16)],
     (baud, fast): (u32, u32),
+    with_sums: bool,
 ) -> Result<Option<Loader>> {
     if options.loader == LoaderChoice::Never {
         return Ok(None);
@@ -223,7 +224,13 @@ fn choose_loader(
         );
     };
     if options.loader == LoaderChoice::Auto {
-        let with = loader_estimate(image.len(), loader.len(), baud, fast);
+        // What goes in: `sums` only when it is wanted.
+        let len = if with_sums {
+            loader.len()
+        } else {
+            usize::from(loader.sums - loader.address())
+        };
+        let with = loader_estimate(image.len(), len, baud, fast);
         if with >= rom_only_estimate(image.len(), baud) {
             return Ok(None);
         }
@@ -373,7 +380,8 @@ pub fn upload_keeping<T: Transport>(
         image.push_area(plan.entry_area());
     }
 
-    let loader = choose_loader(options, &image, &initial, rates)?;
+    let with_sums = wants_sums(&image, keep.wanted());
+    let loader = choose_loader(options, &image, &initial, rates, with_sums)?;
     if loader.is_none() && found_at != base {
         return Err(Error::LeftAtFastRate {
             port: client.transport().name(),
@@ -392,9 +400,17 @@ pub fn upload_keeping<T: Transport>(
             before(HookKind::Unknown),
             (base, options.fast_baud),
             limits,
-            wants_sums(&image, keep.wanted()),
+            with_sums,
             (!rom_checked).then(|| profile.clone()),
         );
+        // A robot whose table lists nothing has had no upload of ours
+        // since it was powered (or none that finished): reading for a
+        // loader left in RAM would cost a question for nothing.
+        running.maybe_resident = plan.as_ref().is_none_or(|plan| {
+            plan.found
+                .first()
+                .is_none_or(|flags| flags.bytes.iter().any(|&flag| flag != 0))
+        });
         let result = running
             .install(client, progress)
             .and_then(|()| {
