@@ -290,8 +290,10 @@ pub fn upload_keeping<T: Transport>(
     // nothing but `/1F`, runs before. A write before the loader (a hook
     // disarmed or an extension replaced points hooks back at the ROM's
     // entries; a table entry freed) reads those entries first, at the base
-    // rate; an upload through the ROM's commands alone, the whole table.
-    let mut rom_checked = options.loader == LoaderChoice::Never;
+    // rate. Through the ROM's commands (`Auto` finding the loader does not
+    // pay), the table is compared while the image goes in, before anything
+    // is hooked; `--loader never` compares it first of all.
+    let rom_checked = options.loader == LoaderChoice::Never;
     if rom_checked {
         fingerprint::check_jump_table(client, profile)?;
     }
@@ -521,11 +523,21 @@ pub fn upload_keeping<T: Transport>(
         }
         session = Some(running);
     } else {
-        check_rom_once(client, profile, &mut rom_checked)?;
         keep_old(client, kept.take(), image.areas(), keep)?;
         written = whole(&image);
         let body;
-        (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+        // The jump table is compared while the image goes in (the return
+        // wire idles under the `/9W`s), before anything is hooked.
+        let check = (!rom_checked).then_some(profile);
+        (body, hooks) = rom_path(
+            client,
+            &image,
+            options,
+            &initial,
+            plan.as_mut(),
+            check,
+            progress,
+        )?;
         (rewrites, passes) = (body.rewrites, body.passes());
     }
     // Through the loader, a reset is found and recovered from while the
@@ -537,7 +549,15 @@ pub fn upload_keeping<T: Transport>(
             plan.forget_flags();
         }
         let body;
-        (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+        (body, hooks) = rom_path(
+            client,
+            &image,
+            options,
+            &initial,
+            plan.as_mut(),
+            None,
+            progress,
+        )?;
         rewrites += body.rewrites;
         passes += body.passes();
         written = whole(&image);
@@ -564,20 +584,6 @@ pub fn upload_keeping<T: Transport>(
         }),
         written,
     })
-}
-
-/// Compares the robot's jump table with the profile's, unless that was
-/// done.
-fn check_rom_once<T: Transport>(
-    client: &mut Client<T>,
-    profile: &RomProfile,
-    checked: &mut bool,
-) -> Result<()> {
-    if !*checked {
-        fingerprint::check_jump_table(client, profile)?;
-        *checked = true;
-    }
-    Ok(())
 }
 
 /// Compares the robot's jump-table entries of the hooks' reset targets
@@ -760,7 +766,8 @@ fn write_ranges<T: Transport>(
 }
 
 /// The body (the table entry with it) through the ROM's `/9W` with `/7R`
-/// verification, the entry's flags, then the hooks. A reset clears the
+/// verification (and, with `check`, the jump table compared on the way),
+/// the entry's flags, then the hooks. A reset clears the
 /// flags: found set after the hooks, no reset undid the body since its
 /// last check; found cleared, the hooks go back and the whole image goes
 /// over again (three times at most).
@@ -770,12 +777,22 @@ fn rom_path<T: Transport>(
     options: &UploadOptions,
     initial: &[(HookKind, u16)],
     mut plan: Option<&mut table::Plan>,
+    mut check: Option<&RomProfile>,
     progress: &mut dyn Progress,
 ) -> Result<(Body, Vec<InstalledHook>)> {
     for _ in 0..3 {
         let mut body = Body::new(image, Writer::Rom);
         body.plan_writes(client.transport().baud(), progress);
+        if let Some(profile) = check {
+            body.add_checks(fingerprint::table_checks(profile));
+        }
         while body.run(client, options.limits(), progress)? != RunEnd::Done {}
+        if let Some(profile) = check.take()
+            && !body.checks_passed()
+        {
+            // Read until two answers agree: what differs, or noise.
+            fingerprint::check_jump_table(client, profile)?;
+        }
         write_flags(client, plan.as_deref_mut(), options)?;
         let hooks = install_hooks(client, image, options, initial, None, progress)?;
         if still_installed(client, plan.as_deref())? {
