@@ -42,6 +42,14 @@ enum Command {
     Read(cmd::read::Args),
     /// List the extensions a robot has installed, and its hooks' chains.
     Installed(cmd::installed::Args),
+    /// A robot's ROM: `rom read -o ROM.elf` reads it into a ROM profile.
+    Rom(cmd::rom::Args),
+    /// Save what a robot holds (user RAM and zero page, the extension
+    /// table, the hooks) to a file, verified.
+    Backup(cmd::backup::BackupArgs),
+    /// Put a backup (or an upload's undo file) back into a robot,
+    /// verified, hooks last.
+    Restore(cmd::backup::RestoreArgs),
     /// Run the virtual Scorpion on a pseudo-terminal or stdin/stdout.
     Sim(cmd::sim::Args),
     /// Send commands to a robot and print the answers.
@@ -82,6 +90,9 @@ fn main() -> ExitCode {
         Command::Ports(args) => cmd::ports::run(&args),
         Command::Read(args) => cmd::read::run(&args),
         Command::Installed(args) => cmd::installed::run(&args),
+        Command::Rom(args) => cmd::rom::run(&args),
+        Command::Backup(args) => cmd::backup::run_backup(&args),
+        Command::Restore(args) => cmd::backup::run_restore(&args),
         Command::Sim(args) => cmd::sim::run(&args),
         Command::Ask(args) => cmd::ask::run(&args),
         Command::New(args) => cmd::new::run(&args),

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 mod limit;
 
-pub use limit::{BINARY, Limit, RAW_IMAGE, SOURCE, TEXT};
+pub use limit::{BACKUP, BINARY, Limit, RAW_IMAGE, SOURCE, TEXT};
 
 /// Why a file was not read.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]

@@ -47,6 +47,12 @@ pub const BINARY: Limit = Limit::new(16 << 20, "an object or image");
 /// is 64 KiB.
 pub const RAW_IMAGE: Limit = Limit::new(1 << 16, "a raw 6502 image");
 
+/// A backup of a robot (`scorpion backup`, an upload's undo file): its
+/// memory records cover at most the 64 KiB address space, each with a
+/// five-byte header; 1 MiB leaves room for any record layout and still
+/// refuses `/dev/zero` at once.
+pub const BACKUP: Limit = Limit::new(1 << 20, "a backup file");
+
 /// `bytes` as people read sizes: `16 MiB`, `64 KiB`, `123 bytes`.
 pub(crate) fn bytes_text(bytes: u64) -> String {
     const KIB: u64 = 1 << 10;

@@ -2,6 +2,7 @@
 
 pub(crate) mod ask;
 pub(crate) mod asm;
+pub(crate) mod backup;
 pub(crate) mod build;
 pub(crate) mod config;
 pub(crate) mod dap;
@@ -16,6 +17,7 @@ pub(crate) mod ports;
 pub(crate) mod profile;
 pub(crate) mod read;
 pub(crate) mod rig;
+pub(crate) mod rom;
 pub(crate) mod sim;
 pub(crate) mod test;
 pub(crate) mod upload;

@@ -62,6 +62,59 @@ pub(crate) struct Args {
     /// command.
     #[arg(long)]
     window: Option<usize>,
+    /// Write every byte. By default an upload through the RAM loader
+    /// compares checksums computed on the robot and writes only the ranges
+    /// that differ.
+    #[arg(long)]
+    full: bool,
+    /// Undo the last upload: put back what it overwrote (its undo file),
+    /// verified, hooks last, instead of uploading.
+    #[arg(long, conflicts_with_all = ["image", "full", "replace"])]
+    undo: bool,
+    /// Where an upload keeps what it overwrites and `--undo` finds it
+    /// [default: target/scorpion/last-upload.undo in a project, else
+    /// scorpion-last-upload.undo here]. Not on `--port emu`, whose robot
+    /// lasts one command.
+    #[arg(long, value_name = "FILE")]
+    undo_file: Option<PathBuf>,
+}
+
+/// Writes what an upload overwrote to the undo file as soon as it is
+/// read, before the image's bytes go out.
+struct UndoFile {
+    path: PathBuf,
+    failed: Option<std::io::Error>,
+}
+
+impl uploader::Keep for UndoFile {
+    fn keep(&mut self, overwritten: &uploader::Backup) {
+        if let Some(parent) = self.path.parent().filter(|p| !p.as_os_str().is_empty())
+            && let Err(error) = std::fs::create_dir_all(parent)
+        {
+            self.failed = Some(error);
+            return;
+        }
+        if let Err(error) = std::fs::write(&self.path, overwritten.encode()) {
+            self.failed = Some(error);
+        }
+    }
+}
+
+impl Args {
+    /// The undo file: `--undo-file`, the project's, or one here.
+    fn undo_path(&self) -> PathBuf {
+        if let Some(path) = &self.undo_file {
+            return path.clone();
+        }
+        match scorpion_project::Project::here() {
+            Ok(project) => project
+                .root
+                .join("target")
+                .join("scorpion")
+                .join("last-upload.undo"),
+            Err(_) => PathBuf::from("scorpion-last-upload.undo"),
+        }
+    }
 }
 
 /// `--loader`.
@@ -85,6 +138,7 @@ impl Args {
             },
             fast_baud: (self.fast_baud != 0).then_some(self.fast_baud),
             replace: self.replace,
+            delta: !self.full,
             ..UploadOptions::default()
         }
     }
@@ -243,6 +297,15 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
             loader.address, loader.len, loader.baud
         );
     }
+    let written: usize = report.written.iter().map(|range| range.1).sum();
+    if written < report.bytes {
+        let _ = write!(
+            text,
+            "\n  {written} bytes written in {} range{}: the robot held the rest (checksums computed on it)",
+            report.written.len(),
+            if report.written.len() == 1 { "" } else { "s" }
+        );
+    }
     for area in image.areas() {
         let _ = write!(text, "\n  ${:04X}-${:04X}", area.address, area.end() - 1);
     }
@@ -272,6 +335,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // upload (and are the robot on `--port emu`), unless flags name others.
     let resolved = args.line.resolve()?;
     resolved.port()?;
+    if args.undo {
+        let path = args.undo_path();
+        let backup = crate::cmd::backup::read_backup(&path)
+            .wrap_err("nothing to undo: no upload has kept what it overwrote there")?;
+        let transport = ports::open_resolved(&resolved, &[])?;
+        let rom = crate::cmd::config::rom(&resolved)?;
+        let profile = crate::cmd::config::profile(rom.as_ref())?;
+        return crate::cmd::backup::restore_into(transport, profile, &backup, &path);
+    }
     match &args.image {
         Some(path) => upload_file(args, &resolved, path),
         None => {
@@ -358,9 +430,25 @@ fn upload_file(
     let transport = ports::open_resolved(resolved, &[])?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
-    let result = uploader::upload(&mut client, &image, &options, &mut bar);
+    let mut undo = UndoFile {
+        path: args.undo_path(),
+        failed: None,
+    };
+    // `emu` is a fresh virtual Scorpion for each command: nothing of it
+    // outlives this one for an undo to put back.
+    let result = if emulated {
+        uploader::upload(&mut client, &image, &options, &mut bar)
+    } else {
+        uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
+    };
     bar.bar.finish_and_clear();
     let report = result?;
+    if let Some(error) = undo.failed {
+        bar.say(&format!(
+            "warning: cannot write the undo file {}: {error}",
+            undo.path.display()
+        ));
+    }
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
     if emulated && let Some(expectations) = &expectations {

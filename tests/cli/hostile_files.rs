@@ -205,3 +205,36 @@ fn a_projects_transcript_and_calls_that_are_not_files_are_refused() {
         "{text}"
     );
 }
+
+/// Issue 27: a backup to restore, an undo file and a `rom read --base`
+/// profile that are a FIFO or `/dev/zero` are refused before the robot
+/// is reached (the old `std::fs::read` blocked on the FIFO and read
+/// `/dev/zero` until memory ran out).
+#[test]
+fn backups_undo_files_and_base_profiles_that_are_not_files_are_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    fifo(&dir.path().join("pipe.bak"));
+    let line = ["--port", "emu"];
+    for (args, said) in [
+        (
+            vec!["restore", "pipe.bak"],
+            "pipe.bak: a FIFO (named pipe), not a regular file",
+        ),
+        (
+            vec!["restore", "/dev/zero"],
+            "/dev/zero: a character device, not a regular file",
+        ),
+        (
+            vec!["upload", "--undo", "--undo-file", "pipe.bak"],
+            "pipe.bak: a FIFO (named pipe), not a regular file",
+        ),
+        (
+            vec!["rom", "read", "-o", "rom.elf", "--base", "/dev/zero"],
+            "/dev/zero: a character device, not a regular file",
+        ),
+    ] {
+        let mut all = args.clone();
+        all.extend(line);
+        refused(&bounded(dir.path(), &all), &[said]);
+    }
+}

@@ -20,6 +20,7 @@ mod link;
 mod profile;
 mod project;
 mod read;
+mod robot;
 mod search_order;
 mod sim;
 mod sim_line;

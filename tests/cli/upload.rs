@@ -268,8 +268,12 @@ fn a_failed_rehearsal_touches_nothing() {
 fn uploads_to_a_robot_with_another_rom_through_a_pseudo_terminal() {
     // The double's hooks point at $F123 and $F045, not the reference ROM's
     // targets: the uploader takes them for installed extensions, keeps the
-    // loader out and chains to them.
-    let robot = PtyRobot::spawn(memory());
+    // loader out and chains to them. Its ROM's bytes are the reference
+    // ROM's (issue 27: a jump table that differs is refused, tested in
+    // robot.rs).
+    let mut memory = memory();
+    memory[usize::from(platform::map::ROM_START)..].copy_from_slice(romlib::ROM);
+    let robot = PtyRobot::spawn(memory);
     let dir = tempfile::tempdir().expect("temporary directory");
     std::fs::write(dir.path().join("ext.elf"), extension_elf(600)).expect("write the image");
     let output = scorpion(

@@ -6,10 +6,12 @@
 //! ROM-only bound (11 characters per 2 bytes).
 //!
 //! `cargo bench -p uploader` (a `harness = false` bench). Device time is
-//! deterministic, so one run of each is the figure. The 1.3x target is
-//! met with the loader switching the line to 19200 baud, as esptool's stub
-//! raises the rate (the lead's decision); the loader at a line kept at
-//! 9600 is printed too, and does not meet it. `cargo run -p uploader
+//! deterministic, so one run of each is the figure. The target (issue 27:
+//! 1.15x, issue 6's was 1.3x) is for the loader switching the line to
+//! 19200 baud, as esptool's stub raises the rate (the lead's decision);
+//! the loader at a line kept at 9600 is printed too, and does not meet it.
+//! Issue 27's one-byte change to the installed extension is measured
+//! against one second of robot time. `cargo run -p uploader
 //! --release --example trace` shows where each run's time goes.
 
 #![allow(clippy::print_stdout, reason = "a benchmark prints its figures")]
@@ -17,12 +19,12 @@
 use std::time::{Duration, Instant};
 
 use uploader::transport::{VirtualTransport, char_time};
-use uploader::{LoaderChoice, NoProgress, UploadOptions, UploadReport};
+use uploader::{Backup, Keep, LoaderChoice, NoProgress, UploadOptions, UploadReport};
 
 #[path = "../tests/common/image.rs"]
 mod image;
 
-use image::extension;
+use image::{extension, one_byte_changed};
 
 const BYTES: usize = 2048;
 const BAUD: u32 = 9600;
@@ -33,6 +35,17 @@ fn upload(options: &UploadOptions) -> (UploadReport, Duration) {
     let report = uploader::upload(&mut client, &extension(BYTES, 0), options, &mut NoProgress)
         .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
     (report, started.elapsed())
+}
+
+/// Keeps what an upload overwrote, as `scorpion upload` does for
+/// `--undo` (its file aside).
+#[derive(Default)]
+struct Undo(usize);
+
+impl Keep for Undo {
+    fn keep(&mut self, overwritten: &Backup) {
+        self.0 = overwritten.len();
+    }
 }
 
 fn main() {
@@ -74,7 +87,7 @@ fn main() {
             LoaderChoice::Always,
             Some(uploader::FAST_BAUD),
             None,
-            1.3,
+            1.15,
         ),
     ];
     let mut missed = Vec::new();
@@ -98,11 +111,91 @@ fn main() {
             missed.push(format!("{name}: {ratio:.3}x, target {target}x"));
         }
     }
+    // Issue 27: the full upload within 1.15x of the line-rate bound, and
+    // a one-byte change to the installed extension (at 9600 baud, the
+    // loader switching to 19200) within one second of robot time.
+    let options = UploadOptions {
+        replace: true,
+        ..UploadOptions::default()
+    };
+    let mut client = uploader::client(VirtualTransport::default(), &options.profile);
+    let image = extension(BYTES, 0);
+    let full = uploader::upload(&mut client, &image, &options, &mut NoProgress)
+        .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
+    let started = Instant::now();
+    let delta = uploader::upload(
+        &mut client,
+        &one_byte_changed(&image, 1000),
+        &options,
+        &mut NoProgress,
+    )
+    .unwrap_or_else(|error| panic!("the one-byte upload failed: {error}"));
+    let wall = started.elapsed();
+    // What `scorpion upload` does: the same upload keeping what it
+    // overwrites for `--undo`, into a fresh robot and as a one-byte change.
+    let mut client = uploader::client(VirtualTransport::default(), &options.profile);
+    let mut undo = Undo::default();
+    let kept_full =
+        uploader::upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut undo)
+            .unwrap_or_else(|error| panic!("the benchmark upload failed: {error}"));
+    let kept_delta = uploader::upload_keeping(
+        &mut client,
+        &one_byte_changed(&image, 1000),
+        &options,
+        &mut NoProgress,
+        &mut undo,
+    )
+    .unwrap_or_else(|error| panic!("the one-byte upload failed: {error}"));
+    let full_ratio = full.device_time.as_secs_f64() / line_bound.as_secs_f64();
+    let delta_ratio = delta.device_time.as_secs_f64() / 1.0;
+    println!(
+        "  {:<34} {:>9.3} {full_ratio:>9.3}x {:>10} {:>8} {:>8}",
+        "default options (delta), full",
+        full.device_time.as_secs_f64(),
+        "",
+        full.chars_sent + full.chars_received,
+        "",
+    );
+    println!(
+        "  {:<34} {:>9.3} {:>10} {:>10} {:>8} {:>8}",
+        "one byte changed (delta)",
+        delta.device_time.as_secs_f64(),
+        format!("{delta_ratio:.3}x 1 s"),
+        format!("{} B", delta.written.iter().map(|r| r.1).sum::<usize>()),
+        delta.chars_sent + delta.chars_received,
+        wall.as_millis()
+    );
+    for (name, report, bound) in [
+        ("keeping for undo, full", &kept_full, &full),
+        ("keeping for undo, one byte", &kept_delta, &delta),
+    ] {
+        println!(
+            "  {name:<34} {:>9.3} {:>10} {:>10} {:>8}",
+            report.device_time.as_secs_f64(),
+            format!(
+                "{:.3}x",
+                report.device_time.as_secs_f64() / bound.device_time.as_secs_f64()
+            ),
+            "no keep",
+            report.chars_sent + report.chars_received,
+        );
+    }
+    if full_ratio > 1.15 {
+        missed.push(format!(
+            "the full upload with default options: {full_ratio:.3}x, target 1.15x"
+        ));
+    }
+    if delta_ratio > 1.0 {
+        missed.push(format!(
+            "the one-byte change: {:.3} s of robot time, target 1 s",
+            delta.device_time.as_secs_f64()
+        ));
+    }
     println!();
     println!(
-        "  targets: ROM only within 1.1x of the ROM-only bound ({:.3} s); the loader, line at 19200, within 1.3x of the line-rate bound ({:.3} s)",
+        "  targets: ROM only within 1.1x of the ROM-only bound ({:.3} s); the loader, line at 19200, within 1.15x of the line-rate bound ({:.3} s); a one-byte change within 1 s",
         rom_bound.as_secs_f64() * 1.1,
-        line_bound.as_secs_f64() * 1.3
+        line_bound.as_secs_f64() * 1.15
     );
     if missed.is_empty() {
         println!("  all targets met");

@@ -7,6 +7,8 @@
 //! cargo run -p uploader --release --example trace            # the loader, 19200 baud
 //! cargo run -p uploader --release --example trace -- 9600    # the loader at 9600 throughout
 //! cargo run -p uploader --release --example trace -- rom     # the ROM's commands only
+//! cargo run -p uploader --release --example trace -- delta   # one byte changed, once installed
+//! cargo run -p uploader --release --example trace -- small   # 109 bytes, as the README's main job
 //! ```
 //!
 //! The image is the benchmark's: a 2 KiB extension at `$0400`
@@ -22,7 +24,7 @@ use uploader::{LoaderChoice, NoProgress, Transport, UploadOptions};
 #[path = "../tests/common/image.rs"]
 mod image;
 
-use image::extension;
+use image::{extension, one_byte_changed};
 
 /// One thing that crossed the line.
 enum Entry {
@@ -88,14 +90,17 @@ fn describe(bytes: &[u8]) -> String {
 }
 
 fn main() -> uploader::Result<()> {
-    let (loader, fast_baud) = match std::env::args().nth(1).as_deref() {
+    let mode = std::env::args().nth(1);
+    let (loader, fast_baud) = match mode.as_deref() {
         Some("rom") => (LoaderChoice::Never, None),
+        Some("delta") => (LoaderChoice::Auto, Some(uploader::FAST_BAUD)),
         Some("9600") => (LoaderChoice::Always, None),
         _ => (LoaderChoice::Always, Some(uploader::FAST_BAUD)),
     };
     let options = UploadOptions {
         loader,
         fast_baud,
+        replace: true,
         ..UploadOptions::default()
     };
     let log = Log {
@@ -103,7 +108,21 @@ fn main() -> uploader::Result<()> {
         entries: Vec::new(),
     };
     let mut client = uploader::client(log, &options.profile);
-    let report = uploader::upload(&mut client, &extension(2048, 0), &options, &mut NoProgress)?;
+    // `small`: an image the size of the README's main job (109 bytes).
+    let mut image = extension(
+        if mode.as_deref() == Some("small") {
+            109
+        } else {
+            2048
+        },
+        0,
+    );
+    if mode.as_deref() == Some("delta") {
+        uploader::upload(&mut client, &image, &options, &mut NoProgress)?;
+        client.transport().entries.clear();
+        image = one_byte_changed(&image, 1000);
+    }
+    let report = uploader::upload(&mut client, &image, &options, &mut NoProgress)?;
     let log = client.into_transport();
 
     // Answer characters arrive in bursts; print each burst once.

@@ -32,6 +32,16 @@
 ; next command's first byte as its last, and the ROM then ignores the rest
 ; of that command (it has no slash): the uploader asks again.
 ;
+; sums    (last): /9Kaaaannnn answers Kaaaass tt: the address, then a
+;         Fletcher-16 of nnnn bytes from aaaa (two sums mod 256, both
+;         starting at zero: ss = the sum of the bytes, tt = the sum of
+;         the running sums), so the uploader can tell which ranges of an
+;         image a robot holds already without reading every byte, and
+;         that the robot's ROM is the one an image was linked against.
+;         Any one byte changed changes ss. Anything else falls into
+;         `frames`. It goes in through `frames`, verified, and only then
+;         is hooked: every part falls only into parts verified before it.
+;
 ; Assembled twice (build.rs): with RING = 1 the data bytes are taken
 ; straight from the ROM's receive ring (RXBUF, RXHEAD, RXTAIL: a 256-byte
 ; ring whose indexes wrap by themselves), 25 cycles a byte against about
@@ -47,6 +57,7 @@
 ; byte of the loader reads back as it was verified.
 
         .import GETCH, CMD_DONE, ACIA_CTRL, RATE_TOGGLE
+        .import GETHEX, PUTCH, PUTHEX, PUTEOL
         .importzp LZP
 .if RING
         .import RXBUF
@@ -61,8 +72,11 @@ SUM1    = LZP + 2
 HEAD    = LZP + 3               ; the header, last byte first: c1 c0 count lo hi
 COUNT   = HEAD + 2
 DEST    = HEAD + 3              ; lo, hi: the frame's first address
+ARGS    = HEAD + 1              ; sums: its fields, last first: count lo, hi, DEST
+LENLO   = HEAD + 1
+LENHI   = HEAD + 2
 
-        .export __scorpion_hook_unknown, rate, frames
+        .export __scorpion_hook_unknown, rate, frames, sums
         .segment "CODE"
 
 rate:   cmp #'F'
@@ -72,7 +86,6 @@ rate:   cmp #'F'
         sta ACIA_CTRL
 drop:   jmp CMD_DONE
 
-__scorpion_hook_unknown:
 frames: cmp #'L'
         bne rate
         jsr GETCH               ; the key
@@ -114,3 +127,62 @@ data:   jsr CHKCH               ; the bytes are usually in the ring already
         bne data
 .endif
         beq drop
+
+; /9Kaaaannnn: the address is answered first, so the answer starts
+; while the sums are added (24 cycles a byte). A part page first: Y
+; starts at 256 - the low byte of the count, DEST that much lower, so
+; one loop over whole pages does all.
+__scorpion_hook_unknown:
+sums:   cmp #'K'
+        bne frames
+        cpx #9
+        bne frames
+        ldy #1
+        ldx #3                  ; address high, low, count high, low
+args:   jsr GETHEX              ; X kept
+        bcs sdrop
+        sta ARGS,x
+        dex
+        bpl args
+        lda #'K'
+        jsr PUTCH
+        lda DEST + 1
+        jsr PUTHEX
+        lda DEST
+        jsr PUTHEX
+        ldx #0                  ; X = the first sum
+        stx SUM1
+        ldy LENLO
+        beq pages               ; whole pages only: Y = 0
+        inc LENHI               ; the part page counts as one
+        tya
+        eor #$FF
+        tay
+        iny                     ; Y = 256 - the low byte
+        sty KEY
+        lda DEST
+        sec
+        sbc KEY
+        sta DEST
+        bcs pages
+        dec DEST + 1
+pages:  lda LENHI
+        beq answer
+add:    txa
+        clc
+        adc (DEST),y
+        tax
+        clc
+        adc SUM1
+        sta SUM1
+        iny
+        bne add
+        inc DEST + 1
+        dec LENHI
+        bne add
+answer: txa
+        jsr PUTHEX
+        lda SUM1
+        jsr PUTHEX
+        jsr PUTEOL
+sdrop:  jmp CMD_DONE

@@ -77,8 +77,23 @@ struct ByteState {
 
 #[derive(Debug, Clone, Copy)]
 enum Work {
-    Write { address: u16, len: u8 },
+    Write {
+        address: u16,
+        len: u8,
+    },
     Read(ReadSpan),
+    /// A read-only comparison (see [`Body::add_checks`]), by index.
+    Check(usize),
+}
+
+/// Bytes outside the image compared with what they should be (the ROM's
+/// jump table), read on the return wire's idle time.
+struct Check {
+    span: ReadSpan,
+    expected: Vec<u8>,
+    tag: Option<u64>,
+    /// Whether the answer matched; `None` until one came.
+    matched: Option<bool>,
 }
 
 /// The transfer of one image: its bytes, flattened, with their states.
@@ -110,6 +125,7 @@ pub(crate) struct Body {
     between_answers: bool,
     /// Bytes written again after reading back wrong.
     pub(crate) rewrites: usize,
+    checks: Vec<Check>,
 }
 
 impl Body {
@@ -141,7 +157,43 @@ impl Body {
             frames_unchecked: 0,
             between_answers: false,
             rewrites: 0,
+            checks: Vec::new(),
         }
+    }
+
+    /// Adds read-only comparisons of `spans` (address span, expected
+    /// bytes), asked after the first write: while the ROM's `/9W`s go out
+    /// the return wire carries little, so their answers cost almost no
+    /// time. Nothing is written because of them; [`Body::checks_passed`]
+    /// says whether every answer came and matched.
+    pub(crate) fn add_checks(&mut self, spans: Vec<(ReadSpan, Vec<u8>)>) {
+        let at = self.queue.len().min(1);
+        for (i, (span, expected)) in spans.into_iter().enumerate() {
+            self.queue.insert(at + i, Work::Check(self.checks.len()));
+            self.checks.push(Check {
+                span,
+                expected,
+                tag: None,
+                matched: None,
+            });
+        }
+    }
+
+    /// Whether every comparison added by [`Body::add_checks`] was answered
+    /// with the expected bytes (a lost or noisy answer says no: the caller
+    /// reads again to tell).
+    pub(crate) fn checks_passed(&self) -> bool {
+        self.checks.iter().all(|check| check.matched == Some(true))
+    }
+
+    /// Records a comparison's answer; `false` when `tag` is none of them.
+    fn checked(&mut self, tag: u64, data: Option<&[u8]>) -> bool {
+        let Some(check) = self.checks.iter_mut().find(|check| check.tag == Some(tag)) else {
+            return false;
+        };
+        check.tag = None;
+        check.matched = Some(data == Some(check.expected.as_slice()));
+        true
     }
 
     /// Read-only passes run.
@@ -351,6 +403,13 @@ impl Body {
                     }
                     let tag = client.ask_read(span)?;
                     self.read_seq.insert(tag, self.seq);
+                }
+                Work::Check(index) => {
+                    let span = self.checks[index].span;
+                    if !client.can_ask(span.count()) {
+                        break;
+                    }
+                    self.checks[index].tag = Some(client.ask_read(span)?);
                 }
             }
             self.seq += 1;
@@ -577,10 +636,14 @@ impl Body {
             let limit = client.config().stall_limit;
             for outcome in client.poll(limit)? {
                 match outcome {
+                    Outcome::Answered { tag, data, .. } if self.checked(tag, Some(&data)) => {
+                        self.between_answers = true;
+                    }
                     Outcome::Answered { span, tag, data } => {
                         self.answered(span, tag, &data, progress);
                         self.between_answers = true;
                     }
+                    Outcome::Lost { tag, .. } if self.checked(tag, None) => {}
                     Outcome::Lost { span, tag } => {
                         progress.event(&Event::LostAnswer {
                             address: span.address(),

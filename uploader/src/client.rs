@@ -355,6 +355,65 @@ impl<T: Transport> Client<T> {
         Ok(())
     }
 
+    /// Sends `questions` (commands whose answers are `answer_len`
+    /// characters, the carriage return included) back to back and returns
+    /// the frames that came back, in order, once every question is
+    /// answered or the answers stop coming (`work` is the robot's time per
+    /// question besides the characters). A question may carry a loader
+    /// frame before it, which the loader takes as it arrives. As with
+    /// [`Client::room`], at most a window of characters goes out after a
+    /// question whose answer has not arrived: what the robot's receive
+    /// ring holds while it works on that question and answers it. Answers
+    /// carry what they answer (an address, say): the caller matches them,
+    /// and asks again for what is missing.
+    ///
+    /// # Errors
+    /// A line error.
+    pub(crate) fn batch(
+        &mut self,
+        questions: &[Vec<u8>],
+        answer_len: usize,
+        work: Duration,
+    ) -> Result<Vec<Vec<u8>>> {
+        self.drain()?;
+        let mut frames = Vec::new();
+        let mut next = 0;
+        // The host's character count just after each unanswered question.
+        let mut marks: VecDeque<usize> = VecDeque::new();
+        let mut deadline = self.transport.now();
+        while next < questions.len() || !marks.is_empty() {
+            while next < questions.len()
+                && marks.front().is_none_or(|&oldest| {
+                    self.sent + questions[next].len() <= oldest + self.config.window
+                })
+            {
+                let bytes = &questions[next];
+                self.send_raw(bytes)?;
+                let now = self.transport.now();
+                deadline = deadline.max(now) + self.chars(bytes.len() + answer_len) + work;
+                marks.push_back(self.sent);
+                next += 1;
+            }
+            if let Some(frame) = self.take_frame() {
+                frames.push(frame);
+                marks.pop_front();
+                continue;
+            }
+            let now = self.transport.now();
+            let until = deadline + self.config.margin;
+            if now >= until {
+                // The rest are lost: the caller asks again.
+                self.stats.lost += marks.len();
+                marks.clear();
+                deadline = now;
+                continue;
+            }
+            self.fill(until - now)?;
+        }
+        self.rx.clear();
+        Ok(frames)
+    }
+
     /// Asks one question and waits for its answer (stop-and-wait), with a
     /// timeout from the baud rate and the configured retries.
     ///

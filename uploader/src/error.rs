@@ -9,6 +9,66 @@ use romlib::protocol::ProtocolError;
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[non_exhaustive]
 pub enum Error {
+    /// The robot's ROM is not the one the image was linked against: the
+    /// image's calls into it would land elsewhere. Nothing was written.
+    #[error(
+        "the robot's ROM is not {profile}: {}",
+        crate::fingerprint::describe(differences, *whole_sum)
+    )]
+    #[diagnostic(
+        code(uploader::wrong_rom),
+        help(
+            "link the image against this robot's ROM (`scorpion rom read -o ROM.elf`, then `[robot] rom = \"ROM.elf\"` or `--rom ROM.elf`), or use the robot it was built for"
+        )
+    )]
+    WrongRom {
+        /// The profile the image was linked against.
+        profile: String,
+        /// Bytes of the jump table and vectors that differ: address,
+        /// expected, found.
+        differences: Vec<(u16, u8, u8)>,
+        /// The whole ROM's checksum, expected and found, when the jump
+        /// table agreed and the sums did not.
+        whole_sum: Option<(u16, u16)>,
+    },
+
+    /// A range written through the loader kept summing otherwise on the
+    /// robot than the image's bytes do.
+    #[error(
+        "${address:04X} and the {len} bytes from it still differ on the robot after {attempts} writes (a checksum computed on the robot)"
+    )]
+    #[diagnostic(
+        code(uploader::sum_failed),
+        help(
+            "the line is very noisy or this memory does not hold what is written to it; `--full --loader never` writes and reads back each byte and names the first that will not hold"
+        )
+    )]
+    SumFailed {
+        /// The range's first address.
+        address: u16,
+        /// Its length.
+        len: usize,
+        /// Writes (or rounds) it took.
+        attempts: u32,
+    },
+
+    /// A backup file that cannot be restored: nothing of it was written.
+    #[error("{name} is not a backup this uploader can restore (at byte {offset}): {reason}")]
+    #[diagnostic(
+        code(uploader::bad_backup),
+        help(
+            "backups are written by `scorpion backup` and by every upload (for `scorpion upload --undo`); a damaged one is refused whole"
+        )
+    )]
+    BadBackup {
+        /// The file.
+        name: String,
+        /// Where in it.
+        offset: usize,
+        /// What is wrong.
+        reason: String,
+    },
+
     /// The serial port is held by another program.
     #[error("serial port {port} is busy")]
     #[diagnostic(

@@ -225,6 +225,14 @@ pub struct RomProfile {
     /// `romlib::installed`'s format) and its entries; `None` for a ROM that
     /// keeps none, whose robot cannot say what is installed.
     pub table: Option<(u16, usize)>,
+    /// The ROM's name, for messages (a file, or the reference ROM).
+    pub name: String,
+    /// The ROM's bytes (`$F000`-`$FFFF`), when the profile has them: what
+    /// a robot's ROM is compared with before anything is written.
+    pub rom: Option<Area>,
+    /// Where an image's calls into the ROM land: the service jump table
+    /// and the vectors, compared byte by byte before any write.
+    pub jump_table: Vec<RangeInclusive<u16>>,
 }
 
 /// The ROM services the RAM loader calls (jump-table entries).
@@ -236,6 +244,15 @@ pub struct Services {
     pub chkch: u16,
     /// `CMD_DONE`: back to the control loop.
     pub cmd_done: u16,
+    /// `GETHEX`: two hex digits of the command into A (`sums` reads its
+    /// fields with it).
+    pub gethex: u16,
+    /// `PUTCH`: send A.
+    pub putch: u16,
+    /// `PUTHEX`: send A as two hex digits.
+    pub puthex: u16,
+    /// `PUTEOL`: end the answer.
+    pub puteol: u16,
     /// The receive ring, when the ROM exports it (`RXBUF`, `RXHEAD`,
     /// `RXTAIL`) and it is 256 bytes (`RXBUF_SIZE`), so that its indexes
     /// wrap by themselves: the loader then takes its data straight from
@@ -325,6 +342,10 @@ impl RomProfile {
                 getch: rom::GETCH,
                 chkch: rom::CHKCH,
                 cmd_done: rom::CMD_DONE,
+                gethex: rom::GETHEX,
+                putch: rom::PUTCH,
+                puthex: rom::PUTHEX,
+                puteol: rom::PUTEOL,
                 ring: ReceiveRing::new(
                     Some(rom::RXBUF),
                     Some(rom::RXBUF_SIZE),
@@ -334,6 +355,14 @@ impl RomProfile {
             }),
             rx_buffer: ring_capacity(rom::RXBUF_SIZE),
             table: Some((romlib::installed::TABLE, romlib::installed::ENTRIES)),
+            name: "scorpion-rom.elf".to_owned(),
+            rom: Some(Area {
+                address: platform::map::ROM_START,
+                bytes: romlib::ROM.to_vec(),
+            }),
+            jump_table: crate::fingerprint::jump_table(|name| {
+                romlib::symbols::find(name).map(|symbol| symbol.value)
+            }),
         }
     }
 
@@ -369,11 +398,31 @@ impl RomProfile {
                 .map(|(first, last)| first..=last),
             writable: vec![zp, ram.clone(), KIM_BUS],
             user_ram: ram,
-            loader_services: match (symbol("GETCH"), symbol("CHKCH"), symbol("CMD_DONE")) {
-                (Some(getch), Some(chkch), Some(cmd_done)) => Some(Services {
+            loader_services: match (
+                symbol("GETCH"),
+                symbol("CHKCH"),
+                symbol("CMD_DONE"),
+                symbol("GETHEX"),
+                symbol("PUTCH"),
+                symbol("PUTHEX"),
+                symbol("PUTEOL"),
+            ) {
+                (
+                    Some(getch),
+                    Some(chkch),
+                    Some(cmd_done),
+                    Some(gethex),
+                    Some(putch),
+                    Some(puthex),
+                    Some(puteol),
+                ) => Some(Services {
                     getch,
                     chkch,
                     cmd_done,
+                    gethex,
+                    putch,
+                    puthex,
+                    puteol,
                     ring: ReceiveRing::new(
                         symbol("RXBUF"),
                         symbol("RXBUF_SIZE"),
@@ -388,6 +437,15 @@ impl RomProfile {
                 .zip(symbol("EXTTAB_ENTRIES"))
                 .filter(|_| symbol("EXTTAB_ENTRY_LEN") == Some(romlib::installed::ENTRY_LEN as u16))
                 .map(|(at, entries)| (at, usize::from(entries))),
+            name: name.to_owned(),
+            rom: (u32::from(platform::map::ROM_START)..=0xFFFF)
+                .map(|address| rom.byte_at(address))
+                .collect::<Option<Vec<u8>>>()
+                .map(|bytes| Area {
+                    address: platform::map::ROM_START,
+                    bytes,
+                }),
+            jump_table: crate::fingerprint::jump_table(symbol),
         })
     }
 

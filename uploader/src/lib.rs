@@ -20,23 +20,31 @@
 //! Nothing here prints: progress goes through [`Progress`], failures are
 //! [`Error`]s.
 
+mod backup;
 mod body;
 mod client;
+mod delta;
 mod error;
 mod expect;
+mod fingerprint;
 mod hooks;
 mod image;
 mod loader;
 mod progress;
 mod session;
+mod summed;
+mod sums;
 mod table;
 mod taper;
 pub mod transport;
 mod upload;
 
+pub use backup::{Backup, Keep, MAGIC, NoKeep, backup, backup_ranges, restore};
 pub use client::{Client, ClientConfig, ClientStats};
+pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, human_duration};
 pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};
+pub use fingerprint::{SERVICES, rom_profile_image};
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
     UploadImage,
@@ -45,8 +53,10 @@ pub use loader::{
     FAST_BAUD, FRAME_MAX, LoaderPlan, loader_estimate, loader_frame, loader_plan, rom_only_estimate,
 };
 pub use progress::{Event, NoProgress, Phase, Progress};
+pub use sums::fletcher16;
 pub use table::{chain_of, read_installed};
 pub use transport::Transport;
 pub use upload::{
     InstalledHook, LoaderChoice, LoaderReport, UploadOptions, UploadReport, client, upload,
+    upload_keeping,
 };

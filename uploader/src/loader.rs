@@ -82,8 +82,11 @@ pub(crate) struct Loader {
     /// `rate`'s address: where `HOOK_UNKNOWN` points while the line is
     /// switched.
     pub(crate) rate: u16,
-    /// `frames`' address: where `HOOK_UNKNOWN` points while frames land.
+    /// `frames`' address: where `HOOK_UNKNOWN` points while `sums` goes in.
     pub(crate) frames: u16,
+    /// `sums`' address: where `HOOK_UNKNOWN` points once the whole loader
+    /// is in (it falls into `frames`, which falls into `rate`).
+    pub(crate) sums: u16,
     /// The first of its zero-page bytes.
     zero_page: u8,
 }
@@ -97,8 +100,11 @@ pub struct LoaderPlan {
     pub code: Area,
     /// `rate`'s address (`HOOK_UNKNOWN`'s target while the line switches).
     pub rate_handler: u16,
-    /// `frames`' address (`HOOK_UNKNOWN`'s target while frames land).
+    /// `frames`' address (`HOOK_UNKNOWN`'s target while `sums` goes in).
     pub frames_handler: u16,
+    /// `sums`' address (`HOOK_UNKNOWN`'s target once the loader is in:
+    /// `/9K` checksums, anything else falls into `frames`).
+    pub sums_handler: u16,
     /// The user zero page it keeps its state in (eight bytes).
     pub zero_page: std::ops::RangeInclusive<u8>,
 }
@@ -119,6 +125,7 @@ pub fn loader_plan(
             code: loader.image.areas()[0].clone(),
             rate_handler: loader.rate,
             frames_handler: loader.frames,
+            sums_handler: loader.sums,
             zero_page: loader.zero_page..=loader.zero_page + (ZERO_PAGE_LEN - 1),
         }),
     )
@@ -169,21 +176,23 @@ impl Loader {
                     message: format!("the loader has no `{name}`"),
                 })
         };
-        let (rate, frames) = (label("rate")?, label("frames")?);
+        let (rate, frames, sums) = (label("rate")?, label("frames")?, label("sums")?);
         let hooked = image
             .hooks()
             .iter()
-            .any(|record| record.kind == HookKind::Unknown && record.handler == frames);
-        if rate != address || !image.contains(frames) || !hooked {
+            .any(|record| record.kind == HookKind::Unknown && record.handler == sums);
+        let ordered = rate == address && rate < frames && frames < sums && image.contains(sums);
+        if !(ordered && hooked) {
             return Err(Error::LoaderLink {
                 address,
-                message: "`rate` must come first and `frames` take HOOK_UNKNOWN".into(),
+                message: "`rate`, `frames` and `sums` must come in that order and `sums` take HOOK_UNKNOWN".into(),
             });
         }
         Ok(Some(Loader {
             image,
             rate,
             frames,
+            sums,
             zero_page,
         }))
     }
@@ -203,20 +212,27 @@ impl Loader {
         self.image.contains(address)
     }
 
-    /// The whole loader, as an image to put into the robot.
-    pub(crate) fn whole(&self) -> &UploadImage {
-        &self.image
-    }
-
     /// `rate` alone: what goes in at the base rate.
     pub(crate) fn rate_part(&self) -> Result<UploadImage> {
         self.part(self.rate, self.frames)
     }
 
-    /// `frames` alone: what goes in at the fast rate.
+    /// `rate` and `frames`: what goes in with the ROM's commands when the
+    /// line stays at one rate.
+    pub(crate) fn rom_part(&self) -> Result<UploadImage> {
+        self.part(self.rate, self.sums)
+    }
+
+    /// `frames` alone: what goes in with the ROM's commands at the fast
+    /// rate.
     pub(crate) fn frames_part(&self) -> Result<UploadImage> {
+        self.part(self.frames, self.sums)
+    }
+
+    /// `sums` alone: what goes in through `frames`.
+    pub(crate) fn sums_part(&self) -> Result<UploadImage> {
         let end = self.image.areas()[0].end();
-        self.part(self.frames, end)
+        self.part(self.sums, end)
     }
 
     fn part(&self, from: u16, to: impl Into<u32>) -> Result<UploadImage> {
@@ -256,6 +272,10 @@ fn link(object: &[u8], address: u16, symbols: &Symbols) -> Result<(UploadImage, 
         symbol("GETCH", services.getch),
         symbol("CHKCH", services.chkch),
         symbol("CMD_DONE", services.cmd_done),
+        symbol("GETHEX", services.gethex),
+        symbol("PUTCH", services.putch),
+        symbol("PUTHEX", services.puthex),
+        symbol("PUTEOL", services.puteol),
         symbol("ACIA_CTRL", ACIA_CONTROL),
         symbol("RATE_TOGGLE", u16::from(symbols.toggle)),
         symbol("LZP", u16::from(symbols.zero_page)),
@@ -506,7 +526,9 @@ mod tests {
         let loader = Loader::place(&profile, &image, rates)
             .expect("links")
             .expect("room above $0E00");
-        assert!(loader.len() < 80, "{} bytes", loader.len());
+        assert!(loader.len() < 200, "{} bytes", loader.len());
+        let through_rom = loader.rom_part().expect("a part").len();
+        assert!(through_rom < 80, "{through_rom} bytes through the ROM");
         assert_eq!(
             usize::from(loader.address()) + loader.len(),
             usize::from(romlib::symbols::USER_RAM_END) + 1,
@@ -516,8 +538,10 @@ mod tests {
         assert_eq!(usize::from(loader.frames - loader.rate), 15, "rate's size");
         let rate = loader.rate_part().expect("a part");
         let frames = loader.frames_part().expect("a part");
-        assert_eq!(rate.len() + frames.len(), loader.len());
+        let sums = loader.sums_part().expect("a part");
+        assert_eq!(rate.len() + frames.len() + sums.len(), loader.len());
         assert_eq!(frames.areas()[0].address, loader.frames);
+        assert_eq!(sums.areas()[0].address, loader.sums);
         assert_eq!(loader.zero_page, 0xF8, "the top of user zero page");
 
         let full = UploadImage::new(

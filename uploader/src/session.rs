@@ -15,7 +15,7 @@
 use std::time::Duration;
 
 use isa::objfmt::HookKind;
-use romlib::protocol::{Command, Extension};
+use romlib::protocol::{Answer, Command, Extension, ReadSpan};
 
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::Client;
@@ -23,6 +23,7 @@ use crate::hooks::{read_hook, switch_hook};
 use crate::image::{RomProfile, UploadImage};
 use crate::loader::{Loader, rate_toggle};
 use crate::progress::{Event, NoProgress, Phase, Progress};
+use crate::summed::{Summed, write_summed};
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
 
@@ -52,6 +53,18 @@ pub(crate) struct Session {
     /// then runs at the base rate).
     fast: Option<u32>,
     limits: Limits,
+    /// Whether `sums` goes in and is hooked (an upload too small to gain
+    /// from it leaves it out: `frames` is then hooked).
+    with_sums: bool,
+    /// The profile whose jump table the robot's is compared with before
+    /// `frames` goes in, if the upload left that to the loader (at the
+    /// fast rate); `None` once it was.
+    rom_check: Option<RomProfile>,
+    /// Whether the loader was written (not found in RAM, verified).
+    wrote: bool,
+    /// Whether an earlier upload may have left the loader in RAM (the
+    /// robot's table lists an extension): only then is it looked for.
+    pub(crate) maybe_resident: bool,
     /// Times the loader was restored.
     pub(crate) recoveries: u32,
 }
@@ -64,6 +77,8 @@ impl Session {
         original: u16,
         (base, fast): (u32, Option<u32>),
         limits: Limits,
+        with_sums: bool,
+        rom_check: Option<RomProfile>,
     ) -> Self {
         Session {
             loader,
@@ -74,13 +89,39 @@ impl Session {
             target: base,
             fast: fast.filter(|&fast| fast != base && rate_toggle((base, fast)) != 0),
             limits,
+            with_sums,
+            rom_check,
+            wrote: false,
+            maybe_resident: true,
             recoveries: 0,
         }
     }
 
-    /// Where `frames` runs: `HOOK_UNKNOWN`'s target while the loader is in.
+    /// `HOOK_UNKNOWN`'s target while the loader is in: `sums`, or
+    /// `frames` without it.
     pub(crate) fn handler(&self) -> u16 {
-        self.loader.frames
+        if self.with_sums {
+            self.loader.sums
+        } else {
+            self.loader.frames
+        }
+    }
+
+    /// Whether the loader was written, rather than found in RAM from an
+    /// earlier upload and verified.
+    pub(crate) fn wrote_loader(&self) -> bool {
+        self.wrote
+    }
+
+    /// The profile whose jump table is still to be compared with the
+    /// robot's (a loader found in RAM leaves that to `sums`); taken.
+    pub(crate) fn take_rom_check(&mut self) -> Option<RomProfile> {
+        self.rom_check.take()
+    }
+
+    /// Whether `sums` is in (and hooked).
+    pub(crate) fn has_sums(&self) -> bool {
+        self.with_sums
     }
 
     /// The rate the transfer ran at.
@@ -88,9 +129,14 @@ impl Session {
         self.target
     }
 
-    /// The loader's first address and size.
+    /// The loader's first address and the size of what went in.
     pub(crate) fn placement(&self) -> (u16, usize) {
-        (self.loader.address(), self.loader.len())
+        let len = if self.with_sums {
+            self.loader.len()
+        } else {
+            usize::from(self.loader.sums - self.loader.address())
+        };
+        (self.loader.address(), len)
     }
 
     /// Installs the loader: `rate` at the base rate, the switch, `frames`
@@ -109,7 +155,15 @@ impl Session {
             }
             client.transport().set_baud(now)?;
         }
-        let mut start = Start::Write;
+        // A loader left in RAM by an earlier upload at the same place (the
+        // usual case when an extension is uploaded again after an edit)
+        // only needs verifying: reading it back costs less than writing it.
+        let mut start = if self.maybe_resident && self.resident(client)? {
+            Start::Resident
+        } else {
+            self.wrote = true;
+            Start::Write
+        };
         loop {
             let error = match self.hook_loader(client, start) {
                 Ok(()) => break,
@@ -135,22 +189,54 @@ impl Session {
         Ok(())
     }
 
-    /// Verifies (or writes) the loader and hooks `frames`, switching the
-    /// line to the fast rate on the way if it is not there. The robot
-    /// answers at the host's rate when this starts.
+    /// Whether `rate` reads back as linked (one read; anything else, a lost
+    /// answer included, says no): the loader is probably in RAM already.
+    fn resident<T: Transport>(&self, client: &mut Client<T>) -> Result<bool> {
+        let rate = self.loader.rate_part()?;
+        let area = &rate.areas()[0];
+        let Ok(span) = ReadSpan::new(area.address, area.bytes.len() as u8) else {
+            return Ok(false);
+        };
+        match client.ask(&Command::ReadMemory(span)) {
+            Ok(Answer::Memory(bytes)) => Ok(bytes == area.bytes),
+            Ok(_) | Err(Error::Protocol(_) | Error::NoAnswer { .. } | Error::WrongBaud { .. }) => {
+                Ok(false)
+            }
+            Err(error) => Err(error),
+        }
+    }
+
+    /// Verifies (or writes) the loader and hooks it, switching the line
+    /// to the fast rate on the way if it is not there: `rate` and `frames`
+    /// through the ROM, `frames` hooked, `sums` through `frames`, `sums`
+    /// hooked. Each part is hooked only once it and every part it falls
+    /// into verified. The robot answers at the host's rate when this
+    /// starts.
     fn hook_loader<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
         match self.fast {
             Some(fast) if client.transport().baud() != fast => {
-                self.put(client, &self.loader.rate_part()?, start)?;
+                // `rate` found in RAM was read whole already, and ran on
+                // this robot before (see `Start::Resident`). `rate` is
+                // hooked before the jump table is compared: it obeys only
+                // `/1F` and calls only CMD_DONE, so on another ROM the worst
+                // it does is leave the robot for its reset button, with
+                // nothing of the image written.
+                if start != Start::Resident {
+                    self.put_checked(client, &self.loader.rate_part()?, start, Vec::new())?;
+                }
                 switch_hook(client, self.hook, self.loader.rate, self.limits.max_writes)?;
                 if !self.switch_rate(client, fast)? {
                     // This robot does not follow: the transfer runs at the
                     // base rate, and no later recovery tries again.
                     self.fast = None;
                 }
-                self.put(client, &self.loader.frames_part()?, start)?;
+                let part = self.loader.frames_part()?;
+                self.put_then_check_rom(client, &part, start)?;
             }
-            _ => self.put(client, self.loader.whole(), start)?,
+            _ => {
+                let part = self.loader.rom_part()?;
+                self.put_then_check_rom(client, &part, start)?;
+            }
         }
         self.target = client.transport().baud();
         switch_hook(
@@ -158,24 +244,98 @@ impl Session {
             self.hook,
             self.loader.frames,
             self.limits.max_writes,
-        )
+        )?;
+        if !self.with_sums {
+            return Ok(());
+        }
+        self.put_framed(client, &self.loader.sums_part()?, start)?;
+        switch_hook(client, self.hook, self.loader.sums, self.limits.max_writes)
     }
 
-    /// Puts loader bytes into the robot through the ROM, verified.
-    fn put<T: Transport>(
+    /// Puts a part of the loader in through the ROM's commands with the
+    /// robot's jump table compared on the way (its answers ride on the
+    /// return wire while the `/9W`s go out); the part is hooked only after
+    /// this returns. A comparison that did not pass (a lost answer, noise,
+    /// another ROM) is read again until two answers agree.
+    fn put_then_check_rom<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        part: &UploadImage,
+        start: Start,
+    ) -> Result<()> {
+        if start == Start::Resident && self.with_sums {
+            // `sums` compares the table, cheaper than reading it.
+            return self
+                .put_checked(client, part, start, Vec::new())
+                .map(|_| ());
+        }
+        let checks = match &self.rom_check {
+            Some(profile) => crate::fingerprint::table_checks(profile),
+            None => Vec::new(),
+        };
+        if self.put_checked(client, part, start, checks)? {
+            self.rom_check = None;
+        }
+        self.check_rom(client)
+    }
+
+    /// Puts loader bytes into the robot through the ROM, verified, with
+    /// read-only comparisons on the way; whether they passed.
+    fn put_checked<T: Transport>(
+        &self,
+        client: &mut Client<T>,
+        image: &UploadImage,
+        start: Start,
+        checks: Vec<(ReadSpan, Vec<u8>)>,
+    ) -> Result<bool> {
+        let mut body = Body::new(image, Writer::Rom);
+        match start {
+            Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
+            Start::Verify | Start::Resident => body.plan_reads(&mut NoProgress),
+        }
+        body.add_checks(checks);
+        match body.run(client, self.limits, &mut NoProgress)? {
+            RunEnd::Done | RunEnd::CheckLoader => Ok(body.checks_passed()),
+        }
+    }
+
+    /// The right ROM before `frames`, which calls into its jump table, is
+    /// hooked (once): the whole table read until two answers agree.
+    fn check_rom<T: Transport>(&mut self, client: &mut Client<T>) -> Result<()> {
+        if let Some(profile) = &self.rom_check {
+            crate::fingerprint::check_jump_table(client, profile)?;
+            self.rom_check = None;
+        }
+        Ok(())
+    }
+
+    /// Puts loader bytes into the robot through `frames` (hooked),
+    /// verified.
+    fn put_framed<T: Transport>(
         &self,
         client: &mut Client<T>,
         image: &UploadImage,
         start: Start,
     ) -> Result<()> {
-        let mut body = Body::new(image, Writer::Rom);
+        let mut body = Body::new(image, Writer::Frames);
         match start {
             Start::Write => body.plan_writes(client.transport().baud(), &mut NoProgress),
-            Start::Verify => body.plan_reads(&mut NoProgress),
+            Start::Verify | Start::Resident => body.plan_reads(&mut NoProgress),
         }
-        match body.run(client, self.limits, &mut NoProgress)? {
-            RunEnd::Done | RunEnd::CheckLoader => Ok(()),
+        for _ in 0..3 {
+            match body.run(client, self.limits, &mut NoProgress)? {
+                RunEnd::Done => return Ok(()),
+                RunEnd::CheckLoader => body.interrupted(),
+            }
         }
+        // Frames keep not landing: `frames` is gone (a reset). A recovery
+        // starts over from the ROM's commands.
+        Err(Error::NoAnswer {
+            port: client.transport().name(),
+            baud: client.transport().baud(),
+            question: "/1L".into(),
+            waited: Duration::ZERO,
+        })
     }
 
     /// Sends `/1F` (`rate` toggles the line, reached directly or through
@@ -242,7 +402,12 @@ impl Session {
         progress: &mut dyn Progress,
     ) -> Result<()> {
         let rate = self.find_rate(client)?;
-        let mut known = vec![self.loader.frames, self.loader.rate, self.original];
+        let mut known = vec![
+            self.loader.sums,
+            self.loader.frames,
+            self.loader.rate,
+            self.original,
+        ];
         known.extend(self.reset);
         // A hook that no longer holds a `JMP` (a `/9W` whose address noise
         // changed) is written whole again by `hook_loader`.
@@ -251,7 +416,7 @@ impl Session {
             Err(Error::NotAHook { .. }) => None,
             Err(error) => return Err(error),
         };
-        if current == Some(self.loader.frames) && rate == self.target {
+        if current == Some(self.handler()) && rate == self.target {
             return Ok(());
         }
         progress.event(&Event::LoaderRestored {
@@ -292,6 +457,60 @@ impl Session {
             }
             body.set_writer(Writer::Frames);
         }
+    }
+
+    /// Writes `areas` in frames verified by the robot's sums (`sums` must
+    /// be in), checking and restoring the loader when the sums stop
+    /// coming; after a restore the sums tell which ranges landed.
+    pub(crate) fn transfer_summed<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        areas: &[crate::image::Area],
+        progress: &mut dyn Progress,
+    ) -> Result<Summed> {
+        let mut held_maybe = false;
+        let mut total = Summed::default();
+        for _ in 0..=MAX_RECOVERIES {
+            match write_summed(client, areas, held_maybe, self.limits, progress) {
+                Ok(done) => {
+                    total.rewrites += done.rewrites;
+                    total.passes += done.passes;
+                    return Ok(total);
+                }
+                Err(error) if recoverable(&error) => {
+                    self.ensure(client, progress).map_err(|_| error)?;
+                    held_maybe = true;
+                    total.passes += 1;
+                }
+                Err(Error::SumFailed {
+                    address,
+                    len,
+                    attempts,
+                }) => {
+                    // A range that will not hold: written and read back
+                    // byte by byte, which names the byte (or, if noise was
+                    // all it was, ends verified).
+                    let part = areas_within(areas, address, len);
+                    let image = UploadImage::new(part, Vec::new())?;
+                    let mut body = Body::new(&image, Writer::Frames);
+                    body.plan_writes(client.transport().baud(), progress);
+                    let limits = self.limits;
+                    self.limits.max_writes = limits.max_writes.saturating_sub(attempts).max(1);
+                    let done = self.transfer(client, &mut body, progress);
+                    self.limits = limits;
+                    done?;
+                    total.rewrites += body.rewrites;
+                    total.passes += body.passes();
+                    held_maybe = true;
+                }
+                Err(error) => return Err(error),
+            }
+        }
+        Err(Error::LoaderUnavailable {
+            reason: format!(
+                "its sums stopped answering {MAX_RECOVERIES} times; the line is too noisy or the robot keeps resetting"
+            ),
+        })
     }
 
     /// Puts the line back on the base rate: `/1F` through the loader,
@@ -346,6 +565,16 @@ impl Session {
         Ok(())
     }
 
+    /// Checks the loader after an error a reset explains and restores it
+    /// (and the line's rate) if it has to.
+    pub(crate) fn recover<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        progress: &mut dyn Progress,
+    ) -> Result<()> {
+        self.ensure(client, progress)
+    }
+
     /// Finds the robot after an error a reset explains, and leaves the
     /// host at its rate.
     pub(crate) fn find<T: Transport>(&mut self, client: &mut Client<T>) -> Result<u32> {
@@ -366,6 +595,24 @@ fn send_toggle<T: Transport>(client: &mut Client<T>, to: u32) -> Result<()> {
     client.transport().clear_input()
 }
 
+/// The bytes of `areas` from `address` for `len` bytes.
+fn areas_within(areas: &[crate::image::Area], address: u16, len: usize) -> Vec<crate::image::Area> {
+    let (from, to) = (u32::from(address), u32::from(address) + len as u32);
+    areas
+        .iter()
+        .filter_map(|area| {
+            let start = from.max(u32::from(area.address));
+            let end = to.min(area.end());
+            (start < end).then(|| crate::image::Area {
+                address: start as u16,
+                bytes: area.bytes[(start - u32::from(area.address)) as usize
+                    ..(end - u32::from(area.address)) as usize]
+                    .to_vec(),
+            })
+        })
+        .collect()
+}
+
 /// Errors a reset or a passing line fault explains: the robot may answer
 /// again, at one of the two rates.
 pub(crate) fn recoverable(error: &Error) -> bool {
@@ -384,4 +631,11 @@ pub(crate) fn recoverable(error: &Error) -> bool {
 enum Start {
     Write,
     Verify,
+    /// `rate` read back as linked: the loader of an earlier upload,
+    /// which compared this robot's jump table and ROM with the profile's
+    /// before it hooked anything, and the robot has stayed powered since
+    /// (its RAM still holds the loader). The rest only needs verifying,
+    /// and the jump table is compared by `sums` (a read if the sums
+    /// differ).
+    Resident,
 }

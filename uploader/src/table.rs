@@ -28,6 +28,9 @@ pub(crate) struct Plan {
     /// Its flags bytes now (set, where an earlier copy of the same image
     /// left its entry).
     current_flags: Vec<Option<u8>>,
+    /// The table as it was read, before anything changed it: its flags
+    /// and the entries in use (what an undo puts back).
+    pub(crate) found: Vec<Area>,
 }
 
 /// Reads what the robot has installed (nothing, for a ROM without a table).
@@ -110,6 +113,16 @@ pub(crate) fn prepare<T: Transport>(
     let Some(mut read) = read_table(client, profile)? else {
         return Ok(None);
     };
+    let mut found = vec![Area {
+        address: table.0,
+        bytes: read.flags.clone(),
+    }];
+    if !read.entries.1.is_empty() {
+        found.push(Area {
+            address: installed::entry_address(table.0, table.1, read.entries.0),
+            bytes: read.entries.1.clone(),
+        });
+    }
     for old in &read.installed {
         match old.overlap(image.extents()) {
             None => kept.push(old.clone()),
@@ -143,6 +156,7 @@ pub(crate) fn prepare<T: Transport>(
         table,
         entry,
         current_flags,
+        found,
     }))
 }
 
@@ -155,6 +169,11 @@ impl Plan {
             address: installed::entry_address(table, capacity, self.entry.slot),
             bytes: self.entry.encode(),
         }
+    }
+
+    /// Whether [`Plan::free_first`] writes anything.
+    pub(crate) fn frees_first(&self) -> bool {
+        !self.current_flags.iter().all(|flags| *flags == Some(0))
     }
 
     /// Frees the entry's slots first, where an earlier copy of the image

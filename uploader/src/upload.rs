@@ -17,18 +17,23 @@ use std::time::Duration;
 use isa::objfmt::HookKind;
 use romlib::protocol::{Command, Extension};
 
+use crate::backup::{Backup, Keep, NoKeep};
 use crate::body::{Body, Limits, RunEnd, Writer};
-use crate::client::{Client, ClientConfig};
+use crate::client::{Client, ClientConfig, spans};
+use crate::delta;
+use crate::fingerprint;
 use crate::hooks::{
     Wanted, read_hook, read_hooks, read_word, settle_hooks, switch_hook, write_word_verified,
 };
-use crate::image::{RomProfile, UploadImage};
+use crate::image::{Area, RomProfile, UploadImage};
 use crate::loader::{FAST_BAUD, Loader, loader_estimate, rom_only_estimate};
 use crate::progress::{Event, Phase, Progress};
 use crate::session::{Session, recoverable};
+use crate::sums::fletcher16;
 use crate::table;
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
+use romlib::protocol::Answer;
 
 /// Whether the RAM loader carries the body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -61,6 +66,10 @@ pub struct UploadOptions {
     /// Take an installed extension that overlaps the image out of its
     /// chains (and out of the table) instead of refusing the upload.
     pub replace: bool,
+    /// Through the loader, write only the ranges whose checksum on the
+    /// robot differs from the image's (see `delta`); `false` writes every
+    /// byte.
+    pub delta: bool,
 }
 
 impl Default for UploadOptions {
@@ -73,6 +82,7 @@ impl Default for UploadOptions {
             loader: LoaderChoice::Auto,
             fast_baud: Some(FAST_BAUD),
             replace: false,
+            delta: true,
         }
     }
 }
@@ -127,6 +137,9 @@ pub struct UploadReport {
     pub hooks: Vec<InstalledHook>,
     /// The RAM loader, if it carried the body.
     pub loader: Option<LoaderReport>,
+    /// The ranges written (address, length), the table entry's included:
+    /// with a delta upload, only those the robot did not hold.
+    pub written: Vec<(u16, usize)>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -136,7 +149,7 @@ pub struct UploadReport {
 /// hooked obeys, and anything else drops) asks it back. A robot that stays
 /// at the fast rate (a `/1R` there unhooked the loader) is read there: only
 /// the loader can bring it back.
-fn connect<T: Transport>(
+pub(crate) fn connect<T: Transport>(
     client: &mut Client<T>,
     options: &UploadOptions,
 ) -> Result<(Vec<(HookKind, u16)>, u32)> {
@@ -182,6 +195,7 @@ fn choose_loader(
     image: &UploadImage,
     initial: &[(HookKind, u16)],
     (baud, fast): (u32, u32),
+    with_sums: bool,
 ) -> Result<Option<Loader>> {
     if options.loader == LoaderChoice::Never {
         return Ok(None);
@@ -210,7 +224,13 @@ fn choose_loader(
         );
     };
     if options.loader == LoaderChoice::Auto {
-        let with = loader_estimate(image.len(), loader.len(), baud, fast);
+        // What goes in: `sums` only when it is wanted.
+        let len = if with_sums {
+            loader.len()
+        } else {
+            usize::from(loader.sums - loader.address())
+        };
+        let with = loader_estimate(image.len(), len, baud, fast);
         if with >= rom_only_estimate(image.len(), baud) {
             return Ok(None);
         }
@@ -230,6 +250,24 @@ pub fn upload<T: Transport>(
     options: &UploadOptions,
     progress: &mut dyn Progress,
 ) -> Result<UploadReport> {
+    upload_keeping(client, image, options, progress, &mut NoKeep)
+}
+
+/// [`upload`], keeping what it overwrites: before the image's bytes are
+/// written, `keep` receives what the robot held there (through the loader
+/// with [`UploadOptions::delta`], only the ranges that differ), the table
+/// of installed extensions and the hooks as the upload found them.
+/// Restoring that ([`crate::restore`]) undoes the upload.
+///
+/// # Errors
+/// As [`upload`].
+pub fn upload_keeping<T: Transport>(
+    client: &mut Client<T>,
+    image: &UploadImage,
+    options: &UploadOptions,
+    progress: &mut dyn Progress,
+    keep: &mut dyn Keep,
+) -> Result<UploadReport> {
     options.profile.check(image)?;
     let start = client.transport().now();
     let stats_before = client.stats();
@@ -245,9 +283,36 @@ pub fn upload<T: Transport>(
     let rates = (base, options.fast_baud.unwrap_or(base));
     let leftover = Loader::place(profile, image, rates)?;
     let (mut hooks_now, found_at) = connect(client, options)?;
+    // The right ROM, or no write. Through the loader the jump table is
+    // read once the line runs at the fast rate, before `frames` (which
+    // calls GETCH and CHKCH) is hooked: only `rate`, which calls nothing
+    // but CMD_DONE (its entry read before `rate` is hooked) and obeys
+    // nothing but `/1F`, runs before. A write before the loader (a hook
+    // disarmed or an extension replaced points hooks back at the ROM's
+    // entries; a table entry freed) reads those entries first, at the base
+    // rate. Through the ROM's commands (`Auto` finding the loader does not
+    // pay), the table is compared while the image goes in, before anything
+    // is hooked; `--loader never` compares it first of all.
+    let rom_checked = options.loader == LoaderChoice::Never;
+    if rom_checked {
+        fingerprint::check_jump_table(client, profile)?;
+    }
+    let mut entries_checked = rom_checked;
+    if options.replace && !entries_checked {
+        fingerprint::check_reset_entries(client, profile)?;
+        entries_checked = true;
+    }
     // What is installed: an overlap is refused (or, with `replace`, the old
     // extension leaves its chains first, which changes the hooks).
     let mut plan = table::prepare(client, profile, image, options.replace, options.max_writes)?;
+    // What an undo puts back: the hooks and the table as found (the table
+    // as `prepare` read it, flags and the entries in use: no more reads).
+    let mut kept = keep.wanted().then(|| Backup {
+        areas: plan
+            .as_ref()
+            .map_or_else(Vec::new, |plan| plan.found.clone()),
+        hooks: hooks_now.clone(),
+    });
     if options.replace {
         hooks_now = read_hooks(client, profile)?;
     }
@@ -255,7 +320,7 @@ pub fn upload<T: Transport>(
     for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
         let loader = leftover.as_ref().filter(|loader| {
-            kind == HookKind::Unknown && (target == loader.frames || target == loader.rate)
+            kind == HookKind::Unknown && [loader.sums, loader.frames, loader.rate].contains(&target)
         });
         if image.contains(target) || loader.is_some() {
             // An earlier copy of this image, probably: the hook goes back
@@ -283,6 +348,7 @@ pub fn upload<T: Transport>(
                     target,
                 });
             };
+            check_entries_once(client, profile, &mut entries_checked)?;
             switch_hook(client, address, to, options.max_writes)?;
             progress.event(&Event::HookDisarmed {
                 kind,
@@ -309,11 +375,15 @@ pub fn upload<T: Transport>(
     // it; its flags, which make it count, once body and entry are in.
     let bytes = image.len();
     if let Some(plan) = plan.as_mut() {
+        if plan.frees_first() {
+            check_entries_once(client, profile, &mut entries_checked)?;
+        }
         plan.free_first(client, options.max_writes)?;
         image.push_area(plan.entry_area());
     }
 
-    let loader = choose_loader(options, &image, &initial, rates)?;
+    let with_sums = wants_sums(&image, keep.wanted());
+    let loader = choose_loader(options, &image, &initial, rates, with_sums)?;
     if loader.is_none() && found_at != base {
         return Err(Error::LeftAtFastRate {
             port: client.transport().name(),
@@ -322,7 +392,8 @@ pub fn upload<T: Transport>(
         });
     }
     let mut session = None;
-    let mut body;
+    let (mut rewrites, mut passes) = (0, 0);
+    let mut written = Vec::new();
     let mut hooks;
     if let Some(loader) = loader {
         let mut running = Session::new(
@@ -331,13 +402,85 @@ pub fn upload<T: Transport>(
             before(HookKind::Unknown),
             (base, options.fast_baud),
             limits,
+            with_sums,
+            (!rom_checked).then(|| profile.clone()),
         );
-        body = Body::new(&image, Writer::Frames);
+        // A robot whose table lists nothing has had no upload of ours
+        // since it was powered (or none that finished): reading for a
+        // loader left in RAM would cost a question for nothing.
+        running.maybe_resident = plan.as_ref().is_none_or(|plan| {
+            plan.found
+                .first()
+                .is_none_or(|flags| flags.bytes.iter().any(|&flag| flag != 0))
+        });
         let result = running
             .install(client, progress)
             .and_then(|()| {
-                body.plan_writes(client.transport().baud(), progress);
-                running.transfer(client, &mut body, progress)
+                if !running.has_sums() {
+                    // A small image: written whole, read back byte by byte.
+                    keep_old(client, kept.take(), image.areas(), keep)?;
+                    written = whole(&image);
+                    let mut body = Body::new(&image, Writer::Frames);
+                    body.plan_writes(client.transport().baud(), progress);
+                    running.transfer(client, &mut body, progress)?;
+                    (rewrites, passes) = (body.rewrites, body.passes());
+                    return Ok(());
+                }
+                // The whole ROM is summed on the robot while the image's
+                // sums are on their way: all before anything of the image
+                // is written. Not when the loader was found in RAM,
+                // verified: this robot has stayed powered since an upload
+                // put it there, which summed its ROM (the jump table is
+                // read each time).
+                let rom = fingerprint::whole_rom(profile).filter(|_| running.wrote_loader());
+                let mut first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
+                let table = running
+                    .take_rom_check()
+                    .map(|profile| (fingerprint::table_sums(&profile), profile));
+                if let Some((sums, _)) = &table {
+                    first.extend(sums.iter().map(|(range, _)| *range));
+                }
+                // A reset while the sums are asked unhooks the loader: it
+                // is restored and they are asked again.
+                let mut tries = 0;
+                let (todo, found) = loop {
+                    let asked = if options.delta {
+                        delta::differing_and(client, &first, &image)
+                    } else if kept.is_some() {
+                        delta::all_and(client, &first, &image)
+                    } else {
+                        crate::sums::robot_sums(client, &first).map(|found| {
+                            let all = image.areas().iter().map(|area| (area.clone(), 0));
+                            (all.collect(), found)
+                        })
+                    };
+                    match asked {
+                        Ok(asked) => break asked,
+                        Err(error) if recoverable(&error) && tries < 3 => {
+                            tries += 1;
+                            running.recover(client, progress).map_err(|_| error)?;
+                        }
+                        Err(error) => return Err(error),
+                    }
+                };
+                let mut found = found.into_iter();
+                if let Some((_, expected)) = rom {
+                    fingerprint::check_whole(profile, expected, found.next().unwrap_or(0))?;
+                }
+                if let Some((sums, profile)) = table {
+                    let differ = sums.iter().any(|(_, sum)| found.next() != Some(*sum));
+                    if differ {
+                        // What differs, read until two answers agree (a
+                        // sum that noise changed passes here).
+                        fingerprint::check_jump_table(client, &profile)?;
+                    }
+                }
+                keep_summed(client, kept.take(), &todo, keep)?;
+                let todo = delta::merged(&todo);
+                written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
+                (rewrites, passes) =
+                    write_ranges(client, &mut running, &image, todo, options, progress)?;
+                Ok(())
             })
             .and_then(|()| write_flags(client, plan.as_mut(), options))
             .and_then(|()| {
@@ -380,7 +523,22 @@ pub fn upload<T: Transport>(
         }
         session = Some(running);
     } else {
-        (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+        keep_old(client, kept.take(), image.areas(), keep)?;
+        written = whole(&image);
+        let body;
+        // The jump table is compared while the image goes in (the return
+        // wire idles under the `/9W`s), before anything is hooked.
+        let check = (!rom_checked).then_some(profile);
+        (body, hooks) = rom_path(
+            client,
+            &image,
+            options,
+            &initial,
+            plan.as_mut(),
+            check,
+            progress,
+        )?;
+        (rewrites, passes) = (body.rewrites, body.passes());
     }
     // Through the loader, a reset is found and recovered from while the
     // body goes in; one after its last check clears the entry's flags, and
@@ -390,7 +548,19 @@ pub fn upload<T: Transport>(
         if let Some(plan) = plan.as_mut() {
             plan.forget_flags();
         }
-        (body, hooks) = rom_path(client, &image, options, &initial, plan.as_mut(), progress)?;
+        let body;
+        (body, hooks) = rom_path(
+            client,
+            &image,
+            options,
+            &initial,
+            plan.as_mut(),
+            None,
+            progress,
+        )?;
+        rewrites += body.rewrites;
+        passes += body.passes();
+        written = whole(&image);
     }
 
     let stats = client.stats();
@@ -399,9 +569,9 @@ pub fn upload<T: Transport>(
         device_time: client.transport().now().saturating_sub(start),
         chars_sent: stats.sent - stats_before.sent,
         chars_received: stats.received - stats_before.received,
-        rewrites: body.rewrites,
+        rewrites,
         lost_answers: stats.lost - stats_before.lost,
-        final_passes: body.passes(),
+        final_passes: passes,
         hooks,
         loader: session.map(|session| {
             let (address, len) = session.placement();
@@ -412,11 +582,192 @@ pub fn upload<T: Transport>(
                 recoveries: session.recoveries,
             }
         }),
+        written,
+    })
+}
+
+/// Compares the robot's jump-table entries of the hooks' reset targets
+/// with the profile's, unless that was done.
+fn check_entries_once<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    checked: &mut bool,
+) -> Result<()> {
+    if !*checked {
+        fingerprint::check_reset_entries(client, profile)?;
+        *checked = true;
+    }
+    Ok(())
+}
+
+/// Every area of `image` as (address, length).
+fn whole(image: &UploadImage) -> Vec<(u16, usize)> {
+    image
+        .areas()
+        .iter()
+        .map(|area| (area.address, area.bytes.len()))
+        .collect()
+}
+
+/// Reads what `areas` will overwrite (two answers agreeing for each span)
+/// and hands it, with the hooks and table read at the start, to `keep`.
+fn keep_old<T: Transport>(
+    client: &mut Client<T>,
+    kept: Option<Backup>,
+    areas: &[Area],
+    keep: &mut dyn Keep,
+) -> Result<()> {
+    let Some(mut kept) = kept else {
+        return Ok(());
+    };
+    for area in areas {
+        // The table entry: the whole table is kept already.
+        let covered = kept
+            .areas
+            .iter()
+            .any(|old| old.address <= area.address && area.end() <= old.end());
+        if covered {
+            continue;
+        }
+        let bytes = client.read_memory(area.address, area.bytes.len())?;
+        kept.areas.push(Area {
+            address: area.address,
+            bytes,
+        });
+    }
+    keep.keep(&kept);
+    Ok(())
+}
+
+/// Hands `keep` what the ranges of `held` hold on the robot now (the
+/// ranges about to be written, each with the robot's sum of it), with the
+/// hooks and table read at the start. A range whose sum is that of zeros
+/// (RAM nothing was loaded into, on the virtual robot) is taken for zeros
+/// without a read, with the same trust a delta upload puts in a sum; any
+/// other is read once at the loader's rate and checked against its sum
+/// (read again, up to four times, if noise changed an answer).
+fn keep_summed<T: Transport>(
+    client: &mut Client<T>,
+    kept: Option<Backup>,
+    held: &[delta::Held],
+    keep: &mut dyn Keep,
+) -> Result<()> {
+    let Some(mut kept) = kept else {
+        return Ok(());
+    };
+    for (area, sum) in held {
+        let len = area.bytes.len();
+        let covered = kept
+            .areas
+            .iter()
+            .any(|old| old.address <= area.address && area.end() <= old.end());
+        if covered {
+            continue;
+        }
+        let zeros = vec![0; len];
+        let bytes = if fletcher16(&zeros) == *sum {
+            zeros
+        } else {
+            read_summed(client, area.address, len, *sum)?
+        };
+        kept.areas.push(Area {
+            address: area.address,
+            bytes,
+        });
+    }
+    keep.keep(&kept);
+    Ok(())
+}
+
+/// `len` bytes from `address`, read once and checked against `sum` (the
+/// robot's), again while they do not agree; then read until two answers
+/// agree.
+fn read_summed<T: Transport>(
+    client: &mut Client<T>,
+    address: u16,
+    len: usize,
+    sum: u16,
+) -> Result<Vec<u8>> {
+    for _ in 0..4 {
+        let mut bytes = Vec::with_capacity(len);
+        for span in spans(address, len) {
+            match client.ask(&Command::ReadMemory(span)) {
+                Ok(Answer::Memory(data)) if data.len() == usize::from(span.count()) => {
+                    bytes.extend(data);
+                }
+                Ok(_)
+                | Err(Error::Protocol(_) | Error::NoAnswer { .. } | Error::WrongBaud { .. }) => {
+                    break;
+                }
+                Err(error) => return Err(error),
+            }
+        }
+        if bytes.len() == len && fletcher16(&bytes) == sum {
+            return Ok(bytes);
+        }
+    }
+    client.read_memory(address, len)
+}
+
+/// Whether the loader's `sums` goes in: it costs about three characters
+/// a byte of it at the fast rate (written, read back), and pays for
+/// itself in an image large enough that its sums spare the return wire
+/// the `/7R` answers, or that the robot may hold already, and in an upload
+/// that keeps what it overwrites (a range of zeros is known by its sum).
+fn wants_sums(image: &UploadImage, keeping: bool) -> bool {
+    keeping || image.len() >= SUMS_PAY
+}
+
+/// The image size from which the loader's `sums` pays for itself.
+const SUMS_PAY: usize = 256;
+
+/// Writes `todo` through the loader, verified by the robot's sums; with a
+/// delta upload, a
+/// transfer that met faults (a write whose address noise changed may have
+/// landed on a range the sums passed) is followed by the sums again, and
+/// whatever differs now is written again.
+fn write_ranges<T: Transport>(
+    client: &mut Client<T>,
+    running: &mut Session,
+    image: &UploadImage,
+    mut todo: Vec<Area>,
+    options: &UploadOptions,
+    progress: &mut dyn Progress,
+) -> Result<(usize, u32)> {
+    let (mut rewrites, mut passes) = (0, 0);
+    for _ in 0..=options.max_passes {
+        if todo.is_empty() {
+            return Ok((rewrites, passes));
+        }
+        let done = running.transfer_summed(client, &todo, progress)?;
+        rewrites += done.rewrites;
+        passes += done.passes;
+        if !options.delta || done.passes == 0 {
+            return Ok((rewrites, passes));
+        }
+        let mut tries = 0;
+        todo = loop {
+            match delta::differing(client, image) {
+                Ok(todo) => break todo,
+                Err(error) if recoverable(&error) && tries < 3 => {
+                    tries += 1;
+                    running.recover(client, progress).map_err(|_| error)?;
+                }
+                Err(error) => return Err(error),
+            }
+        };
+    }
+    Err(Error::LoaderUnavailable {
+        reason: format!(
+            "ranges kept differing after {} rounds of writes and sums",
+            options.max_passes
+        ),
     })
 }
 
 /// The body (the table entry with it) through the ROM's `/9W` with `/7R`
-/// verification, the entry's flags, then the hooks. A reset clears the
+/// verification (and, with `check`, the jump table compared on the way),
+/// the entry's flags, then the hooks. A reset clears the
 /// flags: found set after the hooks, no reset undid the body since its
 /// last check; found cleared, the hooks go back and the whole image goes
 /// over again (three times at most).
@@ -426,12 +777,22 @@ fn rom_path<T: Transport>(
     options: &UploadOptions,
     initial: &[(HookKind, u16)],
     mut plan: Option<&mut table::Plan>,
+    mut check: Option<&RomProfile>,
     progress: &mut dyn Progress,
 ) -> Result<(Body, Vec<InstalledHook>)> {
     for _ in 0..3 {
         let mut body = Body::new(image, Writer::Rom);
         body.plan_writes(client.transport().baud(), progress);
+        if let Some(profile) = check {
+            body.add_checks(fingerprint::table_checks(profile));
+        }
         while body.run(client, options.limits(), progress)? != RunEnd::Done {}
+        if let Some(profile) = check.take()
+            && !body.checks_passed()
+        {
+            // Read until two answers agree: what differs, or noise.
+            fingerprint::check_jump_table(client, profile)?;
+        }
         write_flags(client, plan.as_deref_mut(), options)?;
         let hooks = install_hooks(client, image, options, initial, None, progress)?;
         if still_installed(client, plan.as_deref())? {

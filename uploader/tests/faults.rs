@@ -11,10 +11,13 @@ mod common;
 
 use std::time::Duration;
 
-use common::{assert_at_9600, assert_done, assert_safe, extension, options, robot, run, target};
+use common::{
+    assert_at_9600, assert_done, assert_safe, extension, one_byte_changed, options, robot, run,
+    target,
+};
 use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
 use uploader::transport::{FaultConfig, FaultyTransport, VirtualTransport};
-use uploader::{Error, LoaderChoice};
+use uploader::{Error, LoaderChoice, NoProgress, UploadOptions};
 
 const PATHS: [LoaderChoice; 2] = [LoaderChoice::Never, LoaderChoice::Always];
 
@@ -360,5 +363,100 @@ fn a_byte_that_will_not_hold_fails_naming_it_and_hooks_nothing() {
         assert_safe(transport.robot(), &image, &outcome);
         // The loader, if it ran, is gone: the robot answers at 9600 again.
         assert_at_9600(transport, &outcome);
+    }
+}
+
+/// Issue 27: a reset (`/1R`) or lost bytes in the middle of a patch (a
+/// one-byte change to an installed extension, a delta upload) leave no
+/// hook pointing at code that did not verify, and the next try finishes.
+#[test]
+fn a_reset_or_noise_in_the_middle_of_a_patch_leaves_no_hook_on_unverified_code() {
+    let image = extension(1024, 17);
+    let patched = one_byte_changed(&image, 700);
+    let options = UploadOptions {
+        loader: LoaderChoice::Always,
+        replace: true,
+        ..UploadOptions::default()
+    };
+    let faults: Vec<(String, FaultConfig)> = [40usize, 150, 300, 450, 600, 750]
+        .into_iter()
+        .map(|at| {
+            (
+                format!("/1R after {at}"),
+                FaultConfig {
+                    reset_after: Some(at),
+                    ..FaultConfig::none(21)
+                },
+            )
+        })
+        .chain((0..3).map(|seed| {
+            (
+                format!("1% lost, seed {seed}"),
+                FaultConfig::noise(seed, 0.01, 0.0, 0.0),
+            )
+        }))
+        .collect();
+    for (name, config) in faults {
+        let (installed, transport) = run(robot(), &image, &options);
+        installed.unwrap_or_else(|error| panic!("{name}: the first upload: {error}"));
+        let (result, faulty) = run(FaultyTransport::new(transport, config), &patched, &options);
+        let outcome = format!("{name}: {result:?}");
+        let transport = faulty.into_inner();
+        assert_safe(transport.robot(), &patched, &outcome);
+        let (again, transport) = run(transport, &patched, &options);
+        again.unwrap_or_else(|error| panic!("{outcome}, then: {error}"));
+        assert_done(transport, &patched, &outcome);
+    }
+}
+
+/// Issue 27: a reset or lost bytes in the middle of a restore leave every
+/// hook at the ROM, at the verified loader, or at the backup's handler
+/// with the backup's memory in place; a restore after it puts everything
+/// back.
+#[test]
+fn a_reset_or_noise_in_the_middle_of_a_restore_leaves_no_hook_on_unverified_code() {
+    let image = extension(1024, 18);
+    let options = UploadOptions::default();
+    let faults: Vec<(String, FaultConfig)> = [40usize, 300, 800, 1500, 2500]
+        .into_iter()
+        .map(|at| {
+            (
+                format!("/1R after {at}"),
+                FaultConfig {
+                    reset_after: Some(at),
+                    ..FaultConfig::none(22)
+                },
+            )
+        })
+        .chain((0..2).map(|seed| {
+            (
+                format!("1% lost, seed {seed}"),
+                FaultConfig::noise(seed, 0.01, 0.0, 0.0),
+            )
+        }))
+        .collect();
+    for (name, config) in faults {
+        let (installed, transport) = run(robot(), &image, &options);
+        installed.expect("installed");
+        let mut client = uploader::client(transport, &options.profile);
+        let saved = uploader::backup(&mut client, &options.profile).expect("a backup");
+        let mut transport = client.into_transport();
+        // Hostile: the extension's code overwritten.
+        transport
+            .robot_mut()
+            .robot_mut()
+            .board_mut()
+            .load(0x0400, &[0xA5; 0x200])
+            .expect("RAM");
+        let mut client =
+            uploader::client(FaultyTransport::new(transport, config), &options.profile);
+        let result = uploader::restore(&mut client, &saved, &options, &mut NoProgress);
+        let outcome = format!("{name}: {result:?}");
+        let transport = client.into_transport().into_inner();
+        assert_safe(transport.robot(), &image, &outcome);
+        let mut client = uploader::client(transport, &options.profile);
+        uploader::restore(&mut client, &saved, &options, &mut NoProgress)
+            .unwrap_or_else(|error| panic!("{outcome}, then: {error}"));
+        assert_done(client.into_transport(), &image, &outcome);
     }
 }

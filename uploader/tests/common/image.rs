@@ -27,3 +27,11 @@ pub(crate) fn extension(len: usize, seed: u32) -> UploadImage {
     )
     .expect("a valid image")
 }
+
+/// `image` with the byte at `offset` of its first area changed: the
+/// one-byte change of issue 27.
+pub(crate) fn one_byte_changed(image: &UploadImage, offset: usize) -> UploadImage {
+    let mut areas = image.areas().to_vec();
+    areas[0].bytes[offset] ^= 0x5A;
+    UploadImage::new(areas, image.hooks().to_vec()).expect("an image")
+}

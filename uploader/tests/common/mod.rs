@@ -10,7 +10,7 @@
 
 mod image;
 
-pub(crate) use image::extension;
+pub(crate) use image::{extension, one_byte_changed};
 
 use romlib::VirtualScorpion;
 use romlib::symbols::{BAD_COMMAND, HOOK_LOOP, HOOK_UNKNOWN, ROM_LOOP};
@@ -97,9 +97,12 @@ pub fn assert_safe(robot: &VirtualScorpion, image: &UploadImage, outcome: &str) 
     let code = &plan.code;
     let start = usize::from(code.address);
     // `rate` alone may be in (hooked before `frames` went in); `frames`
-    // falls into `rate`, so with it hooked the whole loader must be there.
-    let end = if hook == plan.frames_handler {
+    // falls into `rate`, `sums` into `frames`: with one hooked, it and
+    // every part before it must be there.
+    let end = if hook == plan.sums_handler {
         start + code.bytes.len()
+    } else if hook == plan.frames_handler {
+        usize::from(plan.sums_handler)
     } else {
         assert_eq!(
             hook, plan.rate_handler,

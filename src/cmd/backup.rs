@@ -1,0 +1,101 @@
+//! `scorpion backup` and `scorpion restore`: what a robot holds (user RAM,
+//! the user zero page, the table of installed extensions, the hooks) saved
+//! to a checksummed file, verified, and written back verified, hooks last.
+//! The file format is `uploader`'s (`uploader::Backup`); every upload
+//! keeps one of what it overwrote, which `scorpion upload --undo` restores.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use miette::{Context, IntoDiagnostic};
+use uploader::{Backup, NoProgress, UploadOptions};
+
+use crate::cmd::ports;
+
+/// Save what the robot holds (user RAM, user zero page, the table of
+/// installed extensions, the hooks) to a file, every span read until two
+/// answers agree.
+#[derive(Debug, clap::Args)]
+pub(crate) struct BackupArgs {
+    #[command(flatten)]
+    line: ports::Line,
+    /// The backup file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// Put a backup (`scorpion backup`'s, or an upload's undo file) back into
+/// the robot, verified: the hooks to the ROM first, the memory (only the
+/// ranges that differ, through the RAM loader), the hooks last.
+#[derive(Debug, clap::Args)]
+pub(crate) struct RestoreArgs {
+    #[command(flatten)]
+    line: ports::Line,
+    /// The backup file.
+    file: PathBuf,
+}
+
+pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
+    let (mut client, profile) = ports::probed(&args.line)?;
+    let backup = uploader::backup(&mut client, &profile)?;
+    std::fs::write(&args.output, backup.encode())
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
+    print(&format!(
+        "saved {} bytes and {} hooks to {}",
+        backup.len(),
+        backup.hooks.len(),
+        args.output.display()
+    ));
+    Ok(ExitCode::SUCCESS)
+}
+
+pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
+    let backup = read_backup(&args.file)?;
+    let resolved = args.line.resolve()?;
+    let transport = ports::open_resolved(&resolved, &[])?;
+    let rom = crate::cmd::config::rom(&resolved)?;
+    let profile = crate::cmd::config::profile(rom.as_ref())?;
+    restore_into(transport, profile, &backup, &args.file)
+}
+
+/// Restores `backup` (from `file`) through `transport` into a robot with
+/// `profile`'s ROM, and says so.
+pub(crate) fn restore_into(
+    transport: Box<dyn uploader::Transport>,
+    profile: uploader::RomProfile,
+    backup: &Backup,
+    file: &Path,
+) -> miette::Result<ExitCode> {
+    let options = UploadOptions {
+        profile,
+        ..UploadOptions::default()
+    };
+    let mut client = uploader::client(transport, &options.profile);
+    let reports = uploader::restore(&mut client, backup, &options, &mut NoProgress)?;
+    let written: usize = reports
+        .iter()
+        .flat_map(|report| report.written.iter().map(|range| range.1))
+        .sum();
+    print(&format!(
+        "restored {} ({} bytes checked, {written} written, {} hooks), verified",
+        file.display(),
+        backup.len(),
+        backup.hooks.len()
+    ));
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Reads (through the bounded reader: a FIFO or `/dev/zero` is refused,
+/// not waited on) and checks a backup file.
+pub(crate) fn read_backup(path: &Path) -> miette::Result<Backup> {
+    let bytes = hostfs::read(path, hostfs::BACKUP)?;
+    Ok(Backup::decode(&path.display().to_string(), &bytes)?)
+}
+
+fn print(text: &str) {
+    #[allow(clippy::print_stdout, reason = "the CLI reports the result")]
+    {
+        println!("{text}");
+    }
+}

@@ -1,0 +1,289 @@
+//! Issue 27 through a real pseudo-terminal to `scorpion sim --pty`
+//! standing for the robot, the tools using nothing but the line: a ROM
+//! that differs in one byte of its jump table refused before anything is
+//! written, and read whole into a profile the sim runs; a backup, a
+//! hostile change, a restore, RAM compared; a one-byte change uploaded as
+//! one range, and the upload undone.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+
+use isa::objfmt::{HookKind, HookRecord, Hooks};
+use linker::{Format, Image, LoadArea};
+
+use crate::{scorpion, scorpion_with_input, transcript};
+
+/// `scorpion sim --pty ARGS`, stopped when dropped.
+struct Sim {
+    child: Child,
+    path: String,
+}
+
+impl Sim {
+    fn start(dir: &std::path::Path, args: &[&str]) -> Sim {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(["sim", "--pty"])
+            .args(args)
+            .current_dir(dir)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the scorpion binary runs");
+        let mut stdout = BufReader::new(child.stdout.take().expect("stdout is piped"));
+        let mut path = String::new();
+        stdout
+            .read_line(&mut path)
+            .expect("the first line is the pseudo-terminal's path");
+        Sim {
+            child,
+            path: path.trim().to_owned(),
+        }
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// An extension of `len` bytes at $0400 (`JMP chain`, a handler that falls
+/// through, filler), with the byte at `changed` (if any) altered.
+fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
+    let mut bytes: Vec<u8> = (0..len).map(|i| (i * 37 + 11) as u8).collect();
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
+    if let Some(at) = changed {
+        bytes[at] ^= 0x5A;
+    }
+    let image = Image {
+        entry: 0x0403,
+        flags: 0,
+        areas: vec![LoadArea {
+            load: 0x0400,
+            run: 0x0400,
+            bytes,
+        }],
+        sections: vec![],
+        symbols: vec![],
+        hooks: Hooks {
+            records: vec![HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0403,
+                chain: Some(0x0401),
+            }],
+        },
+        lines: isa::objfmt::SrcMap::default(),
+    };
+    Format::Elf.write(&image).expect("an ELF image")
+}
+
+/// The reference ROM with PENDING's operand (`$FF2E`, a jump-table byte
+/// the ROM never calls through itself) changed, as a ROM profile file.
+fn changed_rom() -> (Vec<u8>, u8, u8) {
+    let mut rom = Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("parses");
+    let area = rom
+        .areas
+        .iter_mut()
+        .find(|area| area.load <= 0xFF2E && 0xFF2E < area.end())
+        .expect("the ROM loads $FF2E");
+    let at = (0xFF2E - area.load) as usize;
+    let before = area.bytes[at];
+    area.bytes[at] = before ^ 0x10;
+    (
+        Format::Elf.write(&rom).expect("an ELF image"),
+        before,
+        before ^ 0x10,
+    )
+}
+
+#[test]
+fn a_rom_differing_in_one_jump_table_byte_is_refused_and_read_into_a_profile() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (rom, expected, found) = changed_rom();
+    std::fs::write(dir.path().join("changed.elf"), rom).expect("write the ROM");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(600, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--rom", "changed.elf", "--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+
+    let mut args = vec!["upload", "ext.elf", "--no-dry-run"];
+    args.extend(line);
+    let output = scorpion(dir.path(), &args);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    let wanted = format!("$FF2E: expected ${expected:02X}, found ${found:02X}");
+    assert!(text.contains(&wanted), "{text}");
+    assert!(text.contains("uploader::wrong_rom"), "{text}");
+    // Nothing was written: the hook and the image's memory are as at power-up.
+    let mut args = vec!["read", "$0200", "3"];
+    args.extend(line);
+    let output = scorpion(dir.path(), &args);
+    assert!(
+        String::from_utf8_lossy(&output.stdout).starts_with("0200: 4C 21 FF"),
+        "{}",
+        transcript(&output)
+    );
+
+    // The whole ROM, read over the line into a profile the sim runs.
+    let mut args = vec!["rom", "read", "-o", "read.elf"];
+    args.extend(line);
+    let output = scorpion(dir.path(), &args);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{text}");
+    assert!(text.contains("1 byte differs from"), "{text}");
+    let read = Image::parse(
+        "read.elf",
+        &std::fs::read(dir.path().join("read.elf")).expect("the profile"),
+    )
+    .expect("an image");
+    let changed = Image::parse(
+        "changed.elf",
+        &std::fs::read(dir.path().join("changed.elf")).expect("the ROM"),
+    )
+    .expect("an image");
+    for address in 0xF000..=0xFFFFu32 {
+        assert_eq!(
+            read.byte_at(address),
+            changed.byte_at(address),
+            "${address:04X}"
+        );
+    }
+    assert_eq!(read.symbol("GETCH"), changed.symbol("GETCH"));
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["sim", "--rom", "read.elf"],
+        "/7RFF2D03\n",
+    );
+    let text = transcript(&output);
+    assert!(
+        text.contains(&format!("R4C{found:02X}")),
+        "the sim runs the profile: {text}"
+    );
+}
+
+#[test]
+fn backup_a_hostile_change_restore_and_the_ram_compares() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(600, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let run = |args: &[&str]| {
+        let mut all = args.to_vec();
+        all.extend(line);
+        let output = scorpion(dir.path(), &all);
+        let text = transcript(&output);
+        assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
+        text
+    };
+    run(&["upload", "ext.elf", "--no-dry-run"]);
+    run(&["backup", "-o", "before.bak"]);
+    // Hostile: code and zero page overwritten, the hook pointed at them.
+    run(&[
+        "ask",
+        "/9W04100000",
+        "/9W0500DEAD",
+        "/9W00F0BEEF",
+        "/9W02010005",
+    ]);
+    run(&["backup", "-o", "hostile.bak"]);
+    let text = run(&["restore", "before.bak"]);
+    assert!(text.contains("verified"), "{text}");
+    run(&["backup", "-o", "after.bak"]);
+    let read = |name: &str| std::fs::read(dir.path().join(name)).expect("a backup");
+    assert_ne!(read("hostile.bak"), read("before.bak"), "the change took");
+    assert_eq!(
+        read("after.bak"),
+        read("before.bak"),
+        "RAM, table and hooks"
+    );
+}
+
+#[test]
+fn a_one_byte_change_goes_as_one_range_and_undo_puts_it_back() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(2048, None)).expect("the image");
+    std::fs::write(dir.path().join("ext2.elf"), extension_elf(2048, Some(1000)))
+        .expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let run = |args: &[&str]| {
+        let mut all = args.to_vec();
+        all.extend(line);
+        let output = scorpion(dir.path(), &all);
+        let text = transcript(&output);
+        assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
+        text
+    };
+    run(&["upload", "ext.elf", "--no-dry-run"]);
+    run(&["read", "$0400", "2048", "-o", "first.bin"]);
+    let text = run(&["upload", "ext2.elf", "--no-dry-run", "--replace"]);
+    // The changed byte's 32-byte range, and the table entry (its id).
+    assert!(text.contains("47 bytes written in 2 ranges"), "{text}");
+    run(&["read", "$0400", "2048", "-o", "second.bin"]);
+    let first = std::fs::read(dir.path().join("first.bin")).expect("a dump");
+    let second = std::fs::read(dir.path().join("second.bin")).expect("a dump");
+    let differ: Vec<usize> = (0..2048).filter(|&i| first[i] != second[i]).collect();
+    assert_eq!(differ, vec![1000]);
+
+    let text = run(&["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    run(&["read", "$0400", "2048", "-o", "undone.bin"]);
+    assert_eq!(
+        std::fs::read(dir.path().join("undone.bin")).expect("a dump"),
+        first
+    );
+}
+
+#[test]
+fn the_readme_section_runs_as_written_against_the_pty_robot() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(700, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let path = crate::path_with_scorpion();
+    let mut printed = String::new();
+    let script = crate::readme_block("## Back up, restore, undo, and the right ROM", "sh");
+    for line in script.lines() {
+        let output = Command::new("sh")
+            .arg("-c")
+            .arg(format!("{line} 2>&1"))
+            .current_dir(dir.path())
+            .env("PATH", &path)
+            .env("PORT", &sim.path)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("sh runs");
+        assert!(
+            output.status.success(),
+            "`{line}`:\n{}",
+            transcript(&output)
+        );
+        printed.push_str(&String::from_utf8_lossy(&output.stdout));
+    }
+    for expected in [
+        "it is the built-in reference ROM, byte for byte",
+        "uploaded and verified 700 bytes",
+        "0 bytes written in 0 ranges",
+        "restored scorpion-last-upload.undo",
+        "restored robot.bak",
+    ] {
+        assert!(printed.contains(expected), "{expected}:\n{printed}");
+    }
+    // The robot holds what it held before the upload.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "backup",
+            "--port",
+            &sim.path,
+            "--baud",
+            "19200",
+            "-o",
+            "after.bak",
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        std::fs::read(dir.path().join("after.bak")).expect("a backup"),
+        std::fs::read(dir.path().join("robot.bak")).expect("a backup"),
+    );
+}

@@ -1,0 +1,529 @@
+//! What a robot holds, saved and put back: user RAM, the user zero page,
+//! the table of installed extensions and the hooks ([`Backup`]), in a
+//! checksummed file format; and what an upload overwrote, kept through a
+//! [`Keep`] so that the upload can be undone (a restore of it).
+//!
+//! # The file format
+//!
+//! ```text
+//! SCORPION-BACKUP 1\n                       magic line (ASCII)
+//! 'A' address:u16 length:u16 bytes...       memory (repeated)
+//! 'H' kind:u8 target:u16                    a hook's target (0 HOOK_UNKNOWN, 1 HOOK_LOOP)
+//! 'E' fnv1a32:u32                           end: FNV-1a 32 of every byte before 'E'
+//! ```
+//!
+//! Numbers are little-endian. A file that does not end in a matching `E`
+//! record is refused whole: nothing of a damaged backup is written.
+
+use isa::objfmt::HookKind;
+
+use crate::client::Client;
+use crate::fingerprint;
+use crate::hooks::{read_hooks, switch_hook};
+use crate::image::{Area, RomProfile, UploadImage};
+use crate::loader::loader_plan;
+use crate::progress::Progress;
+use crate::transport::Transport;
+use crate::upload::{LoaderChoice, UploadOptions, UploadReport, upload};
+use crate::{Error, Result};
+
+/// The first line of a backup file.
+pub const MAGIC: &[u8] = b"SCORPION-BACKUP 1\n";
+
+/// What a robot held: memory and hook targets.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Backup {
+    /// Memory, by address.
+    pub areas: Vec<Area>,
+    /// Each hook's target.
+    pub hooks: Vec<(HookKind, u16)>,
+}
+
+/// Where an upload keeps what it is about to overwrite.
+pub trait Keep {
+    /// Whether to keep anything (reading it costs line time).
+    fn wanted(&self) -> bool {
+        true
+    }
+
+    /// Called before the upload writes the image's bytes, with what the
+    /// robot held there, its hooks and its table as the upload found them.
+    fn keep(&mut self, overwritten: &Backup);
+}
+
+/// Keeps nothing (reads nothing).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoKeep;
+
+impl Keep for NoKeep {
+    fn wanted(&self) -> bool {
+        false
+    }
+
+    fn keep(&mut self, _overwritten: &Backup) {}
+}
+
+/// FNV-1a, 32 bits.
+fn fnv1a32(bytes: &[u8]) -> u32 {
+    bytes.iter().fold(0x811C_9DC5, |hash, &byte| {
+        (hash ^ u32::from(byte)).wrapping_mul(0x0100_0193)
+    })
+}
+
+fn kind_code(kind: HookKind) -> u8 {
+    match kind {
+        HookKind::Unknown => 0,
+        HookKind::Loop => 1,
+    }
+}
+
+impl Backup {
+    /// The file's bytes.
+    #[must_use]
+    pub fn encode(&self) -> Vec<u8> {
+        let mut out = MAGIC.to_vec();
+        for area in &self.areas {
+            out.push(b'A');
+            out.extend_from_slice(&area.address.to_le_bytes());
+            out.extend_from_slice(&(area.bytes.len() as u16).to_le_bytes());
+            out.extend_from_slice(&area.bytes);
+        }
+        for &(kind, target) in &self.hooks {
+            out.push(b'H');
+            out.push(kind_code(kind));
+            out.extend_from_slice(&target.to_le_bytes());
+        }
+        let sum = fnv1a32(&out);
+        out.push(b'E');
+        out.extend_from_slice(&sum.to_le_bytes());
+        out
+    }
+
+    /// Reads a backup file (`name` for messages).
+    ///
+    /// # Errors
+    /// [`Error::BadBackup`] saying where and what is wrong.
+    pub fn decode(name: &str, bytes: &[u8]) -> Result<Backup> {
+        let bad = |at: usize, reason: &str| Error::BadBackup {
+            name: name.to_owned(),
+            offset: at,
+            reason: reason.to_owned(),
+        };
+        if !bytes.starts_with(MAGIC) {
+            return Err(bad(0, "it does not start with `SCORPION-BACKUP 1`"));
+        }
+        let mut at = MAGIC.len();
+        let mut backup = Backup::default();
+        // Where each hook's and each memory record started: a second
+        // record for the same hook or bytes would make a restore's result
+        // depend on the order it is read in.
+        let mut hooks_at: Vec<(HookKind, usize)> = Vec::new();
+        let mut areas_at: Vec<(u32, u32, usize)> = Vec::new();
+        let take = |at: &mut usize, len: usize| -> Result<&[u8]> {
+            let slice = bytes.get(*at..*at + len).ok_or_else(|| {
+                bad(
+                    *at,
+                    &format!(
+                        "it ends in the middle of a record: expected {len} more bytes, found {}",
+                        bytes.len().saturating_sub(*at)
+                    ),
+                )
+            })?;
+            *at += len;
+            Ok(slice)
+        };
+        loop {
+            let start = at;
+            let tag = take(&mut at, 1)?[0];
+            match tag {
+                b'A' => {
+                    let head = take(&mut at, 4)?;
+                    let address = u16::from_le_bytes([head[0], head[1]]);
+                    let len = usize::from(u16::from_le_bytes([head[2], head[3]]));
+                    let end = u32::from(address) + len as u32;
+                    if end > 0x1_0000 {
+                        return Err(bad(start, "a memory record runs past $FFFF"));
+                    }
+                    if let Some(&(_, _, first)) = areas_at
+                        .iter()
+                        .find(|&&(from, to, _)| u32::from(address) < to && from < end)
+                    {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a memory record (${address:04X}, {len} bytes) overlaps the one at byte {first}"
+                            ),
+                        ));
+                    }
+                    areas_at.push((u32::from(address), end, start));
+                    let data = take(&mut at, len)?.to_vec();
+                    backup.areas.push(Area {
+                        address,
+                        bytes: data,
+                    });
+                }
+                b'H' => {
+                    let record = take(&mut at, 3)?;
+                    let kind = match record[0] {
+                        0 => HookKind::Unknown,
+                        1 => HookKind::Loop,
+                        found => {
+                            return Err(bad(
+                                start + 1,
+                                &format!("an unknown hook: expected 0 or 1, found {found}"),
+                            ));
+                        }
+                    };
+                    if let Some(&(_, first)) = hooks_at.iter().find(|(k, _)| *k == kind) {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a second record for {} (the first is at byte {first})",
+                                kind.rom_symbol()
+                            ),
+                        ));
+                    }
+                    hooks_at.push((kind, start));
+                    backup
+                        .hooks
+                        .push((kind, u16::from_le_bytes([record[1], record[2]])));
+                }
+                b'E' => {
+                    let sum = take(&mut at, 4)?;
+                    let sum = u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]);
+                    let computed = fnv1a32(&bytes[..start]);
+                    if sum != computed {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "its checksum does not match: the end record holds ${sum:08X}, the bytes before it sum to ${computed:08X} (the file is damaged)"
+                            ),
+                        ));
+                    }
+                    if at != bytes.len() {
+                        return Err(bad(at, "bytes follow the end record"));
+                    }
+                    return Ok(backup);
+                }
+                other => {
+                    return Err(bad(
+                        start,
+                        &format!("an unknown record: expected A, H or E, found ${other:02X}"),
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Bytes of memory held.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.areas.iter().map(|area| area.bytes.len()).sum()
+    }
+
+    /// Whether it holds no memory.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.areas.is_empty()
+    }
+}
+
+/// What [`crate::backup`] saves of a robot with `profile`: the user zero
+/// page, user RAM and the table of installed extensions (flags and
+/// entries), as address ranges.
+#[must_use]
+pub fn backup_ranges(profile: &RomProfile) -> Vec<(u16, usize)> {
+    let mut ranges = Vec::new();
+    if let Some(zp) = &profile.user_zero_page {
+        ranges.push((
+            u16::from(*zp.start()),
+            usize::from(*zp.end() - *zp.start()) + 1,
+        ));
+    }
+    ranges.push((
+        *profile.user_ram.start(),
+        usize::from(*profile.user_ram.end() - *profile.user_ram.start()) + 1,
+    ));
+    if let Some(range) = table_range(profile) {
+        ranges.push(range);
+    }
+    ranges
+}
+
+/// The table of installed extensions (flags and entries), if the ROM
+/// keeps one.
+pub(crate) fn table_range(profile: &RomProfile) -> Option<(u16, usize)> {
+    profile
+        .table
+        .map(|(at, entries)| (at, entries * (1 + romlib::installed::ENTRY_LEN)))
+}
+
+/// Reads what `profile`'s robot holds ([`backup_ranges`] and the hooks),
+/// every span read until two answers agree.
+///
+/// # Errors
+/// A line error, [`Error::Unreadable`], [`Error::NotAHook`].
+pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Backup> {
+    let hooks = read_hooks(client, profile)?;
+    let mut areas = Vec::new();
+    for (address, len) in backup_ranges(profile) {
+        areas.push(Area {
+            address,
+            bytes: client.read_memory(address, len)?,
+        });
+    }
+    Ok(Backup { areas, hooks })
+}
+
+/// Puts `backup` back into the robot, verified, hooks last: first every
+/// hook goes to the ROM's own target (verified), so nothing runs the RAM
+/// while it changes; then the memory, through the RAM loader where it
+/// pays (only the ranges whose checksum differs), and where the loader
+/// itself ran, with the ROM's commands; then each hook to its target in
+/// the backup, verified. A reset or a lost byte on the way leaves every
+/// hook at the ROM's target or at verified code.
+///
+/// # Errors
+/// [`Error::WrongRom`], [`Error::BadImage`] for memory an upload may not
+/// write, and every error an upload has.
+pub fn restore<T: Transport>(
+    client: &mut Client<T>,
+    backup: &Backup,
+    options: &UploadOptions,
+    progress: &mut dyn Progress,
+) -> Result<Vec<UploadReport>> {
+    let profile = &options.profile;
+    // A restore or upload that died at the loader's fast rate may have
+    // left the robot there: `connect` finds it and asks it back.
+    crate::upload::connect(client, options)?;
+    fingerprint::check_jump_table(client, profile)?;
+    for kind in HookKind::ALL {
+        if let Some(to) = profile.reset_target(kind) {
+            switch_hook(client, profile.hook_address(kind), to, options.max_writes)?;
+        }
+    }
+    // The table is written as memory, flags and all, while no hook points
+    // into RAM: no table bookkeeping of the upload's own.
+    let mut memory = options.clone();
+    memory.profile.table = None;
+    if let Some((address, len)) = table_range(profile) {
+        memory
+            .profile
+            .writable
+            .push(address..=address + (len as u16 - 1));
+    }
+    let mut reports = Vec::new();
+    if !backup.areas.is_empty() {
+        let whole = UploadImage::new(backup.areas.clone(), Vec::new())?;
+        let (through_loader, after) = split_for_loader(&memory, &whole, client.transport().baud())?;
+        if let Some(image) = through_loader {
+            reports.push(upload(client, &image, &memory, progress)?);
+        }
+        if let Some(image) = after {
+            let rom = UploadOptions {
+                loader: LoaderChoice::Never,
+                ..memory.clone()
+            };
+            reports.push(upload(client, &image, &rom, progress)?);
+        }
+    }
+    for &(kind, target) in &backup.hooks {
+        switch_hook(
+            client,
+            profile.hook_address(kind),
+            target,
+            options.max_writes,
+        )?;
+    }
+    Ok(reports)
+}
+
+/// Where the loader would run for a restore of `whole` (a hole at the top
+/// of user RAM and user zero page), and `whole` split into what goes
+/// through it and what goes in after it, with the ROM's commands. No
+/// loader (a profile without one, `--loader never`): all of it after.
+fn split_for_loader(
+    options: &UploadOptions,
+    whole: &UploadImage,
+    baud: u32,
+) -> Result<(Option<UploadImage>, Option<UploadImage>)> {
+    let profile = &options.profile;
+    let rates = (baud, options.fast_baud.unwrap_or(baud));
+    let ram_end = *profile.user_ram.end();
+    let hole = ram_end.saturating_sub(LOADER_HOLE - 1)..=ram_end;
+    let zp_hole = profile
+        .user_zero_page
+        .as_ref()
+        .map(|zp| u16::from(zp.end().saturating_sub(7))..=u16::from(*zp.end()));
+    let holed = cut(
+        whole,
+        &[Some(hole), zp_hole.clone()]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
+    );
+    let plan = match (&holed, options.loader) {
+        (_, LoaderChoice::Never) | (None, _) => None,
+        (Some(holed), _) => loader_plan(profile, holed, rates)?,
+    };
+    let Some(plan) = plan else {
+        return Ok((None, Some(whole.clone())));
+    };
+    let code = plan.code.address..=(plan.code.end() - 1) as u16;
+    let zp = u16::from(*plan.zero_page.start())..=u16::from(*plan.zero_page.end());
+    let before = cut(whole, &[code.clone(), zp.clone()]);
+    let after = keep_only(whole, &[code, zp]);
+    Ok((before, after))
+}
+
+/// How much of user RAM's top a restore leaves to the loader at first.
+const LOADER_HOLE: u16 = 0x100;
+
+/// `image` without the bytes in `holes`; `None` if nothing is left.
+fn cut(image: &UploadImage, holes: &[std::ops::RangeInclusive<u16>]) -> Option<UploadImage> {
+    select(image, |address| {
+        !holes.iter().any(|hole| hole.contains(&address))
+    })
+}
+
+/// `image`'s bytes in `ranges` alone; `None` if there are none.
+fn keep_only(image: &UploadImage, ranges: &[std::ops::RangeInclusive<u16>]) -> Option<UploadImage> {
+    select(image, |address| {
+        ranges.iter().any(|range| range.contains(&address))
+    })
+}
+
+fn select(image: &UploadImage, wanted: impl Fn(u16) -> bool) -> Option<UploadImage> {
+    let mut areas: Vec<Area> = Vec::new();
+    for area in image.areas() {
+        for (i, &byte) in area.bytes.iter().enumerate() {
+            let address = area.address + i as u16;
+            if !wanted(address) {
+                continue;
+            }
+            match areas.last_mut() {
+                Some(last) if last.end() == u32::from(address) => last.bytes.push(byte),
+                _ => areas.push(Area {
+                    address,
+                    bytes: vec![byte],
+                }),
+            }
+        }
+    }
+    UploadImage::new(areas, Vec::new()).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Backup {
+        Backup {
+            areas: vec![
+                Area {
+                    address: 0x0030,
+                    bytes: vec![1, 2, 3],
+                },
+                Area {
+                    address: 0x0400,
+                    bytes: (0..=255).collect(),
+                },
+            ],
+            hooks: vec![(HookKind::Unknown, 0xFF21), (HookKind::Loop, 0x0456)],
+        }
+    }
+
+    #[test]
+    fn a_backup_round_trips() {
+        let bytes = sample().encode();
+        assert!(bytes.starts_with(MAGIC));
+        assert_eq!(Backup::decode("b", &bytes).expect("decodes"), sample());
+    }
+
+    #[test]
+    fn any_damaged_byte_is_refused() {
+        let bytes = sample().encode();
+        for at in 0..bytes.len() {
+            let mut damaged = bytes.clone();
+            damaged[at] ^= 0x01;
+            assert!(
+                Backup::decode("b", &damaged).is_err(),
+                "byte {at} flipped was taken"
+            );
+        }
+        assert!(Backup::decode("b", &bytes[..bytes.len() - 1]).is_err());
+    }
+
+    /// A backup file with `backup`'s records and a good end record.
+    fn with_end(mut body: Vec<u8>) -> Vec<u8> {
+        let sum = fnv1a32(&body);
+        body.push(b'E');
+        body.extend_from_slice(&sum.to_le_bytes());
+        body
+    }
+
+    #[test]
+    fn a_second_record_for_one_hook_is_refused_at_its_place() {
+        let mut body = MAGIC.to_vec();
+        body.extend_from_slice(&[b'H', 0, 0x21, 0xFF]);
+        let second = body.len();
+        body.extend_from_slice(&[b'H', 0, 0x00, 0x04]);
+        let error = Backup::decode("twice.bak", &with_end(body)).expect_err("refused");
+        let text = error.to_string();
+        assert!(
+            matches!(&error, Error::BadBackup { offset, .. } if *offset == second),
+            "{error:?}"
+        );
+        assert!(text.contains("HOOK_UNKNOWN"), "{text}");
+        assert!(text.contains(&format!("byte {}", MAGIC.len())), "{text}");
+    }
+
+    #[test]
+    fn overlapping_memory_records_are_refused_at_their_place() {
+        let mut body = MAGIC.to_vec();
+        body.extend_from_slice(&[b'A', 0x00, 0x04, 4, 0, 1, 2, 3, 4]);
+        let second = body.len();
+        body.extend_from_slice(&[b'A', 0x02, 0x04, 1, 0, 9]);
+        let error = Backup::decode("overlap.bak", &with_end(body)).expect_err("refused");
+        assert!(
+            matches!(&error, Error::BadBackup { offset, .. } if *offset == second),
+            "{error:?}"
+        );
+        assert!(error.to_string().contains("$0402"), "{error}");
+    }
+
+    #[test]
+    fn a_truncated_or_damaged_file_says_where_and_what_was_expected() {
+        let bytes = sample().encode();
+        let cut = &bytes[..MAGIC.len() + 3];
+        let text = Backup::decode("cut.bak", cut)
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            text.contains(&format!("at byte {}", MAGIC.len() + 1)),
+            "{text}"
+        );
+        assert!(text.contains("expected 4 more bytes, found 2"), "{text}");
+
+        let mut damaged = bytes.clone();
+        let last = damaged.len() - 1;
+        damaged[last] ^= 0x40;
+        let text = Backup::decode("damaged.bak", &damaged)
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            text.contains(&format!("at byte {}", bytes.len() - 5)),
+            "{text}"
+        );
+        assert!(text.contains("the end record holds $"), "{text}");
+    }
+
+    #[test]
+    fn the_reference_backup_covers_zero_page_ram_and_the_table() {
+        let ranges = backup_ranges(&RomProfile::reference());
+        assert_eq!(
+            ranges,
+            vec![(0x0030, 0xD0), (0x0400, 0x0B40), (0x0F80, 0x80)]
+        );
+    }
+}

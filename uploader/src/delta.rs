@@ -1,0 +1,203 @@
+//! Delta uploads: which ranges of an image the robot does not hold yet,
+//! found by checksums the loader's `sums` computes on the robot, not by
+//! reading every byte. A coarse pass sums ranges of [`COARSE`] bytes;
+//! where few differ, each differing one is summed again in ranges of
+//! [`FINE`] bytes, so a one-byte change is written (and read back) as one
+//! short range. Where most differ (a robot that never held the image),
+//! the fine pass would cost more than it saves: the coarse ranges are
+//! written whole.
+//!
+//! A frame costs one character a byte on the way out and its `/7R`
+//! verification two on the way back; a sum question and its answer cost
+//! 21 characters whatever the range. So a fine pass over a coarse range
+//! (8 questions) pays when it spares most of the range's bytes.
+
+use crate::Result;
+use crate::client::Client;
+use crate::image::{Area, UploadImage};
+use crate::sums::{Range, fletcher16, robot_sums};
+use crate::transport::Transport;
+
+/// Bytes of a range of the coarse pass.
+pub const COARSE: usize = 256;
+
+/// Bytes of a range of the fine pass.
+pub const FINE: usize = 32;
+
+/// `image`'s ranges of at most `size` bytes, each within an area, with
+/// their bytes.
+fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
+    let mut out = Vec::new();
+    for area in areas {
+        for (i, chunk) in area.bytes.chunks(size).enumerate() {
+            out.push(((area.address + (i * size) as u16, chunk.len()), chunk));
+        }
+    }
+    out
+}
+
+/// A range's index and the robot's sum of it.
+type Differs = (usize, u16);
+
+/// The ranges of `ranges` whose robot sum differs from the host's, and
+/// the robot's sums of `first` (asked first, in the same batch).
+fn differ<T: Transport>(
+    client: &mut Client<T>,
+    first: &[Range],
+    ranges: &[(Range, &[u8])],
+) -> Result<(Vec<Differs>, Vec<u16>)> {
+    let mut asked: Vec<Range> = first.to_vec();
+    asked.extend(ranges.iter().map(|(range, _)| *range));
+    let mut found = robot_sums(client, &asked)?;
+    let rest = found.split_off(first.len());
+    let wrong = ranges
+        .iter()
+        .zip(rest)
+        .enumerate()
+        .filter(|(_, ((_, bytes), found))| fletcher16(bytes) != *found)
+        .map(|(i, (_, found))| (i, found))
+        .collect();
+    Ok((wrong, found))
+}
+
+/// A range of the image and the robot's sum of what it holds there.
+pub(crate) type Held = (Area, u16);
+
+/// The ranges of `image` the robot does not hold, merged where they
+/// touch; empty when it holds every byte. The loader's `sums` must be
+/// hooked.
+///
+/// # Errors
+/// A line error, or [`crate::Error::Unreadable`] when sums keep being lost.
+pub(crate) fn differing<T: Transport>(
+    client: &mut Client<T>,
+    image: &UploadImage,
+) -> Result<Vec<Area>> {
+    Ok(merged(&differing_and(client, &[], image)?.0))
+}
+
+/// The ranges of `image` the robot does not hold, each with the robot's
+/// sum of what it holds there (what an undo keeps is checked against
+/// it), and the robot's sums of `first`, asked in the same batch as the
+/// coarse pass (the whole ROM's, say: the robot sums it while the other
+/// questions are on their way).
+///
+/// # Errors
+/// As [`differing`].
+pub(crate) fn differing_and<T: Transport>(
+    client: &mut Client<T>,
+    first: &[Range],
+    image: &UploadImage,
+) -> Result<(Vec<Held>, Vec<u16>)> {
+    let coarse = split(image.areas(), COARSE);
+    let (wrong, sums) = differ(client, first, &coarse)?;
+    let held = |range: &(Range, &[u8]), sum: u16| {
+        (
+            Area {
+                address: range.0.0,
+                bytes: range.1.to_vec(),
+            },
+            sum,
+        )
+    };
+    if wrong.len() * 2 > coarse.len() {
+        let out = wrong
+            .iter()
+            .map(|&(i, sum)| held(&coarse[i], sum))
+            .collect();
+        return Ok((out, sums));
+    }
+    let pieces: Vec<Area> = wrong.iter().map(|&(i, _)| held(&coarse[i], 0).0).collect();
+    let fine = split(&pieces, FINE);
+    let out = differ(client, &[], &fine)?
+        .0
+        .iter()
+        .map(|&(i, sum)| held(&fine[i], sum))
+        .collect();
+    Ok((out, sums))
+}
+
+/// Every range of `image` (coarse), each with the robot's sum of what it
+/// holds there, and the robot's sums of `first`: for an upload that
+/// writes every byte and keeps what it overwrites.
+///
+/// # Errors
+/// As [`differing`].
+pub(crate) fn all_and<T: Transport>(
+    client: &mut Client<T>,
+    first: &[Range],
+    image: &UploadImage,
+) -> Result<(Vec<Held>, Vec<u16>)> {
+    let coarse = split(image.areas(), COARSE);
+    let mut asked: Vec<Range> = first.to_vec();
+    asked.extend(coarse.iter().map(|(range, _)| *range));
+    let mut found = robot_sums(client, &asked)?;
+    let rest = found.split_off(first.len());
+    let out = coarse
+        .iter()
+        .zip(rest)
+        .map(|(((address, _), bytes), sum)| {
+            (
+                Area {
+                    address: *address,
+                    bytes: bytes.to_vec(),
+                },
+                sum,
+            )
+        })
+        .collect();
+    Ok((out, found))
+}
+
+/// The ranges of `held`, merged where they touch.
+pub(crate) fn merged(held: &[Held]) -> Vec<Area> {
+    let mut out = Vec::new();
+    for (area, _) in held {
+        push(&mut out, area.address, &area.bytes);
+    }
+    out
+}
+
+/// Appends a range, merged with the last one if it follows it.
+fn push(out: &mut Vec<Area>, address: u16, bytes: &[u8]) {
+    if let Some(last) = out.last_mut()
+        && last.end() == u32::from(address)
+    {
+        last.bytes.extend_from_slice(bytes);
+        return;
+    }
+    out.push(Area {
+        address,
+        bytes: bytes.to_vec(),
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_stay_within_their_areas_and_merge_when_they_touch() {
+        let areas = vec![
+            Area {
+                address: 0x0400,
+                bytes: vec![1; 70],
+            },
+            Area {
+                address: 0x1000,
+                bytes: vec![2; 10],
+            },
+        ];
+        let ranges: Vec<Range> = split(&areas, 32).into_iter().map(|(r, _)| r).collect();
+        assert_eq!(
+            ranges,
+            vec![(0x0400, 32), (0x0420, 32), (0x0440, 6), (0x1000, 10)]
+        );
+        let mut out = Vec::new();
+        push(&mut out, 0x0400, &[1, 2]);
+        push(&mut out, 0x0402, &[3]);
+        push(&mut out, 0x0404, &[4]);
+        assert_eq!(out.len(), 2);
+        assert_eq!(out[0].bytes, vec![1, 2, 3]);
+    }
+}
