@@ -20,6 +20,7 @@ mod link;
 mod profile;
 mod project;
 mod read;
+mod room_path;
 mod search_order;
 mod sim;
 mod sim_line;
