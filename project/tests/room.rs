@@ -68,26 +68,23 @@ fn failure(report: &runner::Report) -> Option<String> {
     }
 }
 
-/// Both wheels 200 steps forward at speed 50 (250 steps a second, 0.8 s):
-/// 22 cm east, stopping 3 cm short of the post.
-const DRIVE: &str = "\
-pose => x=100cm y=100cm heading=0° within 0.01cm 0.01°
-/8C+500200
-/8D+500200
-wait 1000ms
-pose => x=122cm y=100cm heading=0° within 0.5cm 2°
-bumped => nothing
-/8C+500050
-/8D+500050
-wait 500ms
-bumped => $10
-pose => x=125cm y=100cm within 0.5cm
-";
+/// The transcript of docs/WORLD.md ("In a transcript"), run as written:
+/// both wheels 200 steps forward at speed 50 (250 steps a second,
+/// 0.8 s), 22 cm east, 3 cm short of the post; then 50 more, into it.
+fn drive() -> String {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/WORLD.md"))
+            .expect("docs/WORLD.md");
+    let section = &doc[doc.find("## In a transcript").expect("the section")..];
+    let start = section.find("```text\n").expect("a text block") + "```text\n".len();
+    let end = start + section[start..].find("```").expect("its end");
+    section[start..end].to_owned()
+}
 
 #[test]
 fn a_transcript_drives_the_robot_and_asserts_its_pose_and_its_bumps() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let report = run(&project(dir.path(), DRIVE, true), options());
+    let report = run(&project(dir.path(), &drive(), true), options());
     assert_eq!(failure(&report), None, "{report:#?}");
 }
 
@@ -98,12 +95,15 @@ fn a_wrong_pose_and_a_bump_that_did_not_happen_fail_at_their_lines() {
                 pose => x=140cm y=100cm within 1cm\nbumped => $10\n";
     let report = run(&project(dir.path(), text, true), options());
     let message = failure(&report).expect("the transcript fails");
-    assert!(
-        message.contains(
-            "tests/drive.expect:4: `pose` answered `x=122.0cm y=99.7cm heading=0.0°`, expected `x=140cm y=100cm within 1cm`"
-        ),
-        "{message}"
-    );
+    // As docs/WORLD.md shows it.
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/WORLD.md"))
+            .expect("docs/WORLD.md");
+    let shown = doc
+        .lines()
+        .find(|line| line.starts_with("tests/drive.expect:4: `pose` answered"))
+        .expect("the failure in the doc");
+    assert!(message.contains(shown), "{message}\n---\n{shown}");
     assert!(
         message.contains(
             "tests/drive.expect:5: `bumped` answered `no change of the bumpers`, expected `bumpers $10 closed`"
@@ -139,7 +139,7 @@ fn a_mistake_in_a_pose_line_is_said_at_its_line() {
 #[test]
 fn path_draws_one_picture_per_transcript() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let project = project(dir.path(), DRIVE, true);
+    let project = project(dir.path(), &drive(), true);
     let picture = dir.path().join("out.svg");
     let report = run(
         &project,

@@ -11,6 +11,8 @@
 //! bumped => $10                                the front bumper closed
 //! bumped => nothing                            no bumper since that line
 //! ```
+//!
+//! docs/WORLD.md ("In a transcript") is their reference.
 
 use std::time::Duration;
 
@@ -80,7 +82,7 @@ pub fn parse(content: &str) -> Option<Result<RoomLine, String>> {
 fn after_arrow<'a>(word: &str, rest: &'a str) -> Result<&'a str, String> {
     rest.strip_prefix("=>").map(str::trim).ok_or_else(|| {
         format!(
-            "`{word}` is followed by `=>` and what it must be (docs/PROJECT.md, \"Transcripts\")"
+            "`{word}` is followed by `=>` and what it must be (docs/WORLD.md, \"In a transcript\")"
         )
     })
 }
