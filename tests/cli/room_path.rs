@@ -72,3 +72,48 @@ fn test_draws_one_picture_per_transcript() {
     let drive = std::fs::read_to_string(project.join("out/run-drive.svg")).expect("drive");
     assert!(drive.contains(">/8D+500100 at "), "{drive}");
 }
+
+/// examples/linefollow: the line-follower operating system follows the
+/// curved tape of its room.toml to its end, its transcript asserting the
+/// pose there; its path drawn. Moved 20 cm along the line, the pose its
+/// transcript requires fails.
+#[test]
+fn the_line_follower_follows_its_curved_line_to_the_end() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/linefollow");
+    let project = dir.path().join("linefollow");
+    copy_dir(&example, &project);
+    let output = scorpion(&project, &["test", "--path", "path.svg"]);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let picture =
+        std::fs::read_to_string(project.join("path-follow.svg")).expect("the follower's path");
+    assert!(picture.contains(">/2L1 at "), "{picture}");
+
+    let expect = project.join("tests/follow.expect");
+    let text = std::fs::read_to_string(&expect).expect("the transcript");
+    assert!(text.contains("x=230cm y=170cm"), "{text}");
+    std::fs::write(&expect, text.replace("x=230cm y=170cm", "x=230cm y=190cm"))
+        .expect("a wrong pose");
+    let output = scorpion(&project, &["test", "follow"]);
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    assert!(
+        transcript(&output).contains("tests/follow.expect:6: `pose` answered `x=229.5cm y=171.5cm"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+/// Copies the directory `from` into `to`, without its `target/`.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for entry in std::fs::read_dir(from).expect("the example").flatten() {
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            if entry.file_name() != "target" {
+                copy_dir(&entry.path(), &target);
+            }
+        } else {
+            std::fs::copy(entry.path(), &target).expect("a copy");
+        }
+    }
+}
