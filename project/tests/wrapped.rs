@@ -72,7 +72,8 @@ fn a_bad_transcript_line_is_said_as_before() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     let path = dir.path().join("bad.expect");
     std::fs::write(&path, "/1V => V01\n=> V01\n").expect("write");
-    let typed = runner::transcript::read(&path, "tests/bad.expect").expect_err("a bad line");
+    let typed =
+        runner::transcript::read_commands(&path, "tests/bad.expect").expect_err("a bad line");
     let runner::Error::BadTranscript(bad) = &typed else {
         panic!("{typed:?}");
     };

@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use debugger::Debugger;
 use debugger::monitor::{Failure, Monitor, Reply};
 use debugger::sources::Sources;
-use miette::IntoDiagnostic;
+use miette::{IntoDiagnostic, WrapErr};
 
 use crate::cmd::ports;
 
@@ -48,11 +48,32 @@ pub(crate) struct Args {
     /// Cards on the KIM bus and the robot's surroundings.
     #[command(flatten)]
     pub(crate) rig: crate::cmd::rig::Rig,
+    /// Draw the robot's path in its room (a world file, `--world
+    /// room.toml`) to FILE.svg when the session ends, as sim's --path
+    /// does: the room, the trail with a mark every second, the bumps and
+    /// the commands sent. The trail is the robot's as it ran forward: a
+    /// step back does not undraw it.
+    #[arg(long, value_name = "FILE.svg")]
+    pub(crate) path: Option<PathBuf>,
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let here = std::env::current_dir().into_diagnostic()?;
-    let (make, images, root) = recipe(args, &here)?;
+    let ((make, images, root), room) = recipe_in_room(args, &here)?;
+    let room = match &args.path {
+        Some(path) => Some((
+            path,
+            room.get().ok_or_else(|| {
+                miette::miette!(
+                    help = "give a world file: `--world room.toml` (docs/WORLD.md)",
+                    "--path draws the robot in its room, and the robot has none"
+                )
+            })?,
+        )),
+        None => None,
+    };
+    // For the picture of the path: each command sent, at its robot time.
+    let mut commands = Vec::new();
     let mut debugger = Debugger::new(make, &images)?;
     let terminal = std::io::stdin().is_terminal();
     let completion = completion_words(&debugger, &images);
@@ -114,8 +135,14 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         }
         // A Ctrl-C pressed since the last run pauses nothing now.
         interrupt.store(false, Ordering::Relaxed);
+        let at = debugger.robot().cycles();
         match monitor.command(&mut debugger, line.trim()) {
-            Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,
+            Ok(Reply::Text(text)) => {
+                if let Some(sent) = text.strip_prefix("sent ") {
+                    commands.push((at, sent.trim_end().to_owned()));
+                }
+                write!(out, "{text}").into_diagnostic()?;
+            }
             Ok(Reply::Quit) => break,
             Err(error) => {
                 let robot_broke = matches!(error, Failure::Robot(_));
@@ -128,6 +155,11 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     if let Err(error) = debugger.trace_off() {
         broken = true;
         writeln!(out, "error: {}", Failure::from(error).message()).into_diagnostic()?;
+    }
+    if let Some((path, view)) = room {
+        std::fs::write(path, view.svg(&commands))
+            .into_diagnostic()
+            .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
     }
     // A session in which the robot broke (a JAM, a card's fault) or whose
     // trace could not be written fails.
@@ -179,11 +211,21 @@ pub(crate) type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
 /// as a function that builds it afresh, the images it loads, and the
 /// directory their source paths are relative to.
 pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Recipe> {
+    recipe_in_room(args, here).map(|(recipe, _)| recipe)
+}
+
+/// [`recipe`], and where the room of its robot is seen from (a world
+/// file's: its pose and trail).
+pub(crate) fn recipe_in_room(
+    args: &Args,
+    here: &std::path::Path,
+) -> miette::Result<(Recipe, scorpion_project::runner::rig::RoomSlot)> {
     let resolved = crate::cmd::config::resolve_in(
         &crate::cmd::config::flags(None, args.baud, &args.rig, args.rom.as_ref()),
         here,
     )?;
     let rig = crate::cmd::config::rig(&resolved);
+    let room = rig.room.clone();
     let rom = crate::cmd::config::rom(&resolved)?;
     let images: Vec<linker::Image> = crate::cmd::config::images(&resolved, &args.images)?
         .images
@@ -212,5 +254,5 @@ pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Reci
             message: format!("{report}"),
         })
     });
-    Ok((make, images, root))
+    Ok(((make, images, root), room))
 }

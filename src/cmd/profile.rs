@@ -342,6 +342,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         port: None,
         replace: false,
         environment: Environment::from_process()?,
+        path: None,
     };
     let report = runner::run_tests(&found, &options, &mut Quiet { watch: &mut watch })?;
     let mut out = std::io::stdout().lock();

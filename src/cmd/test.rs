@@ -75,6 +75,12 @@ pub(crate) struct Args {
     /// `index.html`.
     #[arg(long, conflicts_with = "port")]
     coverage: bool,
+    /// Draw each transcript's robot in its room (the project's world
+    /// file, docs/WORLD.md) as sim's --path does, one picture per
+    /// transcript beside FILE: `--path out/run.svg` draws
+    /// `tests/patrol.expect` to `out/run-patrol.svg`.
+    #[arg(long, value_name = "FILE.svg")]
+    path: Option<std::path::PathBuf>,
 }
 
 impl Args {
@@ -246,6 +252,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         port: args.port.clone(),
         replace: args.replace,
         environment: Environment::from_process()?,
+        path: args.path.clone(),
     };
     // Budgets need the whole profiler; coverage alone, the counts. With
     // a port, the rehearsal on the virtual Scorpion checks them, before

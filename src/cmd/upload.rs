@@ -238,7 +238,7 @@ fn read_image(path: &PathBuf) -> miette::Result<(linker::Image, UploadImage)> {
 
 fn read_expectations(path: &Path) -> miette::Result<(String, Expectations)> {
     let shown = path.display().to_string();
-    let expectations = transcript::read(path, &shown)?;
+    let expectations = transcript::read_commands(path, &shown)?;
     Ok((shown, expectations))
 }
 

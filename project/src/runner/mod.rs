@@ -14,6 +14,8 @@
 //!   rejecting or leaving one pending snapshot.
 //! - [`transcript`]: transcripts read and their mismatches said as
 //!   failures, all of them, at their `file:line`.
+//! - [`room_lines`]: a transcript's lines about the robot in its room
+//!   (`wait`, `pose =>`, `bumped =>`).
 //! - [`calls`]: routine-level tests (`tests/*.calls`).
 //! - [`rig`]: the virtual Scorpion the tests run on (ROM profile, cards,
 //!   surroundings).
@@ -30,6 +32,7 @@ pub mod memory;
 pub mod report;
 pub mod review;
 pub mod rig;
+pub mod room_lines;
 pub mod run;
 pub mod snapshot;
 pub mod toolchain;
@@ -42,5 +45,5 @@ pub use report::{
 };
 pub use review::{Decision, Mode, Pending};
 pub use rig::{EMU, Rig};
-pub use run::{Options, run_tests};
+pub use run::{Options, path_picture, run_tests};
 pub use toolchain::{builtin_includes, link_objects};

@@ -18,9 +18,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use cards::RoomView;
 use romlib::VirtualScorpion;
 use uploader::transport::{Exchanged, Observed, SerialTransport, VirtualTransport};
-use uploader::{Client, ClientConfig, RomProfile, Transport, UploadImage};
+use uploader::{Client, ClientConfig, Expectations, Mismatch, RomProfile, Transport, UploadImage};
 
 use super::build::{Built, SNAPSHOT_KINDS, build};
 use super::calls;
@@ -28,8 +29,9 @@ use super::error::{Error, FrontEnd, Result, WorkspacePort};
 use super::report::{Failure, MemberReport, Outcome, Passed, Progress, Question, Report};
 use super::review::{self, Decision, Mode};
 use super::rig::{EMU, Rig, Scripts, rom, virtual_robot};
+use super::room_lines::RoomLine;
 use super::snapshot::{self, Compared};
-use super::transcript::{self, Clock};
+use super::transcript::{self, Clock, Step};
 use crate::{Environment, FILE, Flags, Found, Project, Resolved};
 
 /// What to run, and how.
@@ -52,6 +54,25 @@ pub struct Options {
     /// The environment the configuration is resolved with (the line's
     /// rate, the port, the per-user file).
     pub environment: Environment,
+    /// Draw each transcript's robot in its room (a world file) to a
+    /// picture named after this one and the transcript ([`path_picture`]).
+    pub path: Option<PathBuf>,
+}
+
+/// Where `--path FILE.svg` puts the picture of the transcript at
+/// `transcript`: beside FILE, its stem, a dash, the transcript's stem
+/// (`--path out/run.svg` and `tests/patrol.expect`: `out/run-patrol.svg`).
+#[must_use]
+pub fn path_picture(path: &Path, transcript: &Path) -> PathBuf {
+    let stem = |p: &Path| {
+        p.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let extension = path
+        .extension()
+        .map_or_else(|| "svg".to_owned(), |e| e.to_string_lossy().into_owned());
+    path.with_file_name(format!("{}-{}.{extension}", stem(path), stem(transcript)))
 }
 
 /// Runs the tests of `found` (a project, or every member of a workspace),
@@ -471,6 +492,10 @@ impl Run<'_, '_, '_> {
             self.start(&name);
             let result = match self.robot(setup, built, &name) {
                 Ok((robot, scripts)) => {
+                    let room = setup.rig.room.get().map(|view| InRoom {
+                        view,
+                        opened: robot.cycles(),
+                    });
                     let line = Showing::new(
                         VirtualTransport::new(robot),
                         Tell {
@@ -479,10 +504,35 @@ impl Run<'_, '_, '_> {
                         },
                     );
                     let mut client = client(line);
-                    let result = run_transcript(project, &path, &mut client, Clock::Robot);
+                    let mut commands = Vec::new();
+                    let result = run_transcript(
+                        project,
+                        &path,
+                        &mut client,
+                        Clock::Robot,
+                        room.as_ref(),
+                        &mut commands,
+                    );
                     robot_time += client.transport().now();
                     done(client.transport(), &name);
-                    result
+                    match (&self.options.path, &room) {
+                        (Some(picture), Some(room)) => {
+                            let file = path_picture(picture, &path);
+                            std::fs::write(&file, room.view.svg(&commands)).map_err(|source| {
+                                Error::Write {
+                                    path: file.clone(),
+                                    source,
+                                }
+                            })?;
+                            result
+                        }
+                        (Some(_), None) => Err(indent(
+                            "--path draws the robot in its room, and the robot has none: \
+                             give a world file (`world = \"room.toml\"` under [robot] in \
+                             Scorpion.toml, or --world room.toml; docs/WORLD.md)",
+                        )),
+                        _ => result,
+                    }
                 }
                 Err(error) => Err(indent(&rendered(error))),
             };
@@ -559,7 +609,9 @@ impl Run<'_, '_, '_> {
                 continue;
             }
             self.start(&name);
-            let result = run_transcript(project, &path, &mut client, clock);
+            // The robot on a port is seen through its line alone: the
+            // room lines were checked in the rehearsal, and are refused here.
+            let result = run_transcript(project, &path, &mut client, clock, None, &mut Vec::new());
             self.record_result(&name, result.map(|()| Passed::Ok));
         }
         Ok(())
@@ -587,23 +639,115 @@ fn relative(project: &Project, path: &Path) -> String {
         .to_string()
 }
 
+/// The room a transcript's robot is in, and the robot time (cycles) its
+/// line was opened at: the line's clock counts from it, the room's from 0.
+struct InRoom {
+    view: RoomView,
+    opened: u64,
+}
+
+/// Lets robot time pass on `client`'s line for `time`, dropping what the
+/// robot says meanwhile.
+fn wait<T: Transport>(client: &mut Client<T>, time: Duration) -> uploader::Result<()> {
+    let line = client.transport();
+    let until = line.now() + time;
+    let mut dropped = Vec::new();
+    loop {
+        let now = line.now();
+        if now >= until {
+            return Ok(());
+        }
+        dropped.clear();
+        line.receive(&mut dropped, until - now)?;
+    }
+}
+
 /// Runs the transcript at `path` on `client`: every line that differs is
-/// a line of the failure.
+/// a line of the failure. With a `room`, its room lines are checked and
+/// each command is added to `commands` with its robot time (for the
+/// picture of the path).
 fn run_transcript<T: Transport>(
     project: &Project,
     path: &Path,
     client: &mut Client<T>,
     clock: Clock,
+    room: Option<&InRoom>,
+    commands: &mut Vec<(u64, String)>,
 ) -> Result<(), String> {
     let shown = relative(project, path);
-    let expectations = transcript::read(path, &shown).map_err(|e| indent(&rendered(e)))?;
-    let checked = expectations
-        .check_all(client)
-        .map_err(|e| indent(&format!("{:?}", miette::Report::new(e))))?;
-    if checked.mismatches.is_empty() {
+    let transcript = transcript::read(path, &shown).map_err(|e| indent(&rendered(e)))?;
+    let failed = |e: uploader::Error| indent(&format!("{:?}", miette::Report::new(e)));
+    let mismatches = match room {
+        None => {
+            if let Some(line) = transcript.first_room_line() {
+                return Err(indent(&rendered(transcript::no_room(&shown, line))));
+            }
+            transcript
+                .expectations()
+                .check_all(client)
+                .map_err(failed)?
+                .mismatches
+        }
+        Some(room) => {
+            let started = client.transport().now();
+            let mut mismatches = Vec::new();
+            let mut bumps_seen = 0;
+            for step in &transcript.steps {
+                let now = client.transport().now();
+                let at = now.saturating_sub(started);
+                match step {
+                    Step::Command(expectation) => {
+                        let sent = u64::try_from(now.as_micros()).unwrap_or(u64::MAX);
+                        commands.push((
+                            room.opened.saturating_add(sent),
+                            expectation.command.to_string(),
+                        ));
+                        let one = Expectations {
+                            lines: vec![expectation.clone()],
+                        };
+                        let checked = one.check_all(client).map_err(failed)?;
+                        mismatches.extend(checked.mismatches.into_iter().map(|mut m| {
+                            m.at += at;
+                            m
+                        }));
+                    }
+                    Step::Room(_, RoomLine::Wait(time)) => {
+                        wait(client, *time).map_err(failed)?;
+                    }
+                    Step::Room(line, RoomLine::Pose(check)) => {
+                        if let Some(found) = check.check(&room.view) {
+                            mismatches.push(Mismatch {
+                                line: *line,
+                                command: "pose".into(),
+                                expected: check.expected(),
+                                found,
+                                at,
+                            });
+                        }
+                    }
+                    Step::Room(line, RoomLine::Bumped(check)) => {
+                        let bumps = room.view.trail().bumps;
+                        let since = &bumps[bumps_seen.min(bumps.len())..];
+                        bumps_seen = bumps.len();
+                        if let Some(found) = check.check(since) {
+                            mismatches.push(Mismatch {
+                                line: *line,
+                                command: "bumped".into(),
+                                expected: check.expected(),
+                                found,
+                                at,
+                            });
+                        }
+                    }
+                }
+            }
+            mismatches
+        }
+    };
+    if mismatches.is_empty() {
         Ok(())
     } else {
-        Err(transcript::describe(&shown, &checked.mismatches, clock)
+        Err(transcript::describe(&shown, &mismatches, clock)
             .lines()
             .fold(String::new(), |mut out, line| {
                 let _ = writeln!(out, "  {line}");

@@ -7,34 +7,143 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Duration;
 
-use uploader::{Expectations, Mismatch};
+use uploader::{Expectation, Expectations, Mismatch};
 
 use super::error::{BadTranscript, Error, Result};
+use super::room_lines::{self, RoomLine};
+
+/// A transcript's line: a command for the robot (the uploader's
+/// grammar) or a line about the robot in its room ([`room_lines`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    /// A command and what it must answer.
+    Command(Expectation),
+    /// A line about the room, at its line (from 1).
+    Room(usize, RoomLine),
+}
+
+/// A transcript read: its lines in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transcript {
+    /// The lines, in the file's order.
+    pub steps: Vec<Step>,
+}
+
+impl Transcript {
+    /// The command lines alone, as the uploader checks them.
+    #[must_use]
+    pub fn expectations(&self) -> Expectations {
+        Expectations {
+            lines: self
+                .steps
+                .iter()
+                .filter_map(|step| match step {
+                    Step::Command(e) => Some(e.clone()),
+                    Step::Room(..) => None,
+                })
+                .collect(),
+        }
+    }
+
+    /// The first room line, if any: what a robot without a room cannot
+    /// check.
+    #[must_use]
+    pub fn first_room_line(&self) -> Option<usize> {
+        self.steps.iter().find_map(|step| match step {
+            Step::Room(line, _) => Some(*line),
+            Step::Command(_) => None,
+        })
+    }
+}
 
 /// Reads the transcript at `path`, shown to the user as `shown`.
 ///
 /// # Errors
 /// [`Error::Read`] if the file cannot be read, [`Error::BadTranscript`]
 /// at the first line that is not a transcript's.
-pub fn read(path: &Path, shown: &str) -> Result<Expectations> {
+pub fn read(path: &Path, shown: &str) -> Result<Transcript> {
     let text = hostfs::read_text(path, hostfs::TEXT).map_err(|source| Error::Read {
         shown: shown.to_owned(),
         path: path.to_path_buf(),
         source,
     })?;
-    Expectations::parse(&text).map_err(|error| match error {
-        uploader::Error::BadExpectations { line, reason } => {
-            Error::BadTranscript(Box::new(BadTranscript {
-                shown: shown.to_owned(),
-                line,
-                reason,
-            }))
-        }
-        source => Error::Transcript {
+    parse(&text, shown)
+}
+
+/// Reads the transcript at `path` for a robot that has no room (an
+/// upload's rehearsal and check): its commands alone.
+///
+/// # Errors
+/// As [`read`], and [`Error::BadTranscript`] at a room line.
+pub fn read_commands(path: &Path, shown: &str) -> Result<Expectations> {
+    let transcript = read(path, shown)?;
+    if let Some(line) = transcript.first_room_line() {
+        return Err(no_room(shown, line));
+    }
+    Ok(transcript.expectations())
+}
+
+/// The error of a room line (`wait`, `pose`, `bumped`) where the robot
+/// has no room to see it in.
+#[must_use]
+pub fn no_room(shown: &str, line: usize) -> Error {
+    Error::BadTranscript(Box::new(BadTranscript {
+        shown: shown.to_owned(),
+        line,
+        reason: "the robot has no room to check this line in: `wait`, `pose` and `bumped` \
+                 need the virtual Scorpion with a world file (`world = \"room.toml\"` under \
+                 [robot] in Scorpion.toml, or `--world room.toml`; docs/WORLD.md)"
+            .into(),
+    }))
+}
+
+/// Parses a transcript's `text`, shown to the user as `shown`.
+///
+/// # Errors
+/// [`Error::BadTranscript`] at the first line that is not a transcript's.
+pub fn parse(text: &str, shown: &str) -> Result<Transcript> {
+    let bad = |line: usize, reason: String| {
+        Error::BadTranscript(Box::new(BadTranscript {
             shown: shown.to_owned(),
-            source: Box::new(source),
-        },
-    })
+            line,
+            reason,
+        }))
+    };
+    // The room lines are taken out, blank, so the uploader reads the
+    // commands at their own lines.
+    let mut room = Vec::new();
+    let mut commands = String::new();
+    let mut any_command = false;
+    for (index, raw) in text.lines().enumerate() {
+        let content = raw.split('#').next().unwrap_or("").trim();
+        match room_lines::parse(content) {
+            Some(Ok(line)) => room.push(Step::Room(index + 1, line)),
+            Some(Err(reason)) => return Err(bad(index + 1, reason)),
+            None => {
+                any_command |= !content.is_empty();
+                commands.push_str(raw);
+            }
+        }
+        commands.push('\n');
+    }
+    let expectations = if any_command || room.is_empty() {
+        Expectations::parse(&commands).map_err(|error| match error {
+            uploader::Error::BadExpectations { line, reason } => bad(line, reason),
+            source => Error::Transcript {
+                shown: shown.to_owned(),
+                source: Box::new(source),
+            },
+        })?
+    } else {
+        Expectations::default()
+    };
+    let mut steps: Vec<Step> = expectations.lines.into_iter().map(Step::Command).collect();
+    steps.extend(room);
+    steps.sort_by_key(|step| match step {
+        Step::Command(e) => e.line,
+        Step::Room(line, _) => *line,
+    });
+    Ok(Transcript { steps })
 }
 
 /// What the times of a check are measured in.

@@ -1,0 +1,119 @@
+//! `--path FILE.svg` on `test` and `debug` (issue 28, 2), as on `sim`:
+//! the robot's path in its room (a world file) drawn when the run ends,
+//! one picture per transcript for `test`.
+
+use std::path::Path;
+
+use crate::{scorpion, scorpion_with_input, transcript};
+
+/// The example room, copied into `dir`.
+fn room(dir: &Path) {
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/room/room.toml");
+    std::fs::copy(example, dir.join("room.toml")).expect("the example room");
+}
+
+#[test]
+fn debug_draws_the_path_of_its_session() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    room(dir.path());
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--world", "room.toml", "--path", "path.svg"],
+        "/8C+500100\n/8D+500100\ncontinue 600000\nquit\n",
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let picture = std::fs::read_to_string(dir.path().join("path.svg")).expect("the picture");
+    assert!(picture.starts_with("<svg "), "{picture}");
+    assert!(picture.contains(">/8C+500100 at "), "{picture}");
+    assert!(picture.contains("<polyline"), "the trail: {picture}");
+}
+
+#[test]
+fn debug_path_needs_a_room() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let output = scorpion_with_input(Some(dir.path()), &["debug", "--path", "path.svg"], "quit\n");
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    assert!(
+        transcript(&output).contains("--path draws the robot in its room"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+#[test]
+fn test_draws_one_picture_per_transcript() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    assert!(scorpion(dir.path(), &["new", "probe"]).status.success());
+    let project = dir.path().join("probe");
+    room(&project);
+    let file = project.join("Scorpion.toml");
+    let text = std::fs::read_to_string(&file).expect("the project file");
+    std::fs::write(
+        &file,
+        text.replace("cards = []", "cards = []\nworld = \"room.toml\""),
+    )
+    .expect("the world in the project");
+    std::fs::write(
+        project.join("tests/drive.expect"),
+        "/8C+500100\n/8D+500100\nwait 600ms\npose => x=111cm y=100cm within 1cm\n",
+    )
+    .expect("the transcript");
+    let output = scorpion(&project, &["test", "--path", "out/run.svg"]);
+    // The directory is the user's to make.
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    std::fs::create_dir(project.join("out")).expect("out/");
+    let output = scorpion(&project, &["test", "--path", "out/run.svg"]);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    for stem in ["probe", "drive"] {
+        let picture = std::fs::read_to_string(project.join(format!("out/run-{stem}.svg")))
+            .expect("a picture per transcript");
+        assert!(picture.starts_with("<svg "), "{picture}");
+    }
+    let drive = std::fs::read_to_string(project.join("out/run-drive.svg")).expect("drive");
+    assert!(drive.contains(">/8D+500100 at "), "{drive}");
+}
+
+/// examples/linefollow: the line-follower operating system follows the
+/// curved tape of its room.toml to its end, its transcript asserting the
+/// pose there; its path drawn. Moved 20 cm along the line, the pose its
+/// transcript requires fails.
+#[test]
+fn the_line_follower_follows_its_curved_line_to_the_end() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/linefollow");
+    let project = dir.path().join("linefollow");
+    copy_dir(&example, &project);
+    let output = scorpion(&project, &["test", "--path", "path.svg"]);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let picture =
+        std::fs::read_to_string(project.join("path-follow.svg")).expect("the follower's path");
+    assert!(picture.contains(">/2L1 at "), "{picture}");
+
+    let expect = project.join("tests/follow.expect");
+    let text = std::fs::read_to_string(&expect).expect("the transcript");
+    assert!(text.contains("x=230cm y=170cm"), "{text}");
+    std::fs::write(&expect, text.replace("x=230cm y=170cm", "x=230cm y=190cm"))
+        .expect("a wrong pose");
+    let output = scorpion(&project, &["test", "follow"]);
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    assert!(
+        transcript(&output).contains("tests/follow.expect:6: `pose` answered `x=229.5cm y=171.5cm"),
+        "{}",
+        transcript(&output)
+    );
+}
+
+/// Copies the directory `from` into `to`, without its `target/`.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for entry in std::fs::read_dir(from).expect("the example").flatten() {
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            if entry.file_name() != "target" {
+                copy_dir(&entry.path(), &target);
+            }
+        } else {
+            std::fs::copy(entry.path(), &target).expect("a copy");
+        }
+    }
+}
