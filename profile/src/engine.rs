@@ -182,10 +182,9 @@ struct Pending {
 #[derive(Debug, Clone)]
 pub struct Profiler {
     flows: [Flow; 256],
-    /// Executions by address.
-    pub(crate) counts: Vec<u64>,
-    /// Cycles by address.
-    pub(crate) cycles: Vec<u64>,
+    /// Executions and cycles by address, side by side: one cache line
+    /// for both at each instruction.
+    pub(crate) by_address: Vec<[u64; 2]>,
     /// Conditional branches taken, by address.
     pub(crate) taken: Vec<u64>,
     /// Conditional branches not taken, by address.
@@ -202,8 +201,6 @@ pub struct Profiler {
     /// Calls, commands and stacks counted too (not for coverage alone).
     calls: bool,
     pub(crate) commands: Vec<CommandRun>,
-    /// Cycles counted (instructions and interrupt sequences).
-    pub(crate) total: u64,
     /// Laps of idle loops counted without running.
     pub(crate) skipped_laps: u64,
     /// The cycle the last instruction or interrupt sequence counted ended
@@ -230,8 +227,7 @@ impl Profiler {
             watched,
             calls: true,
             flows: flow::table(),
-            counts: vec![0; 0x1_0000],
-            cycles: vec![0; 0x1_0000],
+            by_address: vec![[0; 2]; 0x1_0000],
             taken: vec![0; 0x1_0000],
             not_taken: vec![0; 0x1_0000],
             pending: None,
@@ -242,7 +238,6 @@ impl Profiler {
             labels: Labels::new(labels),
             places,
             commands: Vec::new(),
-            total: 0,
             skipped_laps: 0,
             last_end: None,
         }
@@ -302,7 +297,19 @@ impl Profiler {
     /// Cycles counted so far.
     #[must_use]
     pub fn total_cycles(&self) -> u64 {
-        self.total
+        // Every cycle counted is counted at an address: the sum is the
+        // total (kept out of the per-instruction count).
+        self.by_address.iter().map(|place| place[1]).sum()
+    }
+
+    /// Executions by address.
+    pub(crate) fn counts(&self) -> Vec<u64> {
+        self.by_address.iter().map(|place| place[0]).collect()
+    }
+
+    /// Cycles by address.
+    pub(crate) fn cycles(&self) -> Vec<u64> {
+        self.by_address.iter().map(|place| place[1]).collect()
     }
 
     // Out of line: the CPU's run loop keeps its registers (inlined, this
@@ -329,9 +336,9 @@ impl Profiler {
         let at = usize::from(ran.pc);
         let cycles = ran.cycles * times;
         self.last_end = Some(end);
-        self.counts[at] += times;
-        self.cycles[at] += cycles;
-        self.total += cycles;
+        let place = &mut self.by_address[at];
+        place[0] += times;
+        place[1] += cycles;
         let flow = self.flows[usize::from(ran.opcode)];
         if flow == Flow::Branch {
             if ran.next_pc == ran.pc.wrapping_add(2) {
@@ -497,8 +504,7 @@ impl Hooks for Profiler {
         // The sequence's own seven cycles are the handler's, counted at
         // its first instruction (its address, so its line and label):
         // cycles by address add up to the total, as routines' do.
-        self.total += 7;
-        self.cycles[usize::from(cpu.pc)] += 7;
+        self.by_address[usize::from(cpu.pc)][1] += 7;
         self.last_end = Some(began + 7);
         if self.calls {
             self.stack.interrupt(routine, s_before, began);
