@@ -156,10 +156,12 @@ pub struct CommandRun {
 /// An instruction that ran, as the ring keeps it.
 #[derive(Debug, Clone, Copy, Default)]
 struct Ran {
+    /// Its cycles, saturated (an idle loop's instruction has a few): the
+    /// ring's entries stay 16 bytes, one store per instruction cheaper.
+    cycles: u32,
     pc: u16,
-    opcode: u8,
-    cycles: u64,
     next_pc: u16,
+    opcode: u8,
     s_before: u8,
     s_after: u8,
 }
@@ -316,25 +318,27 @@ impl Profiler {
     // would crowd them out of machine registers on every instruction).
     #[inline(never)]
     fn count_pending(&mut self, pending: Pending, end: u64, next_pc: u16, s_after: u8) {
+        let cycles = end.saturating_sub(pending.start);
         let ran = Ran {
             pc: pending.pc,
             opcode: pending.opcode,
-            cycles: end.saturating_sub(pending.start),
+            cycles: u32::try_from(cycles).unwrap_or(u32::MAX),
             next_pc,
             s_before: pending.s,
             s_after,
         };
-        self.count(ran, 1, end);
+        self.count(ran, cycles, 1, end);
         self.ring[self.ring_next] = ran;
         self.ring_next = (self.ring_next + 1) % RING;
         self.ring_len = (self.ring_len + 1).min(RING);
     }
 
-    /// Counts `ran`, `times` times over, the last one ending at `end`.
+    /// Counts `ran`, which took `cycles`, `times` times over, the last
+    /// one ending at `end`.
     #[inline(always)]
-    fn count(&mut self, ran: Ran, times: u64, end: u64) {
+    fn count(&mut self, ran: Ran, cycles: u64, times: u64, end: u64) {
         let at = usize::from(ran.pc);
-        let cycles = ran.cycles * times;
+        let cycles = cycles * times;
         self.last_end = Some(end);
         let place = &mut self.by_address[at];
         place[0] += times;
@@ -426,13 +430,13 @@ impl Profiler {
         }
         let first = (self.ring_next + RING - len) % RING;
         let lap: Vec<Ran> = (0..len).map(|i| self.ring[(first + i) % RING]).collect();
-        let lap_cycles: u64 = lap.iter().map(|ran| ran.cycles).sum();
+        let lap_cycles: u64 = lap.iter().map(|ran| u64::from(ran.cycles)).sum();
         // Calls made and ended within the lap cost a lap's share; the
         // clock they see starts where the skipped laps began.
         let mut clock = cpu.cycles().saturating_sub(laps * lap_cycles);
         for ran in lap {
-            clock += ran.cycles;
-            self.count(ran, laps, clock);
+            clock += u64::from(ran.cycles);
+            self.count(ran, u64::from(ran.cycles), laps, clock);
         }
         self.skipped_laps += laps;
         // The instruction the probe asked about last is the lap's first
