@@ -156,10 +156,12 @@ pub struct CommandRun {
 /// An instruction that ran, as the ring keeps it.
 #[derive(Debug, Clone, Copy, Default)]
 struct Ran {
+    /// Its cycles, saturated (an idle loop's instruction has a few): the
+    /// ring's entries stay 16 bytes, one store per instruction cheaper.
+    cycles: u32,
     pc: u16,
-    opcode: u8,
-    cycles: u64,
     next_pc: u16,
+    opcode: u8,
     s_before: u8,
     s_after: u8,
 }
@@ -182,10 +184,9 @@ struct Pending {
 #[derive(Debug, Clone)]
 pub struct Profiler {
     flows: [Flow; 256],
-    /// Executions by address.
-    pub(crate) counts: Vec<u64>,
-    /// Cycles by address.
-    pub(crate) cycles: Vec<u64>,
+    /// Executions and cycles by address, side by side: one cache line
+    /// for both at each instruction.
+    pub(crate) by_address: Vec<[u64; 2]>,
     /// Conditional branches taken, by address.
     pub(crate) taken: Vec<u64>,
     /// Conditional branches not taken, by address.
@@ -202,8 +203,6 @@ pub struct Profiler {
     /// Calls, commands and stacks counted too (not for coverage alone).
     calls: bool,
     pub(crate) commands: Vec<CommandRun>,
-    /// Cycles counted (instructions and interrupt sequences).
-    pub(crate) total: u64,
     /// Laps of idle loops counted without running.
     pub(crate) skipped_laps: u64,
     /// The cycle the last instruction or interrupt sequence counted ended
@@ -230,8 +229,7 @@ impl Profiler {
             watched,
             calls: true,
             flows: flow::table(),
-            counts: vec![0; 0x1_0000],
-            cycles: vec![0; 0x1_0000],
+            by_address: vec![[0; 2]; 0x1_0000],
             taken: vec![0; 0x1_0000],
             not_taken: vec![0; 0x1_0000],
             pending: None,
@@ -242,7 +240,6 @@ impl Profiler {
             labels: Labels::new(labels),
             places,
             commands: Vec::new(),
-            total: 0,
             skipped_laps: 0,
             last_end: None,
         }
@@ -302,36 +299,50 @@ impl Profiler {
     /// Cycles counted so far.
     #[must_use]
     pub fn total_cycles(&self) -> u64 {
-        self.total
+        // Every cycle counted is counted at an address: the sum is the
+        // total (kept out of the per-instruction count).
+        self.by_address.iter().map(|place| place[1]).sum()
+    }
+
+    /// Executions by address.
+    pub(crate) fn counts(&self) -> Vec<u64> {
+        self.by_address.iter().map(|place| place[0]).collect()
+    }
+
+    /// Cycles by address.
+    pub(crate) fn cycles(&self) -> Vec<u64> {
+        self.by_address.iter().map(|place| place[1]).collect()
     }
 
     // Out of line: the CPU's run loop keeps its registers (inlined, this
     // would crowd them out of machine registers on every instruction).
     #[inline(never)]
     fn count_pending(&mut self, pending: Pending, end: u64, next_pc: u16, s_after: u8) {
+        let cycles = end.saturating_sub(pending.start);
         let ran = Ran {
             pc: pending.pc,
             opcode: pending.opcode,
-            cycles: end.saturating_sub(pending.start),
+            cycles: u32::try_from(cycles).unwrap_or(u32::MAX),
             next_pc,
             s_before: pending.s,
             s_after,
         };
-        self.count(ran, 1, end);
+        self.count(ran, cycles, 1, end);
         self.ring[self.ring_next] = ran;
         self.ring_next = (self.ring_next + 1) % RING;
         self.ring_len = (self.ring_len + 1).min(RING);
     }
 
-    /// Counts `ran`, `times` times over, the last one ending at `end`.
+    /// Counts `ran`, which took `cycles`, `times` times over, the last
+    /// one ending at `end`.
     #[inline(always)]
-    fn count(&mut self, ran: Ran, times: u64, end: u64) {
+    fn count(&mut self, ran: Ran, cycles: u64, times: u64, end: u64) {
         let at = usize::from(ran.pc);
-        let cycles = ran.cycles * times;
+        let cycles = cycles * times;
         self.last_end = Some(end);
-        self.counts[at] += times;
-        self.cycles[at] += cycles;
-        self.total += cycles;
+        let place = &mut self.by_address[at];
+        place[0] += times;
+        place[1] += cycles;
         let flow = self.flows[usize::from(ran.opcode)];
         if flow == Flow::Branch {
             if ran.next_pc == ran.pc.wrapping_add(2) {
@@ -419,13 +430,13 @@ impl Profiler {
         }
         let first = (self.ring_next + RING - len) % RING;
         let lap: Vec<Ran> = (0..len).map(|i| self.ring[(first + i) % RING]).collect();
-        let lap_cycles: u64 = lap.iter().map(|ran| ran.cycles).sum();
+        let lap_cycles: u64 = lap.iter().map(|ran| u64::from(ran.cycles)).sum();
         // Calls made and ended within the lap cost a lap's share; the
         // clock they see starts where the skipped laps began.
         let mut clock = cpu.cycles().saturating_sub(laps * lap_cycles);
         for ran in lap {
-            clock += ran.cycles;
-            self.count(ran, laps, clock);
+            clock += u64::from(ran.cycles);
+            self.count(ran, u64::from(ran.cycles), laps, clock);
         }
         self.skipped_laps += laps;
         // The instruction the probe asked about last is the lap's first
@@ -497,8 +508,7 @@ impl Hooks for Profiler {
         // The sequence's own seven cycles are the handler's, counted at
         // its first instruction (its address, so its line and label):
         // cycles by address add up to the total, as routines' do.
-        self.total += 7;
-        self.cycles[usize::from(cpu.pc)] += 7;
+        self.by_address[usize::from(cpu.pc)][1] += 7;
         self.last_end = Some(began + 7);
         if self.calls {
             self.stack.interrupt(routine, s_before, began);

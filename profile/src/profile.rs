@@ -173,14 +173,14 @@ impl Profile {
         }
         Profile {
             aliases,
-            counts: profiler.counts.clone(),
-            cycles: profiler.cycles.clone(),
+            counts: profiler.counts(),
+            cycles: profiler.cycles(),
             taken: profiler.taken.clone(),
             not_taken: profiler.not_taken.clone(),
             routines,
             stacks,
             commands: profiler.commands.clone(),
-            total: profiler.total,
+            total: profiler.total_cycles(),
             skipped_laps: profiler.skipped_laps,
             labels: labels.names.clone(),
         }

@@ -102,6 +102,10 @@ pub(crate) struct Stack {
     pub(crate) cells: Vec<u64>,
     pub(crate) cell_keys: Vec<(u32, u32)>,
     cell_ids: FxHashMap<(u32, u32), u32>,
+    /// By label (plus one, so none is 0): the node and cell it was last
+    /// charged in. A loop through a few labels finds its cells here
+    /// instead of hashing at every label it crosses.
+    cell_cache: Vec<(u32, u32)>,
     frames: Vec<Frame>,
     main: u32,
     /// The node code runs in now (the top frame's, or `main`'s).
@@ -127,6 +131,7 @@ impl Stack {
             cells: Vec::new(),
             cell_keys: Vec::new(),
             cell_ids: FxHashMap::default(),
+            cell_cache: Vec::new(),
             frames: Vec::new(),
             main: TOP,
             top: TOP,
@@ -187,12 +192,28 @@ impl Stack {
         let cell = if at == label && node == self.top {
             cell
         } else {
-            let node = self.top;
-            let cell = self.cell(node, label);
-            self.current = (node, label, cell);
-            cell
+            self.cached_cell(label)
         };
         self.cells[cell as usize] += cycles;
+    }
+
+    /// The cell of `label` in the top frame's node, made the current one.
+    fn cached_cell(&mut self, label: u32) -> u32 {
+        let node = self.top;
+        let slot = label.wrapping_add(1) as usize;
+        let cell = match self.cell_cache.get(slot) {
+            Some(&(cached, cell)) if cached == node => cell,
+            _ => {
+                let cell = self.cell(node, label);
+                if slot >= self.cell_cache.len() {
+                    self.cell_cache.resize(slot + 1, (u32::MAX, 0));
+                }
+                self.cell_cache[slot] = (node, cell);
+                cell
+            }
+        };
+        self.current = (node, label, cell);
+        cell
     }
 
     fn push(&mut self, routine: Routine, ends: Ends, entry: u64, times: u64) {
