@@ -156,10 +156,13 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         robot.set_bumpers(mask);
     }
     let mut commands = Vec::new();
+    // Kept only for a picture, and then bounded: a flood on stdin is not
+    // a list of commands to draw.
+    let drawn = room.is_some().then_some(&mut commands);
     let exit = if args.pty {
         serve_pty(&mut robot, resolved.baud.value, &printed)
     } else {
-        serve_stdio(&mut robot, resolved.baud.value, &printed, &mut commands)
+        serve_stdio(&mut robot, resolved.baud.value, &printed, drawn)
     }?;
     if let Some((path, view)) = room {
         std::fs::write(path, view.svg(&commands))
@@ -168,6 +171,10 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     }
     Ok(exit)
 }
+
+/// The most commands a picture of the path names: a session that sends
+/// more is a flood, and its picture would be unreadable anyway.
+const COMMANDS_DRAWN: usize = 4096;
 
 /// Emulated cycles for a wall-clock duration (the CPU runs at 1 MHz).
 fn cycles(elapsed: Duration) -> u64 {
@@ -416,7 +423,7 @@ fn serve_stdio(
     robot: &mut VirtualScorpion,
     baud: u32,
     printed: &[(String, cards::Printed)],
-    commands: &mut Vec<(u64, String)>,
+    mut commands: Option<&mut Vec<(u64, String)>>,
 ) -> miette::Result<ExitCode> {
     let (sender, chunks) = mpsc::sync_channel::<Option<Vec<u8>>>(CHUNKS_AHEAD);
     std::thread::spawn(move || {
@@ -454,13 +461,20 @@ fn serve_stdio(
         loop {
             match next {
                 Ok(Some(bytes)) => {
-                    // For the picture of the path: what arrived, when.
-                    let text = String::from_utf8_lossy(&bytes);
-                    commands.extend(
-                        text.split(['\r', '\n'])
-                            .filter(|command| !command.is_empty())
-                            .map(|command| (robot.cycles(), command.to_owned())),
-                    );
+                    // For the picture of the path: what arrived, when
+                    // (the first commands, each cut to what a label shows).
+                    if let Some(commands) = commands.as_deref_mut() {
+                        let text = String::from_utf8_lossy(&bytes);
+                        let room = COMMANDS_DRAWN.saturating_sub(commands.len());
+                        commands.extend(
+                            text.split(['\r', '\n'])
+                                .filter(|command| !command.is_empty())
+                                .take(room)
+                                .map(|command| {
+                                    (robot.cycles(), command.chars().take(32).collect())
+                                }),
+                        );
+                    }
                     line.accept(&bytes);
                 }
                 Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => ended = true,
