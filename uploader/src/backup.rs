@@ -293,6 +293,17 @@ pub fn restore<T: Transport>(
     progress: &mut dyn Progress,
 ) -> Result<Vec<UploadReport>> {
     let profile = &options.profile;
+    // Everything the file asks is checked before the robot is touched: a
+    // file refused half way must not have moved a hook first.
+    let memory = memory_options(options);
+    let whole = if backup.areas.is_empty() {
+        None
+    } else {
+        let whole = UploadImage::new(backup.areas.clone(), Vec::new())?;
+        memory.profile.check(&whole)?;
+        Some(whole)
+    };
+    check_hook_targets(backup, &memory.profile)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     crate::upload::connect(client, options)?;
@@ -302,19 +313,8 @@ pub fn restore<T: Transport>(
             switch_hook(client, profile.hook_address(kind), to, options.max_writes)?;
         }
     }
-    // The table is written as memory, flags and all, while no hook points
-    // into RAM: no table bookkeeping of the upload's own.
-    let mut memory = options.clone();
-    memory.profile.table = None;
-    if let Some((address, len)) = table_range(profile) {
-        memory
-            .profile
-            .writable
-            .push(address..=address + (len as u16 - 1));
-    }
     let mut reports = Vec::new();
-    if !backup.areas.is_empty() {
-        let whole = UploadImage::new(backup.areas.clone(), Vec::new())?;
+    if let Some(whole) = whole {
         let (through_loader, after) = split_for_loader(&memory, &whole, client.transport().baud())?;
         if let Some(image) = through_loader {
             reports.push(upload(client, &image, &memory, progress)?);
@@ -336,6 +336,44 @@ pub fn restore<T: Transport>(
         )?;
     }
     Ok(reports)
+}
+
+/// The options a restore writes memory with: the table is written as
+/// memory, flags and all, while no hook points into RAM (no table
+/// bookkeeping of the upload's own).
+fn memory_options(options: &UploadOptions) -> UploadOptions {
+    let mut memory = options.clone();
+    memory.profile.table = None;
+    if let Some((address, len)) = table_range(&options.profile) {
+        memory
+            .profile
+            .writable
+            .push(address..=address + (len as u16 - 1));
+    }
+    memory
+}
+
+/// A hook may go back to the ROM (its reset target, or anywhere in the
+/// ROM's bytes) or into memory an upload may write; never into the I/O
+/// page, the stack or the ROM's own RAM, where no code of an extension
+/// can be (a hook there stops the robot at its next command).
+fn check_hook_targets(backup: &Backup, profile: &crate::image::RomProfile) -> Result<()> {
+    for &(kind, target) in &backup.hooks {
+        let to_rom = profile.reset_target(kind) == Some(target)
+            || profile.rom.as_ref().is_some_and(|rom| {
+                u32::from(target) >= u32::from(rom.address) && u32::from(target) < rom.end()
+            });
+        let to_ram = profile.writable.iter().any(|range| range.contains(&target));
+        if !to_rom && !to_ram {
+            return Err(Error::BadImage {
+                reason: format!(
+                    "the backup points {} at ${target:04X}, which is neither the ROM nor memory an extension may hold; nothing was written",
+                    kind.rom_symbol()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Where the loader would run for a restore of `whole` (a hole at the top
@@ -516,6 +554,39 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("the end record holds $"), "{text}");
+    }
+
+    /// A hook into the I/O page, the ROM's zero page or the stack is
+    /// refused (`restore` asks this before it opens the line); RAM an
+    /// extension may hold and the ROM's own target are not.
+    #[test]
+    fn a_hook_into_the_io_page_or_the_roms_ram_is_refused_before_the_line_is_used() {
+        let profile = RomProfile::reference();
+        let options = UploadOptions {
+            profile: profile.clone(),
+            ..UploadOptions::default()
+        };
+        for target in [0xC000, 0x0000, 0x01FD] {
+            let backup = Backup {
+                areas: Vec::new(),
+                hooks: vec![(HookKind::Unknown, target)],
+            };
+            let said = check_hook_targets(&backup, &memory_options(&options).profile)
+                .expect_err("refused")
+                .to_string();
+            assert!(said.contains(&format!("${target:04X}")), "{said}");
+        }
+        let ram = Backup {
+            areas: Vec::new(),
+            hooks: vec![
+                (HookKind::Unknown, 0x0400),
+                (
+                    HookKind::Loop,
+                    profile.reset_target(HookKind::Loop).expect("known"),
+                ),
+            ],
+        };
+        assert!(check_hook_targets(&ram, &profile).is_ok());
     }
 
     #[test]
