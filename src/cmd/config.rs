@@ -155,6 +155,17 @@ pub(crate) fn images(resolved: &Resolved, given: &[PathBuf]) -> miette::Result<I
             let built = scorpion_project::runner::build::build(project, spec)?;
             images.push((built.name.clone(), built.linked.image));
         }
+    } else if let Ok(scorpion_project::Found::Workspace(workspace)) =
+        scorpion_project::Found::here()
+    {
+        // A workspace has no robot of its own: the robot runs bare, and
+        // says so, rather than seem to have lost the members' images.
+        let _ = writeln!(
+            std::io::stderr(),
+            "note: {} is a workspace of {}: the virtual Scorpion runs with no image (run this in a member's directory for its images, or give --image)",
+            scorpion_project::shown(&workspace.root.join(scorpion_project::FILE)),
+            workspace.member_names().join(", ")
+        );
     }
     Ok(Images {
         from_project: resolved.project.is_some(),

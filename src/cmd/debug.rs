@@ -60,18 +60,7 @@ pub(crate) struct Args {
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let here = std::env::current_dir().into_diagnostic()?;
     let ((make, images, root), room) = recipe_in_room(args, &here)?;
-    let room = match &args.path {
-        Some(path) => Some((
-            path,
-            room.get().ok_or_else(|| {
-                miette::miette!(
-                    help = "give a world file: `--world room.toml` (docs/WORLD.md)",
-                    "--path draws the robot in its room, and the robot has none"
-                )
-            })?,
-        )),
-        None => None,
-    };
+    let room = crate::cmd::rig::path_picture(args.path.as_ref(), room.get())?;
     // For the picture of the path: each command sent, at its robot time.
     let mut commands = Vec::new();
     let mut debugger = Debugger::new(make, &images)?;

@@ -96,3 +96,42 @@ pub(crate) fn show_printed(printed: &[(String, Printed)]) {
         }
     }
 }
+
+/// Where `--path FILE.svg` draws, checked before the run: the robot needs
+/// a room (`room`, the rig's view of it) and FILE's directory must exist,
+/// so that a long run does not end in "cannot write".
+pub(crate) fn path_picture<'p, V>(
+    path: Option<&'p PathBuf>,
+    room: Option<V>,
+) -> miette::Result<Option<(&'p PathBuf, V)>> {
+    let Some(path) = path else {
+        return Ok(None);
+    };
+    path_directory_exists(path)?;
+    let room = room.ok_or_else(|| {
+        miette::miette!(
+            help = "give a world file: `--world room.toml` (docs/WORLD.md)",
+            "--path draws the robot in its room, and the robot has none"
+        )
+    })?;
+    Ok(Some((path, room)))
+}
+
+/// `--path`'s directory exists (it is not created: a mistyped directory
+/// would scatter pictures).
+pub(crate) fn path_directory_exists(path: &std::path::Path) -> miette::Result<()> {
+    let directory = path
+        .parent()
+        .filter(|parent| !parent.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if directory.is_dir() {
+        Ok(())
+    } else {
+        Err(miette::miette!(
+            help = "make the directory first, or give a path in one that exists",
+            "--path {}: the directory {} does not exist",
+            path.display(),
+            directory.display()
+        ))
+    }
+}

@@ -140,18 +140,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let images = crate::cmd::config::images(&resolved, &args.images)?;
     let rig = crate::cmd::config::rig(&resolved);
     let (mut robot, printed) = robot(resolved.baud.value, rom.as_ref(), &rig, &images)?;
-    let room = match &args.path {
-        Some(path) => Some((
-            path,
-            rig.room.get().ok_or_else(|| {
-                miette::miette!(
-                    help = "give a world file: `--world room.toml` (docs/WORLD.md)",
-                    "--path draws the robot in its room, and the robot has none"
-                )
-            })?,
-        )),
-        None => None,
-    };
+    let room = crate::cmd::rig::path_picture(args.path.as_ref(), rig.room.get())?;
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }

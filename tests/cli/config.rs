@@ -643,3 +643,25 @@ fn test_on_a_port_replaces_an_earlier_build_only_when_asked() {
     assert!(out.contains("test upload adc ... ok"), "{out}");
     assert!(out.ends_with(" 0 failed\n"), "{out}");
 }
+
+/// In a workspace's root, `sim` and `debug` run a robot with no image, and
+/// say why, rather than seem to have lost the members' extensions (a new
+/// user's finding: `/1V` got no answer and nothing was said).
+#[test]
+fn sim_and_debug_in_a_workspace_say_the_robot_has_no_image() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(
+        dir.path().join("Scorpion.toml"),
+        "[workspace]\nmembers = [\"a\"]\n",
+    )
+    .expect("the workspace");
+    assert!(crate::scorpion(dir.path(), &["new", "a"]).status.success());
+    for args in [&["sim"][..], &["debug"][..]] {
+        let output = crate::scorpion_with_input(Some(dir.path()), args, "quit\n");
+        let said = crate::transcript(&output);
+        assert!(
+            said.contains("is a workspace of a: the virtual Scorpion runs with no image"),
+            "{args:?}: {said}"
+        );
+    }
+}

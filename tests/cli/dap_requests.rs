@@ -282,6 +282,19 @@ fn function_data_and_instruction_breakpoints() {
     ))
     .clone();
     assert_eq!(card["dataId"], "0x9000..0x9002", "{card}");
+    // Two bytes from $FFFF would be one: said, not watched short.
+    let past = ok(&c.request(
+        "dataBreakpointInfo",
+        json!({"name": "0xFFFF", "asAddress": true, "bytes": 2}),
+    ))
+    .clone();
+    assert!(past["dataId"].is_null(), "{past}");
+    assert!(
+        past["description"]
+            .as_str()
+            .is_some_and(|d| d.contains("run past $FFFF")),
+        "{past}"
+    );
     let set = c.request(
         "setDataBreakpoints",
         json!({"breakpoints": [{"dataId": info["dataId"], "accessType": "write"}]}),

@@ -117,3 +117,38 @@ fn copy_dir(from: &Path, to: &Path) {
         }
     }
 }
+
+/// A picture into a directory that does not exist is refused before the
+/// run, by each command that draws one, not after it with the verdict
+/// lost (a new user's finding).
+#[test]
+fn a_path_into_a_missing_directory_is_refused_before_the_run() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    assert!(scorpion(dir.path(), &["new", "probe"]).status.success());
+    let project = dir.path().join("probe");
+    room(&project);
+    let file = project.join("Scorpion.toml");
+    let text = std::fs::read_to_string(&file).expect("the project file");
+    std::fs::write(
+        &file,
+        text.replace("cards = []", "cards = []\nworld = \"room.toml\""),
+    )
+    .expect("the world in the project");
+    for args in [
+        &["test", "--path", "out/run.svg"][..],
+        &["sim", "--path", "out/run.svg"][..],
+        &["debug", "--path", "out/run.svg"][..],
+    ] {
+        let output = scorpion_with_input(Some(&project), args, "quit\n");
+        let said = transcript(&output);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {said}");
+        assert!(
+            said.contains("the directory out does not exist"),
+            "{args:?}: {said}"
+        );
+        assert!(
+            !said.contains("... ok"),
+            "refused before any test ran: {said}"
+        );
+    }
+}

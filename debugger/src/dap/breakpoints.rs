@@ -226,7 +226,15 @@ pub(crate) fn data_info(
             return Ok(no(format!("`bytes` is 1 to 65536, not {bytes}")));
         }
         let last = i64::from(start) + bytes - 1;
-        end = u16::try_from(last.min(0xFFFF)).unwrap_or(0xFFFF);
+        // Past $FFFF is said, not cut short without a word: the watch
+        // would cover fewer bytes than the client asked for.
+        let Ok(last) = u16::try_from(last) else {
+            return Ok(no(format!(
+                "{bytes} bytes from ${start:04X} run past $FFFF: at most {} fit",
+                0x1_0000 - i64::from(start)
+            )));
+        };
+        end = last;
     }
     let place = d
         .symbols()
