@@ -118,12 +118,23 @@ pub(crate) fn path_picture<'p, V>(
 }
 
 /// `--path`'s directory exists (it is not created: a mistyped directory
-/// would scatter pictures).
+/// would scatter pictures), and the path is not a FIFO or a device.
 pub(crate) fn path_directory_exists(path: &std::path::Path) -> miette::Result<()> {
     let directory = path
         .parent()
         .filter(|parent| !parent.as_os_str().is_empty())
         .unwrap_or(std::path::Path::new("."));
+    // An existing FIFO or device would block the write (or eat it) at
+    // the end of a long run: only a regular file is replaced.
+    if let Ok(meta) = std::fs::metadata(path)
+        && !meta.is_file()
+    {
+        return Err(miette::miette!(
+            help = "give the path of a file (it is created or replaced)",
+            "--path {}: not a regular file",
+            path.display()
+        ));
+    }
     if directory.is_dir() {
         Ok(())
     } else {

@@ -151,4 +151,15 @@ fn a_path_into_a_missing_directory_is_refused_before_the_run() {
             "refused before any test ran: {said}"
         );
     }
+    // A FIFO would block the picture's write for ever (a hostile tester's).
+    let fifo = project.join("pipe.svg");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let output = scorpion_with_input(Some(&project), &["sim", "--path", "pipe.svg"], "");
+    let said = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{said}");
+    assert!(said.contains("not a regular file"), "{said}");
 }
