@@ -100,10 +100,10 @@ pub(crate) fn show_printed(printed: &[(String, Printed)]) {
 /// Where `--path FILE.svg` draws, checked before the run: the robot needs
 /// a room (`room`, the rig's view of it) and FILE's directory must exist,
 /// so that a long run does not end in "cannot write".
-pub(crate) fn path_picture<'p, V>(
-    path: Option<&'p PathBuf>,
+pub(crate) fn path_picture<V>(
+    path: Option<&PathBuf>,
     room: Option<V>,
-) -> miette::Result<Option<(&'p PathBuf, V)>> {
+) -> miette::Result<Option<(&PathBuf, V)>> {
     let Some(path) = path else {
         return Ok(None);
     };
