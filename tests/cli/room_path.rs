@@ -12,6 +12,22 @@ fn room(dir: &Path) {
     std::fs::copy(example, dir.join("room.toml")).expect("the example room");
 }
 
+/// A new project `probe` in `dir` whose robot is in the example room
+/// (`[robot] world`).
+fn project_in_room(dir: &Path) -> std::path::PathBuf {
+    assert!(scorpion(dir, &["new", "probe"]).status.success());
+    let project = dir.join("probe");
+    room(&project);
+    let file = project.join("Scorpion.toml");
+    let text = std::fs::read_to_string(&file).expect("the project file");
+    std::fs::write(
+        &file,
+        text.replace("cards = []", "cards = []\nworld = \"room.toml\""),
+    )
+    .expect("the world in the project");
+    project
+}
+
 #[test]
 fn debug_draws_the_path_of_its_session() {
     let dir = tempfile::tempdir().expect("a temporary directory");
@@ -43,16 +59,7 @@ fn debug_path_needs_a_room() {
 #[test]
 fn test_draws_one_picture_per_transcript() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    assert!(scorpion(dir.path(), &["new", "probe"]).status.success());
-    let project = dir.path().join("probe");
-    room(&project);
-    let file = project.join("Scorpion.toml");
-    let text = std::fs::read_to_string(&file).expect("the project file");
-    std::fs::write(
-        &file,
-        text.replace("cards = []", "cards = []\nworld = \"room.toml\""),
-    )
-    .expect("the world in the project");
+    let project = project_in_room(dir.path());
     std::fs::write(
         project.join("tests/drive.expect"),
         "/8C+500100\n/8D+500100\nwait 600ms\npose => x=111cm y=100cm within 1cm\n",
@@ -124,16 +131,7 @@ fn copy_dir(from: &Path, to: &Path) {
 #[test]
 fn a_path_into_a_missing_directory_is_refused_before_the_run() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    assert!(scorpion(dir.path(), &["new", "probe"]).status.success());
-    let project = dir.path().join("probe");
-    room(&project);
-    let file = project.join("Scorpion.toml");
-    let text = std::fs::read_to_string(&file).expect("the project file");
-    std::fs::write(
-        &file,
-        text.replace("cards = []", "cards = []\nworld = \"room.toml\""),
-    )
-    .expect("the world in the project");
+    let project = project_in_room(dir.path());
     for args in [
         &["test", "--path", "out/run.svg"][..],
         &["sim", "--path", "out/run.svg"][..],
