@@ -163,23 +163,23 @@ fn a_path_into_a_missing_directory_is_refused_before_the_run() {
 }
 
 /// `--path FILE.png` (issue 28, 2): the same picture as the SVG of the
-/// same session (debug runs in robot time: both sessions are the same),
+/// same transcript (`test` runs in robot time: both runs are the same),
 /// rasterized at its size; the robot's outline drawn in the trail's blue
 /// where the SVG puts the robot at the end.
 #[test]
 fn a_png_path_is_the_svg_rasterized() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    room(dir.path());
-    let session = "/8C+500100\n/8D+500100\ncontinue 600000\nquit\n";
+    let project = project_in_room(dir.path());
+    std::fs::write(
+        project.join("tests/drive.expect"),
+        "/8C+500100\n/8D+500100\nwait 600ms\npose => x=111cm y=100cm within 1cm\n",
+    )
+    .expect("the transcript");
     for picture in ["path.svg", "path.png"] {
-        let output = scorpion_with_input(
-            Some(dir.path()),
-            &["debug", "--world", "room.toml", "--path", picture],
-            session,
-        );
+        let output = scorpion(&project, &["test", "drive", "--path", picture]);
         assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
     }
-    let svg = std::fs::read_to_string(dir.path().join("path.svg")).expect("the SVG");
+    let svg = std::fs::read_to_string(project.join("path-drive.svg")).expect("the SVG");
     let attribute = |from: &str, name: &str| -> f64 {
         let start = from.find(&format!(" {name}=\"")).expect(name) + name.len() + 3;
         from[start..start + from[start..].find('"').expect("a quote")]
@@ -201,7 +201,7 @@ fn a_png_path_is_the_svg_rasterized() {
     );
     assert!(cx > 105.0, "the robot moved east: {robot}");
 
-    let png = resvg::tiny_skia::Pixmap::load_png(dir.path().join("path.png")).expect("a PNG");
+    let png = resvg::tiny_skia::Pixmap::load_png(project.join("path-drive.png")).expect("a PNG");
     assert_eq!(
         (png.width(), png.height()),
         (

@@ -81,12 +81,12 @@ fn accept(listener: &TcpListener, hub: &Arc<Hub>) {
             refuse(stream);
             continue;
         };
-        let hub = Arc::clone(hub);
+        let shared = Arc::clone(hub);
         let spawned = std::thread::Builder::new()
             .name("view-client".into())
             .spawn(move || {
                 let _slot = slot;
-                serve(stream, &hub);
+                serve(stream, &shared);
             });
         if spawned.is_err() {
             hub.refused.fetch_add(1, Ordering::Relaxed);
