@@ -279,11 +279,11 @@ pub(crate) fn serve(robot: &mut VirtualScorpion, session: Session<'_>) -> miette
                     line.accept(b"\r");
                     console.push("sent", text);
                 }
-                Incoming::Pause => {
+                Incoming::Pause {} => {
                     clock.rebase(robot.cycles());
                     clock.paused = true;
                 }
-                Incoming::Run => {
+                Incoming::Run {} => {
                     clock.rebase(robot.cycles());
                     clock.paused = false;
                 }

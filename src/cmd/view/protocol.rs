@@ -29,10 +29,11 @@ pub(crate) enum Incoming {
         /// The line, as typed.
         text: String,
     },
-    /// Stop the robot's clock.
-    Pause,
+    /// Stop the robot's clock. (Braces: a unit variant would take
+    /// unknown fields without a word.)
+    Pause {},
     /// Start the robot's clock again.
-    Run,
+    Run {},
     /// Pause, then run the robot `ms` milliseconds of robot time.
     Step {
         /// Robot time, milliseconds (1 to 10 000).

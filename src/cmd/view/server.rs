@@ -349,9 +349,13 @@ fn socket(stream: TcpStream, hub: &Hub) {
         if let Some(message) = client.next(hub)
             && let Err(error) = send(&mut socket, &message)
         {
-            hub.say(&format!(
-                "view: {peer}: not reading ({error}); connection dropped"
-            ));
+            // A client that closed is gone; one whose frames cannot be
+            // written within WRITE_TIME is not reading.
+            if let tungstenite::Error::Io(error) = error {
+                hub.say(&format!(
+                    "view: {peer}: not reading ({error}); connection dropped"
+                ));
+            }
             return;
         }
     }
