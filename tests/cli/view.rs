@@ -218,6 +218,10 @@ fn the_console_round_trip_and_the_robot_moving_in_its_room() {
         json!([[0.0, 0.0], [300.0, 0.0], [300.0, 200.0], [0.0, 200.0]])
     );
     assert_eq!(room["room"]["obstacles"][0]["circle"]["radius"], 20.0);
+    // The body in the file's units: degrees.
+    assert_eq!(room["room"]["body"]["bumpers"][4], 0.0);
+    assert_eq!(room["room"]["body"]["bumpers"][6], 90.0);
+    assert_eq!(room["room"]["body"]["bumper_arc"], 45.0);
     let first = state(&mut socket, "a state frame", |_| true);
     assert_eq!(first["pose"]["x"], 100.0, "{first}");
 

@@ -62,6 +62,12 @@ async function main() {
       null,
       { timeout: PATIENCE },
     );
+    // And on the drawn robot: its front arc red.
+    await page.waitForFunction(
+      () => document.querySelector('#robot .bumper[data-bit="4"]').getAttribute("stroke") === "#c00",
+      null,
+      { timeout: PATIENCE },
+    );
     console.log("view: bumper 4 closed at the post");
     if (screenshot) await page.screenshot({ path: screenshot });
     if (errors.length) throw new Error(`the page's errors: ${errors.join("; ")}`);

@@ -143,6 +143,11 @@ impl From<Pose> for PoseJson {
     }
 }
 
+/// Radians to degrees, to a hundredth.
+fn degrees(radians: f64) -> f64 {
+    tenth(radians * 180.0 / cards::room::geometry::PI)
+}
+
 /// To a hundredth: the view draws at a fraction of a centimetre.
 fn tenth(value: f64) -> f64 {
     (value * 100.0).round() / 100.0
@@ -232,8 +237,9 @@ pub(crate) fn room_message(layout: Option<&Layout>) -> String {
             "start": PoseJson::from(layout.start),
             "body": {
                 "radius": body.radius,
-                "bumpers": body.bumpers,
-                "bumper_arc": body.bumper_arc,
+                // Degrees, as the file writes them (the room keeps radians).
+                "bumpers": body.bumpers.iter().map(|&b| degrees(b)).collect::<Vec<_>>(),
+                "bumper_arc": degrees(body.bumper_arc),
                 "left_tracker": [body.left_tracker.0, body.left_tracker.1],
                 "right_tracker": [body.right_tracker.0, body.right_tracker.1],
             },
@@ -257,6 +263,10 @@ impl Client {
     /// The next message for this client, if anything is new.
     pub(crate) fn next(&mut self, hub: &Hub) -> Option<Outgoing<'static>> {
         let (generation, frame) = hub.frame();
+        if frame.room.is_empty() {
+            // The robot's loop has not published its first frame yet.
+            return None;
+        }
         if self.room_version != Some(frame.room_version) {
             self.room_version = Some(frame.room_version);
             return Some(Outgoing::Raw(Arc::clone(&frame.room)));
