@@ -468,3 +468,41 @@ fn the_readmes_live_view_runs_as_written() {
         c.iter().any(|l| l == "answer A57")
     });
 }
+
+/// Stopped by a signal (Ctrl-C's SIGINT, or SIGTERM), the view draws
+/// `--path` with the commands typed in the browser and the room as it was
+/// left: the post where it was dragged.
+#[test]
+fn a_stopped_view_draws_its_path_with_the_room_as_left() {
+    let mut view = View::start(&["--path", "view.svg"]);
+    let mut socket = view.socket();
+    send(&mut socket, &json!({"type": "send", "text": "/1B"}));
+    send(
+        &mut socket,
+        &json!({"type": "move_obstacle", "index": 0, "x": 200.0, "y": 150.0}),
+    );
+    until(&mut socket, &mut Vec::new(), "the post moved", |m, _| {
+        m["type"] == "room" && m["room"]["obstacles"][0]["circle"]["x"] == 200.0
+    });
+    let killed = Command::new("kill")
+        .args(["-TERM", &view.child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = view.child.try_wait().expect("waited for") {
+            break status;
+        }
+        assert!(start.elapsed() < PATIENCE, "the view did not stop");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "{}", view.stderr());
+    let picture =
+        std::fs::read_to_string(view._dir.path().join("view.svg")).expect("the picture drawn");
+    assert!(picture.contains(">/1B at "), "{picture}");
+    assert!(
+        picture.contains(r#"<circle class="obstacle" cx="200.0""#),
+        "{picture}"
+    );
+}
