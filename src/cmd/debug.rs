@@ -53,7 +53,7 @@ pub(crate) struct Args {
     /// does: the room, the trail with a mark every second, the bumps and
     /// the commands sent. The trail is the robot's as it ran forward: a
     /// step back does not undraw it.
-    #[arg(long, value_name = "FILE.svg")]
+    #[arg(long, value_name = "FILE.svg|FILE.png")]
     pub(crate) path: Option<PathBuf>,
 }
 
@@ -146,7 +146,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         writeln!(out, "error: {}", Failure::from(error).message()).into_diagnostic()?;
     }
     if let Some((path, view)) = room {
-        std::fs::write(path, view.svg(&commands))
+        std::fs::write(path, view.picture_for(path, &commands)?)
             .into_diagnostic()
             .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
     }

@@ -21,3 +21,4 @@ pub(crate) mod rom;
 pub(crate) mod sim;
 pub(crate) mod test;
 pub(crate) mod upload;
+pub(crate) mod view;

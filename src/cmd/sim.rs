@@ -52,8 +52,22 @@ pub(crate) struct Args {
     /// Draw the robot's path in its room (a world file, `--world
     /// room.toml`) to FILE.svg when the run ends: the room, the trail with
     /// a mark every second, the bumps and the commands received.
-    #[arg(long, value_name = "FILE.svg")]
+    /// FILE.png draws the same picture rasterized (without its labels).
+    #[arg(long, value_name = "FILE.svg|FILE.png")]
     path: Option<PathBuf>,
+    /// Serve the live view instead of stdin: the room, the robot moving,
+    /// its serial console, bumpers, trackers, lamps and eyes, in the
+    /// browser at the address printed on stdout (`open
+    /// http://127.0.0.1:PORT/`; default 127.0.0.1 and a free port).
+    /// Ctrl-C stops it (and draws --path).
+    #[arg(
+        long,
+        value_name = "ADDR",
+        num_args = 0..=1,
+        default_missing_value = "127.0.0.1:0",
+        conflicts_with = "pty"
+    )]
+    view: Option<std::net::SocketAddr>,
 }
 
 /// A bumper mask in hex: `05`, `$05` or `0x05`.
@@ -144,6 +158,32 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     if let Some(mask) = args.bumpers {
         robot.set_bumpers(mask);
     }
+    if let Some(address) = args.view {
+        let ended = crate::cmd::view::serve(
+            &mut robot,
+            crate::cmd::view::Session {
+                address,
+                baud: resolved.baud.value,
+                printed: &printed,
+                room: rig.room.get(),
+            },
+        )?;
+        if let Some((path, view)) = room {
+            // The room as the session left it: obstacles where they were
+            // dragged.
+            let layout = ended.layout.unwrap_or_else(|| view.layout().clone());
+            let svg = cards::room::picture::svg(&layout, &view.trail(), &ended.commands);
+            let bytes = if cards::room::raster::wants_png(path) {
+                cards::room::raster::png(&svg)?
+            } else {
+                svg.into_bytes()
+            };
+            std::fs::write(path, bytes)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     let mut commands = Vec::new();
     // Kept only for a picture, and then bounded: a flood on stdin is not
     // a list of commands to draw.
@@ -154,7 +194,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         serve_stdio(&mut robot, resolved.baud.value, &printed, drawn)
     }?;
     if let Some((path, view)) = room {
-        std::fs::write(path, view.svg(&commands))
+        std::fs::write(path, view.picture_for(path, &commands)?)
             .into_diagnostic()
             .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
     }

@@ -79,7 +79,7 @@ pub(crate) struct Args {
     /// file, docs/WORLD.md) as sim's --path does, one picture per
     /// transcript beside FILE: `--path out/run.svg` draws
     /// `tests/patrol.expect` to `out/run-patrol.svg`.
-    #[arg(long, value_name = "FILE.svg")]
+    #[arg(long, value_name = "FILE.svg|FILE.png")]
     path: Option<std::path::PathBuf>,
 }
 

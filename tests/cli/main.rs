@@ -27,6 +27,8 @@ mod sim;
 mod sim_line;
 mod terminal;
 mod upload;
+mod view;
+mod view_browser;
 mod vscode;
 
 use std::process::{Command, Output};

@@ -161,3 +161,83 @@ fn a_path_into_a_missing_directory_is_refused_before_the_run() {
     assert_eq!(output.status.code(), Some(1), "{said}");
     assert!(said.contains("not a regular file"), "{said}");
 }
+
+/// `--path FILE.png` (issue 28, 2): the same picture as the SVG of the
+/// same transcript (`test` runs in robot time: both runs are the same),
+/// rasterized at its size; the robot's outline drawn in the trail's blue
+/// where the SVG puts the robot at the end.
+#[test]
+fn a_png_path_is_the_svg_rasterized() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = project_in_room(dir.path());
+    std::fs::write(
+        project.join("tests/drive.expect"),
+        "/8C+500100\n/8D+500100\nwait 600ms\npose => x=111cm y=100cm within 1cm\n",
+    )
+    .expect("the transcript");
+    for picture in ["path.svg", "path.png"] {
+        let output = scorpion(&project, &["test", "drive", "--path", picture]);
+        assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    }
+    let svg = std::fs::read_to_string(project.join("path-drive.svg")).expect("the SVG");
+    let attribute = |from: &str, name: &str| -> f64 {
+        let start = from.find(&format!(" {name}=\"")).expect(name) + name.len() + 3;
+        from[start..start + from[start..].find('"').expect("a quote")]
+            .parse()
+            .expect("a number")
+    };
+    let view_box: Vec<f64> = {
+        let start = svg.find("viewBox=\"").expect("a viewBox") + 9;
+        svg[start..start + svg[start..].find('"').expect("a quote")]
+            .split(' ')
+            .map(|n| n.parse().expect("a number"))
+            .collect()
+    };
+    let robot = &svg[svg.find(r#"<g class="robot">"#).expect("the robot")..];
+    let (cx, cy, r) = (
+        attribute(robot, "cx"),
+        attribute(robot, "cy"),
+        attribute(robot, "r"),
+    );
+    assert!(cx > 105.0, "the robot moved east: {robot}");
+
+    let png = resvg::tiny_skia::Pixmap::load_png(project.join("path-drive.png")).expect("a PNG");
+    assert_eq!(
+        (png.width(), png.height()),
+        (
+            (view_box[2] * 3.0).ceil() as u32,
+            (view_box[3] * 3.0).ceil() as u32
+        ),
+        "3 pixels a centimetre, as the SVG's size says"
+    );
+    let blue = |x: f64, y: f64| {
+        let (px, py) = (
+            ((x - view_box[0]) * 3.0) as i64,
+            ((y - view_box[1]) * 3.0) as i64,
+        );
+        (-2..=2).any(|dx| {
+            (-2..=2).any(|dy| {
+                let (Ok(x), Ok(y)) = (u32::try_from(px + dx), u32::try_from(py + dy)) else {
+                    return false;
+                };
+                png.pixel(x, y)
+                    .is_some_and(|p| (p.red(), p.green(), p.blue()) == (0, 102, 204))
+            })
+        })
+    };
+    // The outline's east and west edges, not its middle.
+    assert!(
+        blue(cx + r, cy) && blue(cx - r, cy),
+        "the robot's outline at ({cx}, {cy})"
+    );
+    assert!(
+        !blue(cx, cy + r / 2.0),
+        "inside the outline the floor shows"
+    );
+    let background = png.pixel(0, 0).expect("a corner");
+    assert_eq!(
+        (background.red(), background.green(), background.blue()),
+        (0xfa, 0xfa, 0xfa),
+        "the picture's floor"
+    );
+}

@@ -9,7 +9,9 @@
 pub mod drive;
 pub mod file;
 pub mod geometry;
+pub mod live;
 pub mod picture;
+pub mod raster;
 
 use std::sync::{Arc, Mutex};
 
@@ -50,6 +52,8 @@ pub const MAX_TRAIL: usize = 200_000;
 pub struct RoomView {
     trail: Arc<Mutex<Trail>>,
     layout: Arc<Layout>,
+    /// The host's changes of the room ([`live`]).
+    edits: Arc<live::Mailbox>,
 }
 
 impl RoomView {
@@ -106,6 +110,7 @@ impl Room {
                 bumps: Vec::new(),
             })),
             layout: Arc::new(layout.clone()),
+            edits: Arc::default(),
         };
         Ok(Room {
             layout,
@@ -238,6 +243,10 @@ impl Room {
 
 impl Surroundings for Room {
     fn next_wake(&self) -> Option<u64> {
+        if self.view.edits.pending() {
+            // Now: the host's edit is made even while the robot stands.
+            return Some(0);
+        }
         let script = self.script.as_ref().and_then(|s| s.next_wake());
         Some(script.map_or(self.next_look, |s| s.min(self.next_look)))
     }
@@ -247,9 +256,12 @@ impl Surroundings for Room {
         now: u64,
         robot: &mut Scorpion,
     ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>> {
+        let edited = self.take_edits(now);
         if now >= self.next_look {
             self.look(now, robot);
             self.next_look = now + TICK;
+        } else if edited {
+            self.look(now, robot);
         }
         if let Some(script) = &mut self.script
             && script.next_wake().is_some_and(|at| at <= now)
@@ -277,6 +289,7 @@ impl Surroundings for Room {
             view: RoomView {
                 trail: Arc::new(Mutex::new(self.view.trail())),
                 layout: Arc::clone(&self.view.layout),
+                edits: Arc::default(),
             },
         }))
     }

@@ -518,11 +518,16 @@ impl Run<'_, '_, '_> {
                     match (&self.options.path, &room) {
                         (Some(picture), Some(room)) => {
                             let file = path_picture(picture, &path);
-                            std::fs::write(&file, room.view.svg(&commands)).map_err(|source| {
+                            // A PNG that cannot be made is a picture not written.
+                            let picture = room.view.picture_for(&file, &commands).map_err(|e| {
                                 Error::Write {
                                     path: file.clone(),
-                                    source,
+                                    source: std::io::Error::other(e.to_string()),
                                 }
+                            })?;
+                            std::fs::write(&file, picture).map_err(|source| Error::Write {
+                                path: file.clone(),
+                                source,
                             })?;
                             result
                         }

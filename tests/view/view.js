@@ -1,0 +1,83 @@
+// Drives the live view of `scorpion sim --view` in the system's chromium,
+// headless, with playwright-core (no browser download): loads the page,
+// sends /2A1 from the console and sees the answer, then drives both
+// motors and sees the drawn robot move. Prints a line per step; exits 1
+// with what it saw on any failure.
+//
+// node view.js URL CHROMIUM [SCREENSHOT.png]
+"use strict";
+
+const { chromium } = require("playwright-core");
+
+const [url, executablePath, screenshot] = process.argv.slice(2);
+const PATIENCE = 30000;
+
+async function main() {
+  const browser = await chromium.launch({
+    executablePath,
+    headless: true,
+    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
+  });
+  try {
+    const page = await browser.newPage({ viewport: { width: 1200, height: 800 } });
+    const errors = [];
+    page.on("pageerror", (error) => errors.push(String(error)));
+    page.on("console", (message) => {
+      if (message.type() === "error") errors.push(message.text());
+    });
+    await page.goto(url);
+    await page.waitForSelector('#status[data-state="open"]', { timeout: PATIENCE });
+    console.log("view: connected");
+    await page.waitForSelector("#robot[data-x]", { timeout: PATIENCE });
+    const start = Number(await page.getAttribute("#robot", "data-x"));
+    console.log(`view: robot drawn at x=${start}`);
+
+    await page.fill("#command", "/2A1");
+    await page.press("#command", "Enter");
+    await page.waitForFunction(
+      () => [...document.querySelectorAll("#console .answer")].length >= 1,
+      null,
+      { timeout: PATIENCE },
+    );
+    const sent = await page.textContent("#console .sent");
+    const answer = await page.textContent("#console .answer");
+    console.log(`view: console ${sent} ${answer}`);
+
+    for (const command of ["/4C+40", "/4D+40"]) {
+      await page.fill("#command", command);
+      await page.press("#command", "Enter");
+    }
+    await page.waitForFunction(
+      (from) => Number(document.getElementById("robot").dataset.x) > from + 3,
+      start,
+      { timeout: PATIENCE },
+    );
+    const moved = Number(await page.getAttribute("#robot", "data-x"));
+    const transform = await page.getAttribute("#robot", "transform");
+    const trail = await page.getAttribute("#trail", "points");
+    console.log(`view: robot moved to x=${moved} (${transform}), trail of ${trail.trim().split(/\s+/).length} points`);
+    // The robot meets the post 45 cm ahead: its front bumper drawn closed.
+    await page.waitForFunction(
+      () => document.querySelector('#bumpers .bit[data-bit="4"]').classList.contains("on"),
+      null,
+      { timeout: PATIENCE },
+    );
+    // And on the drawn robot: its front arc red.
+    await page.waitForFunction(
+      () => document.querySelector('#robot .bumper[data-bit="4"]').getAttribute("stroke") === "#c00",
+      null,
+      { timeout: PATIENCE },
+    );
+    console.log("view: bumper 4 closed at the post");
+    if (screenshot) await page.screenshot({ path: screenshot });
+    if (errors.length) throw new Error(`the page's errors: ${errors.join("; ")}`);
+    console.log("view: done");
+  } finally {
+    await browser.close();
+  }
+}
+
+main().catch((error) => {
+  console.log(`view: failed: ${error && error.stack ? error.stack : error}`);
+  process.exit(1);
+});
