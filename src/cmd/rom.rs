@@ -63,15 +63,19 @@ fn refuse_non_rom(name: &str, image: &linker::Image) -> miette::Result<()> {
         .iter()
         .map(|area| format!("${:04X}-${:04X}", area.load, area.end().saturating_sub(1)))
         .collect();
+    let what = if in_rom {
+        "names none of the jump table's services".to_owned()
+    } else if loads.is_empty() {
+        "loads nothing".to_owned()
+    } else {
+        format!(
+            "loads {}, and a ROM loads at ${start:04X}-$FFFF",
+            loads.join(", ")
+        )
+    };
     Err(miette::miette!(
         help = "give a ROM profile (the ROM's linked ELF, or one `scorpion rom read` wrote), or leave --base out for the reference ROM's names",
-        "--base {name} is not a ROM profile: it loads {} and names {services} of the jump table's {} services (a ROM loads at ${start:04X}-$FFFF and names them)",
-        if loads.is_empty() {
-            "nothing".to_owned()
-        } else {
-            loads.join(", ")
-        },
-        uploader::SERVICES.len()
+        "--base {name} is not a ROM profile: it {what}"
     ))
 }
 

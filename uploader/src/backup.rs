@@ -847,6 +847,55 @@ mod tests {
         assert!(check_hook_targets(&ram, &profile).is_ok());
     }
 
+    /// An undo file whose hook goes back into an extension it holds only a
+    /// part of: the rest of that extension (as the kept table names it)
+    /// is witnessed; a hook at the ROM's target needs no witness.
+    #[test]
+    fn witnesses_cover_the_hooked_extension_less_what_the_backup_holds() {
+        let profile = RomProfile::reference();
+        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
+        let record = isa::objfmt::HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        };
+        let installed = romlib::installed::Installed::new(1, vec![0x0400..=0x0BFF], &[record]);
+        let mut flags = vec![0u8; entries];
+        flags[..installed.entries()].copy_from_slice(&installed.flags());
+        let rom_target = profile.reset_target(HookKind::Loop).expect("known");
+        let backup = Backup {
+            areas: vec![
+                Area {
+                    address: table,
+                    bytes: flags,
+                },
+                Area {
+                    address: romlib::installed::entry_address(table, entries, 0),
+                    bytes: installed.encode(),
+                },
+                Area {
+                    address: 0x0420,
+                    bytes: vec![0; 0x20],
+                },
+            ],
+            hooks: vec![(HookKind::Unknown, 0x0403), (HookKind::Loop, rom_target)],
+            ..Backup::default()
+        };
+        assert_eq!(
+            witness_ranges(&profile, &backup),
+            vec![(0x0400, 0x20), (0x0440, 0x0C00 - 0x0440)]
+        );
+        // No table entry names it: its first bytes.
+        let bare = Backup {
+            hooks: vec![(HookKind::Unknown, 0x0700)],
+            ..Backup::default()
+        };
+        assert_eq!(
+            witness_ranges(&profile, &bare),
+            vec![(0x0700, usize::from(WITNESS_WINDOW))]
+        );
+    }
+
     #[test]
     fn the_reference_backup_covers_zero_page_ram_and_the_table() {
         let ranges = backup_ranges(&RomProfile::reference());
