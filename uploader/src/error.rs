@@ -502,6 +502,21 @@ pub fn human_duration(duration: Duration) -> String {
     format!("{text} {unit}")
 }
 
+/// `$00F0, $00F1 and 3 more`: the first addresses of a list, for messages.
+pub(crate) fn addresses_text(addresses: &[u16]) -> String {
+    const SHOWN: usize = 8;
+    let mut text = addresses
+        .iter()
+        .take(SHOWN)
+        .map(|address| format!("${address:04X}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if addresses.len() > SHOWN {
+        text.push_str(&format!(" and {} more", addresses.len() - SHOWN));
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::human_duration;
@@ -520,19 +535,4 @@ mod tests {
         assert_eq!(human_duration(Duration::from_micros(10_400)), "10.4 ms");
         assert_eq!(human_duration(Duration::ZERO), "0 µs");
     }
-}
-
-/// `$00F0, $00F1 and 3 more`: the first addresses of a list, for messages.
-pub(crate) fn addresses_text(addresses: &[u16]) -> String {
-    const SHOWN: usize = 8;
-    let mut text = addresses
-        .iter()
-        .take(SHOWN)
-        .map(|address| format!("${address:04X}"))
-        .collect::<Vec<_>>()
-        .join(", ");
-    if addresses.len() > SHOWN {
-        text.push_str(&format!(" and {} more", addresses.len() - SHOWN));
-    }
-    text
 }
