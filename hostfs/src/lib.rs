@@ -10,6 +10,11 @@
 //! and reads at most that limit even if the file grows meanwhile, so no
 //! name makes a tool hang or exhaust memory. Its [`Error`] names the file,
 //! what it is and the limit.
+//!
+//! Files a tool writes go through [`check_writable`] (before the tool
+//! does its work: a FIFO would block the write at the end, a device eat
+//! it) and [`write`] (a temporary file in the same directory, renamed over
+//! the target, so an interrupted write leaves the old file whole).
 
 use std::fs::File;
 use std::io::{self, Read};
@@ -77,6 +82,31 @@ pub enum Error {
         offset: usize,
     },
 
+    /// A path to write names a directory, a device, a FIFO or a socket.
+    #[error("{}: {what}, not a regular file; nothing was written to it", path.display())]
+    #[diagnostic(
+        code(hostfs::not_writable),
+        help(
+            "give the path of a regular file (it is created or replaced): a pipe would block the write, a device eat it"
+        )
+    )]
+    NotWritable {
+        /// The path as given.
+        path: PathBuf,
+        /// What it is instead.
+        what: &'static str,
+    },
+
+    /// Writing failed (a missing directory, permissions, a full disk).
+    #[error("{}: cannot write it: {source}", path.display())]
+    #[diagnostic(code(hostfs::write))]
+    Write {
+        /// The path as given.
+        path: PathBuf,
+        /// What the system said.
+        source: io::Error,
+    },
+
     /// The system refused (permissions, an I/O error).
     #[error("{}: cannot read it: {source}", path.display())]
     #[diagnostic(code(hostfs::io))]
@@ -112,6 +142,8 @@ impl Error {
             | Error::NotAFile { path, .. }
             | Error::TooLarge { path, .. }
             | Error::NotText { path, .. }
+            | Error::NotWritable { path, .. }
+            | Error::Write { path, .. }
             | Error::Io { path, .. } => path,
         }
     }
@@ -131,9 +163,11 @@ impl From<Error> for io::Error {
     fn from(error: Error) -> io::Error {
         let kind = match &error {
             Error::NotFound { .. } => io::ErrorKind::NotFound,
-            Error::Io { source, .. } => source.kind(),
+            Error::Io { source, .. } | Error::Write { source, .. } => source.kind(),
             Error::NotText { .. } => io::ErrorKind::InvalidData,
-            Error::NotAFile { .. } | Error::TooLarge { .. } => io::ErrorKind::InvalidInput,
+            Error::NotAFile { .. } | Error::NotWritable { .. } | Error::TooLarge { .. } => {
+                io::ErrorKind::InvalidInput
+            }
         };
         io::Error::new(kind, error)
     }
@@ -245,6 +279,67 @@ pub fn read_text(path: impl AsRef<Path>, limit: Limit) -> Result<String, Error> 
         path: path.to_path_buf(),
         offset: e.utf8_error().valid_up_to(),
     })
+}
+
+/// Checks, without opening it, that `path` can be written as a regular
+/// file: nothing is there yet, or a regular file is (it is replaced), in
+/// a directory that exists.
+///
+/// # Errors
+/// [`Error::NotWritable`] for a FIFO, a device, a socket or a directory;
+/// [`Error::Write`] for a missing directory.
+pub fn check_writable(path: impl AsRef<Path>) -> Result<(), Error> {
+    let path = path.as_ref();
+    match std::fs::metadata(path) {
+        Ok(metadata) => match not_a_file(&metadata) {
+            Some(what) => Err(Error::NotWritable {
+                path: path.to_path_buf(),
+                what,
+            }),
+            None => Ok(()),
+        },
+        Err(_) => {
+            let directory = directory_of(path);
+            if directory.is_dir() {
+                Ok(())
+            } else {
+                Err(Error::Write {
+                    path: path.to_path_buf(),
+                    source: io::Error::new(
+                        io::ErrorKind::NotFound,
+                        format!("the directory {} does not exist", directory.display()),
+                    ),
+                })
+            }
+        }
+    }
+}
+
+fn directory_of(path: &Path) -> &Path {
+    path.parent()
+        .filter(|parent| !parent.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+/// Writes `bytes` to `path` through a temporary file in its directory,
+/// renamed over it: the file is whole or as it was.
+///
+/// # Errors
+/// As [`check_writable`] (asked again: the path may have changed since),
+/// and [`Error::Write`].
+pub fn write(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(), Error> {
+    use std::io::Write as _;
+    let path = path.as_ref();
+    check_writable(path)?;
+    let failed = |source: io::Error| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = tempfile::NamedTempFile::new_in(directory_of(path)).map_err(failed)?;
+    file.write_all(bytes).map_err(failed)?;
+    file.as_file().sync_all().map_err(failed)?;
+    file.persist(path).map_err(|error| failed(error.error))?;
+    Ok(())
 }
 
 #[cfg(test)]

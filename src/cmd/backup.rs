@@ -7,7 +7,6 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use miette::{Context, IntoDiagnostic};
 use uploader::{Backup, NoProgress, UploadOptions};
 
 use crate::cmd::ports;
@@ -33,14 +32,18 @@ pub(crate) struct RestoreArgs {
     line: ports::Line,
     /// The backup file.
     file: PathBuf,
+    /// Restore onto a robot whose ROM differs from the one the backup was
+    /// taken from (its code's calls into the ROM may land elsewhere).
+    #[arg(long)]
+    force: bool,
 }
 
 pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
+    // A FIFO or a device is refused before the line is used.
+    hostfs::check_writable(&args.output)?;
     let (mut client, profile) = ports::probed(&args.line)?;
     let backup = uploader::backup(&mut client, &profile)?;
-    std::fs::write(&args.output, backup.encode())
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
+    hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
         "saved {} bytes and {} hooks to {}",
         backup.len(),
@@ -56,7 +59,7 @@ pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
     let transport = ports::open_resolved(&resolved, &[])?;
     let rom = crate::cmd::config::rom(&resolved)?;
     let profile = crate::cmd::config::profile(rom.as_ref())?;
-    restore_into(transport, profile, &backup, &args.file)
+    restore_into(transport, profile, &backup, &args.file, args.force)
 }
 
 /// Restores `backup` (from `file`) through `transport` into a robot with
@@ -66,9 +69,11 @@ pub(crate) fn restore_into(
     profile: uploader::RomProfile,
     backup: &Backup,
     file: &Path,
+    force_rom: bool,
 ) -> miette::Result<ExitCode> {
     let options = UploadOptions {
         profile,
+        force_rom,
         ..UploadOptions::default()
     };
     let mut client = uploader::client(transport, &options.profile);

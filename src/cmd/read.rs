@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use miette::{Context, IntoDiagnostic};
+use miette::IntoDiagnostic;
 
 use crate::args;
 use crate::cmd::ports;
@@ -33,12 +33,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             args.address
         );
     }
+    // A FIFO or a device is refused before the line is used, not blocked
+    // on after the read.
+    if let Some(path) = &args.output {
+        hostfs::check_writable(path)?;
+    }
     let (mut client, _) = ports::probed(&args.line)?;
     let bytes = client.read_memory(args.address, args.length as usize)?;
     match &args.output {
-        Some(path) => std::fs::write(path, &bytes)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("cannot write {}", path.display()))?,
+        Some(path) => hostfs::write(path, &bytes)?,
         None => {
             let mut out = std::io::stdout().lock();
             debugger::monitor::write_dump(&mut out, args.address, &bytes).into_diagnostic()?;

@@ -83,7 +83,7 @@ pub(crate) struct Args {
 /// read, before the image's bytes go out.
 struct UndoFile {
     path: PathBuf,
-    failed: Option<std::io::Error>,
+    failed: Option<miette::Report>,
 }
 
 impl uploader::Keep for UndoFile {
@@ -91,11 +91,12 @@ impl uploader::Keep for UndoFile {
         if let Some(parent) = self.path.parent().filter(|p| !p.as_os_str().is_empty())
             && let Err(error) = std::fs::create_dir_all(parent)
         {
-            self.failed = Some(error);
+            self.failed = Some(miette::miette!("{error}"));
             return;
         }
-        if let Err(error) = std::fs::write(&self.path, overwritten.encode()) {
-            self.failed = Some(error);
+        // Through a temporary file: an undo file is whole or the last one.
+        if let Err(error) = hostfs::write(&self.path, &overwritten.encode()) {
+            self.failed = Some(error.into());
         }
     }
 }
@@ -337,12 +338,16 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     resolved.port()?;
     if args.undo {
         let path = args.undo_path();
-        let backup = crate::cmd::backup::read_backup(&path)
-            .wrap_err("nothing to undo: no upload has kept what it overwrote there")?;
+        let backup = read_undo(&path)?;
         let transport = ports::open_resolved(&resolved, &[])?;
         let rom = crate::cmd::config::rom(&resolved)?;
         let profile = crate::cmd::config::profile(rom.as_ref())?;
-        return crate::cmd::backup::restore_into(transport, profile, &backup, &path);
+        return crate::cmd::backup::restore_into(transport, profile, &backup, &path, false);
+    }
+    // The undo file is written during the upload: a FIFO or a device there
+    // would block it half way, so it is refused before the robot is touched.
+    if !resolved.is_emulated() {
+        undo_file_writable(&args.undo_path())?;
     }
     match &args.image {
         Some(path) => upload_file(args, &resolved, path),
@@ -362,6 +367,32 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// The undo file, read: a missing one is "nothing to undo"; a damaged
+/// one or something that is not a file says what is wrong with it.
+fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
+    match hostfs::check(path, hostfs::BACKUP) {
+        Err(error) if error.is_not_found() => Err(miette::miette!(
+            help = "`scorpion upload` keeps what it overwrites there; give `--undo-file` if it kept it elsewhere",
+            "nothing to undo: {} does not exist (no upload has kept what it overwrote there)",
+            path.display()
+        )),
+        _ => crate::cmd::backup::read_backup(path)
+            .wrap_err_with(|| format!("cannot undo from {}", path.display())),
+    }
+}
+
+/// The undo file can be written: its directory made (a project's
+/// `target/scorpion`), and no FIFO, device or directory at its path.
+fn undo_file_writable(path: &Path) -> miette::Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .map_err(|error| miette::miette!("cannot make {}: {error}", parent.display()))?;
+    }
+    hostfs::check_writable(path)
+        .map_err(miette::Report::from)
+        .wrap_err("--undo-file: the upload keeps what it overwrites there")
 }
 
 /// Uploads the linked image at `path`.

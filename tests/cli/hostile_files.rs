@@ -238,3 +238,32 @@ fn backups_undo_files_and_base_profiles_that_are_not_files_are_refused() {
         refused(&bounded(dir.path(), &all), &[said]);
     }
 }
+
+/// Issue 28's hostile tester: a world file that is not UTF-8 is named as
+/// the world file (not "the script"); a `script` it names that is missing
+/// is said at the `script` key of the world file, file:line:col.
+#[test]
+fn a_world_file_and_the_script_it_names_are_said_for_what_they_are() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(dir.path().join("latin1.toml"), b"# caf\xE9\nwalls = []\n")
+        .expect("a world file");
+    let output = bounded(dir.path(), &["sim", "--world", "latin1.toml"]);
+    refused(
+        &output,
+        &["cannot read the world file latin1.toml", "not UTF-8 text"],
+    );
+    assert!(!transcript(&output).contains("the script"));
+
+    std::fs::write(
+        dir.path().join("room.toml"),
+        "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]\nscript = \"gone.rhai\"\n[robot]\nx = 100\ny = 100\n",
+    )
+    .expect("a world file");
+    refused(
+        &bounded(dir.path(), &["sim", "--world", "room.toml"]),
+        &[
+            "room.toml:2:10: cannot read the world script: gone.rhai: no such file",
+            "script = \"gone.rhai\"",
+        ],
+    );
+}

@@ -51,17 +51,23 @@ impl Drop for Sim {
 /// An extension of `len` bytes at $0400 (`JMP chain`, a handler that falls
 /// through, filler), with the byte at `changed` (if any) altered.
 fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
+    extension_at(0x0400, len, changed)
+}
+
+/// [`extension_elf`] at `base` instead of $0400.
+fn extension_at(base: u16, len: usize, changed: Option<usize>) -> Vec<u8> {
     let mut bytes: Vec<u8> = (0..len).map(|i| (i * 37 + 11) as u8).collect();
-    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04]);
+    let [low, high] = base.to_le_bytes();
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, low, high]);
     if let Some(at) = changed {
         bytes[at] ^= 0x5A;
     }
     let image = Image {
-        entry: 0x0403,
+        entry: u32::from(base) + 3,
         flags: 0,
         areas: vec![LoadArea {
-            load: 0x0400,
-            run: 0x0400,
+            load: u32::from(base),
+            run: u32::from(base),
             bytes,
         }],
         sections: vec![],
@@ -69,8 +75,8 @@ fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
         hooks: Hooks {
             records: vec![HookRecord {
                 kind: HookKind::Unknown,
-                handler: 0x0403,
-                chain: Some(0x0401),
+                handler: base + 3,
+                chain: Some(base + 1),
             }],
         },
         lines: isa::objfmt::SrcMap::default(),
@@ -286,4 +292,219 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         std::fs::read(dir.path().join("after.bak")).expect("a backup"),
         std::fs::read(dir.path().join("robot.bak")).expect("a backup"),
     );
+}
+
+/// `scorpion ARGS` in `dir`, killed after `seconds` (exit status 124):
+/// for what used to hang.
+fn scorpion_within(dir: &std::path::Path, seconds: u32, args: &[&str]) -> std::process::Output {
+    Command::new("timeout")
+        .arg(seconds.to_string())
+        .arg(env!("CARGO_BIN_EXE_scorpion"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .env("COLUMNS", "100")
+        .output()
+        .expect("timeout runs")
+}
+
+/// What the robot holds (RAM, table, hooks), as `scorpion backup` saves it.
+fn robot_state(dir: &std::path::Path, line: &[&str], name: &str) -> Vec<u8> {
+    let mut args = vec!["backup", "-o", name];
+    args.extend(line);
+    let output = scorpion(dir, &args);
+    assert!(output.status.success(), "{}", transcript(&output));
+    std::fs::read(dir.join(name)).expect("a backup")
+}
+
+/// Hostile F4: an undo file kept on one robot, where the hook went back
+/// into an earlier copy of the image, undone on another robot whose RAM
+/// does not hold that copy: refused, naming the memory and its sums,
+/// before any hook moved.
+#[test]
+fn undo_on_another_robot_is_refused_before_any_hook_moves() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(2048, None)).expect("the image");
+    std::fs::write(dir.path().join("ext2.elf"), extension_elf(2048, Some(1000)))
+        .expect("the image");
+    let first = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", first.path.as_str(), "--baud", "19200"];
+    for args in [
+        vec!["upload", "ext.elf", "--no-dry-run"],
+        vec!["upload", "ext2.elf", "--no-dry-run", "--replace"],
+    ] {
+        let mut args = args;
+        args.extend(line);
+        let output = scorpion(dir.path(), &args);
+        assert!(output.status.success(), "{}", transcript(&output));
+    }
+    drop(first);
+
+    let other = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", other.path.as_str(), "--baud", "19200"];
+    let before = robot_state(dir.path(), &line, "before.bak");
+    let mut args = vec!["upload", "--undo"];
+    args.extend(line);
+    let output = scorpion_within(dir.path(), 120, &args);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("uploader::witness_differs"), "{text}");
+    assert!(text.contains("$0400-"), "{text}");
+    assert_eq!(robot_state(dir.path(), &line, "after.bak"), before);
+}
+
+/// Hostile F5: an output that is a FIFO is refused before the line is
+/// used, not blocked on (each run is killed after 60 s on the old code).
+#[test]
+fn outputs_to_a_fifo_are_refused_before_the_robot_is_touched() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(600, None)).expect("the image");
+    let made = Command::new("mkfifo")
+        .arg(dir.path().join("pipe"))
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let before = robot_state(dir.path(), &line, "before.bak");
+    for args in [
+        vec!["upload", "ext.elf", "--no-dry-run", "--undo-file", "pipe"],
+        vec!["backup", "-o", "pipe"],
+        vec!["rom", "read", "-o", "pipe"],
+        vec!["read", "$0400", "16", "-o", "pipe"],
+    ] {
+        let mut all = args.clone();
+        all.extend(line);
+        let output = scorpion_within(dir.path(), 60, &all);
+        let text = transcript(&output);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {text}");
+        assert!(
+            text.contains("pipe: a FIFO (named pipe)"),
+            "{args:?}: {text}"
+        );
+    }
+    assert_eq!(robot_state(dir.path(), &line, "after.bak"), before);
+}
+
+/// Hostile F6: `--replace --loader always` where the loader cannot be
+/// used (another extension is hooked in front of the replaced one) is
+/// refused before the replaced extension leaves its chain.
+#[test]
+fn a_loader_refusal_comes_before_a_replace_changes_anything() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("a.elf"), extension_at(0x0400, 600, None)).expect("A");
+    std::fs::write(dir.path().join("b.elf"), extension_at(0x0800, 300, None)).expect("B");
+    std::fs::write(
+        dir.path().join("a2.elf"),
+        extension_at(0x0400, 600, Some(300)),
+    )
+    .expect("A changed");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    for image in ["a.elf", "b.elf"] {
+        let mut args = vec!["upload", image, "--no-dry-run"];
+        args.extend(line);
+        let output = scorpion(dir.path(), &args);
+        assert!(output.status.success(), "{}", transcript(&output));
+    }
+    let before = robot_state(dir.path(), &line, "before.bak");
+    let mut args = vec![
+        "upload",
+        "a2.elf",
+        "--no-dry-run",
+        "--replace",
+        "--loader",
+        "always",
+    ];
+    args.extend(line);
+    let output = scorpion(dir.path(), &args);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("nothing was changed"), "{text}");
+    assert_eq!(robot_state(dir.path(), &line, "after.bak"), before);
+}
+
+/// Hostile F7: reading memory the robot writes while it runs (its zero
+/// page and receive buffer) is not blamed on the line.
+#[test]
+fn reading_ram_in_use_says_the_bytes_changed_and_where() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let output = scorpion_within(
+        dir.path(),
+        300,
+        &[
+            "read", "$0000", "512", "--port", &sim.path, "--baud", "19200",
+        ],
+    );
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("uploader::memory_changing"), "{text}");
+    assert!(
+        text.contains("changed between reads of $0000-$01FF"),
+        "{text}"
+    );
+    assert!(!text.contains("uploader::unreadable"), "{text}");
+}
+
+/// Hostile F8: a backup taken from a robot with another ROM is refused
+/// on this one, saying what differs, and restored with `--force`.
+#[test]
+fn a_backup_from_another_rom_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (rom, theirs, ours) = changed_rom();
+    std::fs::write(dir.path().join("changed.elf"), rom).expect("write the ROM");
+    let changed = Sim::start(dir.path(), &["--rom", "changed.elf", "--baud", "19200"]);
+    robot_state(
+        dir.path(),
+        &["--port", changed.path.as_str(), "--baud", "19200"],
+        "theirs.bak",
+    );
+    drop(changed);
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let mut args = vec!["restore", "theirs.bak"];
+    args.extend(line);
+    let output = scorpion(dir.path(), &args);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("uploader::backup_rom_differs"), "{text}");
+    // The backup holds the changed ROM's byte; the robot the reference's.
+    assert!(
+        text.contains(&format!("$FF2E: expected ${ours:02X}, found ${theirs:02X}")),
+        "{text}"
+    );
+    args.push("--force");
+    let output = scorpion(dir.path(), &args);
+    assert!(output.status.success(), "{}", transcript(&output));
+}
+
+/// Hostile minor findings: a missing undo file and a damaged one are told
+/// apart; `rom read --base` refuses an extension's image.
+#[test]
+fn undo_file_errors_say_what_is_wrong_and_rom_read_refuses_an_extension_base() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(600, None)).expect("the image");
+    std::fs::write(
+        dir.path().join("damaged.undo"),
+        b"SCORPION-BACKUP 1\nA\x00\x04",
+    )
+    .expect("a damaged undo file");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let run = |args: &[&str]| {
+        let mut all = args.to_vec();
+        all.extend(["--port", sim.path.as_str(), "--baud", "19200"]);
+        let output = scorpion(dir.path(), &all);
+        assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+        transcript(&output)
+    };
+    let text = run(&["upload", "--undo", "--undo-file", "missing.undo"]);
+    assert!(text.contains("missing.undo does not exist"), "{text}");
+    let text = run(&["upload", "--undo", "--undo-file", "damaged.undo"]);
+    assert!(!text.contains("nothing to undo"), "{text}");
+    assert!(text.contains("(at byte 19)"), "{text}");
+    let text = run(&["rom", "read", "--base", "ext.elf", "-o", "rom.elf"]);
+    assert!(text.contains("is not a ROM profile"), "{text}");
+    assert!(text.contains("$0400-$0657"), "{text}");
+    assert!(!dir.path().join("rom.elf").exists());
 }

@@ -9,6 +9,9 @@
 //! SCORPION-BACKUP 1\n                       magic line (ASCII)
 //! 'A' address:u16 length:u16 bytes...       memory (repeated)
 //! 'H' kind:u8 target:u16                    a hook's target (0 HOOK_UNKNOWN, 1 HOOK_LOOP)
+//! 'W' address:u16 length:u16 sum:u16        a witness: the Fletcher-16 of memory a hook
+//!                                           target lies in, not held by the file itself
+//! 'R' address:u16 length:u16 bytes...       the robot's ROM there (its jump table, vectors)
 //! 'E' fnv1a32:u32                           end: FNV-1a 32 of every byte before 'E'
 //! ```
 //!
@@ -37,6 +40,28 @@ pub struct Backup {
     pub areas: Vec<Area>,
     /// Each hook's target.
     pub hooks: Vec<(HookKind, u16)>,
+    /// What the code a hook goes back to summed when the file was written,
+    /// where the file does not hold that code itself (an upload's undo
+    /// file keeps only what the upload overwrote): a restore compares each
+    /// with the robot's memory before any hook moves, so that no hook is
+    /// pointed at code that is not there (another robot, a restore since).
+    pub witnesses: Vec<Witness>,
+    /// The bytes of the robot's ROM where an image's calls land (its jump
+    /// table and vectors) when the file was written: a restore onto a robot
+    /// whose ROM differs there is refused.
+    pub rom: Vec<Area>,
+}
+
+/// The Fletcher-16 ([`crate::fletcher16`]) of `len` bytes from `address`,
+/// as the robot held them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Witness {
+    /// The first address.
+    pub address: u16,
+    /// How many bytes.
+    pub len: u16,
+    /// Their Fletcher-16.
+    pub sum: u16,
 }
 
 /// Where an upload keeps what it is about to overwrite.
@@ -92,6 +117,18 @@ impl Backup {
             out.push(b'H');
             out.push(kind_code(kind));
             out.extend_from_slice(&target.to_le_bytes());
+        }
+        for witness in &self.witnesses {
+            out.push(b'W');
+            out.extend_from_slice(&witness.address.to_le_bytes());
+            out.extend_from_slice(&witness.len.to_le_bytes());
+            out.extend_from_slice(&witness.sum.to_le_bytes());
+        }
+        for area in &self.rom {
+            out.push(b'R');
+            out.extend_from_slice(&area.address.to_le_bytes());
+            out.extend_from_slice(&(area.bytes.len() as u16).to_le_bytes());
+            out.extend_from_slice(&area.bytes);
         }
         let sum = fnv1a32(&out);
         out.push(b'E');
@@ -188,6 +225,32 @@ impl Backup {
                         .hooks
                         .push((kind, u16::from_le_bytes([record[1], record[2]])));
                 }
+                b'W' => {
+                    let record = take(&mut at, 6)?;
+                    let word = |i: usize| u16::from_le_bytes([record[i], record[i + 1]]);
+                    let (address, len) = (word(0), word(2));
+                    if u32::from(address) + u32::from(len) > 0x1_0000 {
+                        return Err(bad(start, "a witness runs past $FFFF"));
+                    }
+                    backup.witnesses.push(Witness {
+                        address,
+                        len,
+                        sum: word(4),
+                    });
+                }
+                b'R' => {
+                    let head = take(&mut at, 4)?;
+                    let address = u16::from_le_bytes([head[0], head[1]]);
+                    let len = usize::from(u16::from_le_bytes([head[2], head[3]]));
+                    if u32::from(address) + len as u32 > 0x1_0000 {
+                        return Err(bad(start, "a ROM record runs past $FFFF"));
+                    }
+                    let data = take(&mut at, len)?.to_vec();
+                    backup.rom.push(Area {
+                        address,
+                        bytes: data,
+                    });
+                }
                 b'E' => {
                     let sum = take(&mut at, 4)?;
                     let sum = u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]);
@@ -208,7 +271,7 @@ impl Backup {
                 other => {
                     return Err(bad(
                         start,
-                        &format!("an unknown record: expected A, H or E, found ${other:02X}"),
+                        &format!("an unknown record: expected A, H, W, R or E, found ${other:02X}"),
                     ));
                 }
             }
@@ -272,7 +335,184 @@ pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Res
             bytes: client.read_memory(address, len)?,
         });
     }
-    Ok(Backup { areas, hooks })
+    // The robot's own ROM, not the profile's: a restore compares with it.
+    let mut rom = Vec::new();
+    for range in &profile.jump_table {
+        let len = usize::from(range.end() - range.start()) + 1;
+        rom.push(Area {
+            address: *range.start(),
+            bytes: client.read_memory(*range.start(), len)?,
+        });
+    }
+    let mut backup = Backup {
+        areas,
+        hooks,
+        rom,
+        ..Backup::default()
+    };
+    let ranges = witness_ranges(profile, &backup);
+    backup.witnesses = read_witnesses(client, &ranges)?;
+    Ok(backup)
+}
+
+/// How many bytes at a hook's target are witnessed when no entry of the
+/// table says how far its extension reaches.
+const WITNESS_WINDOW: u16 = 16;
+
+/// The memory whose sums witness `backup`'s hooks: for each hook that a
+/// restore points into RAM, the extents of the installed extension (in
+/// the backup's own table) that holds its target, or the first
+/// [`WITNESS_WINDOW`] bytes at the target where no entry holds it; less
+/// what the backup holds itself (a restore writes and verifies that).
+pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16, usize)> {
+    let installed = backup_table(profile, backup);
+    let mut marked = vec![false; 0x1_0000];
+    for &(kind, target) in &backup.hooks {
+        if profile.reset_target(kind) == Some(target) || in_rom(profile, target) {
+            continue;
+        }
+        let extents: Vec<std::ops::RangeInclusive<u16>> = installed
+            .iter()
+            .filter(|entry| entry.extents.iter().any(|extent| extent.contains(&target)))
+            .flat_map(|entry| entry.extents.iter().cloned())
+            .collect();
+        if extents.is_empty() {
+            let end = profile
+                .writable
+                .iter()
+                .find(|range| range.contains(&target))
+                .map_or(target, |range| *range.end());
+            let end = end.min(target.saturating_add(WITNESS_WINDOW - 1));
+            marked[usize::from(target)..=usize::from(end)].fill(true);
+        } else {
+            for extent in extents {
+                marked[usize::from(*extent.start())..=usize::from(*extent.end())].fill(true);
+            }
+        }
+    }
+    for area in &backup.areas {
+        let start = usize::from(area.address);
+        marked[start..start + area.bytes.len()].fill(false);
+    }
+    let mut ranges: Vec<(u16, usize)> = Vec::new();
+    for (address, &wanted) in marked.iter().enumerate() {
+        if !wanted {
+            continue;
+        }
+        match ranges.last_mut() {
+            Some((start, len)) if usize::from(*start) + *len == address => *len += 1,
+            _ => ranges.push((address as u16, 1)),
+        }
+    }
+    ranges
+}
+
+/// The witnesses of `ranges`, from bytes read until two answers agree.
+pub(crate) fn read_witnesses<T: Transport>(
+    client: &mut Client<T>,
+    ranges: &[(u16, usize)],
+) -> Result<Vec<Witness>> {
+    let mut witnesses = Vec::new();
+    for &(address, len) in ranges {
+        let bytes = client.read_memory(address, len)?;
+        witnesses.push(Witness {
+            address,
+            len: len as u16,
+            sum: crate::sums::fletcher16(&bytes),
+        });
+    }
+    Ok(witnesses)
+}
+
+/// The profile's ROM bytes of its jump table and vectors (the upload that
+/// keeps them has compared them with the robot's).
+pub(crate) fn profile_rom(profile: &RomProfile) -> Vec<Area> {
+    let Some(rom) = &profile.rom else {
+        return Vec::new();
+    };
+    profile
+        .jump_table
+        .iter()
+        .filter_map(|range| {
+            let start = usize::from(range.start().checked_sub(rom.address)?);
+            let end = usize::from(range.end().checked_sub(rom.address)?) + 1;
+            Some(Area {
+                address: *range.start(),
+                bytes: rom.bytes.get(start..end)?.to_vec(),
+            })
+        })
+        .collect()
+}
+
+fn in_rom(profile: &RomProfile, target: u16) -> bool {
+    profile.rom.as_ref().is_some_and(|rom| {
+        u32::from(target) >= u32::from(rom.address) && u32::from(target) < rom.end()
+    })
+}
+
+/// The extensions the backup's copy of the table lists (none where it
+/// holds no table, or one that does not decode: the hooks' targets are
+/// then witnessed by their first bytes).
+fn backup_table(profile: &RomProfile, backup: &Backup) -> Vec<romlib::installed::Installed> {
+    let Some((at, entries)) = profile.table else {
+        return Vec::new();
+    };
+    let len = entries * (1 + romlib::installed::ENTRY_LEN);
+    let bytes: Vec<u8> = (0..len)
+        .map(|i| backup.byte_at(u32::from(at) + i as u32).unwrap_or(0))
+        .collect();
+    romlib::installed::decode_table(at, entries, &bytes).unwrap_or_default()
+}
+
+impl Backup {
+    /// The byte the backup holds at `address`, if it holds one.
+    #[must_use]
+    pub fn byte_at(&self, address: u32) -> Option<u8> {
+        self.areas.iter().find_map(|area| {
+            let offset = address.checked_sub(u32::from(area.address))?;
+            area.bytes.get(offset as usize).copied()
+        })
+    }
+}
+
+/// Refuses a restore onto a robot whose ROM differs from the one the
+/// backup was taken from (the RAM it holds calls into that ROM), and one
+/// whose memory under a hook's target no longer sums as it did.
+fn check_robot<T: Transport>(
+    client: &mut Client<T>,
+    backup: &Backup,
+    force_rom: bool,
+) -> Result<()> {
+    if !force_rom {
+        let mut differences = Vec::new();
+        for area in &backup.rom {
+            let found = client.read_memory(area.address, area.bytes.len())?;
+            differences.extend(
+                area.bytes
+                    .iter()
+                    .zip(&found)
+                    .enumerate()
+                    .filter(|(_, (wanted, found))| wanted != found)
+                    .map(|(i, (&wanted, &found))| (area.address + i as u16, wanted, found)),
+            );
+        }
+        if !differences.is_empty() {
+            return Err(Error::BackupRomDiffers { differences });
+        }
+    }
+    for witness in &backup.witnesses {
+        let bytes = client.read_memory(witness.address, usize::from(witness.len))?;
+        let found = crate::sums::fletcher16(&bytes);
+        if found != witness.sum {
+            return Err(Error::WitnessDiffers {
+                address: witness.address,
+                len: witness.len,
+                expected: witness.sum,
+                found,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Puts `backup` back into the robot, verified, hooks last: first every
@@ -283,9 +523,15 @@ pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Res
 /// the backup, verified. A reset or a lost byte on the way leaves every
 /// hook at the ROM's target or at verified code.
 ///
+/// Before any hook moves, the robot's ROM is compared with the one the
+/// backup was taken from ([`Error::BackupRomDiffers`], unless
+/// `options.force_rom`) and each [`Witness`] with the robot's memory
+/// ([`Error::WitnessDiffers`]).
+///
 /// # Errors
-/// [`Error::WrongRom`], [`Error::BadImage`] for memory an upload may not
-/// write, and every error an upload has.
+/// [`Error::WrongRom`], [`Error::BackupRomDiffers`],
+/// [`Error::WitnessDiffers`], [`Error::BadImage`] for memory an upload may
+/// not write, and every error an upload has.
 pub fn restore<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
@@ -308,6 +554,7 @@ pub fn restore<T: Transport>(
     // left the robot there: `connect` finds it and asks it back.
     crate::upload::connect(client, options)?;
     fingerprint::check_jump_table(client, profile)?;
+    check_robot(client, backup, options.force_rom)?;
     for kind in HookKind::ALL {
         if let Some(to) = profile.reset_target(kind) {
             switch_hook(client, profile.hook_address(kind), to, options.max_writes)?;
@@ -468,6 +715,15 @@ mod tests {
                 },
             ],
             hooks: vec![(HookKind::Unknown, 0xFF21), (HookKind::Loop, 0x0456)],
+            witnesses: vec![Witness {
+                address: 0x0800,
+                len: 0x40,
+                sum: 0x1234,
+            }],
+            rom: vec![Area {
+                address: 0xFFFA,
+                bytes: vec![1, 2, 3, 4, 5, 6],
+            }],
         }
     }
 
@@ -570,6 +826,7 @@ mod tests {
             let backup = Backup {
                 areas: Vec::new(),
                 hooks: vec![(HookKind::Unknown, target)],
+                ..Backup::default()
             };
             let said = check_hook_targets(&backup, &memory_options(&options).profile)
                 .expect_err("refused")
@@ -585,8 +842,58 @@ mod tests {
                     profile.reset_target(HookKind::Loop).expect("known"),
                 ),
             ],
+            ..Backup::default()
         };
         assert!(check_hook_targets(&ram, &profile).is_ok());
+    }
+
+    /// An undo file whose hook goes back into an extension it holds only a
+    /// part of: the rest of that extension (as the kept table names it)
+    /// is witnessed; a hook at the ROM's target needs no witness.
+    #[test]
+    fn witnesses_cover_the_hooked_extension_less_what_the_backup_holds() {
+        let profile = RomProfile::reference();
+        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
+        let record = isa::objfmt::HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        };
+        let installed = romlib::installed::Installed::new(1, vec![0x0400..=0x0BFF], &[record]);
+        let mut flags = vec![0u8; entries];
+        flags[..installed.entries()].copy_from_slice(&installed.flags());
+        let rom_target = profile.reset_target(HookKind::Loop).expect("known");
+        let backup = Backup {
+            areas: vec![
+                Area {
+                    address: table,
+                    bytes: flags,
+                },
+                Area {
+                    address: romlib::installed::entry_address(table, entries, 0),
+                    bytes: installed.encode(),
+                },
+                Area {
+                    address: 0x0420,
+                    bytes: vec![0; 0x20],
+                },
+            ],
+            hooks: vec![(HookKind::Unknown, 0x0403), (HookKind::Loop, rom_target)],
+            ..Backup::default()
+        };
+        assert_eq!(
+            witness_ranges(&profile, &backup),
+            vec![(0x0400, 0x20), (0x0440, 0x0C00 - 0x0440)]
+        );
+        // No table entry names it: its first bytes.
+        let bare = Backup {
+            hooks: vec![(HookKind::Unknown, 0x0700)],
+            ..Backup::default()
+        };
+        assert_eq!(
+            witness_ranges(&profile, &bare),
+            vec![(0x0700, usize::from(WITNESS_WINDOW))]
+        );
     }
 
     #[test]

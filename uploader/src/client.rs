@@ -567,7 +567,10 @@ impl<T: Transport> Client<T> {
     ///
     /// # Errors
     /// [`Error::BadImage`] if the range runs past `$FFFF`,
-    /// [`Error::Unreadable`] when a span keeps failing, [`Error::Stalled`].
+    /// [`Error::Unreadable`] when a span keeps failing, [`Error::Stalled`],
+    /// [`Error::MemoryChanging`] when well-formed answers kept differing at
+    /// the same addresses ([`CHANGING`] times or more): memory the robot
+    /// writes while it runs.
     pub fn read_memory(&mut self, address: u16, len: usize) -> Result<Vec<u8>> {
         if u32::from(address) + len as u32 > 0x1_0000 {
             return Err(Error::BadImage {
@@ -582,6 +585,9 @@ impl<T: Transport> Client<T> {
             std::collections::HashMap::new();
         let mut failures = 0u32;
         let mut last_error = None;
+        // How often each address differed between two well-formed answers.
+        let mut changes: std::collections::HashMap<u16, u32> = std::collections::HashMap::new();
+        let mut pairs = 0u32;
         while remaining > 0 {
             while let Some(&span) = todo.front() {
                 if !self.can_ask(span.count()) {
@@ -600,8 +606,17 @@ impl<T: Transport> Client<T> {
                             let offset = usize::from(span.address() - address);
                             out[offset..offset + data.len()].copy_from_slice(&data);
                         } else {
-                            if candidates.insert(span.address(), data).is_some() {
+                            if let Some(before) = candidates.insert(span.address(), data.clone()) {
                                 failures += 1;
+                                pairs += 1;
+                                // Two well-formed answers that differ: noise
+                                // garbles a digit here and there, memory the
+                                // robot writes differs at the same places.
+                                for (i, (was, is)) in before.iter().zip(&data).enumerate() {
+                                    if was != is {
+                                        *changes.entry(span.address() + i as u16).or_insert(0) += 1;
+                                    }
+                                }
                             }
                             todo.push_back(span);
                         }
@@ -618,6 +633,19 @@ impl<T: Transport> Client<T> {
                     Outcome::Stray(error) => last_error = error.or(last_error),
                 }
                 if failures > 40 * self.config.question_attempts {
+                    let mut changed: Vec<u16> = changes
+                        .iter()
+                        .filter(|&(_, &times)| times >= CHANGING && times * 4 >= pairs)
+                        .map(|(&address, _)| address)
+                        .collect();
+                    if !changed.is_empty() {
+                        changed.sort_unstable();
+                        return Err(Error::MemoryChanging {
+                            address,
+                            last: (u32::from(address) + len as u32 - 1) as u16,
+                            changed,
+                        });
+                    }
                     return Err(Error::Unreadable {
                         address,
                         attempts: failures,
@@ -633,6 +661,12 @@ impl<T: Transport> Client<T> {
 /// The least difference between the byte counts of two questions in
 /// flight: an answer must lose or gain 16 characters to pass for another.
 pub(crate) const COUNT_SPACING: u8 = 8;
+
+/// How many times one address must differ between well-formed answers
+/// (and in a quarter of the pairs that differed at all) for a failed read
+/// to be blamed on memory in use rather than noise: noise garbles a digit
+/// at a random place, memory in use differs at the same ones each time.
+pub(crate) const CHANGING: u32 = 4;
 
 /// Splits a range into `/7R` spans of at most 99 bytes whose counts step
 /// down 99, 91, 83, 75 and repeat, so that questions in flight differ in

@@ -246,6 +246,68 @@ pub enum Error {
         attempts: u32,
     },
 
+    /// The robot's ROM is not the one a backup was taken from: the RAM it
+    /// holds calls into that ROM. Nothing was changed.
+    #[error(
+        "the robot's ROM is not the one the backup was taken from: {}",
+        crate::fingerprint::describe(differences, None)
+    )]
+    #[diagnostic(
+        code(uploader::backup_rom_differs),
+        help(
+            "restore it onto the robot it was taken from; `--force` restores it anyway (its code's calls into the ROM may land elsewhere)"
+        )
+    )]
+    BackupRomDiffers {
+        /// Bytes of the jump table and vectors that differ: address, in
+        /// the backup, on the robot.
+        differences: Vec<(u16, u8, u8)>,
+    },
+
+    /// Memory a restored hook would point into no longer holds what it
+    /// held when the backup was written. Nothing was changed.
+    #[error(
+        "${address:04X}-${end:04X}, the code a hook goes back to, is not what it was when the backup was written: its Fletcher-16 was ${expected:04X}, the robot's is ${found:04X}; nothing was changed",
+        end = u32::from(*address) + u32::from(*len) - 1
+    )]
+    #[diagnostic(
+        code(uploader::witness_differs),
+        help(
+            "the hook would point at code that is not there: this is another robot, or a restore or upload has changed it since; upload the image instead of undoing"
+        )
+    )]
+    WitnessDiffers {
+        /// The first address.
+        address: u16,
+        /// How many bytes.
+        len: u16,
+        /// The sum in the backup.
+        expected: u16,
+        /// The robot's.
+        found: u16,
+    },
+
+    /// Reads of the same bytes kept answering differently, well formed:
+    /// memory the robot writes while it runs, not a noisy line.
+    #[error(
+        "the bytes at {} changed between reads of ${address:04X}-${last:04X}: this memory is in use (the robot writes it while it runs), not a noisy line",
+        crate::error::addresses_text(changed)
+    )]
+    #[diagnostic(
+        code(uploader::memory_changing),
+        help(
+            "read memory the robot does not write while it runs (its zero page, receive buffer and stack change with every command); the reads stop after two answers agree"
+        )
+    )]
+    MemoryChanging {
+        /// The first address of the read.
+        address: u16,
+        /// Its last address.
+        last: u16,
+        /// The addresses whose bytes changed between well-formed answers.
+        changed: Vec<u16>,
+    },
+
     /// The answers kept being malformed or lost.
     #[error("gave up reading ${address:04X} after {attempts} garbled or lost answers")]
     #[diagnostic(
@@ -438,6 +500,21 @@ pub fn human_duration(duration: Duration) -> String {
         false => text,
     };
     format!("{text} {unit}")
+}
+
+/// `$00F0, $00F1 and 3 more`: the first addresses of a list, for messages.
+pub(crate) fn addresses_text(addresses: &[u16]) -> String {
+    const SHOWN: usize = 8;
+    let mut text = addresses
+        .iter()
+        .take(SHOWN)
+        .map(|address| format!("${address:04X}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if addresses.len() > SHOWN {
+        text.push_str(&format!(" and {} more", addresses.len() - SHOWN));
+    }
+    text
 }
 
 #[cfg(test)]

@@ -20,6 +20,7 @@
 //! Nothing here prints: progress goes through [`Progress`], failures are
 //! [`Error`]s.
 
+mod always;
 mod backup;
 mod body;
 mod client;
@@ -39,7 +40,7 @@ mod taper;
 pub mod transport;
 mod upload;
 
-pub use backup::{Backup, Keep, MAGIC, NoKeep, backup, backup_ranges, restore};
+pub use backup::{Backup, Keep, MAGIC, NoKeep, Witness, backup, backup_ranges, restore};
 pub use client::{Client, ClientConfig, ClientStats};
 pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, human_duration};

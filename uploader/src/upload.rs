@@ -70,6 +70,9 @@ pub struct UploadOptions {
     /// robot differs from the image's (see `delta`); `false` writes every
     /// byte.
     pub delta: bool,
+    /// Restore a backup onto a robot whose ROM differs from the one it
+    /// was taken from (its code's calls into the ROM may land elsewhere).
+    pub force_rom: bool,
 }
 
 impl Default for UploadOptions {
@@ -83,6 +86,7 @@ impl Default for UploadOptions {
             fast_baud: Some(FAST_BAUD),
             replace: false,
             delta: true,
+            force_rom: false,
         }
     }
 }
@@ -298,6 +302,18 @@ pub fn upload_keeping<T: Transport>(
         fingerprint::check_jump_table(client, profile)?;
     }
     let mut entries_checked = rom_checked;
+    // A refusal comes before anything changes: `prepare` may unhook an
+    // extension it replaces, and `choose_loader` decides only after.
+    if options.loader == LoaderChoice::Always {
+        crate::always::check(
+            client,
+            profile,
+            image,
+            &hooks_now,
+            options.replace,
+            leftover.as_ref(),
+        )?;
+    }
     if options.replace && !entries_checked {
         fingerprint::check_reset_entries(client, profile)?;
         entries_checked = true;
@@ -312,6 +328,8 @@ pub fn upload_keeping<T: Transport>(
             .as_ref()
             .map_or_else(Vec::new, |plan| plan.found.clone()),
         hooks: hooks_now.clone(),
+        rom: crate::backup::profile_rom(profile),
+        ..Backup::default()
     });
     if options.replace {
         hooks_now = read_hooks(client, profile)?;
@@ -418,7 +436,7 @@ pub fn upload_keeping<T: Transport>(
             .and_then(|()| {
                 if !running.has_sums() {
                     // A small image: written whole, read back byte by byte.
-                    keep_old(client, kept.take(), image.areas(), keep)?;
+                    keep_old(client, profile, kept.take(), image.areas(), keep)?;
                     written = whole(&image);
                     let mut body = Body::new(&image, Writer::Frames);
                     body.plan_writes(client.transport().baud(), progress);
@@ -475,7 +493,7 @@ pub fn upload_keeping<T: Transport>(
                         fingerprint::check_jump_table(client, &profile)?;
                     }
                 }
-                keep_summed(client, kept.take(), &todo, keep)?;
+                keep_summed(client, profile, kept.take(), &todo, keep)?;
                 let todo = delta::merged(&todo);
                 written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
                 (rewrites, passes) =
@@ -523,7 +541,7 @@ pub fn upload_keeping<T: Transport>(
         }
         session = Some(running);
     } else {
-        keep_old(client, kept.take(), image.areas(), keep)?;
+        keep_old(client, profile, kept.take(), image.areas(), keep)?;
         written = whole(&image);
         let body;
         // The jump table is compared while the image goes in (the return
@@ -613,6 +631,7 @@ fn whole(image: &UploadImage) -> Vec<(u16, usize)> {
 /// and hands it, with the hooks and table read at the start, to `keep`.
 fn keep_old<T: Transport>(
     client: &mut Client<T>,
+    profile: &RomProfile,
     kept: Option<Backup>,
     areas: &[Area],
     keep: &mut dyn Keep,
@@ -635,6 +654,8 @@ fn keep_old<T: Transport>(
             bytes,
         });
     }
+    let ranges = crate::backup::witness_ranges(profile, &kept);
+    kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
     Ok(())
 }
@@ -648,6 +669,7 @@ fn keep_old<T: Transport>(
 /// (read again, up to four times, if noise changed an answer).
 fn keep_summed<T: Transport>(
     client: &mut Client<T>,
+    profile: &RomProfile,
     kept: Option<Backup>,
     held: &[delta::Held],
     keep: &mut dyn Keep,
@@ -675,6 +697,19 @@ fn keep_summed<T: Transport>(
             bytes,
         });
     }
+    // The code the kept hooks go back to, summed on the robot (the loader's
+    // `sums` is hooked here): an undo checks it is still there.
+    let ranges = crate::backup::witness_ranges(profile, &kept);
+    let sums = crate::sums::robot_sums(client, &ranges)?;
+    kept.witnesses = ranges
+        .iter()
+        .zip(sums)
+        .map(|(&(address, len), sum)| crate::backup::Witness {
+            address,
+            len: len as u16,
+            sum,
+        })
+        .collect();
     keep.keep(&kept);
     Ok(())
 }

@@ -7,7 +7,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::drive::{Drive, Pose};
-use super::geometry::{PI, Point, Shape};
+use super::geometry::{PI, Point, Shape, inside_polygon};
 use crate::error::{Located, ScriptError, offset_of};
 
 /// A floor line the ground trackers see.
@@ -56,25 +56,35 @@ pub struct Layout {
     /// A world script that adds to the file, as written (relative to the
     /// file's folder).
     pub script: Option<String>,
+    /// Where in the file `script`'s value is (bytes), for an error about
+    /// the script it names ([`script_error`]).
+    pub script_span: Option<std::ops::Range<usize>>,
 }
+
+/// A point as written: `[x, y]` (more or fewer numbers are refused at
+/// the point).
+type PointFile = Spanned<Vec<f64>>;
+
+/// A list of points as written.
+type PointsFile = Spanned<Vec<PointFile>>;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct WorldFile {
-    walls: Option<Spanned<Vec<[f64; 2]>>>,
+    walls: Option<PointsFile>,
     #[serde(default, rename = "obstacle")]
     obstacles: Vec<Spanned<ObstacleFile>>,
     #[serde(default, rename = "line")]
     lines: Vec<Spanned<LineFile>>,
     #[serde(default)]
     robot: RobotFile,
-    script: Option<String>,
+    script: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ObstacleFile {
-    polygon: Option<Spanned<Vec<[f64; 2]>>>,
+    polygon: Option<PointsFile>,
     circle: Option<Spanned<CircleFile>>,
 }
 
@@ -86,10 +96,33 @@ struct CircleFile {
     radius: f64,
 }
 
+/// The ranges a world file's numbers must lie in (docs/WORLD.md): wide
+/// enough for any room a robot drives in, narrow enough that the room's
+/// arithmetic stays exact to well under a step.
+pub mod limits {
+    /// The largest coordinate, either way from 0, centimetres (1 km).
+    pub const COORDINATE: f64 = 100_000.0;
+    /// The largest outline radius, centimetres.
+    pub const RADIUS: f64 = 100.0;
+    /// The largest step, centimetres.
+    pub const STEP: f64 = 10.0;
+    /// The largest wheel base, centimetres.
+    pub const WHEEL_BASE: f64 = 200.0;
+    /// The widest floor line, centimetres.
+    pub const LINE_WIDTH: f64 = 100.0;
+    /// The largest angle either way (a heading, a bumper's place), degrees.
+    pub const ANGLE: f64 = 360.0;
+    /// The largest bumper arc, degrees: the whole outline.
+    pub const BUMPER_ARC: f64 = 360.0;
+    /// The farthest a tracker sits from the axle's middle, either way,
+    /// centimetres.
+    pub const TRACKER: f64 = 100.0;
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LineFile {
-    points: Spanned<Vec<[f64; 2]>>,
+    points: PointsFile,
     width: Option<Spanned<f64>>,
 }
 
@@ -104,8 +137,8 @@ struct RobotFile {
     wheel_base: Option<Spanned<f64>>,
     bumpers: Option<Spanned<Vec<f64>>>,
     bumper_arc: Option<Spanned<f64>>,
-    left_tracker: Option<Spanned<[f64; 2]>>,
-    right_tracker: Option<Spanned<[f64; 2]>>,
+    left_tracker: Option<PointFile>,
+    right_tracker: Option<PointFile>,
 }
 
 /// The defaults (docs/WORLD.md lists them).
@@ -146,7 +179,40 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
             "docs/WORLD.md lists the keys of a world file",
         )
     })?;
-    let points = |spanned: &Spanned<Vec<[f64; 2]>>, least: usize, what: &str| {
+    let pair = |point: &PointFile, what: &str| -> Result<Point, ScriptError> {
+        let numbers = point.get_ref();
+        if numbers.len() != 2 {
+            return Err(at(
+                point.span(),
+                format!(
+                    "{what}: a point of {} numbers; a point is [x, y]",
+                    numbers.len()
+                ),
+                "points are [x, y] pairs in centimetres",
+            ));
+        }
+        if numbers.iter().any(|v| !v.is_finite()) {
+            return Err(at(
+                point.span(),
+                format!("{what} has a point that is not a number"),
+                "points are [x, y] pairs in centimetres",
+            ));
+        }
+        if numbers.iter().any(|v| v.abs() > limits::COORDINATE) {
+            return Err(at(
+                point.span(),
+                format!(
+                    "{what}: a point at [{}, {}] is farther than {} cm from 0",
+                    number(numbers[0]),
+                    number(numbers[1]),
+                    limits::COORDINATE
+                ),
+                "coordinates are centimetres, at most 100000 (1 km) either way (docs/WORLD.md)",
+            ));
+        }
+        Ok(Point::new(numbers[0], numbers[1]))
+    };
+    let points = |spanned: &PointsFile, least: usize, what: &str| {
         let list = spanned.get_ref();
         if list.len() < least {
             return Err(at(
@@ -155,55 +221,93 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
                 "points are [x, y] pairs in centimetres",
             ));
         }
-        if list.iter().flatten().any(|v| !v.is_finite()) {
+        list.iter()
+            .map(|point| pair(point, what))
+            .collect::<Result<Vec<_>, _>>()
+    };
+    let polygon = |spanned: &PointsFile, what: &str| {
+        let corners = points(spanned, 3, what)?;
+        if let Some((first, second)) = crossing_edges(&corners) {
+            let edge = |i: usize| {
+                let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+                format!("{} ([{}, {}]-[{}, {}])", i + 1, a.x, a.y, b.x, b.y)
+            };
             return Err(at(
                 spanned.span(),
-                format!("{what} has a point that is not a number"),
-                "points are [x, y] pairs in centimetres",
+                format!(
+                    "{what} crosses itself: edges {} and {} cross",
+                    edge(first),
+                    edge(second)
+                ),
+                "give the corners in order round the polygon (edge 1 runs from the first corner to the second, the last from the last corner back to the first)",
             ));
         }
-        Ok(list
-            .iter()
-            .map(|&[x, y]| Point::new(x, y))
-            .collect::<Vec<_>>())
+        Ok(corners)
     };
-    let positive = |value: &Option<Spanned<f64>>, default: f64, what: &str| match value {
+    // A number in (0, max] (a length), or the default.
+    let length = |value: &Option<Spanned<f64>>, default: f64, max: f64, what: &str| match value {
         None => Ok(default),
-        Some(spanned) if spanned.get_ref().is_finite() && *spanned.get_ref() > 0.0 => {
-            Ok(*spanned.get_ref())
+        Some(spanned) => {
+            let v = *spanned.get_ref();
+            if v.is_finite() && v > 0.0 && v <= max {
+                Ok(v)
+            } else {
+                Err(at(
+                    spanned.span(),
+                    format!(
+                        "{what} is {}; it must be more than 0 and at most {max}",
+                        number(v)
+                    ),
+                    "lengths are in centimetres; docs/WORLD.md gives each one's range",
+                ))
+            }
         }
-        Some(spanned) => Err(at(
-            spanned.span(),
-            format!("{what} is {}; it must be more than 0", spanned.get_ref()),
-            "lengths are in centimetres",
-        )),
     };
-    let finite = |value: &Option<Spanned<f64>>, what: &str| match value {
+    // A number in [-max, max], or 0.
+    let within = |value: &Option<Spanned<f64>>, max: f64, what: &str| match value {
         None => Ok(0.0),
-        Some(spanned) if spanned.get_ref().is_finite() => Ok(*spanned.get_ref()),
-        Some(spanned) => Err(at(
+        Some(spanned) if !spanned.get_ref().is_finite() => Err(at(
             spanned.span(),
             format!("{what} is not a number"),
             "give a number",
+        )),
+        Some(spanned) if spanned.get_ref().abs() <= max => Ok(*spanned.get_ref()),
+        Some(spanned) => Err(at(
+            spanned.span(),
+            format!(
+                "{what} is {}; it must be from -{max} to {max}",
+                number(*spanned.get_ref())
+            ),
+            "docs/WORLD.md gives each number's range",
         )),
     };
 
     let walls = file
         .walls
         .as_ref()
-        .map(|walls| points(walls, 3, "the walls"))
+        .map(|walls| polygon(walls, "the walls"))
         .transpose()?;
     let mut obstacles = Vec::new();
     for obstacle in &file.obstacles {
         let shape = match (&obstacle.get_ref().polygon, &obstacle.get_ref().circle) {
-            (Some(polygon), None) => Shape::Polygon(points(polygon, 3, "a polygon")?),
+            (Some(corners), None) => Shape::Polygon(polygon(corners, "a polygon")?),
             (None, Some(circle)) => {
                 let CircleFile { x, y, radius } = *circle.get_ref();
-                if !(x.is_finite() && y.is_finite() && radius.is_finite() && radius > 0.0) {
+                let finite = x.is_finite() && y.is_finite() && radius.is_finite() && radius > 0.0;
+                if !finite
+                    || x.abs() > limits::COORDINATE
+                    || y.abs() > limits::COORDINATE
+                    || radius > limits::COORDINATE
+                {
                     return Err(at(
                         circle.span(),
-                        format!("a circle at ({x}, {y}) of radius {radius}"),
-                        "a circle is { x = .., y = .., radius = .. } in centimetres, the radius more than 0",
+                        format!(
+                            "a circle at ({}, {}) of radius {}",
+                            number(x),
+                            number(y),
+                            number(radius)
+                        ),
+                        "a circle is { x = .., y = .., radius = .. } in centimetres, the radius more than 0, each at most 100000 (1 km) either way",
                     ));
                 }
                 Shape::Circle {
@@ -219,24 +323,26 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
                 ));
             }
         };
-        obstacles.push(shape);
+        obstacles.push((shape, obstacle.span()));
     }
     let mut lines = Vec::new();
     for line in &file.lines {
         let line = line.get_ref();
         lines.push(FloorLine {
             points: points(&line.points, 2, "a line")?,
-            width: positive(&line.width, defaults::LINE_WIDTH, "the line's width")?,
+            width: length(
+                &line.width,
+                defaults::LINE_WIDTH,
+                limits::LINE_WIDTH,
+                "the line's width",
+            )?,
         });
     }
     let robot = &file.robot;
     let degrees = |d: f64| d * PI / 180.0;
     let bumpers = match &robot.bumpers {
         None => defaults::BUMPERS.to_vec(),
-        Some(list) if list.get_ref().len() <= 8 && list.get_ref().iter().all(|a| a.is_finite()) => {
-            list.get_ref().clone()
-        }
-        Some(list) => {
+        Some(list) if list.get_ref().len() > 8 => {
             return Err(at(
                 list.span(),
                 format!(
@@ -246,43 +352,224 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
                 "give each bumper's angle in degrees counter-clockwise from straight ahead, bit 0 first",
             ));
         }
-    };
-    let tracker = |value: &Option<Spanned<[f64; 2]>>, default: [f64; 2]| match value {
-        None => Ok((default[0], default[1])),
-        Some(spanned) if spanned.get_ref().iter().all(|v| v.is_finite()) => {
-            Ok((spanned.get_ref()[0], spanned.get_ref()[1]))
+        Some(list) if list.get_ref().iter().all(|a| a.abs() <= limits::ANGLE) => {
+            list.get_ref().clone()
         }
-        Some(spanned) => Err(at(
-            spanned.span(),
-            "a tracker's place is not a number".into(),
-            "a tracker is at [forward, left] centimetres from the axle's middle",
-        )),
+        Some(list) => {
+            return Err(at(
+                list.span(),
+                "a bumper's angle is not a number from -360 to 360".into(),
+                "give each bumper's angle in degrees counter-clockwise from straight ahead, bit 0 first",
+            ));
+        }
     };
+    let tracker = |value: &Option<PointFile>, default: [f64; 2], what: &str| match value {
+        None => Ok((default[0], default[1])),
+        Some(spanned) => {
+            let numbers = spanned.get_ref();
+            if numbers.len() != 2 {
+                return Err(at(
+                    spanned.span(),
+                    format!(
+                        "{what} has {} numbers; a tracker is at [forward, left]",
+                        numbers.len()
+                    ),
+                    "a tracker is at [forward, left] centimetres from the axle's middle",
+                ));
+            }
+            if numbers.iter().all(|v| v.abs() <= limits::TRACKER) {
+                Ok((numbers[0], numbers[1]))
+            } else {
+                Err(at(
+                    spanned.span(),
+                    format!("{what} is not at numbers from -100 to 100"),
+                    "a tracker is at [forward, left] centimetres from the axle's middle",
+                ))
+            }
+        }
+    };
+    let start = Point::new(
+        within(&robot.x, limits::COORDINATE, "x")?,
+        within(&robot.y, limits::COORDINATE, "y")?,
+    );
+    // The start pose: inside the walls and in no obstacle, else the room
+    // would see the robot through a wall from its first step. The error
+    // points at `x` (or the `[robot]` table's keys, when `x` is left out).
+    let start_span = robot
+        .x
+        .as_ref()
+        .or(robot.y.as_ref())
+        .map_or(0..0, Spanned::span);
+    if let Some(walls) = &walls
+        && !inside_polygon(walls, start)
+    {
+        return Err(at(
+            start_span,
+            format!(
+                "the robot starts at ({}, {}), outside the walls",
+                start.x, start.y
+            ),
+            "give the robot's `x` and `y` inside the walls (the middle of its axle)",
+        ));
+    }
+    if let Some((_, span)) = obstacles.iter().find(|(shape, _)| shape.contains(start)) {
+        let obstacle = located_line(text, span.start);
+        return Err(at(
+            start_span,
+            format!(
+                "the robot starts at ({}, {}), inside the obstacle at line {obstacle}",
+                start.x, start.y
+            ),
+            "give the robot's `x` and `y` clear of the obstacles (the middle of its axle)",
+        ));
+    }
+    let script_span = file.script.as_ref().map(Spanned::span);
+    if let Some(script) = &file.script
+        && script.get_ref().trim().is_empty()
+    {
+        return Err(at(
+            script.span(),
+            "`script` names no file".into(),
+            "give the world script's path, relative to this file, or leave `script` out",
+        ));
+    }
     Ok(Layout {
         walls,
-        obstacles,
+        obstacles: obstacles.into_iter().map(|(shape, _)| shape).collect(),
         lines,
         start: Pose {
-            at: Point::new(finite(&robot.x, "x")?, finite(&robot.y, "y")?),
-            heading: degrees(finite(&robot.heading, "the heading")?),
+            at: start,
+            heading: degrees(within(&robot.heading, limits::ANGLE, "the heading")?),
         },
         drive: Drive {
-            step: positive(&robot.step, defaults::STEP, "the step")?,
-            wheel_base: positive(&robot.wheel_base, defaults::WHEEL_BASE, "the wheel base")?,
+            step: length(&robot.step, defaults::STEP, limits::STEP, "the step")?,
+            wheel_base: length(
+                &robot.wheel_base,
+                defaults::WHEEL_BASE,
+                limits::WHEEL_BASE,
+                "the wheel base",
+            )?,
         },
         body: Body {
-            radius: positive(&robot.radius, defaults::RADIUS, "the radius")?,
+            radius: length(
+                &robot.radius,
+                defaults::RADIUS,
+                limits::RADIUS,
+                "the radius",
+            )?,
             bumpers: bumpers.into_iter().map(degrees).collect(),
-            bumper_arc: degrees(positive(
+            bumper_arc: degrees(length(
                 &robot.bumper_arc,
                 defaults::BUMPER_ARC,
+                limits::BUMPER_ARC,
                 "the bumper arc",
             )?),
-            left_tracker: tracker(&robot.left_tracker, defaults::LEFT_TRACKER)?,
-            right_tracker: tracker(&robot.right_tracker, defaults::RIGHT_TRACKER)?,
+            left_tracker: tracker(
+                &robot.left_tracker,
+                defaults::LEFT_TRACKER,
+                "the left tracker",
+            )?,
+            right_tracker: tracker(
+                &robot.right_tracker,
+                defaults::RIGHT_TRACKER,
+                "the right tracker",
+            )?,
         },
-        script: file.script,
+        script: file.script.map(Spanned::into_inner),
+        script_span,
     })
+}
+
+/// `v` for a message: `1e300` rather than its 301 digits.
+fn number(v: f64) -> String {
+    if v.is_finite() && v.abs() >= 1e9 {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// The line number of byte `offset` of `text`.
+fn located_line(text: &str, offset: usize) -> usize {
+    text.get(..offset).unwrap_or_default().matches('\n').count() + 1
+}
+
+/// The first two edges of the closed polygon `corners` that cross (edge
+/// `i` runs from corner `i` to the next), if any: neighbours share a
+/// corner and are not counted, unless one folds back along the other.
+#[must_use]
+pub fn crossing_edges(corners: &[Point]) -> Option<(usize, usize)> {
+    let n = corners.len();
+    let edge = |i: usize| (corners[i], corners[(i + 1) % n]);
+    for i in 0..n {
+        for j in i + 1..n {
+            let neighbours = j == i + 1 || (i == 0 && j == n - 1);
+            let (a, b) = edge(i);
+            let (c, d) = edge(j);
+            if neighbours {
+                // Neighbours meet at their shared corner; they cross only
+                // where one runs back along the other.
+                if folds_back(a, b, c, d) {
+                    return Some((i, j));
+                }
+            } else if segments_meet(a, b, c, d) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
+/// The sign of the turn a-b-c: positive counter-clockwise, 0 in line.
+fn turn(a: Point, b: Point, c: Point) -> f64 {
+    (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)
+}
+
+/// Whether `p`, in line with a-b, lies within the box of a-b.
+fn on_segment(a: Point, b: Point, p: Point) -> bool {
+    p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
+}
+
+/// Whether segments a-b and c-d have a point in common.
+fn segments_meet(a: Point, b: Point, c: Point, d: Point) -> bool {
+    let (d1, d2) = (turn(c, d, a), turn(c, d, b));
+    let (d3, d4) = (turn(a, b, c), turn(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on_segment(c, d, a))
+        || (d2 == 0.0 && on_segment(c, d, b))
+        || (d3 == 0.0 && on_segment(a, b, c))
+        || (d4 == 0.0 && on_segment(a, b, d))
+}
+
+/// Whether neighbouring edges a-b and c-d (sharing one corner) overlap
+/// along more than that corner: in line, and pointing back over each
+/// other.
+fn folds_back(a: Point, b: Point, c: Point, d: Point) -> bool {
+    let shared_is_b = b == c;
+    let (corner, p, q) = if shared_is_b { (b, a, d) } else { (a, b, c) };
+    if turn(corner, p, q) != 0.0 {
+        return false;
+    }
+    // In line: back over each other when both run the same way from the
+    // shared corner.
+    (p.x - corner.x) * (q.x - corner.x) + (p.y - corner.y) * (q.y - corner.y) > 0.0
+}
+
+/// An error at `script`'s value in the world file (`name`, `text`): the
+/// script it names cannot be read (`why`).
+#[must_use]
+pub fn script_error(name: &str, text: &str, layout: &Layout, why: String) -> ScriptError {
+    located(
+        name,
+        text,
+        layout.script_span.clone().unwrap_or(0..0),
+        why,
+        "`script` names a world script relative to the world file's folder",
+    )
 }
 
 /// An error at the byte range `span` of the file.
@@ -342,7 +629,7 @@ mod tests {
             ),
             (
                 "[robot]\nstep = -1\n",
-                "world.toml:2:8: the step is -1; it must be more than 0",
+                "world.toml:2:8: the step is -1; it must be more than 0 and at most 10",
             ),
             (
                 "[robot]\nbumpers = [0, 45, 90, 135, 180, 225, 270, 315, 360]\n",

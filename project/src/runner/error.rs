@@ -141,9 +141,12 @@ pub enum Error {
         source: hostfs::Error,
     },
 
-    /// A card's or the world's script that cannot be read.
-    #[error("cannot read the script {}", path.display())]
+    /// A card's script, a world script or a world file that cannot be
+    /// read.
+    #[error("cannot read the {what} {}", path.display())]
     ScriptUnreadable {
+        /// What it is: "script", "world script", "world file".
+        what: &'static str,
         /// The script, as given.
         path: PathBuf,
         /// Why.

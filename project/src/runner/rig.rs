@@ -59,9 +59,10 @@ impl RoomSlot {
 /// What each script of a robot prints, by the script's name.
 pub type Scripts = Vec<(String, Printed)>;
 
-fn read(root: Option<&Path>, path: &Path) -> Result<String> {
+fn read(root: Option<&Path>, path: &Path, what: &'static str) -> Result<String> {
     let full = root.map_or_else(|| path.to_path_buf(), |root| root.join(path));
     hostfs::read_text(&full, hostfs::TEXT).map_err(|source| Error::ScriptUnreadable {
+        what,
         path: path.to_path_buf(),
         source,
     })
@@ -96,7 +97,7 @@ impl Rig {
         let mut printed = Vec::new();
         for card in &self.cards {
             let name = card.path.display().to_string();
-            let text = read(self.root.as_deref(), &card.path)?;
+            let text = read(self.root.as_deref(), &card.path, "script")?;
             let script = ScriptCard::load(&name, &text, card.base)?;
             let (start, end) = script.window();
             printed.push((name.clone(), script.printed()));
@@ -112,14 +113,33 @@ impl Rig {
         }
         if let Some(path) = &self.world {
             let name = path.display().to_string();
-            let text = read(self.world_root.as_deref(), path)?;
-            if path.extension().is_some_and(|e| e == "toml") {
+            let is_file = path.extension().is_some_and(|e| e == "toml");
+            let what = if is_file {
+                "world file"
+            } else {
+                "world script"
+            };
+            let text = read(self.world_root.as_deref(), path, what)?;
+            if is_file {
                 let mut room = Room::load(&name, &text)?;
                 if let Some(script) = room.script_path() {
                     // Written relative to the world file.
                     let script = path.parent().unwrap_or(Path::new("")).join(script);
+                    let full = self
+                        .world_root
+                        .as_deref()
+                        .map_or_else(|| script.clone(), |root| root.join(&script));
+                    // Said at the `script` key of the world file: that is
+                    // what to change.
+                    let text = hostfs::read_text(&full, hostfs::TEXT).map_err(|source| {
+                        cards::room::file::script_error(
+                            &name,
+                            &text,
+                            room.layout(),
+                            format!("cannot read the world script: {source}"),
+                        )
+                    })?;
                     let name = script.display().to_string();
-                    let text = read(self.world_root.as_deref(), &script)?;
                     let world = ScriptWorld::load(&name, &text)?;
                     printed.push((name, world.printed()));
                     room.add(Box::new(world));
