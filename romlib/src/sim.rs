@@ -160,6 +160,14 @@ pub trait Surroundings: std::fmt::Debug + Send {
     fn snapshot(&self) -> Option<Box<dyn Surroundings>> {
         None
     }
+
+    /// The surroundings as [`std::any::Any`], for a host that knows their
+    /// type and asks what they hold now (a room's pose and trail, of the
+    /// copy a debugger went back to rather than of the robot first built).
+    /// `None`, the default, for surroundings that do not say.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }
 
 impl Default for VirtualScorpion {
@@ -404,6 +412,12 @@ impl VirtualScorpion {
     /// time (bumpers, phototransistors), replacing any it had.
     pub fn set_surroundings(&mut self, world: Box<dyn Surroundings>) {
         self.world = Some(world);
+    }
+
+    /// The surroundings the robot has now, if any.
+    #[must_use]
+    pub fn surroundings(&self) -> Option<&dyn Surroundings> {
+        self.world.as_deref()
     }
 
     /// Maps a card into the KIM-bus space at `start..=end`.

@@ -60,7 +60,10 @@ pub(crate) struct Args {
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let here = std::env::current_dir().into_diagnostic()?;
     let ((make, images, root), room) = recipe_in_room(args, &here)?;
-    let room = crate::cmd::rig::path_picture(args.path.as_ref(), room.get())?;
+    // Checked before the session; drawn at its end from the robot the
+    // debugger holds then (a rebuilt robot, or a copy it went back to, has
+    // a room of its own).
+    let picture = crate::cmd::rig::path_picture(args.path.as_ref(), room.get())?;
     // For the picture of the path: each command sent, at its robot time.
     let mut commands = Vec::new();
     let mut debugger = Debugger::new(make, &images)?;
@@ -145,7 +148,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         broken = true;
         writeln!(out, "error: {}", Failure::from(error).message()).into_diagnostic()?;
     }
-    if let Some((path, view)) = room {
+    if let Some((path, first)) = picture {
+        let view = room_now(&debugger).unwrap_or(first);
         std::fs::write(path, view.picture_for(path, &commands)?)
             .into_diagnostic()
             .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
@@ -201,6 +205,16 @@ pub(crate) type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
 /// directory their source paths are relative to.
 pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Recipe> {
     recipe_in_room(args, here).map(|(recipe, _)| recipe)
+}
+
+/// The room of the robot `debugger` holds now, if it is in one.
+fn room_now(debugger: &Debugger) -> Option<cards::room::RoomView> {
+    debugger
+        .robot()
+        .surroundings()?
+        .as_any()?
+        .downcast_ref::<cards::room::Room>()
+        .map(cards::room::Room::view)
 }
 
 /// [`recipe`], and where the room of its robot is seen from (a world

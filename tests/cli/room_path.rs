@@ -42,6 +42,16 @@ fn debug_draws_the_path_of_its_session() {
     assert!(picture.starts_with("<svg "), "{picture}");
     assert!(picture.contains(">/8C+500100 at "), "{picture}");
     assert!(picture.contains("<polyline"), "the trail: {picture}");
+    // The robot drawn is the one the session ran, 11 cm on from where it
+    // started (x=100, the picture's y flipped): not the robot first built
+    // to check the set-up, which never moved.
+    let robot = picture
+        .split(r#"<g class="robot"><circle cx=""#)
+        .nth(1)
+        .and_then(|rest| rest.split('"').next())
+        .expect("the robot drawn");
+    let x: f64 = robot.parse().expect("a number");
+    assert!((x - 111.0).abs() < 1.0, "the robot at x={x}: {picture}");
 }
 
 #[test]

@@ -271,6 +271,10 @@ impl Surroundings for Room {
         Ok(())
     }
 
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     /// The room with its pose and script copied; the copy's trail goes on
     /// from this one's in its own [`RoomView`].
     fn snapshot(&self) -> Option<Box<dyn Surroundings>> {
