@@ -17,6 +17,8 @@
 
 use rustc_hash::FxHashMap;
 
+use crate::engine::Labels;
+
 /// What a frame stands for.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Routine {
@@ -110,8 +112,11 @@ pub(crate) struct Stack {
     main: u32,
     /// The node code runs in now (the top frame's, or `main`'s).
     top: u32,
-    /// The last cell charged: its node, label and index.
-    current: (u32, u32, u32),
+    /// The addresses of the label last charged (the first and how many;
+    /// none once the frames change) and its cell in the top node: an
+    /// instruction in them is charged with one comparison.
+    span: (u16, u32),
+    span_cell: u32,
     /// The command running now (an index into the commands seen).
     pub(crate) command: Option<u32>,
 }
@@ -135,16 +140,15 @@ impl Stack {
             frames: Vec::new(),
             main: TOP,
             top: TOP,
-            current: (u32::MAX, u32::MAX, 0),
+            span: (0, 0),
+            span_cell: 0,
             command: None,
         };
         let main = stack.routine_id(Routine::Main);
         stack.main = stack.child(TOP, main);
         stack.top = stack.main;
         stack.calls[main as usize].calls = 1;
-        stack.current = (stack.main, u32::MAX, 0);
-        let cell = stack.cell(stack.main, u32::MAX);
-        stack.current.2 = cell;
+        stack.cell(stack.main, u32::MAX);
         stack
     }
 
@@ -182,26 +186,37 @@ impl Stack {
 
     fn frames_changed(&mut self) {
         self.top = self.frames.last().map_or(self.main, |frame| frame.node);
+        self.span = (0, 0);
     }
 
-    /// Counts `cycles` spent at an address labelled `label`, in the
+    /// Counts `cycles` spent at `address` (named by `labels`), in the
     /// frame on top.
     #[inline(always)]
-    pub(crate) fn charge(&mut self, label: u32, cycles: u64) {
-        let (node, at, cell) = self.current;
-        let cell = if at == label && node == self.top {
-            cell
+    pub(crate) fn charge(&mut self, address: u16, cycles: u64, labels: &Labels) {
+        let (first, len) = self.span;
+        if u32::from(address.wrapping_sub(first)) < len {
+            self.cells[self.span_cell as usize] += cycles;
         } else {
-            self.cached_cell(label)
-        };
+            self.charge_elsewhere(address, cycles, labels);
+        }
+    }
+
+    /// [`Stack::charge`] at an address out of the last label's: its
+    /// label's cell found, and its addresses made the span.
+    #[inline(never)]
+    fn charge_elsewhere(&mut self, address: u16, cycles: u64, labels: &Labels) {
+        let label = labels.of(address);
+        let cell = self.cached_cell(label);
+        self.span = labels.span(label);
+        self.span_cell = cell;
         self.cells[cell as usize] += cycles;
     }
 
-    /// The cell of `label` in the top frame's node, made the current one.
+    /// The cell of `label` in the top frame's node.
     fn cached_cell(&mut self, label: u32) -> u32 {
         let node = self.top;
         let slot = label.wrapping_add(1) as usize;
-        let cell = match self.cell_cache.get(slot) {
+        match self.cell_cache.get(slot) {
             Some(&(cached, cell)) if cached == node => cell,
             _ => {
                 let cell = self.cell(node, label);
@@ -211,9 +226,7 @@ impl Stack {
                 self.cell_cache[slot] = (node, cell);
                 cell
             }
-        };
-        self.current = (node, label, cell);
-        cell
+        }
     }
 
     fn push(&mut self, routine: Routine, ends: Ends, entry: u64, times: u64) {
