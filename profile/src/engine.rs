@@ -258,8 +258,9 @@ impl Profiler {
         Profiler::new(&robot.labels(), Places::of(robot))
     }
 
-    /// Counts by address and branch only, for coverage: no call stack,
-    /// no commands (faster).
+    /// Counts executions by address and branches only, for coverage: no
+    /// cycles, no call stack, no commands (faster; the profile's cycles
+    /// and total stay 0).
     #[must_use]
     pub fn coverage_only(mut self) -> Profiler {
         self.calls = false;
@@ -319,32 +320,31 @@ impl Profiler {
     /// Counts the instruction at `pc` (`opcode`) that has just run, its
     /// registers as it left them: the per-instruction work, inlined into
     /// the CPU's run loop, with what is rare (calls, returns) out of line.
+    /// Returns its cycles (0 for coverage alone, which counts none).
     #[inline(always)]
     fn ran(&mut self, cpu: &Cpu, pc: u16, opcode: u8) -> u64 {
+        let at = usize::from(pc);
+        let flow = self.flows[usize::from(opcode)];
+        if flow == Flow::Branch {
+            if cpu.pc == pc.wrapping_add(2) {
+                self.not_taken[at] += 1;
+            } else {
+                self.taken[at] += 1;
+            }
+        }
+        if !self.calls {
+            self.by_address[at][0] += 1;
+            return 0;
+        }
         let end = cpu.cycles();
         let cycles = end.saturating_sub(self.start);
         self.last_end = end;
-        let at = usize::from(pc);
         let place = &mut self.by_address[at];
         place[0] += 1;
         place[1] += cycles;
-        if self.calls {
-            self.stack.charge(pc, cycles, &self.labels);
-        }
-        match self.flows[usize::from(opcode)] {
-            Flow::Plain => {}
-            Flow::Branch => {
-                if cpu.pc == pc.wrapping_add(2) {
-                    self.not_taken[at] += 1;
-                } else {
-                    self.taken[at] += 1;
-                }
-            }
-            flow => {
-                if self.calls {
-                    self.flowed(flow, pc, cpu.pc, cpu.s, 1, end);
-                }
-            }
+        self.stack.charge(pc, cycles, &self.labels);
+        if !matches!(flow, Flow::Plain | Flow::Branch) {
+            self.flowed(flow, cpu.pc, cpu.s, 1, end);
         }
         cycles
     }
@@ -370,16 +370,15 @@ impl Profiler {
             return;
         }
         self.stack.charge(ran.pc, cycles, &self.labels);
-        self.flowed(flow, ran.pc, ran.next_pc, ran.s_after, times, end);
+        self.flowed(flow, ran.next_pc, ran.s_after, times, end);
     }
 
-    /// What the instruction at `pc` of kind `flow`, which went to
-    /// `next_pc` leaving S at `s_after`, did to the call stack, `times`
-    /// over, ending at `end`. Its cycles are charged already (a `JSR`'s
-    /// to its caller, an `RTS`'s to the routine it leaves).
+    /// What an instruction of kind `flow`, which went to `next_pc`
+    /// leaving S at `s_after`, did to the call stack, `times` over, ending
+    /// at `end`. Its cycles are charged already (a `JSR`'s to its caller,
+    /// an `RTS`'s to the routine it leaves).
     #[inline(never)]
-    fn flowed(&mut self, flow: Flow, pc: u16, next_pc: u16, s_after: u8, times: u64, end: u64) {
-        let _ = pc;
+    fn flowed(&mut self, flow: Flow, next_pc: u16, s_after: u8, times: u64, end: u64) {
         match flow {
             Flow::Plain | Flow::Branch => {}
             Flow::Call => self
@@ -506,9 +505,11 @@ impl Hooks for Profiler {
 
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
-        self.start = cpu.cycles();
-        if self.watched.contains(cpu.pc) {
-            self.look_once(cpu, bus);
+        if self.calls {
+            self.start = cpu.cycles();
+            if self.watched.contains(cpu.pc) {
+                self.look_once(cpu, bus);
+            }
         }
         Control::Continue
     }
@@ -538,15 +539,16 @@ impl Hooks for Profiler {
             Interrupt::Irq => Routine::Irq,
             Interrupt::Nmi => Routine::Nmi,
         };
+        if !self.calls {
+            return;
+        }
         // The sequence's own seven cycles are the handler's, counted at
         // its first instruction (its address, so its line and label):
         // cycles by address add up to the total, as routines' do.
         self.by_address[usize::from(cpu.pc)][1] += 7;
         self.last_end = began + 7;
-        if self.calls {
-            self.stack.interrupt(routine, s_before, began);
-            self.stack.charge(cpu.pc, 7, &self.labels);
-        }
+        self.stack.interrupt(routine, s_before, began);
+        self.stack.charge(cpu.pc, 7, &self.labels);
     }
 
     fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, _cycles: u64) {
