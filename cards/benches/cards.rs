@@ -138,16 +138,46 @@ y = 450
 heading = 90
 "#;
 
+/// Obstacles in the crowded room.
+const CROWD: usize = 10_000;
+
+/// [`ROOM`] with [`CROWD`] posts 2 cm round, 9 cm apart, all over it but
+/// for a corridor 1 m wide along the robot's way north.
+fn crowded_room() -> String {
+    let mut posts = String::new();
+    let mut count = 0;
+    'rows: for row in 0..111 {
+        for column in 0..111 {
+            let (x, y) = (5 + 9 * column, 5 + 9 * row);
+            if (450..=550).contains(&x) {
+                continue;
+            }
+            if count == CROWD {
+                break 'rows;
+            }
+            posts.push_str(&format!(
+                "[[obstacle]]\ncircle = {{ x = {x}, y = {y}, radius = 1 }}\n"
+            ));
+            count += 1;
+        }
+    }
+    assert_eq!(count, CROWD, "the room holds the crowd");
+    ROOM.replace("[robot]", &format!("{posts}[robot]"))
+}
+
 /// Seconds of wall time for [`ROOM_CYCLES`] of robot time of the
-/// reference ROM driving both motors at speed 40, in the room or not.
-fn run_room(room: bool) -> f64 {
+/// reference ROM, driving both motors at speed 40 or standing still, in
+/// `world` or in no room at all.
+fn run_room(world: Option<&str>, drive: bool) -> f64 {
     let mut robot = romlib::VirtualScorpion::new();
-    if room {
+    if let Some(world) = world {
         robot.set_surroundings(Box::new(
-            cards::Room::load("room.toml", ROOM).expect("loads"),
+            cards::Room::load("room.toml", world).expect("loads"),
         ));
     }
-    robot.send(b"/2G1/4C+40/4D+40");
+    if drive {
+        robot.send(b"/2G1/4C+40/4D+40");
+    }
     let start = Instant::now();
     robot.run_for(ROOM_CYCLES).expect("runs");
     start.elapsed().as_secs_f64()
@@ -289,9 +319,16 @@ fn main() {
     );
 
     let (mut bare, mut roomed) = (f64::MAX, f64::MAX);
+    let crowd = crowded_room();
+    // Driving, then standing still: without a room, in the crowded one.
+    let mut crowded = [[f64::MAX; 2]; 2];
     for _ in 0..ROUNDS {
-        bare = bare.min(run_room(false));
-        roomed = roomed.min(run_room(true));
+        bare = bare.min(run_room(None, true));
+        roomed = roomed.min(run_room(Some(ROOM), true));
+        for (slot, drive) in crowded.iter_mut().zip([true, false]) {
+            slot[0] = slot[0].min(run_room(None, drive));
+            slot[1] = slot[1].min(run_room(Some(&crowd), drive));
+        }
     }
     let robot_seconds = ROOM_CYCLES as f64 / 1e6;
     println!(
@@ -305,6 +342,25 @@ fn main() {
         (roomed - bare) / robot_seconds * 1e3,
         robot_seconds / roomed
     );
+    println!(
+        "the world's cost per robot second, {CROWD} obstacles (the same room with posts all over it but the robot's way; best of {ROUNDS}):"
+    );
+    for ((without, with), how) in crowded
+        .iter()
+        .map(|slot| (slot[0], slot[1]))
+        .zip(["driving at speed 40", "standing still"])
+    {
+        // Standing still, the robot alone idles (its loop skipped): the
+        // ratio to it says little, the world's own cost says it all.
+        println!(
+            "  {how:<20} without the room {:.1} ms, with it {:.1} ms a robot second: the world costs {:.1} ms per robot second; with it {:.2}x the robot's host time alone, {:.0}x real time",
+            without / robot_seconds * 1e3,
+            with / robot_seconds * 1e3,
+            (with - without) / robot_seconds * 1e3,
+            with / without,
+            robot_seconds / with
+        );
+    }
 
     // The bound: all of a script's share spent in calls, then in
     // operations.

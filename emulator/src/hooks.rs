@@ -62,6 +62,26 @@ pub trait Hooks {
         Control::Continue
     }
 
+    /// After each instruction the run executed (not a JAM, which executes
+    /// nothing), before any interrupt sequence that follows it: `pc` is its
+    /// address and `opcode` the byte the CPU fetched there; the registers
+    /// and counters are as it left them (the PC where it went). A profiler
+    /// counts here what the instruction took, from the counters, without
+    /// reading memory.
+    #[inline(always)]
+    fn after_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B, pc: u16, opcode: u8) {
+        let _ = (cpu, bus, pc, opcode);
+    }
+
+    /// [`Hooks::after_instruction`] for an instruction an idle probe ran
+    /// (only with hooks that [`Hooks::may_skip_idle`]): the laps
+    /// [`Hooks::idle_skipped`] tells of are made of such instructions, so
+    /// hooks that replay them keep these, and only these.
+    #[inline(always)]
+    fn after_probed_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B, pc: u16, opcode: u8) {
+        self.after_instruction(cpu, bus, pc, opcode);
+    }
+
     /// After an IRQ or NMI sequence (not BRK, which is an instruction), with
     /// the PC at the handler.
     #[inline(always)]
@@ -130,6 +150,16 @@ impl<H: Hooks + ?Sized> Hooks for &mut H {
     }
 
     #[inline(always)]
+    fn after_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B, pc: u16, opcode: u8) {
+        (**self).after_instruction(cpu, bus, pc, opcode);
+    }
+
+    #[inline(always)]
+    fn after_probed_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B, pc: u16, opcode: u8) {
+        (**self).after_probed_instruction(cpu, bus, pc, opcode);
+    }
+
+    #[inline(always)]
     fn interrupt<B: Bus>(&mut self, cpu: &Cpu, bus: &B, kind: Interrupt) {
         (**self).interrupt(cpu, bus, kind);
     }
@@ -165,6 +195,18 @@ impl<H1: Hooks, H2: Hooks> Hooks for (H1, H2) {
             Control::Stop => Control::Stop,
             Control::Continue => self.1.before_instruction(cpu, bus),
         }
+    }
+
+    #[inline(always)]
+    fn after_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B, pc: u16, opcode: u8) {
+        self.0.after_instruction(cpu, bus, pc, opcode);
+        self.1.after_instruction(cpu, bus, pc, opcode);
+    }
+
+    #[inline(always)]
+    fn after_probed_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B, pc: u16, opcode: u8) {
+        self.0.after_probed_instruction(cpu, bus, pc, opcode);
+        self.1.after_probed_instruction(cpu, bus, pc, opcode);
     }
 
     #[inline(always)]

@@ -479,3 +479,93 @@ fn loops_that_write_or_touch_io_are_run() {
         assert_eq!(robot.cpu.skipped_cycles(), 0, "{what}");
     }
 }
+
+/// Hooks that write down every instruction they are told of after it
+/// ran, and replay the laps of a skipped idle loop from the instructions
+/// the probe ran, as a profiler does.
+#[derive(Default)]
+struct Ledger {
+    /// (address, opcode, cycles it took, where it went), in order.
+    ran: Vec<(u16, u8, u64, u16)>,
+    /// The instructions the probes ran, last ones last.
+    probed: Vec<(u16, u8, u64, u16)>,
+    start: u64,
+}
+
+impl Ledger {
+    fn note(&mut self, cpu: &emulator::Cpu, pc: u16, opcode: u8) -> (u16, u8, u64, u16) {
+        let entry = (pc, opcode, cpu.cycles() - self.start, cpu.pc);
+        self.ran.push(entry);
+        entry
+    }
+}
+
+impl emulator::Hooks for Ledger {
+    fn may_skip_idle(&self) -> bool {
+        true
+    }
+
+    fn before_instruction<B: Bus>(&mut self, cpu: &emulator::Cpu, _bus: &B) -> emulator::Control {
+        self.start = cpu.cycles();
+        emulator::Control::Continue
+    }
+
+    fn after_instruction<B: Bus>(&mut self, cpu: &emulator::Cpu, _bus: &B, pc: u16, opcode: u8) {
+        self.note(cpu, pc, opcode);
+    }
+
+    fn after_probed_instruction<B: Bus>(
+        &mut self,
+        cpu: &emulator::Cpu,
+        _bus: &B,
+        pc: u16,
+        opcode: u8,
+    ) {
+        let entry = self.note(cpu, pc, opcode);
+        self.probed.push(entry);
+    }
+
+    fn idle_skipped(&mut self, _cpu: &emulator::Cpu, laps: u64, instructions: u64, _cycles: u64) {
+        let lap = self.probed[self.probed.len() - instructions as usize..].to_vec();
+        for _ in 0..laps {
+            self.ran.extend_from_slice(&lap);
+        }
+    }
+}
+
+/// Every instruction is told of after it ran, with the opcode the CPU
+/// fetched, what it took and where it went, whether it ran in the run
+/// loop or in the idle probe; and the probe's instructions, replayed for
+/// the laps skipped, are exactly the ones running every lap shows.
+#[test]
+fn the_hooks_are_told_of_every_instruction_after_it_ran() {
+    // $0400: JSR $0410 / LDA $10 / STA $11 / JMP $0400, $0410: RTS.
+    let mut program = vec![0x20, 0x10, 0x04, 0xA5, 0x10, 0x85, 0x11, 0x4C, 0x00, 0x04];
+    program.resize(0x10, 0xEA);
+    program.push(0x60);
+    let [skipped, run] = [true, false].map(|skip| {
+        let mut ram = Ram::new();
+        ram.load(0x0400, &program).expect("fits");
+        let mut machine = Machine::new(ram);
+        machine.cpu.pc = 0x0400;
+        machine.cpu.set_idle_skip(skip);
+        let mut ledger = Ledger::default();
+        let stop = machine.run_with(100_000, &mut ledger);
+        assert_eq!(stop, Stop::Limit);
+        (machine, ledger)
+    });
+    assert!(
+        skipped.0.cpu.skipped_cycles() > 90_000,
+        "the loop was skipped"
+    );
+    assert!(run.1.probed.is_empty(), "no probe without skipping");
+    assert_eq!(run.1.ran.len() as u64, run.0.cpu.instructions());
+    assert_eq!(skipped.1.ran, run.1.ran);
+    for &(pc, opcode, cycles, _) in &run.1.ran {
+        assert_eq!(opcode, run.0.bus.bytes()[usize::from(pc)]);
+        let expected = isa::opcode(opcode).cycles;
+        assert_eq!(u64::from(expected), cycles, "${pc:04X}");
+    }
+    let total: u64 = run.1.ran.iter().map(|entry| entry.2).sum();
+    assert_eq!(total, run.0.cpu.cycles());
+}

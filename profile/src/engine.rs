@@ -2,20 +2,19 @@
 //! conditional branch taken and not taken, the shadow call stack, and each
 //! robot command from its arrival to `CMD_DONE`.
 //!
-//! An instruction's cycles are only known once it has run: they are the
-//! cycle counter's advance from the hooks' look before it to their look
-//! before the next one (or to the start of the interrupt sequence that
-//! follows it, or to the end of the run). So the profiler keeps the
-//! instruction it last let run as pending and counts it at the next look,
-//! when it also sees where it went (a branch taken or not, a call made) and
-//! what it left S at.
+//! An instruction is counted when it has run ([`Hooks::after_instruction`],
+//! which hands over the opcode the CPU fetched): its cycles are the cycle
+//! counter's advance since the hooks' look before it, and the registers
+//! say where it went (a branch taken or not, a call made) and what it left
+//! S at. Nothing is read from memory per instruction.
 //!
 //! An idle loop the emulator skips is counted as if it had run: the probe
 //! that found it ran one lap under these hooks, and
 //! [`Hooks::idle_skipped`] says how many more laps the skip stands for,
 //! so the last lap's instructions (kept in a ring of the last
-//! [`RING`] instructions) are counted that many times more, to their
-//! addresses, lines, routines and branches.
+//! [`RING`] instructions the probes ran: only theirs, so the run's other
+//! instructions pay nothing for it) are counted that many times more, to
+//! their addresses, lines, routines and branches.
 
 use emulator::{Breakpoints, Bus, Control, Cpu, Hooks, Interrupt};
 
@@ -122,6 +121,18 @@ impl Labels {
         self.by_address[usize::from(address)]
     }
 
+    /// The addresses `label` (an index, or `u32::MAX` for none) names: its
+    /// first and how many (up to the next label).
+    pub(crate) fn span(&self, label: u32) -> (u16, u32) {
+        let first = self.names.get(label as usize).map_or(0, |(at, _)| *at);
+        let next = label.wrapping_add(1) as usize;
+        let end = self
+            .names
+            .get(next)
+            .map_or(0x1_0000, |(at, _)| u32::from(*at));
+        (first, end.saturating_sub(u32::from(first)))
+    }
+
     /// `address` named: `label`, `label+$offset`, or `$ADDR`.
     pub(crate) fn name(&self, address: u16) -> String {
         match self.names.get(self.of(address) as usize) {
@@ -156,26 +167,14 @@ pub struct CommandRun {
 /// An instruction that ran, as the ring keeps it.
 #[derive(Debug, Clone, Copy, Default)]
 struct Ran {
-    /// Its cycles, saturated (an idle loop's instruction has a few): the
-    /// ring's entries stay 16 bytes, one store per instruction cheaper.
+    /// Its cycles, saturated (an idle loop's instruction has a few).
     cycles: u32,
     pc: u16,
     next_pc: u16,
     opcode: u8,
-    s_before: u8,
+    /// S as it left it (S before it follows for the instructions that
+    /// push: `JSR` two bytes, `BRK` three).
     s_after: u8,
-}
-
-/// The instruction let run and not yet counted.
-#[derive(Debug, Clone, Copy)]
-struct Pending {
-    pc: u16,
-    opcode: u8,
-    s: u8,
-    /// Instructions run before it.
-    count: u64,
-    /// The cycle it began at.
-    start: u64,
 }
 
 /// The profiler: [`Hooks`] that never stop a run and let idle loops be
@@ -191,7 +190,13 @@ pub struct Profiler {
     pub(crate) taken: Vec<u64>,
     /// Conditional branches not taken, by address.
     pub(crate) not_taken: Vec<u64>,
-    pending: Option<Pending>,
+    /// The cycle the instruction about to run began at (the hooks' look
+    /// before it).
+    start: u64,
+    /// The last look at a watched address: the instructions run before
+    /// it and the PC. A look asked again for the same instruction (the
+    /// idle probe's at a lap's end, then the run's) is not made twice.
+    looked: Option<(u64, u16)>,
     ring: [Ran; RING],
     ring_next: usize,
     ring_len: usize,
@@ -206,9 +211,10 @@ pub struct Profiler {
     /// Laps of idle loops counted without running.
     pub(crate) skipped_laps: u64,
     /// The cycle the last instruction or interrupt sequence counted ended
-    /// at: frames still open at the end close there, not at a later time
-    /// the machine idled or was stuck through without being counted.
-    last_end: Option<u64>,
+    /// at (`u64::MAX` before any): frames still open at the end close
+    /// there, not at a later time the machine idled or was stuck through
+    /// without being counted.
+    last_end: u64,
 }
 
 impl Profiler {
@@ -232,7 +238,8 @@ impl Profiler {
             by_address: vec![[0; 2]; 0x1_0000],
             taken: vec![0; 0x1_0000],
             not_taken: vec![0; 0x1_0000],
-            pending: None,
+            start: 0,
+            looked: None,
             ring: [Ran::default(); RING],
             ring_next: 0,
             ring_len: 0,
@@ -241,7 +248,7 @@ impl Profiler {
             places,
             commands: Vec::new(),
             skipped_laps: 0,
-            last_end: None,
+            last_end: u64::MAX,
         }
     }
 
@@ -251,8 +258,9 @@ impl Profiler {
         Profiler::new(&robot.labels(), Places::of(robot))
     }
 
-    /// Counts by address and branch only, for coverage: no call stack,
-    /// no commands (faster).
+    /// Counts executions by address and branches only, for coverage: no
+    /// cycles, no call stack, no commands (faster; the profile's cycles
+    /// and total stay 0).
     #[must_use]
     pub fn coverage_only(mut self) -> Profiler {
         self.calls = false;
@@ -260,16 +268,11 @@ impl Profiler {
         self
     }
 
-    /// Counts the instruction still pending, which ended at the CPU's
-    /// cycle now: call after a run of the CPU the hooks saw, before
-    /// anything else runs it (the runner does).
+    /// The end of a run of the CPU the hooks saw (the runner calls it).
+    /// Every instruction is counted as it ends, so nothing is left to
+    /// count: kept so that a caller need not know.
     pub fn end_run(&mut self, cpu: &Cpu) {
-        if let Some(pending) = self.pending {
-            if cpu.instructions() == pending.count + 1 {
-                self.count_pending(pending, cpu.cycles(), cpu.pc, cpu.s);
-            }
-        }
-        self.pending = None;
+        let _ = cpu;
     }
 
     /// The host entered the routine at `target` as a `JSR` does, at cycle
@@ -314,32 +317,44 @@ impl Profiler {
         self.by_address.iter().map(|place| place[1]).collect()
     }
 
-    // Out of line: the CPU's run loop keeps its registers (inlined, this
-    // would crowd them out of machine registers on every instruction).
-    #[inline(never)]
-    fn count_pending(&mut self, pending: Pending, end: u64, next_pc: u16, s_after: u8) {
-        let cycles = end.saturating_sub(pending.start);
-        let ran = Ran {
-            pc: pending.pc,
-            opcode: pending.opcode,
-            cycles: u32::try_from(cycles).unwrap_or(u32::MAX),
-            next_pc,
-            s_before: pending.s,
-            s_after,
-        };
-        self.count(ran, cycles, 1, end);
-        self.ring[self.ring_next] = ran;
-        self.ring_next = (self.ring_next + 1) % RING;
-        self.ring_len = (self.ring_len + 1).min(RING);
+    /// Counts the instruction at `pc` (`opcode`) that has just run, its
+    /// registers as it left them: the per-instruction work, inlined into
+    /// the CPU's run loop, with what is rare (calls, returns) out of line.
+    /// Returns its cycles (0 for coverage alone, which counts none).
+    #[inline(always)]
+    fn ran(&mut self, cpu: &Cpu, pc: u16, opcode: u8) -> u64 {
+        let at = usize::from(pc);
+        let flow = self.flows[usize::from(opcode)];
+        if flow == Flow::Branch {
+            if cpu.pc == pc.wrapping_add(2) {
+                self.not_taken[at] += 1;
+            } else {
+                self.taken[at] += 1;
+            }
+        }
+        if !self.calls {
+            self.by_address[at][0] += 1;
+            return 0;
+        }
+        let end = cpu.cycles();
+        let cycles = end.saturating_sub(self.start);
+        self.last_end = end;
+        let place = &mut self.by_address[at];
+        place[0] += 1;
+        place[1] += cycles;
+        self.stack.charge(pc, cycles, &self.labels);
+        if !matches!(flow, Flow::Plain | Flow::Branch) {
+            self.flowed(flow, cpu.pc, cpu.s, 1, end);
+        }
+        cycles
     }
 
     /// Counts `ran`, which took `cycles`, `times` times over, the last
-    /// one ending at `end`.
-    #[inline(always)]
+    /// one ending at `end` (a skipped idle loop's laps).
     fn count(&mut self, ran: Ran, cycles: u64, times: u64, end: u64) {
         let at = usize::from(ran.pc);
         let cycles = cycles * times;
-        self.last_end = Some(end);
+        self.last_end = end;
         let place = &mut self.by_address[at];
         place[0] += times;
         place[1] += cycles;
@@ -354,16 +369,42 @@ impl Profiler {
         if !self.calls {
             return;
         }
-        self.stack.charge(self.labels.of(ran.pc), cycles);
+        self.stack.charge(ran.pc, cycles, &self.labels);
+        self.flowed(flow, ran.next_pc, ran.s_after, times, end);
+    }
+
+    /// What an instruction of kind `flow`, which went to `next_pc`
+    /// leaving S at `s_after`, did to the call stack, `times` over, ending
+    /// at `end`. Its cycles are charged already (a `JSR`'s to its caller,
+    /// an `RTS`'s to the routine it leaves).
+    #[inline(never)]
+    fn flowed(&mut self, flow: Flow, next_pc: u16, s_after: u8, times: u64, end: u64) {
         match flow {
             Flow::Plain | Flow::Branch => {}
-            Flow::Call => self.stack.call(ran.next_pc, ran.s_before, end, times),
-            Flow::Return => self.stack.unwind(ran.s_after, false, end),
+            Flow::Call => self
+                .stack
+                .call(next_pc, s_after.wrapping_add(2), end, times),
+            Flow::Return => self.stack.unwind(s_after, false, end),
             Flow::ReturnFromInterrupt | Flow::SetStack => {
-                self.stack.unwind(ran.s_after, true, end);
+                self.stack.unwind(s_after, true, end);
             }
-            Flow::Break => self.stack.interrupt(Routine::Brk, ran.s_before, end),
+            Flow::Break => self
+                .stack
+                .interrupt(Routine::Brk, s_after.wrapping_add(3), end),
         }
+    }
+
+    /// The instruction at the PC, a watched address, is about to run:
+    /// looks unless it looked already for this very instruction.
+    #[cold]
+    #[inline(never)]
+    fn look_once<B: Bus>(&mut self, cpu: &Cpu, bus: &B) {
+        let this = (cpu.instructions(), cpu.pc);
+        if self.looked == Some(this) {
+            return;
+        }
+        self.looked = Some(this);
+        self.look(cpu.pc, cpu.cycles(), bus);
     }
 
     /// A new instruction at `pc` is about to run at cycle `now`: a
@@ -419,13 +460,17 @@ impl Profiler {
     #[cold]
     fn replay(&mut self, cpu: &Cpu, laps: u64, instructions: u64) {
         let len = usize::try_from(instructions).unwrap_or(usize::MAX);
+        // The look the probe asked at the lap's end stands for the
+        // instruction the run asks about next, after the skipped laps.
+        if let Some((count, pc)) = self.looked {
+            let skipped = laps.saturating_mul(instructions);
+            if pc == cpu.pc && count == cpu.instructions().wrapping_sub(skipped) {
+                self.looked = Some((cpu.instructions(), pc));
+            }
+        }
         if len == 0 || len > self.ring_len {
             // Not a lap these hooks saw (cannot happen with the
-            // emulator's probe): the cycles still count, at the PC.
-            if let Some(pending) = &mut self.pending {
-                pending.start = cpu.cycles();
-                pending.count = cpu.instructions();
-            }
+            // emulator's probe).
             return;
         }
         let first = (self.ring_next + RING - len) % RING;
@@ -439,18 +484,12 @@ impl Profiler {
             self.count(ran, u64::from(ran.cycles), laps, clock);
         }
         self.skipped_laps += laps;
-        // The instruction the probe asked about last is the lap's first
-        // again, now after the skipped laps.
-        if let Some(pending) = &mut self.pending {
-            pending.start = cpu.cycles();
-            pending.count = cpu.instructions();
-        }
     }
 
     /// Ends every frame still open and turns the counts into a profile.
     #[must_use]
     pub fn finish(mut self, now: u64) -> crate::Profile {
-        let end = self.last_end.map_or(now, |end| end.min(now));
+        let end = self.last_end.min(now);
         self.stack.close(end);
         crate::Profile::from_profiler(&self)
     }
@@ -466,54 +505,50 @@ impl Hooks for Profiler {
 
     #[inline(always)]
     fn before_instruction<B: Bus>(&mut self, cpu: &Cpu, bus: &B) -> Control {
-        let count = cpu.instructions();
-        if let Some(pending) = self.pending {
-            if pending.count == count && pending.pc == cpu.pc {
-                // Asked again before it ran (the idle probe's look at a
-                // lap's end).
-                return Control::Continue;
+        if self.calls {
+            self.start = cpu.cycles();
+            if self.watched.contains(cpu.pc) {
+                self.look_once(cpu, bus);
             }
-            self.count_pending(pending, cpu.cycles(), cpu.pc, cpu.s);
         }
-        if self.watched.contains(cpu.pc) {
-            self.look(cpu.pc, cpu.cycles(), bus);
-        }
-        self.pending = Some(Pending {
-            pc: cpu.pc,
-            opcode: bus.peek(cpu.pc),
-            s: cpu.s,
-            count,
-            start: cpu.cycles(),
-        });
         Control::Continue
     }
 
-    fn interrupt<B: Bus>(&mut self, cpu: &Cpu, bus: &B, kind: Interrupt) {
+    #[inline(always)]
+    fn after_instruction<B: Bus>(&mut self, cpu: &Cpu, _bus: &B, pc: u16, opcode: u8) {
+        self.ran(cpu, pc, opcode);
+    }
+
+    fn after_probed_instruction<B: Bus>(&mut self, cpu: &Cpu, _bus: &B, pc: u16, opcode: u8) {
+        let cycles = self.ran(cpu, pc, opcode);
+        self.ring[self.ring_next] = Ran {
+            cycles: u32::try_from(cycles).unwrap_or(u32::MAX),
+            pc,
+            next_pc: cpu.pc,
+            opcode,
+            s_after: cpu.s,
+        };
+        self.ring_next = (self.ring_next + 1) % RING;
+        self.ring_len = (self.ring_len + 1).min(RING);
+    }
+
+    fn interrupt<B: Bus>(&mut self, cpu: &Cpu, _bus: &B, kind: Interrupt) {
         let began = cpu.cycles().saturating_sub(7);
         let s_before = cpu.s.wrapping_add(3);
-        if let Some(pending) = self.pending.take() {
-            // The instruction before the sequence went where the sequence
-            // pushed as the return address.
-            let lo = bus.peek(0x0100 | u16::from(cpu.s.wrapping_add(2)));
-            let hi = bus.peek(0x0100 | u16::from(s_before));
-            let next_pc = u16::from_le_bytes([lo, hi]);
-            if cpu.instructions() == pending.count + 1 {
-                self.count_pending(pending, began, next_pc, s_before);
-            }
-        }
         let routine = match kind {
             Interrupt::Irq => Routine::Irq,
             Interrupt::Nmi => Routine::Nmi,
         };
+        if !self.calls {
+            return;
+        }
         // The sequence's own seven cycles are the handler's, counted at
         // its first instruction (its address, so its line and label):
         // cycles by address add up to the total, as routines' do.
         self.by_address[usize::from(cpu.pc)][1] += 7;
-        self.last_end = Some(began + 7);
-        if self.calls {
-            self.stack.interrupt(routine, s_before, began);
-            self.stack.charge(self.labels.of(cpu.pc), 7);
-        }
+        self.last_end = began + 7;
+        self.stack.interrupt(routine, s_before, began);
+        self.stack.charge(cpu.pc, 7, &self.labels);
     }
 
     fn idle_skipped(&mut self, cpu: &Cpu, laps: u64, instructions: u64, _cycles: u64) {

@@ -38,7 +38,8 @@ pub struct RoutineCost {
 pub struct Profile {
     /// Executions by address (65536 entries).
     pub counts: Vec<u64>,
-    /// Cycles by address.
+    /// Cycles by address (none counted for coverage alone,
+    /// [`crate::Profiler::coverage_only`]).
     pub cycles: Vec<u64>,
     /// Conditional branches taken, by address.
     pub taken: Vec<u64>,
@@ -52,7 +53,7 @@ pub struct Profile {
     pub stacks: BTreeMap<String, u64>,
     /// Every command seen, in order.
     pub commands: Vec<CommandRun>,
-    /// Every cycle counted.
+    /// Every cycle counted (0 for coverage alone).
     pub total: u64,
     /// Laps of idle loops counted without being run.
     pub skipped_laps: u64,

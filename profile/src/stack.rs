@@ -17,6 +17,8 @@
 
 use rustc_hash::FxHashMap;
 
+use crate::engine::Labels;
+
 /// What a frame stands for.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Routine {
@@ -92,12 +94,19 @@ pub(crate) const TOP: u32 = 0;
 pub(crate) struct Stack {
     pub(crate) routines: Vec<Routine>,
     routine_ids: FxHashMap<Routine, u32>,
+    /// The routine id of [`Routine::Sub`] by address, once made
+    /// (`u32::MAX` before): a `JSR` finds its routine without hashing.
+    sub_ids: Vec<u32>,
     pub(crate) calls: Vec<Calls>,
     /// Open frames of each routine: only the outermost one's cycles count
     /// as its inclusive (a recursive routine's inner calls are inside it).
     active: Vec<u32>,
     pub(crate) nodes: Vec<Node>,
     node_ids: FxHashMap<(u32, u32), u32>,
+    /// By routine: the parent and node it was last entered under. A
+    /// routine called from one place over and over finds its node here
+    /// instead of hashing.
+    node_cache: Vec<(u32, u32)>,
     /// Cycles by cell; a cell is a node and a label.
     pub(crate) cells: Vec<u64>,
     pub(crate) cell_keys: Vec<(u32, u32)>,
@@ -110,8 +119,11 @@ pub(crate) struct Stack {
     main: u32,
     /// The node code runs in now (the top frame's, or `main`'s).
     top: u32,
-    /// The last cell charged: its node, label and index.
-    current: (u32, u32, u32),
+    /// The addresses of the label last charged (the first and how many;
+    /// none once the frames change) and its cell in the top node: an
+    /// instruction in them is charged with one comparison.
+    span: (u16, u32),
+    span_cell: u32,
     /// The command running now (an index into the commands seen).
     pub(crate) command: Option<u32>,
 }
@@ -121,6 +133,7 @@ impl Stack {
         let mut stack = Stack {
             routines: Vec::new(),
             routine_ids: FxHashMap::default(),
+            sub_ids: vec![u32::MAX; 0x1_0000],
             calls: Vec::new(),
             active: Vec::new(),
             nodes: vec![Node {
@@ -128,6 +141,7 @@ impl Stack {
                 routine: u32::MAX,
             }],
             node_ids: FxHashMap::default(),
+            node_cache: Vec::new(),
             cells: Vec::new(),
             cell_keys: Vec::new(),
             cell_ids: FxHashMap::default(),
@@ -135,16 +149,15 @@ impl Stack {
             frames: Vec::new(),
             main: TOP,
             top: TOP,
-            current: (u32::MAX, u32::MAX, 0),
+            span: (0, 0),
+            span_cell: 0,
             command: None,
         };
         let main = stack.routine_id(Routine::Main);
         stack.main = stack.child(TOP, main);
         stack.top = stack.main;
         stack.calls[main as usize].calls = 1;
-        stack.current = (stack.main, u32::MAX, 0);
-        let cell = stack.cell(stack.main, u32::MAX);
-        stack.current.2 = cell;
+        stack.cell(stack.main, u32::MAX);
         stack
     }
 
@@ -157,14 +170,35 @@ impl Stack {
         self.routine_ids.insert(routine, id);
         self.calls.push(Calls::default());
         self.active.push(0);
+        self.node_cache.push((u32::MAX, 0));
+        id
+    }
+
+    /// The id of the routine a `JSR` to `target` enters.
+    fn sub_id(&mut self, target: u16) -> u32 {
+        let id = self.sub_ids[usize::from(target)];
+        if id != u32::MAX {
+            return id;
+        }
+        let id = self.routine_id(Routine::Sub(target));
+        self.sub_ids[usize::from(target)] = id;
         id
     }
 
     fn child(&mut self, parent: u32, routine: u32) -> u32 {
-        *self.node_ids.entry((parent, routine)).or_insert_with(|| {
+        if let Some(&(cached, node)) = self.node_cache.get(routine as usize)
+            && cached == parent
+        {
+            return node;
+        }
+        let node = *self.node_ids.entry((parent, routine)).or_insert_with(|| {
             self.nodes.push(Node { parent, routine });
             index(self.nodes.len() - 1)
-        })
+        });
+        if let Some(slot) = self.node_cache.get_mut(routine as usize) {
+            *slot = (parent, node);
+        }
+        node
     }
 
     fn cell(&mut self, node: u32, label: u32) -> u32 {
@@ -182,26 +216,37 @@ impl Stack {
 
     fn frames_changed(&mut self) {
         self.top = self.frames.last().map_or(self.main, |frame| frame.node);
+        self.span = (0, 0);
     }
 
-    /// Counts `cycles` spent at an address labelled `label`, in the
+    /// Counts `cycles` spent at `address` (named by `labels`), in the
     /// frame on top.
     #[inline(always)]
-    pub(crate) fn charge(&mut self, label: u32, cycles: u64) {
-        let (node, at, cell) = self.current;
-        let cell = if at == label && node == self.top {
-            cell
+    pub(crate) fn charge(&mut self, address: u16, cycles: u64, labels: &Labels) {
+        let (first, len) = self.span;
+        if u32::from(address.wrapping_sub(first)) < len {
+            self.cells[self.span_cell as usize] += cycles;
         } else {
-            self.cached_cell(label)
-        };
+            self.charge_elsewhere(address, cycles, labels);
+        }
+    }
+
+    /// [`Stack::charge`] at an address out of the last label's: its
+    /// label's cell found, and its addresses made the span.
+    #[inline(never)]
+    fn charge_elsewhere(&mut self, address: u16, cycles: u64, labels: &Labels) {
+        let label = labels.of(address);
+        let cell = self.cached_cell(label);
+        self.span = labels.span(label);
+        self.span_cell = cell;
         self.cells[cell as usize] += cycles;
     }
 
-    /// The cell of `label` in the top frame's node, made the current one.
+    /// The cell of `label` in the top frame's node.
     fn cached_cell(&mut self, label: u32) -> u32 {
         let node = self.top;
         let slot = label.wrapping_add(1) as usize;
-        let cell = match self.cell_cache.get(slot) {
+        match self.cell_cache.get(slot) {
             Some(&(cached, cell)) if cached == node => cell,
             _ => {
                 let cell = self.cell(node, label);
@@ -211,12 +256,10 @@ impl Stack {
                 self.cell_cache[slot] = (node, cell);
                 cell
             }
-        };
-        self.current = (node, label, cell);
-        cell
+        }
     }
 
-    fn push(&mut self, routine: Routine, ends: Ends, entry: u64, times: u64) {
+    fn push(&mut self, routine: u32, ends: Ends, entry: u64, times: u64) {
         let parent = match ends {
             Ends::Interrupt { .. } => TOP,
             Ends::Return { .. } | Ends::Command => self.node(),
@@ -224,8 +267,7 @@ impl Stack {
         self.push_under(parent, routine, ends, entry, times);
     }
 
-    fn push_under(&mut self, parent: u32, routine: Routine, ends: Ends, entry: u64, times: u64) {
-        let routine = self.routine_id(routine);
+    fn push_under(&mut self, parent: u32, routine: u32, ends: Ends, entry: u64, times: u64) {
         let node = self.child(parent, routine);
         self.calls[routine as usize].calls += times;
         self.active[routine as usize] += 1;
@@ -287,31 +329,23 @@ impl Stack {
     /// A `JSR` to `target` with S at `s_before` before it, ending at `now`.
     pub(crate) fn call(&mut self, target: u16, s_before: u8, now: u64, times: u64) {
         self.overwritten(s_before, now);
-        self.push(
-            Routine::Sub(target),
-            Ends::Return { return_s: s_before },
-            now,
-            times,
-        );
+        let routine = self.sub_id(target);
+        self.push(routine, Ends::Return { return_s: s_before }, now, times);
     }
 
     /// The routine at `target` entered by the host as a `JSR` would (S at
     /// `s_before` before the return address), at `now`: a root.
     pub(crate) fn entered(&mut self, target: u16, s_before: u8, now: u64) {
         self.overwritten(s_before, now);
-        self.push_under(
-            TOP,
-            Routine::Sub(target),
-            Ends::Return { return_s: s_before },
-            now,
-            1,
-        );
+        let routine = self.sub_id(target);
+        self.push_under(TOP, routine, Ends::Return { return_s: s_before }, now, 1);
     }
 
     /// An IRQ, NMI or BRK whose sequence began at `entry`, with S at
     /// `s_before` before its pushes.
     pub(crate) fn interrupt(&mut self, routine: Routine, s_before: u8, entry: u64) {
         self.overwritten(s_before, entry);
+        let routine = self.routine_id(routine);
         self.push(routine, Ends::Interrupt { return_s: s_before }, entry, 1);
     }
 
@@ -334,7 +368,8 @@ impl Stack {
     /// A command arrived (`text`, the `index`th seen) at `now`.
     pub(crate) fn command_begins(&mut self, text: &str, index: u32, now: u64) {
         self.command_ends(now);
-        self.push(Routine::Command(text.to_owned()), Ends::Command, now, 1);
+        let routine = self.routine_id(Routine::Command(text.to_owned()));
+        self.push(routine, Ends::Command, now, 1);
         self.command = Some(index);
     }
 

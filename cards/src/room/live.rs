@@ -191,6 +191,11 @@ impl Room {
                 edit.apply(&mut self.layout, &mut self.pose);
             }
         }
+        // A moved obstacle is in other cells of the grid, and what the
+        // bumpers and trackers last felt is stale even where the pose is not.
+        self.grid = super::geometry::ShapeGrid::new(&self.layout.obstacles);
+        self.felt = None;
+        self.seen = None;
         if let Ok(mut trail) = self.view.trail.lock()
             && trail.poses.len() < super::MAX_TRAIL
         {

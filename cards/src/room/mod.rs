@@ -13,6 +13,7 @@ pub mod live;
 pub mod picture;
 pub mod raster;
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use emulator::board::{Motor, Scorpion};
@@ -21,7 +22,7 @@ use romlib::Surroundings;
 use crate::error::ScriptError;
 use drive::Pose;
 use file::Layout;
-use geometry::{Point, near_polyline, sin_cos};
+use geometry::{Point, ShapeGrid, near_polyline, sin_cos};
 
 /// Robot time between two looks at the motors, cycles (1 ms): a drive
 /// steps at most 495 times a second (speed 99), so each look sees one
@@ -54,6 +55,8 @@ pub struct RoomView {
     layout: Arc<Layout>,
     /// The host's changes of the room ([`live`]).
     edits: Arc<live::Mailbox>,
+    /// The room's [`Room::obstacle_tests`], as of its last look.
+    obstacle_tests: Arc<AtomicU64>,
 }
 
 impl RoomView {
@@ -72,6 +75,13 @@ impl RoomView {
         self.trail.lock().map(|t| t.clone()).unwrap_or_default()
     }
 
+    /// How many times the room has tested a point against an obstacle,
+    /// as of its last look at the motors ([`Room::obstacle_tests`]).
+    #[must_use]
+    pub fn obstacle_tests(&self) -> u64 {
+        self.obstacle_tests.load(Ordering::Relaxed)
+    }
+
     /// The path as a picture (SVG text, [`picture::svg`]), with
     /// `commands` (robot time, text) placed along it.
     #[must_use]
@@ -84,6 +94,8 @@ impl RoomView {
 #[derive(Debug)]
 pub struct Room {
     layout: Layout,
+    /// The obstacles by where they lie.
+    grid: ShapeGrid,
     pose: Pose,
     /// The drive motors' positions at the last look (`None`: no look
     /// yet; the robot stands at its start pose whatever they read).
@@ -91,6 +103,14 @@ pub struct Room {
     /// What the room last set: bumpers, phototransistors.
     bumpers: u8,
     sense: u8,
+    /// The pose the bumpers were last felt at, and what they felt: a
+    /// robot standing still touches what it touched.
+    felt: Option<(Pose, u8)>,
+    /// The pose and lamps the trackers last looked with, and what they
+    /// saw.
+    seen: Option<(Pose, bool, u8)>,
+    /// Points tested against obstacles ([`Room::obstacle_tests`]).
+    obstacle_tests: std::cell::Cell<u64>,
     next_look: u64,
     script: Option<Box<dyn Surroundings>>,
     view: RoomView,
@@ -111,13 +131,18 @@ impl Room {
             })),
             layout: Arc::new(layout.clone()),
             edits: Arc::default(),
+            obstacle_tests: Arc::new(AtomicU64::new(0)),
         };
         Ok(Room {
+            grid: ShapeGrid::new(&layout.obstacles),
             layout,
             pose,
             motors: None,
             bumpers: 0,
             sense: 0,
+            felt: None,
+            seen: None,
+            obstacle_tests: std::cell::Cell::new(0),
             next_look: 0,
             script: None,
             view,
@@ -154,13 +179,28 @@ impl Room {
         self.pose
     }
 
-    /// Whether the floor point `point` is taken by a wall or an obstacle.
+    /// How many times the room has tested a point against an obstacle:
+    /// its work, which grows with the obstacles near the robot, not with
+    /// those far away, and stops while the robot stands still.
+    #[must_use]
+    pub fn obstacle_tests(&self) -> u64 {
+        self.obstacle_tests.get()
+    }
+
+    /// Whether the floor point `point` is taken by a wall or an obstacle
+    /// (only those whose box it is in can hold it).
     fn blocked(&self, point: Point) -> bool {
         self.layout
             .walls
             .as_ref()
             .is_some_and(|walls| !geometry::inside_polygon(walls, point))
-            || self.layout.obstacles.iter().any(|o| o.contains(point))
+            || self.grid.near(point).any(|shape| {
+                self.obstacle_tests.set(self.obstacle_tests.get() + 1);
+                self.layout
+                    .obstacles
+                    .get(shape)
+                    .is_some_and(|o| o.contains(point))
+            })
     }
 
     /// The bumpers closed at the robot's pose: a bit for each whose part
@@ -215,12 +255,23 @@ impl Room {
         if moved {
             self.pose = self.layout.drive.moved(self.pose, left, right);
         }
-        let closed = self.contacts();
+        let closed = match self.felt {
+            Some((pose, closed)) if pose == self.pose => closed,
+            _ => self.contacts(),
+        };
+        self.felt = Some((self.pose, closed));
         if closed != self.bumpers {
             self.bumpers = closed;
             robot.set_bumpers(closed);
         }
-        let sense = self.sees(lamps);
+        let sense = match self.seen {
+            Some((pose, on, sense)) if pose == self.pose && on == lamps => sense,
+            _ => self.sees(lamps),
+        };
+        self.seen = Some((self.pose, lamps, sense));
+        self.view
+            .obstacle_tests
+            .store(self.obstacle_tests.get(), Ordering::Relaxed);
         if sense != self.sense {
             self.sense = sense;
             robot.board_mut().set_phototransistors(sense);
@@ -284,16 +335,21 @@ impl Surroundings for Room {
         };
         Some(Box::new(Room {
             layout: self.layout.clone(),
+            grid: self.grid.clone(),
             pose: self.pose,
             motors: self.motors,
             bumpers: self.bumpers,
             sense: self.sense,
+            felt: self.felt,
+            seen: self.seen,
+            obstacle_tests: self.obstacle_tests.clone(),
             next_look: self.next_look,
             script,
             view: RoomView {
                 trail: Arc::new(Mutex::new(self.view.trail())),
                 layout: Arc::clone(&self.view.layout),
                 edits: Arc::default(),
+                obstacle_tests: Arc::new(AtomicU64::new(self.obstacle_tests.get())),
             },
         }))
     }

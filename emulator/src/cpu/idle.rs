@@ -277,12 +277,16 @@ impl Cpu {
             if !H::PASSIVE && hooks.before_instruction(self, &*probe.bus) == Control::Stop {
                 return Some(Stop::Hook { pc: self.pc });
             }
-            let flow = self.instruction(&mut probe);
+            let pc = self.pc;
+            let (flow, opcode) = self.instruction(&mut probe);
             if flow & JAM != 0 {
                 return Some(Stop::Jam {
                     pc: self.pc,
                     opcode: probe.bus.peek(self.pc),
                 });
+            }
+            if !H::PASSIVE {
+                hooks.after_probed_instruction(self, &*probe.bus, pc, opcode);
             }
             if !H::PASSIVE && flow & TRAP != 0 && hooks.trap(self, &*probe.bus) == Control::Stop {
                 return Some(Stop::Trap { pc: self.pc });

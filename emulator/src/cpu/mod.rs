@@ -408,7 +408,7 @@ impl Cpu {
         if self.nmi_pending || self.irq_pending {
             return Step::Interrupt(self.interrupt_sequence(bus));
         }
-        let flow = self.instruction(bus);
+        let (flow, _) = self.instruction(bus);
         if flow & JAM != 0 {
             Step::Jam {
                 opcode: bus.peek(self.pc),
@@ -508,6 +508,7 @@ impl Cpu {
                         };
                     }
                     self.instructions += 1;
+                    hooks.after_instruction(self, &*bus, pc, opcode);
                     // BRK's sequence polled (a stop the bus asked during
                     // it ends the run here); RTI polls as usual.
                     if flow & NO_POLL != 0 {
@@ -527,6 +528,7 @@ impl Cpu {
                     }
                 } else {
                     self.instructions += 1;
+                    hooks.after_instruction(self, &*bus, pc, opcode);
                     // One comparison while the bus is quiet (see
                     // `instruction`).
                     if self.cycles > bus.quiet_until() {
@@ -554,14 +556,14 @@ impl Cpu {
 
     /// One instruction and its interrupt poll, for [`Cpu::step`] and the
     /// idle probe (the run loop has its own copy). Returns the flow bits,
-    /// with `POLLED` if the poll was made.
+    /// with `POLLED` if the poll was made, and the opcode fetched.
     ///
     /// The poll is skipped when the bus says it would find nothing
     /// ([`Bus::quiet_until`]); a skipped poll changes nothing here either,
     /// since instructions only run with no interrupt pending and a bus only
     /// reports quiet while NMI rests released.
     #[inline(always)]
-    fn instruction<B: Bus>(&mut self, bus: &mut B) -> u8 {
+    fn instruction<B: Bus>(&mut self, bus: &mut B) -> (u8, u8) {
         let pc = self.pc;
         let opcode = self.fetch(bus);
         let flow = self.execute::<B, true>(bus, opcode, pc);
@@ -571,20 +573,20 @@ impl Cpu {
                 // uncounted, so the fault is reported where it happened.
                 self.pc = pc;
                 self.cycles -= 1;
-                return flow;
+                return (flow, opcode);
             }
             self.instructions += 1;
-            return flow;
+            return (flow, opcode);
         }
         self.instructions += 1;
         // Every poll point lies before the instruction's end (two cycles
         // or more before it): one comparison decides, and with a bus that
         // is always quiet (`u64::MAX`) it folds away.
         if self.cycles <= bus.quiet_until() {
-            return flow;
+            return (flow, opcode);
         }
         self.poll_after(bus, flow);
-        flow | POLLED
+        (flow | POLLED, opcode)
     }
 
     /// The poll of the instruction that just ended with `flow`: at its
