@@ -98,7 +98,7 @@ fn a_breakpoint_in_a_handler_stops_it_and_it_goes_on_changed() {
         Err(StubError::Refused { .. })
     ));
     // One step: LDA $0480 runs, it stops before JSR PUTHEX.
-    let Reply::Stopped(after) = debug.step(&[], WAIT).expect("step") else {
+    let Reply::Stopped(after) = debug.step(&[], false, WAIT).expect("step") else {
         panic!("the step did not stop");
     };
     assert_eq!((after.pc, after.a), (0x040F, 0x99));

@@ -97,7 +97,8 @@ pub enum StubError {
 pub type StubResult<T> = std::result::Result<T, StubError>;
 
 /// `bytes` as spaced hex, for messages.
-pub(crate) fn hex(bytes: &[u8]) -> String {
+#[must_use]
+pub fn hex(bytes: &[u8]) -> String {
     bytes
         .iter()
         .map(|b| format!("{b:02X}"))

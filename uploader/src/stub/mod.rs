@@ -16,7 +16,7 @@ pub mod link;
 pub mod patch;
 pub mod session;
 
-pub use error::{StubError, StubResult};
+pub use error::{StubError, StubResult, hex as error_hex};
 pub use link::StubPlan;
 pub use patch::Patch;
 pub use session::{Registers, Reply, RobotDebug};

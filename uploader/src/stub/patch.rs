@@ -106,8 +106,8 @@ pub fn plan(address: u16, image: &UploadImage, entries: &[u16]) -> StubResult<Pa
 
 /// Where the instruction at `pc` (decoded from `read`) can go next, for a
 /// step: `Ok` the successors; the stack's bytes are read through `read`
-/// too (`RTS`, `RTI`). A `JSR` whose target is not in `image` (the ROM) is
-/// stepped over: its successor is the instruction after it.
+/// too (`RTS`, `RTI`). A `JSR` whose target is not in `image` (the ROM),
+/// or any `JSR` when `over`, is stepped over: its successor is the instruction after it.
 ///
 /// # Errors
 /// [`StubError::Refused`] for `BRK` (the ROM's interrupt handler returns
@@ -116,6 +116,7 @@ pub fn successors(
     pc: u16,
     s: u8,
     image: &UploadImage,
+    over: bool,
     read: &mut dyn FnMut(u16) -> StubResult<u8>,
 ) -> StubResult<Vec<u16>> {
     let bytes = [
@@ -139,7 +140,7 @@ pub fn successors(
             vec![word(read, pointer, high)?]
         }
         Mnemonic::Jmp => vec![instruction.operand],
-        Mnemonic::Jsr if image.contains(instruction.operand) => vec![instruction.operand],
+        Mnemonic::Jsr if !over && image.contains(instruction.operand) => vec![instruction.operand],
         Mnemonic::Jsr => vec![next],
         Mnemonic::Rts => vec![word(read, stack(1), stack(2))?.wrapping_add(1)],
         Mnemonic::Rti => vec![word(read, stack(2), stack(3))?],

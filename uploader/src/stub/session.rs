@@ -517,14 +517,15 @@ impl<T: Transport> RobotDebug<T> {
     }
 
     /// One instruction: temporary breakpoints at where the instruction at
-    /// the PC can go (a `JSR` into the ROM stepped over), continue, and
+    /// the PC can go (a `JSR` into the ROM stepped over, any `JSR` when
+    /// `over`), continue, and
     /// the temporary ones removed at the stop. `Ok(None)` when no stop
     /// came within `wait` (the code went into the ROM: a return, say).
     ///
     /// # Errors
     /// [`StubError::Refused`] with the reason (a successor in the ROM, or
     /// in bytes a breakpoint displaced); the line's errors.
-    pub fn step(&mut self, entries: &[u16], wait: Duration) -> StubResult<Reply> {
+    pub fn step(&mut self, entries: &[u16], over: bool, wait: Duration) -> StubResult<Reply> {
         let Some(registers) = self.stopped else {
             return Err(not_stopped("step"));
         };
@@ -542,7 +543,7 @@ impl<T: Transport> RobotDebug<T> {
             known.insert(at, byte);
             Ok(byte)
         };
-        let next = patch::successors(pc, registers.s, &image, &mut read)?;
+        let next = patch::successors(pc, registers.s, &image, over, &mut read)?;
         let mut temporary = Vec::new();
         for &to in &next {
             if self.breakpoints.contains_key(&to) {
