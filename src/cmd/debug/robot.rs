@@ -51,7 +51,13 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     client.probe()?;
     let mut robot = RobotDebug::attach(client, &profile, code)?;
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
-    let symbols = debugger::Symbols::new(&ports::bare_robot(9600, rom.as_ref())?, &linked);
+    // The names: the ROM's and the images' labels, as the virtual robot
+    // with the images loaded has them.
+    let mut named = ports::bare_robot(9600, rom.as_ref())?;
+    for image in &linked {
+        named.load_image(image)?;
+    }
+    let symbols = debugger::Symbols::new(&named, &linked);
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
     let mut monitor = RobotMonitor::new(symbols, linked);
