@@ -78,6 +78,8 @@ pub struct RobotDebug<T> {
     hook: u16,
     /// The part of an answer that came before a stop.
     partial: Vec<u8>,
+    /// The trampoline of the breakpoint being patched in.
+    pending: Option<(u16, Vec<u8>)>,
 }
 
 impl<T: Transport> RobotDebug<T> {
@@ -116,6 +118,7 @@ impl<T: Transport> RobotDebug<T> {
             margin,
             hook,
             partial: Vec::new(),
+            pending: None,
         };
         let (address, bytes) = (debug.stub.address, debug.stub.bytes.clone());
         debug.rom_write_verified(address, &bytes)?;
@@ -149,11 +152,42 @@ impl<T: Transport> RobotDebug<T> {
     /// Writes `bytes` at `address` with `/9W` (`/7W` for an odd last
     /// byte) and reads them back, writing again what differs: a piece at
     /// a time, so that answers keep coming while the writes go out.
+    ///
+    /// Two bytes lost on the line (one inside a command, and the next
+    /// command's slash) can make a command of the ROM that writes
+    /// elsewhere: so the whole range is read once more after the last
+    /// piece, and written again where it differs.
     fn rom_write_verified(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
         for (i, piece) in bytes.chunks(ROM_PIECE).enumerate() {
             self.rom_write_piece(address.wrapping_add((i * ROM_PIECE) as u16), piece)?;
         }
-        Ok(())
+        for _ in 0..ATTEMPTS {
+            let found = self.client.read_memory(address, bytes.len())?;
+            if found == bytes {
+                return Ok(());
+            }
+            for (i, piece) in bytes.chunks(ROM_PIECE).enumerate() {
+                let start = i * ROM_PIECE;
+                if found[start..start + piece.len()] != *piece {
+                    self.rom_write_piece(address.wrapping_add(start as u16), piece)?;
+                }
+            }
+        }
+        self.check(address, bytes)
+    }
+
+    /// Reads `bytes`' range back: [`StubError::Verify`] at the first
+    /// difference.
+    fn check(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        let found = self.client.read_memory(address, bytes.len())?;
+        match (0..bytes.len()).find(|&i| found[i] != bytes[i]) {
+            None => Ok(()),
+            Some(i) => Err(StubError::Verify {
+                address: address.wrapping_add(i as u16),
+                expected: hex(&bytes[i..bytes.len().min(i + 8)]),
+                found: hex(&found[i..bytes.len().min(i + 8)]),
+            }),
+        }
     }
 
     fn rom_write_piece(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
@@ -180,15 +214,7 @@ impl<T: Transport> RobotDebug<T> {
                 return Ok(());
             }
         }
-        let found = self.client.read_memory(address, bytes.len())?;
-        match (0..bytes.len()).find(|&i| found[i] != bytes[i]) {
-            None => Ok(()),
-            Some(i) => Err(StubError::Verify {
-                address: address.wrapping_add(i as u16),
-                expected: hex(&bytes[i..bytes.len().min(i + 8)]),
-                found: hex(&found[i..bytes.len().min(i + 8)]),
-            }),
-        }
+        self.check(address, bytes)
     }
 
     /// Sets a breakpoint at `address`; `entries` are the addresses code
@@ -228,7 +254,10 @@ impl<T: Transport> RobotDebug<T> {
         let trampoline = self.stub.trampoline(slot);
         self.write_verified(trampoline, &patch.trampoline)?;
         let entry = self.stub.entry.to_le_bytes();
-        self.patch(address, [JSR, entry[0], entry[1]])?;
+        self.pending = Some((trampoline, patch.trampoline.clone()));
+        let patched = self.patch(address, [JSR, entry[0], entry[1]]);
+        self.pending = None;
+        patched?;
         self.breakpoints.insert(address, (patch, slot));
         Ok(())
     }
@@ -259,8 +288,20 @@ impl<T: Transport> RobotDebug<T> {
         }
         let at = address.to_le_bytes();
         let staged = [at[0], at[1], bytes[0], bytes[1], bytes[2]];
+        let trampoline = self
+            .breakpoints
+            .get(&address)
+            .map(|(patch, slot)| (self.stub.trampoline(*slot), patch.trampoline.clone()))
+            .or_else(|| self.pending.clone());
         for _ in 0..ATTEMPTS {
             self.rom_write_verified(self.stub.stage, &staged)?;
+            // The stage's writes may have gone astray onto the trampoline
+            // the JSR will reach: it is read again first.
+            if bytes[0] == JSR
+                && let Some((at, code)) = &trampoline
+            {
+                self.rom_write_verified(*at, code)?;
+            }
             let command = Command::parse(b"/1@").map_err(crate::Error::Protocol)?;
             // The answer may be lost: the read back tells.
             let _ = self.client.listen(&command)?;
