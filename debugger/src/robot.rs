@@ -88,6 +88,45 @@ impl RobotMonitor {
         }
     }
 
+    /// Where code may be jumped to (labels and source lines): a step's
+    /// successors are looked for there.
+    #[must_use]
+    pub fn entries(&self) -> &[u16] {
+        &self.entries
+    }
+
+    /// The names the monitor knows.
+    #[must_use]
+    pub fn symbols(&self) -> &Symbols {
+        &self.symbols
+    }
+
+    /// The images the robot runs (their line tables).
+    #[must_use]
+    pub fn images(&self) -> &[linker::Image] {
+        &self.images
+    }
+
+    /// An expression's value, as `print` gives it: its memory read from
+    /// the robot (`/7R` while it runs, the stub at a stop).
+    ///
+    /// # Errors
+    /// [`Failure::Usage`] for an expression that does not read, or a
+    /// register while running; [`Failure::Line`] when the line failed.
+    pub fn value<T: Transport>(&self, d: &mut RobotDebug<T>, text: &str) -> Result<i64, Failure> {
+        let expr = self.parse(text)?;
+        self.eval(d, &expr)
+    }
+
+    /// The name of `address` (a label or a source line), for a frame.
+    #[must_use]
+    pub fn place(&self, address: u16) -> String {
+        match self.symbols.place(address) {
+            Some(name) => format!("${address:04X} ({name})"),
+            None => format!("${address:04X}"),
+        }
+    }
+
     /// Runs one command line on the robot.
     ///
     /// # Errors
@@ -464,13 +503,6 @@ impl RobotMonitor {
         }
         Err(usage("the expression reads memory through too many levels"))
     }
-
-    fn place(&self, address: u16) -> String {
-        match self.symbols.place(address) {
-            Some(name) => format!("${address:04X} ({name})"),
-            None => format!("${address:04X}"),
-        }
-    }
 }
 
 /// Whether an expression reads a register (unknown while running).
@@ -543,7 +575,7 @@ fn refused(what: &str, reason: &str) -> Failure {
 }
 
 /// A refusal is the user's to read; anything else is the line's.
-fn failure(error: StubError) -> Failure {
+pub(crate) fn failure(error: StubError) -> Failure {
     match error {
         StubError::Refused { .. } => Failure::Usage(error.to_string()),
         other => Failure::Line(Box::new(other)),

@@ -21,7 +21,7 @@ use crate::cmd::ports;
 #[cfg(test)]
 mod fuzz;
 mod prompt;
-mod robot;
+pub(crate) mod robot;
 
 use prompt::{Input, Read};
 

@@ -18,7 +18,17 @@ use crate::cmd::ports;
 
 const PROMPT: &str = "(robot) ";
 
-pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
+/// The robot on `port` (empty: the environment's or the project's)
+/// with the stub attached beside the images `args` names, the names of
+/// the ROM and the images, and the images.
+pub(crate) fn attach(
+    args: &Args,
+    port: &str,
+) -> miette::Result<(
+    RobotDebug<Box<dyn uploader::Transport>>,
+    debugger::Symbols,
+    Vec<linker::Image>,
+)> {
     // `--port` alone: the one the environment or the project names.
     let port = (!port.is_empty()).then(|| port.to_owned());
     let resolved = crate::cmd::config::resolve(&crate::cmd::config::flags(
@@ -49,7 +59,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     let transport = ports::open_resolved(&resolved, &images)?;
     let mut client = uploader::client(transport, &profile);
     client.probe()?;
-    let mut robot = RobotDebug::attach(client, &profile, code)?;
+    let robot = RobotDebug::attach(client, &profile, code)?;
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
     // The names: the ROM's and the images' labels, as the virtual robot
     // with the images loaded has them.
@@ -58,6 +68,11 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         named.load_image(image)?;
     }
     let symbols = debugger::Symbols::new(&named, &linked);
+    Ok((robot, symbols, linked))
+}
+
+pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
+    let (mut robot, symbols, linked) = attach(args, port)?;
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
     let mut monitor = RobotMonitor::new(symbols, linked);
