@@ -57,13 +57,8 @@ pub(crate) fn attach(program: &Path, port: &str) -> miette::Result<debugger::dap
         images,
         ..debug::Args::default()
     };
-    let (robot, symbols, images) = debug::robot::attach(&args, port)?;
-    Ok(debugger::dap::Attached {
-        robot,
-        symbols,
-        images,
-        root,
-    })
+    let attached = debug::robot::attach(&args, port)?;
+    Ok(debugger::dap::Attached { root, ..attached })
 }
 
 /// `launch`: the robot with `program` (an image, or a project's

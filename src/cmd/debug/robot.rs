@@ -20,15 +20,8 @@ const PROMPT: &str = "(robot) ";
 
 /// The robot on `port` (empty: the environment's or the project's)
 /// with the stub attached beside the images `args` names, the names of
-/// the ROM and the images, and the images.
-pub(crate) fn attach(
-    args: &Args,
-    port: &str,
-) -> miette::Result<(
-    RobotDebug<Box<dyn uploader::Transport>>,
-    debugger::Symbols,
-    Vec<linker::Image>,
-)> {
+/// the ROM and the images, and the images (their sources from here).
+pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::Attached> {
     // `--port` alone: the one the environment or the project names.
     let port = (!port.is_empty()).then(|| port.to_owned());
     let resolved = crate::cmd::config::resolve(&crate::cmd::config::flags(
@@ -68,11 +61,21 @@ pub(crate) fn attach(
         named.load_image(image)?;
     }
     let symbols = debugger::Symbols::new(&named, &linked);
-    Ok((robot, symbols, linked))
+    Ok(debugger::dap::Attached {
+        robot,
+        symbols,
+        images: linked,
+        root: std::path::PathBuf::from("."),
+    })
 }
 
 pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
-    let (mut robot, symbols, linked) = attach(args, port)?;
+    let debugger::dap::Attached {
+        mut robot,
+        symbols,
+        images: linked,
+        ..
+    } = attach(args, port)?;
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
     let mut monitor = RobotMonitor::new(symbols, linked);
