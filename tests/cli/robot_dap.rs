@@ -264,3 +264,30 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
         [0x4C, 0x03, 0x04]
     );
 }
+
+#[test]
+fn a_launch_on_a_port_that_is_not_there_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
+    let port = dir.path().join("no-such-tty");
+    let port = port.to_str().expect("a path");
+    let mut dap = Client::start();
+    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
+    assert_eq!(init["success"], true, "{init}");
+    let program = dir.path().join("ext.elf");
+    let launch = dap.request(
+        "launch",
+        json!({"program": program.to_str().expect("a path"), "port": port}),
+    );
+    assert_eq!(launch["success"], false, "{launch}");
+    assert!(
+        launch["message"].as_str().is_some_and(|m| m.contains(port)),
+        "{launch}"
+    );
+    // The session goes on: nothing is attached, and it ends cleanly.
+    let trace = dap.request("stackTrace", json!({"threadId": 1}));
+    assert_eq!(trace["success"], false, "{trace}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+}
