@@ -22,7 +22,9 @@ mod fuzz;
 /// `stopOnEntry` stops before anything runs; `commands` (a list like
 /// `["/2A1"]`) go down the robot's serial line once configured; `cwd` is
 /// where an image's source paths start (default: the project's root, or
-/// the image's directory). In the
+/// the image's directory); `port` debugs the real robot on that serial
+/// port instead, through the debug stub (empty: the project's `[robot]
+/// port`; see DEBUGGING.md, "Debug on the robot"). In the
 /// debug console, a line starting with `/` is sent to the robot; anything
 /// else is an address whose byte is shown.
 #[derive(Debug, clap::Args)]

@@ -10,7 +10,9 @@
 //! messages and numbers the responses and events; [`session`] answers
 //! requests on the robot, with a module for each family of them
 //! (`breakpoints` and the `points` they set, `exceptions`, `memory` with
-//! the registers, `disassemble`; `arguments` reads them typed). [`serve`] runs them on two threads: the caller's
+//! the registers, `disassemble`; `arguments` reads them typed), and
+//! [`robot`] on a real robot when `launch` names its `port`. [`serve`]
+//! runs them on two threads: the caller's
 //! reads the requests and answers what cannot wait (a message that is not
 //! a request; `pause` and `disconnect` when the robot does not come back),
 //! the robot's thread answers the rest and runs the robot in slices of
