@@ -1,4 +1,5 @@
-//! Assembles the RAM loader (`loader/loader.s`) with our own assembler
+//! Assembles the debug stub (`stub/stub.s`, linked at attach time) and
+//! the RAM loader (`loader/loader.s`) with our own assembler
 //! when this crate is built, twice: taking its data through the ROM's
 //! `CHKCH` (`RING = 0`), and straight from the ROM's receive ring
 //! (`RING = 1`, for ROM profiles that export it). The objects are embedded
@@ -14,11 +15,24 @@ fn main() {
     #[allow(clippy::print_stdout, reason = "build-script directives go to stdout")]
     {
         println!("cargo:rerun-if-changed=loader");
+        println!("cargo:rerun-if-changed=stub");
     }
-    let name = "loader.s";
-    let text = std::fs::read_to_string(manifest.join("loader").join(name))
-        .unwrap_or_else(|error| panic!("cannot read loader/{name}: {error}"));
+    assemble(&manifest.join("stub"), "stub.s", &out.join("stub.o"), 0);
     for (object, ring) in [("loader.o", 0), ("loader_ring.o", 1)] {
+        assemble(
+            &manifest.join("loader"),
+            "loader.s",
+            &out.join(object),
+            ring,
+        );
+    }
+}
+
+/// Assembles `dir/name` with `RING` defined as `ring` into `object`.
+fn assemble(dir: &std::path::Path, name: &str, object: &std::path::Path, ring: i64) {
+    let text = std::fs::read_to_string(dir.join(name))
+        .unwrap_or_else(|error| panic!("cannot read {name}: {error}"));
+    {
         let options = assembler::Options {
             defines: vec![("RING".to_owned(), ring)],
             ..assembler::Options::default()
@@ -32,10 +46,10 @@ fn main() {
                 .map(|diagnostic| format!("{diagnostic:?}"))
                 .collect();
             panic!(
-                "loader/{name} (RING = {ring}) does not assemble: {error}\n{}",
+                "{name} (RING = {ring}) does not assemble: {error}\n{}",
                 details.join("\n")
             )
         });
-        std::fs::write(out.join(object), assembly.object).expect("OUT_DIR is writable");
+        std::fs::write(object, assembly.object).expect("OUT_DIR is writable");
     }
 }

@@ -25,6 +25,8 @@
 //! - [`monitor`]: the monitor's command language (`scorpion debug`), each
 //!   line answered as text;
 //! - [`dap`]: the Debug Adapter Protocol server (`scorpion dap`);
+//! - [`robot`]: the monitor's language on a real robot, through the
+//!   uploader's debug stub (`scorpion debug --port`);
 //! - [`sources`] and [`line`], which both use: the source lines they show,
 //!   and the commands they put on the robot's serial line.
 //!
@@ -67,6 +69,7 @@ pub mod hooks;
 pub mod line;
 pub mod monitor;
 pub mod points;
+pub mod robot;
 pub mod session;
 pub mod sources;
 pub mod symbols;

@@ -22,20 +22,45 @@ mod fuzz;
 /// `stopOnEntry` stops before anything runs; `commands` (a list like
 /// `["/2A1"]`) go down the robot's serial line once configured; `cwd` is
 /// where an image's source paths start (default: the project's root, or
-/// the image's directory). In the
+/// the image's directory); `port` debugs the real robot on that serial
+/// port instead, through the debug stub (empty: the project's `[robot]
+/// port`; see DEBUGGING.md, "Debug on the robot"). In the
 /// debug console, a line starting with `/` is sent to the robot; anything
 /// else is an address whose byte is shown.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {}
 
 pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
-    debugger::dap::serve(
+    debugger::dap::serve_with(
         BufReader::new(std::io::stdin()),
         Box::new(BufWriter::new(std::io::stdout())),
         Box::new(launch),
+        Some(Box::new(attach)),
     )
     .into_diagnostic()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// `launch` or `attach` with `port`: the real robot there (empty: the
+/// environment's or the project's `[robot] port`), running `program`
+/// (its image; a directory: the project's images), the stub attached as
+/// `scorpion debug --port` attaches it.
+pub(crate) fn attach(program: &Path, port: &str) -> miette::Result<debugger::dap::Attached> {
+    let (images, root) = if program.is_dir() {
+        (Vec::new(), program.to_path_buf())
+    } else {
+        let dir = program
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        (vec![program.to_path_buf()], dir.to_path_buf())
+    };
+    let args = debug::Args {
+        images,
+        ..debug::Args::default()
+    };
+    let attached = debug::robot::attach(&args, port)?;
+    Ok(debugger::dap::Attached { root, ..attached })
 }
 
 /// `launch`: the robot with `program` (an image, or a project's

@@ -21,6 +21,7 @@ use crate::cmd::ports;
 #[cfg(test)]
 mod fuzz;
 mod prompt;
+pub(crate) mod robot;
 
 use prompt::{Input, Read};
 
@@ -55,9 +56,17 @@ pub(crate) struct Args {
     /// step back does not undraw it.
     #[arg(long, value_name = "FILE.svg|FILE.png")]
     pub(crate) path: Option<PathBuf>,
+    /// Debug the real robot on PORT instead (alone: the [robot] port of
+    /// the environment, the per-user file or the project), through a stub
+    /// uploaded beside the image: docs/DEBUGGING.md, "Debug on the robot".
+    #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
+    pub(crate) port: Option<String>,
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
+    if let Some(port) = &args.port {
+        return robot::run(args, port);
+    }
     let here = std::env::current_dir().into_diagnostic()?;
     let ((make, images, root), room) = recipe_in_room(args, &here)?;
     // Checked before the session; drawn at its end from the robot the

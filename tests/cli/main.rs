@@ -21,6 +21,8 @@ mod profile;
 mod project;
 mod read;
 mod robot;
+mod robot_dap;
+mod robot_debug;
 mod room_path;
 mod search_order;
 mod sim;

@@ -14,13 +14,13 @@ use linker::{Format, Image, LoadArea};
 use crate::{scorpion, scorpion_with_input, transcript};
 
 /// `scorpion sim --pty ARGS`, stopped when dropped.
-struct Sim {
-    child: Child,
-    path: String,
+pub(crate) struct Sim {
+    pub(crate) child: Child,
+    pub(crate) path: String,
 }
 
 impl Sim {
-    fn start(dir: &std::path::Path, args: &[&str]) -> Sim {
+    pub(crate) fn start(dir: &std::path::Path, args: &[&str]) -> Sim {
         let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
             .args(["sim", "--pty"])
             .args(args)

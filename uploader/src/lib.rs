@@ -33,6 +33,7 @@ mod image;
 mod loader;
 mod progress;
 mod session;
+pub mod stub;
 mod summed;
 mod sums;
 mod table;

@@ -10,7 +10,9 @@
 //! messages and numbers the responses and events; [`session`] answers
 //! requests on the robot, with a module for each family of them
 //! (`breakpoints` and the `points` they set, `exceptions`, `memory` with
-//! the registers, `disassemble`; `arguments` reads them typed). [`serve`] runs them on two threads: the caller's
+//! the registers, `disassemble`; `arguments` reads them typed), and
+//! [`robot`] on a real robot when `launch` names its `port`. [`serve`]
+//! runs them on two threads: the caller's
 //! reads the requests and answers what cannot wait (a message that is not
 //! a request; `pause` and `disconnect` when the robot does not come back),
 //! the robot's thread answers the rest and runs the robot in slices of
@@ -30,6 +32,7 @@ pub mod framing;
 mod memory;
 mod points;
 pub mod protocol;
+pub mod robot;
 pub mod session;
 
 use protocol::{Incoming, Outbox, Request};
@@ -55,6 +58,33 @@ impl std::fmt::Debug for Launched {
             .finish_non_exhaustive()
     }
 }
+
+/// A real robot attached over its line (`launch` or `attach` with
+/// `port`): the debug stub in place beside the image it runs.
+pub struct Attached {
+    /// The robot, the stub attached.
+    pub robot: uploader::stub::RobotDebug<Box<dyn uploader::Transport>>,
+    /// The ROM's and the images' names.
+    pub symbols: crate::Symbols,
+    /// The images the robot runs (for their code and source lines).
+    pub images: Vec<linker::Image>,
+    /// Where the images' source paths start.
+    pub root: PathBuf,
+}
+
+impl std::fmt::Debug for Attached {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Attached")
+            .field("images", &self.images.len())
+            .field("root", &self.root)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Attaches to the robot on `port` (empty: the project's `[robot] port`)
+/// running `program` (an image or a project's directory), or says why
+/// it cannot, in full.
+pub type Attacher = Box<dyn Fn(&Path, &str) -> miette::Result<Attached> + Send>;
 
 /// Builds the robot for `launch`'s `program` (a linked image or a
 /// project's directory), or says why it cannot, in full.
@@ -98,17 +128,36 @@ pub fn serve(
     output: Box<dyn Write + Send>,
     launcher: Launcher,
 ) -> Result<(), Error> {
+    serve_with(input, output, launcher, None)
+}
+
+/// [`serve`], with `attacher` for a `launch` or `attach` that names a
+/// robot's `port`.
+///
+/// # Errors
+/// [`Error`]: the output's write errors, the robot's thread.
+pub fn serve_with(
+    input: impl BufRead,
+    output: Box<dyn Write + Send>,
+    launcher: Launcher,
+    attacher: Option<Attacher>,
+) -> Result<(), Error> {
     let outbox = Arc::new(Outbox::new(output));
     let busy = Arc::new(Busy::default());
     let (to_robot, requests) = mpsc::channel();
     let robot = {
-        let session = Session::new(Arc::clone(&outbox), Arc::clone(&busy), launcher);
+        let (outbox, busy) = (Arc::clone(&outbox), Arc::clone(&busy));
         // Scripts (Rhai) recurse deeply in a debug build: the robot's
         // thread gets the stack a script's deepest allowed call needs.
+        // The session is made there: a real robot's line stays on it.
         std::thread::Builder::new()
             .name("robot".into())
             .stack_size(ROBOT_STACK)
-            .spawn(move || robot_thread(session, &requests))
+            .spawn(move || {
+                let mut session = Session::new(outbox, busy, launcher);
+                session.attacher = attacher;
+                robot_thread(session, &requests)
+            })
             .map_err(Error::Thread)?
     };
     let mut reader = framing::FrameReader::new(input);

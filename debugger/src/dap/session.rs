@@ -74,6 +74,10 @@ pub struct Session {
     stop_on_entry: bool,
     commands: Vec<String>,
     running: bool,
+    /// Attaches to a real robot, for a `launch` or `attach` with `port`.
+    pub(crate) attacher: Option<super::Attacher>,
+    /// The real robot attached: it answers every request after.
+    robot: Option<super::robot::RobotSession>,
 }
 
 impl std::fmt::Debug for Session {
@@ -119,12 +123,18 @@ impl Session {
             stop_on_entry: false,
             commands: Vec::new(),
             running: false,
+            attacher: None,
+            robot: None,
         }
     }
 
     /// The robot runs (between requests).
     pub fn running(&self) -> bool {
         self.running
+            || self
+                .robot
+                .as_ref()
+                .is_some_and(super::robot::RobotSession::running)
     }
 
     /// A program is launched.
@@ -190,6 +200,18 @@ impl Session {
     /// # Errors
     /// The output's write errors.
     pub fn handle(&mut self, request: &Request) -> std::io::Result<bool> {
+        if let Some(robot) = self.robot.as_mut() {
+            self.busy
+                .start(format!("answering `{}` on the robot", request.command));
+            let more = robot.handle(&self.outbox, request);
+            self.busy.end();
+            return more;
+        }
+        if matches!(request.command.as_str(), "launch" | "attach")
+            && request.arguments.get("port").is_some()
+        {
+            return self.attach(request);
+        }
         self.busy.start(format!("answering `{}`", request.command));
         let answer = self.answer(request);
         self.busy.end();
@@ -539,6 +561,9 @@ impl Session {
     /// # Errors
     /// The output's write errors.
     pub fn run_slice(&mut self) -> std::io::Result<()> {
+        if let Some(robot) = self.robot.as_mut() {
+            return robot.listen(&self.outbox);
+        }
         let Some(debugger) = self.debugger.as_mut() else {
             self.running = false;
             return Ok(());
@@ -594,6 +619,50 @@ impl Session {
         self.launched_with = Some((program.to_path_buf(), cwd));
         self.install_brk().map_err(|e| miette::miette!("{e}"))?;
         Ok(())
+    }
+}
+
+impl Session {
+    /// `launch` or `attach` with `port`: the stub attached to the robot
+    /// there, the robot's capabilities sent.
+    fn attach(&mut self, request: &Request) -> std::io::Result<bool> {
+        let args = Arguments {
+            command: &request.command,
+            map: &request.arguments,
+        };
+        let attached = (|| -> Result<super::Attached, String> {
+            let port = args
+                .string("port")?
+                .ok_or("`port` is the robot's serial port (empty: the project's)")?;
+            let program = args.string("program")?.ok_or(
+                "launch with `port` needs `program`: the image the robot runs (ELF) or its project's directory",
+            )?;
+            let attacher = self
+                .attacher
+                .as_ref()
+                .ok_or("this adapter cannot open a robot's port")?;
+            self.busy.start(format!("attaching to the robot on {port}"));
+            let attached = attacher(Path::new(program), port).map_err(|e| format!("{e:?}"));
+            self.busy.end();
+            attached
+        })();
+        match attached {
+            Ok(attached) => {
+                self.robot = Some(super::robot::RobotSession::new(attached));
+                self.debugger = None;
+                self.running = false;
+                self.outbox
+                    .respond(request.seq, &request.command, Ok(None))?;
+                self.outbox.event(
+                    "capabilities",
+                    Some(json!({"capabilities": super::robot::RobotSession::capabilities()})),
+                )?;
+            }
+            Err(why) => self
+                .outbox
+                .respond(request.seq, &request.command, Err(why))?,
+        }
+        Ok(true)
     }
 }
 

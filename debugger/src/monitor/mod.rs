@@ -117,6 +117,11 @@ pub enum Failure {
     #[error(transparent)]
     #[diagnostic(transparent)]
     Robot(crate::Error),
+    /// The line to a real robot failed (`scorpion debug --port`): the
+    /// session goes on, and fails at its end.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Line(Box<uploader::stub::StubError>),
 }
 
 impl Failure {
@@ -126,6 +131,12 @@ impl Failure {
     pub fn message(&self) -> String {
         match self {
             Failure::Usage(text) => text.clone(),
+            Failure::Line(error) => {
+                let help = miette::Diagnostic::help(error.as_ref())
+                    .map(|help| format!(" ({help})"))
+                    .unwrap_or_default();
+                format!("{error}{help}")
+            }
             Failure::Robot(error) => {
                 let help = miette::Diagnostic::help(error)
                     .map(|help| format!(" ({help})"))

@@ -1,0 +1,583 @@
+//! The monitor's language on a real robot (docs/DEBUGGING.md, "Debug on
+//! the robot"): the same words and expressions as [`crate::monitor`], run
+//! on an [`uploader::stub::RobotDebug`] over the robot's line. What a real
+//! robot can do (break, delete, continue, step, next, regs, set, mem,
+//! print, display, dis, `/` commands) is done; what it cannot (step back,
+//! watchpoints, conditions asked at each hit...) is refused with the
+//! reason. Nothing here prints: the CLI prints the replies.
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use emulator::Cpu;
+use uploader::Transport;
+use uploader::stub::{Registers, Reply as Heard, RobotDebug, StubError};
+
+use crate::expr::{Expr, Machine, Register};
+use crate::monitor::{Failure, Reply};
+use crate::symbols::Symbols;
+
+/// How long a command's answer, or a stop after `continue`, is waited for.
+pub const WAIT: Duration = Duration::from_secs(2);
+
+/// The monitor's commands on the robot, as `help` lists them.
+pub const HELP: &str = "\
+commands on the robot (addresses and values are expressions, as in the monitor):
+  /1Q                  send a command down the line; its answer, or the stop it hits
+  break ADDR | FILE:LINE
+                       a JSR into the stub over the instruction there           (b)
+  delete N             the image's bytes put back and read back
+  info                 the breakpoints and displays
+  continue             let the stopped handler go on; its answer or the next stop (c)
+  step | next          one instruction (next: a JSR with its subroutine)      (s, n)
+  regs                 the registers at the stop                                  (r)
+  set REG VALUE        a register or flag at the stop (PC: where it goes on)
+  mem ADDR [LEN] | mem ADDR BYTE... | poke ADDR BYTE...
+                       read or write memory (written bytes read back)             (m)
+  print EXPR           an expression's value                                      (p)
+  display [EXPR]       show EXPR after each command and stop (read with /7R while it
+                       runs); undisplay N
+  dis [ADDR] [N]       N instructions from ADDR (the PC)                          (d)
+  help, quit (q)       quit removes the breakpoints and the stub's hook
+refused on the robot: back, reverse-continue, who-wrote (a robot cannot be re-run),
+watch (no data breakpoints), break in the ROM, if/hits/log (a JSR always stops)";
+
+/// What the monitor keeps on a robot between commands.
+#[derive(Debug)]
+pub struct RobotMonitor {
+    symbols: Symbols,
+    images: Vec<linker::Image>,
+    /// Where code may be jumped to: labels and source lines.
+    entries: Vec<u16>,
+    /// Breakpoints by number.
+    breakpoints: BTreeMap<u32, u16>,
+    next_id: u32,
+    displays: Vec<Option<Expr>>,
+}
+
+impl RobotMonitor {
+    /// A monitor naming addresses with `symbols`, the images' line tables
+    /// for `FILE:LINE`.
+    #[must_use]
+    pub fn new(symbols: Symbols, images: Vec<linker::Image>) -> RobotMonitor {
+        let mut entries: Vec<u16> = images
+            .iter()
+            .flat_map(|image| {
+                let labels = image
+                    .symbols
+                    .iter()
+                    .filter_map(|symbol| u16::try_from(symbol.value).ok());
+                let lines = image
+                    .lines
+                    .entries
+                    .iter()
+                    .filter_map(|entry| u16::try_from(entry.offset).ok());
+                labels.chain(lines).collect::<Vec<_>>()
+            })
+            .collect();
+        entries.sort_unstable();
+        entries.dedup();
+        RobotMonitor {
+            symbols,
+            images,
+            entries,
+            breakpoints: BTreeMap::new(),
+            next_id: 1,
+            displays: Vec::new(),
+        }
+    }
+
+    /// Where code may be jumped to (labels and source lines): a step's
+    /// successors are looked for there.
+    #[must_use]
+    pub fn entries(&self) -> &[u16] {
+        &self.entries
+    }
+
+    /// The names the monitor knows.
+    #[must_use]
+    pub fn symbols(&self) -> &Symbols {
+        &self.symbols
+    }
+
+    /// The images the robot runs (their line tables).
+    #[must_use]
+    pub fn images(&self) -> &[linker::Image] {
+        &self.images
+    }
+
+    /// An expression's value, as `print` gives it: its memory read from
+    /// the robot (`/7R` while it runs, the stub at a stop).
+    ///
+    /// # Errors
+    /// [`Failure::Usage`] for an expression that does not read, or a
+    /// register while running; [`Failure::Line`] when the line failed.
+    pub fn value<T: Transport>(&self, d: &mut RobotDebug<T>, text: &str) -> Result<i64, Failure> {
+        let expr = self.parse(text)?;
+        self.eval(d, &expr)
+    }
+
+    /// The name of `address` (a label or a source line), for a frame.
+    #[must_use]
+    pub fn place(&self, address: u16) -> String {
+        match self.symbols.place(address) {
+            Some(name) => format!("${address:04X} ({name})"),
+            None => format!("${address:04X}"),
+        }
+    }
+
+    /// Runs one command line on the robot.
+    ///
+    /// # Errors
+    /// [`Failure::Usage`] for a line that cannot be run, or is refused on
+    /// a robot (with the reason); [`Failure::Line`] when the line failed.
+    pub fn command<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        line: &str,
+    ) -> Result<Reply, Failure> {
+        let mut words = line.split_whitespace();
+        let Some(verb) = words.next() else {
+            return Ok(Reply::Text(String::new()));
+        };
+        let rest: Vec<&str> = words.collect();
+        let after = line[verb.len()..].trim();
+        let text = match verb {
+            "help" | "h" | "?" => format!("{HELP}\n"),
+            "quit" | "q" | "exit" => return Ok(Reply::Quit),
+            _ if verb.starts_with('/') => self.send(d, line)?,
+            "send" => self.send(d, after)?,
+            "break" | "b" => self.add_break(d, after)?,
+            "delete" => {
+                let [n] = rest.as_slice() else {
+                    return Err(usage("delete N (watchpoints are refused on the robot)"));
+                };
+                let id: u32 = n.parse().map_err(|_| usage("delete N"))?;
+                let address = self
+                    .breakpoints
+                    .remove(&id)
+                    .ok_or_else(|| usage(&format!("no breakpoint {id}")))?;
+                d.remove_breakpoint(address).map_err(failure)?;
+                format!("deleted breakpoint {id}: ${address:04X} holds the image's bytes again\n")
+            }
+            "info" => {
+                let mut text = String::new();
+                for (id, address) in &self.breakpoints {
+                    text.push_str(&format!("breakpoint {id}: {}\n", self.place(*address)));
+                }
+                for (id, shown) in self.displays.iter().enumerate() {
+                    if let Some(shown) = shown {
+                        text.push_str(&format!("display {}: {shown}\n", id + 1));
+                    }
+                }
+                if text.is_empty() {
+                    text = "no breakpoints\n".into();
+                }
+                text
+            }
+            "continue" | "c" | "run" => {
+                d.resume().map_err(failure)?;
+                let heard = d.wait_event(WAIT).map_err(failure)?;
+                self.heard(d, &heard)?
+            }
+            "step" | "s" | "stepi" | "si" | "next" | "n" => {
+                if !rest.is_empty() {
+                    return Err(usage(
+                        "step takes no count on the robot: each step patches and unpatches over the line",
+                    ));
+                }
+                let over = matches!(verb, "next" | "n");
+                let heard = d.step(&self.entries, over, WAIT).map_err(failure)?;
+                self.heard(d, &heard)?
+            }
+            "regs" | "r" => {
+                let registers = stopped(d, "regs")?;
+                format!("{}\n", show_registers(&registers))
+            }
+            "set" => self.set(d, &rest)?,
+            "mem" | "m" | "poke" => self.mem(d, verb, &rest)?,
+            "print" | "p" => {
+                let expr = self.parse(after)?;
+                let value = self.eval(d, &expr)?;
+                format!("{}\n", crate::expr::show(value))
+            }
+            "display" => {
+                if after.is_empty() {
+                    self.displays(d)?
+                } else {
+                    let expr = self.parse(after)?;
+                    self.displays.push(Some(expr));
+                    format!("display {}: {after}\n", self.displays.len())
+                }
+            }
+            "undisplay" => {
+                let n: usize = after.parse().map_err(|_| usage("undisplay N"))?;
+                match self.displays.get_mut(n.wrapping_sub(1)) {
+                    Some(slot @ Some(_)) => *slot = None,
+                    _ => return Err(usage(&format!("no display {n}"))),
+                }
+                format!("undisplay {n}\n")
+            }
+            "dis" | "d" => self.dis(d, &rest)?,
+            "watch" | "w" => {
+                return Err(refused(
+                    "watchpoints",
+                    "the 6502 has no data breakpoints and the ROM no hook on every access; `display` an expression to see it after each command",
+                ));
+            }
+            "back" | "bs" | "reverse-step" | "reverse-continue" | "rc" | "who-wrote" => {
+                return Err(refused(
+                    verb,
+                    "going back re-runs the robot from copies of it, and a real robot can be neither copied nor re-run; use the virtual Scorpion (`scorpion debug` without --port)",
+                ));
+            }
+            "finish" | "f" | "until" | "u" => {
+                return Err(refused(
+                    verb,
+                    "not on the robot: set a breakpoint where it should stop and `continue`",
+                ));
+            }
+            "trace" | "bumpers" | "bt" | "list" | "l" => {
+                return Err(refused(
+                    verb,
+                    "it needs the virtual Scorpion's insides; the robot shows only its line",
+                ));
+            }
+            _ => {
+                return Err(usage(&format!(
+                    "unknown command `{verb}`; `help` lists them"
+                )));
+            }
+        };
+        Ok(Reply::Text(text))
+    }
+
+    fn send<T: Transport>(&mut self, d: &mut RobotDebug<T>, text: &str) -> Result<String, Failure> {
+        crate::line::command(text).map_err(Failure::Usage)?;
+        let heard = d.command(text.as_bytes(), WAIT).map_err(failure)?;
+        Ok(format!("sent {text}\n{}", self.heard(d, &heard)?))
+    }
+
+    /// What came back, as text: an answer, a stop, or silence; then the
+    /// displays.
+    fn heard<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        heard: &Heard,
+    ) -> Result<String, Failure> {
+        let mut text = match heard {
+            Heard::Answer(answer) => format!(
+                "answer: {}\n",
+                String::from_utf8_lossy(answer.strip_suffix(b"\r").unwrap_or(answer))
+            ),
+            Heard::Stopped(registers) => {
+                let id = self
+                    .breakpoints
+                    .iter()
+                    .find(|(_, at)| **at == registers.pc)
+                    .map(|(id, _)| format!("breakpoint {id}, "))
+                    .unwrap_or_default();
+                format!(
+                    "stopped: {id}{}\n  {}\n",
+                    self.place(registers.pc),
+                    show_registers(registers)
+                )
+            }
+            Heard::Silent => format!("running (nothing came back within {} s)\n", WAIT.as_secs()),
+        };
+        if self.displays.iter().any(Option::is_some) {
+            text.push_str(&self.displays(d)?);
+        }
+        Ok(text)
+    }
+
+    fn add_break<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        after: &str,
+    ) -> Result<String, Failure> {
+        if after.is_empty() {
+            return Err(usage("break ADDR | FILE:LINE"));
+        }
+        if after
+            .split_whitespace()
+            .any(|w| matches!(w, "if" | "hits" | "log"))
+        {
+            return Err(refused(
+                "a condition, a hit count or a log point",
+                "on the robot a breakpoint is a JSR that always stops the handler; the host would have to be asked at each hit, over the line",
+            ));
+        }
+        if after.starts_with('/') || after == "unknown" {
+            return Err(refused(
+                "a breakpoint on a command or the hook",
+                "the ROM's command parser cannot be patched; break on the handler's first instruction",
+            ));
+        }
+        let address = match file_line(after) {
+            Some((file, line)) => self
+                .images
+                .iter()
+                .filter_map(|image| image.address_of_line(file, line))
+                .min()
+                .and_then(|at| u16::try_from(at).ok())
+                .ok_or_else(|| usage(&format!("no code came from {file}:{line}")))?,
+            None => {
+                let expr = self.parse(after)?;
+                u16::try_from(self.eval(d, &expr)?)
+                    .map_err(|_| usage(&format!("{after} is no address")))?
+            }
+        };
+        d.set_breakpoint(address, &self.entries).map_err(failure)?;
+        let id = self.next_id;
+        self.next_id += 1;
+        self.breakpoints.insert(id, address);
+        Ok(format!("breakpoint {id}: {}\n", self.place(address)))
+    }
+
+    fn set<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        rest: &[&str],
+    ) -> Result<String, Failure> {
+        let [name, value @ ..] = rest else {
+            return Err(usage("set REG VALUE"));
+        };
+        let register = Register::named(name).ok_or_else(|| {
+            usage(&format!(
+                "`{name}` is no register or flag: A X Y S P PC C Z I D V N"
+            ))
+        })?;
+        let mut registers = stopped(d, "set")?;
+        let expr = self.parse(&value.join(" "))?;
+        let value = self.eval(d, &expr)?;
+        let value = u16::try_from(value)
+            .ok()
+            .filter(|v| *v <= register.max())
+            .ok_or_else(|| usage(&format!("{value} does not fit {register}")))?;
+        let mut cpu = cpu_of(&registers);
+        register.write(&mut cpu, value);
+        registers = Registers {
+            pc: cpu.pc,
+            a: cpu.a,
+            x: cpu.x,
+            y: cpu.y,
+            p: cpu.p(),
+            s: cpu.s,
+        };
+        d.set_registers(registers).map_err(failure)?;
+        Ok(format!("{}\n", show_registers(&registers)))
+    }
+
+    fn mem<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        verb: &str,
+        rest: &[&str],
+    ) -> Result<String, Failure> {
+        let words: Vec<&str> = rest.iter().copied().filter(|w| *w != "=").collect();
+        let [at, values @ ..] = words.as_slice() else {
+            return Err(usage("mem ADDR [LEN] | mem ADDR BYTE..."));
+        };
+        let expr = self.parse(at)?;
+        let address = u16::try_from(self.eval(d, &expr)?).map_err(|_| usage("no address"))?;
+        let writing = verb == "poke" || values.len() > 1 || rest.contains(&"=");
+        if writing {
+            let mut bytes = Vec::new();
+            for word in values {
+                let expr = self.parse(word)?;
+                let value = self.eval(d, &expr)?;
+                bytes.push(u8::try_from(value).map_err(|_| usage(&format!("{word} is no byte")))?);
+            }
+            d.write_verified(address, &bytes).map_err(failure)?;
+            return Ok(format!(
+                "${address:04X}: {} (read back)\n",
+                uploader::stub::error_hex(&bytes)
+            ));
+        }
+        let len = match values.first() {
+            Some(word) => {
+                let expr = self.parse(word)?;
+                usize::try_from(self.eval(d, &expr)?)
+                    .ok()
+                    .filter(|n| (1..=4096).contains(n))
+                    .ok_or_else(|| usage("mem ADDR LEN: 1 to 4096 bytes on the robot"))?
+            }
+            None => 16,
+        };
+        let len = len.min(0x1_0000 - usize::from(address));
+        let bytes = d.read(address, len).map_err(failure)?;
+        let mut text = String::new();
+        for (i, row) in bytes.chunks(16).enumerate() {
+            let at = address.wrapping_add(16 * i as u16);
+            text.push_str(&format!("${at:04X}: {}\n", uploader::stub::error_hex(row)));
+        }
+        Ok(text)
+    }
+
+    fn dis<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        rest: &[&str],
+    ) -> Result<String, Failure> {
+        let address = match rest.first() {
+            Some(word) => {
+                let expr = self.parse(word)?;
+                u16::try_from(self.eval(d, &expr)?).map_err(|_| usage("no address"))?
+            }
+            None => stopped(d, "dis without an address")?.pc,
+        };
+        let count: usize = match rest.get(1) {
+            Some(n) => n
+                .parse()
+                .ok()
+                .filter(|n| (1..=256).contains(n))
+                .ok_or_else(|| usage("dis [ADDR] [N]: N 1 to 256 on the robot"))?,
+            None => 8,
+        };
+        let len = (count * 3).min(0x1_0000 - usize::from(address));
+        let bytes = d.read(address, len).map_err(failure)?;
+        let mut text = String::new();
+        for line in isa::Disassembler::new(&bytes, address).take(count) {
+            let shown = line.display_with(|at| self.symbols.label(at));
+            text.push_str(&format!("{shown}\n"));
+        }
+        Ok(text)
+    }
+
+    fn displays<T: Transport>(&mut self, d: &mut RobotDebug<T>) -> Result<String, Failure> {
+        let mut text = String::new();
+        let shown: Vec<(usize, Expr)> = self
+            .displays
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| e.clone().map(|e| (i + 1, e)))
+            .collect();
+        for (n, expr) in shown {
+            let value = match self.eval(d, &expr) {
+                Ok(value) => crate::expr::show(value),
+                Err(Failure::Usage(why)) => format!("({why})"),
+                Err(other) => return Err(other),
+            };
+            text.push_str(&format!("{n}: {expr} = {value}\n"));
+        }
+        Ok(text)
+    }
+
+    fn parse(&self, text: &str) -> Result<Expr, Failure> {
+        Expr::parse(text, &self.symbols).map_err(|error| {
+            Failure::Usage(format!(
+                "column {}: {}\n{}",
+                error.column,
+                error.reason,
+                error.pointed()
+            ))
+        })
+    }
+
+    /// An expression's value: its memory read from the robot (`/7R` while
+    /// it runs, the stub at a stop), its registers the stop's.
+    fn eval<T: Transport>(&self, d: &mut RobotDebug<T>, expr: &Expr) -> Result<i64, Failure> {
+        let snapshot = Snapshot {
+            cpu: d.stopped().map(|r| cpu_of(&r)).unwrap_or_default(),
+            memory: RefCell::new(BTreeMap::new()),
+            missing: RefCell::new(Vec::new()),
+        };
+        if d.stopped().is_none() && mentions_register(expr) {
+            return Err(usage(
+                "the robot is running: registers are known only at a stop",
+            ));
+        }
+        // Each round reads what the last one found missing ([[x]] reads twice).
+        for _ in 0..8 {
+            let value = expr.eval(&snapshot);
+            let missing: Vec<u16> = snapshot.missing.borrow_mut().drain(..).collect();
+            if missing.is_empty() {
+                return value.map_err(|error| Failure::Usage(error.to_string()));
+            }
+            for at in missing {
+                let byte = d.read(at, 1).map_err(failure)?[0];
+                snapshot.memory.borrow_mut().insert(at, byte);
+            }
+        }
+        Err(usage("the expression reads memory through too many levels"))
+    }
+}
+
+/// Whether an expression reads a register (unknown while running).
+fn mentions_register(expr: &Expr) -> bool {
+    expr.register().is_some()
+        || expr
+            .text()
+            .split(|c: char| !c.is_ascii_alphanumeric() && c != '_')
+            .any(|word| Register::named(word).is_some())
+}
+
+/// Registers and memory fetched from the robot for one evaluation.
+struct Snapshot {
+    cpu: Cpu,
+    memory: RefCell<BTreeMap<u16, u8>>,
+    missing: RefCell<Vec<u16>>,
+}
+
+impl Machine for Snapshot {
+    fn cpu(&self) -> &Cpu {
+        &self.cpu
+    }
+
+    fn peek(&self, address: u16) -> u8 {
+        if let Some(&byte) = self.memory.borrow().get(&address) {
+            return byte;
+        }
+        self.missing.borrow_mut().push(address);
+        0
+    }
+}
+
+fn cpu_of(registers: &Registers) -> Cpu {
+    let mut cpu = Cpu::default();
+    cpu.a = registers.a;
+    cpu.x = registers.x;
+    cpu.y = registers.y;
+    cpu.s = registers.s;
+    cpu.pc = registers.pc;
+    cpu.set_p(registers.p);
+    cpu
+}
+
+fn show_registers(r: &Registers) -> String {
+    format!(
+        "PC=${:04X} A=${:02X} X=${:02X} Y=${:02X} S=${:02X} P=${:02X}",
+        r.pc, r.a, r.x, r.y, r.s, r.p
+    )
+}
+
+fn stopped<T: Transport>(d: &RobotDebug<T>, what: &str) -> Result<Registers, Failure> {
+    d.stopped().ok_or_else(|| {
+        usage(&format!(
+            "`{what}` needs a stop: the robot is running (break somewhere, then send the command that gets there)"
+        ))
+    })
+}
+
+fn file_line(text: &str) -> Option<(&str, u32)> {
+    let (file, line) = text.rsplit_once(':')?;
+    Some((file, line.parse().ok()?)).filter(|(file, _)| !file.is_empty())
+}
+
+fn usage(text: &str) -> Failure {
+    Failure::Usage(text.to_owned())
+}
+
+fn refused(what: &str, reason: &str) -> Failure {
+    Failure::Usage(format!("{what} is refused on the robot: {reason}"))
+}
+
+/// A refusal is the user's to read; anything else is the line's.
+pub(crate) fn failure(error: StubError) -> Failure {
+    match error {
+        StubError::Refused { .. } => Failure::Usage(error.to_string()),
+        other => Failure::Line(Box::new(other)),
+    }
+}

@@ -1,0 +1,114 @@
+//! The monitor's language on a robot through the debug stub
+//! (`debugger::robot`), over the virtual Scorpion's line: what a robot
+//! cannot do is refused with the reason, and `display` expressions are
+//! read with `/7R` while it runs and from the stub at a stop.
+
+use isa::objfmt::{HookKind, HookRecord};
+use romlib::VirtualScorpion;
+use uploader::stub::RobotDebug;
+use uploader::transport::VirtualTransport;
+use uploader::{Area, RomProfile, UploadImage};
+
+use debugger::monitor::{Failure, Reply};
+use debugger::robot::RobotMonitor;
+
+/// `/1Q` answers `Q` and the byte at $0480 (as in uploader/tests/stub.rs).
+fn handler() -> Vec<u8> {
+    let mut bytes = vec![
+        0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0, 0xF9, 0xA9, b'Q', 0x20, 0x00, 0xFF, 0xAD, 0x80, 0x04,
+        0x20, 0x03, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
+    ];
+    bytes.resize(0x81, 0xEA);
+    bytes[0x80] = 0x42;
+    bytes
+}
+
+fn attached() -> (RobotMonitor, RobotDebug<VirtualTransport>) {
+    let bytes = handler();
+    let mut robot = VirtualScorpion::new();
+    robot
+        .robot_mut()
+        .board_mut()
+        .load(0x0400, &bytes)
+        .expect("RAM");
+    robot
+        .install_hook(HookKind::Unknown, 0x0403, None)
+        .expect("a JMP");
+    let symbols = debugger::Symbols::new(&robot, &[]);
+    let image = UploadImage::new(
+        vec![Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        }],
+    )
+    .expect("an image");
+    let profile = RomProfile::reference();
+    let client = uploader::client(VirtualTransport::new(robot), &profile);
+    let debug = RobotDebug::attach(client, &profile, image).expect("attaches");
+    (RobotMonitor::new(symbols, Vec::new()), debug)
+}
+
+fn text(m: &mut RobotMonitor, d: &mut RobotDebug<VirtualTransport>, line: &str) -> String {
+    match m.command(d, line) {
+        Ok(Reply::Text(text)) => text,
+        other => panic!("`{line}`: {other:?}"),
+    }
+}
+
+fn refusal(m: &mut RobotMonitor, d: &mut RobotDebug<VirtualTransport>, line: &str) -> String {
+    match m.command(d, line) {
+        Err(Failure::Usage(why)) => why,
+        other => panic!("`{line}` was not refused: {other:?}"),
+    }
+}
+
+#[test]
+fn what_a_robot_cannot_do_is_refused_with_the_reason() {
+    let (mut m, mut d) = attached();
+    for (line, reason) in [
+        ("watch $0480", "no data breakpoints"),
+        ("back", "can be neither copied nor re-run"),
+        ("reverse-continue", "can be neither copied nor re-run"),
+        ("who-wrote $0480", "can be neither copied nor re-run"),
+        ("break $FF00", "the ROM cannot be patched"),
+        ("break $040C if A == 1", "always stops"),
+        ("regs", "needs a stop"),
+        ("set A 1", "needs a stop"),
+        ("print A", "registers are known only at a stop"),
+    ] {
+        let why = refusal(&mut m, &mut d, line);
+        assert!(why.contains(reason), "`{line}`: {why}");
+    }
+    // At a stop, commands down the line wait for `continue`.
+    text(&mut m, &mut d, "break $040C");
+    assert!(text(&mut m, &mut d, "/1Q").contains("stopped: breakpoint 1, $040C"));
+    let why = refusal(&mut m, &mut d, "/1X");
+    assert!(why.contains("continue"), "{why}");
+}
+
+#[test]
+fn displays_are_read_while_it_runs_and_at_a_stop() {
+    let (mut m, mut d) = attached();
+    assert_eq!(
+        text(&mut m, &mut d, "display [$0480]"),
+        "display 1: [$0480]\n"
+    );
+    // Running: read with /7R after the command's answer.
+    let shown = text(&mut m, &mut d, "/1Q");
+    assert!(shown.contains("answer: Q42\n1: [$0480] = $42"), "{shown}");
+    text(&mut m, &mut d, "poke $0480 $17");
+    text(&mut m, &mut d, "break $040F");
+    // At the stop: read through the stub, beside the registers.
+    let shown = text(&mut m, &mut d, "/1Q");
+    assert!(shown.contains("A=$17"), "{shown}");
+    assert!(shown.contains("1: [$0480] = $17"), "{shown}");
+    let shown = text(&mut m, &mut d, "print A + [$0480]");
+    assert_eq!(shown, "$2E\n");
+    let shown = text(&mut m, &mut d, "continue");
+    assert!(shown.contains("answer: Q17"), "{shown}");
+}

@@ -1,0 +1,142 @@
+//! `scorpion debug --port PORT`: the monitor on a real robot over its
+//! line (docs/DEBUGGING.md, "Debug on the robot"). The stub goes in
+//! beside the uploaded image, the monitor's language runs through it
+//! ([`debugger::robot`]), and the end of the session (quit, end of input)
+//! takes every breakpoint out and gives the hook back.
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use debugger::monitor::{Failure, Reply};
+use debugger::robot::RobotMonitor;
+use miette::{IntoDiagnostic, WrapErr};
+use uploader::stub::RobotDebug;
+
+use super::Args;
+use super::prompt::{Completion, Input, Read};
+use crate::cmd::ports;
+
+const PROMPT: &str = "(robot) ";
+
+/// The robot on `port` (empty: the environment's or the project's)
+/// with the stub attached beside the images `args` names, the names of
+/// the ROM and the images, and the images (their sources from here).
+pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::Attached> {
+    // `--port` alone: the one the environment or the project names.
+    let port = (!port.is_empty()).then(|| port.to_owned());
+    let resolved = crate::cmd::config::resolve(&crate::cmd::config::flags(
+        port.as_ref(),
+        args.baud,
+        &args.rig,
+        args.rom.as_ref(),
+    ))?;
+    let images = crate::cmd::config::images(&resolved, &args.images)?.images;
+    if images.is_empty() {
+        return Err(miette::miette!(
+            help =
+                "give the uploaded image with --image ELF, or run it in the project that built it",
+            "debugging on the robot needs the image it runs: breakpoints go only into its code, compared with it"
+        ));
+    }
+    let mut areas = Vec::new();
+    let mut hooks = Vec::new();
+    for (name, image) in &images {
+        let upload = uploader::UploadImage::try_from(image)
+            .wrap_err_with(|| format!("cannot debug {name}"))?;
+        areas.extend(upload.areas().iter().cloned());
+        hooks.extend(upload.hooks().iter().copied());
+    }
+    let code = uploader::UploadImage::new(areas, hooks)?;
+    let rom = crate::cmd::config::rom(&resolved)?;
+    let profile = crate::cmd::config::profile(rom.as_ref())?;
+    let transport = ports::open_resolved(&resolved, &images)?;
+    let mut client = uploader::client(transport, &profile);
+    client.probe()?;
+    let robot = RobotDebug::attach(client, &profile, code)?;
+    let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
+    // The names: the ROM's and the images' labels, as the virtual robot
+    // with the images loaded has them.
+    let mut named = ports::bare_robot(9600, rom.as_ref())?;
+    for image in &linked {
+        named.load_image(image)?;
+    }
+    let symbols = debugger::Symbols::new(&named, &linked);
+    Ok(debugger::dap::Attached {
+        robot,
+        symbols,
+        images: linked,
+        root: std::path::PathBuf::from("."),
+    })
+}
+
+pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
+    let debugger::dap::Attached {
+        mut robot,
+        symbols,
+        images: linked,
+        ..
+    } = attach(args, port)?;
+    let mut completion = Completion::default();
+    completion.names.extend(symbols.names().map(str::to_owned));
+    let mut monitor = RobotMonitor::new(symbols, linked);
+    let mut input = Input::new(
+        std::io::IsTerminal::is_terminal(&std::io::stdin()),
+        completion,
+        None,
+    );
+    let mut out = std::io::stdout().lock();
+    let stub = robot.stub().clone();
+    writeln!(
+        out,
+        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands",
+        robot.client().transport().name(),
+        stub.address,
+        u32::from(stub.address) + stub.bytes.len() as u32 - 1,
+        stub.previous
+    )
+    .into_diagnostic()?;
+    let mut broken = false;
+    loop {
+        if !input.is_terminal() {
+            write!(out, "{PROMPT}").into_diagnostic()?;
+        }
+        out.flush().into_diagnostic()?;
+        let line = match input.read(PROMPT).into_diagnostic()? {
+            Read::Line(line) => line,
+            Read::Interrupted => {
+                writeln!(out, "(Ctrl-C: `quit` or Ctrl-D leaves)").into_diagnostic()?;
+                continue;
+            }
+            Read::End => {
+                writeln!(out).into_diagnostic()?;
+                break;
+            }
+            Read::Invalid(why) => {
+                writeln!(out, "error: {why}").into_diagnostic()?;
+                continue;
+            }
+        };
+        if !input.is_terminal() {
+            writeln!(out, "{line}").into_diagnostic()?;
+        }
+        match monitor.command(&mut robot, line.trim()) {
+            Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,
+            Ok(Reply::Quit) => break,
+            Err(error) => {
+                broken |= matches!(error, Failure::Line(_));
+                writeln!(out, "error: {}", error.message()).into_diagnostic()?;
+            }
+        }
+    }
+    robot.detach()?;
+    writeln!(
+        out,
+        "detached: the breakpoints taken out, HOOK_UNKNOWN given back"
+    )
+    .into_diagnostic()?;
+    Ok(if broken {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}

@@ -1,0 +1,293 @@
+//! Issue 27, point 4, through an editor's debugger: `scorpion dap` with a
+//! `launch` that names the robot's `port` (here `scorpion sim --pty`
+//! standing for the robot) drives the debug stub: a breakpoint by source
+//! line in the handler (a condition refused for its breakpoint alone),
+//! the command sent from the debug console stops there, the frame and the
+//! registers, a register and a byte written, a step, continue and the
+//! robot's answer as output, what a robot cannot do refused, disconnect;
+//! then the code (read with `scorpion read`) compared with the image.
+
+use isa::objfmt::{HookKind, HookRecord, Hooks, SourceLoc, SrcMap, SrcMapEntry};
+use linker::layout::SegmentKind;
+use linker::{Format, Image, ImageSection, ImageSymbol, LoadArea};
+use serde_json::json;
+
+use crate::dap::Client;
+use crate::robot::Sim;
+use crate::robot_debug::handler_bytes;
+use crate::{scorpion, transcript};
+
+/// The handler's source, a line for each instruction of
+/// [`handler_bytes`], with where its bytes start.
+const SOURCE: [(&str, u32); 10] = [
+    ("        jmp chain", 0x0400),
+    ("handler: cmp #'Q'", 0x0403),
+    ("        bne $0400", 0x0405),
+    ("        lda #'Q'", 0x0407),
+    ("        jsr PUTCH", 0x0409),
+    ("show:   lda value", 0x040C),
+    ("        jsr PUTHEX", 0x040F),
+    ("        jsr PUTEOL", 0x0412),
+    ("        jmp CMD_DONE", 0x0415),
+    ("value:  .byte $42", 0x0480),
+];
+
+/// The handler as a linked image with its section and line table.
+fn handler_elf() -> Vec<u8> {
+    let symbol = |name: &str, value: u32| ImageSymbol {
+        name: name.to_owned(),
+        value,
+        size: 0,
+        global: true,
+        section: None,
+    };
+    let entries = SOURCE
+        .iter()
+        .zip(1..)
+        .map(|((_, at), line)| SrcMapEntry {
+            section: 0,
+            offset: *at,
+            loc: SourceLoc {
+                file: 0,
+                line,
+                column: 1,
+            },
+        })
+        .collect();
+    let bytes = handler_bytes();
+    let image = Image {
+        entry: 0x0403,
+        flags: 0,
+        sections: vec![ImageSection {
+            name: "CODE".into(),
+            run: 0x0400,
+            load: 0x0400,
+            size: u32::try_from(bytes.len()).expect("small"),
+            kind: SegmentKind::ReadOnly,
+            exec: true,
+        }],
+        areas: vec![LoadArea {
+            load: 0x0400,
+            run: 0x0400,
+            bytes,
+        }],
+        symbols: vec![
+            symbol("handler", 0x0403),
+            symbol("show", 0x040C),
+            symbol("value", 0x0480),
+        ],
+        hooks: Hooks {
+            records: vec![HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0403,
+                chain: Some(0x0401),
+            }],
+        },
+        lines: SrcMap {
+            files: vec!["handler.s".into()],
+            entries,
+            symbols: vec![],
+        },
+    };
+    Format::Elf.write(&image).expect("an ELF image")
+}
+
+#[test]
+fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
+    let source: String = SOURCE.iter().map(|(line, _)| format!("{line}\n")).collect();
+    std::fs::write(dir.path().join("handler.s"), source).expect("the source");
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+
+    let mut dap = Client::start();
+    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
+    assert_eq!(init["success"], true, "{init}");
+    let program = dir.path().join("ext.elf");
+    let launch = dap.request(
+        "launch",
+        json!({"program": program.to_str().expect("a path"), "port": sim.path}),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    // On the robot there is no going back and no data breakpoint.
+    let capabilities = dap.event("capabilities");
+    assert_eq!(
+        capabilities["body"]["capabilities"]["supportsStepBack"], false,
+        "{capabilities}"
+    );
+    assert_eq!(
+        capabilities["body"]["capabilities"]["supportsDataBreakpoints"], false,
+        "{capabilities}"
+    );
+
+    // Line 6 is `show`; line 7's condition is refused, for it alone.
+    let path = dir.path().join("handler.s");
+    let set = dap.request(
+        "setBreakpoints",
+        json!({"source": {"path": path.to_str().expect("a path")},
+               "breakpoints": [{"line": 6}, {"line": 7, "condition": "A == 1"}]}),
+    );
+    assert_eq!(set["success"], true, "{set}");
+    let answers = &set["body"]["breakpoints"];
+    assert_eq!(answers[0]["verified"], true, "{set}");
+    assert_eq!(answers[0]["instructionReference"], "0x040C", "{set}");
+    assert_eq!(answers[1]["verified"], false, "{set}");
+    assert!(
+        answers[1]["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("refused on the robot")),
+        "{set}"
+    );
+    let done = dap.request("configurationDone", json!({}));
+    assert_eq!(done["success"], true, "{done}");
+
+    // The command goes down the line and stops at the breakpoint.
+    let sent = dap.request("evaluate", json!({"expression": "/1Q", "context": "repl"}));
+    assert_eq!(sent["success"], true, "{sent}");
+    assert!(
+        sent["body"]["result"]
+            .as_str()
+            .is_some_and(|r| r.contains("stopped at $040C")),
+        "{sent}"
+    );
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
+    assert_eq!(
+        stopped["body"]["hitBreakpointIds"],
+        json!([answers[0]["id"]])
+    );
+    let frame = dap.top_frame();
+    assert_eq!(frame["line"], 6, "{frame}");
+    assert_eq!(frame["instructionPointerReference"], "0x040C", "{frame}");
+    // At the stop: A holds the letter, X the count (docs/PROTOCOL.md).
+    assert_eq!(dap.register("A"), "$51");
+    assert_eq!(dap.register("X"), "$01");
+    let print = dap.request("evaluate", json!({"expression": "A + 1"}));
+    assert_eq!(print["body"]["result"], "$52", "{print}");
+
+    // A register written back (the handler loads A next: harmless).
+    let set = dap.request(
+        "setVariable",
+        json!({"variablesReference": 1, "name": "A", "value": "$77"}),
+    );
+    assert_eq!(set["success"], true, "{set}");
+    assert_eq!(dap.register("A"), "$77");
+
+    // A byte written through the stub and read back.
+    let written = dap.request(
+        "writeMemory",
+        json!({"memoryReference": "0x0480", "data": "mQ=="}),
+    );
+    assert_eq!(written["success"], true, "{written}");
+    let read = dap.request(
+        "readMemory",
+        json!({"memoryReference": "0x0480", "count": 1}),
+    );
+    assert_eq!(read["body"]["data"], "mQ==", "{read}");
+
+    // One instruction, LDA value: A holds the changed byte.
+    let next = dap.request("next", json!({"threadId": 1}));
+    assert_eq!(next["success"], true, "{next}");
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "step", "{stopped}");
+    assert_eq!(dap.top_frame()["instructionPointerReference"], "0x040F");
+    assert_eq!(dap.register("A"), "$99");
+
+    // What a robot cannot do is refused, with the reason.
+    for refused in ["stepBack", "setDataBreakpoints", "disassemble"] {
+        let answer = dap.request(refused, json!({"threadId": 1}));
+        assert_eq!(answer["success"], false, "{answer}");
+        assert!(
+            answer["message"]
+                .as_str()
+                .is_some_and(|m| m.contains("refused on the robot")),
+            "{answer}"
+        );
+    }
+
+    // Continue: the robot's answer comes as output.
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
+    let mut heard = String::new();
+    while !heard.contains("Q99") {
+        let output = dap.event("output");
+        if output["body"]["category"] == "stdout" {
+            heard.push_str(output["body"]["output"].as_str().unwrap_or_default());
+        }
+    }
+    let pause = dap.request("pause", json!({"threadId": 1}));
+    assert_eq!(pause["success"], false, "{pause}");
+    assert!(
+        pause["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("refused on the robot")),
+        "{pause}"
+    );
+
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+
+    // The code is the image's again, but for the byte changed; the hook
+    // is the handler's again.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "read",
+            "$0400",
+            "129",
+            "-o",
+            "after.bin",
+            "--port",
+            &sim.path,
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let mut expected = handler_bytes();
+    expected[0x80] = 0x99;
+    assert_eq!(
+        std::fs::read(dir.path().join("after.bin")).expect("a dump"),
+        expected
+    );
+    let output = scorpion(
+        dir.path(),
+        &["read", "$0200", "3", "-o", "hook.bin", "--port", &sim.path],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        std::fs::read(dir.path().join("hook.bin")).expect("a dump"),
+        [0x4C, 0x03, 0x04]
+    );
+}
+
+#[test]
+fn a_launch_on_a_port_that_is_not_there_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
+    let port = dir.path().join("no-such-tty");
+    let port = port.to_str().expect("a path");
+    let mut dap = Client::start();
+    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
+    assert_eq!(init["success"], true, "{init}");
+    let program = dir.path().join("ext.elf");
+    let launch = dap.request(
+        "launch",
+        json!({"program": program.to_str().expect("a path"), "port": port}),
+    );
+    assert_eq!(launch["success"], false, "{launch}");
+    assert!(
+        launch["message"].as_str().is_some_and(|m| m.contains(port)),
+        "{launch}"
+    );
+    // The session goes on: nothing is attached, and it ends cleanly.
+    let trace = dap.request("stackTrace", json!({"threadId": 1}));
+    assert_eq!(trace["success"], false, "{trace}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+}

@@ -1,0 +1,206 @@
+//! Issue 27, point 4, through a real pseudo-terminal to `scorpion sim
+//! --pty` standing for the robot, the tools using nothing but the line:
+//! `scorpion debug --port` attaches its stub beside an uploaded handler, a
+//! breakpoint inside the handler is hit by its command, the registers
+//! read, a byte of memory changed, a step, continue and the command
+//! answered with the changed byte, the breakpoint removed, and the code
+//! (read with `scorpion read`) compared with the image.
+
+use isa::objfmt::{HookKind, HookRecord, Hooks};
+use linker::{Format, Image, ImageSymbol, LoadArea};
+
+use crate::robot::Sim;
+use crate::{scorpion, scorpion_with_input, transcript};
+
+/// The handler's bytes at $0400: `/1Q` answers `Q` and the byte at
+/// `value` ($0480) in hex.
+///
+/// ```text
+/// $0400  JMP chain      ; the chain slot, $0401
+/// $0403  handler: CMP #'Q'
+/// $0405  BNE $0400
+/// $0407  LDA #'Q'
+/// $0409  JSR PUTCH
+/// $040C  show: LDA value
+/// $040F  JSR PUTHEX
+/// $0412  JSR PUTEOL
+/// $0415  JMP CMD_DONE
+/// $0480  value: .byte $42
+/// ```
+pub(crate) fn handler_bytes() -> Vec<u8> {
+    let mut bytes = vec![
+        0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0, 0xF9, 0xA9, b'Q', 0x20, 0x00, 0xFF, 0xAD, 0x80, 0x04,
+        0x20, 0x03, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
+    ];
+    bytes.resize(0x81, 0xEA);
+    bytes[0x80] = 0x42;
+    bytes
+}
+
+/// The handler as a linked image, with its names (constants: the image
+/// has no sections, so the monitor shows addresses bare).
+fn handler_elf() -> Vec<u8> {
+    let symbol = |name: &str, value: u32| ImageSymbol {
+        name: name.to_owned(),
+        value,
+        size: 0,
+        global: true,
+        section: None,
+    };
+    let image = Image {
+        entry: 0x0403,
+        flags: 0,
+        areas: vec![LoadArea {
+            load: 0x0400,
+            run: 0x0400,
+            bytes: handler_bytes(),
+        }],
+        sections: vec![],
+        symbols: vec![
+            symbol("handler", 0x0403),
+            symbol("show", 0x040C),
+            symbol("value", 0x0480),
+        ],
+        hooks: Hooks {
+            records: vec![HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0403,
+                chain: Some(0x0401),
+            }],
+        },
+        lines: isa::objfmt::SrcMap::default(),
+    };
+    Format::Elf.write(&image).expect("an ELF image")
+}
+
+const SESSION: &str = "\
+break show
+/1Q
+regs
+print A
+mem value 1
+poke value $99
+step
+continue
+break handler
+delete 1
+/1Q
+quit
+";
+
+#[test]
+fn a_breakpoint_in_a_handler_on_the_pty_robot_and_the_code_compared_after() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        SESSION,
+    );
+    let printed = transcript(&output);
+    assert!(output.status.success(), "{printed}");
+    let in_order = [
+        "breakpoint 1: $040C",
+        "stopped: breakpoint 1, $040C",
+        // At the stop: A holds the letter, X the count (docs/PROTOCOL.md).
+        "PC=$040C A=$51 X=$01",
+        "$51",
+        "$0480: 42",
+        "$0480: 99 (read back)",
+        // One instruction, LDA value: A holds the changed byte.
+        "stopped: $040F",
+        "A=$99",
+        "answer: Q99",
+        // A branch would be displaced at `handler`: refused, said why.
+        "a breakpoint at $0403 is refused on the robot: the branch at $0405",
+        "deleted breakpoint 1",
+        "answer: Q99",
+        "detached",
+    ];
+    let mut from = 0;
+    for expected in in_order {
+        let at = printed[from..]
+            .find(expected)
+            .unwrap_or_else(|| panic!("`{expected}` after byte {from}:\n{printed}"));
+        from += at + expected.len();
+    }
+    // The second /1Q ran through without a stop.
+    assert_eq!(
+        printed.matches("stopped: breakpoint").count(),
+        1,
+        "{printed}"
+    );
+    // The code is the image's again, but for the byte changed; the hook
+    // is the handler's again.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "read",
+            "$0400",
+            "129",
+            "-o",
+            "after.bin",
+            "--port",
+            &sim.path,
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let mut expected = handler_bytes();
+    expected[0x80] = 0x99;
+    assert_eq!(
+        std::fs::read(dir.path().join("after.bin")).expect("a dump"),
+        expected
+    );
+    let output = scorpion(
+        dir.path(),
+        &["read", "$0200", "3", "-o", "hook.bin", "--port", &sim.path],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        std::fs::read(dir.path().join("hook.bin")).expect("a dump"),
+        [0x4C, 0x03, 0x04]
+    );
+}
+
+#[test]
+fn the_readme_section_runs_as_written_against_the_pty_robot() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
+    let sim = Sim::start(dir.path(), &[]);
+    let path = crate::path_with_scorpion();
+    let mut printed = String::new();
+    let script = crate::readme_block("## Debug on the robot", "sh");
+    for line in script.lines() {
+        let output = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!("{line} 2>&1"))
+            .current_dir(dir.path())
+            .env("PATH", &path)
+            .env("PORT", &sim.path)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("sh runs");
+        assert!(
+            output.status.success(),
+            "`{line}`:\n{}",
+            transcript(&output)
+        );
+        printed.push_str(&String::from_utf8_lossy(&output.stdout));
+    }
+    for expected in [
+        "stopped: breakpoint 1, $040C",
+        "$0480: 99 (read back)",
+        "A=$99",
+        "answer: Q99",
+        "deleted breakpoint 1",
+        "detached",
+    ] {
+        assert!(printed.contains(expected), "{expected}:\n{printed}");
+    }
+}

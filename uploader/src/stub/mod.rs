@@ -1,0 +1,22 @@
+//! Debugging on the robot itself, over its line (docs/DEBUGGING.md,
+//! "Debug on the robot"; the framing in docs/PROTOCOL.md, section 5).
+//! The ROM has no BRK hook, so a breakpoint is a `JSR` into a small stub
+//! (`uploader/stub/stub.s`) patched over the uploaded code; the stub
+//! reports the registers and serves the host's frames through the ROM's
+//! `GETCH`/`PUTCH` until it is told to go on.
+//!
+//! - [`link`]: the stub linked where the image leaves room;
+//! - [`frame`]: the stub's framing;
+//! - [`patch`]: what a breakpoint displaces, and where a step goes;
+//! - [`session`]: [`RobotDebug`], the debugger attached.
+
+pub mod error;
+pub mod frame;
+pub mod link;
+pub mod patch;
+pub mod session;
+
+pub use error::{StubError, StubResult, hex as error_hex};
+pub use link::StubPlan;
+pub use patch::Patch;
+pub use session::{Registers, Reply, RobotDebug};

@@ -1,0 +1,681 @@
+//! The debugger attached to a robot through the stub: the stub written
+//! and hooked, breakpoints patched in and out safely, the stub's frames
+//! at a stop (memory read and written, continue, step), commands sent
+//! while it runs.
+//!
+//! Safety of the patches: a trampoline is written and read back before
+//! any `JSR` can reach it, and the three bytes of a patch (or of its
+//! removal) are staged in the stub, read back, then copied by the robot
+//! in one command (`/1@`) while it runs, or written in one frame while it
+//! is stopped: no moment exists where the code holds part of a `JSR`, or
+//! a `JSR` into bytes not verified. A reset in between unhooks the stub,
+//! so a `/1@` after it does nothing; the bytes are read back after every
+//! patch, so the host always knows which of the two the code holds.
+
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use romlib::protocol::Command;
+
+use super::error::{StubError, StubResult, hex};
+use super::frame::{self, Heard, IN_MAX};
+use super::link::{StubPlan, TRAMPOLINES};
+use super::patch::{self, JSR, Patch};
+use crate::client::Client;
+use crate::image::{RomProfile, UploadImage};
+use crate::transport::{Transport, char_time};
+
+/// The registers at a stop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Registers {
+    /// Where it stopped: the instruction not run yet.
+    pub pc: u16,
+    /// The accumulator.
+    pub a: u8,
+    /// Index X.
+    pub x: u8,
+    /// Index Y.
+    pub y: u8,
+    /// The status register.
+    pub p: u8,
+    /// The stack pointer.
+    pub s: u8,
+}
+
+/// What came back after a command was sent to a running robot.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Reply {
+    /// Its answer (through the carriage return).
+    Answer(Vec<u8>),
+    /// A breakpoint stopped it first.
+    Stopped(Registers),
+    /// Nothing in the time waited.
+    Silent,
+}
+
+/// Attempts at a frame exchange before the line is given up.
+const ATTEMPTS: u32 = 4;
+
+/// Bytes written with the ROM's commands before they are read back.
+const ROM_PIECE: usize = 32;
+
+/// Bytes a stopped stub is asked for at once.
+const READ_CHUNK: usize = 64;
+
+/// A debugger attached to a robot.
+#[derive(Debug)]
+pub struct RobotDebug<T> {
+    client: Client<T>,
+    stub: StubPlan,
+    image: UploadImage,
+    /// Breakpoints by address, each with its trampoline's slot.
+    breakpoints: BTreeMap<u16, (Patch, usize)>,
+    /// The registers while stopped.
+    stopped: Option<Registers>,
+    rx: Vec<u8>,
+    margin: Duration,
+    /// `HOOK_UNKNOWN`'s address.
+    hook: u16,
+    /// The part of an answer that came before a stop.
+    partial: Vec<u8>,
+    /// The trampoline of the breakpoint being patched in.
+    pending: Option<(u16, Vec<u8>)>,
+}
+
+impl<T: Transport> RobotDebug<T> {
+    /// Attaches to the robot on `client` running `image` (as uploaded,
+    /// linked against `profile`): the stub linked where the image leaves
+    /// room, written with the ROM's commands and read back, then hooked
+    /// into `HOOK_UNKNOWN` ahead of what was there.
+    ///
+    /// # Errors
+    /// The line's errors, [`StubError::NoRoom`], [`StubError::Verify`].
+    pub fn attach(
+        mut client: Client<T>,
+        profile: &RomProfile,
+        image: UploadImage,
+    ) -> StubResult<Self> {
+        let hook = profile.hook_unknown;
+        let jump = client.read_memory(hook, 3)?;
+        let mut previous = u16::from_le_bytes([jump[1], jump[2]]);
+        // A stub left hooked by an earlier session (the host died): chain
+        // to where it chained.
+        let first = StubPlan::place(profile, &image, previous)?;
+        if previous == first.handler {
+            let code = client.read_memory(first.address, first.bytes.len())?;
+            let at = usize::from(first.code_end - first.address) - 2;
+            previous = u16::from_le_bytes([code[at], code[at + 1]]);
+        }
+        let stub = StubPlan::place(profile, &image, previous)?;
+        let margin = client.config().margin * 4;
+        let mut debug = RobotDebug {
+            client,
+            stub,
+            image,
+            breakpoints: BTreeMap::new(),
+            stopped: None,
+            rx: Vec::new(),
+            margin,
+            hook,
+            partial: Vec::new(),
+            pending: None,
+        };
+        let (address, bytes) = (debug.stub.address, debug.stub.bytes.clone());
+        debug.rom_write_verified(address, &bytes)?;
+        let handler = debug.stub.handler.to_le_bytes();
+        debug.rom_write_verified(hook + 1, &handler)?;
+        Ok(debug)
+    }
+
+    /// The stub as placed.
+    #[must_use]
+    pub fn stub(&self) -> &StubPlan {
+        &self.stub
+    }
+
+    /// The registers, when stopped.
+    #[must_use]
+    pub fn stopped(&self) -> Option<Registers> {
+        self.stopped
+    }
+
+    /// The breakpoints' addresses.
+    pub fn breakpoints(&self) -> impl Iterator<Item = u16> + '_ {
+        self.breakpoints.keys().copied()
+    }
+
+    /// The client, for reads with `/7R` while the robot runs.
+    pub fn client(&mut self) -> &mut Client<T> {
+        &mut self.client
+    }
+
+    /// Writes `bytes` at `address` with `/9W` (`/7W` for an odd last
+    /// byte) and reads them back, writing again what differs: a piece at
+    /// a time, so that answers keep coming while the writes go out.
+    ///
+    /// Two bytes lost on the line (one inside a command, and the next
+    /// command's slash) can make a command of the ROM that writes
+    /// elsewhere: so the whole range is read once more after the last
+    /// piece, and written again where it differs.
+    fn rom_write_verified(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        for (i, piece) in bytes.chunks(ROM_PIECE).enumerate() {
+            self.rom_write_piece(address.wrapping_add((i * ROM_PIECE) as u16), piece)?;
+        }
+        for _ in 0..ATTEMPTS {
+            let found = self.client.read_memory(address, bytes.len())?;
+            if found == bytes {
+                return Ok(());
+            }
+            for (i, piece) in bytes.chunks(ROM_PIECE).enumerate() {
+                let start = i * ROM_PIECE;
+                if found[start..start + piece.len()] != *piece {
+                    self.rom_write_piece(address.wrapping_add(start as u16), piece)?;
+                }
+            }
+        }
+        self.check(address, bytes)
+    }
+
+    /// Reads `bytes`' range back: [`StubError::Verify`] at the first
+    /// difference.
+    fn check(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        let found = self.client.read_memory(address, bytes.len())?;
+        match (0..bytes.len()).find(|&i| found[i] != bytes[i]) {
+            None => Ok(()),
+            Some(i) => Err(StubError::Verify {
+                address: address.wrapping_add(i as u16),
+                expected: hex(&bytes[i..bytes.len().min(i + 8)]),
+                found: hex(&found[i..bytes.len().min(i + 8)]),
+            }),
+        }
+    }
+
+    fn rom_write_piece(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        let mut todo = vec![(address, bytes.to_vec())];
+        for _ in 0..ATTEMPTS {
+            for (at, part) in &todo {
+                let mut text = Vec::new();
+                for (i, pair) in part.chunks(2).enumerate() {
+                    let here = at.wrapping_add(2 * i as u16);
+                    match pair {
+                        [a, b] => text.extend(format!("/9W{here:04X}{a:02X}{b:02X}").bytes()),
+                        [a] => text.extend(format!("/7W{here:04X}{a:02X}").bytes()),
+                        _ => {}
+                    }
+                }
+                self.client.send_raw(&text)?;
+            }
+            let found = self.client.read_memory(address, bytes.len())?;
+            todo = (0..bytes.len())
+                .filter(|&i| found[i] != bytes[i])
+                .map(|i| (address.wrapping_add(i as u16), vec![bytes[i]]))
+                .collect();
+            if todo.is_empty() {
+                return Ok(());
+            }
+        }
+        self.check(address, bytes)
+    }
+
+    /// Sets a breakpoint at `address`; `entries` are the addresses code
+    /// may jump to (labels, source lines), which a patch must not cover
+    /// past its first instruction.
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] with the reason (the ROM, a branch
+    /// displaced, a jump target covered, no trampoline free, overlapping
+    /// another breakpoint); the line's errors.
+    pub fn set_breakpoint(&mut self, address: u16, entries: &[u16]) -> StubResult<()> {
+        if self.breakpoints.contains_key(&address) {
+            return Ok(());
+        }
+        let patch = patch::plan(address, &self.image, entries)?;
+        let refuse = |reason: String| StubError::Refused {
+            what: format!("a breakpoint at ${address:04X}"),
+            reason,
+        };
+        for (other, _) in self.breakpoints.values() {
+            let overlaps = |a: &Patch, b: &Patch| {
+                u32::from(a.address) < u32::from(b.address) + 3
+                    && u32::from(b.address) < u32::from(a.address) + a.displaced.len() as u32
+            };
+            if overlaps(&patch, other) || overlaps(other, &patch) {
+                return Err(refuse(format!(
+                    "its bytes overlap the breakpoint at ${:04X}",
+                    other.address
+                )));
+            }
+        }
+        let used: Vec<usize> = self.breakpoints.values().map(|(_, slot)| *slot).collect();
+        let slot = (0..TRAMPOLINES)
+            .find(|slot| !used.contains(slot))
+            .ok_or_else(|| refuse(format!("the stub holds {TRAMPOLINES} breakpoints at once")))?;
+        // The trampoline first, verified: the JSR can only reach it after.
+        let trampoline = self.stub.trampoline(slot);
+        self.write_verified(trampoline, &patch.trampoline)?;
+        let entry = self.stub.entry.to_le_bytes();
+        self.pending = Some((trampoline, patch.trampoline.clone()));
+        let patched = self.patch(address, [JSR, entry[0], entry[1]]);
+        self.pending = None;
+        patched?;
+        self.breakpoints.insert(address, (patch, slot));
+        Ok(())
+    }
+
+    /// Removes the breakpoint at `address`: the image's bytes put back,
+    /// read back and compared with the image.
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] when there is none; the line's errors.
+    pub fn remove_breakpoint(&mut self, address: u16) -> StubResult<()> {
+        let Some((patch, _)) = self.breakpoints.get(&address).cloned() else {
+            return Err(StubError::Refused {
+                what: format!("removing a breakpoint at ${address:04X}"),
+                reason: "there is none there".into(),
+            });
+        };
+        self.patch(address, patch.original())?;
+        self.breakpoints.remove(&address);
+        Ok(())
+    }
+
+    /// Writes three bytes at `address` in one go: in one frame when
+    /// stopped, else staged in the stub, read back, and copied by `/1@`.
+    /// Reads them back either way.
+    fn patch(&mut self, address: u16, bytes: [u8; 3]) -> StubResult<()> {
+        if self.stopped.is_some() {
+            return self.write_verified(address, &bytes);
+        }
+        let at = address.to_le_bytes();
+        let staged = [at[0], at[1], bytes[0], bytes[1], bytes[2]];
+        let trampoline = self
+            .breakpoints
+            .get(&address)
+            .map(|(patch, slot)| (self.stub.trampoline(*slot), patch.trampoline.clone()))
+            .or_else(|| self.pending.clone());
+        for _ in 0..ATTEMPTS {
+            self.rom_write_verified(self.stub.stage, &staged)?;
+            // The stage's writes may have gone astray onto the trampoline
+            // the JSR will reach: it is read again first.
+            if bytes[0] == JSR
+                && let Some((at, code)) = &trampoline
+            {
+                self.rom_write_verified(*at, code)?;
+            }
+            let command = Command::parse(b"/1@").map_err(crate::Error::Protocol)?;
+            // The answer may be lost: the read back tells.
+            let _ = self.client.listen(&command)?;
+            let found = self.client.read_memory(address, 3)?;
+            if found == bytes {
+                return Ok(());
+            }
+        }
+        let found = self.client.read_memory(address, 3)?;
+        Err(StubError::Verify {
+            address,
+            expected: hex(&bytes),
+            found: hex(&found),
+        })
+    }
+
+    /// Writes `bytes` at `address` and reads them back: through the stub
+    /// when stopped, else with the ROM's commands.
+    ///
+    /// # Errors
+    /// [`StubError::Verify`], the line's errors.
+    pub fn write_verified(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        if self.stopped.is_none() {
+            return self.rom_write_verified(address, bytes);
+        }
+        for (i, part) in bytes.chunks(IN_MAX - 4).enumerate() {
+            let at = address.wrapping_add((i * (IN_MAX - 4)) as u16);
+            let mut payload = vec![
+                b'W',
+                at.to_le_bytes()[0],
+                at.to_le_bytes()[1],
+                part.len() as u8,
+            ];
+            payload.extend_from_slice(part);
+            let found = self.memory_exchange(&payload, at, part.len())?;
+            if found != part {
+                return Err(StubError::Verify {
+                    address: at,
+                    expected: hex(part),
+                    found: hex(&found),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads `len` bytes at `address`: from the stub when stopped, else
+    /// with `/7R` (each span read until two answers agree).
+    ///
+    /// # Errors
+    /// The line's errors, a garbled reply.
+    pub fn read(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
+        if self.stopped.is_none() {
+            return Ok(self.client.read_memory(address, len)?);
+        }
+        let mut out = Vec::with_capacity(len);
+        while out.len() < len {
+            let at = address.wrapping_add(out.len() as u16);
+            let count = (len - out.len()).min(READ_CHUNK);
+            let payload = [b'R', at.to_le_bytes()[0], at.to_le_bytes()[1], count as u8];
+            out.extend(self.memory_exchange(&payload, at, count)?);
+        }
+        Ok(out)
+    }
+
+    /// Sends a read or write request to the stopped stub and takes its
+    /// `M` reply, retrying after a NAK or a garbled frame.
+    fn memory_exchange(&mut self, payload: &[u8], at: u16, count: usize) -> StubResult<Vec<u8>> {
+        let asked = format!(
+            "{} of {count} bytes at ${at:04X}",
+            if payload[0] == b'R' {
+                "a read"
+            } else {
+                "a write"
+            }
+        );
+        let mut last = None;
+        for _ in 0..ATTEMPTS {
+            self.rx.clear();
+            self.client.transport().clear_input()?;
+            self.client.send_raw(&frame::encode(payload))?;
+            let wait = char_time(
+                payload.len() * 2 + count + 16,
+                self.client.transport().baud(),
+            ) + self.margin;
+            match self.next_heard(wait)? {
+                Some(Heard::Frame(reply)) => {
+                    let expected = [b'M', at.to_le_bytes()[0], at.to_le_bytes()[1]];
+                    if reply.len() == count + 3 && reply[..3] == expected {
+                        return Ok(reply[3..].to_vec());
+                    }
+                    if reply.first() == Some(&b'S') {
+                        // The stop frame again: it took our bytes for a command.
+                        last = Some(("`M` and the address".to_owned(), hex(&reply)));
+                        continue;
+                    }
+                    last = Some((format!("{} {count} bytes", hex(&expected)), hex(&reply)));
+                }
+                Some(Heard::BadFrame(bytes) | Heard::Text(bytes)) => {
+                    last = Some((
+                        "a frame with a good sum".into(),
+                        bytes.escape_ascii().to_string(),
+                    ));
+                }
+                None => {
+                    last = None;
+                }
+            }
+        }
+        Err(match last {
+            Some((expected, found)) => StubError::Garbled {
+                asked,
+                expected,
+                found,
+            },
+            None => StubError::Timeout {
+                asked,
+                waited: self.margin,
+            },
+        })
+    }
+
+    /// The next frame or answer, waiting up to `wait`.
+    fn next_heard(&mut self, wait: Duration) -> StubResult<Option<Heard>> {
+        let transport = self.client.transport();
+        let deadline = transport.now() + wait;
+        loop {
+            if let Some(heard) = frame::take(&mut self.rx) {
+                return Ok(Some(heard));
+            }
+            let now = self.client.transport().now();
+            if now >= deadline {
+                return Ok(None);
+            }
+            self.client
+                .transport()
+                .receive(&mut self.rx, deadline - now)?;
+        }
+    }
+
+    /// Takes a stop frame's payload as the registers.
+    fn take_stop(&mut self, payload: &[u8]) -> Option<Registers> {
+        let [b'S', pcl, pch, a, x, y, p, s] = *payload else {
+            return None;
+        };
+        let registers = Registers {
+            pc: u16::from_le_bytes([pcl, pch]).wrapping_sub(2),
+            a,
+            x,
+            y,
+            p,
+            s,
+        };
+        self.stopped = Some(registers);
+        Some(registers)
+    }
+
+    /// Sends `command` to the running robot and waits up to `wait` for its
+    /// answer, or for a stop.
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] while stopped; the line's errors.
+    pub fn command(&mut self, command: &[u8], wait: Duration) -> StubResult<Reply> {
+        if self.stopped.is_some() {
+            return Err(StubError::Refused {
+                what: format!("sending {}", command.escape_ascii()),
+                reason: "the robot is stopped at a breakpoint: its control loop reads no command until `continue`".into(),
+            });
+        }
+        self.rx.clear();
+        self.partial.clear();
+        self.client.transport().clear_input()?;
+        self.client.send_raw(command)?;
+        let wait = wait + char_time(command.len(), self.client.transport().baud());
+        self.wait_event(wait)
+    }
+
+    /// Waits up to `wait` for an answer or a stop.
+    ///
+    /// # Errors
+    /// The line's errors.
+    pub fn wait_event(&mut self, wait: Duration) -> StubResult<Reply> {
+        loop {
+            match self.next_heard(wait)? {
+                None => return Ok(Reply::Silent),
+                Some(Heard::Text(text)) => {
+                    // An answer begun before a stop ends after it.
+                    self.partial.extend_from_slice(&text);
+                    if text.last() == Some(&b'\r') {
+                        return Ok(Reply::Answer(std::mem::take(&mut self.partial)));
+                    }
+                }
+                Some(Heard::Frame(payload)) => {
+                    if let Some(registers) = self.take_stop(&payload) {
+                        return Ok(Reply::Stopped(registers));
+                    }
+                }
+                Some(Heard::BadFrame(_)) => {
+                    // A stop frame that came garbled: a slash makes the
+                    // stub send it again.
+                    self.client.send_raw(b"/")?;
+                }
+            }
+        }
+    }
+
+    /// Changes the registers of the stopped robot (the PC is where
+    /// `resume` goes on).
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] while running; the line's errors.
+    pub fn set_registers(&mut self, registers: Registers) -> StubResult<()> {
+        let Some(old) = self.stopped else {
+            return Err(not_stopped("setting a register"));
+        };
+        let block = [
+            registers.a,
+            registers.x,
+            registers.y,
+            registers.p,
+            registers.s,
+        ];
+        if block != [old.a, old.x, old.y, old.p, old.s] {
+            self.write_verified(self.stub.regs + 3, &block)?;
+        }
+        self.stopped = Some(registers);
+        Ok(())
+    }
+
+    /// Where the stopped robot goes on: a breakpoint's address is its
+    /// trampoline (the displaced instructions, then back).
+    fn resume_address(&self, pc: u16) -> u16 {
+        match self.breakpoints.get(&pc) {
+            Some((_, slot)) => self.stub.trampoline(*slot),
+            None => pc,
+        }
+    }
+
+    /// Lets the stopped robot go on (the command it was handling is
+    /// finished, its answer comes); `wait_event` then takes what comes.
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] while running; the line's errors.
+    pub fn resume(&mut self) -> StubResult<()> {
+        let Some(registers) = self.stopped else {
+            return Err(not_stopped("continue"));
+        };
+        let to = self.resume_address(registers.pc).to_le_bytes();
+        self.rx.clear();
+        self.client
+            .send_raw(&frame::encode(&[b'C', to[0], to[1]]))?;
+        self.stopped = None;
+        Ok(())
+    }
+
+    /// One instruction: temporary breakpoints at where the instruction at
+    /// the PC can go (a `JSR` into the ROM stepped over, any `JSR` when
+    /// `over`), continue, and
+    /// the temporary ones removed at the stop. `Ok(None)` when no stop
+    /// came within `wait` (the code went into the ROM: a return, say).
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] with the reason (a successor in the ROM, or
+    /// in bytes a breakpoint displaced); the line's errors.
+    pub fn step(&mut self, entries: &[u16], over: bool, wait: Duration) -> StubResult<Reply> {
+        let Some(registers) = self.stopped else {
+            return Err(not_stopped("step"));
+        };
+        let pc = registers.pc;
+        let image = self.image.clone();
+        let mut known: BTreeMap<u16, u8> = BTreeMap::new();
+        let mut read = |at: u16| -> StubResult<u8> {
+            if let Some(byte) = image.byte(at) {
+                return Ok(byte);
+            }
+            if let Some(&byte) = known.get(&at) {
+                return Ok(byte);
+            }
+            let byte = self.read(at, 1)?[0];
+            known.insert(at, byte);
+            Ok(byte)
+        };
+        let next = patch::successors(pc, registers.s, &image, over, &mut read)?;
+        let mut temporary = Vec::new();
+        for &to in &next {
+            if self.breakpoints.contains_key(&to) {
+                continue;
+            }
+            if !self.image.contains(to) {
+                return Err(StubError::Refused {
+                    what: format!("a step from ${pc:04X}"),
+                    reason: format!(
+                        "it goes to ${to:04X}, outside the uploaded code (the ROM cannot be patched): set a breakpoint where it comes back and continue"
+                    ),
+                });
+            }
+            if let Some((other, _)) = self.breakpoints.values().find(|(p, _)| p.covers_inside(to)) {
+                return Err(StubError::Refused {
+                    what: format!("a step from ${pc:04X}"),
+                    reason: format!(
+                        "the next instruction, ${to:04X}, is among the bytes the breakpoint at ${:04X} displaced",
+                        other.address
+                    ),
+                });
+            }
+            temporary.push(to);
+        }
+        for &to in &temporary {
+            if let Err(error) = self.set_breakpoint(to, entries) {
+                for &done in &temporary {
+                    if self.breakpoints.contains_key(&done) {
+                        self.remove_breakpoint(done)?;
+                    }
+                }
+                return Err(error);
+            }
+        }
+        self.resume()?;
+        let reply = self.wait_event(wait)?;
+        if self.stopped.is_some() {
+            for &to in &temporary {
+                self.remove_breakpoint(to)?;
+            }
+        }
+        Ok(reply)
+    }
+
+    /// Detaches: continues a stopped robot, removes every breakpoint (the
+    /// code compared with the image), and gives `HOOK_UNKNOWN` back to
+    /// what it pointed at. The stub's bytes stay in RAM, unreached.
+    ///
+    /// # Errors
+    /// The line's errors.
+    pub fn detach(mut self) -> StubResult<Client<T>> {
+        let addresses: Vec<u16> = self.breakpoints.keys().copied().collect();
+        for address in addresses {
+            self.remove_breakpoint(address)?;
+        }
+        if self.stopped.is_some() {
+            self.resume()?;
+            let _ = self.wait_event(self.margin)?;
+        }
+        let hook = self.hook;
+        let jump = self.client.read_memory(hook, 3)?;
+        if u16::from_le_bytes([jump[1], jump[2]]) == self.stub.handler {
+            let previous = self.stub.previous.to_le_bytes();
+            self.rom_write_verified(hook + 1, &previous)?;
+        }
+        Ok(self.client)
+    }
+
+    /// The robot's bytes where the image has code, compared with it:
+    /// the first difference, if any (address, image, robot).
+    ///
+    /// # Errors
+    /// The line's errors.
+    pub fn compare_with_image(&mut self) -> StubResult<Option<(u16, u8, u8)>> {
+        for area in self.image.areas().to_vec() {
+            let found = self.read(area.address, area.bytes.len())?;
+            if let Some(i) = (0..found.len()).find(|&i| found[i] != area.bytes[i]) {
+                return Ok(Some((
+                    area.address.wrapping_add(i as u16),
+                    area.bytes[i],
+                    found[i],
+                )));
+            }
+        }
+        Ok(None)
+    }
+}
+
+fn not_stopped(what: &str) -> StubError {
+    StubError::Refused {
+        what: what.into(),
+        reason: "the robot is running: it stops at a breakpoint".into(),
+    }
+}

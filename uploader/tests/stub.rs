@@ -1,0 +1,198 @@
+//! The debug stub (`uploader/stub/stub.s`) on the virtual Scorpion,
+//! driven through nothing but the line: attached beside a handler, a
+//! breakpoint hit inside it by its command, the registers read, a byte
+//! changed, a step, continue and the command answered with the changed
+//! byte, the breakpoint removed and the code compared with the image, the
+//! hook given back at detach. And the refusals (the ROM, a branch
+//! displaced, a jump target covered).
+
+mod common;
+
+use isa::objfmt::{HookKind, HookRecord};
+use romlib::VirtualScorpion;
+use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
+use std::time::Duration;
+use uploader::stub::{Reply, RobotDebug, StubError};
+use uploader::transport::VirtualTransport;
+use uploader::{Area, RomProfile, UploadImage};
+
+/// `/1Q` answers `Q` and the byte at $0480 in hex:
+///
+/// ```text
+/// $0400  JMP chain      ; the chain slot, $0401
+/// $0403  CMP #'Q'       ; the handler
+/// $0405  BNE $0400
+/// $0407  LDA #'Q'
+/// $0409  JSR PUTCH
+/// $040C  LDA $0480
+/// $040F  JSR PUTHEX
+/// $0412  JSR PUTEOL
+/// $0415  JMP CMD_DONE
+/// $0480  .byte $42
+/// ```
+fn handler() -> UploadImage {
+    let mut bytes = vec![
+        0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0, 0xF9, 0xA9, b'Q', 0x20, 0x00, 0xFF, 0xAD, 0x80, 0x04,
+        0x20, 0x03, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
+    ];
+    bytes.resize(0x81, 0xEA);
+    bytes[0x80] = 0x42;
+    UploadImage::new(
+        vec![Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        }],
+    )
+    .expect("an image")
+}
+
+/// A robot with the handler loaded and hooked, as an upload leaves it.
+fn robot(image: &UploadImage) -> VirtualTransport {
+    let mut robot = VirtualScorpion::new();
+    let area = &image.areas()[0];
+    robot
+        .robot_mut()
+        .board_mut()
+        .load(area.address, &area.bytes)
+        .expect("RAM");
+    robot
+        .install_hook(HookKind::Unknown, 0x0403, None)
+        .expect("HOOK_UNKNOWN is a JMP");
+    VirtualTransport::new(robot)
+}
+
+fn attach(image: &UploadImage) -> RobotDebug<VirtualTransport> {
+    let profile = RomProfile::reference();
+    let client = uploader::client(robot(image), &profile);
+    RobotDebug::attach(client, &profile, image.clone()).expect("attaches")
+}
+
+const WAIT: Duration = Duration::from_secs(1);
+
+#[test]
+fn a_breakpoint_in_a_handler_stops_it_and_it_goes_on_changed() {
+    let image = handler();
+    let mut debug = attach(&image);
+    debug.set_breakpoint(0x040C, &[]).expect("set");
+    // The patch is a JSR into the stub's entry.
+    let entry = debug.stub().entry.to_le_bytes();
+    assert_eq!(
+        debug.read(0x040C, 3).expect("read"),
+        [0x20, entry[0], entry[1]]
+    );
+    let reply = debug.command(b"/1Q", WAIT).expect("sent");
+    let Reply::Stopped(registers) = reply else {
+        panic!("no stop: {reply:?}");
+    };
+    assert_eq!((registers.pc, registers.a, registers.x), (0x040C, b'Q', 1));
+    assert_eq!(debug.read(0x0480, 1).expect("read"), [0x42]);
+    debug.write_verified(0x0480, &[0x99]).expect("write");
+    // A command sent while stopped is refused, not lost.
+    assert!(matches!(
+        debug.command(b"/1X", WAIT),
+        Err(StubError::Refused { .. })
+    ));
+    // One step: LDA $0480 runs, it stops before JSR PUTHEX.
+    let Reply::Stopped(after) = debug.step(&[], false, WAIT).expect("step") else {
+        panic!("the step did not stop");
+    };
+    assert_eq!((after.pc, after.a), (0x040F, 0x99));
+    // The step's temporary breakpoint is gone.
+    assert_eq!(debug.read(0x040F, 3).expect("read"), [0x20, 0x03, 0xFF]);
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"Q99\r".to_vec())
+    );
+    // It stops again at the next command; removed, it does not.
+    assert!(matches!(
+        debug.command(b"/1Q", WAIT).expect("sent"),
+        Reply::Stopped(_)
+    ));
+    debug.remove_breakpoint(0x040C).expect("removed");
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"Q99\r".to_vec())
+    );
+    // The code as the image has it, but for the byte changed (data).
+    assert_eq!(
+        debug.compare_with_image().expect("read"),
+        Some((0x0480, 0x42, 0x99))
+    );
+    let stub = debug.stub().clone();
+    let client = debug.detach().expect("detached");
+    let robot = client.into_transport().into_robot();
+    let memory = robot.robot().board().memory();
+    let hook = usize::from(HOOK_UNKNOWN);
+    assert_eq!(
+        memory[hook + 1..hook + 3],
+        [0x03, 0x04],
+        "the hook is given back"
+    );
+    assert_eq!(stub.previous, 0x0403);
+    assert_eq!(&memory[0x0400..0x0480], &image.areas()[0].bytes[..0x80]);
+}
+
+#[test]
+fn registers_changed_at_a_stop_are_the_ones_it_goes_on_with() {
+    let image = handler();
+    let mut debug = attach(&image);
+    // At $0407 (LDA #'Q', JSR PUTCH displaced together): set A... then
+    // LDA overwrites it; so stop at $040F and change A before PUTHEX.
+    debug.set_breakpoint(0x040F, &[]).expect("set");
+    let Reply::Stopped(mut registers) = debug.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    assert_eq!(registers.a, 0x42);
+    registers.a = 0x5A;
+    debug.set_registers(registers).expect("set A");
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"Q5A\r".to_vec())
+    );
+}
+
+#[test]
+fn breakpoints_the_robot_cannot_take_are_refused_with_the_reason() {
+    let image = handler();
+    let mut debug = attach(&image);
+    let refused = |result: Result<(), StubError>| match result {
+        Err(StubError::Refused { reason, .. }) => reason,
+        other => panic!("not refused: {other:?}"),
+    };
+    let rom = refused(debug.set_breakpoint(BAD_COMMAND, &[]));
+    assert!(rom.contains("ROM"), "{rom}");
+    // $0403 CMP #'Q' then BNE: the branch would be displaced.
+    let branch = refused(debug.set_breakpoint(0x0403, &[]));
+    assert!(branch.contains("branch"), "{branch}");
+    // $0407 LDA #'Q' (two bytes) displaces JSR PUTCH at $0409 too: refused
+    // when a label or a line starts there.
+    let covered = refused(debug.set_breakpoint(0x0407, &[0x0409]));
+    assert!(covered.contains("$0409"), "{covered}");
+    debug.set_breakpoint(0x0407, &[]).expect("no label inside");
+    let overlap = refused(debug.set_breakpoint(0x0409, &[]));
+    assert!(overlap.contains("$0407"), "{overlap}");
+    // Nothing half-written: the code is the image's but for the patch.
+    let stub = debug.stub().entry.to_le_bytes();
+    assert_eq!(
+        debug.read(0x0403, 9).expect("read"),
+        [0xC9, b'Q', 0xD0, 0xF9, 0x20, stub[0], stub[1], 0x00, 0xFF]
+    );
+    // And it stops there, and the displaced pair runs from the trampoline.
+    let Reply::Stopped(registers) = debug.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    assert_eq!(registers.pc, 0x0407);
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"Q42\r".to_vec())
+    );
+}
