@@ -171,7 +171,12 @@ fn a_breakpoint_in_a_handler_on_the_pty_robot_and_the_code_compared_after() {
 #[test]
 fn the_readme_section_runs_as_written_against_the_pty_robot() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
+    // The README's source, built by its own first command.
+    std::fs::write(
+        dir.path().join("ext.s"),
+        crate::readme_block("## Debug on the robot", "asm"),
+    )
+    .expect("the source");
     let sim = Sim::start(dir.path(), &[]);
     let path = crate::path_with_scorpion();
     let mut printed = String::new();
@@ -194,8 +199,8 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         printed.push_str(&String::from_utf8_lossy(&output.stdout));
     }
     for expected in [
-        "stopped: breakpoint 1, $040C",
-        "$0480: 99 (read back)",
+        "stopped: breakpoint 1, $0409 (show)",
+        "$0418: 99 (read back)",
         "A=$99",
         "answer: Q99",
         "deleted breakpoint 1",
