@@ -94,6 +94,9 @@ fn the_manifest_grammar_and_examples_are_json_and_point_at_each_other() {
     let grammar_entry = &contributes["grammars"][0];
     let grammar = json(&extension().join(grammar_entry["path"].as_str().expect("a path")));
     assert_eq!(grammar["scopeName"], grammar_entry["scopeName"]);
+    // The launch attribute that debugs a real robot (docs/DEBUGGING.md).
+    let launch = &contributes["debuggers"][0]["configurationAttributes"]["launch"];
+    assert_eq!(launch["properties"]["port"]["type"], "string", "{launch}");
     for example in ["launch.json", "tasks.json"] {
         json(&extension().join("examples").join(example));
     }
