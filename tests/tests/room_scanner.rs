@@ -61,3 +61,22 @@ fn a_plus_step_turns_the_scanner_right() {
     assert_eq!(left, scanner::reading(Some(85.0)), "the west wall");
     assert!(right > data[centre], "more than the north wall ahead");
 }
+
+/// A world script's `scene_at` wins where it sets the reading; the room
+/// fills the rest of the row.
+#[test]
+fn a_world_script_wins_where_it_sets_the_scene() {
+    let script = "fn init() { wake_at(ms(1)); }\nfn wake(now) { scene_at(0, 0, 7); }\n";
+    let mut room = Room::load("room.toml", &room(0)).expect("the world file loads");
+    let world = cards::ScriptWorld::load("world.rhai", script).expect("the script loads");
+    room.add(Box::new(world));
+    let mut s = Session::new();
+    s.robot.set_surroundings(Box::new(room));
+    s.send("/3H02");
+    s.wait_ms(2500);
+    let Some(Answer::Scan(scan)) = s.send("/1S") else {
+        panic!("/1S answers S...")
+    };
+    assert_eq!(scan.data[2], 7, "{:02X?}", scan.data);
+    assert!(scan.data[1] > 0xD0, "the room's post: {:02X?}", scan.data);
+}

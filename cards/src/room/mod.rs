@@ -219,6 +219,10 @@ impl Room {
             board.motor(Motor::Right).position(),
         );
         let lamps = board.lamps();
+        // The first look sets the scanner's readings whatever the
+        // drivers: a world script's `scene_at` then lands on the room's
+        // row and keeps the rest of it.
+        let first = self.motors.is_none();
         let last = self.motors.unwrap_or(motors);
         let (left, right) = (motors.0 - last.0, motors.1 - last.1);
         self.motors = Some(motors);
@@ -240,7 +244,7 @@ impl Room {
         // The detector is read while a scan runs, which has a scanner's
         // driver enabled: 256 rays at every look of a drive would cost
         // as much as the robot's own program.
-        if self.scan_due && robot.board().drive_latch() & SCANNERS != 0 {
+        if self.scan_due && (first || robot.board().drive_latch() & SCANNERS != 0) {
             self.scan_due = false;
             let row = self.scanner.row(&self.layout, self.pose);
             robot.board_mut().scene_mut().set_row(&row);
