@@ -3,7 +3,8 @@
 //! [`Room`] follows the drive motors' steps to the robot's pose
 //! ([`drive`]) and closes a bumper while its part of the outline touches
 //! something, lights a ground-tracker phototransistor over a floor line
-//! while the lamps are on. A world script named by the file adds what
+//! while the lamps are on, and fills the infrared scanner's readings
+//! from what is round the robot ([`scanner`]). A world script named by the file adds what
 //! the file cannot say. See docs/WORLD.md.
 
 pub mod drive;
@@ -12,6 +13,7 @@ pub mod geometry;
 pub mod live;
 pub mod picture;
 pub mod raster;
+pub mod scanner;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -29,6 +31,9 @@ use geometry::{Point, ShapeGrid, near_polyline, sin_cos};
 /// step a wheel at most, and a bumper closes within a millisecond of the
 /// step that made the contact.
 pub const TICK: u64 = 1000;
+
+/// The `DRIVE` latch's scanner driver enables.
+const SCANNERS: u8 = platform::map::drive::H_SCANNER | platform::map::drive::V_SCANNER;
 
 /// Points each bumper's part of the outline is felt at.
 const FEELERS: u32 = 9;
@@ -112,6 +117,10 @@ pub struct Room {
     /// Points tested against obstacles ([`Room::obstacle_tests`]).
     obstacle_tests: std::cell::Cell<u64>,
     next_look: u64,
+    /// The scanner's rays, and whether the pose (or the room) changed
+    /// since its readings were last set.
+    scanner: scanner::Scanner,
+    scan_due: bool,
     script: Option<Box<dyn Surroundings>>,
     view: RoomView,
 }
@@ -144,6 +153,8 @@ impl Room {
             seen: None,
             obstacle_tests: std::cell::Cell::new(0),
             next_look: 0,
+            scanner: scanner::Scanner::default(),
+            scan_due: true,
             script: None,
             view,
         })
@@ -248,6 +259,10 @@ impl Room {
             board.motor(Motor::Right).position(),
         );
         let lamps = board.lamps();
+        // The first look sets the scanner's readings whatever the
+        // drivers: a world script's `scene_at` then lands on the room's
+        // row and keeps the rest of it.
+        let first = self.motors.is_none();
         let last = self.motors.unwrap_or(motors);
         let (left, right) = (motors.0 - last.0, motors.1 - last.1);
         self.motors = Some(motors);
@@ -275,6 +290,15 @@ impl Room {
         if sense != self.sense {
             self.sense = sense;
             robot.board_mut().set_phototransistors(sense);
+        }
+        self.scan_due |= moved;
+        // The detector is read while a scan runs, which has a scanner's
+        // driver enabled: 256 rays at every look of a drive would cost
+        // as much as the robot's own program.
+        if self.scan_due && (first || robot.board().drive_latch() & SCANNERS != 0) {
+            self.scan_due = false;
+            let row = self.scanner.row(&self.layout, self.pose);
+            robot.board_mut().scene_mut().set_row(&row);
         }
         if let Ok(mut trail) = self.view.trail.lock() {
             if moved && trail.poses.len() < MAX_TRAIL {
@@ -308,6 +332,7 @@ impl Surroundings for Room {
         robot: &mut Scorpion,
     ) -> Result<(), Box<dyn miette::Diagnostic + Send + Sync>> {
         let edited = self.take_edits(now);
+        self.scan_due |= edited;
         if now >= self.next_look {
             self.look(now, robot);
             self.next_look = now + TICK;
@@ -344,6 +369,8 @@ impl Surroundings for Room {
             seen: self.seen,
             obstacle_tests: self.obstacle_tests.clone(),
             next_look: self.next_look,
+            scanner: self.scanner.clone(),
+            scan_due: self.scan_due,
             script,
             view: RoomView {
                 trail: Arc::new(Mutex::new(self.view.trail())),

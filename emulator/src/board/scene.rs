@@ -1,12 +1,16 @@
 //! What the infrared scanner sees: a reading for every position the
 //! horizontal and vertical scanners can point at.
 
+use std::collections::BTreeMap;
+
 /// Readings by scanner position. Positions are steps from the centre,
 /// clamped to -128..=127 on each axis.
 ///
 /// A scene keeps a table of its 65,536 readings only once a single
 /// position is set: every virtual robot starts with the default wall, and
-/// filling a table for it cost more than booting the robot.
+/// filling a table for it cost more than booting the robot. A room sets
+/// a row ([`Scene::set_row`]): a reading per horizontal step, the same at
+/// every vertical one, 256 bytes to refill when the robot moves.
 #[derive(Clone)]
 pub struct Scene {
     readings: Readings,
@@ -20,6 +24,12 @@ enum Readings {
     Uniform(u8),
     /// A reading per position, at [`index`].
     Table(Box<[u8]>),
+    /// A reading per horizontal step (at `h + 128`), the same for every
+    /// vertical one, under the positions set one by one since, which win.
+    Row {
+        row: Box<[u8]>,
+        set: BTreeMap<(i64, i64), u8>,
+    },
 }
 
 impl std::fmt::Debug for Scene {
@@ -47,6 +57,11 @@ fn clamp(step: i64) -> i64 {
 
 fn index(h: i64, v: i64) -> usize {
     usize::try_from((clamp(v) + SIDE / 2) * SIDE + clamp(h) + SIDE / 2).unwrap_or(0)
+}
+
+/// The place of the horizontal step `h` in a row.
+fn column(h: i64) -> usize {
+    usize::try_from(clamp(h) + SIDE / 2).unwrap_or(0)
 }
 
 /// Every position, in [`index`] order.
@@ -94,11 +109,43 @@ impl Scene {
             Readings::Wall => wall(clamp(h), clamp(v)),
             Readings::Uniform(value) => *value,
             Readings::Table(table) => table[index(h, v)],
+            Readings::Row { row, set } => set
+                .get(&(clamp(h), clamp(v)))
+                .copied()
+                .unwrap_or_else(|| row[column(h)]),
+        }
+    }
+
+    /// Sets the readings from one per horizontal step, `row[h + 128]`
+    /// for h from -128 to 127, the same at every vertical step (what a
+    /// room sees round the robot), when the scene is the default wall or
+    /// such a row already. What was set whole ([`Scene::uniform`],
+    /// [`Scene::from_fn`]) or position by position ([`Scene::set`]) since
+    /// stays: the one who set it wins where it did. Returns whether the
+    /// row was taken.
+    pub fn set_row(&mut self, new: &[u8; 256]) -> bool {
+        match &mut self.readings {
+            Readings::Wall => {
+                self.readings = Readings::Row {
+                    row: Box::new(*new),
+                    set: BTreeMap::new(),
+                };
+                true
+            }
+            Readings::Row { row, .. } => {
+                row.copy_from_slice(new);
+                true
+            }
+            Readings::Uniform(_) | Readings::Table(_) => false,
         }
     }
 
     /// Sets the reading at (h, v).
     pub fn set(&mut self, h: i64, v: i64, value: u8) {
+        if let Readings::Row { set, .. } = &mut self.readings {
+            set.insert((clamp(h), clamp(v)), value);
+            return;
+        }
         if !matches!(self.readings, Readings::Table(_)) {
             *self = Scene::from_fn(|h, v| self.reading(h, v));
         }
@@ -138,5 +185,33 @@ mod tests {
         wall.set(4, -4, 0xC0 - 16);
         assert_eq!(wall, Scene::default());
         assert_eq!(Scene::uniform(3), Scene::from_fn(|_, _| 3));
+    }
+
+    #[test]
+    fn a_row_reads_by_horizontal_step_under_positions_set_since() {
+        let mut row = [0u8; 256];
+        for (k, reading) in row.iter_mut().enumerate() {
+            *reading = u8::try_from(k).unwrap_or(0);
+        }
+        let mut scene = Scene::default();
+        assert!(scene.set_row(&row), "the default wall takes a row");
+        assert_eq!(scene.reading(-128, 0), 0);
+        assert_eq!(scene.reading(5, 0), 133);
+        assert_eq!(scene.reading(5, -40), 133, "the same at every v");
+        assert_eq!(scene.reading(500, 9), 255, "clamped");
+        scene.set(5, 1, 7);
+        assert_eq!(scene.reading(5, 1), 7);
+        assert_eq!(scene.reading(5, 0), 133);
+        row[133] = 1;
+        assert!(scene.set_row(&row));
+        assert_eq!(scene.reading(5, 0), 1, "the new row");
+        assert_eq!(scene.reading(5, 1), 7, "the position set still wins");
+        let mut whole = Scene::uniform(9);
+        assert!(!whole.set_row(&row), "a scene set whole stays");
+        assert_eq!(whole, Scene::uniform(9));
+        let mut table = Scene::default();
+        table.set(0, 0, 3);
+        assert!(!table.set_row(&row), "a scene set by position stays");
+        assert_eq!(table.reading(0, 0), 3);
     }
 }

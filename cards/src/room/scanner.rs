@@ -1,0 +1,263 @@
+//! What the infrared scanner sees in a room: a ray from the robot's axle
+//! middle at each horizontal scanner step, against the walls and the
+//! obstacles, its distance turned into a reading. Pure geometry, with the
+//! same `+ - * /` and `sqrt` as [`geometry`](super::geometry), so the
+//! readings are the same bits on every platform.
+
+use super::drive::Pose;
+use super::file::Layout;
+use super::geometry::{PI, Point, Shape, sin_cos};
+
+/// The scanner's turn per horizontal step, degrees: a 200-step-a-turn
+/// stepper like the wheels', so the largest scan (`/3H99`) sweeps 178°
+/// each side of straight ahead. A step `+` (the `SCAN_DIR` line high)
+/// turns it right, clockwise seen from above.
+pub const STEP_DEGREES: f64 = 1.8;
+
+/// How far the scanner sees, centimetres from the robot's outline: past
+/// it, a ray reads [`BACKGROUND`].
+pub const RANGE: f64 = 200.0;
+
+/// The reading of a ray that meets nothing within [`RANGE`]: the dark
+/// floor and the open room reflect nothing back.
+pub const BACKGROUND: u8 = 0;
+
+/// The horizontal steps a row has, -128 to 127 (the scene's positions).
+const STEPS: usize = 256;
+
+/// The cross product's z of `a` and `b`.
+fn cross(a: Point, b: Point) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+/// How far along the ray from `origin` in the unit direction `direction`
+/// it meets the circle at `centre` of `radius`; 0 from inside it, `None`
+/// when it passes by or the circle is behind.
+#[must_use]
+pub fn ray_circle(origin: Point, direction: Point, centre: Point, radius: f64) -> Option<f64> {
+    let from = Point::new(origin.x - centre.x, origin.y - centre.y);
+    let inside = from.x * from.x + from.y * from.y - radius * radius;
+    if inside <= 0.0 {
+        return Some(0.0);
+    }
+    let half_b = from.x * direction.x + from.y * direction.y;
+    let discriminant = half_b * half_b - inside;
+    if discriminant < 0.0 {
+        return None;
+    }
+    let near = -half_b - discriminant.sqrt();
+    (near >= 0.0).then_some(near)
+}
+
+/// How far along the ray (as [`ray_circle`]) it meets the segment `a`-`b`;
+/// `None` when it misses, or runs along it (a ray grazing an edge end on
+/// meets the edges beside it).
+#[must_use]
+pub fn ray_segment(origin: Point, direction: Point, a: Point, b: Point) -> Option<f64> {
+    let edge = Point::new(b.x - a.x, b.y - a.y);
+    let denominator = cross(direction, edge);
+    if denominator == 0.0 {
+        return None;
+    }
+    let to_a = Point::new(a.x - origin.x, a.y - origin.y);
+    let along_ray = cross(to_a, edge) / denominator;
+    let along_edge = cross(to_a, direction) / denominator;
+    (along_ray >= 0.0 && (0.0..=1.0).contains(&along_edge)).then_some(along_ray)
+}
+
+/// How far along the ray it first meets an edge of the closed polygon
+/// `corners` (from outside or from inside: the walls are such a polygon).
+#[must_use]
+pub fn ray_polygon(origin: Point, direction: Point, corners: &[Point]) -> Option<f64> {
+    let count = corners.len();
+    (0..count)
+        .filter_map(|k| ray_segment(origin, direction, corners[k], corners[(k + 1) % count]))
+        .min_by(f64::total_cmp)
+}
+
+/// How far along the ray it first meets a wall or an obstacle of
+/// `layout`; `None` when nothing is in its way (an open floor).
+#[must_use]
+pub fn distance(layout: &Layout, origin: Point, direction: Point) -> Option<f64> {
+    let walls = layout
+        .walls
+        .as_deref()
+        .and_then(|walls| ray_polygon(origin, direction, walls));
+    layout
+        .obstacles
+        .iter()
+        .filter_map(|obstacle| match obstacle {
+            Shape::Circle { centre, radius } => ray_circle(origin, direction, *centre, *radius),
+            Shape::Polygon(corners) => ray_polygon(origin, direction, corners),
+        })
+        .chain(walls)
+        .min_by(f64::total_cmp)
+}
+
+/// The reading for something `gap` centimetres beyond the robot's outline
+/// (`None`: nothing): `round(255 × (RANGE − gap) / RANGE)`, 0xFF at
+/// contact falling in a straight line to 0 at [`RANGE`], then
+/// [`BACKGROUND`].
+#[must_use]
+pub fn reading(gap: Option<f64>) -> u8 {
+    match gap {
+        Some(gap) if gap < RANGE => {
+            let gap = gap.max(0.0);
+            // In 0..=255 by the guard above: the cast cannot truncate.
+            (255.0 * (RANGE - gap) / RANGE).round() as u8
+        }
+        _ => BACKGROUND,
+    }
+}
+
+/// The scanner's directions, kept from one pose to the next: the sine
+/// and cosine of each step's turn from straight ahead.
+#[derive(Debug, Clone)]
+pub struct Scanner {
+    turns: Vec<(f64, f64)>,
+}
+
+impl Default for Scanner {
+    fn default() -> Scanner {
+        let turns = (0..STEPS)
+            .map(|column| {
+                let h = column as f64 - (STEPS / 2) as f64;
+                sin_cos(h * STEP_DEGREES * PI / 180.0)
+            })
+            .collect();
+        Scanner { turns }
+    }
+}
+
+impl Scanner {
+    /// The readings at `pose` in `layout`, one per horizontal step h
+    /// from -128 to 127 (at `h + 128`): the ray at `heading − h ×
+    /// STEP_DEGREES` from the axle's middle, its distance less the
+    /// outline's radius through [`reading`].
+    #[must_use]
+    pub fn row(&self, layout: &Layout, pose: Pose) -> [u8; STEPS] {
+        let (sin, cos) = sin_cos(pose.heading);
+        let mut row = [BACKGROUND; STEPS];
+        for (reading_at, &(turn_sin, turn_cos)) in row.iter_mut().zip(&self.turns) {
+            // heading − turn: a `+` step turns right (clockwise).
+            let direction = Point::new(
+                cos * turn_cos + sin * turn_sin,
+                sin * turn_cos - cos * turn_sin,
+            );
+            let gap = distance(layout, pose.at, direction).map(|d| d - layout.body.radius);
+            *reading_at = reading(gap);
+        }
+        row
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EAST: Point = Point { x: 1.0, y: 0.0 };
+    const ORIGIN: Point = Point { x: 0.0, y: 0.0 };
+
+    fn layout(text: &str) -> Layout {
+        super::super::file::parse("room.toml", text).expect("the world file loads")
+    }
+
+    fn close(found: Option<f64>, expected: f64) -> bool {
+        found.is_some_and(|d| (d - expected).abs() < 1e-9)
+    }
+
+    #[test]
+    fn distance_to_a_circle() {
+        let centre = Point::new(50.0, 0.0);
+        assert!(close(ray_circle(ORIGIN, EAST, centre, 10.0), 40.0));
+        // Off the axis by 6: the chord's near end at 50 − 8.
+        let off = Point::new(50.0, 6.0);
+        assert!(close(ray_circle(ORIGIN, EAST, off, 10.0), 42.0));
+        assert_eq!(ray_circle(ORIGIN, EAST, Point::new(50.0, 11.0), 10.0), None);
+        assert_eq!(ray_circle(ORIGIN, EAST, Point::new(-50.0, 0.0), 10.0), None);
+        assert!(close(
+            ray_circle(ORIGIN, EAST, Point::new(5.0, 0.0), 10.0),
+            0.0
+        ));
+    }
+
+    #[test]
+    fn distance_to_a_polygon_edge() {
+        let a = Point::new(30.0, -5.0);
+        let b = Point::new(30.0, 5.0);
+        assert!(close(ray_segment(ORIGIN, EAST, a, b), 30.0));
+        assert_eq!(ray_segment(ORIGIN, EAST, a, Point::new(30.0, -1.0)), None);
+        assert_eq!(ray_segment(ORIGIN, Point::new(-1.0, 0.0), a, b), None);
+        let north_east = Point::new(0.6, 0.8);
+        // It meets x = 30 at y = 40: past this edge, on a longer one.
+        assert_eq!(ray_segment(ORIGIN, north_east, a, b), None);
+        let long = Point::new(30.0, 45.0);
+        assert!(close(ray_segment(ORIGIN, north_east, a, long), 50.0));
+        // A square ahead: its near side first.
+        let square = [
+            Point::new(20.0, -10.0),
+            Point::new(40.0, -10.0),
+            Point::new(40.0, 10.0),
+            Point::new(20.0, 10.0),
+        ];
+        assert!(close(ray_polygon(ORIGIN, EAST, &square), 20.0));
+    }
+
+    #[test]
+    fn distance_to_the_walls_from_inside() {
+        let layout = layout("walls = [[-100, -50], [100, -50], [100, 50], [-100, 50]]");
+        assert!(close(distance(&layout, ORIGIN, EAST), 100.0));
+        assert!(close(
+            distance(&layout, ORIGIN, Point::new(0.0, -1.0)),
+            50.0
+        ));
+    }
+
+    #[test]
+    fn nothing_hit_on_an_open_floor() {
+        let layout = layout("");
+        assert_eq!(distance(&layout, ORIGIN, EAST), None);
+        let row = Scanner::default().row(&layout, layout.start);
+        assert!(row.iter().all(|&r| r == BACKGROUND));
+    }
+
+    #[test]
+    fn nearer_reads_stronger() {
+        assert_eq!(reading(Some(0.0)), 0xFF);
+        assert_eq!(reading(Some(-3.0)), 0xFF, "inside the outline: contact");
+        assert_eq!(reading(Some(RANGE / 2.0)), 128);
+        assert_eq!(reading(Some(RANGE)), BACKGROUND);
+        assert_eq!(reading(None), BACKGROUND);
+        assert!(reading(Some(10.0)) > reading(Some(20.0)));
+    }
+
+    #[test]
+    fn a_row_sees_a_post_ahead_and_to_the_right() {
+        // A post 60 cm east of the robot (radius 15), 20 cm round.
+        let layout =
+            layout("[[obstacle]]\ncircle = { x = 60, y = 0, radius = 20 }\n[robot]\nradius = 15\n");
+        let scanner = Scanner::default();
+        let pose = Pose {
+            at: ORIGIN,
+            heading: 0.0,
+        };
+        let row = scanner.row(&layout, pose);
+        assert_eq!(
+            row[128],
+            reading(Some(60.0 - 20.0 - 15.0)),
+            "straight ahead"
+        );
+        // The post spans asin(20/60) = 19.5°: steps up to 10 either way.
+        assert!(row[128 + 10] > BACKGROUND && row[128 - 10] > BACKGROUND);
+        assert_eq!(row[128 + 11], BACKGROUND);
+        assert_eq!(row[128 - 11], BACKGROUND);
+        // Facing north, the post is 50 steps (90°) to the right.
+        let north = Pose {
+            at: ORIGIN,
+            heading: PI / 2.0,
+        };
+        let turned = scanner.row(&layout, north);
+        assert_eq!(turned[128 + 50], row[128]);
+        assert_eq!(turned[128 - 50], BACKGROUND);
+    }
+}
