@@ -7,6 +7,7 @@
 
 mod args;
 mod cmd;
+mod report;
 
 use std::io::Write as _;
 use std::process::ExitCode;
@@ -76,9 +77,7 @@ fn main() -> ExitCode {
     // terminal folds them): an editor's problem matcher (editors/vscode's
     // `$scorpion`) reads the message on the line above its place, which a
     // message wrapped at 80 columns split from it.
-    let _ = miette::set_hook(Box::new(|_| {
-        Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
-    }));
+    let _ = miette::set_hook(Box::new(|_| Box::new(report::Reports::new())));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Asm(args) => cmd::asm::run(&args),

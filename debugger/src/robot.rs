@@ -329,6 +329,25 @@ impl RobotMonitor {
                     .map_err(|_| usage(&format!("{after} is no address")))?
             }
         };
+        // Built images start a source line at every instruction: any other
+        // address of theirs is inside one, and a JSR there would cut it in
+        // two (found by the hostile tester: the robot reset).
+        if self
+            .images
+            .iter()
+            .any(|image| !image.lines.entries.is_empty())
+            && self.entries.binary_search(&address).is_err()
+        {
+            return Err(usage(&format!(
+                "a breakpoint at ${address:04X} is refused on the robot: no instruction of the image starts there (no label or source line does), and a JSR there would cut one in two"
+            )));
+        }
+        if let Some((id, _)) = self.breakpoints.iter().find(|(_, at)| **at == address) {
+            return Err(usage(&format!(
+                "breakpoint {id} is already at {}",
+                self.place(address)
+            )));
+        }
         d.set_breakpoint(address, &self.entries).map_err(failure)?;
         let id = self.next_id;
         self.next_id += 1;

@@ -267,3 +267,20 @@ fn a_world_file_and_the_script_it_names_are_said_for_what_they_are() {
         ],
     );
 }
+
+/// The hostile tester's panic: miette's renderer cannot pad past column
+/// 65535, so an error far along a long line (a generated source, a world
+/// file of 100,000 corners) crashed every command. Narrated instead, with
+/// its place.
+#[test]
+fn an_error_past_column_65535_is_said_not_a_panic() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let source = format!("; a long line\n{}lda #$1FFFF\n", " ".repeat(70_000));
+    std::fs::write(dir.path().join("long.s"), source).expect("the source");
+    let output = bounded(dir.path(), &["asm", "long.s", "-o", "long.o"]);
+    refused(&output, &["long.s", "$1FFFF"]);
+    let world = format!("[robot]\nx = {}\"10\"\n", " ".repeat(70_000));
+    std::fs::write(dir.path().join("long.toml"), world).expect("the world");
+    let output = bounded(dir.path(), &["sim", "--world", "long.toml"]);
+    refused(&output, &["long.toml"]);
+}

@@ -209,3 +209,146 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         assert!(printed.contains(expected), "{expected}:\n{printed}");
     }
 }
+
+/// The hostile tester's F1 and M1: a breakpoint inside an instruction of a
+/// built image was patched (the robot reset), and one address took two
+/// breakpoints. Both refused, the robot's code left as uploaded.
+#[test]
+fn a_breakpoint_inside_an_instruction_or_twice_at_one_place_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("ext.s"),
+        crate::readme_block("## Debug on the robot", "asm"),
+    )
+    .expect("the source");
+    let built = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion(
+        dir.path(),
+        &[
+            "read",
+            "$0400",
+            "25",
+            "-o",
+            "before.bin",
+            "--port",
+            &sim.path,
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    // `show` (LDA value) is at $0409: $040A is its operand.
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        "break $040A\nbreak show\nbreak show\n/1Q\ncontinue\nquit\n",
+    );
+    let printed = transcript(&output);
+    assert!(output.status.success(), "{printed}");
+    assert!(
+        printed.contains("a breakpoint at $040A is refused on the robot: no instruction"),
+        "{printed}"
+    );
+    assert!(
+        printed.contains("breakpoint 1 is already at $0409"),
+        "{printed}"
+    );
+    assert!(printed.contains("answer: Q42"), "{printed}");
+    let output = scorpion(
+        dir.path(),
+        &[
+            "read",
+            "$0400",
+            "25",
+            "-o",
+            "after.bin",
+            "--port",
+            &sim.path,
+        ],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        std::fs::read(dir.path().join("after.bin")).expect("a dump"),
+        std::fs::read(dir.path().join("before.bin")).expect("a dump")
+    );
+}
+
+/// The hostile tester's F2: a signal (Ctrl-C sent to a piped monitor, a
+/// closed terminal, `kill`) while the robot was stopped at a breakpoint
+/// ended the process there, the robot stuck in the stub for good. Now it
+/// ends the session: the breakpoints taken out, the hook given back.
+#[test]
+fn a_signal_at_a_stop_gives_the_robot_back() {
+    use std::io::{BufRead as _, BufReader, Write as _};
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("ext.s"),
+        crate::readme_block("## Debug on the robot", "asm"),
+    )
+    .expect("the source");
+    let built = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
+        .current_dir(dir.path())
+        .env("NO_COLOR", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("scorpion runs");
+    let mut stdin = child.stdin.take().expect("its input");
+    stdin.write_all(b"break show\n/1Q\n").expect("the lines");
+    let mut stdout = BufReader::new(child.stdout.take().expect("its output"));
+    let mut seen = String::new();
+    while !seen.contains("PC=") {
+        let mut line = String::new();
+        let read = stdout.read_line(&mut line).expect("a line");
+        assert!(read > 0, "ended before the stop:\n{seen}");
+        seen.push_str(&line);
+    }
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    // The session ends at the next line read (here, a line it does not
+    // obey) and gives the robot back.
+    stdin.write_all(b"delete 1\n").expect("a line");
+    drop(stdin);
+    let mut rest = String::new();
+    let _ = std::io::Read::read_to_string(&mut stdout, &mut rest);
+    let status = child.wait().expect("it ends");
+    seen.push_str(&rest);
+    assert!(seen.contains("detached"), "{seen}");
+    assert!(!seen.contains("deleted breakpoint"), "{seen}");
+    assert_eq!(status.code(), Some(0), "{seen}");
+    // The robot goes on: its code is the image's again and /1Q answers.
+    let output = scorpion(
+        dir.path(),
+        &["read", "$0409", "3", "-o", "show.bin", "--port", &sim.path],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    assert_eq!(
+        std::fs::read(dir.path().join("show.bin")).expect("a dump"),
+        [0xAD, 0x18, 0x04]
+    );
+    let output = scorpion(dir.path(), &["ask", "/1Q", "--port", &sim.path]);
+    assert!(
+        String::from_utf8_lossy(&output.stdout).contains("Q42"),
+        "{}",
+        transcript(&output)
+    );
+}

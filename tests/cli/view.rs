@@ -105,7 +105,11 @@ impl View {
         stream
             .set_read_timeout(Some(PATIENCE))
             .expect("a read timeout");
-        write!(stream, "{method} {path} HTTP/1.1\r\nHost: x\r\n\r\n").expect("the request");
+        write!(
+            stream,
+            "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"
+        )
+        .expect("the request");
         let mut response = String::new();
         let _ = stream.read_to_string(&mut response);
         response

@@ -72,8 +72,20 @@ pub fn parse(content: &str) -> Option<Result<RoomLine, String>> {
     let (word, rest) = keyword(content)?;
     Some(match word {
         "wait" => time(rest)
-            .map(RoomLine::Wait)
-            .ok_or_else(|| format!("`wait {rest}` is not a time: write `wait 500ms` or `wait 2s`")),
+            .ok_or_else(|| format!("`wait {rest}` is not a time: write `wait 500ms` or `wait 2s`"))
+            .and_then(|wait| {
+                // A transcript runs in robot time, about a thousand times
+                // faster than the robot: an hour is seconds; a typo of a
+                // few more digits would run for days.
+                if wait > MAX_WAIT {
+                    Err(format!(
+                        "`wait {rest}` is longer than a transcript may wait ({} s of robot time)",
+                        MAX_WAIT.as_secs()
+                    ))
+                } else {
+                    Ok(RoomLine::Wait(wait))
+                }
+            }),
         "pose" => after_arrow(word, rest).and_then(pose).map(RoomLine::Pose),
         _ => after_arrow(word, rest).and_then(bump).map(RoomLine::Bumped),
     })
@@ -86,6 +98,9 @@ fn after_arrow<'a>(word: &str, rest: &'a str) -> Result<&'a str, String> {
         )
     })
 }
+
+/// The longest `wait` a transcript may give: an hour of robot time.
+pub const MAX_WAIT: Duration = Duration::from_secs(3600);
 
 /// `500ms`, `2s`, `300us`.
 fn time(text: &str) -> Option<Duration> {
@@ -333,6 +348,11 @@ mod tests {
         assert!(reason("pose x=1cm").contains("followed by `=>`"));
         assert!(reason("bumped => 10").contains("not a bumper mask"));
         assert!(reason("wait 3 parsecs").contains("not a time"));
+        // The hostile tester's hang: a wait of years.
+        assert!(reason("wait 99999999999s").contains("longer than a transcript may wait"));
+        assert!(reason("wait 18446744073709551615ms").contains("longer than"));
+        assert!(reason("wait 3601s").contains("longer than"));
+        assert!(matches!(parse("wait 3600s"), Some(Ok(RoomLine::Wait(_)))));
     }
 
     #[test]

@@ -6,6 +6,8 @@
 
 use std::io::Write;
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use debugger::monitor::{Failure, Reply};
 use debugger::robot::RobotMonitor;
@@ -95,8 +97,47 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         stub.previous
     )
     .into_diagnostic()?;
+    // A Ctrl-C, a closed terminal or a `kill` must not end the process
+    // with the robot stopped in the stub or a JSR left in its code: each
+    // ends the session at the next line read (or the end of input), and
+    // the robot is given back as at `quit`.
+    let ended = Arc::new(AtomicBool::new(false));
+    for signal in [
+        signal_hook::consts::SIGINT,
+        signal_hook::consts::SIGHUP,
+        signal_hook::consts::SIGTERM,
+    ] {
+        signal_hook::flag::register(signal, Arc::clone(&ended)).into_diagnostic()?;
+    }
+    let session = converse(&mut robot, &mut monitor, &mut input, &mut out, &ended);
+    // Given back whatever ended the conversation (an unwritable terminal
+    // too), before its error is said.
+    let detached = robot.detach();
+    let broken = session?;
+    detached?;
+    // The terminal may be gone: what cannot be said is dropped.
+    let _ = writeln!(
+        out,
+        "detached: the breakpoints taken out, HOOK_UNKNOWN given back"
+    );
+    Ok(if broken {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Reads and answers the monitor's lines until `quit`, the end of input
+/// or a signal (`ended`); whether the line failed on the way.
+fn converse<T: uploader::transport::Transport>(
+    robot: &mut RobotDebug<T>,
+    monitor: &mut RobotMonitor,
+    input: &mut Input,
+    out: &mut impl Write,
+    ended: &AtomicBool,
+) -> miette::Result<bool> {
     let mut broken = false;
-    loop {
+    while !ended.load(Ordering::Relaxed) {
         if !input.is_terminal() {
             write!(out, "{PROMPT}").into_diagnostic()?;
         }
@@ -104,6 +145,8 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         let line = match input.read(PROMPT).into_diagnostic()? {
             Read::Line(line) => line,
             Read::Interrupted => {
+                // rustyline read the key; the signal's flag is not set.
+                ended.store(false, Ordering::Relaxed);
                 writeln!(out, "(Ctrl-C: `quit` or Ctrl-D leaves)").into_diagnostic()?;
                 continue;
             }
@@ -119,7 +162,10 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         if !input.is_terminal() {
             writeln!(out, "{line}").into_diagnostic()?;
         }
-        match monitor.command(&mut robot, line.trim()) {
+        if ended.load(Ordering::Relaxed) {
+            break;
+        }
+        match monitor.command(robot, line.trim()) {
             Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,
             Ok(Reply::Quit) => break,
             Err(error) => {
@@ -128,15 +174,5 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
             }
         }
     }
-    robot.detach()?;
-    writeln!(
-        out,
-        "detached: the breakpoints taken out, HOOK_UNKNOWN given back"
-    )
-    .into_diagnostic()?;
-    Ok(if broken {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(broken)
 }

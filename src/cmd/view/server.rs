@@ -217,6 +217,9 @@ fn asked(request: &httparse::Request<'_, '_>) -> Asked {
             ),
         );
     }
+    if let Some(refused) = foreign(request) {
+        return refused;
+    }
     let upgrade = request.headers.iter().any(|header| {
         header.name.eq_ignore_ascii_case("upgrade")
             && String::from_utf8_lossy(header.value).eq_ignore_ascii_case("websocket")
@@ -227,6 +230,48 @@ fn asked(request: &httparse::Request<'_, '_>) -> Asked {
             Asked::Refused("426 Upgrade Required", "/ws is the view's WebSocket".into())
         }
         _ => Asked::File(path.to_owned()),
+    }
+}
+
+/// A request from elsewhere than the user's own browser on this page: a
+/// `Host` that is a name other than `localhost` (a DNS-rebinding page
+/// names its own domain; an address, as typed or printed, is kept), or an
+/// `Origin` other than the page's own (any web page the user has open may
+/// open a WebSocket to a local port: it must not type to the robot).
+/// Clients that send no `Origin` (not a browser) are served.
+fn foreign(request: &httparse::Request<'_, '_>) -> Option<Asked> {
+    let header = |name: &str| {
+        request
+            .headers
+            .iter()
+            .find(|header| header.name.eq_ignore_ascii_case(name))
+            .map(|header| String::from_utf8_lossy(header.value).trim().to_owned())
+    };
+    let Some(host) = header("host") else {
+        return Some(Asked::Refused(
+            "400 Bad Request",
+            "a request without its Host".into(),
+        ));
+    };
+    let name = host
+        .rsplit_once(':')
+        .filter(|(_, port)| port.chars().all(|c| c.is_ascii_digit()))
+        .map_or(host.as_str(), |(name, _)| name);
+    let name = name.trim_start_matches('[').trim_end_matches(']');
+    if !(name.eq_ignore_ascii_case("localhost") || name.parse::<std::net::IpAddr>().is_ok()) {
+        return Some(Asked::Refused(
+            "403 Forbidden",
+            format!("Host {host} is not this machine's address: open the address the view printed"),
+        ));
+    }
+    match header("origin") {
+        Some(origin) if !origin.eq_ignore_ascii_case(&format!("http://{host}")) => {
+            Some(Asked::Refused(
+                "403 Forbidden",
+                format!("a page from {origin} may not drive the robot: open http://{host}/"),
+            ))
+        }
+        _ => None,
     }
 }
 
@@ -384,20 +429,58 @@ mod tests {
     #[test]
     fn heads_ask_for_the_page_the_socket_or_nothing() {
         assert_eq!(
-            parse("GET /?x=1 HTTP/1.1\r\nHost: a\r\n\r\n"),
+            parse("GET /?x=1 HTTP/1.1\r\nHost: localhost\r\n\r\n"),
             Asked::File("/".into())
         );
         assert_eq!(
-            parse("GET /ws HTTP/1.1\r\nUpgrade: WebSocket\r\nConnection: Upgrade\r\n\r\n"),
+            parse(
+                "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:80\r\nUpgrade: WebSocket\r\nConnection: Upgrade\r\n\r\n"
+            ),
             Asked::Socket
         );
         assert!(matches!(
-            parse("GET /ws HTTP/1.1\r\n\r\n"),
+            parse("GET /ws HTTP/1.1\r\nHost: localhost:8\r\n\r\n"),
             Asked::Refused("426 Upgrade Required", _)
         ));
         assert!(matches!(
             parse("POST / HTTP/1.1\r\n\r\n"),
             Asked::Refused("405 Method Not Allowed", _)
         ));
+    }
+
+    /// The hostile tester's finding: any web page could drive the robot
+    /// through the socket (cross-site WebSocket), or read the page by DNS
+    /// rebinding.
+    #[test]
+    fn pages_from_elsewhere_are_refused() {
+        let socket = "Upgrade: websocket\r\nConnection: Upgrade\r\n\r\n";
+        assert_eq!(
+            parse(&format!(
+                "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:5\r\nOrigin: http://127.0.0.1:5\r\n{socket}"
+            )),
+            Asked::Socket
+        );
+        assert_eq!(
+            parse(&format!("GET /ws HTTP/1.1\r\nHost: [::1]:5\r\n{socket}")),
+            Asked::Socket
+        );
+        for head in [
+            format!(
+                "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:5\r\nOrigin: http://evil.example\r\n{socket}"
+            ),
+            format!(
+                "GET /ws HTTP/1.1\r\nHost: evil.example\r\nOrigin: http://evil.example\r\n{socket}"
+            ),
+            "GET / HTTP/1.1\r\nHost: evil.example:5\r\n\r\n".to_owned(),
+            "GET / HTTP/1.1\r\n\r\n".to_owned(),
+        ] {
+            assert!(
+                matches!(
+                    parse(&head),
+                    Asked::Refused("403 Forbidden" | "400 Bad Request", _)
+                ),
+                "{head}"
+            );
+        }
     }
 }
