@@ -215,20 +215,7 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
 /// breakpoints. Both refused, the robot's code left as uploaded.
 #[test]
 fn a_breakpoint_inside_an_instruction_or_twice_at_one_place_is_refused() {
-    let dir = tempfile::tempdir().expect("temporary directory");
-    std::fs::write(
-        dir.path().join("ext.s"),
-        crate::readme_block("## Debug on the robot", "asm"),
-    )
-    .expect("the source");
-    let built = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
-    assert!(built.status.success(), "{}", transcript(&built));
-    let sim = Sim::start(dir.path(), &[]);
-    let output = scorpion(
-        dir.path(),
-        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
-    );
-    assert!(output.status.success(), "{}", transcript(&output));
+    let (dir, sim) = readme_handler_on_a_pty_robot();
     let output = scorpion(
         dir.path(),
         &[
@@ -286,20 +273,7 @@ fn a_breakpoint_inside_an_instruction_or_twice_at_one_place_is_refused() {
 fn a_signal_at_a_stop_gives_the_robot_back() {
     use std::io::{BufRead as _, BufReader, Write as _};
     use std::process::{Command, Stdio};
-    let dir = tempfile::tempdir().expect("temporary directory");
-    std::fs::write(
-        dir.path().join("ext.s"),
-        crate::readme_block("## Debug on the robot", "asm"),
-    )
-    .expect("the source");
-    let built = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
-    assert!(built.status.success(), "{}", transcript(&built));
-    let sim = Sim::start(dir.path(), &[]);
-    let output = scorpion(
-        dir.path(),
-        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
-    );
-    assert!(output.status.success(), "{}", transcript(&output));
+    let (dir, sim) = readme_handler_on_a_pty_robot();
     let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
         .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
         .current_dir(dir.path())
@@ -351,4 +325,24 @@ fn a_signal_at_a_stop_gives_the_robot_back() {
         "{}",
         transcript(&output)
     );
+}
+
+/// The README's handler built from its source and uploaded to a pty
+/// robot: the directory holding `ext.s` and `ext.elf`, and the robot.
+fn readme_handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("ext.s"),
+        crate::readme_block("## Debug on the robot", "asm"),
+    )
+    .expect("the source");
+    let built = scorpion(dir.path(), &["build", "ext.s", "-o", "ext.elf"]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    (dir, sim)
 }
