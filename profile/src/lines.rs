@@ -7,12 +7,19 @@
 //! macro body's line, so a macro used twice counts both uses on its
 //! lines). A line holds code when its text is an instruction (a 6502
 //! mnemonic after an optional label): data in a code section (`.byte`
-//! tables) is not a line a test could run. When the source cannot be read,
-//! the bytes of executable sections count as code.
+//! tables) is not a line a test could run, unless the code around it runs
+//! into it: a line of data that a branch, `JMP` or `JSR` of a code line
+//! targets, or that a code line falls through into, is an instruction
+//! written as bytes (the chain `JMP` of `SCORPION_CHAIN_UNKNOWN` is
+//! `.byte $4C` + `.addr`), so it is a code line too. Falling through a
+//! `JSR` does not count (routines that read their arguments from after
+//! the call return past them), nor through a conditional branch (one
+//! that always goes, `CLC` then `BCC`, is often followed by data). When the source cannot be read, the
+//! bytes of executable sections count as code.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
-use isa::Mnemonic;
+use isa::{AddressingMode, Mnemonic};
 
 /// A source line with code.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -71,7 +78,9 @@ impl LineTable {
         let mut code: BTreeMap<(String, u32), Line> = BTreeMap::new();
         let mut table = LineTable::default();
         let mut place_ids: HashMap<(String, u32), usize> = HashMap::new();
-        for image in images {
+        // Lines of data in executable sections: (image, first, end, file, line).
+        let mut data: Vec<(usize, u32, u32, (String, u32))> = Vec::new();
+        for (image_index, image) in images.iter().enumerate() {
             let entries = &image.lines.entries;
             for (index, entry) in entries.iter().enumerate() {
                 let Some(file) = image.lines.file_name(entry.loc) else {
@@ -112,28 +121,25 @@ impl LineTable {
                     None => true,
                 };
                 if !is_code {
+                    data.push((image_index, start, end, key));
                     continue;
                 }
-                let line = code.entry(key.clone()).or_insert_with(|| Line {
-                    file: key.0.clone(),
-                    line: key.1,
-                    starts: Vec::new(),
-                    branches: Vec::new(),
-                });
-                let mut at = start;
-                while at < end {
-                    let Some(opcode) = image.byte_at(at) else {
-                        break;
-                    };
-                    let Ok(address) = u16::try_from(at) else {
-                        break;
-                    };
-                    line.starts.push(address);
-                    if crate::is_branch(opcode) {
-                        line.branches.push(address);
-                    }
-                    at += u32::from(isa::opcode(opcode).mode.len());
-                }
+                decode_into(&mut code, key, image, start, end);
+            }
+        }
+        // Data lines the code runs into, until no more are found (one
+        // such line may run into the next).
+        loop {
+            let entries = entry_points(&code, images);
+            let (reached, rest): (Vec<_>, Vec<_>) = data
+                .into_iter()
+                .partition(|(_, start, _, _)| entries.contains(start));
+            data = rest;
+            if reached.is_empty() {
+                break;
+            }
+            for (image_index, start, end, key) in reached {
+                decode_into(&mut code, key, images[image_index], start, end);
             }
         }
         table.ranges.sort_unstable();
@@ -154,6 +160,75 @@ impl LineTable {
         let (file, line) = &self.places[*place];
         Some((file.as_str(), *line))
     }
+}
+
+/// Adds the instructions of `start..end` in `image` to the code line `key`.
+fn decode_into(
+    code: &mut BTreeMap<(String, u32), Line>,
+    key: (String, u32),
+    image: &linker::Image,
+    start: u32,
+    end: u32,
+) {
+    let line = code.entry(key.clone()).or_insert_with(|| Line {
+        file: key.0,
+        line: key.1,
+        starts: Vec::new(),
+        branches: Vec::new(),
+    });
+    let mut at = start;
+    while at < end {
+        let Some(opcode) = image.byte_at(at) else {
+            break;
+        };
+        let Ok(address) = u16::try_from(at) else {
+            break;
+        };
+        line.starts.push(address);
+        if crate::is_branch(opcode) {
+            line.branches.push(address);
+        }
+        at += u32::from(isa::opcode(opcode).mode.len());
+    }
+}
+
+/// Where the code lines' instructions can go next: branch, `JMP` and
+/// `JSR` targets, and the next instruction after one that falls through
+/// (not after a `JSR` or a branch, see the module's header).
+fn entry_points(code: &BTreeMap<(String, u32), Line>, images: &[&linker::Image]) -> BTreeSet<u32> {
+    let byte = |address: u32| images.iter().find_map(|image| image.byte_at(address));
+    let mut entries = BTreeSet::new();
+    for line in code.values() {
+        for &start in &line.starts {
+            let at = u32::from(start);
+            let Some(opcode) = byte(at) else {
+                continue;
+            };
+            let info = isa::opcode(opcode);
+            let next = at + u32::from(info.mode.len());
+            let operand16 = || Some(u32::from(byte(at + 1)?) | (u32::from(byte(at + 2)?) << 8));
+            match (info.mnemonic, info.mode) {
+                (Mnemonic::Jmp | Mnemonic::Jsr, AddressingMode::Absolute) => {
+                    entries.extend(operand16());
+                }
+                // Where these go is not in the code, or nowhere.
+                (Mnemonic::Jmp | Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk, _) => {}
+                // A conditional branch's target only: code falls through a
+                // branch into data when the branch always goes (`CLC` then
+                // `BCC`), so that is no sign the data runs.
+                (_, AddressingMode::Relative) => {
+                    if let Some(offset) = byte(at + 1) {
+                        let target = (i64::from(next) + i64::from(offset as i8)) & 0xFFFF;
+                        entries.extend(u32::try_from(target));
+                    }
+                }
+                _ => {
+                    entries.insert(next);
+                }
+            }
+        }
+    }
+    entries
 }
 
 #[cfg(test)]
