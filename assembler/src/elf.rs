@@ -106,6 +106,11 @@ pub(crate) fn write_object(
     }
     // Sorted here, in place, so that encoding needs no sorted copy.
     entries.sort_unstable();
+    let mut calls = std::mem::take(&mut out.calls);
+    for call in &mut calls {
+        call.section = Numbering::section(call.section as usize);
+    }
+    calls.sort_unstable();
     object.srcmap = Some(SrcMap {
         files: files.files.iter().map(|f| f.name.clone()).collect(),
         entries,
@@ -126,6 +131,7 @@ pub(crate) fn write_object(
                 })
             })
             .collect(),
+        calls,
     });
     object.asserts = out
         .asserts

@@ -308,6 +308,8 @@ pub(crate) struct Item {
     pub(crate) column: u32,
     /// Instruction length, 0 for data.
     pub(crate) instr_len: u8,
+    /// The context it was assembled in (a macro's expansion, an include).
+    pub(crate) ctx: CtxId,
 }
 
 /// A `.assert` checked after layout.

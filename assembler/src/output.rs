@@ -92,6 +92,9 @@ pub(crate) struct Output {
     /// Where every item came from; `section` is the index in
     /// [`Output::sections`] until the object writer numbers the sections.
     pub(crate) items: Vec<SrcMapEntry>,
+    /// For the items a macro made: the outermost macro call, keyed as in
+    /// [`Output::items`].
+    pub(crate) calls: Vec<SrcMapEntry>,
     pub(crate) asserts: Vec<OutAssert>,
     /// Fields the linker computes.
     pub(crate) fields: Vec<OutField>,

@@ -87,6 +87,15 @@ fn sample() -> RelObject {
             },
         }],
         symbols: Vec::new(),
+        calls: vec![SrcMapEntry {
+            section: Numbering::section(0),
+            offset: 3,
+            loc: SourceLoc {
+                file: 0,
+                line: 2,
+                column: 9,
+            },
+        }],
     });
     object.asserts = vec![Assertion {
         action: AssertAction::Error,

@@ -211,8 +211,8 @@ pub(crate) fn build_image(
 }
 
 /// The objects' source maps by run address: every entry of every placed
-/// section moved to where its bytes run, the files of all objects in one
-/// list.
+/// section moved to where its bytes run (and the macro calls that made
+/// them), the files of all objects in one list.
 fn lines(objects: &[Object], placement: &Placement) -> SrcMap {
     let mut lines = SrcMap::default();
     let mut file_numbers: BTreeMap<String, u32> = BTreeMap::new();
@@ -220,36 +220,34 @@ fn lines(objects: &[Object], placement: &Placement) -> SrcMap {
         let Some(map) = &object.srcmap else {
             continue;
         };
-        for entry in &map.entries {
-            let Some(position) = object
+        let mut moved = |entry: &SrcMapEntry| {
+            let position = object
                 .sections
                 .iter()
-                .position(|section| section.index == entry.section as usize)
-            else {
-                continue;
-            };
-            let Some((segment, offset)) = placement.sections[object_index][position] else {
-                continue;
-            };
+                .position(|section| section.index == entry.section as usize)?;
+            let (segment, offset) = placement.sections[object_index][position]?;
             let address = placement.segments[segment].run + offset + u64::from(entry.offset);
-            let (Ok(address), Some(name)) = (u32::try_from(address), map.file_name(entry.loc))
-            else {
-                continue;
-            };
+            let address = u32::try_from(address).ok()?;
+            let name = map.file_name(entry.loc)?;
             let next = u32::try_from(file_numbers.len()).unwrap_or(u32::MAX);
             let file = *file_numbers.entry(name.to_owned()).or_insert(next);
-            lines.entries.push(SrcMapEntry {
+            Some(SrcMapEntry {
                 section: 0,
                 offset: address,
                 loc: SourceLoc { file, ..entry.loc },
-            });
-        }
+            })
+        };
+        lines
+            .entries
+            .extend(map.entries.iter().filter_map(&mut moved));
+        lines.calls.extend(map.calls.iter().filter_map(&mut moved));
     }
     lines.files = vec![String::new(); file_numbers.len()];
     for (name, number) in file_numbers {
         lines.files[number as usize] = name;
     }
     lines.entries.sort();
+    lines.calls.sort();
     lines
 }
 

@@ -3,6 +3,7 @@
 //! taken; written as LCOV (`lcov.info`, what editors' coverage gutters and
 //! genhtml read) and as a self-contained HTML page.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::lines::LineTable;
@@ -75,44 +76,58 @@ pub struct Coverage {
 impl Coverage {
     /// The coverage `profile` gives the code lines of `table`, of the
     /// files `keep` accepts (the user's own: not the ROM's, not built-in
-    /// includes, unless asked).
+    /// includes, unless asked). The code a macro from a file not kept
+    /// made (a built-in include's `SCORPION_CHAIN_UNKNOWN`) counts at the
+    /// kept line that called it.
     #[must_use]
     pub fn new(profile: &Profile, table: &LineTable, keep: &dyn Fn(&str) -> bool) -> Coverage {
-        let mut files: Vec<FileCoverage> = Vec::new();
+        let mut kept: BTreeMap<String, BTreeMap<u32, LineHits>> = BTreeMap::new();
+        let mut count = |file: &str, line: u32, at: Option<u16>, is_branch: bool| {
+            let hits = kept
+                .entry(file.to_owned())
+                .or_default()
+                .entry(line)
+                .or_insert_with(|| LineHits {
+                    line,
+                    hits: 0,
+                    branches: Vec::new(),
+                });
+            let Some(at) = at else {
+                return;
+            };
+            hits.hits += profile.counts[usize::from(at)];
+            if is_branch {
+                hits.branches.push((
+                    profile.taken[usize::from(at)],
+                    profile.not_taken[usize::from(at)],
+                ));
+            }
+        };
         for line in &table.lines {
-            if !keep(&line.file) {
-                continue;
+            let own = keep(&line.file);
+            if own {
+                count(&line.file, line.line, None, false);
             }
-            if files.last().is_none_or(|f| f.file != line.file) {
-                files.push(FileCoverage {
-                    file: line.file.clone(),
-                    lines: Vec::new(),
-                });
-            }
-            let hits = line
-                .starts
-                .iter()
-                .map(|&at| profile.counts[usize::from(at)])
-                .sum();
-            let branches = line
-                .branches
-                .iter()
-                .map(|&at| {
-                    (
-                        profile.taken[usize::from(at)],
-                        profile.not_taken[usize::from(at)],
-                    )
-                })
-                .collect();
-            if let Some(file) = files.last_mut() {
-                file.lines.push(LineHits {
-                    line: line.line,
-                    hits,
-                    branches,
-                });
+            for &at in &line.starts {
+                let is_branch = line.branches.contains(&at);
+                if own {
+                    count(&line.file, line.line, Some(at), is_branch);
+                } else if let Some((file, call)) = table.call_of(at)
+                    && keep(file)
+                {
+                    count(file, call, Some(at), is_branch);
+                }
             }
         }
-        Coverage { files }
+        Coverage {
+            files: kept
+                .into_iter()
+                .map(|(file, lines)| FileCoverage {
+                    file,
+                    lines: lines.into_values().collect(),
+                })
+                .collect(),
+        }
     }
 
     /// Code lines and those run, over every file.

@@ -45,6 +45,9 @@ pub struct LineTable {
     ranges: Vec<(u16, u16, usize)>,
     /// Every (file, line) the ranges point at.
     places: Vec<(String, u32)>,
+    /// The byte ranges a macro made: (first, last, the place of the
+    /// outermost call), sorted.
+    calls: Vec<(u16, u16, usize)>,
 }
 
 /// Whether a source line's text is an instruction: a mnemonic, maybe
@@ -107,6 +110,16 @@ impl LineTable {
                     table.places.len() - 1
                 });
                 table.ranges.push((first, last, place));
+                if let Some(call) = image.lines.call(0, start)
+                    && let Some(call_file) = image.lines.file_name(call)
+                {
+                    let key = (call_file.to_owned(), call.line);
+                    let call_place = *place_ids.entry(key.clone()).or_insert_with(|| {
+                        table.places.push(key);
+                        table.places.len() - 1
+                    });
+                    table.calls.push((first, last, call_place));
+                }
                 if !section.exec {
                     continue;
                 }
@@ -143,6 +156,7 @@ impl LineTable {
             }
         }
         table.ranges.sort_unstable();
+        table.calls.sort_unstable();
         table.lines = code.into_values().collect();
         table
     }
@@ -150,10 +164,19 @@ impl LineTable {
     /// The file and line the byte at `address` came from.
     #[must_use]
     pub fn place_of(&self, address: u16) -> Option<(&str, u32)> {
-        let index = self
-            .ranges
-            .partition_point(|(first, _, _)| *first <= address);
-        let (_, last, place) = self.ranges.get(index.checked_sub(1)?)?;
+        self.find(&self.ranges, address)
+    }
+
+    /// The file and line of the outermost macro call that made the byte at
+    /// `address`, when a macro made it (the user's line).
+    #[must_use]
+    pub fn call_of(&self, address: u16) -> Option<(&str, u32)> {
+        self.find(&self.calls, address)
+    }
+
+    fn find(&self, ranges: &[(u16, u16, usize)], address: u16) -> Option<(&str, u32)> {
+        let index = ranges.partition_point(|(first, _, _)| *first <= address);
+        let (_, last, place) = ranges.get(index.checked_sub(1)?)?;
         if address > *last {
             return None;
         }

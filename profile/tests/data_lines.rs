@@ -2,10 +2,14 @@
 //! bytes that the code runs into is one (the chain `JMP` of
 //! `SCORPION_CHAIN_UNKNOWN`, a `BIT` that skips the next instruction);
 //! a table after an always-taken branch, a string after a `JSR` that
-//! reads it, and a table only loaded from are not.
+//! reads it, and a table only loaded from are not. A built-in macro's
+//! code counts at the user's line that called it.
 
 use std::collections::BTreeMap;
 
+use romlib::VirtualScorpion;
+use scorpion_profile::Recorder;
+use scorpion_profile::coverage::Coverage;
 use scorpion_profile::lines::LineTable;
 
 const SOURCE: &str = "        .include \"scorpion.inc\"
@@ -33,7 +37,16 @@ not_mine:
 ";
 
 fn table() -> LineTable {
-    let files = assembler::MemorySource::new().with("q.s", SOURCE);
+    let image = image(SOURCE);
+    LineTable::new(&[&image], &|file| match file {
+        "q.s" => Some(SOURCE.to_owned()),
+        "scorpion.inc" => Some(romlib::SCORPION_INC.to_owned()),
+        _ => None,
+    })
+}
+
+fn image(source: &str) -> linker::Image {
+    let files = assembler::MemorySource::new().with("q.s", source);
     let options = assembler::Options {
         builtin_includes: BTreeMap::from([(
             "scorpion.inc".to_owned(),
@@ -43,13 +56,7 @@ fn table() -> LineTable {
     };
     let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
         .expect("the handler assembles");
-    let image = romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext")
-        .expect("the handler links");
-    LineTable::new(&[&image], &|file| match file {
-        "q.s" => Some(SOURCE.to_owned()),
-        "scorpion.inc" => Some(romlib::SCORPION_INC.to_owned()),
-        _ => None,
-    })
+    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
 }
 
 /// The line of `file` whose text (trimmed) is `text`, from 1.
@@ -97,4 +104,57 @@ fn a_bit_that_skips_an_instruction_is_code_data_around_it_is_not() {
             "{data} is data"
         );
     }
+}
+
+/// `/1Q` answers `Q`; anything else goes down the chain.
+const HANDLER: &str = "        .include \"scorpion.inc\"
+        .code
+        SCORPION_UNKNOWN_HANDLER
+        cmp #'Q'
+        bne not_mine
+        jsr PUTCH
+        jsr PUTEOL
+        jmp CMD_DONE
+not_mine:
+        SCORPION_CHAIN_UNKNOWN
+";
+
+/// The coverage of the handler's own file after `commands`.
+fn covered(commands: &[&[u8]]) -> Coverage {
+    let image = image(HANDLER);
+    let mut robot = VirtualScorpion::new();
+    robot.load_image(&image).expect("the image loads");
+    let recorder = Recorder::attach(&mut robot);
+    for command in commands {
+        // BAD_COMMAND, at the end of the chain, answers nothing.
+        let answer = robot.transact(command, 1_000_000);
+        assert!(answer.is_ok() || command != b"/1Q", "{answer:?}");
+    }
+    let profile = recorder.finish(&mut robot);
+    let table = LineTable::new(&[&image], &|file| {
+        (file == "q.s").then(|| HANDLER.to_owned())
+    });
+    Coverage::new(&profile, &table, &|file| file == "q.s")
+}
+
+#[test]
+fn the_chain_macro_counts_at_the_users_line_run_or_not() {
+    let call = line_of(HANDLER, "SCORPION_CHAIN_UNKNOWN");
+    let hits = |coverage: &Coverage| {
+        let file = &coverage.files[0];
+        assert_eq!(coverage.files.len(), 1, "only q.s is kept");
+        file.lines
+            .iter()
+            .find(|l| l.line == call)
+            .map(|l| l.hits)
+            .expect("the macro's line is a code line of q.s")
+    };
+    let only_mine = covered(&[b"/1Q"]);
+    assert_eq!(hits(&only_mine), 0, "no command went down the chain");
+    let (lines, run) = only_mine.line_counts();
+    assert_eq!(run + 1, lines, "all but the chain line ran");
+    let chained = covered(&[b"/1Q", b"/1Z"]);
+    assert_eq!(hits(&chained), 1, "/1Z went down the chain once");
+    let (lines, run) = chained.line_counts();
+    assert_eq!(run, lines);
 }

@@ -153,10 +153,12 @@ fn stdout(output: &std::process::Output) -> String {
 }
 
 /// A new project's transcript sends only `/1V`: its handler's two
-/// `bne not_mine` are never taken, and coverage says so, line by line,
-/// in the summary, the LCOV file and the HTML page. Two more transcript
-/// lines (a `/2V0` and a `/1W`, neither the extension's) take both, and
-/// coverage is whole.
+/// `bne not_mine` are never taken and its chain `JMP` (the built-in
+/// `SCORPION_CHAIN_UNKNOWN`, counted at the line that uses it) never
+/// runs, and coverage says so, line by line, in the summary, the LCOV
+/// file and the HTML page. Two more transcript lines (a `/2V0` and a
+/// `/1W`, neither the extension's) take both and run it, and coverage is
+/// whole.
 #[test]
 fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
     let dir = tempfile::tempdir().expect("a temporary directory");
@@ -176,7 +178,17 @@ fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
             "{text}"
         );
     }
-    assert!(!text.contains("never run:"), "/1V runs every line: {text}");
+    let chain = lines_with(&source, "SCORPION_CHAIN_UNKNOWN");
+    assert_eq!(chain.len(), 1, "{source}");
+    assert!(
+        text.contains(&format!("  never run: src/myext.s:{}\n", chain[0])),
+        "/1V never goes down the chain: {text}"
+    );
+    assert_eq!(
+        text.matches("never run:").count(),
+        1,
+        "/1V runs every other line: {text}"
+    );
     assert!(text.contains("branches (50.0%)"), "{text}");
     let lcov = std::fs::read_to_string(project.join("target/scorpion/coverage/lcov.info"))
         .expect("lcov.info");
@@ -233,6 +245,7 @@ fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
         "{text}"
     );
     assert!(!text.contains("branch never taken"), "{text}");
+    assert!(!text.contains("never run"), "{text}");
 }
 
 /// The examples' projects covered: each one's LCOV names its source with

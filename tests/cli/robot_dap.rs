@@ -86,7 +86,7 @@ fn handler_elf() -> Vec<u8> {
         lines: SrcMap {
             files: vec!["handler.s".into()],
             entries,
-            symbols: vec![],
+            ..SrcMap::default()
         },
     };
     Format::Elf.write(&image).expect("an ELF image")

@@ -159,6 +159,7 @@ impl<'a> Asm<'a> {
             line: self.input.line.line,
             column,
             instr_len,
+            ctx: self.input.line_ctx,
         });
     }
 }

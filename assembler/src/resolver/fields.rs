@@ -123,6 +123,13 @@ impl Asm<'_> {
                         column: item.column,
                     },
                 });
+                if let Some((file, line, column)) = self.outermost_expansion(item.ctx) {
+                    out.calls.push(SrcMapEntry {
+                        section: section as u32,
+                        offset,
+                        loc: SourceLoc { file, line, column },
+                    });
+                }
             }
         }
         self.check_asserts(&mut out, &sym_index);

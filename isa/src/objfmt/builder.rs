@@ -299,6 +299,7 @@ impl ObjectBuilder {
                         expanded_at: None,
                     })
                     .collect(),
+                calls: Vec::new(),
             });
         }
         for assertion in &mut object.asserts {

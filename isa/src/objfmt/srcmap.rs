@@ -11,6 +11,11 @@
 //!   u32, column: u32`, the outermost macro call that defined the symbol
 //!   (the user's line, where the definition's own place is in the macro's
 //!   body). Version 1 maps decode with none.
+//! - version 3 adds calls: count, then entries as above (`section, offset,
+//!   file, line, column`), one for each entry a macro made, at the same
+//!   (section, offset), giving the outermost macro call (the user's line)
+//!   those bytes came from. Coverage counts a built-in macro's code at the
+//!   user's line through them. Older maps decode with none.
 //!
 //! `section` is an ELF section header index. Lines and columns count from 1.
 
@@ -18,7 +23,7 @@ use super::SRCMAP_SECTION;
 use super::codec::{FormatError, Reader, Writer};
 
 const MAGIC: &[u8; 4] = b"SCSM";
-const VERSION: u8 = 2;
+const VERSION: u8 = 3;
 
 /// A place in a source file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -64,6 +69,9 @@ pub struct SrcMap {
     pub entries: Vec<SrcMapEntry>,
     /// Symbol definitions.
     pub symbols: Vec<SymbolLoc>,
+    /// For the entries a macro made: the same (section, offset), and the
+    /// outermost macro call as the place (the user's line). Sorted.
+    pub calls: Vec<SrcMapEntry>,
 }
 
 impl SrcMap {
@@ -109,6 +117,14 @@ impl SrcMap {
         for (symbol, loc) in expanded {
             out.u32(symbol);
             write_loc(&mut out, loc);
+        }
+        let mut calls = self.calls.clone();
+        calls.sort_unstable();
+        out.len32(calls.len());
+        for call in &calls {
+            out.u32(call.section);
+            out.u32(call.offset);
+            write_loc(&mut out, call.loc);
         }
         out.bytes
     }
@@ -168,13 +184,30 @@ impl SrcMap {
                 symbols[index].expanded_at = Some(loc);
             }
         }
+        let mut calls = Vec::new();
+        if version >= 3 {
+            let count = input.count(20)?;
+            calls.reserve(count);
+            for _ in 0..count {
+                let section = input.u32()?;
+                let offset = input.u32()?;
+                let loc = read_loc(&mut input, files.len())?;
+                calls.push(SrcMapEntry {
+                    section,
+                    offset,
+                    loc,
+                });
+            }
+            calls.sort_unstable();
+        }
         if !input.is_empty() {
-            return Err(input.error("trailing bytes after the symbol table"));
+            return Err(input.error("trailing bytes after the last table"));
         }
         Ok(SrcMap {
             files,
             entries,
             symbols,
+            calls,
         })
     }
 
@@ -187,6 +220,25 @@ impl SrcMap {
             .partition_point(|entry| (entry.section, entry.offset) <= (section, offset));
         let entry = self.entries.get(index.checked_sub(1)?)?;
         (entry.section == section).then_some(entry.loc)
+    }
+
+    /// The outermost macro call that made the byte at `offset` in
+    /// `section`, when a macro made it: the user's line.
+    #[must_use]
+    pub fn call(&self, section: u32, offset: u32) -> Option<SourceLoc> {
+        let index = self
+            .entries
+            .partition_point(|entry| (entry.section, entry.offset) <= (section, offset));
+        let entry = self.entries.get(index.checked_sub(1)?)?;
+        if entry.section != section {
+            return None;
+        }
+        let key = (entry.section, entry.offset);
+        let at = self
+            .calls
+            .binary_search_by(|call| (call.section, call.offset).cmp(&key))
+            .ok()?;
+        Some(self.calls[at].loc)
     }
 
     /// Where symbol `symbol` (a `.symtab` index) was defined.
@@ -270,6 +322,11 @@ mod tests {
                     expanded_at: Some(loc(40)),
                 },
             ],
+            calls: vec![SrcMapEntry {
+                section: 2,
+                offset: 3,
+                loc: loc(50),
+            }],
         }
     }
 
@@ -286,6 +343,9 @@ mod tests {
         assert_eq!(map.symbol(8), None);
         assert_eq!(map.symbol_entry(7).unwrap().expanded_at, None);
         assert_eq!(map.symbol_entry(9).unwrap().expanded_at.unwrap().line, 40);
+        assert_eq!(map.call(2, 0), None, "no macro made it");
+        assert_eq!(map.call(2, 4).unwrap().line, 50, "inside the macro's entry");
+        assert_eq!(map.call(4, 0), None);
     }
 
     #[test]
