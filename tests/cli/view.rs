@@ -772,3 +772,31 @@ fn a_storm_of_random_requests_keeps_the_room_whole_and_the_robot_answering() {
         "resident memory {before} KiB before the storm, {after} KiB after"
     );
 }
+
+/// Found trying to break it again: a text frame of bytes that are not
+/// UTF-8 closed the connection without a word. Now a close frame, 1007
+/// (invalid payload) with a reason.
+#[test]
+fn a_text_message_not_utf8_is_closed_with_1007() {
+    let view = View::start(&[]);
+    let mut socket = view.socket();
+    // A masked text frame (the client's frames are masked: RFC 6455, 5.3)
+    // of three bytes that are no UTF-8, written past tungstenite, which
+    // only sends text it has checked.
+    let frame = [0x81, 0x83, 0, 0, 0, 0, 0xff, 0xfe, 0xfd];
+    socket
+        .get_mut()
+        .write_all(&frame)
+        .expect("the frame written");
+    let start = Instant::now();
+    let close = loop {
+        match socket.read() {
+            Ok(Message::Close(frame)) => break frame,
+            Ok(_) if start.elapsed() < PATIENCE => {}
+            other => panic!("a close frame, not {other:?}"),
+        }
+    };
+    let close = close.expect("a close frame with a code");
+    assert_eq!(u16::from(close.code), 1007, "{close:?}");
+    assert!(close.reason.as_str().contains("UTF-8"), "{close:?}");
+}

@@ -440,6 +440,19 @@ fn socket(stream: TcpStream, hub: &Hub) {
                 drain(socket.get_mut());
                 return;
             }
+            Err(tungstenite::Error::Utf8(error)) => {
+                // 1007: a text message that is not UTF-8 (RFC 6455, 7.4.1).
+                hub.say(&format!(
+                    "view: {peer}: a text message not UTF-8 ({error}); connection closed"
+                ));
+                let _ = socket.close(Some(CloseFrame {
+                    code: CloseCode::Invalid,
+                    reason: "a text message must be UTF-8 (JSON)".into(),
+                }));
+                let _ = socket.flush();
+                drain(socket.get_mut());
+                return;
+            }
             Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => {
                 return;
             }
