@@ -510,3 +510,293 @@ fn a_stopped_view_draws_its_path_with_the_room_as_left() {
         "{picture}"
     );
 }
+
+/// The hostile tester's finding: a drag put the robot inside the post or
+/// through a wall, which the world file refuses for a start. Refused
+/// now, said on the console, and the room and the robot stay as they
+/// were (the room is sent again, so a page draws the obstacle back).
+#[test]
+fn drags_into_an_obstacle_or_through_a_wall_are_refused() {
+    let view = View::start(&[]);
+    let mut socket = view.socket();
+    send(&mut socket, &json!({"type": "pause"}));
+    let mut console = Vec::new();
+    for (request, said) in [
+        (
+            json!({"type": "move_robot", "x": 160.0, "y": 100.0, "heading": 0.0}),
+            "the robot cannot go to x=160 y=100: its middle would be in obstacle 0",
+        ),
+        (
+            json!({"type": "move_robot", "x": 10.0, "y": 100.0, "heading": 0.0}),
+            "its outline would be 5.0 cm across the walls",
+        ),
+        (
+            json!({"type": "move_robot", "x": -40.0, "y": 100.0, "heading": 0.0}),
+            "its middle would be outside the walls",
+        ),
+        (
+            json!({"type": "move_obstacle", "index": 0, "x": 110.0, "y": 100.0}),
+            "obstacle 0 cannot go to x=110 y=100: it would be 25.0 cm into the robot",
+        ),
+        (
+            json!({"type": "move_obstacle", "index": 1, "x": 300.0, "y": 100.0}),
+            "obstacle 1 cannot go to x=300 y=100: it would be across or outside the walls",
+        ),
+    ] {
+        send(&mut socket, &request);
+        until(&mut socket, &mut console, said, |_, c| {
+            c.iter().any(|l| l.starts_with("note ") && l.contains(said))
+        });
+    }
+    // The room sent again as it was, the robot where it started.
+    send(
+        &mut socket,
+        &json!({"type": "move_obstacle", "index": 0, "x": 100.0, "y": 100.0}),
+    );
+    let room = until(&mut socket, &mut console, "the room again", |m, _| {
+        m["type"] == "room"
+    });
+    assert_eq!(room["room"]["obstacles"][0]["circle"]["x"], 160.0, "{room}");
+    send(&mut socket, &json!({"type": "step", "ms": 10}));
+    let still = state(&mut socket, "a frame after the step", |_| true);
+    assert_eq!(still["pose"]["x"], 100.0, "{still}");
+    assert_eq!(still["bumpers"], 0, "{still}");
+}
+
+/// The hostile tester's finding: a carriage return inside one `send`
+/// typed two commands (`/1B` and `/4C+40`: the left motor ran). One send
+/// is one command line: the request is refused and nothing is typed.
+#[test]
+fn a_send_with_a_carriage_return_is_refused_not_typed() {
+    let view = View::start(&[]);
+    let mut socket = view.socket();
+    let mut console = Vec::new();
+    send(&mut socket, &json!({"type": "send", "text": "/1B\r/4C+40"}));
+    until(&mut socket, &mut console, "the refusal", |m, _| {
+        m["type"] == "error"
+            && m["message"]
+                .as_str()
+                .is_some_and(|t| t.contains("one command") && t.contains("\\r at character 4"))
+    });
+    send(&mut socket, &json!({"type": "send", "text": "/1B"}));
+    until(&mut socket, &mut console, "the answer to /1B", |_, c| {
+        c.iter().any(|l| l == "answer B00")
+    });
+    let sent: Vec<&String> = console.iter().filter(|l| l.starts_with("sent ")).collect();
+    assert_eq!(sent, ["sent /1B"], "{console:?}");
+    let answers = console.iter().filter(|l| l.starts_with("answer ")).count();
+    assert_eq!(answers, 1, "{console:?}");
+    send(&mut socket, &json!({"type": "step", "ms": 200}));
+    let after = state(&mut socket, "a frame after the step", |m| {
+        m["paused"] == true
+    });
+    assert_eq!(after["motors"], json!([0, 0]), "{after}");
+}
+
+/// The new user's finding: `curl -I` (a HEAD) was answered 405. HEAD is
+/// answered as GET is, the same head and no body (RFC 9110, 9.3.2); a
+/// 405 says what is allowed.
+#[test]
+fn head_is_answered_like_get_without_a_body() {
+    let view = View::start(&[]);
+    for path in ["/", "/page.js", "/page.css", "/nothing"] {
+        let get = view.http("GET", path);
+        let head = view.http("HEAD", path);
+        let (get_head, get_body) = get.split_once("\r\n\r\n").expect("a GET's head");
+        assert_eq!(head, format!("{get_head}\r\n\r\n"), "HEAD {path}");
+        assert!(
+            get_head.contains(&format!("\r\nContent-Length: {}\r\n", get_body.len())),
+            "{get_head}"
+        );
+    }
+    assert!(view.http("HEAD", "/").starts_with("HTTP/1.1 200 OK\r\n"));
+    let post = view.http("POST", "/");
+    assert!(post.starts_with("HTTP/1.1 405 "), "{post}");
+    assert!(post.contains("\r\nAllow: GET, HEAD\r\n"), "{post}");
+}
+
+/// The hostile tester's finding: a message past the limit was answered
+/// by a TCP reset, so the page could not say why it lost its
+/// connection. Now a close frame, 1009 (message too big) with a reason,
+/// reaches the client.
+#[test]
+fn an_oversized_message_is_closed_with_1009_and_a_reason() {
+    let view = View::start(&[]);
+    let mut huge = view.socket();
+    huge.send(Message::text("x".repeat(1 << 20)))
+        .expect("the whole message written: the view reads it");
+    let start = Instant::now();
+    let close = loop {
+        match huge.read() {
+            Ok(Message::Close(frame)) => break frame,
+            Ok(_) if start.elapsed() < PATIENCE => {}
+            other => panic!("a close frame, not {other:?}"),
+        }
+    };
+    let close = close.expect("a close frame with a code");
+    assert_eq!(u16::from(close.code), 1009, "{close:?}");
+    assert!(
+        close
+            .reason
+            .as_str()
+            .contains("a message may be 16384 bytes"),
+        "{close:?}"
+    );
+}
+
+/// Trying to break it again (issue 28 point 3): eight clients at once
+/// send a storm of seeded random requests, good and bad (not JSON,
+/// numbers at 1e300 and past u64, `NaN` and `Infinity` spelled out,
+/// drags anywhere, pause, step and run racing each other, console lines
+/// of junk that is no command). Every frame any client gets keeps the
+/// room one the world file could give (the robot inside the walls and
+/// out of the post, the post inside the walls), and after the storm the
+/// robot still answers.
+#[test]
+fn a_storm_of_random_requests_keeps_the_room_whole_and_the_robot_answering() {
+    use rand::{RngExt as _, SeedableRng as _, rngs::StdRng};
+
+    let mut view = View::start(&[]);
+    let seed: u64 = std::env::var("VIEW_STORM_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(28);
+    let before = view.resident();
+    let clients: Vec<_> = (0..8)
+        .map(|client| {
+            let mut socket = view.socket();
+            std::thread::spawn(move || {
+                let mut rng = StdRng::seed_from_u64(seed * 100 + client);
+                let mut seen = Vec::new();
+                let number = |rng: &mut StdRng| -> String {
+                    match rng.random_range(0..8) {
+                        0 => "1e300".into(),
+                        1 => "-1e300".into(),
+                        2 => "NaN".into(),
+                        3 => "Infinity".into(),
+                        4 => "18446744073709551616".into(),
+                        _ => format!("{:.2}", rng.random_range(-400.0..400.0)),
+                    }
+                };
+                for _ in 0..150 {
+                    let request = match rng.random_range(0..10) {
+                        0 => "{\"type\":".to_owned(),
+                        1 => json!({"type": "pause"}).to_string(),
+                        2 => json!({"type": "run"}).to_string(),
+                        3 => format!(r#"{{"type":"step","ms":{}}}"#, number(&mut rng)),
+                        4 => format!(r#"{{"type":"step","ms":{}}}"#, rng.random_range(0..30)),
+                        5 => format!(r#"{{"type":"speed","factor":{}}}"#, number(&mut rng)),
+                        6 | 7 => format!(
+                            r#"{{"type":"move_robot","x":{},"y":{},"heading":{}}}"#,
+                            number(&mut rng),
+                            number(&mut rng),
+                            number(&mut rng)
+                        ),
+                        8 => format!(
+                            r#"{{"type":"move_obstacle","index":{},"x":{},"y":{}}}"#,
+                            rng.random_range(0..3),
+                            number(&mut rng),
+                            number(&mut rng)
+                        ),
+                        // Junk that is no command (no `/`): the motors stay.
+                        _ => json!({"type": "send", "text": (0..rng.random_range(0..20))
+                            .map(|_| char::from(rng.random_range(b'0'..=b'z')))
+                            .collect::<String>()})
+                        .to_string(),
+                    };
+                    if socket.send(Message::text(request)).is_err() {
+                        break;
+                    }
+                    while let Ok(Message::Text(text)) = socket.read() {
+                        seen.push(text.as_str().to_owned());
+                        let _ = socket
+                            .get_ref()
+                            .set_read_timeout(Some(Duration::from_millis(1)));
+                    }
+                    let _ = socket
+                        .get_ref()
+                        .set_read_timeout(Some(Duration::from_millis(1)));
+                }
+                seen
+            })
+        })
+        .collect();
+    let mut frames = 0;
+    for client in clients {
+        let seen = client.join().expect("a client's thread");
+        // Each client's frames in order: a state follows its room.
+        let mut post = (160.0, 100.0);
+        for text in seen {
+            let message: Value = serde_json::from_str(&text).expect("JSON from the view");
+            if message["type"] == "room" {
+                let circle = &message["room"]["obstacles"][0]["circle"];
+                post = (
+                    circle["x"].as_f64().expect("x"),
+                    circle["y"].as_f64().expect("y"),
+                );
+                assert!(
+                    (18.0..=282.0).contains(&post.0) && (18.0..=182.0).contains(&post.1),
+                    "the post across a wall: {message}"
+                );
+            } else if message["type"] == "state" {
+                frames += 1;
+                let (x, y) = (
+                    message["pose"]["x"].as_f64().expect("x"),
+                    message["pose"]["y"].as_f64().expect("y"),
+                );
+                assert!(
+                    (13.0..=287.0).contains(&x) && (13.0..=187.0).contains(&y),
+                    "the robot across a wall: {message}"
+                );
+                let apart = ((x - post.0).powi(2) + (y - post.1).powi(2)).sqrt();
+                assert!(
+                    apart >= 32.99,
+                    "the robot in the post at {post:?}: {message}"
+                );
+            }
+        }
+    }
+    assert!(frames > 0, "no state frames seen");
+    assert!(view.alive(), "{}", view.stderr());
+    let mut socket = view.socket();
+    send(&mut socket, &json!({"type": "run"}));
+    let mut console = Vec::new();
+    send(&mut socket, &json!({"type": "send", "text": "/1B"}));
+    until(&mut socket, &mut console, "the answer to /1B", |_, c| {
+        c.iter()
+            .any(|l| l.starts_with("answer B") && l.len() == "answer B00".len())
+    });
+    let after = view.resident();
+    assert!(
+        after < before + 64 * 1024,
+        "resident memory {before} KiB before the storm, {after} KiB after"
+    );
+}
+
+/// Found trying to break it again: a text frame of bytes that are not
+/// UTF-8 closed the connection without a word. Now a close frame, 1007
+/// (invalid payload) with a reason.
+#[test]
+fn a_text_message_not_utf8_is_closed_with_1007() {
+    let view = View::start(&[]);
+    let mut socket = view.socket();
+    // A masked text frame (the client's frames are masked: RFC 6455, 5.3)
+    // of three bytes that are no UTF-8, written past tungstenite, which
+    // only sends text it has checked.
+    let frame = [0x81, 0x83, 0, 0, 0, 0, 0xff, 0xfe, 0xfd];
+    socket
+        .get_mut()
+        .write_all(&frame)
+        .expect("the frame written");
+    let start = Instant::now();
+    let close = loop {
+        match socket.read() {
+            Ok(Message::Close(frame)) => break frame,
+            Ok(_) if start.elapsed() < PATIENCE => {}
+            other => panic!("a close frame, not {other:?}"),
+        }
+    };
+    let close = close.expect("a close frame with a code");
+    assert_eq!(u16::from(close.code), 1007, "{close:?}");
+    assert!(close.reason.as_str().contains("UTF-8"), "{close:?}");
+}

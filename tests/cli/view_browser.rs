@@ -3,7 +3,8 @@
 //! tests/view/ (its own package.json and lock; `npm ci` there, as
 //! `.ci/install-test-tools` does). The page loads, `/2A1` typed in its
 //! console is answered, and the motor commands move the drawn robot to
-//! the post, whose contact lights the front bumper. Without chromium,
+//! the post, whose contact lights the bumper named "4 front" (the
+//! indicators are labelled, in lists named by their headers). Without chromium,
 //! node or the package the test skips here and fails in CI.
 
 use std::io::{BufRead, BufReader};
@@ -99,7 +100,9 @@ fn the_live_view_in_chromium_answers_its_console_and_moves_the_robot() {
         "view: connected",
         "view: console > /2A1 < A57",
         "view: robot moved to x=",
-        "view: bumper 4 closed at the post",
+        "view: bumper named \"4 front closed\", drawn as \"bumper 4 front\"",
+        "view: trackers, lamps and eyes named",
+        "view: bumper 4 front closed at the post",
         "view: done",
     ] {
         assert!(said.contains(step), "{step:?} in {said}");

@@ -56,19 +56,40 @@ async function main() {
     const transform = await page.getAttribute("#robot", "transform");
     const trail = await page.getAttribute("#trail", "points");
     console.log(`view: robot moved to x=${moved} (${transform}), trail of ${trail.trim().split(/\s+/).length} points`);
+    // The bumpers are named (bit and place), in a list named by its
+    // header: the front one (bit 4) open before the bump.
+    const front = page
+      .getByRole("list", { name: "Bumpers" })
+      .getByRole("listitem")
+      .filter({ hasText: /^4 front (open|closed)$/ });
+    if ((await front.count()) !== 1) throw new Error(`no one bumper named "4 front": ${await page.textContent("#bumpers")}`);
     // The robot meets the post 45 cm ahead: its front bumper drawn closed.
     await page.waitForFunction(
-      () => document.querySelector('#bumpers .bit[data-bit="4"]').classList.contains("on"),
+      () => {
+        const item = document.querySelector('#bumpers li[data-name="4 front"]');
+        return item && item.classList.contains("on") && item.textContent.endsWith("closed");
+      },
       null,
       { timeout: PATIENCE },
     );
+    const named = (await front.textContent()).trim();
+    // Only the front bumper closed: the others named and open.
+    const others = await page.$$eval("#bumpers li:not(.on)", (items) => items.map((i) => i.textContent));
+    if (others.length !== 7 || !others.every((t) => t.endsWith("open"))) throw new Error(`the other bumpers: ${others}`);
+    const title = await page.textContent('#robot .bumper[data-bit="4"] title');
+    console.log(`view: bumper named "${named}", drawn as "${title}"`);
+    for (const [list, name] of [["Trackers", "left"], ["Trackers", "right"], ["Lamps", "tracker lamps"], ["Eyes", "left"], ["Eyes", "right"]]) {
+      const item = page.getByRole("list", { name: list }).getByRole("listitem").filter({ hasText: new RegExp(`^${name} (lit|dark|on|off)$`) });
+      if ((await item.count()) !== 1) throw new Error(`no ${list} item named "${name}"`);
+    }
+    console.log("view: trackers, lamps and eyes named");
     // And on the drawn robot: its front arc red.
     await page.waitForFunction(
       () => document.querySelector('#robot .bumper[data-bit="4"]').getAttribute("stroke") === "#c00",
       null,
       { timeout: PATIENCE },
     );
-    console.log("view: bumper 4 closed at the post");
+    console.log("view: bumper 4 front closed at the post");
     if (screenshot) await page.screenshot({ path: screenshot });
     if (errors.length) throw new Error(`the page's errors: ${errors.join("; ")}`);
     console.log("view: done");

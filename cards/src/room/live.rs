@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::drive::Pose;
 use super::file::Layout;
-use super::geometry::{Point, Shape};
+use super::geometry::{Point, Shape, inside_polygon, segment_distance2};
 use super::{Room, RoomView};
 
 /// The most edits waiting: a host that sends more before the robot runs
@@ -20,6 +20,13 @@ pub const MAX_EDITS: usize = 64;
 /// The farthest from the origin anything may be put, centimetres (a
 /// kilometre): past it a number is a mistake, not a room.
 pub const MAX_COORDINATE: f64 = 100_000.0;
+
+/// How far a drag may press the robot's outline into a wall or an
+/// obstacle, centimetres: a bumper pressed against something (which
+/// closes it, the point of such a drag), not a robot inside it. The world
+/// file's start pose is refused inside an obstacle or outside the walls;
+/// a drag is held to the outline, as the robot is a body, not a point.
+pub const CONTACT: f64 = 2.0;
 
 /// A change of the room asked by the host.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,39 +44,83 @@ pub enum Edit {
 }
 
 impl Edit {
-    /// Whether the edit can be made to `layout`: finite numbers within
-    /// [`MAX_COORDINATE`], an obstacle that exists. The reason if not.
+    /// Whether the edit can be made to `layout` with the robot at
+    /// `pose`: finite numbers within [`MAX_COORDINATE`], an obstacle that
+    /// exists, and a room that still makes sense after it: the robot's
+    /// outline inside the walls and out of every obstacle (pressed into
+    /// one [`CONTACT`] at most), an obstacle not across a wall nor onto
+    /// the robot. The reason if not.
     ///
     /// # Errors
     /// What is wrong with the edit, in words for the host to show.
-    pub fn check(&self, layout: &Layout) -> Result<(), String> {
+    pub fn check(&self, layout: &Layout, pose: Pose) -> Result<(), String> {
         let near = |p: Point| {
             p.x.is_finite()
                 && p.y.is_finite()
                 && p.x.abs() <= MAX_COORDINATE
                 && p.y.abs() <= MAX_COORDINATE
         };
+        let radius = layout.body.radius;
         match *self {
-            Edit::MoveRobot(pose) => {
-                if !near(pose.at) || !pose.heading.is_finite() || pose.heading.abs() > 1000.0 {
+            Edit::MoveRobot(to) => {
+                if !near(to.at) || !to.heading.is_finite() || to.heading.abs() > 1000.0 {
                     return Err(format!(
                         "the robot cannot go to x={} y={} heading={} (within {MAX_COORDINATE} cm of the origin)",
-                        pose.at.x, pose.at.y, pose.heading
+                        to.at.x, to.at.y, to.heading
                     ));
+                }
+                let here = format!("the robot cannot go to x={} y={}", to.at.x, to.at.y);
+                if let Some(walls) = &layout.walls {
+                    let depth = circle_out_of(walls, to.at, radius);
+                    if !inside_polygon(walls, to.at) {
+                        return Err(format!("{here}: its middle would be outside the walls"));
+                    }
+                    if depth > CONTACT {
+                        return Err(format!(
+                            "{here}: its outline would be {} cm across the walls (it may press a wall {CONTACT} cm at most)",
+                            centimetres(depth)
+                        ));
+                    }
+                }
+                for (index, shape) in layout.obstacles.iter().enumerate() {
+                    let depth = circle_into(shape, to.at, radius);
+                    if shape.contains(to.at) {
+                        return Err(format!("{here}: its middle would be in obstacle {index}"));
+                    }
+                    if depth > CONTACT {
+                        return Err(format!(
+                            "{here}: its outline would be {} cm into obstacle {index} (it may press an obstacle {CONTACT} cm at most)",
+                            centimetres(depth)
+                        ));
+                    }
                 }
             }
             Edit::MoveObstacle { index, to } => {
-                if index >= layout.obstacles.len() {
+                let Some(shape) = layout.obstacles.get(index) else {
                     return Err(format!(
                         "the room has {} obstacle(s); there is no obstacle {index}",
                         layout.obstacles.len()
                     ));
-                }
+                };
                 if !near(to) {
                     return Err(format!(
                         "obstacle {index} cannot go to x={} y={} (within {MAX_COORDINATE} cm of the origin)",
                         to.x, to.y
                     ));
+                }
+                let moved = moved_to(shape, to);
+                let here = format!("obstacle {index} cannot go to x={} y={}", to.x, to.y);
+                let depth = circle_into(&moved, pose.at, radius);
+                if depth > CONTACT {
+                    return Err(format!(
+                        "{here}: it would be {} cm into the robot (it may press the robot {CONTACT} cm at most)",
+                        centimetres(depth)
+                    ));
+                }
+                if let Some(walls) = &layout.walls
+                    && shape_out_of(walls, &moved) > CONTACT
+                {
+                    return Err(format!("{here}: it would be across or outside the walls"));
                 }
             }
         }
@@ -83,20 +134,103 @@ impl Edit {
             Edit::MoveRobot(to) => *pose = to,
             Edit::MoveObstacle { index, to } => {
                 if let Some(shape) = layout.obstacles.get_mut(index) {
-                    let middle = middle(shape);
-                    let (dx, dy) = (to.x - middle.x, to.y - middle.y);
-                    match shape {
-                        Shape::Circle { centre, .. } => *centre = to,
-                        Shape::Polygon(corners) => {
-                            for corner in corners {
-                                *corner = Point::new(corner.x + dx, corner.y + dy);
-                            }
-                        }
-                    }
+                    *shape = moved_to(shape, to);
                 }
             }
         }
     }
+}
+
+/// `shape` moved so that its middle is at `to`.
+fn moved_to(shape: &Shape, to: Point) -> Shape {
+    let middle = middle(shape);
+    let (dx, dy) = (to.x - middle.x, to.y - middle.y);
+    match shape {
+        Shape::Circle { radius, .. } => Shape::Circle {
+            centre: to,
+            radius: *radius,
+        },
+        Shape::Polygon(corners) => Shape::Polygon(
+            corners
+                .iter()
+                .map(|c| Point::new(c.x + dx, c.y + dy))
+                .collect(),
+        ),
+    }
+}
+
+/// The distance from `point` to the nearest edge of the closed polygon
+/// `corners`.
+fn edge_distance(corners: &[Point], point: Point) -> f64 {
+    let count = corners.len();
+    (0..count)
+        .map(|i| segment_distance2(point, corners[i], corners[(i + 1) % count]))
+        .fold(f64::INFINITY, f64::min)
+        .sqrt()
+}
+
+/// How far a circle (the robot's outline) at `centre` reaches into
+/// `shape`, centimetres (0 or less: clear of it). A centre inside the
+/// shape is the radius and more.
+fn circle_into(shape: &Shape, centre: Point, radius: f64) -> f64 {
+    match shape {
+        Shape::Circle {
+            centre: middle,
+            radius: size,
+        } => radius + size - centre.distance2(*middle).sqrt(),
+        Shape::Polygon(corners) => {
+            let edge = edge_distance(corners, centre);
+            if inside_polygon(corners, centre) {
+                radius + edge
+            } else {
+                radius - edge
+            }
+        }
+    }
+}
+
+/// How far a circle at `centre` reaches out of the walls `walls`
+/// (0 or less: inside them). A centre outside them is the radius and
+/// more.
+fn circle_out_of(walls: &[Point], centre: Point, radius: f64) -> f64 {
+    let edge = edge_distance(walls, centre);
+    if inside_polygon(walls, centre) {
+        radius - edge
+    } else {
+        radius + edge
+    }
+}
+
+/// How far `shape` reaches out of (or across) the walls: a circle as
+/// [`circle_out_of`]; a polygon by its farthest corner outside, or the
+/// walls' deepest corner inside it (a wall's corner poking through).
+fn shape_out_of(walls: &[Point], shape: &Shape) -> f64 {
+    match shape {
+        Shape::Circle { centre, radius } => circle_out_of(walls, *centre, *radius),
+        Shape::Polygon(corners) => {
+            let out = corners
+                .iter()
+                .filter(|c| !inside_polygon(walls, **c))
+                .map(|c| edge_distance(walls, *c))
+                .fold(0.0, f64::max);
+            let through = walls
+                .iter()
+                .filter(|w| inside_polygon(corners, **w))
+                .map(|w| edge_distance(corners, *w))
+                .fold(0.0, f64::max);
+            // A number that is not one (a corner at NaN) is never clear.
+            if out.is_nan() || through.is_nan() {
+                f64::INFINITY
+            } else {
+                out.max(through)
+            }
+        }
+    }
+}
+
+/// A length to a tenth of a centimetre, for a message.
+fn centimetres(length: f64) -> String {
+    format!("{:.1}", (length * 10.0).round() / 10.0)
 }
 
 /// A shape's middle: a circle's centre, the mean of a polygon's corners.
@@ -187,7 +321,7 @@ impl Room {
             return false;
         }
         for edit in &edits {
-            if edit.check(&self.layout).is_ok() {
+            if edit.check(&self.layout, self.pose).is_ok() {
                 edit.apply(&mut self.layout, &mut self.pose);
             }
         }
@@ -202,5 +336,143 @@ impl Room {
             trail.poses.push((now, self.pose));
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::room::file::parse;
+
+    /// The example room: walls 300 by 200, a post 20 cm round at (160,
+    /// 100), a box from (240, 20) to (280, 60); the robot 15 cm round.
+    const ROOM: &str = "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]
+[[obstacle]]
+circle = { x = 160, y = 100, radius = 20 }
+[[obstacle]]
+polygon = [[240, 20], [280, 20], [280, 60], [240, 60]]
+[robot]
+x = 100
+y = 100
+radius = 15
+";
+
+    fn robot_to(x: f64, y: f64) -> Edit {
+        Edit::MoveRobot(Pose {
+            at: Point::new(x, y),
+            heading: 0.0,
+        })
+    }
+
+    /// The hostile tester's finding: a drag put the robot through a wall
+    /// or inside the post, which the world file refuses for its start.
+    /// The outline decides: pressed against something (a bumper closed)
+    /// is a drag's point; farther in is refused.
+    #[test]
+    fn drags_keep_the_robot_in_the_room_and_out_of_the_obstacles() {
+        let layout = parse("room.toml", ROOM).expect("the room");
+        let pose = layout.start;
+        for (edit, refused) in [
+            // Pressed 1 cm against the post: its front bumper closes.
+            (robot_to(126.0, 100.0), None),
+            // 2 cm against the west wall, 1 cm against the box.
+            (robot_to(13.0, 100.0), None),
+            (robot_to(226.0, 40.0), None),
+            (
+                robot_to(160.0, 100.0),
+                Some("its middle would be in obstacle 0"),
+            ),
+            (
+                robot_to(130.0, 100.0),
+                Some("its outline would be 5.0 cm into obstacle 0"),
+            ),
+            (
+                robot_to(250.0, 30.0),
+                Some("its middle would be in obstacle 1"),
+            ),
+            (
+                robot_to(228.0, 40.0),
+                Some("its outline would be 3.0 cm into obstacle 1"),
+            ),
+            (
+                robot_to(-5.0, 100.0),
+                Some("its middle would be outside the walls"),
+            ),
+            (
+                robot_to(10.0, 100.0),
+                Some("its outline would be 5.0 cm across the walls"),
+            ),
+            (
+                robot_to(f64::NAN, 100.0),
+                Some("within 100000 cm of the origin"),
+            ),
+            // The post onto the robot at (100, 100), and pressed against it.
+            (
+                Edit::MoveObstacle {
+                    index: 0,
+                    to: Point::new(120.0, 100.0),
+                },
+                Some("it would be 15.0 cm into the robot"),
+            ),
+            (
+                Edit::MoveObstacle {
+                    index: 0,
+                    to: Point::new(134.0, 100.0),
+                },
+                None,
+            ),
+            // Through a wall, flush with it, and outside the room.
+            (
+                Edit::MoveObstacle {
+                    index: 0,
+                    to: Point::new(160.0, 190.0),
+                },
+                Some("across or outside the walls"),
+            ),
+            (
+                Edit::MoveObstacle {
+                    index: 1,
+                    to: Point::new(280.0, 180.0),
+                },
+                None,
+            ),
+            (
+                Edit::MoveObstacle {
+                    index: 1,
+                    to: Point::new(290.0, 100.0),
+                },
+                Some("across or outside the walls"),
+            ),
+            (
+                Edit::MoveObstacle {
+                    index: 1,
+                    to: Point::new(500.0, 100.0),
+                },
+                Some("across or outside the walls"),
+            ),
+        ] {
+            match (edit.check(&layout, pose), refused) {
+                (Ok(()), None) => {}
+                (Err(why), Some(said)) => assert!(why.contains(said), "{edit:?}: {why}"),
+                (outcome, _) => panic!("{edit:?}: {outcome:?}, expected {refused:?}"),
+            }
+        }
+    }
+
+    /// The room checks again what it is given: a refused edit sent past
+    /// the host's check leaves the robot and the room as they were.
+    #[test]
+    fn the_room_ignores_an_edit_that_does_not_fit() {
+        let layout = parse("room.toml", ROOM).expect("the room");
+        let mut room = crate::room::Room::load("room.toml", ROOM).expect("the room");
+        let view = room.view();
+        assert!(view.edit(robot_to(160.0, 100.0)));
+        assert!(view.edit(Edit::MoveObstacle {
+            index: 0,
+            to: Point::new(100.0, 100.0),
+        }));
+        assert!(room.take_edits(0));
+        assert_eq!(room.pose(), layout.start);
+        assert_eq!(room.layout().obstacles, layout.obstacles);
     }
 }

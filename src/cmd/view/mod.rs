@@ -310,8 +310,12 @@ pub(crate) fn serve(robot: &mut VirtualScorpion, session: Session<'_>) -> miette
                         index,
                         to: Point::new(x, y),
                     };
-                    if edit_room(robot, &session.room, layout.as_mut(), edit, &mut console)? {
-                        room_version += 1;
+                    // Refused too, the room goes out again: the page
+                    // that dragged the obstacle draws it back where it is.
+                    let moved =
+                        edit_room(robot, &session.room, layout.as_mut(), edit, &mut console)?;
+                    room_version += 1;
+                    if moved {
                         room_text = Arc::new(protocol::room_message(layout.as_ref()));
                     }
                 }
@@ -401,7 +405,8 @@ fn edit_room(
         );
         return Ok(false);
     };
-    if let Err(why) = edit.check(layout) {
+    let mut pose = room.pose().unwrap_or(layout.start);
+    if let Err(why) = edit.check(layout, pose) {
         console.push("note", why);
         return Ok(false);
     }
@@ -409,7 +414,6 @@ fn edit_room(
         console.push("note", "too many changes wait for the room".into());
         return Ok(false);
     }
-    let mut pose = room.pose().unwrap_or(layout.start);
     edit.apply(layout, &mut pose);
     // The room takes the edit at a wake-up: one of no time makes it now.
     robot.run_for(0)?;

@@ -120,17 +120,20 @@ function drawRobot(body) {
   el("line", { x1: 0, y1: 0, x2: body.radius, y2: 0, stroke: "#06c", "stroke-width": 0.8 }, robot);
   body.bumpers.forEach((middle, bit) => {
     // Drawn in the flipped frame: an arc counter-clockwise on the floor.
-    el("path", {
+    const path = el("path", {
       class: "bumper", "data-bit": bit,
       d: arc(body.radius, middle - body.bumper_arc / 2, middle + body.bumper_arc / 2),
       fill: "none", stroke: "#bbb", "stroke-width": 1.6,
     }, robot);
+    el("title", {}, path).textContent = `bumper ${bumperName(bit)}`;
   });
   for (const [name, [forward, left]] of [["right", body.right_tracker], ["left", body.left_tracker]]) {
-    el("circle", { class: "tracker", "data-side": name, cx: forward, cy: left, r: 1, fill: "#444" }, robot);
+    const dot = el("circle", { class: "tracker", "data-side": name, cx: forward, cy: left, r: 1, fill: "#444" }, robot);
+    el("title", {}, dot).textContent = `${name} tracker`;
   }
   for (const [name, left] of [["left", 4], ["right", -4]]) {
-    el("circle", { class: "eye", "data-side": name, cx: body.radius - 3, cy: left, r: 1.5, fill: "#555" }, robot);
+    const dot = el("circle", { class: "eye", "data-side": name, cx: body.radius - 3, cy: left, r: 1.5, fill: "#555" }, robot);
+    el("title", {}, dot).textContent = `${name} eye`;
   }
   robot.addEventListener("pointerdown", (event) => startDrag(event, { robot: true }));
   if (pose) placeRobot(pose);
@@ -144,30 +147,67 @@ function placeRobot(p) {
   robot.dataset.heading = p.heading;
 }
 
-function bits(box, count, value, prefix) {
-  if (box.childElementCount !== count) {
+// Where on the outline a bumper sits, in words: its angle from straight
+// ahead (degrees, counter-clockwise) to the nearest eighth of a turn.
+const SIDES = ["front", "front-left", "left", "back-left", "back", "back-right", "right", "front-right"];
+function side(degrees) {
+  return SIDES[((Math.round(degrees / 45) % 8) + 8) % 8];
+}
+
+// The bumpers' names: the bit and, with a room, where the bumper is.
+function bumperName(bit) {
+  const angle = room && room.body.bumpers[bit];
+  return angle === undefined ? `${bit}` : `${bit} ${side(angle)}`;
+}
+
+// A list of labelled indicators: each a dot, its name, and its state
+// in words (for screen readers and tests; the dot shows it). `items` are
+// [key, name, on]; the list is rebuilt when the names change.
+function switches(box, items, words) {
+  const names = items.map(([key, name]) => `${key}:${name}`).join(",");
+  if (box.dataset.names !== names) {
     box.textContent = "";
-    for (let bit = count - 1; bit >= 0; bit--) {
-      const span = document.createElement("span");
-      span.className = "bit";
-      span.title = `${prefix} ${bit}`;
-      span.dataset.bit = bit;
-      box.appendChild(span);
+    for (const [key, name] of items) {
+      const item = document.createElement("li");
+      item.className = "switch";
+      item.dataset.key = key;
+      item.dataset.name = name;
+      const dot = document.createElement("span");
+      dot.className = box.id === "bumpers" ? "bit" : "lamp";
+      dot.setAttribute("aria-hidden", "true");
+      const label = document.createElement("span");
+      label.className = "name";
+      label.textContent = name;
+      const state = document.createElement("span");
+      state.className = "state";
+      item.append(dot, label, " ", state);
+      box.appendChild(item);
     }
+    box.dataset.names = names;
   }
-  for (const span of box.children) span.classList.toggle("on", ((value >> Number(span.dataset.bit)) & 1) === 1);
-  box.dataset.value = value;
+  items.forEach(([, , on], index) => {
+    const item = box.children[index];
+    item.classList.toggle("on", on);
+    item.querySelector(".state").textContent = on ? words[0] : words[1];
+  });
 }
 
 function showState(s) {
   paused = s.paused;
   document.getElementById("pause").textContent = paused ? "Run" : "Pause";
   document.getElementById("time").textContent = `${(s.ms / 1000).toFixed(3)} s${paused ? " (paused)" : ""} at ${s.speed}×`;
-  bits(document.getElementById("bumpers"), 8, s.bumpers, "bumper");
-  bits(document.getElementById("trackers"), 2, s.trackers, "tracker (0 right, 1 left)");
-  document.getElementById("lamps").classList.toggle("on", s.lamps);
-  document.getElementById("eye-left").classList.toggle("on", s.eyes[0]);
-  document.getElementById("eye-right").classList.toggle("on", s.eyes[1]);
+  const bumpers = [];
+  for (let bit = 7; bit >= 0; bit--) bumpers.push([bit, bumperName(bit), ((s.bumpers >> bit) & 1) === 1]);
+  switches(document.getElementById("bumpers"), bumpers, ["closed", "open"]);
+  switches(document.getElementById("trackers"), [
+    [1, "left", ((s.trackers >> 1) & 1) === 1],
+    [0, "right", (s.trackers & 1) === 1],
+  ], ["lit", "dark"]);
+  switches(document.getElementById("lamps"), [["lamps", "tracker lamps", s.lamps]], ["on", "off"]);
+  switches(document.getElementById("eyes"), [
+    ["left", "left", s.eyes[0]],
+    ["right", "right", s.eyes[1]],
+  ], ["on", "off"]);
   document.getElementById("motors").textContent = `left ${s.motors[0]}, right ${s.motors[1]} steps`;
   for (const line of s.console) note(line.kind, line.text);
   if (s.trail.length && trail) {
@@ -256,9 +296,13 @@ function connect() {
     statusBox.textContent = "connected";
     statusBox.dataset.state = "open";
   });
-  socket.addEventListener("close", () => {
-    statusBox.textContent = "disconnected: is `scorpion sim --view` still running? (reload to reconnect)";
+  socket.addEventListener("close", (event) => {
+    // The server says why when it closes (1009: a message too big).
+    statusBox.textContent = event.reason
+      ? `disconnected: ${event.reason} (reload to reconnect)`
+      : "disconnected: is `scorpion sim --view` still running? (reload to reconnect)";
     statusBox.dataset.state = "closed";
+    statusBox.dataset.code = event.code;
   });
   socket.addEventListener("message", (event) => {
     const message = JSON.parse(event.data);

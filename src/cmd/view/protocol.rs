@@ -77,6 +77,22 @@ impl Incoming {
                 "a console line may be {MAX_COMMAND} characters; this one has {}",
                 text.chars().count()
             )),
+            // One send is one command line: a carriage return inside it
+            // would type several commands (and other control characters
+            // are not the robot's ASCII), so they are refused, not
+            // stripped: what is typed is what the robot gets.
+            Incoming::Send { text } if text.chars().any(|c| c.is_ascii_control()) => {
+                let (at, control) = text
+                    .chars()
+                    .enumerate()
+                    .find(|(_, c)| c.is_ascii_control())
+                    .unwrap_or((0, '\0'));
+                Err(format!(
+                    "a console line is one command, without control characters: this one has {} at character {}; send each command on its own",
+                    control.escape_default(),
+                    at + 1
+                ))
+            }
             Incoming::Step { ms } if !(1..=10_000).contains(ms) => {
                 Err(format!("a step is 1 to 10000 ms of robot time, not {ms}"))
             }
@@ -357,6 +373,38 @@ mod tests {
             Incoming::parse(&long)
                 .expect_err("too long")
                 .contains("256 characters")
+        );
+    }
+
+    /// The hostile tester's finding: `/1B` CR `/4C+40` in one send typed
+    /// two commands. One send is one line; control characters are
+    /// refused, named with their place.
+    #[test]
+    fn a_console_line_is_one_command() {
+        for (text, said) in [
+            (
+                r#"{"type":"send","text":"/1B\r/4C+40"}"#,
+                "\\r at character 4",
+            ),
+            (r#"{"type":"send","text":"/1B\n"}"#, "\\n at character 4"),
+            (
+                r#"{"type":"send","text":"\u001b/1B"}"#,
+                "\\u{1b} at character 1",
+            ),
+            (
+                r#"{"type":"send","text":"/1B\u007f"}"#,
+                "\\u{7f} at character 4",
+            ),
+        ] {
+            let error = Incoming::parse(text).expect_err(text);
+            assert!(error.contains(said), "{text}: {error}");
+            assert!(error.contains("one command"), "{text}: {error}");
+        }
+        assert_eq!(
+            Incoming::parse(r#"{"type":"send","text":"/2A1 é"}"#),
+            Ok(Incoming::Send {
+                text: "/2A1 é".into()
+            })
         );
     }
 }

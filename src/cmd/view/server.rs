@@ -21,6 +21,8 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use tungstenite::protocol::WebSocketConfig;
+use tungstenite::protocol::frame::CloseFrame;
+use tungstenite::protocol::frame::coding::CloseCode;
 use tungstenite::{Message, WebSocket};
 
 use super::Hub;
@@ -43,6 +45,12 @@ pub(crate) const WRITE_TIME: Duration = Duration::from_secs(2);
 
 /// The largest message a client may send, bytes (a command is a few).
 pub(crate) const MAX_MESSAGE: usize = 16 * 1024;
+
+/// How long a connection closed for a message too big reads (and
+/// drops) the rest of it: closed with bytes unread, the socket would
+/// answer with a TCP reset, and the client would lose the close frame
+/// that says why.
+const DRAIN_TIME: Duration = Duration::from_secs(5);
 
 /// How often a connection looks for a new frame while waiting for its
 /// client's messages.
@@ -121,14 +129,24 @@ fn refuse(mut stream: TcpStream) {
         "503 Service Unavailable",
         "text/plain; charset=utf-8",
         &format!("too many connections to the view (at most {MAX_CONNECTIONS})\n"),
+        true,
     ));
 }
 
-/// An HTTP/1.1 response that closes the connection.
-fn response(status: &str, kind: &str, body: &str) -> Vec<u8> {
+/// An HTTP/1.1 response that closes the connection; without its body
+/// (`with_body` false) for a HEAD, which is answered as a GET with the
+/// same head, `Content-Length` included (RFC 9110, 9.3.2).
+fn response(status: &str, kind: &str, body: &str, with_body: bool) -> Vec<u8> {
+    // A 405 says which methods are served (RFC 9110, 15.5.6).
+    let allow = if status.starts_with("405") {
+        "Allow: GET, HEAD\r\n"
+    } else {
+        ""
+    };
     format!(
-        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n{body}",
-        body.len()
+        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\n{allow}Cache-Control: no-store\r\nConnection: close\r\n\r\n{}",
+        body.len(),
+        if with_body { body } else { "" }
     )
     .into_bytes()
 }
@@ -145,14 +163,21 @@ enum Asked {
 }
 
 /// Reads (peeks: a WebSocket's head stays for tungstenite's handshake)
-/// the request head and says what it asks for, and how long it is.
-fn read_head(stream: &TcpStream) -> (Asked, usize) {
+/// the request head and says what it asks for, how long it is, and
+/// whether the answer has a body (not for a HEAD).
+fn read_head(stream: &TcpStream) -> (Asked, usize, bool) {
     let deadline = Instant::now() + HEAD_TIME;
     let mut buffer = vec![0u8; MAX_HEAD];
     let mut seen = 0;
     loop {
         let count = match stream.peek(&mut buffer) {
-            Ok(0) => return (Asked::Refused("400 Bad Request", "no request".into()), 0),
+            Ok(0) => {
+                return (
+                    Asked::Refused("400 Bad Request", "no request".into()),
+                    0,
+                    true,
+                );
+            }
             Ok(count) => count,
             Err(error)
                 if matches!(
@@ -164,12 +189,20 @@ fn read_head(stream: &TcpStream) -> (Asked, usize) {
             {
                 seen
             }
-            Err(error) => return (Asked::Refused("400 Bad Request", error.to_string()), 0),
+            Err(error) => {
+                return (
+                    Asked::Refused("400 Bad Request", error.to_string()),
+                    0,
+                    true,
+                );
+            }
         };
         let mut headers = [httparse::EMPTY_HEADER; 32];
         let mut request = httparse::Request::new(&mut headers);
         match request.parse(&buffer[..count]) {
-            Ok(httparse::Status::Complete(length)) => return (asked(&request), length),
+            Ok(httparse::Status::Complete(length)) => {
+                return (asked(&request), length, request.method != Some("HEAD"));
+            }
             Ok(httparse::Status::Partial) if count >= MAX_HEAD => {
                 return (
                     Asked::Refused(
@@ -177,6 +210,7 @@ fn read_head(stream: &TcpStream) -> (Asked, usize) {
                         format!("a request head longer than {MAX_HEAD} bytes"),
                     ),
                     0,
+                    true,
                 );
             }
             Ok(httparse::Status::Partial) => {}
@@ -184,6 +218,7 @@ fn read_head(stream: &TcpStream) -> (Asked, usize) {
                 return (
                     Asked::Refused("400 Bad Request", format!("not an HTTP request: {error}")),
                     0,
+                    true,
                 );
             }
         }
@@ -194,6 +229,7 @@ fn read_head(stream: &TcpStream) -> (Asked, usize) {
                     format!("no whole request head within {HEAD_TIME:?}"),
                 ),
                 0,
+                true,
             );
         }
         if count == seen {
@@ -208,11 +244,11 @@ fn read_head(stream: &TcpStream) -> (Asked, usize) {
 fn asked(request: &httparse::Request<'_, '_>) -> Asked {
     let path = request.path.unwrap_or("/");
     let path = path.split('?').next().unwrap_or(path);
-    if request.method != Some("GET") {
+    if !matches!(request.method, Some("GET" | "HEAD")) {
         return Asked::Refused(
             "405 Method Not Allowed",
             format!(
-                "{} is not served: the view only GETs",
+                "{} is not served: the view answers GET and HEAD",
                 request.method.unwrap_or("?")
             ),
         );
@@ -283,25 +319,40 @@ fn serve(mut stream: TcpStream, hub: &Hub) {
     {
         return;
     }
-    let (asked, length) = read_head(&stream);
+    let (asked, length, with_body) = read_head(&stream);
     let reply = match asked {
-        Asked::Socket => {
+        Asked::Socket if with_body => {
             socket(stream, hub);
             return;
         }
+        Asked::Socket => response(
+            "426 Upgrade Required",
+            "text/plain; charset=utf-8",
+            "/ws is the view's WebSocket: GET it with an Upgrade\n",
+            false,
+        ),
         Asked::File(path) => match path.as_str() {
-            "/" | "/index.html" => response("200 OK", "text/html; charset=utf-8", PAGE),
-            "/page.js" => response("200 OK", "text/javascript; charset=utf-8", SCRIPT),
-            "/page.css" => response("200 OK", "text/css; charset=utf-8", STYLE),
+            "/" | "/index.html" => response("200 OK", "text/html; charset=utf-8", PAGE, with_body),
+            "/page.js" => response(
+                "200 OK",
+                "text/javascript; charset=utf-8",
+                SCRIPT,
+                with_body,
+            ),
+            "/page.css" => response("200 OK", "text/css; charset=utf-8", STYLE, with_body),
             _ => response(
                 "404 Not Found",
                 "text/plain; charset=utf-8",
                 &format!("{path}: not part of the view (open /)\n"),
+                with_body,
             ),
         },
-        Asked::Refused(status, why) => {
-            response(status, "text/plain; charset=utf-8", &format!("{why}\n"))
-        }
+        Asked::Refused(status, why) => response(
+            status,
+            "text/plain; charset=utf-8",
+            &format!("{why}\n"),
+            with_body,
+        ),
     };
     // The head is taken off the socket before the answer, so that
     // closing does not reset the connection under the client's read.
@@ -379,8 +430,27 @@ fn socket(stream: TcpStream, hub: &Hub) {
                         "{error}: a message may be {MAX_MESSAGE} bytes; connection closed"
                     )),
                 );
-                let _ = socket.close(None);
+                // 1009 says why to the page (RFC 6455, 7.4.1); the reason
+                // is at most 123 bytes.
+                let _ = socket.close(Some(CloseFrame {
+                    code: CloseCode::Size,
+                    reason: format!("message too big: a message may be {MAX_MESSAGE} bytes").into(),
+                }));
                 let _ = socket.flush();
+                drain(socket.get_mut());
+                return;
+            }
+            Err(tungstenite::Error::Utf8(error)) => {
+                // 1007: a text message that is not UTF-8 (RFC 6455, 7.4.1).
+                hub.say(&format!(
+                    "view: {peer}: a text message not UTF-8 ({error}); connection closed"
+                ));
+                let _ = socket.close(Some(CloseFrame {
+                    code: CloseCode::Invalid,
+                    reason: "a text message must be UTF-8 (JSON)".into(),
+                }));
+                let _ = socket.flush();
+                drain(socket.get_mut());
                 return;
             }
             Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => {
@@ -404,6 +474,23 @@ fn socket(stream: TcpStream, hub: &Hub) {
             return;
         }
     }
+}
+
+/// Reads what the client still sends (the rest of a message too big, its
+/// close frame) and drops it, until it stops sending for a moment, closes
+/// or [`DRAIN_TIME`] has passed, then closes: the close frame sent before
+/// reaches the client instead of a reset.
+fn drain(stream: &mut TcpStream) {
+    let deadline = Instant::now() + DRAIN_TIME;
+    let _ = stream.set_read_timeout(Some(Duration::from_millis(200)));
+    let mut buffer = [0u8; 16 * 1024];
+    while Instant::now() < deadline {
+        match stream.read(&mut buffer) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {}
+        }
+    }
+    let _ = stream.shutdown(std::net::Shutdown::Both);
 }
 
 /// Sends `message`, flushed: an error if it cannot be written within
