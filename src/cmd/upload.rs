@@ -50,7 +50,9 @@ pub(crate) struct Args {
     /// it such an upload is refused; `scorpion installed` lists what is there.
     #[arg(long)]
     replace: bool,
-    /// The RAM loader: `auto` uses it when it is faster and safe to place.
+    /// The RAM loader: `auto` uses it when it is faster, or the robot may
+    /// hold the image already (compared by checksums), and it can go in
+    /// beside what is installed; the upload says why where it does not.
     #[arg(long, value_enum, default_value_t = Loader::Auto)]
     loader: Loader,
     /// The rate the loader switches the line to for the transfer; 0 keeps
@@ -116,7 +118,8 @@ impl Args {
 /// `--loader`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Loader {
-    /// When the estimate says it is faster and it can be placed safely.
+    /// When it is faster or the robot may hold the image, and it can go in
+    /// beside what is installed.
     Auto,
     /// Never: the ROM's `/9W` for every byte.
     Never,

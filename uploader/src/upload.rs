@@ -38,7 +38,10 @@ use romlib::protocol::Answer;
 /// Whether the RAM loader carries the body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LoaderChoice {
-    /// When the estimate says it is faster and it can be placed safely.
+    /// When the estimate says it is faster, or the robot may hold the
+    /// image already (its sums spare the writes), and it can go in beside
+    /// the extensions installed ([`UploadReport::without_loader`] says why
+    /// not).
     #[default]
     Auto,
     /// Never: the ROM's `/9W` for every byte.
