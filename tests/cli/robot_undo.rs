@@ -9,7 +9,7 @@ use crate::robot::{Sim, changed_rom, extension_at};
 use crate::{scorpion, transcript};
 
 /// A handler whose `/1Q` counts its calls in a BSS byte and answers `Q`,
-/// the count and `version`; 200 bytes of table between, so that a
+/// the count and `version`; 600 bytes of table between, so that a
 /// change of `version` and a byte of the table are 32-byte ranges apart.
 fn counter_source(version: u8) -> String {
     format!(
@@ -29,7 +29,7 @@ fn counter_source(version: u8) -> String {
         jmp CMD_DONE
 not_mine:
         SCORPION_CHAIN_UNKNOWN
-table:  .res 200, $EA
+table:  .res 600, $EA
 version: .byte ${version:02X}
         .bss
 count:  .res 1

@@ -998,6 +998,75 @@ mod tests {
         );
     }
 
+    /// What an upload keeps witnesses only code: of the extension the
+    /// kept hook goes back to (its table extent $0400-$050F, BSS and all),
+    /// the bytes the new image loads, less what the file holds; never the
+    /// new image's BSS ($0500-$050F), which its code writes.
+    #[test]
+    fn an_uploads_witnesses_cover_the_code_it_loads_not_its_bss() {
+        let profile = RomProfile::reference();
+        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
+        let record = isa::objfmt::HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        };
+        let old = romlib::installed::Installed::new(1, vec![0x0400..=0x050F], &[record]);
+        let mut flags = vec![0u8; entries];
+        flags[..old.entries()].copy_from_slice(&old.flags());
+        let kept = Backup {
+            areas: vec![
+                Area {
+                    address: table,
+                    bytes: flags,
+                },
+                Area {
+                    address: romlib::installed::entry_address(table, entries, 0),
+                    bytes: old.encode(),
+                },
+                Area {
+                    address: 0x0420,
+                    bytes: vec![0; 0x20],
+                },
+            ],
+            hooks: vec![(HookKind::Unknown, 0x0403)],
+            ..Backup::default()
+        };
+        let linked = linker::Image {
+            entry: 0x0403,
+            flags: 0,
+            areas: vec![linker::LoadArea {
+                load: 0x0400,
+                run: 0x0400,
+                bytes: vec![0xEA; 0x100],
+            }],
+            sections: vec![linker::ImageSection {
+                name: "BSS".into(),
+                run: 0x0500,
+                load: 0x0500,
+                size: 0x10,
+                kind: linker::layout::SegmentKind::Bss,
+                exec: false,
+            }],
+            symbols: Vec::new(),
+            hooks: isa::objfmt::Hooks {
+                records: vec![record],
+            },
+            lines: isa::objfmt::SrcMap::default(),
+        };
+        let image = UploadImage::try_from(&linked).expect("an image");
+        assert_eq!(image.extents(), &[0x0400..=0x050F]);
+        assert_eq!(
+            kept_witness_ranges(&profile, &kept, &image),
+            vec![(0x0400, 0x20), (0x0440, 0xC0)]
+        );
+        // The whole extent, BSS included, by the rule for a full backup.
+        assert_eq!(
+            witness_ranges(&profile, &kept),
+            vec![(0x0400, 0x20), (0x0440, 0xD0)]
+        );
+    }
+
     #[test]
     fn the_reference_backup_covers_zero_page_ram_and_the_table() {
         let ranges = backup_ranges(&RomProfile::reference());

@@ -1,6 +1,6 @@
 //! Whether the RAM loader may go in beside the extensions a robot has
-//! installed: every hook, and every chain behind it, must lead to the ROM
-//! or into memory an entry of the table of installed extensions names
+//! installed: every hook, and every chain behind it, must lead to the ROM's
+//! reset target or into memory an entry of the table of installed extensions names
 //! (code nothing names could be where the loader lands), and the loader
 //! must meet none of those extensions' memory. Then an upload compares by
 //! checksums and writes only what differs, extensions installed or not.
@@ -41,16 +41,13 @@ pub(crate) fn refusal<T: Transport>(
             )));
         }
     }
-    let in_rom = |target: u16| {
-        profile.rom.as_ref().is_some_and(|rom| {
-            u32::from(target) >= u32::from(rom.address) && u32::from(target) < rom.end()
-        })
-    };
     for &(kind, first) in hooks {
         let mut target = first;
         let mut ended = false;
         for _ in 0..LONGEST_CHAIN {
-            if profile.reset_target(kind) == Some(target) || in_rom(target) {
+            // Code elsewhere in the ROM (an operating system's, say) is
+            // taken as unknown too: what RAM it uses, no table says.
+            if profile.reset_target(kind) == Some(target) {
                 ended = true;
                 break;
             }
