@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use uploader::{Backup, NoProgress, UploadOptions};
+use uploader::{Backup, UploadOptions};
 
 use crate::cmd::ports;
 
@@ -33,7 +33,11 @@ pub(crate) struct RestoreArgs {
     /// The backup file.
     file: PathBuf,
     /// Restore onto a robot whose ROM differs from the one the backup was
-    /// taken from (its code's calls into the ROM may land elsewhere).
+    /// taken from, or from the ROM profile (the project's, else the
+    /// reference ROM): its code's calls into the ROM may land elsewhere.
+    /// Each check overridden is printed as a warning, and the memory goes
+    /// in through the ROM's own commands (the RAM loader would call the
+    /// ROM that differs).
     #[arg(long)]
     force: bool,
 }
@@ -77,7 +81,8 @@ pub(crate) fn restore_into(
         ..UploadOptions::default()
     };
     let mut client = uploader::client(transport, &options.profile);
-    let reports = uploader::restore(&mut client, backup, &options, &mut NoProgress)?;
+    let mut told = Overrides;
+    let reports = uploader::restore(&mut client, backup, &options, &mut told)?;
     let written: usize = reports
         .iter()
         .flat_map(|report| report.written.iter().map(|range| range.1))
@@ -89,6 +94,20 @@ pub(crate) fn restore_into(
         backup.hooks.len()
     ));
     Ok(ExitCode::SUCCESS)
+}
+
+/// Says, as it happens, each ROM check `--force` overrode.
+struct Overrides;
+
+impl uploader::Progress for Overrides {
+    fn event(&mut self, event: &uploader::Event) {
+        if let uploader::Event::RomCheckOverridden { refusal } = event {
+            #[allow(clippy::print_stderr, reason = "the CLI warns")]
+            {
+                eprintln!("warning: --force overrides: {refusal}");
+            }
+        }
+    }
 }
 
 /// Reads (through the bounded reader: a FIFO or `/dev/zero` is refused,

@@ -50,7 +50,9 @@ pub(crate) struct Args {
     /// it such an upload is refused; `scorpion installed` lists what is there.
     #[arg(long)]
     replace: bool,
-    /// The RAM loader: `auto` uses it when it is faster and safe to place.
+    /// The RAM loader: `auto` uses it when it is faster, or the robot may
+    /// hold the image already (compared by checksums), and it can go in
+    /// beside what is installed; the upload says why where it does not.
     #[arg(long, value_enum, default_value_t = Loader::Auto)]
     loader: Loader,
     /// The rate the loader switches the line to for the transfer; 0 keeps
@@ -88,13 +90,8 @@ struct UndoFile {
 
 impl uploader::Keep for UndoFile {
     fn keep(&mut self, overwritten: &uploader::Backup) {
-        if let Some(parent) = self.path.parent().filter(|p| !p.as_os_str().is_empty())
-            && let Err(error) = std::fs::create_dir_all(parent)
-        {
-            self.failed = Some(miette::miette!("{error}"));
-            return;
-        }
-        // Through a temporary file: an undo file is whole or the last one.
+        // Its directory exists: `undo_file_writable` made the project's or
+        // refused a missing one. Through a temporary file: an undo file is whole or the last one.
         if let Err(error) = hostfs::write(&self.path, &overwritten.encode()) {
             self.failed = Some(error.into());
         }
@@ -121,7 +118,8 @@ impl Args {
 /// `--loader`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Loader {
-    /// When the estimate says it is faster and it can be placed safely.
+    /// When it is faster or the robot may hold the image, and it can go in
+    /// beside what is installed.
     Auto,
     /// Never: the ROM's `/9W` for every byte.
     Never,
@@ -307,6 +305,12 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
             if report.written.len() == 1 { "" } else { "s" }
         );
     }
+    if let Some(reason) = &report.without_loader {
+        let _ = write!(
+            text,
+            "\n  every byte written with the ROM's commands, none compared by checksums: the RAM loader was not used ({reason})"
+        );
+    }
     for area in image.areas() {
         let _ = write!(text, "\n  ${:04X}-${:04X}", area.address, area.end() - 1);
     }
@@ -347,7 +351,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // The undo file is written during the upload: a FIFO or a device there
     // would block it half way, so it is refused before the robot is touched.
     if !resolved.is_emulated() {
-        undo_file_writable(&args.undo_path())?;
+        undo_file_writable(&args.undo_path(), args.undo_file.is_none())?;
     }
     match &args.image {
         Some(path) => upload_file(args, &resolved, path),
@@ -383,10 +387,12 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
     }
 }
 
-/// The undo file can be written: its directory made (a project's
-/// `target/scorpion`), and no FIFO, device or directory at its path.
-fn undo_file_writable(path: &Path) -> miette::Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+/// The undo file can be written: no FIFO, device or directory at its
+/// path, and its directory there. A missing directory is refused, naming
+/// it, as for every other output; only the default one in a project
+/// (`target/scorpion`, the tool's own, like a build's) is made.
+fn undo_file_writable(path: &Path, default: bool) -> miette::Result<()> {
+    if default && let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
             .map_err(|error| miette::miette!("cannot make {}: {error}", parent.display()))?;
     }

@@ -55,7 +55,7 @@ fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
 }
 
 /// [`extension_elf`] at `base` instead of $0400.
-fn extension_at(base: u16, len: usize, changed: Option<usize>) -> Vec<u8> {
+pub(crate) fn extension_at(base: u16, len: usize, changed: Option<usize>) -> Vec<u8> {
     let mut bytes: Vec<u8> = (0..len).map(|i| (i * 37 + 11) as u8).collect();
     let [low, high] = base.to_le_bytes();
     bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, low, high]);
@@ -86,7 +86,7 @@ fn extension_at(base: u16, len: usize, changed: Option<usize>) -> Vec<u8> {
 
 /// The reference ROM with PENDING's operand (`$FF2E`, a jump-table byte
 /// the ROM never calls through itself) changed, as a ROM profile file.
-fn changed_rom() -> (Vec<u8>, u8, u8) {
+pub(crate) fn changed_rom() -> (Vec<u8>, u8, u8) {
     let mut rom = Image::parse("scorpion-rom.elf", romlib::ROM_ELF).expect("parses");
     let area = rom
         .areas

@@ -1,8 +1,8 @@
 //! `--loader always` refused before anything on the robot changes: the
 //! hooks as they will be once an overlapping extension is replaced and
 //! an earlier copy of the image disarmed, predicted from reads alone, must
-//! all be the ROM's own targets (an installed extension hooked elsewhere
-//! lives where the loader could land), and the loader must have a place.
+//! lead to the ROM or to extensions the table names, whose memory the
+//! loader leaves alone (`beside`), and the loader must have a place.
 //! Without this, the upload unhooked the old extension first and refused
 //! after.
 
@@ -46,14 +46,22 @@ pub(crate) fn check<T: Transport>(
     {
         return Ok(());
     }
+    let installed = crate::table::read_installed(client, profile)?;
     let replaced: Vec<Installed> = if replace {
-        crate::table::read_installed(client, profile)?
-            .into_iter()
+        installed
+            .iter()
             .filter(|old| old.overlap(image.extents()).is_some())
+            .cloned()
             .collect()
     } else {
         Vec::new()
     };
+    // What stays installed beside the image.
+    let others: Vec<Installed> = installed
+        .into_iter()
+        .filter(|old| old.overlap(image.extents()).is_none())
+        .collect();
+    let mut predicted = Vec::new();
     for &(kind, first) in hooks_now {
         let mut target = first;
         for _ in 0..LONGEST_CHAIN {
@@ -98,12 +106,14 @@ pub(crate) fn check<T: Transport>(
                 None => break,
             }
         }
-        if !at_reset(kind, target) {
-            return refuse(format!(
-                "{} points at ${target:04X}, an installed extension whose extent is unknown; the loader could overwrite it; nothing was changed",
-                kind.rom_symbol()
-            ));
-        }
+        predicted.push((kind, target));
     }
-    Ok(())
+    match leftover {
+        Some(loader) => match crate::beside::refusal(client, profile, &predicted, &others, loader)?
+        {
+            Some(reason) => refuse(format!("{reason}; nothing was changed")),
+            None => Ok(()),
+        },
+        None => Ok(()),
+    }
 }

@@ -74,6 +74,14 @@ pub trait Keep {
     /// Called before the upload writes the image's bytes, with what the
     /// robot held there, its hooks and its table as the upload found them.
     fn keep(&mut self, overwritten: &Backup);
+
+    /// Called once the upload has finished, verified, with what
+    /// [`Keep::keep`] received and a witness of the image's entry in the
+    /// table: what an undo checks first, so that it is applied to the robot
+    /// the upload went to and nowhere else. By default, kept again.
+    fn finished(&mut self, kept: &Backup) {
+        self.keep(kept);
+    }
 }
 
 /// Keeps nothing (reads nothing).
@@ -86,6 +94,8 @@ impl Keep for NoKeep {
     }
 
     fn keep(&mut self, _overwritten: &Backup) {}
+
+    fn finished(&mut self, _kept: &Backup) {}
 }
 
 /// FNV-1a, 32 bits.
@@ -365,31 +375,100 @@ const WITNESS_WINDOW: u16 = 16;
 /// [`WITNESS_WINDOW`] bytes at the target where no entry holds it; less
 /// what the backup holds itself (a restore writes and verifies that).
 pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16, usize)> {
-    let installed = backup_table(profile, backup);
     let mut marked = vec![false; 0x1_0000];
-    for &(kind, target) in &backup.hooks {
-        if profile.reset_target(kind) == Some(target) || in_rom(profile, target) {
-            continue;
-        }
-        let extents: Vec<std::ops::RangeInclusive<u16>> = installed
-            .iter()
-            .filter(|entry| entry.extents.iter().any(|extent| extent.contains(&target)))
-            .flat_map(|entry| entry.extents.iter().cloned())
-            .collect();
+    for (target, extents) in hooked_extents(profile, backup) {
         if extents.is_empty() {
-            let end = profile
-                .writable
-                .iter()
-                .find(|range| range.contains(&target))
-                .map_or(target, |range| *range.end());
-            let end = end.min(target.saturating_add(WITNESS_WINDOW - 1));
-            marked[usize::from(target)..=usize::from(end)].fill(true);
+            mark_window(&mut marked, profile, target, None);
         } else {
             for extent in extents {
                 marked[usize::from(*extent.start())..=usize::from(*extent.end())].fill(true);
             }
         }
     }
+    unmarked_but_held(marked, backup)
+}
+
+/// The memory whose sums witness the hooks of what an upload of `image`
+/// keeps (`kept`): only what is known to be code, never RAM the code
+/// writes, which changes as soon as an extension runs. Of the extension
+/// a kept hook goes back to, that is the bytes `image` loads there (the
+/// robot holds them already, verified by their sums, or the file does),
+/// and the first [`WITNESS_WINDOW`] bytes at the target (its handler's
+/// entry); less the image's own RAM it does not load (its BSS and zero
+/// page) and what the file holds.
+pub(crate) fn kept_witness_ranges(
+    profile: &RomProfile,
+    kept: &Backup,
+    image: &UploadImage,
+) -> Vec<(u16, usize)> {
+    let mut marked = vec![false; 0x1_0000];
+    for (target, extents) in hooked_extents(profile, kept) {
+        let home = extents.iter().find(|extent| extent.contains(&target));
+        mark_window(&mut marked, profile, target, home);
+        for extent in &extents {
+            for address in extent.clone() {
+                if image.contains(address) {
+                    marked[usize::from(address)] = true;
+                }
+            }
+        }
+    }
+    for extent in image.extents() {
+        for address in extent.clone() {
+            if !image.contains(address) {
+                marked[usize::from(address)] = false;
+            }
+        }
+    }
+    unmarked_but_held(marked, kept)
+}
+
+/// Each hook of `backup` that a restore points into RAM: its target and
+/// the extents of the installed extension (in the backup's own table)
+/// that holds it (none where no entry does).
+fn hooked_extents(
+    profile: &RomProfile,
+    backup: &Backup,
+) -> Vec<(u16, Vec<std::ops::RangeInclusive<u16>>)> {
+    let installed = backup_table(profile, backup);
+    backup
+        .hooks
+        .iter()
+        .filter(|&&(kind, target)| {
+            profile.reset_target(kind) != Some(target) && !in_rom(profile, target)
+        })
+        .map(|&(_, target)| {
+            let extents = installed
+                .iter()
+                .filter(|entry| entry.extents.iter().any(|extent| extent.contains(&target)))
+                .flat_map(|entry| entry.extents.iter().cloned())
+                .collect();
+            (target, extents)
+        })
+        .collect()
+}
+
+/// Marks the first [`WITNESS_WINDOW`] bytes at `target`, within the
+/// writable range that holds it and within `home` (its extension's
+/// extent) where known.
+fn mark_window(
+    marked: &mut [bool],
+    profile: &RomProfile,
+    target: u16,
+    home: Option<&std::ops::RangeInclusive<u16>>,
+) {
+    let end = profile
+        .writable
+        .iter()
+        .find(|range| range.contains(&target))
+        .map_or(target, |range| *range.end());
+    let end = end.min(target.saturating_add(WITNESS_WINDOW - 1));
+    let end = home.map_or(end, |home| end.min(*home.end()));
+    marked[usize::from(target)..=usize::from(end)].fill(true);
+}
+
+/// The marked addresses as ranges, less what `backup` holds itself.
+fn unmarked_but_held(mut marked: Vec<bool>, backup: &Backup) -> Vec<(u16, usize)> {
     for area in &backup.areas {
         let start = usize::from(area.address);
         marked[start..start + area.bytes.len()].fill(false);
@@ -476,14 +555,16 @@ impl Backup {
 }
 
 /// Refuses a restore onto a robot whose ROM differs from the one the
-/// backup was taken from (the RAM it holds calls into that ROM), and one
-/// whose memory under a hook's target no longer sums as it did.
+/// backup was taken from (the RAM it holds calls into that ROM), unless
+/// `force_rom` (then returns the refusal it overrode), and one whose
+/// memory under a hook's target no longer sums as it did.
 fn check_robot<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
     force_rom: bool,
-) -> Result<()> {
-    if !force_rom {
+) -> Result<Option<Error>> {
+    let mut overridden = None;
+    {
         let mut differences = Vec::new();
         for area in &backup.rom {
             let found = client.read_memory(area.address, area.bytes.len())?;
@@ -497,7 +578,11 @@ fn check_robot<T: Transport>(
             );
         }
         if !differences.is_empty() {
-            return Err(Error::BackupRomDiffers { differences });
+            let error = Error::BackupRomDiffers { differences };
+            if !force_rom {
+                return Err(error);
+            }
+            overridden = Some(error);
         }
     }
     for witness in &backup.witnesses {
@@ -512,7 +597,7 @@ fn check_robot<T: Transport>(
             });
         }
     }
-    Ok(())
+    Ok(overridden)
 }
 
 /// Puts `backup` back into the robot, verified, hooks last: first every
@@ -523,10 +608,14 @@ fn check_robot<T: Transport>(
 /// the backup, verified. A reset or a lost byte on the way leaves every
 /// hook at the ROM's target or at verified code.
 ///
-/// Before any hook moves, the robot's ROM is compared with the one the
-/// backup was taken from ([`Error::BackupRomDiffers`], unless
-/// `options.force_rom`) and each [`Witness`] with the robot's memory
-/// ([`Error::WitnessDiffers`]).
+/// Before any hook moves, the robot's ROM is compared with the profile's
+/// ([`Error::WrongRom`]) and with the one the backup was taken from
+/// ([`Error::BackupRomDiffers`]), and each [`Witness`] with the robot's
+/// memory ([`Error::WitnessDiffers`]). With `options.force_rom` a ROM that
+/// differs is not refused: each refusal overridden is told to `progress`
+/// ([`crate::Event::RomCheckOverridden`]), and the memory then goes in
+/// through the ROM's own commands alone (the RAM loader calls the ROM
+/// through the jump table that differs), unchecked against the ROM.
 ///
 /// # Errors
 /// [`Error::WrongRom`], [`Error::BackupRomDiffers`],
@@ -553,8 +642,21 @@ pub fn restore<T: Transport>(
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     crate::upload::connect(client, options)?;
-    fingerprint::check_jump_table(client, profile)?;
-    check_robot(client, backup, options.force_rom)?;
+    let mut overridden = Vec::new();
+    match fingerprint::check_jump_table(client, profile) {
+        Err(error @ Error::WrongRom { .. }) if options.force_rom => overridden.push(error),
+        other => other?,
+    }
+    overridden.extend(check_robot(client, backup, options.force_rom)?);
+    for error in &overridden {
+        progress.event(&crate::progress::Event::RomCheckOverridden {
+            refusal: error.to_string(),
+        });
+    }
+    let mut memory = memory;
+    if !overridden.is_empty() {
+        memory.loader = LoaderChoice::Never;
+    }
     for kind in HookKind::ALL {
         if let Some(to) = profile.reset_target(kind) {
             switch_hook(client, profile.hook_address(kind), to, options.max_writes)?;
@@ -893,6 +995,75 @@ mod tests {
         assert_eq!(
             witness_ranges(&profile, &bare),
             vec![(0x0700, usize::from(WITNESS_WINDOW))]
+        );
+    }
+
+    /// What an upload keeps witnesses only code: of the extension the
+    /// kept hook goes back to (its table extent $0400-$050F, BSS and all),
+    /// the bytes the new image loads, less what the file holds; never the
+    /// new image's BSS ($0500-$050F), which its code writes.
+    #[test]
+    fn an_uploads_witnesses_cover_the_code_it_loads_not_its_bss() {
+        let profile = RomProfile::reference();
+        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
+        let record = isa::objfmt::HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        };
+        let old = romlib::installed::Installed::new(1, vec![0x0400..=0x050F], &[record]);
+        let mut flags = vec![0u8; entries];
+        flags[..old.entries()].copy_from_slice(&old.flags());
+        let kept = Backup {
+            areas: vec![
+                Area {
+                    address: table,
+                    bytes: flags,
+                },
+                Area {
+                    address: romlib::installed::entry_address(table, entries, 0),
+                    bytes: old.encode(),
+                },
+                Area {
+                    address: 0x0420,
+                    bytes: vec![0; 0x20],
+                },
+            ],
+            hooks: vec![(HookKind::Unknown, 0x0403)],
+            ..Backup::default()
+        };
+        let linked = linker::Image {
+            entry: 0x0403,
+            flags: 0,
+            areas: vec![linker::LoadArea {
+                load: 0x0400,
+                run: 0x0400,
+                bytes: vec![0xEA; 0x100],
+            }],
+            sections: vec![linker::ImageSection {
+                name: "BSS".into(),
+                run: 0x0500,
+                load: 0x0500,
+                size: 0x10,
+                kind: linker::layout::SegmentKind::Bss,
+                exec: false,
+            }],
+            symbols: Vec::new(),
+            hooks: isa::objfmt::Hooks {
+                records: vec![record],
+            },
+            lines: isa::objfmt::SrcMap::default(),
+        };
+        let image = UploadImage::try_from(&linked).expect("an image");
+        assert_eq!(image.extents(), &[0x0400..=0x050F]);
+        assert_eq!(
+            kept_witness_ranges(&profile, &kept, &image),
+            vec![(0x0400, 0x20), (0x0440, 0xC0)]
+        );
+        // The whole extent, BSS included, by the rule for a full backup.
+        assert_eq!(
+            witness_ranges(&profile, &kept),
+            vec![(0x0400, 0x20), (0x0440, 0xD0)]
         );
     }
 

@@ -18,7 +18,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::wrong_rom),
         help(
-            "link the image against this robot's ROM (`scorpion rom read -o ROM.elf`, then `[robot] rom = \"ROM.elf\"` or `--rom ROM.elf`), or use the robot it was built for"
+            "link the image against this robot's ROM (`scorpion rom read -o ROM.elf`, then `[robot] rom = \"ROM.elf\"` in the project's Scorpion.toml, or `scorpion link --just-symbols ROM.elf` outside a project), or use the robot it was built for"
         )
     )]
     WrongRom {

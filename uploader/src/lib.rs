@@ -22,6 +22,7 @@
 
 mod always;
 mod backup;
+mod beside;
 mod body;
 mod client;
 mod delta;

@@ -212,6 +212,17 @@ impl Loader {
         self.image.contains(address)
     }
 
+    /// Whether the loader's code or zero page meets `extent` (an installed
+    /// extension's memory, which it must leave alone).
+    pub(crate) fn meets(&self, extent: &std::ops::RangeInclusive<u16>) -> bool {
+        let zero_page =
+            u16::from(self.zero_page)..=u16::from(self.zero_page) + u16::from(ZERO_PAGE_LEN - 1);
+        let code = self.address()..=(self.image.areas()[0].end() - 1) as u16;
+        [zero_page, code]
+            .iter()
+            .any(|ours| ours.start() <= extent.end() && extent.start() <= ours.end())
+    }
+
     /// `rate` alone: what goes in at the base rate.
     pub(crate) fn rate_part(&self) -> Result<UploadImage> {
         self.part(self.rate, self.frames)

@@ -84,6 +84,12 @@ pub enum Event {
     },
     /// The RAM loader was removed.
     LoaderRemoved,
+    /// A ROM check refused, and the caller's `force_rom` overrode it (a
+    /// restore with `--force`): what it found.
+    RomCheckOverridden {
+        /// The refusal the check gave.
+        refusal: String,
+    },
 }
 
 /// Receives progress; every method has a no-op default.

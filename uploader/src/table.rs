@@ -31,6 +31,13 @@ pub(crate) struct Plan {
     /// The table as it was read, before anything changed it: its flags
     /// and the entries in use (what an undo puts back).
     pub(crate) found: Vec<Area>,
+    /// The extensions that stay installed beside the image (neither
+    /// replaced nor an earlier copy of it): where the RAM loader must not
+    /// go, and what a hook into them is known to be.
+    pub(crate) others: Vec<Installed>,
+    /// Whether the robot may hold much of the image already: the table
+    /// lists an earlier copy of it, or an extension it replaces.
+    pub(crate) held_maybe: bool,
 }
 
 /// Reads what the robot has installed (nothing, for a ROM without a table).
@@ -123,11 +130,13 @@ pub(crate) fn prepare<T: Transport>(
             bytes: read.entries.1.clone(),
         });
     }
+    let mut replaced = false;
     for old in &read.installed {
         match old.overlap(image.extents()) {
             None => kept.push(old.clone()),
             Some(_) if old.id == id && old.extents == image.extents() => reused = Some(old.clone()),
             Some(_) if replace => {
+                replaced = true;
                 remove(client, profile, &read.installed, old, max_writes)?;
                 // Its flags are cleared now, verified.
                 read.flags[old.slot..old.slot + old.entries()].fill(0);
@@ -157,6 +166,8 @@ pub(crate) fn prepare<T: Transport>(
         entry,
         current_flags,
         found,
+        held_maybe: replaced || reused.is_some(),
+        others: kept,
     }))
 }
 

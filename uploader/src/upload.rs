@@ -38,7 +38,10 @@ use romlib::protocol::Answer;
 /// Whether the RAM loader carries the body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LoaderChoice {
-    /// When the estimate says it is faster and it can be placed safely.
+    /// When the estimate says it is faster, or the robot may hold the
+    /// image already (its sums spare the writes), and it can go in beside
+    /// the extensions installed ([`UploadReport::without_loader`] says why
+    /// not).
     #[default]
     Auto,
     /// Never: the ROM's `/9W` for every byte.
@@ -71,7 +74,9 @@ pub struct UploadOptions {
     /// byte.
     pub delta: bool,
     /// Restore a backup onto a robot whose ROM differs from the one it
-    /// was taken from (its code's calls into the ROM may land elsewhere).
+    /// was taken from or from the profile (its code's calls into the ROM
+    /// may land elsewhere): [`crate::restore`] tells what it overrides,
+    /// and an upload with it compares nothing of the ROM.
     pub force_rom: bool,
 }
 
@@ -144,6 +149,10 @@ pub struct UploadReport {
     /// The ranges written (address, length), the table entry's included:
     /// with a delta upload, only those the robot did not hold.
     pub written: Vec<(u16, usize)>,
+    /// Why `--loader auto` did not use the RAM loader, where it did not:
+    /// every byte went through the ROM's commands, none compared with the
+    /// robot's by checksums.
+    pub without_loader: Option<String>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -193,41 +202,43 @@ pub(crate) fn connect<T: Transport>(
     }
 }
 
-/// Whether the loader carries this upload, and where it goes.
-fn choose_loader(
+/// Whether the loader carries this upload, and where it goes; else why
+/// not, where `auto` considered it (said in the report: then every byte
+/// goes through the ROM's commands, none compared by checksums).
+fn choose_loader<T: Transport>(
+    client: &mut Client<T>,
     options: &UploadOptions,
     image: &UploadImage,
     initial: &[(HookKind, u16)],
     (baud, fast): (u32, u32),
     with_sums: bool,
-) -> Result<Option<Loader>> {
+    plan: Option<&table::Plan>,
+) -> Result<(Option<Loader>, Option<String>)> {
     if options.loader == LoaderChoice::Never {
-        return Ok(None);
+        return Ok((None, None));
     }
     let profile = &options.profile;
     let refuse = |reason: String| {
         if options.loader == LoaderChoice::Always {
             Err(Error::LoaderUnavailable { reason })
         } else {
-            Ok(None)
+            Ok((None, Some(reason)))
         }
     };
-    // An extension already hooked lives somewhere in RAM, and nothing says
-    // how far it reaches: the loader must not land on it.
-    for &(kind, target) in initial {
-        if profile.reset_target(kind) != Some(target) {
-            return refuse(format!(
-                "{} points at ${target:04X}, an installed extension whose extent is unknown; the loader could overwrite it",
-                kind.rom_symbol()
-            ));
-        }
-    }
     let Some(loader) = Loader::place(profile, image, (baud, fast))? else {
         return refuse(
             "the image leaves no room for it in user RAM or user zero page, or the ROM lacks GETCH, CHKCH or CMD_DONE".into(),
         );
     };
-    if options.loader == LoaderChoice::Auto {
+    // An extension already hooked lives somewhere in RAM: the table says
+    // where, or nothing does and the loader could land on it.
+    let others = plan.map_or(&[][..], |plan| plan.others.as_slice());
+    if let Some(reason) = crate::beside::refusal(client, profile, initial, others, &loader)? {
+        return refuse(reason);
+    }
+    // A robot that may hold the image already: its sums spare the writes.
+    let held_maybe = with_sums && options.delta && plan.is_some_and(|plan| plan.held_maybe);
+    if options.loader == LoaderChoice::Auto && !held_maybe {
         // What goes in: `sums` only when it is wanted.
         let len = if with_sums {
             loader.len()
@@ -236,10 +247,16 @@ fn choose_loader(
         };
         let with = loader_estimate(image.len(), len, baud, fast);
         if with >= rom_only_estimate(image.len(), baud) {
-            return Ok(None);
+            return Ok((
+                None,
+                Some(format!(
+                    "for {} bytes the ROM's commands are estimated faster",
+                    image.len()
+                )),
+            ));
         }
     }
-    Ok(Some(loader))
+    Ok((Some(loader), None))
 }
 
 /// Uploads `image` through `client`: body, verification, then hooks.
@@ -297,8 +314,10 @@ pub fn upload_keeping<T: Transport>(
     // rate. Through the ROM's commands (`Auto` finding the loader does not
     // pay), the table is compared while the image goes in, before anything
     // is hooked; `--loader never` compares it first of all.
-    let rom_checked = options.loader == LoaderChoice::Never;
-    if rom_checked {
+    // `force_rom` (a forced restore, whose caller has compared and told)
+    // skips every comparison.
+    let rom_checked = options.loader == LoaderChoice::Never || options.force_rom;
+    if rom_checked && !options.force_rom {
         fingerprint::check_jump_table(client, profile)?;
     }
     let mut entries_checked = rom_checked;
@@ -392,16 +411,30 @@ pub fn upload_keeping<T: Transport>(
     // The image's entry in the table goes in with the body, verified with
     // it; its flags, which make it count, once body and entry are in.
     let bytes = image.len();
+    let mut entry = None;
     if let Some(plan) = plan.as_mut() {
         if plan.frees_first() {
             check_entries_once(client, profile, &mut entries_checked)?;
         }
         plan.free_first(client, options.max_writes)?;
+        entry = Some(plan.entry_area());
         image.push_area(plan.entry_area());
     }
+    // What was kept, once kept: the upload's entry is added to it at the
+    // end (see `finished`).
+    let mut kept_file: Option<Backup> = None;
 
-    let with_sums = wants_sums(&image, keep.wanted());
-    let loader = choose_loader(options, &image, &initial, rates, with_sums)?;
+    let with_sums = wants_sums(&image, keep.wanted())
+        || (options.delta && plan.as_ref().is_some_and(|plan| plan.held_maybe));
+    let (loader, without_loader) = choose_loader(
+        client,
+        options,
+        &image,
+        &initial,
+        rates,
+        with_sums,
+        plan.as_ref(),
+    )?;
     if loader.is_none() && found_at != base {
         return Err(Error::LeftAtFastRate {
             port: client.transport().name(),
@@ -436,7 +469,7 @@ pub fn upload_keeping<T: Transport>(
             .and_then(|()| {
                 if !running.has_sums() {
                     // A small image: written whole, read back byte by byte.
-                    keep_old(client, profile, kept.take(), image.areas(), keep)?;
+                    kept_file = keep_old(client, profile, kept.take(), &image, keep)?;
                     written = whole(&image);
                     let mut body = Body::new(&image, Writer::Frames);
                     body.plan_writes(client.transport().baud(), progress);
@@ -450,7 +483,8 @@ pub fn upload_keeping<T: Transport>(
                 // verified: this robot has stayed powered since an upload
                 // put it there, which summed its ROM (the jump table is
                 // read each time).
-                let rom = fingerprint::whole_rom(profile).filter(|_| running.wrote_loader());
+                let rom = fingerprint::whole_rom(profile)
+                    .filter(|_| running.wrote_loader() && !options.force_rom);
                 let mut first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
                 let table = running
                     .take_rom_check()
@@ -493,7 +527,7 @@ pub fn upload_keeping<T: Transport>(
                         fingerprint::check_jump_table(client, &profile)?;
                     }
                 }
-                keep_summed(client, profile, kept.take(), &todo, keep)?;
+                kept_file = keep_summed(client, profile, kept.take(), &todo, &image, keep)?;
                 let todo = delta::merged(&todo);
                 written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
                 (rewrites, passes) =
@@ -541,7 +575,7 @@ pub fn upload_keeping<T: Transport>(
         }
         session = Some(running);
     } else {
-        keep_old(client, profile, kept.take(), image.areas(), keep)?;
+        kept_file = keep_old(client, profile, kept.take(), &image, keep)?;
         written = whole(&image);
         let body;
         // The jump table is compared while the image goes in (the return
@@ -581,6 +615,9 @@ pub fn upload_keeping<T: Transport>(
         written = whole(&image);
     }
 
+    if let Some(kept) = kept_file {
+        keep.finished(&finished(kept, entry));
+    }
     let stats = client.stats();
     Ok(UploadReport {
         bytes,
@@ -601,6 +638,7 @@ pub fn upload_keeping<T: Transport>(
             }
         }),
         written,
+        without_loader,
     })
 }
 
@@ -627,19 +665,20 @@ fn whole(image: &UploadImage) -> Vec<(u16, usize)> {
         .collect()
 }
 
-/// Reads what `areas` will overwrite (two answers agreeing for each span)
-/// and hands it, with the hooks and table read at the start, to `keep`.
+/// Reads what `image` will overwrite (two answers agreeing for each span)
+/// and hands it, with the hooks and table read at the start, to `keep`;
+/// returns what it handed.
 fn keep_old<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     kept: Option<Backup>,
-    areas: &[Area],
+    image: &UploadImage,
     keep: &mut dyn Keep,
-) -> Result<()> {
+) -> Result<Option<Backup>> {
     let Some(mut kept) = kept else {
-        return Ok(());
+        return Ok(None);
     };
-    for area in areas {
+    for area in image.areas() {
         // The table entry: the whole table is kept already.
         let covered = kept
             .areas
@@ -654,10 +693,26 @@ fn keep_old<T: Transport>(
             bytes,
         });
     }
-    let ranges = crate::backup::witness_ranges(profile, &kept);
+    let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
     kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
-    Ok(())
+    Ok(Some(kept))
+}
+
+/// What an upload kept, once it has finished: with the sum of the
+/// image's entry in the table as the upload wrote it, which an undo finds
+/// only on the robot the upload went to, and only until another upload or
+/// a restore has changed the table (an undo file applied to another robot
+/// is refused, `--port emu`'s fresh one included).
+fn finished(mut kept: Backup, entry: Option<Area>) -> Backup {
+    if let Some(entry) = entry {
+        kept.witnesses.push(crate::backup::Witness {
+            address: entry.address,
+            len: entry.bytes.len() as u16,
+            sum: fletcher16(&entry.bytes),
+        });
+    }
+    kept
 }
 
 /// Hands `keep` what the ranges of `held` hold on the robot now (the
@@ -672,10 +727,11 @@ fn keep_summed<T: Transport>(
     profile: &RomProfile,
     kept: Option<Backup>,
     held: &[delta::Held],
+    image: &UploadImage,
     keep: &mut dyn Keep,
-) -> Result<()> {
+) -> Result<Option<Backup>> {
     let Some(mut kept) = kept else {
-        return Ok(());
+        return Ok(None);
     };
     for (area, sum) in held {
         let len = area.bytes.len();
@@ -699,7 +755,7 @@ fn keep_summed<T: Transport>(
     }
     // The code the kept hooks go back to, summed on the robot (the loader's
     // `sums` is hooked here): an undo checks it is still there.
-    let ranges = crate::backup::witness_ranges(profile, &kept);
+    let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
     let sums = crate::sums::robot_sums(client, &ranges)?;
     kept.witnesses = ranges
         .iter()
@@ -711,7 +767,7 @@ fn keep_summed<T: Transport>(
         })
         .collect();
     keep.keep(&kept);
-    Ok(())
+    Ok(Some(kept))
 }
 
 /// `len` bytes from `address`, read once and checked against `sum` (the

@@ -1,0 +1,197 @@
+//! Issue 27's second round of a new user's findings, on `scorpion sim
+//! --pty` standing for the robot: an undo after the extension has run
+//! (its variables changed) and the refusal of one whose code was
+//! tampered with; an undo file applied to another robot; `restore
+//! --force` onto a robot with another ROM; a second identical upload with
+//! another extension installed; an undo file in a missing directory.
+
+use crate::robot::{Sim, changed_rom, extension_at};
+use crate::{scorpion, transcript};
+
+/// A handler whose `/1Q` counts its calls in a BSS byte and answers `Q`,
+/// the count and `version`; 600 bytes of table between, so that a
+/// change of `version` and a byte of the table are 32-byte ranges apart.
+fn counter_source(version: u8) -> String {
+    format!(
+        "        .include \"scorpion.inc\"
+        .code
+        SCORPION_UNKNOWN_HANDLER
+        cmp #'Q'
+        bne not_mine
+        inc count
+        lda #'Q'
+        jsr PUTCH
+        lda count
+        jsr PUTHEX
+        lda version
+        jsr PUTHEX
+        jsr PUTEOL
+        jmp CMD_DONE
+not_mine:
+        SCORPION_CHAIN_UNKNOWN
+table:  .res 600, $EA
+version: .byte ${version:02X}
+        .bss
+count:  .res 1
+"
+    )
+}
+
+/// `scorpion ARGS` on the line `line`: the output, and whether it exited 0.
+fn on(dir: &std::path::Path, line: &[&str], args: &[&str]) -> (bool, String) {
+    let mut all = args.to_vec();
+    all.extend(line);
+    let output = scorpion(dir, &all);
+    (output.status.success(), transcript(&output))
+}
+
+/// `on` that must succeed.
+fn ok(dir: &std::path::Path, line: &[&str], args: &[&str]) -> String {
+    let (success, text) = on(dir, line, args);
+    assert!(success, "{args:?}: {text}");
+    text
+}
+
+/// F4': the undo file's witness covered the extension's BSS, so an undo
+/// was refused once the new image had run. It covers code alone now: the
+/// undo works after `/1Q` changed the count, and the robot answers as
+/// with the first image; a byte of the code changed on the robot is still
+/// refused.
+#[test]
+fn undo_works_after_the_extension_ran_and_refuses_tampered_code() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    for (name, version) in [("a", 0xA1), ("b", 0xB2)] {
+        std::fs::write(
+            dir.path().join(format!("{name}.s")),
+            counter_source(version),
+        )
+        .expect("the source");
+        let built = scorpion(
+            dir.path(),
+            &["build", &format!("{name}.s"), "-o", &format!("{name}.elf")],
+        );
+        assert!(built.status.success(), "{}", transcript(&built));
+    }
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let d = dir.path();
+    ok(d, &line, &["upload", "a.elf", "--no-dry-run"]);
+    ok(d, &line, &["upload", "b.elf", "--no-dry-run", "--replace"]);
+    let text = ok(d, &line, &["ask", "/1Q", "/1Q"]);
+    assert!(text.contains("Q02B2"), "B answers and counted: {text}");
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    let text = ok(d, &line, &["ask", "/1Q"]);
+    assert!(text.contains("A1"), "A answers again: {text}");
+
+    // Again, and a byte of the code both images load (the table, far from
+    // `version`) changed on the robot before the undo.
+    ok(d, &line, &["upload", "b.elf", "--no-dry-run", "--replace"]);
+    ok(d, &line, &["ask", "/1Q"]);
+    let installed = ok(d, &line, &["read", "$0440", "2"]);
+    assert!(installed.contains("0440: EA EA"), "{installed}");
+    ok(d, &line, &["ask", "/9W04401111"]);
+    let (success, text) = on(d, &line, &["upload", "--undo"]);
+    assert!(!success, "{text}");
+    assert!(text.contains("uploader::witness_differs"), "{text}");
+}
+
+/// M5: an undo file kept on the pty robot, applied to `--port emu` (a
+/// fresh virtual Scorpion): refused, the upload's table entry not there.
+#[test]
+fn an_undo_file_from_one_robot_is_refused_on_another() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 600, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(dir.path(), &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let (success, text) = on(dir.path(), &["--port", "emu"], &["upload", "--undo"]);
+    assert!(!success, "{text}");
+    assert!(text.contains("uploader::witness_differs"), "{text}");
+    assert!(text.contains("$0F88-"), "the table entry: {text}");
+    // On its own robot it works.
+    let text = ok(dir.path(), &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+}
+
+/// F6': `restore --force` onto a robot whose ROM differs from the profile
+/// (and from the backup's) goes through, saying what it overrides.
+#[test]
+fn restore_force_onto_another_rom_goes_through_and_says_what_it_overrides() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (rom, reference, changed) = changed_rom();
+    std::fs::write(dir.path().join("changed.elf"), rom).expect("write the ROM");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(dir.path(), &line, &["backup", "-o", "reference.bak"]);
+    drop(sim);
+    let sim = Sim::start(dir.path(), &["--rom", "changed.elf", "--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let (success, text) = on(dir.path(), &line, &["restore", "reference.bak"]);
+    assert!(!success, "{text}");
+    let text = ok(dir.path(), &line, &["restore", "reference.bak", "--force"]);
+    assert!(text.contains("restored reference.bak"), "{text}");
+    let wrong = format!("$FF2E: expected ${reference:02X}, found ${changed:02X}");
+    assert!(
+        text.contains("warning: --force overrides: the robot's ROM is not"),
+        "{text}"
+    );
+    assert!(text.matches(&wrong).count() >= 2, "both checks: {text}");
+}
+
+/// F5': with another extension installed, a second identical upload is
+/// compared by checksums under `--loader auto` and writes nothing.
+#[test]
+fn a_second_identical_upload_beside_another_extension_writes_nothing() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("other.elf"),
+        extension_at(0x0C00, 200, None),
+    )
+    .expect("the image");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 700, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let d = dir.path();
+    ok(d, &line, &["upload", "other.elf", "--no-dry-run"]);
+    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let text = ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    assert!(text.contains("0 bytes written in 0 ranges"), "{text}");
+    assert!(text.contains("through the RAM loader"), "{text}");
+    // Both still installed, chained.
+    let text = ok(d, &line, &["installed"]);
+    assert!(
+        text.contains("-> $0C03") || text.contains("$0C03"),
+        "{text}"
+    );
+    assert!(text.contains("$0403"), "{text}");
+}
+
+/// F7': `--undo-file` in a directory that does not exist is refused,
+/// naming it, before the robot is touched; nothing is made.
+#[test]
+fn an_undo_file_in_a_missing_directory_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let (success, text) = on(
+        dir.path(),
+        &line,
+        &[
+            "upload",
+            "ext.elf",
+            "--no-dry-run",
+            "--undo-file",
+            "nowhere/x.undo",
+        ],
+    );
+    assert!(!success, "{text}");
+    assert!(
+        text.contains("the directory nowhere does not exist"),
+        "{text}"
+    );
+    assert!(!dir.path().join("nowhere").exists());
+    let text = ok(dir.path(), &line, &["read", "$0200", "3"]);
+    assert!(text.contains("0200: 4C 21 FF"), "untouched: {text}");
+}
