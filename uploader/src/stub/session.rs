@@ -82,6 +82,10 @@ pub struct RobotDebug<T> {
     pending: Option<(u16, Vec<u8>)>,
     /// What attach found of an earlier session.
     recovery: Recovery,
+    /// Where the image's instructions start, when known (sorted).
+    starts: Option<Vec<u16>>,
+    /// A step's breakpoints, taken out at the next stop.
+    temporary: Vec<u16>,
 }
 
 /// What attach found of an earlier session that ended without detaching
@@ -177,6 +181,8 @@ impl<T: Transport> RobotDebug<T> {
             partial: Vec::new(),
             pending: None,
             recovery: Recovery::default(),
+            starts: None,
+            temporary: Vec::new(),
         };
         match debug.probe_stopped()? {
             Some(registers) => {
@@ -320,7 +326,7 @@ impl<T: Transport> RobotDebug<T> {
                 }
             }
             if let Some(i) = (0..found.len()).find(|&i| found[i] != area.bytes[i]) {
-                let end = found.len().min(i + 8);
+                let end = found.len().min(i + 4);
                 return Err(StubError::NotTheImage {
                     address: area.address.wrapping_add(i as u16),
                     expected: hex(&area.bytes[i..end]),
@@ -332,6 +338,16 @@ impl<T: Transport> RobotDebug<T> {
             self.image.set_byte(at, byte);
         }
         Ok(leftovers)
+    }
+
+    /// Tells where every instruction of the image starts (a built
+    /// image's line tables start a line at each): a breakpoint anywhere
+    /// else in the image is refused, since its `JSR` would cut an
+    /// instruction in two. Without it, only the image's decoding guides.
+    pub fn set_instruction_starts(&mut self, mut starts: Vec<u16>) {
+        starts.sort_unstable();
+        starts.dedup();
+        self.starts = Some(starts);
     }
 
     /// What attach found of an earlier session, and did about it.
@@ -435,18 +451,29 @@ impl<T: Transport> RobotDebug<T> {
     /// past its first instruction.
     ///
     /// # Errors
-    /// [`StubError::Refused`] with the reason (the ROM, a branch
-    /// displaced, a jump target covered, no trampoline free, overlapping
-    /// another breakpoint); the line's errors.
+    /// [`StubError::Refused`] with the reason (the ROM, inside an
+    /// instruction, one there already, a branch displaced, a jump target
+    /// covered, no trampoline free, overlapping another breakpoint); the
+    /// line's errors.
     pub fn set_breakpoint(&mut self, address: u16, entries: &[u16]) -> StubResult<()> {
-        if self.breakpoints.contains_key(&address) {
-            return Ok(());
-        }
-        let patch = patch::plan(address, &self.image, entries)?;
         let refuse = |reason: String| StubError::Refused {
             what: format!("a breakpoint at ${address:04X}"),
             reason,
         };
+        if self.breakpoints.contains_key(&address) {
+            return Err(refuse(
+                "one is there already (its JSR would displace the JSR)".into(),
+            ));
+        }
+        if let Some(starts) = &self.starts
+            && self.image.contains(address)
+            && starts.binary_search(&address).is_err()
+        {
+            return Err(refuse(
+                "no instruction of the image starts there (its line tables start a line at every instruction), and a JSR there would cut one in two".into(),
+            ));
+        }
+        let patch = patch::plan(address, &self.image, entries)?;
         for (other, _) in self.breakpoints.values() {
             let overlaps = |a: &Patch, b: &Patch| {
                 u32::from(a.address) < u32::from(b.address) + 3
@@ -709,6 +736,7 @@ impl<T: Transport> RobotDebug<T> {
                 }
                 Some(Heard::Frame(payload)) => {
                     if let Some(registers) = self.take_stop(&payload) {
+                        self.drop_temporary()?;
                         return Ok(Reply::Stopped(registers));
                     }
                 }
@@ -829,17 +857,53 @@ impl<T: Transport> RobotDebug<T> {
                         self.remove_breakpoint(done)?;
                     }
                 }
-                return Err(error);
+                // A step stops with a breakpoint's JSR on the next
+                // instruction: where that cannot go (an instruction of one
+                // or two bytes followed by a branch or a line of its own),
+                // neither can the step.
+                return Err(match error {
+                    StubError::Refused { reason, .. } => StubError::Refused {
+                        what: format!("a step from ${pc:04X}"),
+                        reason: format!(
+                            "it stops with a JSR (three bytes) on the next instruction, ${to:04X}, and that is refused: {reason}; set a breakpoint further on and continue"
+                        ),
+                    },
+                    other => other,
+                });
             }
         }
+        // Taken out at the next stop, whenever it comes: the step may run
+        // on (a `JSR` into the ROM that ends the answer, `JMP CMD_DONE`)
+        // and stop there later, or at another breakpoint.
+        self.temporary.extend(temporary);
         self.resume()?;
-        let reply = self.wait_event(wait)?;
-        if self.stopped.is_some() {
-            for &to in &temporary {
+        self.wait_event(wait)
+    }
+
+    /// The step's breakpoints, taken out at a stop.
+    fn drop_temporary(&mut self) -> StubResult<()> {
+        for to in std::mem::take(&mut self.temporary) {
+            if self.breakpoints.contains_key(&to) {
                 self.remove_breakpoint(to)?;
             }
         }
-        Ok(reply)
+        Ok(())
+    }
+
+    /// What the running robot said unasked, within `wait`: a stop (a
+    /// step that ran on, a command another program sent), an answer, or
+    /// `None`. `None` at once when it is stopped.
+    ///
+    /// # Errors
+    /// The line's errors.
+    pub fn poll(&mut self, wait: Duration) -> StubResult<Option<Reply>> {
+        if self.stopped.is_some() {
+            return Ok(None);
+        }
+        Ok(match self.wait_event(wait)? {
+            Reply::Silent => None,
+            reply => Some(reply),
+        })
     }
 
     /// Detaches: continues a stopped robot, removes every breakpoint (the
@@ -849,6 +913,14 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// The line's errors.
     pub fn detach(mut self) -> StubResult<Client<T>> {
+        if self.stopped.is_none() {
+            // A stop nobody saw (its frame lost, or unread): the stub
+            // answers a frame only when it runs.
+            if let Some(registers) = self.probe_stopped()? {
+                self.stopped = Some(registers);
+                self.drop_temporary()?;
+            }
+        }
         let addresses: Vec<u16> = self.breakpoints.keys().copied().collect();
         for address in addresses {
             self.remove_breakpoint(address)?;
