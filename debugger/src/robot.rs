@@ -212,8 +212,8 @@ impl RobotMonitor {
                 if matches!(heard, Heard::Answer(_)) {
                     // The instruction ended the answer (`JSR PUTEOL`): the
                     // stop comes after it, or it ran on.
-                    if let Some(more) = self.notice(d, WAIT)? {
-                        text.push_str(&more);
+                    if let Some(more) = d.poll(WAIT).map_err(failure)? {
+                        text.push_str(&self.heard(d, &more)?);
                     }
                 }
                 text

@@ -168,7 +168,7 @@ fn a_step_over_puteol_sees_the_stop_after_the_answer_and_quit_lets_it_go() {
     assert!(output.status.success(), "{printed}");
     for expected in [
         "answer: Q42",
-        "(a stop not asked for) stopped: $0412",
+        "answer: Q42\nstopped: $0412",
         "PC=$0412",
         "detached",
     ] {
