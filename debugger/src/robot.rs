@@ -43,6 +43,41 @@ commands on the robot (addresses and values are expressions, as in the monitor):
 refused on the robot: back, reverse-continue, who-wrote (a robot cannot be re-run),
 watch (no data breakpoints), break in the ROM, if/hits/log (a JSR always stops)";
 
+/// Where the images' instructions start, when their line tables say so
+/// (a built image starts a source line at every instruction; its labels
+/// count too): for [`RobotDebug::set_instruction_starts`], which refuses
+/// a breakpoint anywhere else in the code. `None` for images without
+/// line tables.
+#[must_use]
+pub fn instruction_starts(images: &[linker::Image]) -> Option<Vec<u16>> {
+    if images.iter().all(|image| image.lines.entries.is_empty()) {
+        return None;
+    }
+    Some(jump_targets(images))
+}
+
+/// The images' labels and source lines' addresses, sorted.
+fn jump_targets(images: &[linker::Image]) -> Vec<u16> {
+    let mut entries: Vec<u16> = images
+        .iter()
+        .flat_map(|image| {
+            let labels = image
+                .symbols
+                .iter()
+                .filter_map(|symbol| u16::try_from(symbol.value).ok());
+            let lines = image
+                .lines
+                .entries
+                .iter()
+                .filter_map(|entry| u16::try_from(entry.offset).ok());
+            labels.chain(lines).collect::<Vec<_>>()
+        })
+        .collect();
+    entries.sort_unstable();
+    entries.dedup();
+    entries
+}
+
 /// What the monitor keeps on a robot between commands.
 #[derive(Debug)]
 pub struct RobotMonitor {
@@ -61,23 +96,7 @@ impl RobotMonitor {
     /// for `FILE:LINE`.
     #[must_use]
     pub fn new(symbols: Symbols, images: Vec<linker::Image>) -> RobotMonitor {
-        let mut entries: Vec<u16> = images
-            .iter()
-            .flat_map(|image| {
-                let labels = image
-                    .symbols
-                    .iter()
-                    .filter_map(|symbol| u16::try_from(symbol.value).ok());
-                let lines = image
-                    .lines
-                    .entries
-                    .iter()
-                    .filter_map(|entry| u16::try_from(entry.offset).ok());
-                labels.chain(lines).collect::<Vec<_>>()
-            })
-            .collect();
-        entries.sort_unstable();
-        entries.dedup();
+        let entries = jump_targets(&images);
         RobotMonitor {
             symbols,
             images,
@@ -189,7 +208,15 @@ impl RobotMonitor {
                 }
                 let over = matches!(verb, "next" | "n");
                 let heard = d.step(&self.entries, over, WAIT).map_err(failure)?;
-                self.heard(d, &heard)?
+                let mut text = self.heard(d, &heard)?;
+                if matches!(heard, Heard::Answer(_)) {
+                    // The instruction ended the answer (`JSR PUTEOL`): the
+                    // stop comes after it, or it ran on.
+                    if let Some(more) = d.poll(WAIT).map_err(failure)? {
+                        text.push_str(&self.heard(d, &more)?);
+                    }
+                }
+                text
             }
             "regs" | "r" => {
                 let registers = stopped(d, "regs")?;
@@ -251,6 +278,30 @@ impl RobotMonitor {
             }
         };
         Ok(Reply::Text(text))
+    }
+
+    /// What the running robot said unasked within `wait` (a stop a step
+    /// ran on to, a command another program sent, an answer), as text:
+    /// the front end asks before each command, so that it is run on the
+    /// robot as it is.
+    ///
+    /// # Errors
+    /// [`Failure::Line`] when the line failed.
+    pub fn notice<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        wait: Duration,
+    ) -> Result<Option<String>, Failure> {
+        match d.poll(wait).map_err(failure)? {
+            None => Ok(None),
+            Some(heard) => {
+                let what = match heard {
+                    Heard::Stopped(_) => "(a stop not asked for) ",
+                    _ => "(unasked) ",
+                };
+                Ok(Some(format!("{what}{}", self.heard(d, &heard)?)))
+            }
+        }
     }
 
     fn send<T: Transport>(&mut self, d: &mut RobotDebug<T>, text: &str) -> Result<String, Failure> {
@@ -329,25 +380,6 @@ impl RobotMonitor {
                     .map_err(|_| usage(&format!("{after} is no address")))?
             }
         };
-        // Built images start a source line at every instruction: any other
-        // address of theirs is inside one, and a JSR there would cut it in
-        // two (found by the hostile tester: the robot reset).
-        if self
-            .images
-            .iter()
-            .any(|image| !image.lines.entries.is_empty())
-            && self.entries.binary_search(&address).is_err()
-        {
-            return Err(usage(&format!(
-                "a breakpoint at ${address:04X} is refused on the robot: no instruction of the image starts there (no label or source line does), and a JSR there would cut one in two"
-            )));
-        }
-        if let Some((id, _)) = self.breakpoints.iter().find(|(_, at)| **at == address) {
-            return Err(usage(&format!(
-                "breakpoint {id} is already at {}",
-                self.place(address)
-            )));
-        }
         d.set_breakpoint(address, &self.entries).map_err(failure)?;
         let id = self.next_id;
         self.next_id += 1;
@@ -565,7 +597,9 @@ fn cpu_of(registers: &Registers) -> Cpu {
     cpu
 }
 
-fn show_registers(r: &Registers) -> String {
+/// The registers as the monitor shows them.
+#[must_use]
+pub fn show_registers(r: &Registers) -> String {
     format!(
         "PC=${:04X} A=${:02X} X=${:02X} Y=${:02X} S=${:02X} P=${:02X}",
         r.pc, r.a, r.x, r.y, r.s, r.p

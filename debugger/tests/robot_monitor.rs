@@ -112,3 +112,37 @@ fn displays_are_read_while_it_runs_and_at_a_stop() {
     let shown = text(&mut m, &mut d, "continue");
     assert!(shown.contains("answer: Q17"), "{shown}");
 }
+
+/// The hostile tester's F5: `next` over `JSR PUTEOL` ends the answer
+/// before the stop; the stop after it is shown with it, and the monitor
+/// knows the robot is stopped.
+#[test]
+fn a_step_whose_stop_comes_after_the_answer_shows_both() {
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $0412");
+    let shown = text(&mut m, &mut d, "/1Q");
+    assert!(shown.contains("stopped: breakpoint 1, $0412"), "{shown}");
+    let shown = text(&mut m, &mut d, "next");
+    assert!(shown.contains("answer: Q42\nstopped: $0415"), "{shown}");
+    assert!(text(&mut m, &mut d, "regs").contains("PC=$0415"));
+}
+
+/// G2: a command another program sends down the line hits a breakpoint
+/// while the monitor idles; the front end's `notice` before the next
+/// command sees the stop.
+#[test]
+fn a_stop_while_idle_is_noticed() {
+    use uploader::Transport as _;
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $040C");
+    d.client().transport().send(b"/1Q").expect("sent");
+    let noticed = m
+        .notice(&mut d, std::time::Duration::from_secs(1))
+        .expect("the line")
+        .expect("a stop");
+    assert!(
+        noticed.contains("(a stop not asked for) stopped: breakpoint 1, $040C"),
+        "{noticed}"
+    );
+    assert!(text(&mut m, &mut d, "regs").contains("PC=$040C"));
+}

@@ -242,7 +242,7 @@ fn a_breakpoint_inside_an_instruction_or_twice_at_one_place_is_refused() {
         "{printed}"
     );
     assert!(
-        printed.contains("breakpoint 1 is already at $0409"),
+        printed.contains("a breakpoint at $0409 is refused on the robot: one is there already"),
         "{printed}"
     );
     assert!(printed.contains("answer: Q42"), "{printed}");
@@ -329,7 +329,7 @@ fn a_signal_at_a_stop_gives_the_robot_back() {
 
 /// The README's handler built from its source and uploaded to a pty
 /// robot: the directory holding `ext.s` and `ext.elf`, and the robot.
-fn readme_handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {
+pub(crate) fn readme_handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {
     let dir = tempfile::tempdir().expect("temporary directory");
     std::fs::write(
         dir.path().join("ext.s"),

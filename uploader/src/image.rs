@@ -25,7 +25,7 @@ impl Area {
         u32::from(self.address) + self.bytes.len() as u32
     }
 
-    fn contains(&self, address: u16) -> bool {
+    pub(crate) fn contains(&self, address: u16) -> bool {
         (u32::from(self.address)..self.end()).contains(&u32::from(address))
     }
 }

@@ -8,69 +8,11 @@
 
 mod common;
 
-use isa::objfmt::{HookKind, HookRecord};
-use romlib::VirtualScorpion;
+use common::stub::{attach, handler};
+
 use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
 use std::time::Duration;
-use uploader::stub::{Reply, RobotDebug, StubError};
-use uploader::transport::VirtualTransport;
-use uploader::{Area, RomProfile, UploadImage};
-
-/// `/1Q` answers `Q` and the byte at $0480 in hex:
-///
-/// ```text
-/// $0400  JMP chain      ; the chain slot, $0401
-/// $0403  CMP #'Q'       ; the handler
-/// $0405  BNE $0400
-/// $0407  LDA #'Q'
-/// $0409  JSR PUTCH
-/// $040C  LDA $0480
-/// $040F  JSR PUTHEX
-/// $0412  JSR PUTEOL
-/// $0415  JMP CMD_DONE
-/// $0480  .byte $42
-/// ```
-fn handler() -> UploadImage {
-    let mut bytes = vec![
-        0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0, 0xF9, 0xA9, b'Q', 0x20, 0x00, 0xFF, 0xAD, 0x80, 0x04,
-        0x20, 0x03, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
-    ];
-    bytes.resize(0x81, 0xEA);
-    bytes[0x80] = 0x42;
-    UploadImage::new(
-        vec![Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        }],
-    )
-    .expect("an image")
-}
-
-/// A robot with the handler loaded and hooked, as an upload leaves it.
-fn robot(image: &UploadImage) -> VirtualTransport {
-    let mut robot = VirtualScorpion::new();
-    let area = &image.areas()[0];
-    robot
-        .robot_mut()
-        .board_mut()
-        .load(area.address, &area.bytes)
-        .expect("RAM");
-    robot
-        .install_hook(HookKind::Unknown, 0x0403, None)
-        .expect("HOOK_UNKNOWN is a JMP");
-    VirtualTransport::new(robot)
-}
-
-fn attach(image: &UploadImage) -> RobotDebug<VirtualTransport> {
-    let profile = RomProfile::reference();
-    let client = uploader::client(robot(image), &profile);
-    RobotDebug::attach(client, &profile, image.clone()).expect("attaches")
-}
+use uploader::stub::{Reply, StubError};
 
 const WAIT: Duration = Duration::from_secs(1);
 
@@ -179,6 +121,9 @@ fn breakpoints_the_robot_cannot_take_are_refused_with_the_reason() {
     debug.set_breakpoint(0x0407, &[]).expect("no label inside");
     let overlap = refused(debug.set_breakpoint(0x0409, &[]));
     assert!(overlap.contains("$0407"), "{overlap}");
+    // One address, one breakpoint: the second would displace the first's JSR.
+    let twice = refused(debug.set_breakpoint(0x0407, &[]));
+    assert!(twice.contains("already"), "{twice}");
     // Nothing half-written: the code is the image's but for the patch.
     let stub = debug.stub().entry.to_le_bytes();
     assert_eq!(
@@ -195,4 +140,78 @@ fn breakpoints_the_robot_cannot_take_are_refused_with_the_reason() {
         debug.wait_event(WAIT).expect("an answer"),
         Reply::Answer(b"Q42\r".to_vec())
     );
+}
+
+#[test]
+fn a_breakpoint_where_no_instruction_starts_is_refused_when_the_starts_are_known() {
+    let image = handler();
+    let mut debug = attach(&image);
+    // The handler's instructions, as a built image's line table has them.
+    debug.set_instruction_starts(vec![
+        0x0400, 0x0403, 0x0405, 0x0407, 0x0409, 0x040C, 0x040F, 0x0412, 0x0415,
+    ]);
+    // $040D is `LDA $0480`'s operand.
+    match debug.set_breakpoint(0x040D, &[]) {
+        Err(StubError::Refused { reason, .. }) => {
+            assert!(reason.contains("no instruction"), "{reason}");
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+    assert_eq!(debug.breakpoints().count(), 0);
+    assert_eq!(debug.compare_with_image().expect("read"), None);
+    debug
+        .set_breakpoint(0x040C, &[])
+        .expect("an instruction starts there");
+}
+
+/// The hostile tester's F5: a step over `JSR PUTEOL` ends the answer
+/// before it stops. The stop after it is not lost: `poll` sees it, the
+/// step's breakpoint is taken out at it, and a detach without it gives
+/// the robot back running all the same.
+#[test]
+fn a_stop_after_the_answer_of_a_step_is_noticed_and_detach_lets_it_go() {
+    let image = handler();
+    let mut debug = attach(&image);
+    debug
+        .set_breakpoint(0x0412, &[])
+        .expect("set at JSR PUTEOL");
+    assert!(matches!(
+        debug.command(b"/1Q", WAIT).expect("sent"),
+        Reply::Stopped(_)
+    ));
+    let reply = debug.step(&[], true, WAIT).expect("next");
+    assert_eq!(reply, Reply::Answer(b"Q42\r".to_vec()));
+    let Some(Reply::Stopped(registers)) = debug.poll(WAIT).expect("polled") else {
+        panic!("the stop after the answer was not seen");
+    };
+    assert_eq!(registers.pc, 0x0415);
+    assert_eq!(debug.stopped(), Some(registers));
+    // The step's breakpoint is out; the user's stays.
+    assert_eq!(debug.read(0x0415, 3).expect("read"), [0x4C, 0x1E, 0xFF]);
+    assert_eq!(debug.breakpoints().collect::<Vec<_>>(), [0x0412]);
+    debug.resume().expect("continue");
+    assert_eq!(debug.poll(WAIT).expect("polled"), None);
+    // Again, and this time nobody looks before detach.
+    assert!(matches!(
+        debug.command(b"/1Q", WAIT).expect("sent"),
+        Reply::Stopped(_)
+    ));
+    debug.step(&[], true, WAIT).expect("next");
+    let client = debug.detach().expect("detached");
+    let mut robot = client.into_transport();
+    let answer = {
+        use uploader::transport::Transport as _;
+        robot.send(b"/1Q").expect("sent");
+        let mut heard = Vec::new();
+        let deadline = robot.now() + WAIT;
+        while !heard.ends_with(b"\r") && robot.now() < deadline {
+            let left = deadline - robot.now();
+            robot.receive(&mut heard, left).expect("heard");
+        }
+        heard
+    };
+    assert_eq!(answer, b"Q42\r", "the robot runs its control loop again");
+    let memory = robot.into_robot();
+    let memory = memory.robot().board().memory();
+    assert_eq!(&memory[0x0400..0x0481], &image.areas()[0].bytes[..]);
 }

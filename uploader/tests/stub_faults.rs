@@ -6,53 +6,18 @@
 //! bytes or the whole `JSR` into the stub, and a `JSR` or a hook into the
 //! stub finds the stub's code and the trampoline intact.
 
+mod common;
+
+use common::stub::{handler, robot};
 use std::time::Duration;
 
-use isa::objfmt::{HookKind, HookRecord};
-use romlib::VirtualScorpion;
 use romlib::symbols::HOOK_UNKNOWN;
 use uploader::stub::{RobotDebug, StubPlan, patch};
 use uploader::transport::{FaultConfig, FaultyTransport, Transport, VirtualTransport};
-use uploader::{Area, RomProfile, UploadImage};
-
-/// `/1Q` answers `Q` and the byte at $0480 (as in tests/stub.rs).
-fn handler() -> UploadImage {
-    let mut bytes = vec![
-        0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0, 0xF9, 0xA9, b'Q', 0x20, 0x00, 0xFF, 0xAD, 0x80, 0x04,
-        0x20, 0x03, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
-    ];
-    bytes.resize(0x81, 0xEA);
-    bytes[0x80] = 0x42;
-    UploadImage::new(
-        vec![Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        }],
-    )
-    .expect("an image")
-}
+use uploader::{RomProfile, UploadImage};
 
 /// Where the breakpoint goes: `LDA $0480`.
 const AT: u16 = 0x040C;
-
-fn robot(image: &UploadImage) -> VirtualTransport {
-    let mut robot = VirtualScorpion::new();
-    let area = &image.areas()[0];
-    robot
-        .robot_mut()
-        .board_mut()
-        .load(area.address, &area.bytes)
-        .expect("RAM");
-    robot
-        .install_hook(HookKind::Unknown, 0x0403, None)
-        .expect("HOOK_UNKNOWN is a JMP");
-    VirtualTransport::new(robot)
-}
 
 /// Patch, hit it, go on, unpatch: the first failure.
 fn exercise<T: Transport>(debug: &mut RobotDebug<T>) -> Result<(), String> {

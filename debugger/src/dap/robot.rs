@@ -216,7 +216,16 @@ impl RobotSession {
             }
             "setBreakpoints" => Some(self.set_breakpoints(&args)?),
             "setExceptionBreakpoints" => Some(json!({"breakpoints": []})),
-            "configurationDone" => return Ok((None, After::Run)),
+            "configurationDone" => {
+                // A robot an earlier session left stopped is stopped now.
+                return Ok((
+                    None,
+                    match self.robot()?.stopped() {
+                        Some(registers) => After::Heard(Heard::Stopped(registers), "entry"),
+                        None => After::Run,
+                    },
+                ));
+            }
             "threads" => Some(json!({"threads": [{"id": THREAD, "name": "6502"}]})),
             "stackTrace" => {
                 let registers = self.stopped("stackTrace")?;

@@ -20,6 +20,10 @@ use crate::cmd::ports;
 
 const PROMPT: &str = "(robot) ";
 
+/// How long the line is listened to before each command, for what the
+/// robot said unasked.
+const NOTICE: std::time::Duration = std::time::Duration::from_millis(30);
+
 /// The robot on `port` (empty: the environment's or the project's)
 /// with the stub attached beside the images `args` names, the names of
 /// the ROM and the images, and the images (their sources from here).
@@ -52,10 +56,17 @@ pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::A
     let rom = crate::cmd::config::rom(&resolved)?;
     let profile = crate::cmd::config::profile(rom.as_ref())?;
     let transport = ports::open_resolved(&resolved, &images)?;
-    let mut client = uploader::client(transport, &profile);
-    client.probe()?;
+    // No `/1X` first: a robot left stopped in the stub answers none; attach
+    // finds that out with a frame, and asks `/1X` of a running one.
+    let client = uploader::client(transport, &profile);
     let robot = RobotDebug::attach(client, &profile, code)?;
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
+    // A JSR where no instruction starts would cut one in two: the line
+    // tables say where they start, for the monitor and DAP alike.
+    let mut robot = robot;
+    if let Some(starts) = debugger::robot::instruction_starts(&linked) {
+        robot.set_instruction_starts(starts);
+    }
     // The names: the ROM's and the images' labels, as the virtual robot
     // with the images loaded has them.
     let mut named = ports::bare_robot(9600, rom.as_ref())?;
@@ -97,6 +108,18 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         stub.previous
     )
     .into_diagnostic()?;
+    if robot.recovery().found() {
+        writeln!(out, "{}", robot.recovery().describe()).into_diagnostic()?;
+    }
+    if let Some(registers) = robot.stopped() {
+        writeln!(
+            out,
+            "stopped at {}: {}",
+            monitor.place(registers.pc),
+            debugger::robot::show_registers(&registers)
+        )
+        .into_diagnostic()?;
+    }
     // A Ctrl-C, a closed terminal or a `kill` must not end the process
     // with the robot stopped in the stub or a JSR left in its code: each
     // ends the session at the next line read (or the end of input), and
@@ -164,6 +187,17 @@ fn converse<T: uploader::transport::Transport>(
         }
         if ended.load(Ordering::Relaxed) {
             break;
+        }
+        // A stop that came unasked (a step that ran on, a command sent by
+        // another program) is said first: the command runs on the robot
+        // as it is.
+        match monitor.notice(robot, NOTICE) {
+            Ok(Some(text)) => write!(out, "{text}").into_diagnostic()?,
+            Ok(None) => {}
+            Err(error) => {
+                broken |= matches!(error, Failure::Line(_));
+                writeln!(out, "error: {}", error.message()).into_diagnostic()?;
+            }
         }
         match monitor.command(robot, line.trim()) {
             Ok(Reply::Text(text)) => write!(out, "{text}").into_diagnostic()?,

@@ -82,6 +82,26 @@ pub enum StubError {
         found: String,
     },
 
+    /// The robot's code is not the image's: attaching would patch
+    /// instructions that are not there.
+    #[error(
+        "the robot does not hold the image: ${address:04X} holds {found}, the image has {expected}"
+    )]
+    #[diagnostic(
+        code(uploader::stub::not_the_image),
+        help(
+            "upload the image first (`scorpion upload ELF --port PORT --replace`), or give `debug` the image the robot runs; nothing was written"
+        )
+    )]
+    NotTheImage {
+        /// The first address that differs.
+        address: u16,
+        /// The image's bytes there (hex).
+        expected: String,
+        /// The robot's (hex).
+        found: String,
+    },
+
     /// What the robot cannot do, and why.
     #[error("{what} is refused on the robot: {reason}")]
     #[diagnostic(code(uploader::stub::refused))]

@@ -19,4 +19,4 @@ pub mod session;
 pub use error::{StubError, StubResult, hex as error_hex};
 pub use link::StubPlan;
 pub use patch::Patch;
-pub use session::{Registers, Reply, RobotDebug};
+pub use session::{Recovery, Registers, Reply, RobotDebug};

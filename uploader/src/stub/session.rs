@@ -80,37 +80,98 @@ pub struct RobotDebug<T> {
     partial: Vec<u8>,
     /// The trampoline of the breakpoint being patched in.
     pending: Option<(u16, Vec<u8>)>,
+    /// What attach found of an earlier session.
+    recovery: Recovery,
+    /// Where the image's instructions start, when known (sorted).
+    starts: Option<Vec<u16>>,
+    /// A step's breakpoints, taken out at the next stop.
+    temporary: Vec<u16>,
+}
+
+/// What attach found of an earlier session that ended without detaching
+/// (its process killed), and what it did: the earlier breakpoints are
+/// taken out, not adopted (their numbers and conditions died with that
+/// session), and a stopped robot stays stopped where it was.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Recovery {
+    /// The robot was stopped in the stub: its registers. It stays
+    /// stopped; `resume` lets it go on.
+    pub stopped: Option<Registers>,
+    /// The stub was still hooked on `HOOK_UNKNOWN`.
+    pub hooked: bool,
+    /// `JSR`s into the stub left in the code: the image's bytes put back
+    /// and read back.
+    pub removed: Vec<u16>,
+}
+
+impl Recovery {
+    /// Whether anything of an earlier session was found.
+    #[must_use]
+    pub fn found(&self) -> bool {
+        self.stopped.is_some() || self.hooked || !self.removed.is_empty()
+    }
+
+    /// What was found and done, in a sentence; empty when nothing was.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        if !self.found() {
+            return String::new();
+        }
+        let mut parts = Vec::new();
+        if let Some(registers) = self.stopped {
+            parts.push(format!(
+                "the robot was stopped in its stub at ${:04X} and stays stopped there (`continue` lets it go on)",
+                registers.pc
+            ));
+        }
+        if self.hooked {
+            parts.push("its stub was still hooked on HOOK_UNKNOWN (hooked again)".to_owned());
+        }
+        if !self.removed.is_empty() {
+            let at: Vec<String> = self.removed.iter().map(|a| format!("${a:04X}")).collect();
+            parts.push(format!(
+                "its breakpoints at {} were taken out: the image's bytes put back and read back",
+                at.join(", ")
+            ));
+        }
+        format!(
+            "an earlier session did not detach (cleaned up, not adopted): {}",
+            parts.join("; ")
+        )
+    }
 }
 
 impl<T: Transport> RobotDebug<T> {
     /// Attaches to the robot on `client` running `image` (as uploaded,
-    /// linked against `profile`): the stub linked where the image leaves
-    /// room, written with the ROM's commands and read back, then hooked
-    /// into `HOOK_UNKNOWN` ahead of what was there.
+    /// linked against `profile`).
+    ///
+    /// Nothing is written before the robot is known to hold the image:
+    /// first a frame to a stub (a running robot ignores it) tells whether
+    /// the robot is stopped in one left by an earlier session, then the
+    /// robot's code is read and compared with the image. The bytes of
+    /// the image's chain slots are the robot's (the uploader filled them),
+    /// and are taken from it. A `JSR` into the stub left in the code by a
+    /// session that died is taken out (the image's bytes put back and
+    /// read back), and a robot found stopped stays stopped, its PC at the
+    /// image's instruction: [`RobotDebug::recovery`] says what was found.
+    /// Then the stub is linked where the image leaves room, written with
+    /// the ROM's commands and read back (only its code, through the stub's
+    /// frames, when it is the one running), and hooked into
+    /// `HOOK_UNKNOWN` ahead of what was there.
     ///
     /// # Errors
-    /// The line's errors, [`StubError::NoRoom`], [`StubError::Verify`].
-    pub fn attach(
-        mut client: Client<T>,
-        profile: &RomProfile,
-        image: UploadImage,
-    ) -> StubResult<Self> {
+    /// The line's errors, [`StubError::NotTheImage`] (nothing written),
+    /// [`StubError::NoRoom`], [`StubError::Verify`], [`StubError::Refused`]
+    /// for a robot stopped in a stub that is not this image's.
+    pub fn attach(client: Client<T>, profile: &RomProfile, image: UploadImage) -> StubResult<Self> {
         let hook = profile.hook_unknown;
-        let jump = client.read_memory(hook, 3)?;
-        let mut previous = u16::from_le_bytes([jump[1], jump[2]]);
-        // A stub left hooked by an earlier session (the host died): chain
-        // to where it chained.
-        let first = StubPlan::place(profile, &image, previous)?;
-        if previous == first.handler {
-            let code = client.read_memory(first.address, first.bytes.len())?;
-            let at = usize::from(first.code_end - first.address) - 2;
-            previous = u16::from_le_bytes([code[at], code[at + 1]]);
-        }
-        let stub = StubPlan::place(profile, &image, previous)?;
+        // Where the stub goes depends on the image only; what it chains
+        // to is learnt below.
+        let placed = StubPlan::place(profile, &image, hook)?;
         let margin = client.config().margin * 4;
         let mut debug = RobotDebug {
             client,
-            stub,
+            stub: placed.clone(),
             image,
             breakpoints: BTreeMap::new(),
             stopped: None,
@@ -119,12 +180,180 @@ impl<T: Transport> RobotDebug<T> {
             hook,
             partial: Vec::new(),
             pending: None,
+            recovery: Recovery::default(),
+            starts: None,
+            temporary: Vec::new(),
         };
-        let (address, bytes) = (debug.stub.address, debug.stub.bytes.clone());
-        debug.rom_write_verified(address, &bytes)?;
-        let handler = debug.stub.handler.to_le_bytes();
-        debug.rom_write_verified(hook + 1, &handler)?;
+        match debug.probe_stopped()? {
+            Some(registers) => {
+                debug.stopped = Some(registers);
+                debug.recovery.stopped = Some(registers);
+            }
+            None => {
+                debug.client.probe()?;
+            }
+        }
+        let jump = debug.read(hook, 3)?;
+        let target = u16::from_le_bytes([jump[1], jump[2]]);
+        let code_len = usize::from(placed.code_end - placed.address);
+        let code = debug.read(placed.address, code_len)?;
+        // The stub's code but for `JMP PREV`'s operand, its last two bytes.
+        let present = code[..code_len - 2] == placed.bytes[..code_len - 2];
+        if debug.stopped.is_some() && !present {
+            return Err(StubError::Refused {
+                what: "attaching".into(),
+                reason: format!(
+                    "the robot is stopped in a debug stub that is not where this image's goes (${:04X}): it was attached with another image; attach with that one, or reset the robot",
+                    placed.address
+                ),
+            });
+        }
+        debug.recovery.hooked = target == placed.handler;
+        let previous = if debug.recovery.hooked {
+            if !present {
+                return Err(StubError::NotTheImage {
+                    address: placed.address,
+                    expected: hex(&placed.bytes[..8]),
+                    found: hex(&code[..8]),
+                });
+            }
+            u16::from_le_bytes([code[code_len - 2], code[code_len - 1]])
+        } else {
+            target
+        };
+        debug.stub = StubPlan::place(profile, &debug.image, previous)?;
+        let leftovers = debug.check_image()?;
+        let stub = debug.stub.clone();
+        if debug.stopped.is_some() {
+            // The stub runs: its data (the stop's registers) is kept.
+            debug.write_verified(stub.address, &stub.bytes[..code_len])?;
+        } else {
+            debug.rom_write_verified(stub.address, &stub.bytes)?;
+        }
+        debug.write_verified(hook + 1, &stub.handler.to_le_bytes())?;
+        for (address, original) in leftovers {
+            debug.patch(address, original)?;
+            debug.recovery.removed.push(address);
+        }
         Ok(debug)
+    }
+
+    /// Whether the robot is stopped in a stub: the stub's registers read
+    /// with a frame, which a running robot ignores.
+    fn probe_stopped(&mut self) -> StubResult<Option<Registers>> {
+        let regs = self.stub.regs.to_le_bytes();
+        let payload = [b'R', regs[0], regs[1], 8];
+        for _ in 0..2 {
+            self.rx.clear();
+            self.client.transport().clear_input()?;
+            self.client.send_raw(&frame::encode(&payload))?;
+            let wait =
+                char_time(2 * payload.len() + 32, self.client.transport().baud()) + self.margin;
+            let deadline = self.client.transport().now() + wait;
+            loop {
+                let now = self.client.transport().now();
+                if now >= deadline {
+                    break;
+                }
+                match self.next_heard(deadline - now)? {
+                    Some(Heard::Frame(reply)) => {
+                        if let [b'M', _, _, rest @ ..] = reply.as_slice()
+                            && let Some(registers) = self.take_stop(rest)
+                        {
+                            self.stopped = None;
+                            return Ok(Some(registers));
+                        }
+                        if let Some(registers) = self.take_stop(&reply) {
+                            self.stopped = None;
+                            return Ok(Some(registers));
+                        }
+                        if reply == [b'N'] {
+                            // A stub, which heard the frame damaged: again.
+                            break;
+                        }
+                        return Err(StubError::Refused {
+                            what: "attaching".into(),
+                            reason: format!(
+                                "the robot is stopped in a debug stub that is not where this image's goes (${:04X}): it was attached with another image; attach with that one, or reset the robot",
+                                self.stub.address
+                            ),
+                        });
+                    }
+                    Some(_) => {}
+                    None => break,
+                }
+            }
+        }
+        self.rx.clear();
+        Ok(None)
+    }
+
+    /// Reads the robot's code where the image has it and compares: the
+    /// chain slots' bytes taken from the robot, a `JSR` into the stub over
+    /// the image's bytes kept aside (a breakpoint an earlier session left:
+    /// its address and the image's bytes), any other difference refused.
+    fn check_image(&mut self) -> StubResult<Vec<(u16, [u8; 3])>> {
+        let slots: Vec<u16> = self
+            .image
+            .hooks()
+            .iter()
+            .filter_map(|record| record.chain)
+            .collect();
+        let entry = self.stub.entry.to_le_bytes();
+        let call = [JSR, entry[0], entry[1]];
+        let mut leftovers = Vec::new();
+        let mut adopted = Vec::new();
+        for area in self.image.areas().to_vec() {
+            let mut found = self.read(area.address, area.bytes.len())?;
+            for &slot in &slots {
+                for at in [slot, slot.wrapping_add(1)] {
+                    if area.contains(at) {
+                        let i = usize::from(at - area.address);
+                        adopted.push((at, found[i]));
+                        found[i] = area.bytes[i];
+                    }
+                }
+            }
+            let mut i = 0;
+            while i + 3 <= found.len() {
+                if found[i..i + 3] == call && area.bytes[i..i + 3] != call {
+                    let original = [area.bytes[i], area.bytes[i + 1], area.bytes[i + 2]];
+                    leftovers.push((area.address.wrapping_add(i as u16), original));
+                    found[i..i + 3].copy_from_slice(&original);
+                    i += 3;
+                } else {
+                    i += 1;
+                }
+            }
+            if let Some(i) = (0..found.len()).find(|&i| found[i] != area.bytes[i]) {
+                let end = found.len().min(i + 4);
+                return Err(StubError::NotTheImage {
+                    address: area.address.wrapping_add(i as u16),
+                    expected: hex(&area.bytes[i..end]),
+                    found: hex(&found[i..end]),
+                });
+            }
+        }
+        for (at, byte) in adopted {
+            self.image.set_byte(at, byte);
+        }
+        Ok(leftovers)
+    }
+
+    /// Tells where every instruction of the image starts (a built
+    /// image's line tables start a line at each): a breakpoint anywhere
+    /// else in the image is refused, since its `JSR` would cut an
+    /// instruction in two. Without it, only the image's decoding guides.
+    pub fn set_instruction_starts(&mut self, mut starts: Vec<u16>) {
+        starts.sort_unstable();
+        starts.dedup();
+        self.starts = Some(starts);
+    }
+
+    /// What attach found of an earlier session, and did about it.
+    #[must_use]
+    pub fn recovery(&self) -> &Recovery {
+        &self.recovery
     }
 
     /// The stub as placed.
@@ -222,18 +451,29 @@ impl<T: Transport> RobotDebug<T> {
     /// past its first instruction.
     ///
     /// # Errors
-    /// [`StubError::Refused`] with the reason (the ROM, a branch
-    /// displaced, a jump target covered, no trampoline free, overlapping
-    /// another breakpoint); the line's errors.
+    /// [`StubError::Refused`] with the reason (the ROM, inside an
+    /// instruction, one there already, a branch displaced, a jump target
+    /// covered, no trampoline free, overlapping another breakpoint); the
+    /// line's errors.
     pub fn set_breakpoint(&mut self, address: u16, entries: &[u16]) -> StubResult<()> {
-        if self.breakpoints.contains_key(&address) {
-            return Ok(());
-        }
-        let patch = patch::plan(address, &self.image, entries)?;
         let refuse = |reason: String| StubError::Refused {
             what: format!("a breakpoint at ${address:04X}"),
             reason,
         };
+        if self.breakpoints.contains_key(&address) {
+            return Err(refuse(
+                "one is there already (its JSR would displace the JSR)".into(),
+            ));
+        }
+        if let Some(starts) = &self.starts
+            && self.image.contains(address)
+            && starts.binary_search(&address).is_err()
+        {
+            return Err(refuse(
+                "no instruction of the image starts there (its line tables start a line at every instruction), and a JSR there would cut one in two".into(),
+            ));
+        }
+        let patch = patch::plan(address, &self.image, entries)?;
         for (other, _) in self.breakpoints.values() {
             let overlaps = |a: &Patch, b: &Patch| {
                 u32::from(a.address) < u32::from(b.address) + 3
@@ -496,6 +736,7 @@ impl<T: Transport> RobotDebug<T> {
                 }
                 Some(Heard::Frame(payload)) => {
                     if let Some(registers) = self.take_stop(&payload) {
+                        self.drop_temporary()?;
                         return Ok(Reply::Stopped(registers));
                     }
                 }
@@ -616,17 +857,53 @@ impl<T: Transport> RobotDebug<T> {
                         self.remove_breakpoint(done)?;
                     }
                 }
-                return Err(error);
+                // A step stops with a breakpoint's JSR on the next
+                // instruction: where that cannot go (an instruction of one
+                // or two bytes followed by a branch or a line of its own),
+                // neither can the step.
+                return Err(match error {
+                    StubError::Refused { reason, .. } => StubError::Refused {
+                        what: format!("a step from ${pc:04X}"),
+                        reason: format!(
+                            "it stops with a JSR (three bytes) on the next instruction, ${to:04X}, and that is refused: {reason}; set a breakpoint further on and continue"
+                        ),
+                    },
+                    other => other,
+                });
             }
         }
+        // Taken out at the next stop, whenever it comes: the step may run
+        // on (a `JSR` into the ROM that ends the answer, `JMP CMD_DONE`)
+        // and stop there later, or at another breakpoint.
+        self.temporary.extend(temporary);
         self.resume()?;
-        let reply = self.wait_event(wait)?;
-        if self.stopped.is_some() {
-            for &to in &temporary {
+        self.wait_event(wait)
+    }
+
+    /// The step's breakpoints, taken out at a stop.
+    fn drop_temporary(&mut self) -> StubResult<()> {
+        for to in std::mem::take(&mut self.temporary) {
+            if self.breakpoints.contains_key(&to) {
                 self.remove_breakpoint(to)?;
             }
         }
-        Ok(reply)
+        Ok(())
+    }
+
+    /// What the running robot said unasked, within `wait`: a stop (a
+    /// step that ran on, a command another program sent), an answer, or
+    /// `None`. `None` at once when it is stopped.
+    ///
+    /// # Errors
+    /// The line's errors.
+    pub fn poll(&mut self, wait: Duration) -> StubResult<Option<Reply>> {
+        if self.stopped.is_some() {
+            return Ok(None);
+        }
+        Ok(match self.wait_event(wait)? {
+            Reply::Silent => None,
+            reply => Some(reply),
+        })
     }
 
     /// Detaches: continues a stopped robot, removes every breakpoint (the
@@ -636,6 +913,14 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// The line's errors.
     pub fn detach(mut self) -> StubResult<Client<T>> {
+        if self.stopped.is_none() {
+            // A stop nobody saw (its frame lost, or unread): the stub
+            // answers a frame only when it runs.
+            if let Some(registers) = self.probe_stopped()? {
+                self.stopped = Some(registers);
+                self.drop_temporary()?;
+            }
+        }
         let addresses: Vec<u16> = self.breakpoints.keys().copied().collect();
         for address in addresses {
             self.remove_breakpoint(address)?;
@@ -651,6 +936,15 @@ impl<T: Transport> RobotDebug<T> {
             self.rom_write_verified(hook + 1, &previous)?;
         }
         Ok(self.client)
+    }
+
+    /// Lets go of the line without detaching: the robot keeps the stub
+    /// hooked, the breakpoints and a stop, as a session whose process was
+    /// killed leaves it (for the tests of [`RobotDebug::attach`]'s
+    /// recovery).
+    #[must_use]
+    pub fn abandon(self) -> Client<T> {
+        self.client
     }
 
     /// The robot's bytes where the image has code, compared with it:

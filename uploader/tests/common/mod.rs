@@ -9,6 +9,7 @@
 )]
 
 mod image;
+pub(crate) mod stub;
 
 pub(crate) use image::{extension, one_byte_changed};
 

@@ -1,0 +1,173 @@
+//! Attaching to a robot that is not as the image says (issue 27's hostile
+//! findings F3, F4, F6): a robot holding other code is refused before
+//! anything is written; a session whose process was killed (the stub
+//! hooked, a `JSR` left in the code, the robot stopped in the stub) is
+//! cleaned up by the next one, which says so; a chain slot's bytes are the
+//! robot's, not the image's.
+
+mod common;
+
+use common::stub::{attach, handler, robot};
+use romlib::symbols::HOOK_UNKNOWN;
+use std::time::Duration;
+use uploader::stub::{Reply, RobotDebug, StubError};
+use uploader::transport::VirtualTransport;
+use uploader::{Client, RomProfile, UploadImage};
+
+const WAIT: Duration = Duration::from_secs(1);
+
+/// `LDA $0480`, where the breakpoints go.
+const AT: u16 = 0x040C;
+
+fn reattach(client: Client<VirtualTransport>, image: &UploadImage) -> RobotDebug<VirtualTransport> {
+    RobotDebug::attach(client, &RomProfile::reference(), image.clone()).expect("attaches again")
+}
+
+/// The robot's memory once `debug` has detached.
+fn detached_memory(debug: RobotDebug<VirtualTransport>) -> Vec<u8> {
+    let client = debug.detach().expect("detached");
+    let robot = client.into_transport().into_robot();
+    robot.robot().board().memory().to_vec()
+}
+
+#[test]
+fn a_robot_holding_other_code_is_refused_naming_the_first_difference() {
+    let image = handler();
+    // The robot runs a build whose `LDA $0480` reads $0481.
+    let mut other = image.areas()[0].bytes.clone();
+    other[0x0D] = 0x81;
+    let on_robot = UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0400,
+            bytes: other,
+        }],
+        image.hooks().to_vec(),
+    )
+    .expect("an image");
+    let profile = RomProfile::reference();
+    let client = uploader::client(robot(&on_robot), &profile);
+    match RobotDebug::attach(client, &profile, image) {
+        Err(StubError::NotTheImage {
+            address,
+            expected,
+            found,
+        }) => {
+            assert_eq!(address, 0x040D);
+            assert!(expected.starts_with("80 04"), "{expected}");
+            assert!(found.starts_with("81 04"), "{found}");
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+}
+
+#[test]
+fn a_session_killed_while_the_robot_runs_is_cleaned_up_by_the_next() {
+    let image = handler();
+    let mut first = attach(&image);
+    first.set_breakpoint(AT, &[]).expect("set");
+    let client = first.abandon();
+    let mut second = reattach(client, &image);
+    let recovery = second.recovery().clone();
+    assert!(recovery.hooked, "{recovery:?}");
+    assert_eq!(recovery.removed, [AT]);
+    assert_eq!(recovery.stopped, None);
+    assert!(second.recovery().describe().contains("$040C"));
+    assert_eq!(second.compare_with_image().expect("read"), None);
+    // The command runs through, no stop.
+    assert_eq!(
+        second.command(b"/1Q", WAIT).expect("sent"),
+        Reply::Answer(b"Q42\r".to_vec())
+    );
+    let memory = detached_memory(second);
+    assert_eq!(&memory[0x0400..0x0481], &image.areas()[0].bytes[..]);
+    let hook = usize::from(HOOK_UNKNOWN);
+    assert_eq!(
+        memory[hook + 1..hook + 3],
+        [0x03, 0x04],
+        "the hook given back"
+    );
+}
+
+#[test]
+fn a_jsr_into_a_stub_no_longer_hooked_is_taken_out() {
+    let image = handler();
+    let mut first = attach(&image);
+    first.set_breakpoint(AT, &[]).expect("set");
+    let mut client = first.abandon();
+    // What an older second session did: the hook given back, the JSR left.
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(HOOK_UNKNOWN + 1, &[0x03, 0x04])
+        .expect("RAM");
+    let mut second = reattach(client, &image);
+    assert!(!second.recovery().hooked);
+    assert_eq!(second.recovery().removed, [AT]);
+    assert_eq!(second.stub().previous, 0x0403);
+    assert_eq!(
+        second.command(b"/1Q", WAIT).expect("sent"),
+        Reply::Answer(b"Q42\r".to_vec())
+    );
+    let memory = detached_memory(second);
+    assert_eq!(&memory[0x0400..0x0481], &image.areas()[0].bytes[..]);
+}
+
+#[test]
+fn a_robot_left_stopped_in_the_stub_is_found_stopped_and_goes_on() {
+    let image = handler();
+    let mut first = attach(&image);
+    first.set_breakpoint(AT, &[]).expect("set");
+    let Reply::Stopped(registers) = first.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    let client = first.abandon();
+    let mut second = reattach(client, &image);
+    assert_eq!(second.recovery().stopped, Some(registers));
+    assert_eq!(second.stopped(), Some(registers));
+    assert_eq!(second.recovery().removed, [AT]);
+    // The image's bytes are back under the stop: it goes on through them.
+    assert_eq!(second.read(AT, 3).expect("read"), [0xAD, 0x80, 0x04]);
+    second.resume().expect("continue");
+    // The `Q` went out before the stop, to the killed session.
+    assert_eq!(
+        second.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"42\r".to_vec())
+    );
+    let memory = detached_memory(second);
+    assert_eq!(&memory[0x0400..0x0481], &image.areas()[0].bytes[..]);
+    let hook = usize::from(HOOK_UNKNOWN);
+    assert_eq!(memory[hook + 1..hook + 3], [0x03, 0x04]);
+}
+
+#[test]
+fn a_breakpoint_on_a_chain_slot_jmp_displaces_and_restores_the_robots_bytes() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let mut transport = robot(&image);
+    // The uploader chained the handler to another extension's, here
+    // CMD_DONE's address standing for it: the image says $FF21.
+    let chained = [0x1E, 0xFF];
+    transport
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(0x0401, &chained)
+        .expect("RAM");
+    let client = uploader::client(transport, &profile);
+    let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    debug.set_breakpoint(0x0400, &[]).expect("set");
+    let trampoline = debug.stub().trampoline(0);
+    assert_eq!(
+        debug.read(trampoline, 3).expect("read"),
+        [0x4C, chained[0], chained[1]],
+        "the trampoline runs the robot's JMP"
+    );
+    debug.remove_breakpoint(0x0400).expect("removed");
+    assert_eq!(
+        debug.read(0x0400, 3).expect("read"),
+        [0x4C, chained[0], chained[1]]
+    );
+    assert_eq!(debug.compare_with_image().expect("read"), None);
+}
