@@ -321,10 +321,10 @@ fn a_path_that_is_not_a_picture_is_refused() {
 fn a_failed_write_of_the_path_leaves_the_file_as_it_was() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     room(dir.path());
-    let args = ["sim", "--world", "room.toml", "--path", "path.svg"];
+    let args = ["sim", "--world", "room.toml", "--path", "path.png"];
     let output = scorpion_with_input(Some(dir.path()), &args, "");
     assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
-    let whole = std::fs::metadata(dir.path().join("path.svg"))
+    let whole = std::fs::metadata(dir.path().join("path.png"))
         .expect("drawn")
         .len();
     assert!(
@@ -332,8 +332,8 @@ fn a_failed_write_of_the_path_leaves_the_file_as_it_was() {
         "a picture larger than the limit: {whole} bytes"
     );
 
-    let old = "<svg>the last run's picture</svg>";
-    std::fs::write(dir.path().join("path.svg"), old).expect("the old picture");
+    let old = "the last run's picture";
+    std::fs::write(dir.path().join("path.png"), old).expect("the old picture");
     let output = std::process::Command::new("sh")
         .arg("-c")
         // 2 blocks: 1 KiB or 2, whichever sh counts in.
@@ -346,9 +346,9 @@ fn a_failed_write_of_the_path_leaves_the_file_as_it_was() {
         .expect("sh runs");
     let said = transcript(&output);
     assert_eq!(output.status.code(), Some(1), "{said}");
-    assert!(said.contains("cannot write the path to path.svg"), "{said}");
+    assert!(said.contains("cannot write the path to path.png"), "{said}");
     assert_eq!(
-        std::fs::read_to_string(dir.path().join("path.svg")).expect("the picture"),
+        std::fs::read_to_string(dir.path().join("path.png")).expect("the picture"),
         old,
         "the file as it was: {said}"
     );
@@ -356,5 +356,5 @@ fn a_failed_write_of_the_path_leaves_the_file_as_it_was() {
         .expect("the directory")
         .map(|entry| entry.expect("an entry").file_name())
         .collect();
-    assert_eq!(left.len(), 2, "room.toml and path.svg alone: {left:?}");
+    assert_eq!(left.len(), 2, "room.toml and path.png alone: {left:?}");
 }
