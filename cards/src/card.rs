@@ -130,13 +130,13 @@ impl ScriptCard {
             (Some(base), _) => {
                 return Err(window(
                     outside(u32::from(base)),
-                    "cards sit on the KIM bus; move the card with `--card FILE@ADDR`",
+                    "cards sit on the KIM bus; move the card: `--card FILE@ADDR`, or `\"FILE@ADDR\"` in a project's [robot] cards",
                 ));
             }
             (None, None) => {
                 return Err(window(
                     "the card declares no `BASE` and none was given".into(),
-                    "declare `const BASE = 0x9000;` or give the address: `--card card.rhai@9000`",
+                    "declare `const BASE = 0x9000;` or give the address: `--card card.rhai@9000`, or `\"card.rhai@9000\"` in a project's [robot] cards",
                 ));
             }
             (None, Some(Ok(base))) => match u16::try_from(base) {
@@ -145,7 +145,7 @@ impl ScriptCard {
                     return Err(script.error_at_declaration(
                         "BASE",
                         outside(u32::from(base)),
-                        "cards sit on the KIM bus; move the card with `--card FILE@ADDR`".into(),
+                        "cards sit on the KIM bus; move the card: `--card FILE@ADDR`, or `\"FILE@ADDR\"` in a project's [robot] cards".into(),
                     ));
                 }
                 Err(_) => {

@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use debugger::Debugger;
 use debugger::monitor::{Failure, Monitor, Reply};
 use debugger::sources::Sources;
-use miette::{IntoDiagnostic, WrapErr};
+use miette::IntoDiagnostic;
 
 use crate::cmd::ports;
 
@@ -159,9 +159,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     }
     if let Some((path, first)) = picture {
         let view = room_now(&debugger).unwrap_or(first);
-        std::fs::write(path, view.picture_for(path, &commands)?)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
+        crate::cmd::rig::write_picture(path, &view.picture_for(path, &commands)?)?;
     }
     // A session in which the robot broke (a JAM, a card's fault) or whose
     // trace could not be written fails.

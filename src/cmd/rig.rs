@@ -98,8 +98,9 @@ pub(crate) fn show_printed(printed: &[(String, Printed)]) {
 }
 
 /// Where `--path FILE.svg` draws, checked before the run: the robot needs
-/// a room (`room`, the rig's view of it) and FILE's directory must exist,
-/// so that a long run does not end in "cannot write".
+/// a room (`room`, the rig's view of it) and FILE must be one
+/// [`check_path`] takes, so that a long run does not end in "cannot
+/// write".
 pub(crate) fn path_picture<V>(
     path: Option<&PathBuf>,
     room: Option<V>,
@@ -107,7 +108,7 @@ pub(crate) fn path_picture<V>(
     let Some(path) = path else {
         return Ok(None);
     };
-    path_directory_exists(path)?;
+    check_path(path)?;
     let room = room.ok_or_else(|| {
         miette::miette!(
             help = "give a world file: `--world room.toml` (docs/WORLD.md)",
@@ -117,9 +118,27 @@ pub(crate) fn path_picture<V>(
     Ok(Some((path, room)))
 }
 
-/// `--path`'s directory exists (it is not created: a mistyped directory
-/// would scatter pictures), and the path is not a FIFO or a device.
-pub(crate) fn path_directory_exists(path: &std::path::Path) -> miette::Result<()> {
+/// The pictures `--path` draws, by the extension that asks for each (any
+/// case).
+const PICTURE_EXTENSIONS: [&str; 2] = ["svg", "png"];
+
+/// `--path` names a picture (`.svg` or `.png`: anything else would get an
+/// SVG under a name that says otherwise) in a directory that exists (it
+/// is not created: a mistyped directory would scatter pictures), and is
+/// not a FIFO or a device.
+pub(crate) fn check_path(path: &std::path::Path) -> miette::Result<()> {
+    let picture = path.extension().is_some_and(|extension| {
+        PICTURE_EXTENSIONS
+            .iter()
+            .any(|known| extension.eq_ignore_ascii_case(known))
+    });
+    if !picture {
+        return Err(miette::miette!(
+            help = "end the path in .svg (the picture as SVG text) or .png (rasterized)",
+            "--path {}: a picture is .svg or .png",
+            path.display()
+        ));
+    }
     let directory = path
         .parent()
         .filter(|parent| !parent.as_os_str().is_empty())
@@ -145,4 +164,13 @@ pub(crate) fn path_directory_exists(path: &std::path::Path) -> miette::Result<()
             directory.display()
         ))
     }
+}
+
+/// Writes the picture `bytes` to `path` through a temporary file in its
+/// directory renamed over it: a write that fails (a full disk, a file
+/// size limit) leaves what was there, not half a picture.
+pub(crate) fn write_picture(path: &std::path::Path, bytes: &[u8]) -> miette::Result<()> {
+    use miette::Context as _;
+    hostfs::write(path, bytes)
+        .wrap_err_with(|| format!("cannot write the path to {}", path.display()))
 }

@@ -178,9 +178,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             } else {
                 svg.into_bytes()
             };
-            std::fs::write(path, bytes)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
+            crate::cmd::rig::write_picture(path, &bytes)?;
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -194,9 +192,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         serve_stdio(&mut robot, resolved.baud.value, &printed, drawn)
     }?;
     if let Some((path, view)) = room {
-        std::fs::write(path, view.picture_for(path, &commands)?)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("cannot write the path to {}", path.display()))?;
+        crate::cmd::rig::write_picture(path, &view.picture_for(path, &commands)?)?;
     }
     Ok(exit)
 }

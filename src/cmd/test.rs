@@ -245,7 +245,7 @@ impl Progress for Printer {
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let found = Found::here()?;
     if let Some(path) = &args.path {
-        crate::cmd::rig::path_directory_exists(path)?;
+        crate::cmd::rig::check_path(path)?;
     }
     let started = std::time::Instant::now();
     let filter = args.filter.clone().filter(|f| !f.is_empty());

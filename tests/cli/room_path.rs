@@ -251,3 +251,110 @@ fn a_png_path_is_the_svg_rasterized() {
         "the picture's floor"
     );
 }
+
+/// `test --path` in a project whose robot has no room is refused before
+/// any test runs, naming what `test` reads (the project's `[robot]
+/// world`), not a `--world` it does not take; it failed every transcript
+/// (issue 28's fourth pass).
+#[test]
+fn test_path_without_a_room_is_refused_up_front() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    assert!(scorpion(dir.path(), &["new", "probe"]).status.success());
+    let project = dir.path().join("probe");
+    let output = scorpion(&project, &["test", "--path", "run.svg"]);
+    let said = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("--path draws each transcript's robot in its room"),
+        "{said}"
+    );
+    assert!(
+        said.contains(r#"`world = "room.toml"` under [robot]"#),
+        "{said}"
+    );
+    assert!(!said.contains("--world"), "test takes no --world: {said}");
+    assert!(
+        !said.contains("... "),
+        "refused before any test ran: {said}"
+    );
+    // Filtered to no transcript, there is nothing to draw: the snapshots run.
+    let output = scorpion(&project, &["test", "probe/", "--path", "run.svg"]);
+    let said = transcript(&output);
+    assert!(!said.contains("--path draws"), "{said}");
+    assert!(said.contains("test probe/listing ... "), "{said}");
+}
+
+/// `--path` names a picture: `.svg` or `.png`, any case; anything else
+/// (which got an SVG under its name) is refused before the run, by each
+/// command that draws one.
+#[test]
+fn a_path_that_is_not_a_picture_is_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = project_in_room(dir.path());
+    for path in ["run.jpg", "run.txt", "run", "run.svg.bak"] {
+        for command in ["test", "sim", "debug"] {
+            let output = scorpion_with_input(Some(&project), &[command, "--path", path], "quit\n");
+            let said = transcript(&output);
+            assert_eq!(output.status.code(), Some(1), "{command} {path}: {said}");
+            assert!(
+                said.contains(&format!("--path {path}: a picture is .svg or .png")),
+                "{command} {path}: {said}"
+            );
+            assert!(!said.contains("... "), "refused before the run: {said}");
+            assert!(
+                !project.join(path).exists(),
+                "{command} {path}: nothing written"
+            );
+        }
+    }
+    let output = scorpion(&project, &["test", "probe.expect", "--path", "RUN.SVG"]);
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let picture = std::fs::read_to_string(project.join("RUN-probe.SVG")).expect("drawn");
+    assert!(picture.starts_with("<svg "), "{picture}");
+}
+
+/// A picture whose write fails half way (here the file size limit of
+/// `ulimit -f`, with SIGXFSZ ignored so that the write returns an error)
+/// leaves the file as it was, not half a picture, and no temporary file
+/// beside it.
+#[test]
+fn a_failed_write_of_the_path_leaves_the_file_as_it_was() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    room(dir.path());
+    let args = ["sim", "--world", "room.toml", "--path", "path.png"];
+    let output = scorpion_with_input(Some(dir.path()), &args, "");
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let whole = std::fs::metadata(dir.path().join("path.png"))
+        .expect("drawn")
+        .len();
+    assert!(
+        whole > 4096,
+        "a picture larger than the limit: {whole} bytes"
+    );
+
+    let old = "the last run's picture";
+    std::fs::write(dir.path().join("path.png"), old).expect("the old picture");
+    let output = std::process::Command::new("sh")
+        .arg("-c")
+        // 2 blocks: 1 KiB or 2, whichever sh counts in.
+        .arg(r#"ulimit -f 2 && trap "" XFSZ && exec "$0" "$@" < /dev/null"#)
+        .arg(env!("CARGO_BIN_EXE_scorpion"))
+        .args(args)
+        .current_dir(dir.path())
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("sh runs");
+    let said = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{said}");
+    assert!(said.contains("cannot write the path to path.png"), "{said}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("path.png")).expect("the picture"),
+        old,
+        "the file as it was: {said}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("the directory")
+        .map(|entry| entry.expect("an entry").file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "room.toml and path.png alone: {left:?}");
+}

@@ -97,9 +97,10 @@ fn a_crowd_far_away_changes_nothing_and_costs_no_test() {
 
 #[test]
 fn a_robot_standing_still_is_not_felt_again() {
-    // No walls: the robot stands among the posts.
+    // No walls: the robot stands among the posts, 3 cm round to stand
+    // clear of them (a start touching one is refused).
     let world = format!(
-        "{}\n[robot]\nx = 455\ny = -385\nheading = 0\n",
+        "{}\n[robot]\nx = 455\ny = -385\nheading = 0\nradius = 3\n",
         posts(10_000)
     );
     let room = Room::load("room.toml", &world).expect("the world file loads");

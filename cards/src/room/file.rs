@@ -7,7 +7,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::drive::{Drive, Pose};
-use super::geometry::{PI, Point, Shape, inside_polygon};
+use super::geometry::{PI, Point, Shape, inside_polygon, segment_distance2};
 use crate::error::{Located, ScriptError, offset_of};
 
 /// A floor line the ground trackers see.
@@ -423,6 +423,43 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
             "give the robot's `x` and `y` clear of the obstacles (the middle of its axle)",
         ));
     }
+    // The outline clear of everything too: touching a wall or an
+    // obstacle, the robot would start with a bumper closed, and the room
+    // would see its first step as a bump it never made.
+    let radius = length(
+        &robot.radius,
+        defaults::RADIUS,
+        limits::RADIUS,
+        "the radius",
+    )?;
+    if let Some(walls) = &walls
+        && let Some(edge) = touched_edge(walls, start, radius)
+    {
+        return Err(at(
+            start_span,
+            format!(
+                "the robot starts at ({}, {}) with its outline ({radius} cm round) touching the walls, at edge {}",
+                start.x,
+                start.y,
+                edge + 1
+            ),
+            "give the robot's `x` and `y` more than its `radius` from the walls and the obstacles (edge 1 runs from the first corner to the second)",
+        ));
+    }
+    if let Some((_, span)) = obstacles
+        .iter()
+        .find(|(shape, _)| outline_touches(shape, start, radius))
+    {
+        let obstacle = located_line(text, span.start);
+        return Err(at(
+            start_span,
+            format!(
+                "the robot starts at ({}, {}) with its outline ({radius} cm round) touching the obstacle at line {obstacle}",
+                start.x, start.y
+            ),
+            "give the robot's `x` and `y` more than its `radius` from the walls and the obstacles",
+        ));
+    }
     let script_span = file.script.as_ref().map(Spanned::span);
     if let Some(script) = &file.script
         && script.get_ref().trim().is_empty()
@@ -451,12 +488,7 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
             )?,
         },
         body: Body {
-            radius: length(
-                &robot.radius,
-                defaults::RADIUS,
-                limits::RADIUS,
-                "the radius",
-            )?,
+            radius,
             bumpers: bumpers.into_iter().map(degrees).collect(),
             bumper_arc: degrees(length(
                 &robot.bumper_arc,
@@ -478,6 +510,27 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
         script: file.script.map(Spanned::into_inner),
         script_span,
     })
+}
+
+/// The first edge (from 0) of the closed polygon `corners` that the
+/// outline of `radius` round `centre` touches (within it, or on it).
+fn touched_edge(corners: &[Point], centre: Point, radius: f64) -> Option<usize> {
+    let count = corners.len();
+    (0..count).find(|&k| {
+        segment_distance2(centre, corners[k], corners[(k + 1) % count]) <= radius * radius
+    })
+}
+
+/// Whether the outline of `radius` round `centre` touches `shape` (an
+/// edge within it or on it; the centre inside it is refused before).
+fn outline_touches(shape: &Shape, centre: Point, radius: f64) -> bool {
+    match shape {
+        Shape::Circle {
+            centre: middle,
+            radius: round,
+        } => centre.distance2(*middle) <= (radius + round) * (radius + round),
+        Shape::Polygon(corners) => touched_edge(corners, centre, radius).is_some(),
+    }
 }
 
 /// `v` for a message: `1e300` rather than its 301 digits.

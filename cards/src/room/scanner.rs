@@ -6,7 +6,7 @@
 
 use super::drive::Pose;
 use super::file::Layout;
-use super::geometry::{PI, Point, Shape, sin_cos};
+use super::geometry::{PI, Point, Shape, inside_polygon, segment_distance2, sin_cos};
 
 /// The scanner's turn per horizontal step, degrees: a 200-step-a-turn
 /// stepper like the wheels', so the largest scan (`/3H99`) sweeps 178°
@@ -24,6 +24,18 @@ pub const BACKGROUND: u8 = 0;
 
 /// The horizontal steps a row has, -128 to 127 (the scene's positions).
 const STEPS: usize = 256;
+
+/// How far past its ends (a fraction of its length) a ray may meet an
+/// edge. Rounding puts a ray aimed exactly at a corner a little past the
+/// end of each of the two edges that meet there: without the slack it
+/// would slip between them through a closed room's corner (and read an
+/// open floor). A billionth of an edge is far below a reading's worth.
+const EDGE_SLACK: f64 = 1e-9;
+
+/// How much farther than [`RANGE`] past the outline a row looks before
+/// it leaves a wall or an obstacle out: enough that the rounding of the
+/// gap cannot bring anything it leaves out into range.
+const REACH_MARGIN: f64 = 1.0;
 
 /// The cross product's z of `a` and `b`.
 fn cross(a: Point, b: Point) -> f64 {
@@ -62,7 +74,8 @@ pub fn ray_segment(origin: Point, direction: Point, a: Point, b: Point) -> Optio
     let to_a = Point::new(a.x - origin.x, a.y - origin.y);
     let along_ray = cross(to_a, edge) / denominator;
     let along_edge = cross(to_a, direction) / denominator;
-    (along_ray >= 0.0 && (0.0..=1.0).contains(&along_edge)).then_some(along_ray)
+    (along_ray >= 0.0 && (-EDGE_SLACK..=1.0 + EDGE_SLACK).contains(&along_edge))
+        .then_some(along_ray)
 }
 
 /// How far along the ray it first meets an edge of the closed polygon
@@ -76,22 +89,78 @@ pub fn ray_polygon(origin: Point, direction: Point, corners: &[Point]) -> Option
 }
 
 /// How far along the ray it first meets a wall or an obstacle of
-/// `layout`; `None` when nothing is in its way (an open floor).
+/// `layout`; `None` when nothing is in its way (an open floor). From
+/// inside an obstacle, 0: the robot is in contact with it whichever way
+/// it looks.
 #[must_use]
 pub fn distance(layout: &Layout, origin: Point, direction: Point) -> Option<f64> {
-    let walls = layout
-        .walls
-        .as_deref()
-        .and_then(|walls| ray_polygon(origin, direction, walls));
-    layout
-        .obstacles
-        .iter()
-        .filter_map(|obstacle| match obstacle {
-            Shape::Circle { centre, radius } => ray_circle(origin, direction, *centre, *radius),
-            Shape::Polygon(corners) => ray_polygon(origin, direction, corners),
-        })
-        .chain(walls)
-        .min_by(f64::total_cmp)
+    Near::of(layout, origin, f64::INFINITY).distance(origin, direction)
+}
+
+/// What a ray from one place can meet within a reach: the edges (of the
+/// walls and the polygons) and the circles near enough, so that a row's
+/// 256 rays are not each tested against a room's far obstacles.
+#[derive(Debug, Default)]
+struct Near {
+    edges: Vec<(Point, Point)>,
+    circles: Vec<(Point, f64)>,
+    /// The place is inside a polygon obstacle: every ray meets it at 0.
+    inside: bool,
+}
+
+impl Near {
+    /// What lies within `reach` of `origin` in `layout`.
+    fn of(layout: &Layout, origin: Point, reach: f64) -> Near {
+        let reach2 = reach * reach;
+        let mut near = Near::default();
+        let add_edges = |near: &mut Near, corners: &[Point]| {
+            let count = corners.len();
+            for k in 0..count {
+                let (a, b) = (corners[k], corners[(k + 1) % count]);
+                if segment_distance2(origin, a, b) <= reach2 {
+                    near.edges.push((a, b));
+                }
+            }
+        };
+        if let Some(walls) = &layout.walls {
+            add_edges(&mut near, walls);
+        }
+        for obstacle in &layout.obstacles {
+            // A box out of reach holds nothing within it.
+            if let Some((low, high)) = obstacle.bounds() {
+                let dx = (low.x - origin.x).max(origin.x - high.x).max(0.0);
+                let dy = (low.y - origin.y).max(origin.y - high.y).max(0.0);
+                if dx * dx + dy * dy > reach2 {
+                    continue;
+                }
+            }
+            match obstacle {
+                Shape::Circle { centre, radius } => near.circles.push((*centre, *radius)),
+                Shape::Polygon(corners) => {
+                    near.inside |= inside_polygon(corners, origin);
+                    add_edges(&mut near, corners);
+                }
+            }
+        }
+        near
+    }
+
+    /// How far along the ray from `origin` in `direction` it first meets
+    /// something near.
+    fn distance(&self, origin: Point, direction: Point) -> Option<f64> {
+        if self.inside {
+            return Some(0.0);
+        }
+        self.circles
+            .iter()
+            .filter_map(|&(centre, radius)| ray_circle(origin, direction, centre, radius))
+            .chain(
+                self.edges
+                    .iter()
+                    .filter_map(|&(a, b)| ray_segment(origin, direction, a, b)),
+            )
+            .min_by(f64::total_cmp)
+    }
 }
 
 /// The reading for something `gap` centimetres beyond the robot's outline
@@ -138,13 +207,18 @@ impl Scanner {
     pub fn row(&self, layout: &Layout, pose: Pose) -> [u8; STEPS] {
         let (sin, cos) = sin_cos(pose.heading);
         let mut row = [BACKGROUND; STEPS];
+        // Anything farther reads BACKGROUND: left out, the row is the
+        // same and costs what the room near the robot costs.
+        let near = Near::of(layout, pose.at, RANGE + layout.body.radius + REACH_MARGIN);
         for (reading_at, &(turn_sin, turn_cos)) in row.iter_mut().zip(&self.turns) {
             // heading − turn: a `+` step turns right (clockwise).
             let direction = Point::new(
                 cos * turn_cos + sin * turn_sin,
                 sin * turn_cos - cos * turn_sin,
             );
-            let gap = distance(layout, pose.at, direction).map(|d| d - layout.body.radius);
+            let gap = near
+                .distance(pose.at, direction)
+                .map(|d| d - layout.body.radius);
             *reading_at = reading(gap);
         }
         row
@@ -259,5 +333,135 @@ mod tests {
         let turned = scanner.row(&layout, north);
         assert_eq!(turned[128 + 50], row[128]);
         assert_eq!(turned[128 - 50], BACKGROUND);
+    }
+    /// A square room of 300 by 200 cm.
+    const ROOM: &str =
+        "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]\n[robot]\nx = 100\ny = 100\n";
+
+    /// A ray aimed exactly at a corner of a closed room meets the walls:
+    /// rounding put it a little past the end of both edges there, and it
+    /// slipped through to an open floor (the hostile pass's finding). The
+    /// robot is placed back along each ray from each corner.
+    #[test]
+    fn a_ray_at_a_corner_of_the_room_meets_it() {
+        let layout = layout(ROOM);
+        let walls = layout.walls.clone().expect("walls");
+        let scanner = Scanner::default();
+        let mut slipped = Vec::new();
+        for corner in &walls {
+            for heading_step in [0.0, 25.0, 50.0, 137.0] {
+                let heading = heading_step * STEP_DEGREES * PI / 180.0;
+                let (sin, cos) = sin_cos(heading);
+                for (column, &(turn_sin, turn_cos)) in scanner.turns.iter().enumerate() {
+                    let direction = Point::new(
+                        cos * turn_cos + sin * turn_sin,
+                        sin * turn_cos - cos * turn_sin,
+                    );
+                    for back in [7.3, 58.0, 91.7, 123.4, 170.9] {
+                        let at = Point::new(
+                            corner.x - direction.x * back,
+                            corner.y - direction.y * back,
+                        );
+                        if !super::super::geometry::inside_polygon(&walls, at) {
+                            continue;
+                        }
+                        if distance(&layout, at, direction).is_none() {
+                            slipped.push((at, column));
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            slipped.is_empty(),
+            "rays through a corner met nothing: {slipped:?}"
+        );
+        // One the pass found, the whole row's way (heading east, step 47
+        // right): the corner at (300, 0), read as its distance.
+        let at = Point::new(294.437_167_709_281_94, 58.848_618_669_432_47);
+        let row = scanner.row(&layout, Pose { at, heading: 0.0 });
+        let corner = Point::new(300.0, 0.0).distance2(at).sqrt();
+        assert_eq!(row[128 + 47], reading(Some(corner - layout.body.radius)));
+    }
+
+    /// Readings worked by hand in the room of 300 by 200 cm from (100,
+    /// 100) facing east, the outline 15 cm round: `round(255 × (200 −
+    /// gap) / 200)` with the gap to the wall the ray meets.
+    #[test]
+    fn readings_agree_with_a_hand_computation() {
+        let layout = layout(ROOM);
+        let row = Scanner::default().row(&layout, layout.start);
+        // Straight ahead: the east wall 200 cm off, a gap of 185:
+        // 255 × 15 / 200 = 19.125.
+        assert_eq!(row[128], 19);
+        // Step 25 left, 45° north of east: the north wall at 100 / sin
+        // 45° = 141.42, a gap of 126.42: 255 × 73.58 / 200 = 93.81.
+        assert_eq!(row[128 - 25], 94);
+        // Step 25 right, 45° south: the south wall as far.
+        assert_eq!(row[128 + 25], 94);
+        // Step 50 right, due south: 100 cm, a gap of 85: 146.625.
+        assert_eq!(row[128 + 50], 147);
+        // Step 30 right, 54° south of east: 100 / sin 54° = 123.61, a gap
+        // of 108.61: 255 × 91.39 / 200 = 116.53.
+        assert_eq!(row[128 + 30], 117);
+        // Step 100 right, 180°: the west wall 100 cm behind: 147 too.
+        assert_eq!(row[128 + 100], 147);
+    }
+
+    /// A robot dragged into a polygon obstacle is in contact with it
+    /// whichever way it looks, as inside a circle: not the distance to
+    /// the far side of the polygon.
+    #[test]
+    fn inside_a_polygon_every_ray_reads_contact() {
+        let layout = layout(
+            "[[obstacle]]\npolygon = [[40, 40], [160, 40], [160, 160], [40, 160]]\n[[obstacle]]\ncircle = { x = 400, y = 100, radius = 60 }\n",
+        );
+        let scanner = Scanner::default();
+        for at in [Point::new(100.0, 100.0), Point::new(400.0, 100.0)] {
+            let row = scanner.row(&layout, Pose { at, heading: 0.0 });
+            assert!(row.iter().all(|&r| r == 0xFF), "at {at:?}: {row:02X?}");
+        }
+    }
+
+    /// Obstacles beyond the scanner's range (10,000 of them) change no
+    /// reading: the row leaves them out, and is the one every ray
+    /// tested against everything gives.
+    #[test]
+    fn far_obstacles_change_nothing() {
+        let mut text = String::from(ROOM);
+        text.push_str("[[obstacle]]\ncircle = { x = 200, y = 150, radius = 10 }\n");
+        for k in 0..10_000 {
+            let (x, y) = (600 + (k % 100) * 30, (k / 100) * 30 - 1500);
+            text.push_str(&format!(
+                "[[obstacle]]\ncircle = {{ x = {x}, y = {y}, radius = 5 }}\n"
+            ));
+            if k % 3 == 0 {
+                text.push_str(&format!(
+                    "[[obstacle]]\npolygon = [[{x}, {y}], [{}, {y}], [{x}, {}]]\n",
+                    x + 4,
+                    y + 4
+                ));
+            }
+        }
+        // And some in range, just past the walls (the walls hide them).
+        text.push_str("[[obstacle]]\ncircle = { x = 320, y = 100, radius = 5 }\n");
+        let crowded = layout(&text);
+        let scanner = Scanner::default();
+        for (x, y, heading) in [(100.0, 100.0, 0.0), (250.0, 60.0, 1.0), (40.0, 170.0, 4.0)] {
+            let pose = Pose {
+                at: Point::new(x, y),
+                heading,
+            };
+            let row = scanner.row(&crowded, pose);
+            let (sin, cos) = sin_cos(heading);
+            for (column, &(turn_sin, turn_cos)) in scanner.turns.iter().enumerate() {
+                let direction = Point::new(
+                    cos * turn_cos + sin * turn_sin,
+                    sin * turn_cos - cos * turn_sin,
+                );
+                let every = distance(&crowded, pose.at, direction).map(|d| d - crowded.body.radius);
+                assert_eq!(row[column], reading(every), "at {pose:?}, column {column}");
+            }
+        }
     }
 }

@@ -76,6 +76,11 @@ pub enum Error {
     #[error(transparent)]
     WorkspacePort(Box<WorkspacePort>),
 
+    /// `--path` given where a project whose transcripts run has no room
+    /// (no world file) to draw its robot in.
+    #[error(transparent)]
+    PathWithoutRoom(Box<PathWithoutRoom>),
+
     /// A directory of the project that cannot be made.
     #[error("cannot create {}: {error}", path.display())]
     CreateDir {
@@ -239,6 +244,7 @@ impl Error {
             Error::BadTranscript(e) => &**e,
             Error::Baud(e) => &**e,
             Error::WorkspacePort(e) => &**e,
+            Error::PathWithoutRoom(e) => &**e,
             Error::Review(e) => e,
             Error::Read { source, .. }
             | Error::ScriptUnreadable { source, .. }
@@ -269,6 +275,7 @@ impl Error {
                 | Error::BadTranscript(_)
                 | Error::Baud(_)
                 | Error::WorkspacePort(_)
+                | Error::PathWithoutRoom(_)
                 | Error::Review(_)
         )
     }
@@ -366,6 +373,27 @@ pub struct Baud {
 pub struct WorkspacePort {
     /// The workspace's directory.
     pub root: PathBuf,
+}
+
+/// `--path` given to the tests of a project whose robot has no room: the
+/// transcripts take the world from the project (`[robot] world`), not
+/// from the command line, so the project is what to change.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[error(
+    "--path draws each transcript's robot in its room, and the robot of {file} has none{}",
+    world.as_ref().map(|w| format!(" (its world, {w}, is a script, not a world file)")).unwrap_or_default()
+)]
+#[diagnostic(
+    code(project::path_without_room),
+    help(
+        "give the project a world file: `world = \"room.toml\"` under [robot] in {file} (docs/WORLD.md); `scorpion test` takes the world from the project"
+    )
+)]
+pub struct PathWithoutRoom {
+    /// The project's file, as shown to the user.
+    pub file: String,
+    /// The project's `[robot] world`, when it is a world script.
+    pub world: Option<String>,
 }
 
 /// An error of the front end (its [`Progress`](super::Progress)), shown as

@@ -56,6 +56,13 @@ impl RoomSlot {
     }
 }
 
+/// Whether the world at `path` is a world file (a room: `.toml`) rather
+/// than a world script.
+#[must_use]
+pub fn is_world_file(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "toml")
+}
+
 /// What each script of a robot prints, by the script's name.
 pub type Scripts = Vec<(String, Printed)>;
 
@@ -113,7 +120,7 @@ impl Rig {
         }
         if let Some(path) = &self.world {
             let name = path.display().to_string();
-            let is_file = path.extension().is_some_and(|e| e == "toml");
+            let is_file = is_world_file(path);
             let what = if is_file {
                 "world file"
             } else {

@@ -25,10 +25,10 @@ use uploader::{Client, ClientConfig, Expectations, Mismatch, RomProfile, Transpo
 
 use super::build::{Built, SNAPSHOT_KINDS, build};
 use super::calls;
-use super::error::{Error, FrontEnd, Result, WorkspacePort};
+use super::error::{Error, FrontEnd, PathWithoutRoom, Result, WorkspacePort};
 use super::report::{Failure, MemberReport, Outcome, Passed, Progress, Question, Report};
 use super::review::{self, Decision, Mode};
-use super::rig::{EMU, Rig, Scripts, rom, virtual_robot};
+use super::rig::{EMU, Rig, Scripts, is_world_file, rom, virtual_robot};
 use super::room_lines::RoomLine;
 use super::snapshot::{self, Compared};
 use super::transcript::{self, Clock, Step};
@@ -91,6 +91,9 @@ pub fn run_tests(found: &Found, options: &Options, progress: &mut dyn Progress) 
         progress: &progress,
         started: None,
     };
+    if options.path.is_some() {
+        rooms_to_draw(found, run.filter.as_deref())?;
+    }
     match found {
         Found::Project(project) => run.project(project)?,
         Found::Workspace(workspace) => {
@@ -121,6 +124,38 @@ pub fn run_tests(found: &Found, options: &Options, progress: &mut dyn Progress) 
         }
     }
     Ok(run.report)
+}
+
+/// For `--path`: every project whose transcripts the run selects has a
+/// room to draw them in (a world file), checked before anything is built
+/// so that the flag is refused once, not by a failure of every
+/// transcript.
+fn rooms_to_draw(found: &Found, filter: Option<&str>) -> Result<()> {
+    let members;
+    let projects: Vec<&Project> = match found {
+        Found::Project(project) => vec![project],
+        Found::Workspace(workspace) => {
+            members = workspace.projects()?;
+            members.iter().map(|(_, project)| project).collect()
+        }
+    };
+    for project in projects {
+        let world = project.file.robot.world.as_deref();
+        if world.is_some_and(|w| is_world_file(Path::new(w))) {
+            continue;
+        }
+        let selected = project.transcripts().iter().any(|path| {
+            let name = format!("transcript {}", relative(project, path));
+            filter.is_none_or(|filter| name.contains(filter))
+        });
+        if selected {
+            return Err(Error::PathWithoutRoom(Box::new(PathWithoutRoom {
+                file: project.shown().to_owned(),
+                world: world.map(str::to_owned),
+            })));
+        }
+    }
+    Ok(())
 }
 
 /// The progress, shared between the run and the lines it opens (a line
@@ -525,16 +560,21 @@ impl Run<'_, '_, '_> {
                                     source: std::io::Error::other(e.to_string()),
                                 }
                             })?;
-                            std::fs::write(&file, picture).map_err(|source| Error::Write {
+                            // Whole or not at all: through a file renamed over it.
+                            hostfs::write(&file, &picture).map_err(|error| Error::Write {
                                 path: file.clone(),
-                                source,
+                                source: match error {
+                                    hostfs::Error::Write { source, .. } => source,
+                                    other => std::io::Error::other(other.to_string()),
+                                },
                             })?;
                             result
                         }
+                        // Refused before the run ([`rooms_to_draw`]).
                         (Some(_), None) => Err(indent(
                             "--path draws the robot in its room, and the robot has none: \
-                             give a world file (`world = \"room.toml\"` under [robot] in \
-                             Scorpion.toml, or --world room.toml; docs/WORLD.md)",
+                             give the project a world file (`world = \"room.toml\"` under \
+                             [robot] in Scorpion.toml; docs/WORLD.md)",
                         )),
                         _ => result,
                     }

@@ -91,8 +91,9 @@ pub fn no_room(shown: &str, line: usize) -> Error {
         shown: shown.to_owned(),
         line,
         reason: "the robot has no room to check this line in: `wait`, `pose` and `bumped` \
-                 need the virtual Scorpion with a world file (`world = \"room.toml\"` under \
-                 [robot] in Scorpion.toml, or `--world room.toml`; docs/WORLD.md)"
+                 need the virtual Scorpion in a room: the project's world file (`world = \
+                 \"room.toml\"` under [robot] in Scorpion.toml; docs/WORLD.md), with which \
+                 `scorpion test` runs its transcripts"
             .into(),
     }))
 }
