@@ -322,7 +322,10 @@ fn directory_of(path: &Path) -> &Path {
 }
 
 /// Writes `bytes` to `path` through a temporary file in its directory,
-/// renamed over it: the file is whole or as it was.
+/// renamed over it: the file is whole or as it was. The file keeps the
+/// permissions it had; a new one gets what the umask leaves of
+/// read-write for all, as a plain create would (not the temporary
+/// file's owner-only mode).
 ///
 /// # Errors
 /// As [`check_writable`] (asked again: the path may have changed since),
@@ -335,7 +338,18 @@ pub fn write(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(), Error> {
         path: path.to_path_buf(),
         source,
     };
-    let mut file = tempfile::NamedTempFile::new_in(directory_of(path)).map_err(failed)?;
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut file = builder.tempfile_in(directory_of(path)).map_err(failed)?;
+    if let Ok(old) = std::fs::metadata(path) {
+        file.as_file()
+            .set_permissions(old.permissions())
+            .map_err(failed)?;
+    }
     file.write_all(bytes).map_err(failed)?;
     file.as_file().sync_all().map_err(failed)?;
     file.persist(path).map_err(|error| failed(error.error))?;

@@ -168,3 +168,28 @@ fn sizes_read_as_people_write_them() {
     assert_eq!(limit::bytes_text(70_000), "70000 bytes");
     assert_eq!(limit::bytes_text(1), "1 byte");
 }
+
+/// A file written over keeps its mode; a new one is not owner-only (the
+/// temporary file's mode), unless the umask says so.
+#[cfg(unix)]
+#[test]
+fn a_file_written_keeps_its_permissions() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = tempfile::tempdir().expect("a directory");
+    let old = dir.path().join("old.svg");
+    std::fs::write(&old, b"before").expect("written");
+    std::fs::set_permissions(&old, std::fs::Permissions::from_mode(0o640)).expect("chmod");
+    write(&old, b"after").expect("written over");
+    let mode = std::fs::metadata(&old).expect("there").permissions().mode() & 0o777;
+    assert_eq!(mode, 0o640);
+    let new = dir.path().join("new.svg");
+    write(&new, b"new").expect("written");
+    let plain = dir.path().join("plain.svg");
+    std::fs::write(&plain, b"plain").expect("written");
+    let mode = |path: &Path| std::fs::metadata(path).expect("there").permissions().mode() & 0o777;
+    assert_eq!(
+        mode(&new),
+        mode(&plain),
+        "as a plain create under this umask"
+    );
+}

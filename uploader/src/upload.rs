@@ -149,8 +149,9 @@ pub struct UploadReport {
     /// The ranges written (address, length), the table entry's included:
     /// with a delta upload, only those the robot did not hold.
     pub written: Vec<(u16, usize)>,
-    /// Why `--loader auto` did not use the RAM loader, where it did not:
-    /// every byte went through the ROM's commands, none compared with the
+    /// Why `--loader auto` could not use the RAM loader, where it could
+    /// not (not where the ROM's commands were estimated faster): every
+    /// byte went through the ROM's commands, none compared with the
     /// robot's by checksums.
     pub without_loader: Option<String>,
 }
@@ -247,13 +248,8 @@ fn choose_loader<T: Transport>(
         };
         let with = loader_estimate(image.len(), len, baud, fast);
         if with >= rom_only_estimate(image.len(), baud) {
-            return Ok((
-                None,
-                Some(format!(
-                    "for {} bytes the ROM's commands are estimated faster",
-                    image.len()
-                )),
-            ));
+            // The faster way chosen: nothing the user need be told.
+            return Ok((None, None));
         }
     }
     Ok((Some(loader), None))

@@ -215,3 +215,117 @@ fn a_stop_after_the_answer_of_a_step_is_noticed_and_detach_lets_it_go() {
     let memory = memory.robot().board().memory();
     assert_eq!(&memory[0x0400..0x0481], &image.areas()[0].bytes[..]);
 }
+
+/// `/1Z` answers the digit X ends at, written to $0480 first:
+///
+/// ```text
+/// $0400  JMP chain      ; the chain slot
+/// $0403  CMP #'Z'
+/// $0405  BNE $0400
+/// $0407  LDX #3         ; the breakpoint: it displaces LDX and INX
+/// $0409  INX
+/// $040A  DEX
+/// $040B  DEX
+/// $040C  TXA
+/// $040D  CLC
+/// $040E  ADC #'0'
+/// $0410  STA $0480
+/// $0413  JSR PUTCH
+/// $0416  JSR PUTEOL
+/// $0419  JMP CMD_DONE
+/// ```
+fn short_instructions() -> uploader::UploadImage {
+    let mut bytes = vec![
+        0x4C, 0x21, 0xFF, 0xC9, b'Z', 0xD0, 0xF9, 0xA2, 0x03, 0xE8, 0xCA, 0xCA, 0x8A, 0x18, 0x69,
+        b'0', 0x8D, 0x80, 0x04, 0x20, 0x00, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
+    ];
+    bytes.resize(0x81, 0xEA);
+    uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![isa::objfmt::HookRecord {
+            kind: isa::objfmt::HookKind::Unknown,
+            handler: 0x0403,
+            chain: Some(0x0401),
+        }],
+    )
+    .expect("an image")
+}
+
+/// Steps over one- and two-byte instructions, which a breakpoint's
+/// three-byte `JSR` cannot stop before: the host does them for the robot
+/// (registers and the byte written as the robot would have them), from
+/// among the bytes the breakpoint displaced too, and the robot goes on
+/// from there with the right answer.
+#[test]
+fn steps_over_short_instructions_are_done_on_the_host() {
+    let image = short_instructions();
+    let mut debug = attach(&image);
+    debug
+        .set_breakpoint(0x0407, &[])
+        .expect("LDX and INX displaced");
+    let Reply::Stopped(at) = debug.command(b"/1Z", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    assert_eq!(at.pc, 0x0407);
+    let mut trace = Vec::new();
+    for _ in 0..7 {
+        let Reply::Stopped(after) = debug.step(&[], false, WAIT).expect("step") else {
+            panic!("the step did not stop: {trace:?}");
+        };
+        trace.push((after.pc, after.a, after.x));
+    }
+    assert_eq!(
+        trace,
+        [
+            (0x0409, b'Z', 3),
+            (0x040A, b'Z', 4),
+            (0x040B, b'Z', 3),
+            (0x040C, b'Z', 2),
+            (0x040D, 2, 2),
+            (0x040E, 2, 2),
+            (0x0410, b'2', 2),
+        ]
+    );
+    let Reply::Stopped(stored) = debug.step(&[], false, WAIT).expect("STA") else {
+        panic!("STA did not stop");
+    };
+    assert_eq!(stored.pc, 0x0413);
+    assert_eq!(
+        debug.read(0x0480, 1).expect("read"),
+        [b'2'],
+        "written for it"
+    );
+    // Nothing patched for those steps: the code is the image's.
+    assert_eq!(
+        debug.read(0x040A, 9).expect("read"),
+        image.areas()[0].bytes[10..19]
+    );
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"2\r".to_vec())
+    );
+    // Stopped again, one step leaves the PC among the displaced bytes
+    // (INX at $0409): it goes on from the trampoline's copy.
+    assert!(matches!(
+        debug.command(b"/1Z", WAIT).expect("sent"),
+        Reply::Stopped(_)
+    ));
+    let Reply::Stopped(inside) = debug.step(&[], false, WAIT).expect("LDX") else {
+        panic!("LDX did not stop");
+    };
+    assert_eq!((inside.pc, inside.x), (0x0409, 3));
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"2\r".to_vec())
+    );
+    debug.remove_breakpoint(0x0407).expect("removed");
+    assert_eq!(
+        debug.compare_with_image().expect("read"),
+        Some((0x0480, 0xEA, b'2'))
+    );
+}

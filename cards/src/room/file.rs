@@ -108,6 +108,10 @@ pub mod limits {
     pub const STEP: f64 = 10.0;
     /// The largest wheel base, centimetres.
     pub const WHEEL_BASE: f64 = 200.0;
+    /// The smallest wheel base, centimetres: a step's turn is the step
+    /// over the wheel base, and below this the heading grows past what
+    /// the room's sines keep exact.
+    pub const WHEEL_BASE_MIN: f64 = 1.0;
     /// The widest floor line, centimetres.
     pub const LINE_WIDTH: f64 = 100.0;
     /// The largest angle either way (a heading, a bumper's place), degrees.
@@ -240,6 +244,22 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
                     edge(second)
                 ),
                 "give the corners in order round the polygon (edge 1 runs from the first corner to the second, the last from the last corner back to the first)",
+            ));
+        }
+        // Twice the area (the shoelace sum): none when every corner is on
+        // one line, a polygon neither the bumpers nor the scanner can meet
+        // the way they meet a circle of any size.
+        let area2: f64 = (0..corners.len())
+            .map(|i| {
+                let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+                a.x * b.y - b.x * a.y
+            })
+            .sum();
+        if area2 == 0.0 {
+            return Err(at(
+                spanned.span(),
+                format!("{what} has no area: its corners are all on one line"),
+                "give at least three corners that are not on one line (a post is a circle)",
             ));
         }
         Ok(corners)
@@ -480,12 +500,27 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
         },
         drive: Drive {
             step: length(&robot.step, defaults::STEP, limits::STEP, "the step")?,
-            wheel_base: length(
+            wheel_base: match length(
                 &robot.wheel_base,
                 defaults::WHEEL_BASE,
                 limits::WHEEL_BASE,
                 "the wheel base",
-            )?,
+            )? {
+                base if base < limits::WHEEL_BASE_MIN => {
+                    let span = robot.wheel_base.as_ref().map_or(0..0, Spanned::span);
+                    return Err(at(
+                        span,
+                        format!(
+                            "the wheel base is {}; it must be at least {} and at most {}",
+                            number(base),
+                            limits::WHEEL_BASE_MIN,
+                            limits::WHEEL_BASE
+                        ),
+                        "lengths are in centimetres; docs/WORLD.md gives each one's range",
+                    ));
+                }
+                base => base,
+            },
         },
         body: Body {
             radius,

@@ -243,14 +243,22 @@ impl PoseCheck {
     pub fn check(&self, room: &RoomView) -> Option<String> {
         let pose = room.pose()?;
         let heading = pose.heading_degrees();
-        let (dx, dy) = (pose.at.x - self.x, pose.at.y - self.y);
-        let far = (dx * dx + dy * dy).sqrt() > self.within;
+        self.misses(pose.at.x, pose.at.y, heading)
+            .then(|| said(pose.at.x, pose.at.y, heading))
+    }
+
+    /// Whether a robot at `x`, `y` facing `heading` degrees is not where
+    /// the line says. Written as "not within" so that a pose gone to NaN
+    /// misses.
+    fn misses(&self, x: f64, y: f64, heading: f64) -> bool {
+        let (dx, dy) = (x - self.x, y - self.y);
+        let far = !((dx * dx + dy * dy).sqrt() <= self.within);
         let turned = self.heading.is_some_and(|(h, a)| {
             // The difference either way round the circle.
             let d = (heading - h).rem_euclid(360.0);
-            d.min(360.0 - d) > a
+            !(d.min(360.0 - d) <= a)
         });
-        (far || turned).then(|| said(pose.at.x, pose.at.y, heading))
+        far || turned
     }
 }
 
@@ -368,5 +376,21 @@ mod tests {
             BumpCheck::Closed(0x01).check(&[]).as_deref(),
             Some("no change of the bumpers")
         );
+    }
+
+    #[test]
+    fn a_pose_gone_to_nan_is_never_where_a_line_says() {
+        let Some(Ok(RoomLine::Pose(line))) = parse("pose => x=125cm y=100cm within 99999cm") else {
+            panic!("not a pose line");
+        };
+        assert!(!line.misses(125.0, 100.0, 0.0));
+        assert!(line.misses(f64::NAN, f64::NAN, 0.0), "a NaN position");
+        let Some(Ok(RoomLine::Pose(turned))) =
+            parse("pose => x=125cm y=100cm heading=90° within 1cm 2°")
+        else {
+            panic!("not a pose line");
+        };
+        assert!(!turned.misses(125.0, 100.0, 91.0));
+        assert!(turned.misses(125.0, 100.0, f64::NAN), "a NaN heading");
     }
 }

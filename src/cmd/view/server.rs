@@ -283,6 +283,21 @@ fn foreign(request: &httparse::Request<'_, '_>) -> Option<Asked> {
             .find(|header| header.name.eq_ignore_ascii_case(name))
             .map(|header| String::from_utf8_lossy(header.value).trim().to_owned())
     };
+    // Two of either would have only the first checked (RFC 9112 asks a
+    // server to refuse a second Host).
+    for name in ["host", "origin"] {
+        let count = request
+            .headers
+            .iter()
+            .filter(|header| header.name.eq_ignore_ascii_case(name))
+            .count();
+        if count > 1 {
+            return Some(Asked::Refused(
+                "400 Bad Request",
+                format!("a request with {count} {name} headers"),
+            ));
+        }
+    }
     let Some(host) = header("host") else {
         return Some(Asked::Refused(
             "400 Bad Request",
@@ -560,6 +575,11 @@ mod tests {
             ),
             "GET / HTTP/1.1\r\nHost: evil.example:5\r\n\r\n".to_owned(),
             "GET / HTTP/1.1\r\n\r\n".to_owned(),
+            // Only the first of two was checked.
+            format!("GET /ws HTTP/1.1\r\nHost: 127.0.0.1:5\r\nHost: evil.example\r\n{socket}"),
+            format!(
+                "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:5\r\nOrigin: http://127.0.0.1:5\r\nOrigin: http://evil.example\r\n{socket}"
+            ),
         ] {
             assert!(
                 matches!(

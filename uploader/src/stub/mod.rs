@@ -12,6 +12,7 @@
 
 pub mod error;
 pub mod frame;
+pub mod host_step;
 pub mod link;
 pub mod patch;
 pub mod session;

@@ -19,6 +19,7 @@ use romlib::protocol::Command;
 
 use super::error::{StubError, StubResult, hex};
 use super::frame::{self, Heard, IN_MAX};
+use super::host_step;
 use super::link::{StubPlan, TRAMPOLINES};
 use super::patch::{self, JSR, Patch};
 use crate::client::Client;
@@ -775,8 +776,17 @@ impl<T: Transport> RobotDebug<T> {
     /// Where the stopped robot goes on: a breakpoint's address is its
     /// trampoline (the displaced instructions, then back).
     fn resume_address(&self, pc: u16) -> u16 {
-        match self.breakpoints.get(&pc) {
-            Some((_, slot)) => self.stub.trampoline(*slot),
+        if let Some((_, slot)) = self.breakpoints.get(&pc) {
+            return self.stub.trampoline(*slot);
+        }
+        // A step done on the host can leave the PC among the bytes a
+        // breakpoint displaced: the trampoline holds them in order.
+        match self
+            .breakpoints
+            .values()
+            .find(|(patch, _)| patch.covers_inside(pc))
+        {
+            Some((patch, slot)) => self.stub.trampoline(*slot) + (pc - patch.address),
             None => pc,
         }
     }
@@ -811,6 +821,9 @@ impl<T: Transport> RobotDebug<T> {
         let Some(registers) = self.stopped else {
             return Err(not_stopped("step"));
         };
+        if let Some(stop) = self.step_on_host(registers)? {
+            return Ok(stop);
+        }
         let pc = registers.pc;
         let image = self.image.clone();
         let mut known: BTreeMap<u16, u8> = BTreeMap::new();
@@ -878,6 +891,50 @@ impl<T: Transport> RobotDebug<T> {
         self.temporary.extend(temporary);
         self.resume()?;
         self.wait_event(wait)
+    }
+
+    /// A step the host does for the robot (see [`host_step`]): the
+    /// instruction's bytes as the program has them (a breakpoint's
+    /// displaced ones, not its `JSR`), its writes written and verified,
+    /// the registers set. `None` when it is one for the patching step: a
+    /// push, or a write outside RAM (an I/O register reads back other
+    /// than written), into the stub, its zero page or a patched byte.
+    fn step_on_host(&mut self, registers: Registers) -> StubResult<Option<Reply>> {
+        let patched: Vec<(u16, Vec<u8>)> = self
+            .breakpoints
+            .values()
+            .map(|(patch, _)| (patch.address, patch.displaced.clone()))
+            .collect();
+        let displaced = |at: u16| {
+            patched.iter().find_map(|(address, bytes)| {
+                let offset = usize::from(at.wrapping_sub(*address));
+                bytes.get(offset).copied()
+            })
+        };
+        let stub = self.stub.clone();
+        // The stub's bytes and its zero-page pointer hold the stub's
+        // values at a stop, not the program's.
+        let the_stubs = |at: u16| {
+            stub.contains(at)
+                || at == u16::from(stub.zero_page)
+                || at == u16::from(stub.zero_page.wrapping_add(1))
+        };
+        let unwritable =
+            |at: u16| the_stubs(at) || at > platform::map::RAM_END || displaced(at).is_some();
+        let mut read = |at: u16| -> StubResult<u8> {
+            if let Some(byte) = displaced(at) {
+                return Ok(byte);
+            }
+            Ok(self.read(at, 1)?[0])
+        };
+        let Some(effects) = host_step::step(registers, &mut read, &the_stubs, &unwritable)? else {
+            return Ok(None);
+        };
+        for &(at, value) in &effects.writes {
+            self.write_verified(at, &[value])?;
+        }
+        self.set_registers(effects.registers)?;
+        Ok(Some(Reply::Stopped(effects.registers)))
     }
 
     /// The step's breakpoints, taken out at a stop.
