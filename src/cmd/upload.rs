@@ -350,7 +350,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             .map_err(|report| undo_refused(report, &path))?;
         // Marked used: a second undo says "already undone" rather than
         // comparing the robot with an upload no longer on it. Kept (as
-        // `.undone`) for `scorpion restore`.
+        // `.undone`), not deleted: what was undone stays on disk.
         let used = undone_path(&path);
         if let Err(error) = std::fs::rename(&path, &used) {
             miette::bail!(
@@ -394,7 +394,7 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
         Err(error) if error.is_not_found() && used.is_file() => Err(miette::miette!(
             code = "upload::already_undone",
             help = format!(
-                "a successful undo keeps its undo file as {0}; `scorpion restore {0}` puts it back again",
+                "a successful undo keeps its undo file as {}; the next upload keeps a new one",
                 used.display()
             ),
             "nothing to undo: the last upload kept in {} is already undone",
