@@ -98,23 +98,25 @@ pub enum Error {
     },
 
     /// Writing failed (a missing directory, permissions, a full disk).
-    #[error("{}: cannot write it: {source}", path.display())]
+    // The cause is in the message and is not the error's `source`: a
+    // source would be printed a second time under it.
+    #[error("{}: cannot write it: {cause}", path.display())]
     #[diagnostic(code(hostfs::write))]
     Write {
         /// The path as given.
         path: PathBuf,
         /// What the system said.
-        source: io::Error,
+        cause: io::Error,
     },
 
     /// The system refused (permissions, an I/O error).
-    #[error("{}: cannot read it: {source}", path.display())]
+    #[error("{}: cannot read it: {cause}", path.display())]
     #[diagnostic(code(hostfs::io))]
     Io {
         /// The path as given.
         path: PathBuf,
         /// What the system said.
-        source: io::Error,
+        cause: io::Error,
     },
 }
 
@@ -163,7 +165,7 @@ impl From<Error> for io::Error {
     fn from(error: Error) -> io::Error {
         let kind = match &error {
             Error::NotFound { .. } => io::ErrorKind::NotFound,
-            Error::Io { source, .. } | Error::Write { source, .. } => source.kind(),
+            Error::Io { cause, .. } | Error::Write { cause, .. } => cause.kind(),
             Error::NotText { .. } => io::ErrorKind::InvalidData,
             Error::NotAFile { .. } | Error::NotWritable { .. } | Error::TooLarge { .. } => {
                 io::ErrorKind::InvalidInput
@@ -209,7 +211,7 @@ fn io_error(path: &Path, source: io::Error) -> Error {
     } else {
         Error::Io {
             path: path.to_path_buf(),
-            source,
+            cause: source,
         }
     }
 }
@@ -305,7 +307,7 @@ pub fn check_writable(path: impl AsRef<Path>) -> Result<(), Error> {
             } else {
                 Err(Error::Write {
                     path: path.to_path_buf(),
-                    source: io::Error::new(
+                    cause: io::Error::new(
                         io::ErrorKind::NotFound,
                         format!("the directory {} does not exist", directory.display()),
                     ),
@@ -334,9 +336,9 @@ pub fn write(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(), Error> {
     use std::io::Write as _;
     let path = path.as_ref();
     check_writable(path)?;
-    let failed = |source: io::Error| Error::Write {
+    let failed = |cause: io::Error| Error::Write {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     let mut builder = tempfile::Builder::new();
     #[cfg(unix)]

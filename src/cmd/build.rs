@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use miette::{Context, IntoDiagnostic};
+use miette::IntoDiagnostic;
 
 use crate::cmd::asm::{AsmOptions, report};
 use crate::cmd::link::{DiskSources, LinkArgs, link_and_write};
@@ -98,6 +98,11 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     if args.sources.is_empty() {
         return project(args);
     }
+    // Every output is checked before anything is written.
+    if let Some(path) = &args.listing {
+        hostfs::check_writable(path)?;
+    }
+    crate::cmd::link::check_outputs(&args.link)?;
     let options = args.assembler.options(args.listing.is_some());
     let mut objects = Vec::with_capacity(args.sources.len());
     let mut listings = String::new();
@@ -126,9 +131,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         return Err(last.into());
     }
     if let Some(path) = &args.listing {
-        std::fs::write(path, &listings)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("cannot write {}", path.display()))?;
+        hostfs::write(path, listings.as_bytes())?;
     }
     link_and_write(&objects, &args.link, &DiskSources)
 }

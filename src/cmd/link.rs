@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use linker::{Format, Image, Linked, SourceProvider, Target};
-use miette::{Context, IntoDiagnostic};
+use miette::Context;
 
 use crate::args;
 
@@ -161,6 +161,12 @@ pub(crate) fn link_and_write(
         scorpion_project::runner::link_objects(objects, &target, &symbol_images, sources)?;
     report_warnings(&mut linked);
     let bytes = linked.write(args.format())?;
+    // Every output is checked before any is written: a missing directory
+    // for the map must not leave a new image beside the old map.
+    check_outputs(args)?;
+    for file in &linked.other_files {
+        hostfs::check_writable(file.path(&output.display().to_string()))?;
+    }
     write(output, &bytes)?;
     let mut others = Vec::new();
     for file in &linked.other_files {
@@ -179,10 +185,19 @@ pub(crate) fn link_and_write(
     Ok(ExitCode::SUCCESS)
 }
 
+/// Refuses outputs that cannot be written (a missing directory, a FIFO, a
+/// device), before anything is written.
+pub(crate) fn check_outputs(args: &LinkArgs) -> miette::Result<()> {
+    for path in args.output.iter().chain(&args.map).chain(&args.labels) {
+        hostfs::check_writable(path)?;
+    }
+    Ok(())
+}
+
+/// Writes an output as every command does (whole or not at all, and the
+/// same words when it cannot).
 fn write(path: &Path, bytes: &[u8]) -> miette::Result<()> {
-    std::fs::write(path, bytes)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot write {}", path.display()))
+    Ok(hostfs::write(path, bytes)?)
 }
 
 fn report_warnings(linked: &mut Linked) {

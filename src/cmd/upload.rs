@@ -346,7 +346,20 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let transport = ports::open_resolved(&resolved, &[])?;
         let rom = crate::cmd::config::rom(&resolved)?;
         let profile = crate::cmd::config::profile(rom.as_ref())?;
-        return crate::cmd::backup::restore_into(transport, profile, &backup, &path, false);
+        let code = crate::cmd::backup::restore_into(transport, profile, &backup, &path, false)
+            .map_err(|report| undo_refused(report, &path))?;
+        // Marked used: a second undo says "already undone" rather than
+        // comparing the robot with an upload no longer on it. Kept (as
+        // `.undone`), not deleted: what was undone stays on disk.
+        let used = undone_path(&path);
+        if let Err(error) = std::fs::rename(&path, &used) {
+            miette::bail!(
+                "undone, but cannot mark the undo file {} used (as {}): {error}",
+                path.display(),
+                used.display()
+            );
+        }
+        return Ok(code);
     }
     // The undo file is written during the upload: a FIFO or a device there
     // would block it half way, so it is refused before the robot is touched.
@@ -376,7 +389,17 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 /// The undo file, read: a missing one is "nothing to undo"; a damaged
 /// one or something that is not a file says what is wrong with it.
 fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
+    let used = undone_path(path);
     match hostfs::check(path, hostfs::BACKUP) {
+        Err(error) if error.is_not_found() && used.is_file() => Err(miette::miette!(
+            code = "upload::already_undone",
+            help = format!(
+                "a successful undo keeps its undo file as {}; the next upload keeps a new one",
+                used.display()
+            ),
+            "nothing to undo: the last upload kept in {} is already undone",
+            path.display()
+        )),
         Err(error) if error.is_not_found() => Err(miette::miette!(
             help = "`scorpion upload` keeps what it overwrites there; give `--undo-file` if it kept it elsewhere",
             "nothing to undo: {} does not exist (no upload has kept what it overwrote there)",
@@ -384,6 +407,35 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
         )),
         _ => crate::cmd::backup::read_backup(path)
             .wrap_err_with(|| format!("cannot undo from {}", path.display())),
+    }
+}
+
+/// Where a used undo file is kept: `X.undo` becomes `X.undo.undone`.
+fn undone_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".undone");
+    PathBuf::from(name)
+}
+
+/// An undo refused because the robot no longer holds what the undo file's
+/// upload put there, said as such: that upload is no longer on the robot.
+fn undo_refused(report: miette::Report, path: &Path) -> miette::Report {
+    match report.downcast_ref::<uploader::Error>() {
+        Some(uploader::Error::WitnessDiffers {
+            what,
+            address,
+            len,
+            expected,
+            found,
+            ..
+        }) => miette::miette!(
+            code = "uploader::witness_differs",
+            help = "another upload replaced it, or it was undone already (by a restore or an undo with another undo file); nothing was changed: upload the image you want instead of undoing",
+            "the upload the undo file {} undoes is no longer on the robot: ${address:04X}-${:04X}, {what}, is not what it was when the undo file was written (its Fletcher-16 was ${expected:04X}, the robot's is ${found:04X})",
+            path.display(),
+            u32::from(*address) + u32::from(*len) - 1
+        ),
+        _ => report,
     }
 }
 

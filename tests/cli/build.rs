@@ -188,3 +188,56 @@ fn two_extensions_in_one_link_name_the_users_lines_that_took_the_hook() {
         assert!(stderr.contains(wanted), "`{wanted}` missing from: {stderr}");
     }
 }
+
+/// N3 (issue 27): an output that cannot be written is refused before any
+/// is written (the image stays unwritten when the map's directory is
+/// missing); a missing directory for the image is worded as every other
+/// command words it (`hostfs::write`), its cause said once.
+#[test]
+fn outputs_are_checked_before_any_is_written_and_worded_once() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_sources(dir.path());
+    let output = scorpion(
+        dir.path(),
+        &[
+            "build",
+            "main.s",
+            "lib.s",
+            "-o",
+            "e.elf",
+            "--target",
+            "flat",
+            "--start",
+            "$0800",
+            "--map",
+            "nodir/e.map",
+        ],
+    );
+    let text = transcript(&output);
+    assert!(!output.status.success(), "{text}");
+    assert!(text.contains("nodir/e.map"), "{text}");
+    assert!(!dir.path().join("e.elf").exists(), "e.elf written: {text}");
+
+    let output = scorpion(
+        dir.path(),
+        &[
+            "build",
+            "main.s",
+            "lib.s",
+            "-o",
+            "nodir/e.elf",
+            "--target",
+            "flat",
+            "--start",
+            "$0800",
+        ],
+    );
+    let text = transcript(&output);
+    assert!(!output.status.success(), "{text}");
+    assert!(text.contains("hostfs::write"), "{text}");
+    assert_eq!(
+        text.matches("the directory nodir does not exist").count(),
+        1,
+        "the cause once: {text}"
+    );
+}

@@ -109,9 +109,40 @@ fn an_undo_file_from_one_robot_is_refused_on_another() {
     assert!(!success, "{text}");
     assert!(text.contains("uploader::witness_differs"), "{text}");
     assert!(text.contains("$0F88-"), "the table entry: {text}");
+    // F4 (round 3): said as what it is, an undo file whose upload is not
+    // there, the range named as the table's entry.
+    assert!(
+        text.contains(
+            "the upload the undo file scorpion-last-upload.undo undoes is no longer on the robot"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("installed-extension table's entry"), "{text}");
+    assert!(!text.contains("the backup was written"), "{text}");
     // On its own robot it works.
     let text = ok(dir.path(), &line, &["upload", "--undo"]);
     assert!(text.contains("restored"), "{text}");
+}
+
+/// F4 (issue 27, round 3): after a successful undo the undo file is
+/// marked used (kept as `.undone`): a second undo says the upload is
+/// already undone, and touches nothing.
+#[test]
+fn a_second_undo_says_already_undone() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let d = dir.path();
+    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    assert!(!d.join("scorpion-last-upload.undo").exists());
+    assert!(d.join("scorpion-last-upload.undo.undone").is_file());
+    let (success, text) = on(d, &line, &["upload", "--undo"]);
+    assert!(!success, "{text}");
+    assert!(text.contains("already undone"), "{text}");
+    assert!(!text.contains("witness_differs"), "{text}");
 }
 
 /// F6': `restore --force` onto a robot whose ROM differs from the profile
@@ -129,6 +160,11 @@ fn restore_force_onto_another_rom_goes_through_and_says_what_it_overrides() {
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
     let (success, text) = on(dir.path(), &line, &["restore", "reference.bak"]);
     assert!(!success, "{text}");
+    // F5 (round 3): the refusal the README documents, its help naming
+    // `restore --force`; not the upload's, about linking an image.
+    assert!(text.contains("uploader::backup_rom_differs"), "{text}");
+    assert!(!text.contains("uploader::wrong_rom"), "{text}");
+    assert!(text.contains("restore FILE --force"), "{text}");
     let text = ok(dir.path(), &line, &["restore", "reference.bak", "--force"]);
     assert!(text.contains("restored reference.bak"), "{text}");
     let wrong = format!("$FF2E: expected ${reference:02X}, found ${changed:02X}");
@@ -194,4 +230,27 @@ fn an_undo_file_in_a_missing_directory_is_refused() {
     assert!(!dir.path().join("nowhere").exists());
     let text = ok(dir.path(), &line, &["read", "$0200", "3"]);
     assert!(text.contains("0200: 4C 21 FF"), "untouched: {text}");
+}
+
+/// F7 (issue 27, round 3): the README's loader paragraph names the size
+/// `upload` prints on a serial port (where it keeps an undo file, so the
+/// checksum part goes in), not only the demo's on `--port emu`.
+#[test]
+fn the_readme_names_the_loader_size_a_serial_upload_prints() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 700, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let text = ok(dir.path(), &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let loader = text
+        .split("through the RAM loader (")
+        .nth(1)
+        .and_then(|rest| rest.split(')').next())
+        .unwrap_or_else(|| panic!("no loader in: {text}"));
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    assert!(
+        readme.contains(&format!("`through the RAM loader ({loader})`")),
+        "README.md does not say `through the RAM loader ({loader})`"
+    );
 }

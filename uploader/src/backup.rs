@@ -556,9 +556,8 @@ impl Backup {
 
 /// Refuses a restore onto a robot whose ROM differs from the one the
 /// backup was taken from (the RAM it holds calls into that ROM), unless
-/// `force_rom` (then returns the refusal it overrode), and one whose
-/// memory under a hook's target no longer sums as it did.
-fn check_robot<T: Transport>(
+/// `force_rom` (then returns the refusal it overrode).
+fn check_backup_rom<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
     force_rom: bool,
@@ -585,11 +584,32 @@ fn check_robot<T: Transport>(
             overridden = Some(error);
         }
     }
+    Ok(overridden)
+}
+
+/// Refuses a restore onto a robot whose memory under a hook's target (the
+/// table's entry of the hooked extension, or its code) no longer sums as
+/// it did when the backup was written.
+fn check_witnesses<T: Transport>(
+    client: &mut Client<T>,
+    backup: &Backup,
+    profile: &RomProfile,
+) -> Result<()> {
+    let table = table_range(profile);
     for witness in &backup.witnesses {
         let bytes = client.read_memory(witness.address, usize::from(witness.len))?;
         let found = crate::sums::fletcher16(&bytes);
         if found != witness.sum {
+            let in_table = table.is_some_and(|(at, len)| {
+                let start = usize::from(witness.address);
+                start >= usize::from(at) && start < usize::from(at) + len
+            });
             return Err(Error::WitnessDiffers {
+                what: if in_table {
+                    "the installed-extension table's entry a hook goes back to"
+                } else {
+                    "the code a hook goes back to"
+                },
                 address: witness.address,
                 len: witness.len,
                 expected: witness.sum,
@@ -597,7 +617,7 @@ fn check_robot<T: Transport>(
             });
         }
     }
-    Ok(overridden)
+    Ok(())
 }
 
 /// Puts `backup` back into the robot, verified, hooks last: first every
@@ -642,12 +662,16 @@ pub fn restore<T: Transport>(
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     crate::upload::connect(client, options)?;
+    // The ROM the backup was taken from first: a robot with another ROM
+    // is told as that (`restore --force` overrides it), not as a ROM the
+    // profile's image was linked against.
     let mut overridden = Vec::new();
+    overridden.extend(check_backup_rom(client, backup, options.force_rom)?);
     match fingerprint::check_jump_table(client, profile) {
         Err(error @ Error::WrongRom { .. }) if options.force_rom => overridden.push(error),
         other => other?,
     }
-    overridden.extend(check_robot(client, backup, options.force_rom)?);
+    check_witnesses(client, backup, profile)?;
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
             refusal: error.to_string(),

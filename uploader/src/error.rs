@@ -255,7 +255,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::backup_rom_differs),
         help(
-            "restore it onto the robot it was taken from; `--force` restores it anyway (its code's calls into the ROM may land elsewhere)"
+            "restore it onto the robot it was taken from; `scorpion restore FILE --force` restores it anyway (its code's calls into the ROM may land elsewhere)"
         )
     )]
     BackupRomDiffers {
@@ -267,7 +267,7 @@ pub enum Error {
     /// Memory a restored hook would point into no longer holds what it
     /// held when the backup was written. Nothing was changed.
     #[error(
-        "${address:04X}-${end:04X}, the code a hook goes back to, is not what it was when the backup was written: its Fletcher-16 was ${expected:04X}, the robot's is ${found:04X}; nothing was changed",
+        "${address:04X}-${end:04X}, {what}, is not what it was when the backup was written: its Fletcher-16 was ${expected:04X}, the robot's is ${found:04X}; nothing was changed",
         end = u32::from(*address) + u32::from(*len) - 1
     )]
     #[diagnostic(
@@ -277,6 +277,9 @@ pub enum Error {
         )
     )]
     WitnessDiffers {
+        /// What the memory is: the table of installed extensions' entry
+        /// of the hooked extension, or the code a hook goes back to.
+        what: &'static str,
         /// The first address.
         address: u16,
         /// How many bytes.

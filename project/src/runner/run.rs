@@ -564,7 +564,7 @@ impl Run<'_, '_, '_> {
                             hostfs::write(&file, &picture).map_err(|error| Error::Write {
                                 path: file.clone(),
                                 source: match error {
-                                    hostfs::Error::Write { source, .. } => source,
+                                    hostfs::Error::Write { cause, .. } => cause,
                                     other => std::io::Error::other(other.to_string()),
                                 },
                             })?;
