@@ -655,6 +655,9 @@ impl Parser<'_> {
                 if let Some(register) = Register::named(&name) {
                     return Ok(Node::Register(register));
                 }
+                if let Some(why) = self.symbols.ambiguity(&name) {
+                    return Err(self.error_at(start, &why));
+                }
                 if let Some(value) = self.symbols.get(&name) {
                     return Ok(Node::Number(i64::from(value)));
                 }

@@ -12,6 +12,9 @@ pub struct Symbols {
     by_name: HashMap<String, u16>,
     /// Labels (names of places in code or data), by address.
     labels: Vec<(u16, String)>,
+    /// Names that two images define at different addresses: each place,
+    /// for the refusal.
+    ambiguous: HashMap<String, Vec<Place>>,
 }
 
 impl Symbols {
@@ -23,9 +26,20 @@ impl Symbols {
         for symbol in romlib::symbols::ALL {
             symbols.by_name.insert(symbol.name.to_owned(), symbol.value);
         }
-        for image in images {
+        let mut defined: HashMap<&str, Vec<Place>> = HashMap::new();
+        for (number, image) in images.iter().enumerate() {
             for symbol in &image.symbols {
                 if let Ok(value) = u16::try_from(symbol.value) {
+                    let places = defined.entry(symbol.name.as_str()).or_default();
+                    if !places.iter().any(|place| place.address == value) {
+                        places.push(Place {
+                            address: value,
+                            image: number + 1,
+                            line: image
+                                .source_of(u32::from(value))
+                                .map(|(file, line, _)| format!("{file}:{line}")),
+                        });
+                    }
                     let entry = symbols.by_name.entry(symbol.name.clone());
                     if symbol.global {
                         *entry.or_default() = value;
@@ -35,6 +49,11 @@ impl Symbols {
                 }
             }
         }
+        symbols.ambiguous = defined
+            .into_iter()
+            .filter(|(_, places)| places.len() > 1)
+            .map(|(name, places)| (name.to_owned(), places))
+            .collect();
         symbols.labels = robot.labels();
         for (at, name) in &symbols.labels {
             symbols.by_name.entry(name.clone()).or_insert(*at);
@@ -52,6 +71,38 @@ impl Symbols {
     #[must_use]
     pub fn get(&self, name: &str) -> Option<u16> {
         self.by_name.get(name).copied()
+    }
+
+    /// Why `name` cannot be taken for an address, when two images define
+    /// it at different addresses: each address and the image it is in,
+    /// and how to choose one (by address or by `file:line`).
+    #[must_use]
+    pub fn ambiguity(&self, name: &str) -> Option<String> {
+        let places = self.ambiguous.get(name)?;
+        let said: Vec<String> = places
+            .iter()
+            .map(|place| {
+                let line = place
+                    .line
+                    .as_ref()
+                    .map(|line| format!(" ({line})"))
+                    .unwrap_or_default();
+                format!("${:04X} in image {}{line}", place.address, place.image)
+            })
+            .collect();
+        let first = &places[0];
+        let line = first
+            .line
+            .as_ref()
+            .map(|line| format!(" or its FILE:LINE (`{line}`)"))
+            .unwrap_or_default();
+        Some(format!(
+            "`{}` is ambiguous: {} images define it, at {}; name the place by its address (`${:04X}`){line}",
+            shown(name),
+            places.len(),
+            said.join(" and "),
+            first.address
+        ))
     }
 
     /// The label at `address` exactly.
@@ -124,6 +175,9 @@ impl Symbols {
         if term.starts_with(|c: char| c.is_ascii_digit()) {
             return number(term, 10);
         }
+        if let Some(why) = self.ambiguity(term) {
+            return Err(why);
+        }
         self.get(term)
             .map(i64::from)
             .ok_or_else(|| self.unknown(term))
@@ -163,6 +217,17 @@ impl Symbols {
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.by_name.keys().map(String::as_str)
     }
+}
+
+/// Where an image defines a name.
+#[derive(Debug, Clone)]
+struct Place {
+    /// The name's value there.
+    address: u16,
+    /// Which image (from 1, in the order given).
+    image: usize,
+    /// `file:line` the address came from, when the image's line table says.
+    line: Option<String>,
 }
 
 /// The most characters of an expression an error repeats.
@@ -211,5 +276,60 @@ mod tests {
         let dispatch = symbols.get("dispatch").expect("the ROM's dispatch label");
         assert_eq!(symbols.place(dispatch).as_deref(), Some("dispatch"));
         assert_eq!(symbols.place(dispatch + 2), Some("dispatch+$2".into()));
+    }
+
+    /// An image whose label `name` is at `address`.
+    fn image_with(name: &str, address: u16) -> linker::Image {
+        linker::Image {
+            symbols: vec![linker::ImageSymbol {
+                name: name.into(),
+                value: u32::from(address),
+                size: 0,
+                global: false,
+                section: Some(0),
+            }],
+            ..linker::Image::default()
+        }
+    }
+
+    /// Issue 27 F3: two images both defining `not_mine` made `break
+    /// not_mine` take the first silently. Refused, naming both places
+    /// and how to choose; a name both define at one address is not.
+    #[test]
+    fn a_label_two_images_define_apart_is_refused_naming_both() {
+        let robot = romlib::VirtualScorpion::new();
+        let images = [
+            image_with("not_mine", 0x0412),
+            image_with("not_mine", 0x0612),
+            image_with("shared", 0x0700),
+        ];
+        let mut both = images.to_vec();
+        both.push(image_with("shared", 0x0700));
+        let symbols = Symbols::new(&robot, &both);
+        let said = symbols
+            .address("not_mine")
+            .expect_err("ambiguous")
+            .to_string();
+        for expected in [
+            "ambiguous",
+            "$0412 in image 1",
+            "$0612 in image 2",
+            "`$0412`",
+        ] {
+            assert!(said.contains(expected), "{expected}: {said}");
+        }
+        let parsed = crate::expr::Expr::parse("not_mine+1", &symbols)
+            .err()
+            .map(|e| e.to_string());
+        assert!(
+            parsed.as_deref().is_some_and(|e| e.contains("ambiguous")),
+            "{parsed:?}"
+        );
+        assert_eq!(symbols.address("shared").ok(), Some(0x0700));
+        assert_eq!(symbols.address("$0612").ok(), Some(0x0612));
+        // One image alone: no question.
+        let one = Symbols::new(&robot, &images[..1]);
+        assert_eq!(one.address("not_mine").ok(), Some(0x0412));
+        assert!(one.ambiguity("not_mine").is_none());
     }
 }

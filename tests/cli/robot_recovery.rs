@@ -173,3 +173,63 @@ fn a_step_over_puteol_sees_the_stop_after_the_answer_and_quit_lets_it_go() {
     assert_eq!(code(dir.path(), &sim), before);
     answers(dir.path(), &sim);
 }
+
+/// A new user's F1 (issue 27): after the README's own session, whose
+/// `poke value $99` changes a byte of `.data`, a second session attaches
+/// (the robot's code is the image's; its data is the program's own), and
+/// sees the poked byte.
+#[test]
+fn after_the_readme_session_a_second_attach_works() {
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    let before = code(dir.path(), &sim);
+    let first = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        "break show\n/1Q\nregs\npoke value $99\nstep\ncontinue\ndelete 1\n/1Q\n",
+    );
+    assert!(first.status.success(), "{}", transcript(&first));
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        "/1Q\nquit\n",
+    );
+    let printed = transcript(&output);
+    assert!(output.status.success(), "{printed}");
+    for expected in ["answer: Q99", "detached"] {
+        assert!(printed.contains(expected), "{expected}:\n{printed}");
+    }
+    assert!(!printed.contains("does not hold the image"), "{printed}");
+    // The code as uploaded; only `value` ($0418) changed.
+    let after = code(dir.path(), &sim);
+    assert_eq!(after[..0x18], before[..0x18]);
+    assert_eq!((before[0x18], after[0x18]), (0x42, 0x99));
+}
+
+/// The other half of F1: a byte of the image's code changed on the robot
+/// (`cmp #'Q'` made `cmp #'R'` at a stop) is still refused.
+#[test]
+fn a_changed_code_byte_is_still_refused() {
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    let first = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        "break show\n/1Q\npoke $0401 $52\ncontinue\ndelete 1\nquit\n",
+    );
+    assert!(first.status.success(), "{}", transcript(&first));
+    let changed = code(dir.path(), &sim);
+    assert_eq!(changed[1], 0x52, "{}", transcript(&first));
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        "break show\nquit\n",
+    );
+    let printed = transcript(&output);
+    assert!(!output.status.success(), "{printed}");
+    let said = printed.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        said.contains("the robot does not hold the image: $0401 holds 52"),
+        "{printed}"
+    );
+    assert!(said.contains("the image has 51"), "{printed}");
+    assert_eq!(code(dir.path(), &sim), changed);
+}

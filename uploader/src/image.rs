@@ -39,6 +39,10 @@ pub struct UploadImage {
     /// The memory the image owns: its areas, and where a linked image's
     /// segments run (BSS and zero page too), merged.
     extents: Vec<std::ops::RangeInclusive<u16>>,
+    /// Where the image loads code (its `SHF_EXECINSTR` sections), sorted
+    /// and merged, when known: what the program cannot change, unlike its
+    /// data. `None`: every loaded byte counts as code.
+    code: Option<Vec<std::ops::RangeInclusive<u16>>>,
 }
 
 impl UploadImage {
@@ -79,6 +83,7 @@ impl UploadImage {
             areas,
             hooks,
             extents,
+            code: None,
         };
         for record in &image.hooks {
             if !image.contains(record.handler) {
@@ -116,6 +121,40 @@ impl UploadImage {
     #[must_use]
     pub fn extents(&self) -> &[std::ops::RangeInclusive<u16>] {
         &self.extents
+    }
+
+    /// Where the image loads code (its executable sections), sorted and
+    /// merged, when known; `None` when every loaded byte is to be taken
+    /// for code (an image made of bare areas, or one whose sections say
+    /// nothing executable). The robot's bytes there must stay the image's;
+    /// the rest (`.data`, tables) is the program's to change.
+    #[must_use]
+    pub fn code(&self) -> Option<&[std::ops::RangeInclusive<u16>]> {
+        self.code.as_deref()
+    }
+
+    /// Says where the image loads code (see [`UploadImage::code`]): an
+    /// image merged from several linked ones keeps theirs. An empty list
+    /// is taken as not known.
+    pub fn set_code(&mut self, ranges: Vec<std::ops::RangeInclusive<u16>>) {
+        let merged = romlib::installed::merge(ranges.into_iter().map(|range| {
+            (
+                u64::from(*range.start()),
+                u64::from(*range.end()) - u64::from(*range.start()) + 1,
+            )
+        }));
+        self.code = (!merged.is_empty()).then_some(merged);
+    }
+
+    /// Whether `address` is code the robot must hold as the image has it:
+    /// inside [`UploadImage::code`], or loaded at all when that is not
+    /// known.
+    #[must_use]
+    pub fn is_code(&self, address: u16) -> bool {
+        match &self.code {
+            Some(ranges) => ranges.iter().any(|range| range.contains(&address)),
+            None => self.contains(address),
+        }
     }
 
     /// Its id in the table of installed extensions (24 bits of a hash of
@@ -184,6 +223,20 @@ impl TryFrom<&linker::Image> for UploadImage {
         }
         let mut upload = UploadImage::new(areas, image.hooks.records.clone())?;
         upload.extents = romlib::installed::image_extents(image);
+        // Where code is loaded (not where it runs: the upload writes the
+        // load addresses).
+        upload.set_code(
+            image
+                .sections
+                .iter()
+                .filter(|section| section.exec && section.size > 0)
+                .filter_map(|section| {
+                    let start = u16::try_from(section.load).ok()?;
+                    let end = section.load.checked_add(section.size - 1)?.min(0xFFFF);
+                    Some(start..=u16::try_from(end).ok()?)
+                })
+                .collect(),
+        );
         Ok(upload)
     }
 }

@@ -46,13 +46,24 @@ pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::A
     }
     let mut areas = Vec::new();
     let mut hooks = Vec::new();
+    let mut executable = Vec::new();
     for (name, image) in &images {
         let upload = uploader::UploadImage::try_from(image)
             .wrap_err_with(|| format!("cannot debug {name}"))?;
         areas.extend(upload.areas().iter().cloned());
         hooks.extend(upload.hooks().iter().copied());
+        // Attach compares only code with the robot: each image's, or all
+        // it loads when its sections do not say.
+        match upload.code() {
+            Some(ranges) => executable.extend(ranges.iter().cloned()),
+            None => executable.extend(upload.areas().iter().filter_map(|area| {
+                let end = u16::try_from(area.end() - 1).ok()?;
+                Some(area.address..=end)
+            })),
+        }
     }
-    let code = uploader::UploadImage::new(areas, hooks)?;
+    let mut code = uploader::UploadImage::new(areas, hooks)?;
+    code.set_code(executable);
     let rom = crate::cmd::config::rom(&resolved)?;
     let profile = crate::cmd::config::profile(rom.as_ref())?;
     let transport = ports::open_resolved(&resolved, &images)?;

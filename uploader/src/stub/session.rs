@@ -315,9 +315,18 @@ impl<T: Transport> RobotDebug<T> {
                     }
                 }
             }
+            // Only code is compared: the program may have changed its
+            // data (a `poke` of the README's session did), and a `JSR`
+            // into the stub is patched only into code.
+            let code: Vec<bool> = (0..found.len())
+                .map(|i| self.image.is_code(area.address.wrapping_add(i as u16)))
+                .collect();
             let mut i = 0;
             while i + 3 <= found.len() {
-                if found[i..i + 3] == call && area.bytes[i..i + 3] != call {
+                if code[i..i + 3].iter().all(|&c| c)
+                    && found[i..i + 3] == call
+                    && area.bytes[i..i + 3] != call
+                {
                     let original = [area.bytes[i], area.bytes[i + 1], area.bytes[i + 2]];
                     leftovers.push((area.address.wrapping_add(i as u16), original));
                     found[i..i + 3].copy_from_slice(&original);
@@ -326,8 +335,11 @@ impl<T: Transport> RobotDebug<T> {
                     i += 1;
                 }
             }
-            if let Some(i) = (0..found.len()).find(|&i| found[i] != area.bytes[i]) {
-                let end = found.len().min(i + 4);
+            if let Some(i) = (0..found.len()).find(|&i| code[i] && found[i] != area.bytes[i]) {
+                let end = (i..found.len().min(i + 4))
+                    .take_while(|&j| code[j])
+                    .last()
+                    .map_or(i + 1, |j| j + 1);
                 return Err(StubError::NotTheImage {
                     address: area.address.wrapping_add(i as u16),
                     expected: hex(&area.bytes[i..end]),
@@ -1005,14 +1017,17 @@ impl<T: Transport> RobotDebug<T> {
     }
 
     /// The robot's bytes where the image has code, compared with it:
-    /// the first difference, if any (address, image, robot).
+    /// the first difference, if any (address, image, robot). Its data is
+    /// the program's to change, and is not compared.
     ///
     /// # Errors
     /// The line's errors.
     pub fn compare_with_image(&mut self) -> StubResult<Option<(u16, u8, u8)>> {
         for area in self.image.areas().to_vec() {
             let found = self.read(area.address, area.bytes.len())?;
-            if let Some(i) = (0..found.len()).find(|&i| found[i] != area.bytes[i]) {
+            if let Some(i) = (0..found.len()).find(|&i| {
+                found[i] != area.bytes[i] && self.image.is_code(area.address.wrapping_add(i as u16))
+            }) {
                 return Ok(Some((
                     area.address.wrapping_add(i as u16),
                     area.bytes[i],
