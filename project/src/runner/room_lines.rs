@@ -248,15 +248,16 @@ impl PoseCheck {
     }
 
     /// Whether a robot at `x`, `y` facing `heading` degrees is not where
-    /// the line says. Written as "not within" so that a pose gone to NaN
-    /// misses.
+    /// the line says; a pose gone to NaN misses (a NaN compares false).
     fn misses(&self, x: f64, y: f64, heading: f64) -> bool {
         let (dx, dy) = (x - self.x, y - self.y);
-        let far = !((dx * dx + dy * dy).sqrt() <= self.within);
+        let distance = (dx * dx + dy * dy).sqrt();
+        let far = distance.is_nan() || distance > self.within;
         let turned = self.heading.is_some_and(|(h, a)| {
             // The difference either way round the circle.
             let d = (heading - h).rem_euclid(360.0);
-            !(d.min(360.0 - d) <= a)
+            let off = d.min(360.0 - d);
+            off.is_nan() || off > a
         });
         far || turned
     }
