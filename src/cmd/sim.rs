@@ -50,7 +50,8 @@ pub(crate) struct Args {
     #[command(flatten)]
     rig: crate::cmd::rig::Rig,
     /// Draw the robot's path in its room (a world file, `--world
-    /// room.toml`) to FILE.svg when the run ends: the room, the trail with
+    /// room.toml`) to FILE.svg when the run ends (stdin's end; with
+    /// `--pty` or `--view`, Ctrl-C or SIGTERM): the room, the trail with
     /// a mark every second, the bumps and the commands received.
     /// FILE.png draws the same picture rasterized (without its labels).
     #[arg(long, value_name = "FILE.svg|FILE.png")]
@@ -259,6 +260,12 @@ fn serve_pty(
     master
         .set_timeout(Duration::from_millis(2))
         .into_diagnostic()?;
+    // Ctrl-C (or SIGTERM) ends the session, not the process: `--path` is
+    // drawn after it, as `--view` draws it.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(signal, std::sync::Arc::clone(&stop)).into_diagnostic()?;
+    }
     // Our end of the slave stays open, so the master never sees a hang-up
     // between the clients' opens and closes.
     let _slave = slave;
@@ -269,6 +276,9 @@ fn serve_pty(
     // the pseudo-terminal never holds back more than a real line would.
     let mut buffer = vec![0u8; host_line::HOLDS];
     loop {
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok(ExitCode::SUCCESS);
+        }
         match master.read(&mut buffer) {
             Ok(count) => line.accept(&buffer[..count]),
             Err(error) if error.kind() == std::io::ErrorKind::TimedOut => {}

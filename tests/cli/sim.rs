@@ -141,6 +141,67 @@ fn sim_serves_a_pseudo_terminal_at_the_baud_rate() {
     assert!(elapsed >= Duration::from_millis(50), "{elapsed:?}");
 }
 
+/// The hostile tester's finding: `sim --pty` runs until interrupted, and
+/// an interrupt killed it before `--path` was drawn, so it never was.
+/// SIGINT ends the session and the picture shows the trail the robot
+/// drove, commanded through the pseudo-terminal.
+#[test]
+fn an_interrupted_pty_session_draws_its_path() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let world = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/room/room.toml");
+    let picture = dir.path().join("pty.svg");
+    let mut child = Child(
+        Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(["sim", "--pty", "--world"])
+            .arg(&world)
+            .arg("--path")
+            .arg(&picture)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the scorpion binary runs"),
+    );
+    let mut stdout = BufReader::new(child.0.stdout.take().expect("stdout is piped"));
+    let mut path = String::new();
+    stdout
+        .read_line(&mut path)
+        .expect("the first line is the path");
+    let mut port = serialport::new(path.trim(), 9600)
+        .timeout(Duration::from_millis(50))
+        .open()
+        .expect("the pseudo-terminal opens");
+    port.write_all(b"/4C+40/4D+40")
+        .expect("commands are written");
+    std::thread::sleep(Duration::from_millis(1500));
+    let interrupted = Command::new("kill")
+        .args(["-INT", &child.0.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(interrupted.success());
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = child.0.try_wait().expect("waited for") {
+            break status;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "sim did not stop"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "{status:?}");
+    let svg = std::fs::read_to_string(&picture).expect("the picture drawn");
+    let points = svg
+        .split(r#"<polyline class="trail" points=""#)
+        .nth(1)
+        .and_then(|rest| rest.split('"').next())
+        .expect("a trail");
+    assert!(
+        points.split_whitespace().count() >= 2,
+        "the robot drove, and its trail is drawn: {points}"
+    );
+}
+
 /// Issue 11's first reproduction: two extensions built with the defaults
 /// both sit at `$0400`. The second is refused before a byte of it is
 /// loaded, naming both extents, and the sim exits non-zero instead of
