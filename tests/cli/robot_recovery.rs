@@ -66,6 +66,15 @@ fn a_monitor_killed_at_a_stop_is_cleaned_up_by_the_next_session() {
     let (dir, sim) = readme_handler_on_a_pty_robot();
     let before = code(dir.path(), &sim);
     killed_monitor(dir.path(), &sim, "break show\n/1Q\n", "PC=");
+    // Another command meets the stopped robot: it says so, and what to
+    // run, rather than blaming the baud rate.
+    let other = scorpion_with_input(Some(dir.path()), &["installed", "--port", &sim.path], "");
+    let said = transcript(&other);
+    assert!(!other.status.success(), "{said}");
+    assert!(
+        said.contains("stopped in the debug stub") && said.contains("scorpion debug --port"),
+        "{said}"
+    );
     let output = scorpion_with_input(
         Some(dir.path()),
         &["debug", "--port", &sim.path, "--image", "ext.elf"],

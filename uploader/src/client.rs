@@ -462,6 +462,11 @@ impl<T: Transport> Client<T> {
                     return Ok(None);
                 }
                 let mut heard = std::mem::take(&mut self.rx);
+                if stopped_in_stub(&heard) {
+                    return Err(Error::StoppedInDebugStub {
+                        port: self.transport.name(),
+                    });
+                }
                 heard.truncate(40);
                 return Err(Error::WrongBaud {
                     port: self.transport.name(),
@@ -511,6 +516,11 @@ impl<T: Transport> Client<T> {
                 baud: self.transport.baud(),
                 question: command.to_string(),
                 waited: timeout * attempts,
+            });
+        }
+        if stopped_in_stub(&heard) {
+            return Err(Error::StoppedInDebugStub {
+                port: self.transport.name(),
             });
         }
         if heard
@@ -694,4 +704,13 @@ pub(crate) fn pieces(address: u16, len: usize, size: u8) -> impl Iterator<Item =
         at += size;
         Some(span)
     })
+}
+
+/// Whether `heard` holds the debug stub's stop frame: its start, the
+/// length 8 and `S` (docs/PROTOCOL.md, section 5), which no answer of
+/// the ROM's has (its answers are printable ASCII).
+fn stopped_in_stub(heard: &[u8]) -> bool {
+    heard
+        .windows(3)
+        .any(|three| three == [crate::stub::frame::SOF_OUT, 8, b'S'])
 }

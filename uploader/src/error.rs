@@ -187,6 +187,23 @@ pub enum Error {
         waited: Duration,
     },
 
+    /// What came back is the debug stub's stop frame (docs/PROTOCOL.md,
+    /// section 5): a debug session that did not detach left the robot
+    /// stopped at a breakpoint, and it reads no command.
+    #[error(
+        "the robot on {port} is stopped in the debug stub: a debug session left it at a breakpoint, and it reads no command"
+    )]
+    #[diagnostic(
+        code(uploader::stopped_in_debug_stub),
+        help(
+            "`scorpion debug --port {port} --image ELF` (the image it runs) finds it stopped, takes the breakpoints and the stub out and lets it go on; or reset the robot"
+        )
+    )]
+    StoppedInDebugStub {
+        /// The transport's name.
+        port: String,
+    },
+
     /// Bytes came back, but never a well-formed answer: the usual sign of a
     /// baud-rate mismatch.
     #[error("the robot on {port} answers garbage at {baud} baud: `{sample}`")]
