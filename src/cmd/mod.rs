@@ -22,3 +22,17 @@ pub(crate) mod sim;
 pub(crate) mod test;
 pub(crate) mod upload;
 pub(crate) mod view;
+
+/// A flag that any of `signals` sets, instead of ending the process: the
+/// command looks at it where stopping leaves things right (a picture
+/// drawn, a robot given back).
+pub(crate) fn flag_on_signals(
+    signals: &[i32],
+) -> miette::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    use miette::IntoDiagnostic as _;
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    for &signal in signals {
+        signal_hook::flag::register(signal, std::sync::Arc::clone(&flag)).into_diagnostic()?;
+    }
+    Ok(flag)
+}

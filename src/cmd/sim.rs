@@ -262,10 +262,8 @@ fn serve_pty(
         .into_diagnostic()?;
     // Ctrl-C (or SIGTERM) ends the session, not the process: `--path` is
     // drawn after it, as `--view` draws it.
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register(signal, std::sync::Arc::clone(&stop)).into_diagnostic()?;
-    }
+    let stop =
+        crate::cmd::flag_on_signals(&[signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM])?;
     // Our end of the slave stays open, so the master never sees a hang-up
     // between the clients' opens and closes.
     let _slave = slave;

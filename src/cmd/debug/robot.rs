@@ -6,7 +6,6 @@
 
 use std::io::Write;
 use std::process::ExitCode;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use debugger::monitor::{Failure, Reply};
@@ -135,14 +134,11 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     // with the robot stopped in the stub or a JSR left in its code: each
     // ends the session at the next line read (or the end of input), and
     // the robot is given back as at `quit`.
-    let ended = Arc::new(AtomicBool::new(false));
-    for signal in [
+    let ended = crate::cmd::flag_on_signals(&[
         signal_hook::consts::SIGINT,
         signal_hook::consts::SIGHUP,
         signal_hook::consts::SIGTERM,
-    ] {
-        signal_hook::flag::register(signal, Arc::clone(&ended)).into_diagnostic()?;
-    }
+    ])?;
     let session = converse(&mut robot, &mut monitor, &mut input, &mut out, &ended);
     // Given back whatever ended the conversation (an unwritable terminal
     // too), before its error is said.

@@ -228,10 +228,8 @@ const COMMANDS_DRAWN: usize = 4096;
 
 /// Serves the view until SIGINT or SIGTERM.
 pub(crate) fn serve(robot: &mut VirtualScorpion, session: Session<'_>) -> miette::Result<Ended> {
-    let stop = Arc::new(AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register(signal, Arc::clone(&stop)).into_diagnostic()?;
-    }
+    let stop =
+        crate::cmd::flag_on_signals(&[signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM])?;
     let (hub, requests) = Hub::new(session.room.clone());
     let mut layout = session.room.as_ref().map(|room| room.layout().clone());
     let mut room_version = 0;
