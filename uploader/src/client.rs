@@ -461,20 +461,27 @@ impl<T: Transport> Client<T> {
                 if self.rx.is_empty() {
                     return Ok(None);
                 }
-                let mut heard = std::mem::take(&mut self.rx);
-                if stopped_in_stub(&heard) {
-                    return Err(Error::StoppedInDebugStub {
-                        port: self.transport.name(),
-                    });
-                }
-                heard.truncate(40);
-                return Err(Error::WrongBaud {
-                    port: self.transport.name(),
-                    baud: self.transport.baud(),
-                    sample: heard.escape_ascii().to_string(),
-                });
+                let heard = std::mem::take(&mut self.rx);
+                return Err(self.garbage(heard));
             }
             self.fill(deadline - now)?;
+        }
+    }
+
+    /// What bytes that are no answer say: the debug stub's stop frame
+    /// among them, a robot left stopped by a debug session; otherwise
+    /// the usual sign of a baud-rate mismatch, a sample of them named.
+    fn garbage(&self, mut heard: Vec<u8>) -> Error {
+        if stopped_in_stub(&heard) {
+            return Error::StoppedInDebugStub {
+                port: self.transport.name(),
+            };
+        }
+        heard.truncate(40);
+        Error::WrongBaud {
+            port: self.transport.name(),
+            baud: self.transport.baud(),
+            sample: heard.escape_ascii().to_string(),
         }
     }
 
@@ -518,22 +525,14 @@ impl<T: Transport> Client<T> {
                 waited: timeout * attempts,
             });
         }
-        if stopped_in_stub(&heard) {
-            return Err(Error::StoppedInDebugStub {
-                port: self.transport.name(),
-            });
-        }
+        // The stub's stop frame starts with a byte outside ASCII: it
+        // takes this way too.
         if heard
             .iter()
             .any(|&b| !(0x20..0x7F).contains(&b) && b != EOL)
             || last_error.is_none()
         {
-            heard.truncate(40);
-            return Err(Error::WrongBaud {
-                port: self.transport.name(),
-                baud: self.transport.baud(),
-                sample: heard.escape_ascii().to_string(),
-            });
+            return Err(self.garbage(heard));
         }
         Err(last_error.map_or_else(
             || Error::NoAnswer {
