@@ -31,11 +31,25 @@ impl Patch {
         [self.displaced[0], self.displaced[1], self.displaced[2]]
     }
 
+    /// Where `address` is among the displaced bytes: its offset from the
+    /// first (the trampoline holds them in the same order), if it is one.
+    #[must_use]
+    pub fn offset_of(&self, address: u16) -> Option<u16> {
+        let offset = address.checked_sub(self.address)?;
+        (usize::from(offset) < self.displaced.len()).then_some(offset)
+    }
+
+    /// The program's byte at `address`, if it is one the patch displaced.
+    #[must_use]
+    pub fn displaced_at(&self, address: u16) -> Option<u8> {
+        self.offset_of(address)
+            .map(|offset| self.displaced[usize::from(offset)])
+    }
+
     /// Whether `address` is one of the displaced bytes after the first.
     #[must_use]
     pub fn covers_inside(&self, address: u16) -> bool {
-        address > self.address
-            && u32::from(address) < u32::from(self.address) + self.displaced.len() as u32
+        self.offset_of(address).is_some_and(|offset| offset > 0)
     }
 }
 

@@ -201,13 +201,7 @@ impl<T: Transport> RobotDebug<T> {
         // The stub's code but for `JMP PREV`'s operand, its last two bytes.
         let present = code[..code_len - 2] == placed.bytes[..code_len - 2];
         if debug.stopped.is_some() && !present {
-            return Err(StubError::Refused {
-                what: "attaching".into(),
-                reason: format!(
-                    "the robot is stopped in a debug stub that is not where this image's goes (${:04X}): it was attached with another image; attach with that one, or reset the robot",
-                    placed.address
-                ),
-            });
+            return Err(stopped_in_another_stub(placed.address));
         }
         debug.recovery.hooked = target == placed.handler;
         let previous = if debug.recovery.hooked {
@@ -272,13 +266,7 @@ impl<T: Transport> RobotDebug<T> {
                             // A stub, which heard the frame damaged: again.
                             break;
                         }
-                        return Err(StubError::Refused {
-                            what: "attaching".into(),
-                            reason: format!(
-                                "the robot is stopped in a debug stub that is not where this image's goes (${:04X}): it was attached with another image; attach with that one, or reset the robot",
-                                self.stub.address
-                            ),
-                        });
+                        return Err(stopped_in_another_stub(self.stub.address));
                     }
                     Some(_) => {}
                     None => break,
@@ -788,17 +776,14 @@ impl<T: Transport> RobotDebug<T> {
     /// Where the stopped robot goes on: a breakpoint's address is its
     /// trampoline (the displaced instructions, then back).
     fn resume_address(&self, pc: u16) -> u16 {
-        if let Some((_, slot)) = self.breakpoints.get(&pc) {
-            return self.stub.trampoline(*slot);
-        }
-        // A step done on the host can leave the PC among the bytes a
-        // breakpoint displaced: the trampoline holds them in order.
-        match self
+        // A step done on the host can also leave the PC among the bytes
+        // a breakpoint displaced: the trampoline holds them in order.
+        let displaced = self
             .breakpoints
             .values()
-            .find(|(patch, _)| patch.covers_inside(pc))
-        {
-            Some((patch, slot)) => self.stub.trampoline(*slot) + (pc - patch.address),
+            .find_map(|(patch, slot)| Some((patch.offset_of(pc)?, *slot)));
+        match displaced {
+            Some((offset, slot)) => self.stub.trampoline(slot) + offset,
             None => pc,
         }
     }
@@ -912,17 +897,13 @@ impl<T: Transport> RobotDebug<T> {
     /// push, or a write outside RAM (an I/O register reads back other
     /// than written), into the stub, its zero page or a patched byte.
     fn step_on_host(&mut self, registers: Registers) -> StubResult<Option<Reply>> {
-        let patched: Vec<(u16, Vec<u8>)> = self
+        // Taken out of `self`, which the reads below borrow.
+        let patches: Vec<Patch> = self
             .breakpoints
             .values()
-            .map(|(patch, _)| (patch.address, patch.displaced.clone()))
+            .map(|(patch, _)| patch.clone())
             .collect();
-        let displaced = |at: u16| {
-            patched.iter().find_map(|(address, bytes)| {
-                let offset = usize::from(at.wrapping_sub(*address));
-                bytes.get(offset).copied()
-            })
-        };
+        let displaced = |at: u16| patches.iter().find_map(|patch| patch.displaced_at(at));
         let stub = self.stub.clone();
         // The stub's bytes and its zero-page pointer hold the stub's
         // values at a stop, not the program's.
@@ -1036,6 +1017,17 @@ impl<T: Transport> RobotDebug<T> {
             }
         }
         Ok(None)
+    }
+}
+
+/// The refusal to attach to a robot stopped in a stub other than the one
+/// this image's attach would place at `address`.
+fn stopped_in_another_stub(address: u16) -> StubError {
+    StubError::Refused {
+        what: "attaching".into(),
+        reason: format!(
+            "the robot is stopped in a debug stub that is not where this image's goes (${address:04X}): it was attached with another image; attach with that one, or reset the robot"
+        ),
     }
 }
 
