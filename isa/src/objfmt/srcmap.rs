@@ -78,31 +78,17 @@ impl SrcMap {
     /// Serialises the map (entries are sorted first).
     #[must_use]
     pub fn encode(&self) -> Vec<u8> {
-        // Entries usually arrive sorted: no copy then (a large program's
-        // map runs to megabytes).
-        let sorted_copy;
-        let entries = if self.entries.is_sorted() {
-            &self.entries
-        } else {
-            let mut copy = self.entries.clone();
-            copy.sort_unstable();
-            sorted_copy = copy;
-            &sorted_copy
-        };
+        let entries = sorted(&self.entries);
+        let calls = sorted(&self.calls);
         let mut out = Writer::header(MAGIC, VERSION);
         let strings: usize = self.files.iter().map(|f| 4 + f.len()).sum();
         out.bytes
-            .reserve(12 + strings + 20 * entries.len() + 16 * self.symbols.len());
+            .reserve(16 + strings + 20 * (entries.len() + calls.len()) + 16 * self.symbols.len());
         out.len32(self.files.len());
         for file in &self.files {
             out.string(file);
         }
-        out.len32(entries.len());
-        for entry in entries {
-            out.u32(entry.section);
-            out.u32(entry.offset);
-            write_loc(&mut out, entry.loc);
-        }
+        write_entries(&mut out, &entries);
         out.len32(self.symbols.len());
         for symbol in &self.symbols {
             out.u32(symbol.symbol);
@@ -118,14 +104,7 @@ impl SrcMap {
             out.u32(symbol);
             write_loc(&mut out, loc);
         }
-        let mut calls = self.calls.clone();
-        calls.sort_unstable();
-        out.len32(calls.len());
-        for call in &calls {
-            out.u32(call.section);
-            out.u32(call.offset);
-            write_loc(&mut out, call.loc);
-        }
+        write_entries(&mut out, &calls);
         out.bytes
     }
 
@@ -142,20 +121,7 @@ impl SrcMap {
         for _ in 0..file_count {
             files.push(input.string()?);
         }
-        let entry_count = input.count(20)?;
-        let mut entries = Vec::with_capacity(entry_count);
-        for _ in 0..entry_count {
-            let section = input.u32()?;
-            let offset = input.u32()?;
-            let loc = read_loc(&mut input, files.len())?;
-            entries.push(SrcMapEntry {
-                section,
-                offset,
-                loc,
-            });
-        }
-        // Lookups binary-search; a foreign producer may not have sorted.
-        entries.sort_unstable();
+        let entries = read_entries(&mut input, files.len())?;
         let symbol_count = input.count(16)?;
         let mut symbols = Vec::with_capacity(symbol_count);
         for _ in 0..symbol_count {
@@ -184,22 +150,11 @@ impl SrcMap {
                 symbols[index].expanded_at = Some(loc);
             }
         }
-        let mut calls = Vec::new();
-        if version >= 3 {
-            let count = input.count(20)?;
-            calls.reserve(count);
-            for _ in 0..count {
-                let section = input.u32()?;
-                let offset = input.u32()?;
-                let loc = read_loc(&mut input, files.len())?;
-                calls.push(SrcMapEntry {
-                    section,
-                    offset,
-                    loc,
-                });
-            }
-            calls.sort_unstable();
-        }
+        let calls = if version >= 3 {
+            read_entries(&mut input, files.len())?
+        } else {
+            Vec::new()
+        };
         if !input.is_empty() {
             return Err(input.error("trailing bytes after the last table"));
         }
@@ -259,6 +214,50 @@ impl SrcMap {
     pub fn file_name(&self, loc: SourceLoc) -> Option<&str> {
         self.files.get(loc.file as usize).map(String::as_str)
     }
+}
+
+/// `list` sorted: itself when it already is, as it usually arrives (a
+/// large program's map runs to megabytes: no copy then).
+fn sorted(list: &[SrcMapEntry]) -> std::borrow::Cow<'_, [SrcMapEntry]> {
+    if list.is_sorted() {
+        std::borrow::Cow::Borrowed(list)
+    } else {
+        let mut copy = list.to_vec();
+        copy.sort_unstable();
+        std::borrow::Cow::Owned(copy)
+    }
+}
+
+/// A count, then each entry: `section, offset, file, line, column`.
+fn write_entries(out: &mut Writer, list: &[SrcMapEntry]) {
+    out.len32(list.len());
+    for entry in list {
+        out.u32(entry.section);
+        out.u32(entry.offset);
+        write_loc(out, entry.loc);
+    }
+}
+
+/// What [`write_entries`] wrote, sorted (lookups binary-search; a foreign
+/// producer may not have sorted).
+fn read_entries(
+    input: &mut Reader<'_>,
+    file_count: usize,
+) -> Result<Vec<SrcMapEntry>, FormatError> {
+    let count = input.count(20)?;
+    let mut entries = Vec::with_capacity(count);
+    for _ in 0..count {
+        let section = input.u32()?;
+        let offset = input.u32()?;
+        let loc = read_loc(input, file_count)?;
+        entries.push(SrcMapEntry {
+            section,
+            offset,
+            loc,
+        });
+    }
+    entries.sort_unstable();
+    Ok(entries)
 }
 
 fn write_loc(out: &mut Writer, loc: SourceLoc) {
