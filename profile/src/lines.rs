@@ -14,12 +14,13 @@
 //! `.byte $4C` + `.addr`), so it is a code line too. Falling through a
 //! `JSR` does not count (routines that read their arguments from after
 //! the call return past them), nor through a conditional branch (one
-//! that always goes, `CLC` then `BCC`, is often followed by data). When the source cannot be read, the
-//! bytes of executable sections count as code.
+//! that always goes, `CLC` then `BCC`, is often followed by data). When
+//! the source cannot be read, the bytes of executable sections count as
+//! code.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
-use isa::{AddressingMode, Mnemonic};
+use isa::{AddressingMode, Instruction, Mnemonic};
 
 /// A source line with code.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -219,34 +220,30 @@ fn decode_into(
 /// `JSR` targets, and the next instruction after one that falls through
 /// (not after a `JSR` or a branch, see the module's header).
 fn entry_points(code: &BTreeMap<(String, u32), Line>, images: &[&linker::Image]) -> BTreeSet<u32> {
-    let byte = |address: u32| images.iter().find_map(|image| image.byte_at(address));
+    let byte = |address: u16| {
+        images
+            .iter()
+            .find_map(|image| image.byte_at(u32::from(address)))
+    };
     let mut entries = BTreeSet::new();
     for line in code.values() {
         for &start in &line.starts {
-            let at = u32::from(start);
-            let Some(opcode) = byte(at) else {
+            if byte(start).is_none() {
                 continue;
-            };
-            let info = isa::opcode(opcode);
-            let next = at + u32::from(info.mode.len());
-            let operand16 = || Some(u32::from(byte(at + 1)?) | (u32::from(byte(at + 2)?) << 8));
-            match (info.mnemonic, info.mode) {
-                (Mnemonic::Jmp | Mnemonic::Jsr, AddressingMode::Absolute) => {
-                    entries.extend(operand16());
-                }
-                // Where these go is not in the code, or nowhere.
-                (Mnemonic::Jmp | Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk, _) => {}
+            }
+            let instruction = Instruction::decode_with(start, |at| byte(at).unwrap_or(0));
+            match (instruction.opcode.mnemonic, instruction.opcode.mode) {
                 // A conditional branch's target only: code falls through a
                 // branch into data when the branch always goes (`CLC` then
                 // `BCC`), so that is no sign the data runs.
-                (_, AddressingMode::Relative) => {
-                    if let Some(offset) = byte(at + 1) {
-                        let target = (i64::from(next) + i64::from(offset as i8)) & 0xFFFF;
-                        entries.extend(u32::try_from(target));
-                    }
+                (Mnemonic::Jmp | Mnemonic::Jsr, AddressingMode::Absolute)
+                | (_, AddressingMode::Relative) => {
+                    entries.extend(instruction.target().map(u32::from));
                 }
+                // Where these go is not in the code, or nowhere.
+                (Mnemonic::Jmp | Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk, _) => {}
                 _ => {
-                    entries.insert(next);
+                    entries.insert(u32::from(instruction.next_address()));
                 }
             }
         }

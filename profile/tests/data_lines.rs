@@ -5,7 +5,7 @@
 //! reads it, and a table only loaded from are not. A built-in macro's
 //! code counts at the user's line that called it.
 
-use std::collections::BTreeMap;
+mod common;
 
 use romlib::VirtualScorpion;
 use scorpion_profile::Recorder;
@@ -37,26 +37,12 @@ not_mine:
 ";
 
 fn table() -> LineTable {
-    let image = image(SOURCE);
+    let image = common::extension(SOURCE);
     LineTable::new(&[&image], &|file| match file {
         "q.s" => Some(SOURCE.to_owned()),
         "scorpion.inc" => Some(romlib::SCORPION_INC.to_owned()),
         _ => None,
     })
-}
-
-fn image(source: &str) -> linker::Image {
-    let files = assembler::MemorySource::new().with("q.s", source);
-    let options = assembler::Options {
-        builtin_includes: BTreeMap::from([(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]),
-        ..assembler::Options::default()
-    };
-    let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
-        .expect("the handler assembles");
-    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
 }
 
 /// The line of `file` whose text (trimmed) is `text`, from 1.
@@ -121,7 +107,7 @@ not_mine:
 
 /// The coverage of the handler's own file after `commands`.
 fn covered(commands: &[&[u8]]) -> Coverage {
-    let image = image(HANDLER);
+    let image = common::extension(HANDLER);
     let mut robot = VirtualScorpion::new();
     robot.load_image(&image).expect("the image loads");
     let recorder = Recorder::attach(&mut robot);

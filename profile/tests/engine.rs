@@ -2,7 +2,7 @@
 //! emulator skips counted as if run, a command timed from its arrival to
 //! `CMD_DONE` against breakpoints, interrupts as roots of their own.
 
-use std::collections::BTreeMap;
+mod common;
 
 use emulator::{Breakpoints, Machine, StopAtTrap};
 use romlib::VirtualScorpion;
@@ -98,17 +98,7 @@ not_mine:
 ";
 
 fn image() -> linker::Image {
-    let files = assembler::MemorySource::new().with("q.s", SOURCE);
-    let options = assembler::Options {
-        builtin_includes: BTreeMap::from([(
-            "scorpion.inc".to_owned(),
-            romlib::SCORPION_INC.as_bytes().to_vec(),
-        )]),
-        ..assembler::Options::default()
-    };
-    let assembly = assembler::assemble(&files, std::path::Path::new("q.s"), &options)
-        .expect("the handler assembles");
-    romlib::link_against_rom("q.s", &assembly.object, "scorpion-ext").expect("the handler links")
+    common::extension(SOURCE)
 }
 
 fn robot() -> VirtualScorpion {
