@@ -973,37 +973,45 @@ mod tests {
         assert!(check_hook_targets(&ram, &profile).is_ok());
     }
 
+    /// The handler of the extension the witness tests keep at $0400.
+    const HANDLER: isa::objfmt::HookRecord = isa::objfmt::HookRecord {
+        kind: HookKind::Unknown,
+        handler: 0x0403,
+        chain: Some(0x0401),
+    };
+
+    /// A file's areas: the table of installed extensions naming one at
+    /// `extent` (its handler [`HANDLER`]), and $0420-$043F of its code.
+    fn table_naming(profile: &RomProfile, extent: std::ops::RangeInclusive<u16>) -> Vec<Area> {
+        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
+        let installed = romlib::installed::Installed::new(1, vec![extent], &[HANDLER]);
+        let mut flags = vec![0u8; entries];
+        flags[..installed.entries()].copy_from_slice(&installed.flags());
+        vec![
+            Area {
+                address: table,
+                bytes: flags,
+            },
+            Area {
+                address: romlib::installed::entry_address(table, entries, 0),
+                bytes: installed.encode(),
+            },
+            Area {
+                address: 0x0420,
+                bytes: vec![0; 0x20],
+            },
+        ]
+    }
+
     /// An undo file whose hook goes back into an extension it holds only a
     /// part of: the rest of that extension (as the kept table names it)
     /// is witnessed; a hook at the ROM's target needs no witness.
     #[test]
     fn witnesses_cover_the_hooked_extension_less_what_the_backup_holds() {
         let profile = RomProfile::reference();
-        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
-        let record = isa::objfmt::HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        };
-        let installed = romlib::installed::Installed::new(1, vec![0x0400..=0x0BFF], &[record]);
-        let mut flags = vec![0u8; entries];
-        flags[..installed.entries()].copy_from_slice(&installed.flags());
         let rom_target = profile.reset_target(HookKind::Loop).expect("known");
         let backup = Backup {
-            areas: vec![
-                Area {
-                    address: table,
-                    bytes: flags,
-                },
-                Area {
-                    address: romlib::installed::entry_address(table, entries, 0),
-                    bytes: installed.encode(),
-                },
-                Area {
-                    address: 0x0420,
-                    bytes: vec![0; 0x20],
-                },
-            ],
+            areas: table_naming(&profile, 0x0400..=0x0BFF),
             hooks: vec![(HookKind::Unknown, 0x0403), (HookKind::Loop, rom_target)],
             ..Backup::default()
         };
@@ -1029,30 +1037,8 @@ mod tests {
     #[test]
     fn an_uploads_witnesses_cover_the_code_it_loads_not_its_bss() {
         let profile = RomProfile::reference();
-        let (table, entries) = profile.table.expect("the reference ROM keeps a table");
-        let record = isa::objfmt::HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        };
-        let old = romlib::installed::Installed::new(1, vec![0x0400..=0x050F], &[record]);
-        let mut flags = vec![0u8; entries];
-        flags[..old.entries()].copy_from_slice(&old.flags());
         let kept = Backup {
-            areas: vec![
-                Area {
-                    address: table,
-                    bytes: flags,
-                },
-                Area {
-                    address: romlib::installed::entry_address(table, entries, 0),
-                    bytes: old.encode(),
-                },
-                Area {
-                    address: 0x0420,
-                    bytes: vec![0; 0x20],
-                },
-            ],
+            areas: table_naming(&profile, 0x0400..=0x050F),
             hooks: vec![(HookKind::Unknown, 0x0403)],
             ..Backup::default()
         };
@@ -1074,7 +1060,7 @@ mod tests {
             }],
             symbols: Vec::new(),
             hooks: isa::objfmt::Hooks {
-                records: vec![record],
+                records: vec![HANDLER],
             },
             lines: isa::objfmt::SrcMap::default(),
         };
