@@ -254,3 +254,94 @@ fn the_readme_names_the_loader_size_a_serial_upload_prints() {
         "README.md does not say `through the RAM loader ({loader})`"
     );
 }
+
+/// F6 (issue 27, round 6): an undo file crafted with a valid checksum
+/// whose hook points into RAM it neither restores nor witnesses ($0900,
+/// beside the extension) is refused by `upload --undo` and by `restore`,
+/// naming the hook, its target and why, before anything is written; the
+/// upload's own undo file still undoes it.
+#[test]
+fn an_undo_file_whose_hook_goes_to_memory_it_neither_holds_nor_witnesses_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let d = dir.path();
+    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let kept = std::fs::read(d.join("scorpion-last-upload.undo")).expect("the undo file");
+    let mut crafted = uploader::Backup::decode("kept", &kept).expect("it reads");
+    assert!(
+        crafted.hooks.iter().all(|&(_, target)| target >= 0xF000),
+        "the upload found the hooks at the ROM: {:?}",
+        crafted.hooks
+    );
+    for hook in &mut crafted.hooks {
+        if hook.0 == isa::objfmt::HookKind::Unknown {
+            hook.1 = 0x0900;
+        }
+    }
+    assert!(
+        crafted.byte_at(0x0900).is_none()
+            && crafted
+                .witnesses
+                .iter()
+                .all(|w| !(w.address..w.address.saturating_add(w.len)).contains(&0x0900)),
+        "the crafted file neither holds nor witnesses $0900"
+    );
+    std::fs::write(d.join("crafted.undo"), crafted.encode()).expect("the crafted file");
+    let before = ok(d, &line, &["read", "$0200", "6"]);
+    assert!(before.contains("0200: 4C 03 04"), "{before}");
+    for args in [
+        vec!["upload", "--undo", "--undo-file", "crafted.undo"],
+        vec!["restore", "crafted.undo"],
+    ] {
+        let (success, text) = on(d, &line, &args);
+        assert!(!success, "{args:?}: {text}");
+        assert!(text.contains("uploader::unwitnessed_hook"), "{text}");
+        assert!(text.contains("HOOK_UNKNOWN at $0900"), "{text}");
+        assert!(text.contains("not in the ROM's code"), "{text}");
+        assert!(text.contains("not restored by this file"), "{text}");
+        assert!(text.contains("not witnessed"), "{text}");
+        assert_eq!(ok(d, &line, &["read", "$0200", "6"]), before, "{args:?}");
+    }
+    assert!(d.join("crafted.undo").is_file(), "not marked used");
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    let text = ok(d, &line, &["read", "$0200", "3"]);
+    assert!(text.contains("0200: 4C 21 FF"), "undone: {text}");
+}
+
+/// F6's other side: with two extensions chained, the undo of the second
+/// goes back to the first's handler, which the undo file witnesses
+/// (not holds): it is taken, and the hook goes back there.
+#[test]
+fn the_undo_of_a_chained_extension_goes_back_to_the_first() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("first.elf"),
+        extension_at(0x0C00, 200, None),
+    )
+    .expect("the image");
+    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let d = dir.path();
+    ok(d, &line, &["upload", "first.elf", "--no-dry-run"]);
+    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let kept = std::fs::read(d.join("scorpion-last-upload.undo")).expect("the undo file");
+    let kept = uploader::Backup::decode("kept", &kept).expect("it reads");
+    assert!(
+        kept.hooks
+            .contains(&(isa::objfmt::HookKind::Unknown, 0x0C03)),
+        "{:?}",
+        kept.hooks
+    );
+    assert!(
+        kept.byte_at(0x0C03).is_none(),
+        "witnessed, not held: {kept:?}"
+    );
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    let text = ok(d, &line, &["read", "$0200", "3"]);
+    assert!(text.contains("0200: 4C 03 0C"), "back to the first: {text}");
+}

@@ -640,7 +640,9 @@ fn check_witnesses<T: Transport>(
 /// # Errors
 /// [`Error::WrongRom`], [`Error::BackupRomDiffers`],
 /// [`Error::WitnessDiffers`], [`Error::BadImage`] for memory an upload may
-/// not write, and every error an upload has.
+/// not write, [`Error::UnwitnessedHook`] for a hook into RAM the file
+/// neither holds nor witnesses (before the line is used), and every error
+/// an upload has.
 pub fn restore<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
@@ -729,7 +731,9 @@ fn memory_options(options: &UploadOptions) -> UploadOptions {
 /// A hook may go back to the ROM (its reset target, or anywhere in the
 /// ROM's bytes) or into memory an upload may write; never into the I/O
 /// page, the stack or the ROM's own RAM, where no code of an extension
-/// can be (a hook there stops the robot at its next command).
+/// can be (a hook there stops the robot at its next command). A hook into
+/// RAM must go where the file restores memory or holds a witness
+/// ([`Error::UnwitnessedHook`]), so that the code it reaches is checked.
 fn check_hook_targets(backup: &Backup, profile: &crate::image::RomProfile) -> Result<()> {
     for &(kind, target) in &backup.hooks {
         let to_rom = profile.reset_target(kind) == Some(target)
@@ -743,6 +747,22 @@ fn check_hook_targets(backup: &Backup, profile: &crate::image::RomProfile) -> Re
                     "the backup points {} at ${target:04X}, which is neither the ROM nor memory an extension may hold; nothing was written",
                     kind.rom_symbol()
                 ),
+            });
+        }
+        // A file written by `backup` holds the RAM a hook goes to, and an
+        // upload's undo file holds or witnesses it (`kept_witness_ranges`
+        // marks the target first): a hook into RAM that neither covers was
+        // made by something else, and nothing would be checked there
+        // before the robot jumps in.
+        let held = backup.byte_at(u32::from(target)).is_some();
+        let witnessed = backup.witnesses.iter().any(|witness| {
+            u32::from(witness.address) <= u32::from(target)
+                && u32::from(target) < u32::from(witness.address) + u32::from(witness.len)
+        });
+        if !to_rom && !held && !witnessed {
+            return Err(Error::UnwitnessedHook {
+                hook: kind.rom_symbol(),
+                target,
             });
         }
     }
@@ -960,7 +980,10 @@ mod tests {
             assert!(said.contains(&format!("${target:04X}")), "{said}");
         }
         let ram = Backup {
-            areas: Vec::new(),
+            areas: vec![Area {
+                address: 0x0400,
+                bytes: vec![0xEA; 4],
+            }],
             hooks: vec![
                 (HookKind::Unknown, 0x0400),
                 (
@@ -971,6 +994,60 @@ mod tests {
             ..Backup::default()
         };
         assert!(check_hook_targets(&ram, &profile).is_ok());
+    }
+
+    /// F6 (issue 27, round 6): a hook into RAM the file neither restores
+    /// nor witnesses is refused, naming the hook and its target; one the
+    /// file holds a byte at, or a witness covers, is taken.
+    #[test]
+    fn a_hook_into_ram_the_file_neither_holds_nor_witnesses_is_refused() {
+        let profile = RomProfile::reference();
+        let bare = Backup {
+            hooks: vec![(HookKind::Loop, 0x0700)],
+            witnesses: vec![Witness {
+                address: 0x0701,
+                len: 0x10,
+                sum: 0,
+            }],
+            ..Backup::default()
+        };
+        let error = check_hook_targets(&bare, &profile).expect_err("refused");
+        assert!(
+            matches!(
+                error,
+                Error::UnwitnessedHook {
+                    hook: "HOOK_LOOP",
+                    target: 0x0700
+                }
+            ),
+            "{error:?}"
+        );
+        let said = error.to_string();
+        for part in [
+            "HOOK_LOOP at $0700",
+            "not in the ROM's code",
+            "not restored by this file",
+            "not witnessed",
+        ] {
+            assert!(said.contains(part), "{part}: {said}");
+        }
+        let witnessed = Backup {
+            witnesses: vec![Witness {
+                address: 0x06F8,
+                len: 0x09,
+                sum: 0,
+            }],
+            ..bare.clone()
+        };
+        assert!(check_hook_targets(&witnessed, &profile).is_ok());
+        let held = Backup {
+            areas: vec![Area {
+                address: 0x0700,
+                bytes: vec![0x60],
+            }],
+            ..bare
+        };
+        assert!(check_hook_targets(&held, &profile).is_ok());
     }
 
     /// The handler of the extension the witness tests keep at $0400.

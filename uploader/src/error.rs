@@ -307,6 +307,25 @@ pub enum Error {
         found: u16,
     },
 
+    /// A backup or undo file points a hook into RAM that it neither
+    /// restores nor witnesses: nothing tells what code is there, and the
+    /// robot would jump into whatever it holds. Nothing was written.
+    #[error(
+        "the file points {hook} at ${target:04X}, which is not in the ROM's code, not restored by this file (it holds no byte there) and not witnessed by it (no checksum of the file covers it): the robot would jump into whatever that memory holds; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::unwitnessed_hook),
+        help(
+            "a file `scorpion backup` writes holds the memory each hook goes to, and an upload's undo file holds or witnesses the code each kept hook goes back to: this file was made or changed by something else; restore another backup, or upload the image instead"
+        )
+    )]
+    UnwitnessedHook {
+        /// The hook (`HOOK_UNKNOWN`, `HOOK_LOOP`).
+        hook: &'static str,
+        /// Where the file points it.
+        target: u16,
+    },
+
     /// Reads of the same bytes kept answering differently, well formed:
     /// memory the robot writes while it runs, not a noisy line.
     #[error(
