@@ -581,6 +581,29 @@ impl<T: Transport> Client<T> {
     /// the same addresses ([`CHANGING`] times or more): memory the robot
     /// writes while it runs.
     pub fn read_memory(&mut self, address: u16, len: usize) -> Result<Vec<u8>> {
+        self.read_agreeing(address, len, None)
+    }
+
+    /// Reads `expected.len()` bytes from `address` as [`Client::read_memory`]
+    /// does, but a span whose first answer is what `expected` says (`None`:
+    /// any byte) is taken at once: a memory that holds what the host
+    /// expects is read once, not twice. For a wrong byte to pass, noise
+    /// would have to turn the robot's digits into exactly the expected
+    /// ones; an answer that differs is read until two agree, as always,
+    /// so what differs is named with the bytes the robot holds.
+    ///
+    /// # Errors
+    /// As [`Client::read_memory`].
+    pub fn read_expecting(&mut self, address: u16, expected: &[Option<u8>]) -> Result<Vec<u8>> {
+        self.read_agreeing(address, expected.len(), Some(expected))
+    }
+
+    fn read_agreeing(
+        &mut self,
+        address: u16,
+        len: usize,
+        expected: Option<&[Option<u8>]>,
+    ) -> Result<Vec<u8>> {
         if u32::from(address) + len as u32 > 0x1_0000 {
             return Err(Error::BadImage {
                 reason: format!("reading {len} bytes at ${address:04X} runs past $FFFF"),
@@ -608,11 +631,21 @@ impl<T: Transport> Client<T> {
             for outcome in self.poll(self.config.stall_limit)? {
                 match outcome {
                     Outcome::Answered { span, data, .. } => {
-                        if candidates.get(&span.address()) == Some(&data) {
+                        let offset = usize::from(span.address() - address);
+                        let as_expected = expected.is_some_and(|expected| {
+                            expected
+                                .get(offset..offset + data.len())
+                                .is_some_and(|wanted| {
+                                    wanted
+                                        .iter()
+                                        .zip(&data)
+                                        .all(|(want, got)| want.is_none_or(|want| want == *got))
+                                })
+                        });
+                        if as_expected || candidates.get(&span.address()) == Some(&data) {
                             failures = 0;
                             size = size.saturating_add(4).min(MAX_READ);
                             remaining -= data.len();
-                            let offset = usize::from(span.address() - address);
                             out[offset..offset + data.len()].copy_from_slice(&data);
                         } else {
                             if let Some(before) = candidates.insert(span.address(), data.clone()) {

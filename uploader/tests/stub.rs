@@ -329,3 +329,38 @@ fn steps_over_short_instructions_are_done_on_the_host() {
         Some((0x0480, 0xEA, b'2'))
     );
 }
+
+/// The handler with `extra` bytes of code (NOPs) after its byte at $0480.
+fn longer_handler(extra: usize) -> uploader::UploadImage {
+    let image = handler();
+    let mut area = image.areas()[0].clone();
+    area.bytes.resize(area.bytes.len() + extra, 0xEA);
+    uploader::UploadImage::new(vec![area], image.hooks().to_vec()).expect("an image")
+}
+
+/// Issue 27, round 6: attach compares the robot's code with the image
+/// reading each span once when it is the image's (it read every byte
+/// until two answers agreed): 512 more bytes of code cost under three
+/// characters a byte on the return wire (two hex digits and the
+/// answers' letters), not four. Prints the robot time at 9600 baud.
+#[test]
+fn attach_reads_code_that_is_the_images_once() {
+    let cost = |extra: usize| {
+        let image = longer_handler(extra);
+        let mut client = attach(&image).abandon();
+        let received = client.stats().received;
+        let time = uploader::transport::Transport::now(client.transport());
+        (received, time)
+    };
+    let (short, short_time) = cost(0);
+    let (long, long_time) = cost(512);
+    let per_byte = (long - short) as f64 / 512.0;
+    println!(
+        "attach at 9600 baud: {short} characters received, {:.3} s of robot time with {} bytes of code; {long}, {:.3} s with 512 more ({per_byte:.2} characters and {:.2} ms a byte more)",
+        short_time.as_secs_f64(),
+        handler().len(),
+        long_time.as_secs_f64(),
+        (long_time - short_time).as_secs_f64() * 1000.0 / 512.0,
+    );
+    assert!(per_byte < 3.0, "{per_byte:.2} characters a byte");
+}

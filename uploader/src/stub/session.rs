@@ -293,7 +293,7 @@ impl<T: Transport> RobotDebug<T> {
         let mut leftovers = Vec::new();
         let mut adopted = Vec::new();
         for area in self.image.areas().to_vec() {
-            let mut found = self.read(area.address, area.bytes.len())?;
+            let mut found = self.read_code(&area, &slots)?;
             for &slot in &slots {
                 for at in [slot, slot.wrapping_add(1)] {
                     if area.contains(at) {
@@ -339,6 +339,49 @@ impl<T: Transport> RobotDebug<T> {
             self.image.set_byte(at, byte);
         }
         Ok(leftovers)
+    }
+
+    /// The robot's bytes of `area` where the image has code (its data
+    /// is the image's, unread), each run of code read once when it is the
+    /// image's (`Client::read_expecting`; the chain slots `slots`, which
+    /// the robot holds as the uploader filled them, may be anything): a
+    /// robot that holds the image is read at half the line time, and a
+    /// difference is read until two answers agree, so that it is named
+    /// with the robot's bytes.
+    fn read_code(&mut self, area: &crate::image::Area, slots: &[u16]) -> StubResult<Vec<u8>> {
+        let mut found = area.bytes.clone();
+        let slot = |address: u16| {
+            slots
+                .iter()
+                .any(|&slot| address == slot || address == slot.wrapping_add(1))
+        };
+        let code: Vec<bool> = (0..area.bytes.len())
+            .map(|i| {
+                let address = area.address.wrapping_add(i as u16);
+                self.image.is_code(address) || slot(address)
+            })
+            .collect();
+        let mut i = 0;
+        while i < code.len() {
+            if !code[i] {
+                i += 1;
+                continue;
+            }
+            let end = (i..code.len()).find(|&j| !code[j]).unwrap_or(code.len());
+            let at = area.address.wrapping_add(i as u16);
+            let bytes = if self.stopped.is_some() {
+                // Through the stub's frames, which carry their own sum.
+                self.read(at, end - i)?
+            } else {
+                let expected: Vec<Option<u8>> = (i..end)
+                    .map(|j| (!slot(area.address.wrapping_add(j as u16))).then_some(area.bytes[j]))
+                    .collect();
+                self.client.read_expecting(at, &expected)?
+            };
+            found[i..end].copy_from_slice(&bytes);
+            i = end;
+        }
+        Ok(found)
     }
 
     /// Tells where every instruction of the image starts (a built
