@@ -92,8 +92,9 @@ fn handler_elf() -> Vec<u8> {
     Format::Elf.write(&image).expect("an ELF image")
 }
 
-#[test]
-fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
+/// The handler and its source in a new directory, uploaded to a new pty
+/// robot.
+fn handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {
     let dir = tempfile::tempdir().expect("temporary directory");
     std::fs::write(dir.path().join("ext.elf"), handler_elf()).expect("the image");
     let source: String = SOURCE.iter().map(|(line, _)| format!("{line}\n")).collect();
@@ -104,16 +105,28 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
         &["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"],
     );
     assert!(output.status.success(), "{}", transcript(&output));
+    (dir, sim)
+}
 
+/// An adapter initialized and launched on `sim`'s robot with `dir`'s
+/// `ext.elf`.
+fn launched(dir: &std::path::Path, sim: &Sim) -> Client {
     let mut dap = Client::start();
     let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
     assert_eq!(init["success"], true, "{init}");
-    let program = dir.path().join("ext.elf");
+    let program = dir.join("ext.elf");
     let launch = dap.request(
         "launch",
         json!({"program": program.to_str().expect("a path"), "port": sim.path}),
     );
     assert_eq!(launch["success"], true, "{launch}");
+    dap
+}
+
+#[test]
+fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
+    let (dir, sim) = handler_on_a_pty_robot();
+    let mut dap = launched(dir.path(), &sim);
     // On the robot there is no going back and no data breakpoint.
     let capabilities = dap.event("capabilities");
     assert_eq!(
@@ -287,6 +300,95 @@ fn a_launch_on_a_port_that_is_not_there_is_an_error_naming_it() {
     // The session goes on: nothing is attached, and it ends cleanly.
     let trace = dap.request("stackTrace", json!({"threadId": 1}));
     assert_eq!(trace["success"], false, "{trace}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+}
+
+/// Issue 27, round 6: a `next` over `JSR PUTEOL` runs on (the answer ends
+/// before it stops): its stop, heard later, is where the step ended, so
+/// its reason is `step` with no breakpoint named (it was `breakpoint`).
+#[test]
+fn a_step_that_ran_on_stops_with_the_reason_step() {
+    let (dir, sim) = handler_on_a_pty_robot();
+    let mut dap = launched(dir.path(), &sim);
+    let path = dir.path().join("handler.s");
+    // Line 8 is `jsr PUTEOL`, at $0412.
+    let set = dap.request(
+        "setBreakpoints",
+        json!({"source": {"path": path.to_str().expect("a path")},
+               "breakpoints": [{"line": 8}]}),
+    );
+    let id = set["body"]["breakpoints"][0]["id"].clone();
+    assert_eq!(set["body"]["breakpoints"][0]["verified"], true, "{set}");
+    let done = dap.request("configurationDone", json!({}));
+    assert_eq!(done["success"], true, "{done}");
+    let sent = dap.request("evaluate", json!({"expression": "/1Q", "context": "repl"}));
+    assert_eq!(sent["success"], true, "{sent}");
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
+    assert_eq!(
+        stopped["body"]["hitBreakpointIds"],
+        json!([id]),
+        "{stopped}"
+    );
+    assert_eq!(dap.top_frame()["instructionPointerReference"], "0x0412");
+
+    let next = dap.request("next", json!({"threadId": 1}));
+    assert_eq!(next["success"], true, "{next}");
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "step", "{stopped}");
+    assert!(
+        stopped["body"].get("hitBreakpointIds").is_none(),
+        "{stopped}"
+    );
+    assert_eq!(dap.top_frame()["instructionPointerReference"], "0x0415");
+    let mut heard = String::new();
+    while !heard.contains("Q42") {
+        let output = dap.event("output");
+        if output["body"]["category"] == "stdout" {
+            heard.push_str(output["body"]["output"].as_str().unwrap_or_default());
+        }
+    }
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+}
+
+/// Issue 27, round 6: a launch that cleans up after a monitor killed at a
+/// stop says so in the editor's console (the monitor's sentence), before
+/// the first stop, which is where the robot was found.
+#[test]
+fn a_launch_says_what_it_cleaned_up_in_the_console_before_the_first_stop() {
+    let (dir, sim) = crate::robot_debug::readme_handler_on_a_pty_robot();
+    crate::robot_recovery::killed_monitor(dir.path(), &sim, "break show\n/1Q\n", "PC=");
+    let mut dap = launched(dir.path(), &sim);
+    let said = loop {
+        let output = dap.event("output");
+        if output["body"]["category"] == "console" {
+            break output;
+        }
+    };
+    let text = said["body"]["output"].as_str().unwrap_or_default();
+    for expected in [
+        "an earlier session did not detach",
+        "stopped in its stub at $0409",
+        "breakpoints at $0409 were taken out",
+    ] {
+        assert!(text.contains(expected), "{expected}: {said}");
+    }
+    let done = dap.request("configurationDone", json!({}));
+    assert_eq!(done["success"], true, "{done}");
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "entry", "{stopped}");
+    assert!(
+        said["seq"].as_i64().expect("a seq") < stopped["seq"].as_i64().expect("a seq"),
+        "the sentence before the stop: {said} {stopped}"
+    );
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
     let bye = dap.request("disconnect", json!({}));
     assert_eq!(bye["success"], true, "{bye}");
     assert!(dap.ends());

@@ -36,7 +36,7 @@ fn answers(dir: &std::path::Path, sim: &Sim) {
 
 /// A monitor fed `lines`, killed with SIGKILL once its output holds
 /// `until`: what it printed.
-fn killed_monitor(dir: &std::path::Path, sim: &Sim, lines: &str, until: &str) -> String {
+pub(crate) fn killed_monitor(dir: &std::path::Path, sim: &Sim, lines: &str, until: &str) -> String {
     let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
         .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
         .current_dir(dir)

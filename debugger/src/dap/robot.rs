@@ -40,6 +40,10 @@ pub struct RobotSession {
     breakpoints: BTreeMap<i64, (String, u16)>,
     next_id: i64,
     running: bool,
+    /// A `next` or `stepIn` ran on (its stop had not come when it was
+    /// answered): the next stop that no breakpoint of the client's made is
+    /// where the step ended.
+    stepping: bool,
 }
 
 impl std::fmt::Debug for RobotSession {
@@ -76,7 +80,17 @@ impl RobotSession {
             breakpoints: BTreeMap::new(),
             next_id: 1,
             running: false,
+            stepping: false,
         }
+    }
+
+    /// What attach found of a session that did not detach and cleaned up
+    /// (the sentence the monitor prints), if anything: for the editor's
+    /// console before the first stop.
+    #[must_use]
+    pub fn recovery(&self) -> Option<String> {
+        let recovery = self.robot.as_ref()?.recovery();
+        recovery.found().then(|| recovery.describe())
     }
 
     /// The robot runs its control loop (between requests, its line is
@@ -162,6 +176,7 @@ impl RobotSession {
         match heard {
             Heard::Answer(answer) => {
                 self.running = true;
+                self.stepping |= reason == "step";
                 let text = String::from_utf8_lossy(answer).replace('\r', "\n");
                 outbox.output("stdout", &text)
             }
@@ -173,7 +188,18 @@ impl RobotSession {
                     .filter(|(_, (_, at))| *at == registers.pc)
                     .map(|(id, _)| *id)
                     .collect();
-                let reason = if hit.is_empty() { reason } else { "breakpoint" };
+                // DAP: `breakpoint` (with the ids) when one of the client's
+                // breakpoints stopped it; `step` where a step that ran on
+                // ended (at its own breakpoints, which the client does not
+                // know), however long after the step was answered.
+                let reason = if !hit.is_empty() {
+                    "breakpoint"
+                } else if self.stepping {
+                    "step"
+                } else {
+                    reason
+                };
+                self.stepping = false;
                 let mut body = json!({
                     "reason": reason,
                     "threadId": THREAD,
@@ -187,6 +213,7 @@ impl RobotSession {
             }
             Heard::Silent => {
                 self.running = true;
+                self.stepping |= reason == "step";
                 Ok(())
             }
         }

@@ -648,7 +648,9 @@ impl Session {
         })();
         match attached {
             Ok(attached) => {
-                self.robot = Some(super::robot::RobotSession::new(attached));
+                let robot = super::robot::RobotSession::new(attached);
+                let recovery = robot.recovery();
+                self.robot = Some(robot);
                 self.debugger = None;
                 self.running = false;
                 self.outbox
@@ -657,6 +659,13 @@ impl Session {
                     "capabilities",
                     Some(json!({"capabilities": super::robot::RobotSession::capabilities()})),
                 )?;
+                // What the monitor prints when attach cleaned up a session
+                // that died: the editor's console says it before the
+                // first stop (`configurationDone` shows a robot found
+                // stopped).
+                if let Some(sentence) = recovery {
+                    self.outbox.output("console", &format!("{sentence}\n"))?;
+                }
             }
             Err(why) => self
                 .outbox
