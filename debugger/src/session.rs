@@ -105,6 +105,9 @@ pub struct Debugger {
     symbols: Symbols,
     /// The loaded images, for their source lines.
     images: Vec<linker::Image>,
+    /// Where the images' source paths start: which files are the user's
+    /// own, for the lines a user is shown ([`Debugger::source_of`]).
+    source_root: std::path::PathBuf,
     breakpoints: Vec<Option<Breakpoint>>,
     /// Each breakpoint's condition, hit count and log message.
     options: Vec<PointOptions>,
@@ -224,6 +227,7 @@ impl Debugger {
             robot,
             symbols,
             images: images.to_vec(),
+            source_root: std::path::PathBuf::from("."),
             breakpoints: Vec::new(),
             options: Vec::new(),
             hits: Vec::new(),
@@ -284,18 +288,31 @@ impl Debugger {
         lines
     }
 
-    /// The source file (as the assembler was given it) and line that the
-    /// byte at `address` came from, if a loaded image says.
+    /// Says where the images' source paths start (the project's root, or
+    /// the directory a front end reads them from; the current directory
+    /// until told): the files there are the user's own.
+    pub fn set_source_root(&mut self, root: std::path::PathBuf) {
+        self.source_root = root;
+    }
+
+    /// The source file (as the assembler was given it) and line a user
+    /// is shown for the byte at `address`, if a loaded image says: the
+    /// line it came from, or for a built-in macro's code (`scorpion.inc`,
+    /// not a file of the user's) the user's line that called the macro
+    /// ([`isa::objfmt::user_place`], as the profile and the coverage
+    /// count it).
     #[must_use]
     pub fn source_of(&self, address: u16) -> Option<(String, u32)> {
+        let is_users = |file: &str| hostfs::is_users_source(&self.source_root, file);
         self.images.iter().find_map(|image| {
-            let (file, line, _) = image.source_of(u32::from(address))?;
+            let (file, line) = image.user_source_of(u32::from(address), &is_users)?;
             Some((file.to_owned(), line))
         })
     }
 
     /// The first address whose bytes came from `line` of `file` (a path,
-    /// or its last components: `adc.s`).
+    /// or its last components: `adc.s`), or that a macro called there
+    /// made (`break myext.s:26` on `SCORPION_CHAIN_UNKNOWN`: its `JMP`).
     #[must_use]
     pub fn address_of_line(&self, file: &str, line: u32) -> Option<u16> {
         self.images
@@ -586,6 +603,38 @@ impl Debugger {
         };
         let until = self.robot.cycles().saturating_add(budget);
         self.go(until, goal)
+    }
+
+    /// One source line, as a user sees lines ([`Debugger::source_of`]),
+    /// each `JSR` with the whole subroutine it calls: instructions as
+    /// [`Debugger::next`] runs them until the PC is on another line (or
+    /// where no line is: the ROM), a stop that is not a step's comes, or
+    /// `budget` cycles have run. A built-in macro's code is shown at the
+    /// user's line that called it, so the call is one line. Where the PC
+    /// has no line, one instruction.
+    ///
+    /// # Errors
+    /// As [`Debugger::run`].
+    pub fn next_line(&mut self, budget: u64) -> Result<Stopped, Error> {
+        let Some(line) = self.source_of(self.cpu().pc) else {
+            return self.next(budget);
+        };
+        let until = self.robot.cycles().saturating_add(budget);
+        let mut stopped = self.next(budget)?;
+        while stopped.why == Why::Stepped && self.source_of(self.cpu().pc).as_ref() == Some(&line) {
+            let left = until.saturating_sub(self.robot.cycles());
+            if left == 0 {
+                stopped.why = Why::Budget;
+                break;
+            }
+            let more = self.next(left)?;
+            stopped.why = more.why;
+            stopped.pc = more.pc;
+            stopped.cycles += more.cycles;
+            stopped.instructions += more.instructions;
+            stopped.received.extend(more.received);
+        }
+        Ok(stopped)
     }
 
     /// Runs until the current subroutine returns (its `RTS` pops the

@@ -283,6 +283,19 @@ pub fn read_text(path: impl AsRef<Path>, limit: Limit) -> Result<String, Error> 
     })
 }
 
+/// Whether `name`, a source file's name as its build gave it to the
+/// assembler (relative to `root`, the project's root), is one of the
+/// user's own files, which they can open: a regular file there. A
+/// built-in include (`scorpion.inc`, served by the toolchain, not on
+/// disk) is not, nor is a name that leaves `root` by an absolute path.
+/// The debuggers, the profile and the coverage all ask this
+/// (with `isa::objfmt::user_place`, which line a user is shown).
+#[must_use]
+pub fn is_users_source(root: &Path, name: &str) -> bool {
+    let path = root.join(name);
+    path.starts_with(root) && std::fs::metadata(&path).is_ok_and(|m| m.is_file())
+}
+
 /// Checks, without opening it, that `path` can be written as a regular
 /// file: nothing is there yet, or a regular file is (it is replaced), in
 /// a directory that exists.

@@ -109,14 +109,35 @@ impl Image {
         Some((self.lines.file_name(loc)?, loc.line, loc.column))
     }
 
+    /// The line a user is shown for the byte at run address `address`
+    /// ([`isa::objfmt::user_place`]: a built-in macro's code at the
+    /// user's line that called it); `is_users` says whether a file is one
+    /// the user can open. `None` outside the image's sections.
+    #[must_use]
+    pub fn user_source_of(
+        &self,
+        address: u32,
+        is_users: &dyn Fn(&str) -> bool,
+    ) -> Option<(&str, u32)> {
+        let (file, line, _) = self.source_of(address)?;
+        let call = self
+            .lines
+            .call(0, address)
+            .and_then(|loc| Some((self.lines.file_name(loc)?, loc.line)));
+        Some(isa::objfmt::user_place((file, line), call, is_users))
+    }
+
     /// The lowest run address whose bytes came from line `line` of the
     /// source file whose path ends with `file` (`adc.s` finds
-    /// `examples/adc/adc.s`).
+    /// `examples/adc/adc.s`), or that a macro called on that line made
+    /// (its first byte: a line that calls a macro is where the macro's
+    /// code begins).
     #[must_use]
     pub fn address_of_line(&self, file: &str, line: u32) -> Option<u32> {
         self.lines
             .entries
             .iter()
+            .chain(&self.lines.calls)
             .filter(|entry| entry.loc.line == line)
             .filter(|entry| {
                 self.lines

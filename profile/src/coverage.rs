@@ -76,9 +76,11 @@ pub struct Coverage {
 impl Coverage {
     /// The coverage `profile` gives the code lines of `table`, of the
     /// files `keep` accepts (the user's own: not the ROM's, not built-in
-    /// includes, unless asked). The code a macro from a file not kept
-    /// made (a built-in include's `SCORPION_CHAIN_UNKNOWN`) counts at the
-    /// kept line that called it.
+    /// includes, unless asked). Each instruction counts at the line a
+    /// user is shown for it ([`isa::objfmt::user_place`], as the
+    /// debuggers and the profile show it): the code a macro from a file
+    /// not kept made (a built-in include's `SCORPION_CHAIN_UNKNOWN`)
+    /// counts at the kept line that called it.
     #[must_use]
     pub fn new(profile: &Profile, table: &LineTable, keep: &dyn Fn(&str) -> bool) -> Coverage {
         let mut kept: BTreeMap<String, BTreeMap<u32, LineHits>> = BTreeMap::new();
@@ -104,18 +106,15 @@ impl Coverage {
             }
         };
         for line in &table.lines {
-            let own = keep(&line.file);
-            if own {
+            if keep(&line.file) {
                 count(&line.file, line.line, None, false);
             }
             for &at in &line.starts {
                 let is_branch = line.branches.contains(&at);
-                if own {
-                    count(&line.file, line.line, Some(at), is_branch);
-                } else if let Some((file, call)) = table.call_of(at)
-                    && keep(file)
-                {
-                    count(file, call, Some(at), is_branch);
+                let call = table.call_of(at);
+                let (file, shown) = isa::objfmt::user_place((&line.file, line.line), call, keep);
+                if keep(file) {
+                    count(file, shown, Some(at), is_branch);
                 }
             }
         }

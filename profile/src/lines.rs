@@ -175,6 +175,24 @@ impl LineTable {
         self.find(&self.calls, address)
     }
 
+    /// The file and line a user is shown for the byte at `address`
+    /// ([`isa::objfmt::user_place`]: a built-in macro's code at the
+    /// user's line that called it), as the debuggers show it; `is_users`
+    /// says whether a file is one the user can open.
+    #[must_use]
+    pub fn user_place_of(
+        &self,
+        address: u16,
+        is_users: &dyn Fn(&str) -> bool,
+    ) -> Option<(&str, u32)> {
+        let own = self.place_of(address)?;
+        Some(isa::objfmt::user_place(
+            own,
+            self.call_of(address),
+            is_users,
+        ))
+    }
+
     fn find(&self, ranges: &[(u16, u16, usize)], address: u16) -> Option<(&str, u32)> {
         let index = ranges.partition_point(|(first, _, _)| *first <= address);
         let (_, last, place) = ranges.get(index.checked_sub(1)?)?;

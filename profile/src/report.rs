@@ -130,9 +130,16 @@ pub struct HotLine {
     pub cycles: u64,
 }
 
-/// Every line (or label) that ran, dearest first.
+/// Every line (or label) that ran, dearest first: each at the line a
+/// user is shown for it ([`LineTable::user_place_of`]: a built-in macro's
+/// code at the user's line that called it, as the coverage counts it);
+/// `is_users` says whether a file is one the user can open.
 #[must_use]
-pub fn hot_lines(profile: &Profile, lines: &LineTable) -> Vec<HotLine> {
+pub fn hot_lines(
+    profile: &Profile,
+    lines: &LineTable,
+    is_users: &dyn Fn(&str) -> bool,
+) -> Vec<HotLine> {
     let mut by_place: BTreeMap<String, (u64, u64)> = BTreeMap::new();
     for (address, (&count, &cycles)) in profile.counts.iter().zip(&profile.cycles).enumerate() {
         // An interrupt's entry counted at a handler the run ended before
@@ -143,7 +150,7 @@ pub fn hot_lines(profile: &Profile, lines: &LineTable) -> Vec<HotLine> {
         let Ok(address) = u16::try_from(address) else {
             continue;
         };
-        let place = match lines.place_of(address) {
+        let place = match lines.user_place_of(address, is_users) {
             Some((file, line)) => format!("{file}:{line}"),
             None => {
                 let name = profile.name_of(address);
@@ -169,14 +176,19 @@ pub fn hot_lines(profile: &Profile, lines: &LineTable) -> Vec<HotLine> {
 
 /// The hot source lines as a table, at most `limit` (code without a line
 /// table, the ROM's, is summed on a line of its own: the routines and
-/// the flame graph name it).
+/// the flame graph name it); lines as [`hot_lines`] places them.
 #[must_use]
-pub fn hot_lines_table(profile: &Profile, lines: &LineTable, limit: usize) -> String {
+pub fn hot_lines_table(
+    profile: &Profile,
+    lines: &LineTable,
+    is_users: &dyn Fn(&str) -> bool,
+    limit: usize,
+) -> String {
     let mut text = format!(
         "{:<40} {:>10} {:>12} {:>7}\n",
         "line", "runs", "cycles", "share"
     );
-    let (sourced, unsourced): (Vec<HotLine>, Vec<HotLine>) = hot_lines(profile, lines)
+    let (sourced, unsourced): (Vec<HotLine>, Vec<HotLine>) = hot_lines(profile, lines, is_users)
         .into_iter()
         .partition(|line| !line.place.ends_with("(no source)"));
     let elsewhere: u64 = unsourced.iter().map(|line| line.cycles).sum();

@@ -363,7 +363,7 @@ fn an_interrupt_entry_is_counted_at_its_handler() {
     assert!(profile.routines["IRQ"].calls > 0, "the session interrupts");
     assert_eq!(profile.cycles.iter().sum::<u64>(), profile.total);
     let table = scorpion_profile::lines::LineTable::default();
-    let by_line: u64 = scorpion_profile::report::hot_lines(&profile, &table)
+    let by_line: u64 = scorpion_profile::report::hot_lines(&profile, &table, &|_| true)
         .iter()
         .map(|line| line.cycles)
         .sum();

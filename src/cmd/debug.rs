@@ -89,6 +89,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             .into_diagnostic()?;
         debugger.set_interrupt(Arc::clone(&interrupt));
     }
+    debugger.set_source_root(root.clone());
     let mut monitor = Monitor::new(Sources::new(root));
     monitor.set_pausable(input.is_terminal());
     let mut out = std::io::stdout().lock();
@@ -177,7 +178,17 @@ fn is_repeatable(line: &str) -> bool {
     let verb = line.split_whitespace().next().unwrap_or_default();
     matches!(
         verb,
-        "step" | "s" | "stepi" | "si" | "next" | "n" | "back" | "bs" | "reverse-step"
+        "step"
+            | "s"
+            | "stepi"
+            | "si"
+            | "next"
+            | "n"
+            | "nexti"
+            | "ni"
+            | "back"
+            | "bs"
+            | "reverse-step"
     )
 }
 

@@ -118,7 +118,7 @@ impl Member {
     ) -> miette::Result<()> {
         let coverage =
             scorpion_profile::coverage::Coverage::new(&self.profile, &self.lines(), &|file| {
-                read_source(&self.root, file).is_some()
+                self.is_users(file)
             });
         let (lines, _) = coverage.line_counts();
         if lines == 0 {
@@ -176,6 +176,14 @@ impl Member {
             let _ = writeln!(out, "  branch {how}: {}:{}", missed.file, missed.line);
         }
         Ok(())
+    }
+
+    /// Whether `file` (as its build named it) is one of the project's own
+    /// sources, which the user can open: its lines are shown, and a
+    /// built-in macro's code counts at the line of it that called the
+    /// macro (`isa::objfmt::user_place`, as the debuggers show it).
+    pub(crate) fn is_users(&self, file: &str) -> bool {
+        hostfs::is_users_source(&self.root, file)
     }
 
     /// The line tables of its images, its own sources read.
@@ -377,7 +385,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let _ = writeln!(
         out,
         "{}",
-        report::hot_lines_table(profile, &lines, args.limit)
+        report::hot_lines_table(profile, &lines, &|file| member.is_users(file), args.limit)
     );
     let target = project.root.join("target/scorpion");
     let folded = args

@@ -381,6 +381,53 @@ fn an_image_launched_runs_to_a_breakpoint_by_line() {
     assert!(c.ends());
 }
 
+/// A line that calls a built-in macro (`scorpion new`'s
+/// `SCORPION_CHAIN_UNKNOWN`, whose code is `scorpion.inc`'s) takes a
+/// breakpoint at the macro's first byte: verified at that line, hit when
+/// a command goes down the chain, and the frame shows the user's line,
+/// the one they can open (the old adapter answered "no code came from
+/// line 26").
+#[test]
+fn a_breakpoint_on_a_line_that_calls_a_built_in_macro_stops_there() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = crate::scorpion(dir.path(), &["new", "myext"]);
+    assert!(made.status.success(), "{}", crate::transcript(&made));
+    let project = dir.path().join("myext");
+    let text = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let chain = text
+        .lines()
+        .position(|l| l.trim() == "SCORPION_CHAIN_UNKNOWN")
+        .expect("the chain line")
+        + 1;
+    let mut c = Client::start();
+    c.request("initialize", json!({"adapterID": "scorpion"}));
+    let launch = c.request(
+        "launch",
+        json!({"program": project.display().to_string(), "commands": ["/1W"]}),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    let source = project.join("src/myext.s").display().to_string();
+    let set = c.request(
+        "setBreakpoints",
+        json!({"source": {"path": source}, "breakpoints": [{"line": chain}]}),
+    );
+    let answer = &set["body"]["breakpoints"][0];
+    assert_eq!(answer["verified"], true, "{set}");
+    assert_eq!(answer["line"], chain, "{set}");
+    c.request("configurationDone", json!({}));
+    assert_eq!(c.event("stopped")["body"]["reason"], "breakpoint");
+    let frame = c.top_frame();
+    assert_eq!(frame["line"], chain, "{frame}");
+    assert!(
+        frame["source"]["path"]
+            .as_str()
+            .is_some_and(|path| path.ends_with("src/myext.s")),
+        "{frame}"
+    );
+    c.request("disconnect", json!({}));
+    assert!(c.ends());
+}
+
 impl Client {
     /// Sends a request with `body` as its whole message (no `arguments`
     /// added); returns its seq.

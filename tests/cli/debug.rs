@@ -78,6 +78,51 @@ fn a_robot_that_breaks_fails_the_session() {
     assert!(text.contains("error: ") && text.contains("$0400"), "{text}");
 }
 
+/// `scorpion new`'s project: `break src/myext.s:26`, the line that
+/// calls the built-in `SCORPION_CHAIN_UNKNOWN`, stops at the macro's
+/// `JMP` when a command no extension knows goes down the chain; the stop,
+/// `bt` and `list` show that line of the user's source, not
+/// `scorpion.inc`'s (the old monitor refused the breakpoint: "no code
+/// came from src/myext.s:26").
+#[test]
+fn a_line_that_calls_a_built_in_macro_takes_a_breakpoint() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let made = scorpion(dir.path(), &["new", "myext"]);
+    assert!(made.status.success(), "{}", transcript(&made));
+    let project = dir.path().join("myext");
+    let text = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let chain = text
+        .lines()
+        .position(|l| l.trim() == "SCORPION_CHAIN_UNKNOWN")
+        .expect("the chain line")
+        + 1;
+    let output = scorpion_with_input(
+        Some(&project),
+        &["debug"],
+        &format!("break src/myext.s:{chain}\n/1W\ncontinue\nbt\nlist\nquit\n"),
+    );
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    let shown = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        shown.contains("breakpoint 1: $") && shown.contains("breakpoint 1 ($"),
+        "set and hit: {shown}"
+    );
+    let line = format!("src/myext.s:{chain}");
+    assert!(
+        shown.contains(&format!("  {line}:         SCORPION_CHAIN_UNKNOWN\n")),
+        "the stop shows the user's line: {shown}"
+    );
+    assert!(
+        shown.contains("#0 ") && shown.contains(&format!("  {line}: SCORPION_CHAIN_UNKNOWN")),
+        "bt: {shown}"
+    );
+    assert!(
+        shown.contains(&format!("> {line}   ")),
+        "list marks the user's line: {shown}"
+    );
+    assert!(!shown.contains("scorpion.inc"), "{shown}");
+}
+
 #[test]
 fn the_readmes_debugging_section_runs_as_written() {
     let tmp = tempfile::tempdir().expect("a temporary directory");

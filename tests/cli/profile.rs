@@ -248,6 +248,36 @@ fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
     assert!(!text.contains("never run"), "{text}");
 }
 
+/// The cycles of a built-in macro's code (`SCORPION_CHAIN_UNKNOWN`'s
+/// `JMP`, written in `scorpion.inc`) are the user's line that called it
+/// in the profile's hot lines, as in the coverage and the debuggers (the
+/// old report said `scorpion.inc:80`, a file the user cannot open).
+#[test]
+fn a_built_in_macros_cycles_are_the_calling_lines() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let created = scorpion(dir.path(), &["new", "myext"]);
+    assert!(created.status.success(), "{}", transcript(&created));
+    let project = dir.path().join("myext");
+    let source = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let chain = lines_with(&source, "SCORPION_CHAIN_UNKNOWN");
+    assert_eq!(chain.len(), 1, "{source}");
+    let expect = project.join("tests/myext.expect");
+    let mut transcript_text = std::fs::read_to_string(&expect).expect("the transcript");
+    transcript_text.push_str("/1W => nothing            # down the chain\n");
+    std::fs::write(&expect, transcript_text).expect("write");
+    let output = scorpion(&project, &["profile", "--limit", "100"]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let text = stdout(&output);
+    let row = text
+        .lines()
+        .find(|l| l.starts_with(&format!("src/myext.s:{} ", chain[0])))
+        .unwrap_or_else(|| panic!("no row for the chain's line: {text}"));
+    let runs: Vec<&str> = row.split_whitespace().collect();
+    assert_eq!(runs[1], "1", "one /1W ran the JMP once (3 cycles): {row}");
+    assert_eq!(runs[2], "3", "{row}");
+    assert!(!text.contains("scorpion.inc"), "{text}");
+}
+
 /// The examples' projects covered: each one's LCOV names its source with
 /// lines run, and its HTML page shows the source.
 #[test]

@@ -327,6 +327,41 @@ fn a_signal_at_a_stop_gives_the_robot_back() {
     );
 }
 
+/// On the robot too, the line that calls the built-in
+/// `SCORPION_CHAIN_UNKNOWN` takes a breakpoint at the macro's `JMP` (the
+/// old monitor refused it: "no code came from ext.s:15"), hit by a
+/// command the handler passes down the chain, which then goes on down it.
+#[test]
+fn a_line_that_calls_a_built_in_macro_takes_a_breakpoint_on_the_robot() {
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    let source = std::fs::read_to_string(dir.path().join("ext.s")).expect("the source");
+    let chain = source
+        .lines()
+        .position(|l| l.trim() == "SCORPION_CHAIN_UNKNOWN")
+        .expect("the chain line")
+        + 1;
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        &format!("break ext.s:{chain}\n/1Z\ncontinue\n/1Q\nquit\n"),
+    );
+    let printed = transcript(&output);
+    assert!(output.status.success(), "{printed}");
+    let mut from = 0;
+    for expected in [
+        "breakpoint 1: $",
+        "(not_mine)",
+        "stopped: breakpoint 1, $",
+        "answer: Q42",
+        "detached",
+    ] {
+        let at = printed[from..]
+            .find(expected)
+            .unwrap_or_else(|| panic!("`{expected}` after byte {from}:\n{printed}"));
+        from += at + expected.len();
+    }
+}
+
 /// The README's handler built from its source and uploaded to a pty
 /// robot: the directory holding `ext.s` and `ext.elf`, and the robot.
 pub(crate) fn readme_handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {

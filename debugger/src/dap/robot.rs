@@ -403,12 +403,13 @@ impl RobotSession {
             "column": 1,
             "instructionPointerReference": format!("0x{pc:04X}"),
         });
+        let is_users = |file: &str| hostfs::is_users_source(&self.root, file);
         let source = self
             .monitor
             .images()
             .iter()
-            .find_map(|image| image.source_of(u32::from(pc)));
-        if let Some((file, line, _)) = source {
+            .find_map(|image| image.user_source_of(u32::from(pc), &is_users));
+        if let Some((file, line)) = source {
             frame["line"] = json!(line);
             frame["source"] = disassemble::source(&self.root, file);
         }

@@ -401,7 +401,7 @@ impl Session {
                 self.debugger.as_ref().ok_or(NOT_LAUNCHED)?;
                 return Ok((None, Then::Pause));
             }
-            "next" => return self.step_by(|d| d.next(STEP_BUDGET)),
+            "next" => return self.step_by(|d| d.next_line(STEP_BUDGET)),
             "stepIn" => return self.step_by(|d| d.step(1)),
             "stepOut" => return self.step_by(|d| d.finish(STEP_BUDGET)),
             "stepBack" => return self.step_by(|d| d.back(1)),
@@ -490,6 +490,7 @@ impl Session {
         let super::Launched { make, images, root } =
             (self.launcher)(&program).map_err(|e| format!("{e:?}"))?;
         let mut debugger = Debugger::new(make, &images).map_err(|e| e.to_string())?;
+        debugger.set_source_root(cwd.clone().unwrap_or_else(|| root.clone()));
         self.points.install_all(&mut debugger);
         for command in &commands {
             debugger.send(command.as_bytes());
@@ -608,7 +609,9 @@ impl Session {
     /// directory).
     fn launch(&mut self, program: &Path, cwd: Option<PathBuf>) -> miette::Result<()> {
         let super::Launched { make, images, root } = (self.launcher)(program)?;
-        self.debugger = Some(Debugger::new(make, &images)?);
+        let mut debugger = Debugger::new(make, &images)?;
+        debugger.set_source_root(cwd.clone().unwrap_or_else(|| root.clone()));
+        self.debugger = Some(debugger);
         self.points.forget();
         self.files = files(&images);
         self.exception = None;

@@ -47,7 +47,9 @@ CMDBUF+1, registers A X Y S P PC, flags C Z I D V N, [ADDR] a byte, {ADDR} a wor
   continue [CYCLES]    run until a stop, at most CYCLES (1 s; 60000000 at most);
                        Ctrl-C pauses it                                          (c)
   step [N]             run N instructions (1; 10000000 at most)                   (s)
-  next                 one instruction, a JSR with its whole subroutine            (n)
+  next                 one source line (a macro's call one line), each JSR with its
+                       whole subroutine                                           (n)
+  nexti                one instruction, a JSR with its whole subroutine           (ni)
   finish               run until the current subroutine returns                   (f)
   until [ADDR|FILE:LINE]
                        run until the PC reaches there (alone: the next instruction
@@ -304,6 +306,10 @@ fn command(d: &mut Debugger, m: &mut Monitor, line: &str) -> Result<Reply, Failu
             stop_report(d, m, &stop)
         }
         "next" | "n" => {
+            let stop = d.next_line(BUDGET)?;
+            stop_report(d, m, &stop)
+        }
+        "nexti" | "ni" => {
             let stop = d.next(BUDGET)?;
             stop_report(d, m, &stop)
         }

@@ -41,7 +41,7 @@ pub use hooks::{
     CHAIN_LOOP_SYMBOL, CHAIN_UNKNOWN_SYMBOL, HOOK_LOOP_SYMBOL, HOOK_UNKNOWN_SYMBOL, HookKind,
     HookRecord, Hooks,
 };
-pub use srcmap::{SourceLoc, SrcMap, SrcMapEntry, SymbolLoc};
+pub use srcmap::{SourceLoc, SrcMap, SrcMapEntry, SymbolLoc, user_place};
 pub use write::{
     Binding, Definition, Numbering, ObjReloc, ObjSection, ObjSymbol, RelObject, RelocTarget,
 };

@@ -14,8 +14,11 @@
 //! - version 3 adds calls: count, then entries as above (`section, offset,
 //!   file, line, column`), one for each entry a macro made, at the same
 //!   (section, offset), giving the outermost macro call (the user's line)
-//!   those bytes came from. Coverage counts a built-in macro's code at the
-//!   user's line through them. Older maps decode with none.
+//!   those bytes came from. Older maps decode with none.
+//!
+//! Which of the two places a user is shown is decided once, by
+//! [`user_place`]: the debuggers' stops, frames and listings, the
+//! profile's line report and the coverage all call it.
 //!
 //! `section` is an ELF section header index. Lines and columns count from 1.
 
@@ -216,6 +219,28 @@ impl SrcMap {
     }
 }
 
+/// The place a user is shown for bytes whose own place (file, line) is
+/// `own`, made by a macro called at `call` when a macro made them;
+/// `is_users` says whether a file is one the user can open (their own
+/// sources, not a built-in include such as `scorpion.inc`).
+///
+/// The rule, the same in every view: code a macro from a file that is not
+/// the user's made (`SCORPION_CHAIN_UNKNOWN`'s `JMP`) is shown at the
+/// user's line that called the macro; everything else at its own line,
+/// so a macro the user defined shows its own lines inside it, and code
+/// of an include of their own shows the include's line.
+#[must_use]
+pub fn user_place<'a>(
+    own: (&'a str, u32),
+    call: Option<(&'a str, u32)>,
+    is_users: &dyn Fn(&str) -> bool,
+) -> (&'a str, u32) {
+    match call {
+        Some(call) if !is_users(own.0) && is_users(call.0) => call,
+        _ => own,
+    }
+}
+
 /// `list` sorted: itself when it already is, as it usually arrives (a
 /// large program's map runs to megabytes: no copy then).
 fn sorted(list: &[SrcMapEntry]) -> std::borrow::Cow<'_, [SrcMapEntry]> {
@@ -345,6 +370,27 @@ mod tests {
         assert_eq!(map.call(2, 0), None, "no macro made it");
         assert_eq!(map.call(2, 4).unwrap().line, 50, "inside the macro's entry");
         assert_eq!(map.call(4, 0), None);
+    }
+
+    #[test]
+    fn a_built_in_macros_code_is_shown_at_the_users_call() {
+        let users = |file: &str| file.ends_with(".s");
+        let call = Some(("main.s", 26));
+        assert_eq!(
+            user_place(("scorpion.inc", 80), call, &users),
+            ("main.s", 26)
+        );
+        assert_eq!(
+            user_place(("macros.s", 7), call, &users),
+            ("macros.s", 7),
+            "the user's own macro shows its own line"
+        );
+        assert_eq!(
+            user_place(("scorpion.inc", 80), Some(("other.inc", 3)), &users),
+            ("scorpion.inc", 80),
+            "called from a file the user cannot open either"
+        );
+        assert_eq!(user_place(("scorpion.inc", 80), None, &users).1, 80);
     }
 
     #[test]

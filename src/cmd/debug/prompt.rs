@@ -36,6 +36,7 @@ pub(crate) const COMMANDS: &[&str] = &[
     "list",
     "mem",
     "next",
+    "nexti",
     "poke",
     "quit",
     "regs",
