@@ -242,3 +242,49 @@ fn a_changed_code_byte_is_still_refused() {
     assert!(said.contains("the image has 51"), "{printed}");
     assert_eq!(code(dir.path(), &sim), changed);
 }
+
+/// The hooks' six bytes, as `scorpion read` dumps them.
+fn hooks(dir: &std::path::Path, sim: &Sim) -> Vec<u8> {
+    let output = scorpion(
+        dir,
+        &["read", "$0200", "6", "-o", "hooks.bin", "--port", &sim.path],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    std::fs::read(dir.join("hooks.bin")).expect("a dump")
+}
+
+/// The `orphan` round's F1 (issue 27): a monitor killed while the robot
+/// runs leaves its stub hooked and a breakpoint in the code; an upload of
+/// the same image chained the image to the stub, which chains to the
+/// image (`/1Z` looped), and said nothing. Now it is refused, naming the
+/// stub and what takes it out, with nothing written; after that
+/// (`debug --port`, `quit`) the upload goes in and `/1Z` is answered.
+#[test]
+fn an_upload_over_a_killed_monitors_stub_is_refused_until_debug_cleans_up() {
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    killed_monitor(dir.path(), &sim, "break show\n", "breakpoint 1:");
+    let (code_left, hooks_left) = (code(dir.path(), &sim), hooks(dir.path(), &sim));
+    let upload = ["upload", "ext.elf", "--port", &sim.path, "--no-dry-run"];
+    let output = scorpion(dir.path(), &upload);
+    let printed = transcript(&output);
+    assert!(!output.status.success(), "{printed}");
+    let said = printed.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        said.contains("HOOK_UNKNOWN") && said.contains("leads to a debug stub"),
+        "{printed}"
+    );
+    assert!(said.contains("scorpion debug --port"), "{printed}");
+    assert_eq!(code(dir.path(), &sim), code_left);
+    assert_eq!(hooks(dir.path(), &sim), hooks_left);
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "ext.elf"],
+        "quit\n",
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion(dir.path(), &upload);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion(dir.path(), &["ask", "/1Z", "--port", &sim.path]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    answers(dir.path(), &sim);
+}

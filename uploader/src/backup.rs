@@ -663,7 +663,10 @@ pub fn restore<T: Transport>(
     check_hook_targets(backup, &memory.profile)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
-    crate::upload::connect(client, options)?;
+    let (hooks, _) = crate::upload::connect(client, options)?;
+    // A debug stub a killed session left hooked: its breakpoints are not
+    // the backup's to take out.
+    crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
     // The ROM the backup was taken from first: a robot with another ROM
     // is told as that (`restore --force` overrides it), not as a ROM the
     // profile's image was linked against.

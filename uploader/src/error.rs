@@ -204,6 +204,31 @@ pub enum Error {
         port: String,
     },
 
+    /// A debug stub a session left hooked (its process killed before it
+    /// detached): chaining to it would loop back to the image it debugged,
+    /// and its breakpoints may still be in the code.
+    #[error(
+        "{hook} on {port} leads to a debug stub at ${stub:04X}-${end:04X} (chaining to ${previous:04X}): a debug session did not detach, and its breakpoints may still be in the code; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::debug_stub_hooked),
+        help(
+            "`scorpion debug --port {port} --image ELF` (the image it debugged) takes the stub and its breakpoints out: run it, `quit`, and try again; or reset the robot"
+        )
+    )]
+    DebugStubHooked {
+        /// The transport's name.
+        port: String,
+        /// The hook's name.
+        hook: &'static str,
+        /// Where the stub starts.
+        stub: u16,
+        /// Its code's last byte.
+        end: u16,
+        /// What it chains to.
+        previous: u16,
+    },
+
     /// Bytes came back, but never a well-formed answer: the usual sign of a
     /// baud-rate mismatch.
     #[error("the robot on {port} answers garbage at {baud} baud: `{sample}`")]

@@ -70,20 +70,36 @@ impl Table {
 }
 
 fn read_table<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Option<Table>> {
+    read_table_with(profile, &mut |at, len| client.read_memory(at, len))
+}
+
+/// What the robot has installed, read with `read` (through the debug
+/// stub's frames, when the robot is stopped in it).
+///
+/// # Errors
+/// `read`'s, or [`romlib::Error::DamagedTable`].
+pub(crate) fn installed_with<E: From<Error>>(
+    profile: &RomProfile,
+    read: &mut dyn FnMut(u16, usize) -> std::result::Result<Vec<u8>, E>,
+) -> std::result::Result<Vec<Installed>, E> {
+    Ok(read_table_with(profile, read)?.map_or_else(Vec::new, |table| table.installed))
+}
+
+fn read_table_with<E: From<Error>>(
+    profile: &RomProfile,
+    read: &mut dyn FnMut(u16, usize) -> std::result::Result<Vec<u8>, E>,
+) -> std::result::Result<Option<Table>, E> {
     let Some((address, capacity)) = profile.table else {
         return Ok(None);
     };
-    let flags = client.read_memory(address, capacity)?;
+    let flags = read(address, capacity)?;
     let used: Vec<usize> = (0..capacity)
         .filter(|&slot| flags[slot] & 0x80 != 0)
         .collect();
     let entries = match (used.first(), used.last()) {
         (Some(&first), Some(&last)) => {
             let at = installed::entry_address(address, capacity, first);
-            (
-                first,
-                client.read_memory(at, (last + 1 - first) * ENTRY_LEN)?,
-            )
+            (first, read(at, (last + 1 - first) * ENTRY_LEN)?)
         }
         _ => (0, Vec::new()),
     };
@@ -95,7 +111,7 @@ fn read_table<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Res
     table.installed = installed::decode(address, &table.flags, |slot| {
         table.entry(slot).unwrap_or_default()
     })
-    .map_err(|damaged| Error::Robot(damaged.into()))?;
+    .map_err(|damaged| E::from(Error::Robot(damaged.into())))?;
     Ok(Some(table))
 }
 

@@ -300,6 +300,15 @@ pub fn upload_keeping<T: Transport>(
     let rates = (base, options.fast_baud.unwrap_or(base));
     let leftover = Loader::place(profile, image, rates)?;
     let (mut hooks_now, found_at) = connect(client, options)?;
+    // A debug stub a killed session left hooked is no extension to chain
+    // to: refused before anything is written.
+    let known = |target: u16| {
+        image.hooks().iter().any(|record| record.handler == target)
+            || leftover
+                .as_ref()
+                .is_some_and(|loader| [loader.sums, loader.frames, loader.rate].contains(&target))
+    };
+    crate::stub::left::refuse_hooked(client, profile, &hooks_now, &known)?;
     // The right ROM, or no write. Through the loader the jump table is
     // read once the line runs at the fast rate, before `frames` (which
     // calls GETCH and CHKCH) is hooked: only `rate`, which calls nothing

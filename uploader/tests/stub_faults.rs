@@ -46,7 +46,18 @@ fn attached(
 
 /// The invariant, on the emulated memory.
 fn assert_safe(memory: &[u8], image: &UploadImage, outcome: &str) {
-    let stub = StubPlan::place(&RomProfile::reference(), image, 0x0403).expect("links");
+    // Where attach puts it on a robot whose table is empty: beside the
+    // image and the RAM loader an upload of it uses.
+    let profile = RomProfile::reference();
+    let loader = uploader::loader_plan(&profile, image, (9600, uploader::FAST_BAUD))
+        .expect("links")
+        .expect("room for the loader");
+    let code = &loader.code;
+    let taken = [
+        code.address..=code.address + code.bytes.len() as u16 - 1,
+        u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()),
+    ];
+    let stub = StubPlan::place_beside(&profile, image, 0x0403, &taken).expect("links");
     let code = usize::from(stub.address)..usize::from(stub.code_end);
     let stub_intact = memory[code.clone()] == stub.bytes[..code.len()];
     let hook = usize::from(HOOK_UNKNOWN);

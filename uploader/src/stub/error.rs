@@ -22,19 +22,22 @@ pub enum StubError {
         message: String,
     },
 
-    /// No room for the stub beside the image.
+    /// No room for the stub beside the image and what the robot holds.
     #[error(
-        "no room for the debug stub ({len} bytes) in user RAM or two bytes of user zero page beside the image"
+        "no room for the debug stub ({len} bytes) in user RAM or two bytes of user zero page: taken are {taken}"
     )]
     #[diagnostic(
         code(uploader::stub::no_room),
         help(
-            "the stub goes where the image leaves room in user RAM ($0400-$0F3F); make the image smaller"
+            "the stub goes where neither the image, nor an extension the robot's table names, nor the RAM loader lies, in user RAM ($0400-$0F3F); make the image smaller, or take an extension out"
         )
     )]
     NoRoom {
         /// The stub's size.
         len: usize,
+        /// The ranges it had to leave (the image's, the installed
+        /// extensions', the loader's), as `$0400-$0452, ...`.
+        taken: String,
     },
 
     /// A reply from the stub that is not what was asked for.

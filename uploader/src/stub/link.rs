@@ -2,6 +2,8 @@
 //! and linked at attach time where the image leaves room, against the ROM
 //! profile's services and the hook's target it chains to.
 
+use std::ops::RangeInclusive;
+
 use linker::{Image, ImageSymbol};
 
 use super::error::{StubError, StubResult};
@@ -49,14 +51,33 @@ impl StubPlan {
     /// [`StubError::NoRoom`], or [`StubError::Link`] (a defect of this
     /// crate).
     pub fn place(profile: &RomProfile, image: &UploadImage, previous: u16) -> StubResult<StubPlan> {
+        Self::place_beside(profile, image, previous, &[])
+    }
+
+    /// [`StubPlan::place`], where none of `taken` lies either (the
+    /// extensions the robot's table names, the RAM loader's memory): a
+    /// stub written over them would break what they hold.
+    ///
+    /// # Errors
+    /// As [`StubPlan::place`]; [`StubError::NoRoom`] names `taken`.
+    pub fn place_beside(
+        profile: &RomProfile,
+        image: &UploadImage,
+        previous: u16,
+        taken: &[RangeInclusive<u16>],
+    ) -> StubResult<StubPlan> {
+        let no_room = |len: usize| StubError::NoRoom {
+            len,
+            taken: taken_text(image, taken),
+        };
         let services = profile.loader_services.ok_or_else(|| StubError::Refused {
             what: "the debug stub".into(),
             reason: "the ROM profile lacks GETCH, PUTCH or CMD_DONE".into(),
         })?;
-        let zero_page = free_zero_page(profile, image).ok_or(StubError::NoRoom { len: 2 })?;
+        let zero_page = free_zero_page(profile, image, taken).ok_or_else(|| no_room(2))?;
         let start = *profile.user_ram.start();
         let len = link(start, services, zero_page, previous)?.0.len();
-        let address = free_space(profile, image, len).ok_or(StubError::NoRoom { len })?;
+        let address = free_space(profile, image, taken, len).ok_or_else(|| no_room(len))?;
         let (bytes, linked) = link(address, services, zero_page, previous)?;
         let label = |name: &str| {
             linked
@@ -143,17 +164,40 @@ fn link(
     }
 }
 
+/// What a stub must not go over: the image's memory, and `taken`.
+fn occupied<'a>(
+    image: &'a UploadImage,
+    taken: &'a [RangeInclusive<u16>],
+) -> impl Iterator<Item = &'a RangeInclusive<u16>> + 'a {
+    image.extents().iter().chain(taken)
+}
+
+/// The ranges a stub that found no room had to leave, for its message.
+fn taken_text(image: &UploadImage, taken: &[RangeInclusive<u16>]) -> String {
+    let mut ranges: Vec<&RangeInclusive<u16>> = occupied(image, taken).collect();
+    ranges.sort_by_key(|range| (*range.start(), *range.end()));
+    ranges.dedup();
+    ranges
+        .iter()
+        .map(|range| romlib::installed::extent_text(range))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The highest `len` bytes of user RAM that none of the image's memory
-/// (loaded, BSS, zero page) takes.
-fn free_space(profile: &RomProfile, image: &UploadImage, len: usize) -> Option<u16> {
+/// (loaded, BSS, zero page) nor `taken` takes.
+fn free_space(
+    profile: &RomProfile,
+    image: &UploadImage,
+    taken: &[RangeInclusive<u16>],
+    len: usize,
+) -> Option<u16> {
     let first = u32::from(*profile.user_ram.start());
     let mut top = u32::from(*profile.user_ram.end()) + 1;
     let len = len as u32;
     while top >= first + len {
         let start = top - len;
-        let clash = image
-            .extents()
-            .iter()
+        let clash = occupied(image, taken)
             .filter(|e| u32::from(*e.start()) < top && u32::from(*e.end()) >= start)
             .map(|e| u32::from(*e.start()))
             .min();
@@ -165,11 +209,46 @@ fn free_space(profile: &RomProfile, image: &UploadImage, len: usize) -> Option<u
     None
 }
 
-/// The highest two bytes of user zero page the image's memory leaves.
-fn free_zero_page(profile: &RomProfile, image: &UploadImage) -> Option<u8> {
+/// The highest two bytes of user zero page the image's memory and
+/// `taken` leave.
+fn free_zero_page(
+    profile: &RomProfile,
+    image: &UploadImage,
+    taken: &[RangeInclusive<u16>],
+) -> Option<u8> {
     let zero_page = profile.user_zero_page.clone()?;
-    let owned = |at: u8| image.extents().iter().any(|e| e.contains(&u16::from(at)));
+    let owned = |at: u8| occupied(image, taken).any(|e| e.contains(&u16::from(at)));
     (*zero_page.start()..*zero_page.end())
         .rev()
         .find(|&at| !owned(at) && !owned(at + 1))
+}
+
+/// The stub's code as a session would have linked it at `address` for
+/// `profile`, a byte `None` where it depends on what else it was linked
+/// with (its zero page, the target it chains to), and its handler's
+/// address: what the robot holds at `address` when a session left its
+/// stub there. `None` when no stub links there (the profile lacks the
+/// ROM's services, the address is out of reach).
+pub(crate) fn left_pattern(profile: &RomProfile, address: u16) -> Option<(Vec<Option<u8>>, u16)> {
+    let services = profile.loader_services?;
+    // Two links that differ in every byte of the zero page and the chain.
+    let (one, linked) = link(address, services, 0x10, 0x1234).ok()?;
+    let (two, _) = link(address, services, 0x2A, 0xA5C3).ok()?;
+    let at = |name: &str| linked.symbol(name).and_then(|at| u16::try_from(at).ok());
+    let (handler, code_end) = (at("handler")?, at("code_end")?);
+    let len = usize::from(code_end.checked_sub(address)?);
+    let pattern = one[..len]
+        .iter()
+        .zip(&two[..len])
+        .map(|(&a, &b)| (a == b).then_some(a))
+        .collect();
+    Some((pattern, handler))
+}
+
+/// Where the stub's handler lies from its start (the same wherever it is
+/// linked).
+pub(crate) fn handler_offset(profile: &RomProfile) -> Option<u16> {
+    let start = *profile.user_ram.start();
+    let (_, handler) = left_pattern(profile, start)?;
+    handler.checked_sub(start)
 }

@@ -6,6 +6,7 @@
 //! `GETCH`/`PUTCH` until it is told to go on.
 //!
 //! - [`link`]: the stub linked where the image leaves room;
+//! - [`left`]: a stub a killed session left hooked, recognised;
 //! - [`frame`]: the stub's framing;
 //! - [`patch`]: what a breakpoint displaces, and where a step goes;
 //! - [`session`]: [`RobotDebug`], the debugger attached.
@@ -13,6 +14,7 @@
 pub mod error;
 pub mod frame;
 pub mod host_step;
+pub mod left;
 pub mod link;
 pub mod patch;
 pub mod session;

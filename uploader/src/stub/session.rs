@@ -13,6 +13,7 @@
 //! patch, so the host always knows which of the two the code holds.
 
 use std::collections::BTreeMap;
+use std::ops::RangeInclusive;
 use std::time::Duration;
 
 use romlib::protocol::Command;
@@ -20,7 +21,7 @@ use romlib::protocol::Command;
 use super::error::{StubError, StubResult, hex};
 use super::frame::{self, Heard, IN_MAX};
 use super::host_step;
-use super::link::{StubPlan, TRAMPOLINES};
+use super::link::{StubPlan, TRAMPOLINE_LEN, TRAMPOLINES};
 use super::patch::{self, JSR, Patch};
 use crate::client::Client;
 use crate::image::{RomProfile, UploadImage};
@@ -166,13 +167,15 @@ impl<T: Transport> RobotDebug<T> {
     /// for a robot stopped in a stub that is not this image's.
     pub fn attach(client: Client<T>, profile: &RomProfile, image: UploadImage) -> StubResult<Self> {
         let hook = profile.hook_unknown;
-        // Where the stub goes depends on the image only; what it chains
-        // to is learnt below.
-        let placed = StubPlan::place(profile, &image, hook)?;
+        // A first guess at where the stub goes, for the frame that asks
+        // whether one is stopped (any stub answers it). Where it goes
+        // depends on what the robot has installed, read below; what it
+        // chains to is learnt after that.
+        let guess = StubPlan::place(profile, &image, hook)?;
         let margin = client.config().margin * 4;
         let mut debug = RobotDebug {
             client,
-            stub: placed.clone(),
+            stub: guess,
             image,
             breakpoints: BTreeMap::new(),
             stopped: None,
@@ -185,17 +188,39 @@ impl<T: Transport> RobotDebug<T> {
             starts: None,
             temporary: Vec::new(),
         };
-        match debug.probe_stopped()? {
-            Some(registers) => {
-                debug.stopped = Some(registers);
-                debug.recovery.stopped = Some(registers);
-            }
-            None => {
-                debug.client.probe()?;
-            }
+        let stopped = debug.probe()?.is_some();
+        if stopped {
+            // Reads go through the stopped stub's frames from here.
+            debug.stopped = Some(Registers::default());
+        } else {
+            debug.client.probe()?;
+        }
+        let taken = debug.taken(profile)?;
+        let placed = StubPlan::place_beside(profile, &debug.image, hook, &taken)?;
+        debug.stub = placed.clone();
+        if stopped {
+            let block = debug.read(placed.regs, 8)?;
+            let registers = debug
+                .take_stop(&block)
+                .ok_or_else(|| stopped_in_another_stub(placed.address))?;
+            debug.recovery.stopped = Some(registers);
         }
         let jump = debug.read(hook, 3)?;
         let target = u16::from_le_bytes([jump[1], jump[2]]);
+        if !stopped
+            && target != placed.handler
+            && profile.reset_target(isa::objfmt::HookKind::Unknown) != Some(target)
+            && let Some(other) = super::left::at_target(&mut debug.client, profile, target)?
+        {
+            // Chaining to it would keep it, and its breakpoints, reachable.
+            return Err(StubError::Refused {
+                what: "attaching".into(),
+                reason: format!(
+                    "HOOK_UNKNOWN leads to a debug stub at ${:04X}, not where this image's goes (${:04X}): a session with another image, or beside other extensions, left it; attach with that image (and `quit`), or reset the robot",
+                    other.address, placed.address
+                ),
+            });
+        }
         let code_len = usize::from(placed.code_end - placed.address);
         let code = debug.read(placed.address, code_len)?;
         // The stub's code but for `JMP PREV`'s operand, its last two bytes.
@@ -216,7 +241,7 @@ impl<T: Transport> RobotDebug<T> {
         } else {
             target
         };
-        debug.stub = StubPlan::place(profile, &debug.image, previous)?;
+        debug.stub = StubPlan::place_beside(profile, &debug.image, previous, &taken)?;
         let leftovers = debug.check_image()?;
         let stub = debug.stub.clone();
         if debug.stopped.is_some() {
@@ -233,9 +258,29 @@ impl<T: Transport> RobotDebug<T> {
         Ok(debug)
     }
 
-    /// Whether the robot is stopped in a stub: the stub's registers read
-    /// with a frame, which a running robot ignores.
-    fn probe_stopped(&mut self) -> StubResult<Option<Registers>> {
+    /// What the stub must not go over besides the image: the extensions
+    /// the robot's table names (read from the robot) and the RAM loader's
+    /// memory (an upload of the image puts it there, and may find it
+    /// again).
+    fn taken(&mut self, profile: &RomProfile) -> StubResult<Vec<RangeInclusive<u16>>> {
+        let mut taken: Vec<RangeInclusive<u16>> =
+            crate::table::installed_with(profile, &mut |at, len| self.read(at, len))?
+                .into_iter()
+                .flat_map(|installed| installed.extents)
+                .collect();
+        let rates = (self.client.transport().baud(), crate::loader::FAST_BAUD);
+        if let Some(loader) = crate::loader::loader_plan(profile, &self.image, rates)? {
+            let code = &loader.code;
+            taken.push(code.address..=code.address.wrapping_add(code.bytes.len() as u16 - 1));
+            taken.push(u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()));
+        }
+        Ok(taken)
+    }
+
+    /// Whether the robot is stopped in a stub, wherever it is: `Some`
+    /// when a stub answered a frame (which a running robot ignores), with
+    /// the registers when they were where this stub keeps them.
+    fn probe(&mut self) -> StubResult<Option<Option<Registers>>> {
         let regs = self.stub.regs.to_le_bytes();
         let payload = [b'R', regs[0], regs[1], 8];
         for _ in 0..2 {
@@ -252,15 +297,14 @@ impl<T: Transport> RobotDebug<T> {
                 }
                 match self.next_heard(deadline - now)? {
                     Some(Heard::Frame(reply)) => {
-                        if let [b'M', _, _, rest @ ..] = reply.as_slice()
-                            && let Some(registers) = self.take_stop(rest)
-                        {
+                        if let [b'M', _, _, rest @ ..] = reply.as_slice() {
+                            let registers = self.take_stop(rest);
                             self.stopped = None;
                             return Ok(Some(registers));
                         }
                         if let Some(registers) = self.take_stop(&reply) {
                             self.stopped = None;
-                            return Ok(Some(registers));
+                            return Ok(Some(Some(registers)));
                         }
                         if reply == [b'N'] {
                             // A stub, which heard the frame damaged: again.
@@ -275,6 +319,15 @@ impl<T: Transport> RobotDebug<T> {
         }
         self.rx.clear();
         Ok(None)
+    }
+
+    /// Whether the robot is stopped in this stub: its registers.
+    fn probe_stopped(&mut self) -> StubResult<Option<Registers>> {
+        match self.probe()? {
+            None => Ok(None),
+            Some(Some(registers)) => Ok(Some(registers)),
+            Some(None) => Err(stopped_in_another_stub(self.stub.address)),
+        }
     }
 
     /// Reads the robot's code where the image has it and compares: the
@@ -292,17 +345,12 @@ impl<T: Transport> RobotDebug<T> {
         let call = [JSR, entry[0], entry[1]];
         let mut leftovers = Vec::new();
         let mut adopted = Vec::new();
+        let slot_bytes: Vec<u16> = slots
+            .iter()
+            .flat_map(|&slot| [slot, slot.wrapping_add(1)])
+            .collect();
         for area in self.image.areas().to_vec() {
             let mut found = self.read_code(&area, &slots)?;
-            for &slot in &slots {
-                for at in [slot, slot.wrapping_add(1)] {
-                    if area.contains(at) {
-                        let i = usize::from(at - area.address);
-                        adopted.push((at, found[i]));
-                        found[i] = area.bytes[i];
-                    }
-                }
-            }
             // Only code is compared: the program may have changed its
             // data (a `poke` of the README's session did), and a `JSR`
             // into the stub is patched only into code.
@@ -315,12 +363,27 @@ impl<T: Transport> RobotDebug<T> {
                     && found[i..i + 3] == call
                     && area.bytes[i..i + 3] != call
                 {
-                    let original = [area.bytes[i], area.bytes[i + 1], area.bytes[i + 2]];
-                    leftovers.push((area.address.wrapping_add(i as u16), original));
+                    let at = area.address.wrapping_add(i as u16);
+                    let mut original = [area.bytes[i], area.bytes[i + 1], area.bytes[i + 2]];
+                    // A chain slot's bytes under the JSR are the robot's
+                    // (the uploader wrote them), not the image's: the
+                    // trampoline's copy on the robot holds them.
+                    if (0..3).any(|k| slot_bytes.contains(&at.wrapping_add(k))) {
+                        let copy = self.displaced_copy(at, &slot_bytes)?;
+                        original.copy_from_slice(&copy[..3]);
+                    }
+                    leftovers.push((at, original));
                     found[i..i + 3].copy_from_slice(&original);
                     i += 3;
                 } else {
                     i += 1;
+                }
+            }
+            for &at in &slot_bytes {
+                if area.contains(at) {
+                    let i = usize::from(at - area.address);
+                    adopted.push((at, found[i]));
+                    found[i] = area.bytes[i];
                 }
             }
             if let Some(i) = (0..found.len()).find(|&i| code[i] && found[i] != area.bytes[i]) {
@@ -382,6 +445,34 @@ impl<T: Transport> RobotDebug<T> {
             i = end;
         }
         Ok(found)
+    }
+
+    /// The bytes a breakpoint an earlier session left at `address`
+    /// displaced, as the robot held them: its trampoline's copy in the
+    /// stub (the displaced bytes, then `JMP` past them), found by that
+    /// `JMP` and the image's bytes but for the chain slots' (`slot_bytes`).
+    fn displaced_copy(&mut self, address: u16, slot_bytes: &[u16]) -> StubResult<Vec<u8>> {
+        let patch = patch::plan(address, &self.image, &[])?;
+        let len = patch.displaced.len();
+        let back = address.wrapping_add(len as u16).to_le_bytes();
+        let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
+        tramps
+            .chunks(TRAMPOLINE_LEN as usize)
+            .find(|copy| {
+                copy[len..len + 3] == [patch::JMP, back[0], back[1]]
+                    && (0..len).all(|k| {
+                        slot_bytes.contains(&address.wrapping_add(k as u16))
+                            || copy[k] == patch.displaced[k]
+                    })
+            })
+            .map(|copy| copy[..len].to_vec())
+            .ok_or_else(|| StubError::Refused {
+                what: "attaching".into(),
+                reason: format!(
+                    "an earlier session's breakpoint at ${address:04X} covers a chain slot, and no trampoline of the stub at ${:04X} holds the robot's bytes it displaced: reset the robot and upload the image again",
+                    self.stub.address
+                ),
+            })
     }
 
     /// Tells where every instruction of the image starts (a built

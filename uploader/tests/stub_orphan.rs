@@ -1,0 +1,282 @@
+//! What a killed debug session leaves, and where the stub goes (issue 27,
+//! the hostile tester's F1 to F5 of the `orphan` round): an upload, a
+//! restore or an undo finding a stub a killed session left hooked refuses
+//! before anything is written (chaining to it made a loop); the stub goes
+//! where no installed extension and no RAM loader lies; a breakpoint a
+//! killed session left on a chain slot's `JMP` is taken out with the
+//! robot's bytes, not the image's.
+
+mod common;
+
+use common::stub::handler;
+use isa::objfmt::{HookKind, HookRecord};
+use romlib::protocol::{Answer, Command, Extension};
+use romlib::symbols::{HOOK_UNKNOWN, USER_RAM_END};
+use std::time::Duration;
+use uploader::stub::{Reply, RobotDebug};
+use uploader::transport::VirtualTransport;
+use uploader::{
+    Area, Client, Error, LoaderChoice, NoProgress, RomProfile, UploadImage, UploadOptions,
+};
+
+const WAIT: Duration = Duration::from_secs(1);
+
+/// `LDA $0480` in the handler, where the breakpoints go.
+const AT: u16 = 0x040C;
+
+fn options() -> UploadOptions {
+    UploadOptions {
+        loader: LoaderChoice::Never,
+        ..UploadOptions::default()
+    }
+}
+
+/// An extension at `base` whose `/1<letter>` answers `<letter>`; anything
+/// else falls through its chain slot (`base + 20`).
+fn answering(base: u16, letter: u8) -> UploadImage {
+    let bytes = vec![
+        0xE0, 0x01, // CPX #1
+        0xD0, 0x0F, // BNE chain
+        0xC9, letter, // CMP #letter
+        0xD0, 0x0B, // BNE chain
+        0xA9, letter, // LDA #letter
+        0x20, 0x00, 0xFF, // JSR PUTCH
+        0x20, 0x09, 0xFF, // JSR PUTEOL
+        0x4C, 0x1E, 0xFF, // JMP CMD_DONE
+        0x4C, 0x21, 0xFF, // chain: JMP BAD_COMMAND
+    ];
+    UploadImage::new(
+        vec![Area {
+            address: base,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: base,
+            chain: Some(base + 20),
+        }],
+    )
+    .expect("an image")
+}
+
+/// `images` uploaded in turn onto a fresh virtual robot, each verified.
+fn uploaded(images: &[&UploadImage]) -> Client<VirtualTransport> {
+    let profile = RomProfile::reference();
+    let mut client = uploader::client(common::robot(), &profile);
+    for image in images {
+        uploader::upload(&mut client, image, &options(), &mut NoProgress).expect("uploaded");
+    }
+    client
+}
+
+fn attach(client: Client<VirtualTransport>, image: &UploadImage) -> RobotDebug<VirtualTransport> {
+    RobotDebug::attach(client, &RomProfile::reference(), image.clone()).expect("attaches")
+}
+
+/// A session with a breakpoint at [`AT`], its process killed while the
+/// robot runs.
+fn killed_session(image: &UploadImage) -> Client<VirtualTransport> {
+    let client = uploaded(&[image]);
+    let mut first = attach(client, image);
+    first.set_breakpoint(AT, &[]).expect("set");
+    first.abandon()
+}
+
+/// What an upload or a restore writes: the hooks, the table of
+/// installed extensions, user RAM (the ROM's own workspace changes as it
+/// answers).
+fn written(client: &mut Client<VirtualTransport>) -> Vec<u8> {
+    let memory = memory(client);
+    let profile = RomProfile::reference();
+    let hook = usize::from(HOOK_UNKNOWN);
+    let mut kept = memory[hook..hook + 6].to_vec();
+    if let Some((table, capacity)) = profile.table {
+        let table = usize::from(table);
+        kept.extend_from_slice(
+            &memory[table..table + capacity * (1 + romlib::installed::ENTRY_LEN)],
+        );
+    }
+    kept.extend_from_slice(&memory[0x0400..=usize::from(USER_RAM_END)]);
+    kept
+}
+
+fn memory(client: &mut Client<VirtualTransport>) -> Vec<u8> {
+    client
+        .transport()
+        .robot_mut()
+        .robot()
+        .board()
+        .memory()
+        .to_vec()
+}
+
+/// `/1<letter>`'s answer, if one came.
+fn ask(client: &mut Client<VirtualTransport>, letter: u8) -> Option<Answer> {
+    let command = Command::Extension(Extension::new(vec![letter]).expect("a command"));
+    client.listen(&command).expect("the line works")
+}
+
+fn refused_naming_the_stub(result: uploader::Result<impl std::fmt::Debug>, stub: u16) {
+    match result {
+        Err(error @ Error::DebugStubHooked { .. }) => {
+            let Error::DebugStubHooked { stub: found, .. } = &error else {
+                unreachable!()
+            };
+            assert_eq!(*found, stub, "{error}");
+            let said = error.to_string();
+            assert!(
+                said.contains("debug stub") && said.contains("HOOK_UNKNOWN"),
+                "{said}"
+            );
+            let help = miette::Diagnostic::help(&error).map(|h| h.to_string());
+            assert!(
+                help.as_deref()
+                    .is_some_and(|h| h.contains("scorpion debug --port")),
+                "{help:?}"
+            );
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+}
+
+#[test]
+fn an_upload_of_the_same_image_over_a_stub_left_hooked_is_refused_with_nothing_written() {
+    let image = handler();
+    let stub = {
+        let client = uploaded(&[&image]);
+        attach(client, &image).stub().address
+    };
+    let mut client = killed_session(&image);
+    let before = written(&mut client);
+    let result = uploader::upload(&mut client, &image, &options(), &mut NoProgress);
+    refused_naming_the_stub(result, stub);
+    assert!(written(&mut client) == before, "something was written");
+    // What the refusal says to run cleans it up; then the upload works,
+    // and an unknown command falls through to the ROM (no loop).
+    let debug = attach(client, &image);
+    assert_eq!(debug.recovery().removed, [AT]);
+    let mut client = debug.detach().expect("detached");
+    uploader::upload(&mut client, &image, &options(), &mut NoProgress).expect("uploaded");
+    let fresh = ask(&mut uploaded(&[&image]), b'Z');
+    assert_eq!(
+        ask(&mut client, b'Z'),
+        fresh,
+        "`/1Z` as on a robot never debugged"
+    );
+    assert_eq!(ask(&mut client, b'Q'), Some(Answer::Text("Q42".into())));
+}
+
+#[test]
+fn an_upload_of_another_image_over_a_stub_left_hooked_is_refused() {
+    let image = handler();
+    let mut client = killed_session(&image);
+    let before = written(&mut client);
+    let other = answering(0x0600, b'U');
+    let result = uploader::upload(&mut client, &other, &options(), &mut NoProgress);
+    assert!(
+        matches!(result, Err(Error::DebugStubHooked { .. })),
+        "{result:?}"
+    );
+    assert!(written(&mut client) == before, "something was written");
+}
+
+#[test]
+fn a_restore_over_a_stub_left_hooked_is_refused() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let mut client = uploaded(&[&image]);
+    let saved = uploader::backup(&mut client, &profile).expect("a backup");
+    let mut first = attach(client, &image);
+    first.set_breakpoint(AT, &[]).expect("set");
+    let mut client = first.abandon();
+    let before = written(&mut client);
+    let result = uploader::restore(&mut client, &saved, &options(), &mut NoProgress);
+    assert!(
+        matches!(result, Err(Error::DebugStubHooked { .. })),
+        "{result:?}"
+    );
+    assert!(written(&mut client) == before, "something was written");
+}
+
+#[test]
+fn the_stub_goes_beside_an_installed_extension_not_over_it() {
+    // An extension at the very top of user RAM, where the stub went.
+    let top = answering(USER_RAM_END - 21, b'U');
+    let image = handler();
+    let client = uploaded(&[&top, &image]);
+    let mut debug = attach(client, &image);
+    let stub = debug.stub().clone();
+    let end = u32::from(stub.address) + stub.bytes.len() as u32;
+    assert!(
+        end <= u32::from(USER_RAM_END - 21),
+        "the stub at ${:04X}-${end:04X} meets the extension at ${:04X}",
+        stub.address,
+        USER_RAM_END - 21
+    );
+    // The installed extension still answers, through the stub's chain.
+    assert_eq!(
+        debug.command(b"/1U", WAIT).expect("sent"),
+        Reply::Answer(b"U\r".to_vec())
+    );
+    debug.detach().expect("detached");
+}
+
+#[test]
+fn the_stub_goes_beside_the_ram_loader_not_over_it() {
+    let image = handler();
+    let client = uploaded(&[&image]);
+    let debug = attach(client, &image);
+    let stub = debug.stub().clone();
+    let loader = uploader::loader_plan(
+        &RomProfile::reference(),
+        &image,
+        (9600, uploader::FAST_BAUD),
+    )
+    .expect("links")
+    .expect("room for the loader");
+    let (start, end) = (
+        u32::from(loader.code.address),
+        u32::from(loader.code.address) + loader.code.bytes.len() as u32,
+    );
+    let stub_end = u32::from(stub.address) + stub.bytes.len() as u32;
+    assert!(
+        stub_end <= start || end <= u32::from(stub.address),
+        "the stub at ${:04X} meets the loader at ${start:04X}-${end:04X}",
+        stub.address
+    );
+    let zero_page = u16::from(stub.zero_page);
+    let loader_zp = u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end());
+    assert!(
+        !loader_zp.contains(&zero_page) && !loader_zp.contains(&(zero_page + 1)),
+        "the stub's zero page ${zero_page:02X} meets the loader's {loader_zp:?}"
+    );
+}
+
+#[test]
+fn a_session_killed_with_a_breakpoint_on_a_chain_slot_jmp_is_cleaned_up_with_the_robots_bytes() {
+    // The handler chained to an installed extension: its chain slot holds
+    // that extension's handler, the image's placeholder does not.
+    let other = answering(0x0600, b'U');
+    let image = handler();
+    let client = uploaded(&[&other, &image]);
+    let chained = {
+        let mut client = client;
+        let held = memory(&mut client)[0x0400..0x0403].to_vec();
+        assert_eq!(held, [0x4C, 0x00, 0x06], "the chain slot as uploaded");
+        client
+    };
+    let mut first = attach(chained, &image);
+    first.set_breakpoint(0x0400, &[]).expect("set");
+    let client = first.abandon();
+    let mut second = attach(client, &image);
+    assert_eq!(second.recovery().removed, [0x0400]);
+    assert_eq!(second.read(0x0400, 3).expect("read"), [0x4C, 0x00, 0x06]);
+    assert_eq!(second.compare_with_image().expect("read"), None);
+    assert_eq!(
+        second.command(b"/1U", WAIT).expect("sent"),
+        Reply::Answer(b"U\r".to_vec())
+    );
+    let mut client = second.detach().expect("detached");
+    let hook = usize::from(HOOK_UNKNOWN);
+    assert_eq!(memory(&mut client)[hook..hook + 3], [0x4C, 0x03, 0x04]);
+}
