@@ -52,8 +52,8 @@ pub(crate) struct Args {
     /// Draw the robot's path in its room (a world file, `--world
     /// room.toml`) to FILE.svg when the session ends, as sim's --path
     /// does: the room, the trail with a mark every second, the bumps and
-    /// the commands sent. The trail is the robot's as it ran forward: a
-    /// step back does not undraw it.
+    /// the commands sent. The trail is the robot's whole run, its robot
+    /// time going forward: a step back does not undraw it.
     #[arg(long, value_name = "FILE.svg|FILE.png")]
     pub(crate) path: Option<PathBuf>,
     /// Debug the real robot on PORT instead (alone: the [robot] port of
@@ -73,9 +73,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // debugger holds then (a rebuilt robot, or a copy it went back to, has
     // a room of its own).
     let picture = crate::cmd::rig::path_picture(args.path.as_ref(), room.get())?;
-    // For the picture of the path: each command sent, at its robot time.
+    // For the picture of the path: each command sent, at its robot time,
+    // and the robot's whole run as its robot time went forward.
     let mut commands = Vec::new();
+    let mut run = Run::default();
     let mut debugger = Debugger::new(make, &images)?;
+    run.gather(&debugger);
     let terminal = std::io::stdin().is_terminal();
     let completion = completion_words(&debugger, &images);
     let mut input = Input::new(terminal, completion, prompt::history_file(&root));
@@ -138,7 +141,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         // A Ctrl-C pressed since the last run pauses nothing now.
         interrupt.store(false, Ordering::Relaxed);
         let at = debugger.robot().cycles();
-        match monitor.command(&mut debugger, line.trim()) {
+        let reply = monitor.command(&mut debugger, line.trim());
+        run.gather(&debugger);
+        match reply {
             Ok(Reply::Text(text)) => {
                 if let Some(sent) = text.strip_prefix("sent ") {
                     commands.push((at, sent.trim_end().to_owned()));
@@ -160,7 +165,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     }
     if let Some((path, first)) = picture {
         let view = room_now(&debugger).unwrap_or(first);
-        crate::cmd::rig::write_picture(path, &view.picture_for(path, &commands)?)?;
+        crate::cmd::rig::write_picture(path, &view.picture_of(path, &run.trail, &commands)?)?;
     }
     // A session in which the robot broke (a JAM, a card's fault) or whose
     // trace could not be written fails.
@@ -223,6 +228,32 @@ pub(crate) type Recipe = (debugger::MakeRobot, Vec<linker::Image>, PathBuf);
 /// directory their source paths are relative to.
 pub(crate) fn recipe(args: &Args, here: &std::path::Path) -> miette::Result<Recipe> {
     recipe_in_room(args, here).map(|(recipe, _)| recipe)
+}
+
+/// The robot's whole run in its room, gathered after each command as its
+/// robot time goes forward: a step back (to a copy of the robot, or one
+/// rebuilt and run again, each with a trail of its own) undraws nothing,
+/// and robot time run again after it is drawn once, as first run.
+#[derive(Debug, Default)]
+struct Run {
+    trail: cards::room::Trail,
+    /// The furthest robot time gathered.
+    reached: Option<u64>,
+}
+
+impl Run {
+    fn gather(&mut self, debugger: &Debugger) {
+        let Some(view) = room_now(debugger) else {
+            return;
+        };
+        let now = debugger.robot().cycles();
+        let (then, tail) = match self.reached {
+            None => (None, view.trail()),
+            Some(reached) => view.trail_after(reached),
+        };
+        self.trail.follow(then, tail);
+        self.reached = Some(self.reached.map_or(now, |reached| reached.max(now)));
+    }
 }
 
 /// The room of the robot `debugger` holds now, if it is in one.

@@ -54,6 +54,39 @@ fn debug_draws_the_path_of_its_session() {
     assert!((x - 111.0).abs() < 1.0, "the robot at x={x}: {picture}");
 }
 
+/// The hostile tester's finding: a step back undrew the trail (the
+/// picture was of the robot the session held at its end, a copy from
+/// before), though the picture is of the whole run. Forward 2 s (the robot
+/// meets the post at x=125 and bumps), back, on a little, quit: the trail
+/// still reaches the post, and the bump is drawn, as without the step
+/// back.
+#[test]
+fn debug_draws_the_whole_run_past_a_step_back() {
+    let ends = |session: &str| {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        room(dir.path());
+        let output = scorpion_with_input(
+            Some(dir.path()),
+            &["debug", "--world", "room.toml", "--path", "path.svg"],
+            session,
+        );
+        assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+        let picture = std::fs::read_to_string(dir.path().join("path.svg")).expect("the picture");
+        let trail = picture
+            .split(r#"<polyline class="trail" points=""#)
+            .nth(1)
+            .and_then(|rest| rest.split('"').next())
+            .expect("the trail");
+        let last = trail.split(' ').next_back().expect("a point").to_owned();
+        (last, picture.matches(r#"<g class="bump">"#).count())
+    };
+    let forward = ends("/4C+40\n/4D+40\ncontinue 2000000\nquit\n");
+    let back = ends("/4C+40\n/4D+40\ncontinue 2000000\nback 500000\ncontinue 100000\nquit\n");
+    assert!(forward.0.starts_with("125."), "forward: {forward:?}");
+    assert_eq!(forward.1, 1, "one bump forward");
+    assert_eq!(back, forward, "a step back undraws nothing");
+}
+
 #[test]
 fn debug_path_needs_a_room() {
     let dir = tempfile::tempdir().expect("a temporary directory");

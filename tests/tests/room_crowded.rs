@@ -10,10 +10,11 @@ use std::fmt::Write as _;
 use cards::Room;
 use rom_support::{Session, build, examples_dir};
 
-/// The room of tests/tests/room.rs: 3 by 2 metres, a post 20 cm round in
-/// front of the robot, which stands at (100, 100) facing east.
+/// The room of tests/tests/room.rs, its walls wide enough for the posts
+/// (the world file refuses obstacles beyond the walls): a post 20 cm round
+/// in front of the robot, which stands at (100, 100) facing east.
 const ROOM: &str = r#"
-walls = [[0, 0], [300, 0], [300, 200], [0, 200]]
+walls = [[0, -500], [1500, -500], [1500, 700], [0, 700]]
 
 [[obstacle]]
 circle = { x = 160, y = 100, radius = 20 }
@@ -25,7 +26,7 @@ heading = 0
 "#;
 
 /// `count` posts 2 cm round, 10 cm apart, in rows of 100 from (400,
-/// -400): beyond the east wall of [`ROOM`], where its robot can never be.
+/// -400): far east of [`ROOM`]'s robot, where patrol does not take it.
 fn posts(count: usize) -> String {
     let mut text = String::new();
     for index in 0..count {
@@ -41,7 +42,7 @@ fn posts(count: usize) -> String {
     text
 }
 
-/// [`ROOM`] with `count` [`posts`] beyond its wall.
+/// [`ROOM`] with `count` [`posts`] far from its robot.
 fn crowded(count: usize) -> String {
     ROOM.replace("[robot]", &format!("{}\n[robot]", posts(count)))
 }

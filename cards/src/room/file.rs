@@ -8,6 +8,7 @@ use toml::Spanned;
 
 use super::drive::{Drive, Pose};
 use super::geometry::{PI, Point, Shape, inside_polygon, segment_distance2};
+use super::live;
 use crate::error::{Located, ScriptError, offset_of};
 
 /// A floor line the ground trackers see.
@@ -343,6 +344,28 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
                 ));
             }
         };
+        // One rule with the view's drags (`live::obstacle_out_of_walls`):
+        // an obstacle beyond the walls is one the robot can never meet,
+        // a mistake, and one across them a wall the file does not draw.
+        if let Some(walls) = &walls
+            && let Some(out) = live::obstacle_out_of_walls(walls, &shape)
+        {
+            let file = obstacle.get_ref();
+            let span = file
+                .polygon
+                .as_ref()
+                .map(Spanned::span)
+                .or_else(|| file.circle.as_ref().map(Spanned::span))
+                .unwrap_or_else(|| obstacle.span());
+            return Err(at(
+                span,
+                format!(
+                    "an obstacle outside the walls or across them: it reaches {} cm out of them",
+                    live::centimetres(out)
+                ),
+                "give the obstacle inside the walls (it may press a wall 2 cm at most, as a drag in the live view may put it)",
+            ));
+        }
         obstacles.push((shape, obstacle.span()));
     }
     let mut lines = Vec::new();

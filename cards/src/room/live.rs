@@ -118,9 +118,12 @@ impl Edit {
                     ));
                 }
                 if let Some(walls) = &layout.walls
-                    && shape_out_of(walls, &moved) > CONTACT
+                    && let Some(out) = obstacle_out_of_walls(walls, &moved)
                 {
-                    return Err(format!("{here}: it would be across or outside the walls"));
+                    return Err(format!(
+                        "{here}: it would be across or outside the walls ({} cm out of them; it may press a wall {CONTACT} cm at most)",
+                        centimetres(out)
+                    ));
                 }
             }
         }
@@ -228,8 +231,19 @@ fn shape_out_of(walls: &[Point], shape: &Shape) -> f64 {
     }
 }
 
+/// How far `shape` reaches across or out of the walls, if more than
+/// [`CONTACT`]: the one rule of where an obstacle may be, for the world
+/// file's obstacles and the view's drags alike (a drag keeps the room one
+/// the file could give). `None`: it is inside them (pressing a wall
+/// `CONTACT` at most).
+#[must_use]
+pub fn obstacle_out_of_walls(walls: &[Point], shape: &Shape) -> Option<f64> {
+    let out = shape_out_of(walls, shape);
+    (out > CONTACT || out.is_nan()).then_some(out)
+}
+
 /// A length to a tenth of a centimetre, for a message.
-fn centimetres(length: f64) -> String {
+pub(super) fn centimetres(length: f64) -> String {
     format!("{:.1}", (length * 10.0).round() / 10.0)
 }
 
@@ -299,27 +313,34 @@ impl RoomView {
     }
 
     /// The trail's poses from the `from`th on, at most `most` of them,
-    /// and how many poses the trail has: a view draws the trail as it
-    /// grows without copying all of it each time.
+    /// each with whether the robot was put there (a jump: a drag, not a
+    /// drive), and how many poses the trail has: a view draws the trail
+    /// as it grows without copying all of it each time.
     #[must_use]
-    pub fn trail_since(&self, from: usize, most: usize) -> (Vec<(u64, Pose)>, usize) {
+    pub fn trail_since(&self, from: usize, most: usize) -> (Vec<(u64, Pose, bool)>, usize) {
         self.trail.lock().map_or((Vec::new(), from), |trail| {
             let total = trail.poses.len();
             let start = from.min(total);
             let end = total.min(start.saturating_add(most));
-            (trail.poses[start..end].to_vec(), total)
+            let poses = (start..end)
+                .zip(&trail.poses[start..end])
+                .map(|(index, &(at, pose))| (at, pose, trail.is_jump(index)))
+                .collect();
+            (poses, total)
         })
     }
 }
 
 impl Room {
     /// Makes the host's waiting edits; whether there were any. A moved
-    /// robot's new pose joins the trail.
+    /// robot's new pose joins the trail as a jump: it was put there, it
+    /// did not drive.
     pub(super) fn take_edits(&mut self, now: u64) -> bool {
         let edits = self.view.edits.take();
         if edits.is_empty() {
             return false;
         }
+        let before = self.pose;
         for edit in &edits {
             if edit.check(&self.layout, self.pose).is_ok() {
                 edit.apply(&mut self.layout, &mut self.pose);
@@ -330,10 +351,10 @@ impl Room {
         self.grid = super::geometry::ShapeGrid::new(&self.layout.obstacles);
         self.felt = None;
         self.seen = None;
-        if let Ok(mut trail) = self.view.trail.lock()
-            && trail.poses.len() < super::MAX_TRAIL
+        if self.pose != before
+            && let Ok(mut trail) = self.view.trail.lock()
         {
-            trail.poses.push((now, self.pose));
+            trail.jump(now, self.pose);
         }
         true
     }
@@ -474,5 +495,67 @@ radius = 15
         assert!(room.take_edits(0));
         assert_eq!(room.pose(), layout.start);
         assert_eq!(room.layout().obstacles, layout.obstacles);
+    }
+
+    /// A drag puts the robot somewhere: a jump in the trail, not a
+    /// stretch driven; an obstacle moved is no pose at all.
+    #[test]
+    fn a_dragged_robot_jumps_in_the_trail() {
+        let mut room = crate::room::Room::load("room.toml", ROOM).expect("the room");
+        let view = room.view();
+        assert!(view.edit(robot_to(60.0, 60.0)));
+        assert!(room.take_edits(5000));
+        assert!(view.edit(Edit::MoveObstacle {
+            index: 0,
+            to: Point::new(170.0, 100.0),
+        }));
+        assert!(room.take_edits(6000));
+        let trail = view.trail();
+        assert_eq!(trail.poses.len(), 2, "{trail:?}");
+        assert_eq!(trail.poses[1], (5000, room.pose()));
+        assert_eq!(trail.jumps, vec![1]);
+        let (poses, _) = view.trail_since(0, 10);
+        assert_eq!(poses.iter().map(|p| p.2).collect::<Vec<_>>(), [false, true]);
+    }
+
+    /// One rule for where an obstacle may be: the world file refuses what
+    /// a drag refuses (an obstacle outside the walls could not be dragged,
+    /// even to where it was), and takes what a drag may do.
+    #[test]
+    fn the_file_and_a_drag_agree_on_where_an_obstacle_may_be() {
+        for (obstacle, fits) in [
+            ("circle = { x = 1000, y = 100, radius = 5 }", false),
+            ("circle = { x = 160, y = 195, radius = 10 }", false),
+            ("circle = { x = 292, y = 150, radius = 10 }", true),
+            ("polygon = [[200, 180], [240, 180], [240, 210]]", false),
+            ("polygon = [[200, 150], [240, 150], [240, 190]]", true),
+        ] {
+            let text = format!(
+                "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]\n[[obstacle]]\n{obstacle}\n[robot]\nx = 100\ny = 100\n"
+            );
+            let file = parse("room.toml", &text);
+            assert_eq!(file.is_ok(), fits, "{obstacle}: {file:?}");
+            // The same obstacle in the same room, dragged to where it is.
+            let mut layout = parse(
+                "room.toml",
+                "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]\n[robot]\nx = 100\ny = 100\n",
+            )
+            .expect("the room");
+            let alone = format!("[[obstacle]]\n{obstacle}\n[robot]\nx = -500\ny = -500\n");
+            let shape = parse("room.toml", &alone)
+                .expect("the obstacle alone")
+                .obstacles[0]
+                .clone();
+            let drag = Edit::MoveObstacle {
+                index: 0,
+                to: middle(&shape),
+            };
+            layout.obstacles.push(shape);
+            assert_eq!(
+                drag.check(&layout, layout.start).is_ok(),
+                fits,
+                "{obstacle}"
+            );
+        }
     }
 }

@@ -14,6 +14,7 @@ pub mod live;
 pub mod picture;
 pub mod raster;
 pub mod scanner;
+pub mod trail;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -25,6 +26,7 @@ use crate::error::ScriptError;
 use drive::Pose;
 use file::Layout;
 use geometry::{Point, ShapeGrid, near_polyline, sin_cos};
+pub use trail::{MAX_TRAIL, Trail};
 
 /// Robot time between two looks at the motors, cycles (1 ms): a drive
 /// steps at most 495 times a second (speed 99), so each look sees one
@@ -37,20 +39,6 @@ const SCANNERS: u8 = platform::map::drive::H_SCANNER | platform::map::drive::V_S
 
 /// Points each bumper's part of the outline is felt at.
 const FEELERS: u32 = 9;
-
-/// Where the robot went, kept for the picture and the transcripts.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Trail {
-    /// The pose after each look at which the robot had moved, with the
-    /// robot time (cycles); the start pose at 0 first.
-    pub poses: Vec<(u64, Pose)>,
-    /// Each change of the bumpers the room closed, with the robot time.
-    pub bumps: Vec<(u64, u8)>,
-}
-
-/// The most poses a trail keeps: past that, the robot's later moves are
-/// not drawn (a run of hours), and the pose is still followed.
-pub const MAX_TRAIL: usize = 200_000;
 
 /// A handle on the room as the robot runs: its pose and trail, read by
 /// the host while the room itself belongs to the virtual robot.
@@ -78,6 +66,18 @@ impl RoomView {
     #[must_use]
     pub fn trail(&self) -> Trail {
         self.trail.lock().map(|t| t.clone()).unwrap_or_default()
+    }
+
+    /// What the trail holds after robot time `after`, and the pose then
+    /// ([`Trail::after`]): a session that goes back in time gathers its
+    /// whole run with [`Trail::follow`], without copying all of it each
+    /// time.
+    #[must_use]
+    pub fn trail_after(&self, after: u64) -> (Option<Pose>, Trail) {
+        self.trail
+            .lock()
+            .map(|trail| trail.after(after))
+            .unwrap_or_default()
     }
 
     /// How many times the room has tested a point against an obstacle,
@@ -136,7 +136,7 @@ impl Room {
         let view = RoomView {
             trail: Arc::new(Mutex::new(Trail {
                 poses: vec![(0, pose)],
-                bumps: Vec::new(),
+                ..Trail::default()
             })),
             layout: Arc::new(layout.clone()),
             edits: Arc::default(),

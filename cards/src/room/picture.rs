@@ -104,65 +104,263 @@ pub fn svg(layout: &Layout, trail: &Trail, commands: &[(u64, String)]) -> String
             }
         }
     }
-    // A point every half centimetre at most (the robot is looked at
-    // every millisecond): the picture stays small.
-    let mut trail_points: Vec<Point> = Vec::new();
-    for (index, (_, pose)) in trail.poses.iter().enumerate() {
-        let far = trail_points
-            .last()
-            .is_none_or(|last| last.distance2(pose.at) >= 0.25);
-        if far || index + 1 == trail.poses.len() {
-            trail_points.push(pose.at);
-        }
-    }
-    let _ = writeln!(
-        out,
-        r##"<polyline class="trail" points="{}" fill="none" stroke="#06c" stroke-width="0.5"/>"##,
-        list(&trail_points)
-    );
+    trail_lines(&mut out, trail, &at);
     let pose_at = |cycle: u64| {
-        trail
-            .poses
-            .iter()
-            .take_while(|(at, _)| *at <= cycle)
-            .last()
+        let index = trail.poses.partition_point(|&(at, _)| at <= cycle);
+        index
+            .checked_sub(1)
+            .and_then(|index| trail.poses.get(index))
             .map_or(layout.start, |&(_, pose)| pose)
     };
+    // Marks and their labels, laid out so that no label covers another:
+    // the marks of one drawn point share one label (a robot standing
+    // still through several seconds, commands sent together), and a
+    // label that would cover one laid before goes below it.
+    let mut labels = Labels::default();
     let end = trail.poses.last().map_or(0, |&(at, _)| at);
+    let mut times: Vec<(String, Vec<u64>)> = Vec::new();
     let mut mark = MARK_EVERY;
     while mark <= end {
-        let (x, y) = split(&at(pose_at(mark).at));
-        let _ = writeln!(
-            out,
-            r##"<g class="time"><circle cx="{x}" cy="{y}" r="1" fill="#06c"/><text x="{x}" y="{y}" dx="2" font-size="4">{} s</text></g>"##,
-            mark / MARK_EVERY
-        );
+        let point = at(pose_at(mark).at);
+        match times.last_mut() {
+            Some((last, marks)) if *last == point => marks.push(mark / MARK_EVERY),
+            _ => times.push((point, vec![mark / MARK_EVERY])),
+        }
         mark += MARK_EVERY;
     }
+    for (point, marks) in &times {
+        let text = format!("{} s", runs(marks));
+        labels.mark(
+            &mut out,
+            "time",
+            "#06c",
+            1.0,
+            point,
+            &[text],
+            LabelSide::Right,
+        );
+    }
+    let mut bumps: Vec<(String, Vec<String>)> = Vec::new();
     for &(cycle, mask) in &trail.bumps {
         if mask == 0 {
             continue;
         }
-        let (x, y) = split(&at(pose_at(cycle).at));
-        let _ = writeln!(
-            out,
-            r##"<g class="bump"><circle cx="{x}" cy="{y}" r="2" fill="#c00"/><text x="{x}" y="{y}" dy="-3" font-size="4" fill="#c00">bump {mask:02X} at {}</text></g>"##,
-            seconds(cycle)
+        let point = at(pose_at(cycle).at);
+        let text = format!("bump {mask:02X} at {}", seconds(cycle));
+        match bumps.last_mut() {
+            Some((last, texts)) if *last == point => texts.push(text),
+            _ => bumps.push((point, vec![text])),
+        }
+    }
+    for (point, texts) in &bumps {
+        labels.mark(
+            &mut out,
+            "bump",
+            "#c00",
+            2.0,
+            point,
+            texts,
+            LabelSide::Above,
         );
     }
+    let mut sent: Vec<(String, Vec<String>)> = Vec::new();
     for (cycle, command) in commands {
-        let (x, y) = split(&at(pose_at(*cycle).at));
-        let _ = writeln!(
-            out,
-            r##"<g class="command"><circle cx="{x}" cy="{y}" r="1" fill="#080"/><text x="{x}" y="{y}" dy="5" font-size="4" fill="#080">{} at {}</text></g>"##,
-            escape(command),
-            seconds(*cycle)
+        let point = at(pose_at(*cycle).at);
+        let text = format!("{} at {}", escape(command), seconds(*cycle));
+        match sent.iter_mut().find(|(p, _)| *p == point) {
+            Some((_, texts)) => texts.push(text),
+            None => sent.push((point, vec![text])),
+        }
+    }
+    for (point, texts) in &sent {
+        labels.mark(
+            &mut out,
+            "command",
+            "#080",
+            1.0,
+            point,
+            texts,
+            LabelSide::Below,
         );
     }
     let last = trail.poses.last().map_or(layout.start, |&(_, pose)| pose);
     robot(&mut out, layout, last, &at);
     out.push_str("</svg>\n");
     out
+}
+
+/// The trail: the driven stretches as polylines, a point every half
+/// centimetre at most (the robot is looked at every millisecond: the
+/// picture stays small), and each jump (the robot put somewhere by a drag
+/// in the live view, not driven there) a dashed line of its own.
+fn trail_lines(out: &mut String, trail: &Trail, at: &dyn Fn(Point) -> String) {
+    let mut stretch: Vec<Point> = Vec::new();
+    let flush = |out: &mut String, stretch: &mut Vec<Point>| {
+        let list = stretch.iter().map(|&p| at(p)).collect::<Vec<_>>().join(" ");
+        let _ = writeln!(
+            out,
+            r##"<polyline class="trail" points="{list}" fill="none" stroke="#06c" stroke-width="0.5"/>"##
+        );
+        stretch.clear();
+    };
+    for (index, (_, pose)) in trail.poses.iter().enumerate() {
+        if trail.is_jump(index)
+            && let Some(&from) = stretch.last()
+        {
+            flush(out, &mut stretch);
+            let ((x1, y1), (x2, y2)) = (split(&at(from)), split(&at(pose.at)));
+            let _ = writeln!(
+                out,
+                r##"<line class="jump" x1="{x1}" y1="{y1}" x2="{x2}" y2="{y2}" stroke="#06c" stroke-width="0.5" stroke-dasharray="1.5 1.5"/>"##
+            );
+        }
+        let far = stretch
+            .last()
+            .is_none_or(|last| last.distance2(pose.at) >= 0.25);
+        let last_of_stretch = index + 1 == trail.poses.len() || trail.is_jump(index + 1);
+        if far || last_of_stretch {
+            stretch.push(pose.at);
+        }
+    }
+    flush(out, &mut stretch);
+}
+
+/// Whole seconds as runs: `1-3, 5`.
+fn runs(marks: &[u64]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut index = 0;
+    while index < marks.len() {
+        let first = marks[index];
+        let mut last = first;
+        while index + 1 < marks.len() && marks[index + 1] == last + 1 {
+            index += 1;
+            last = marks[index];
+        }
+        parts.push(if last == first {
+            first.to_string()
+        } else {
+            format!("{first}-{last}")
+        });
+        index += 1;
+    }
+    parts.join(", ")
+}
+
+/// A label's font size, in the picture's units (centimetres).
+const FONT: f64 = 4.0;
+/// The height of a line of labels: the font and a little space.
+const LINE: f64 = 5.0;
+/// The widest a character of a label is taken to be, a share of the font
+/// size: more than the average of any common font, so that a box laid
+/// clear of another is clear of it once drawn.
+const CHAR_WIDTH: f64 = 0.62;
+
+/// Where a mark's label goes first, before it is moved clear of others.
+#[derive(Debug, Clone, Copy)]
+enum LabelSide {
+    /// Right of the mark (time marks).
+    Right,
+    /// Above it (bumps).
+    Above,
+    /// Below it (commands).
+    Below,
+}
+
+/// The labels laid so far (their boxes: left, top, right, bottom in the
+/// picture's units), so that each new one is laid clear of them.
+#[derive(Debug, Default)]
+struct Labels {
+    boxes: Vec<[f64; 4]>,
+}
+
+impl Labels {
+    /// Draws a mark of `class` at `point` (the picture's "x,y") and its
+    /// label, a line per text, where it covers no label laid before: at
+    /// its `side` of the mark if that is clear, else moved down past what
+    /// it would cover, joined to its mark by a thin line.
+    #[allow(clippy::too_many_arguments, reason = "one mark's look")]
+    fn mark(
+        &mut self,
+        out: &mut String,
+        class: &str,
+        colour: &str,
+        radius: f64,
+        point: &str,
+        texts: &[String],
+        side: LabelSide,
+    ) {
+        let (x, y) = split(point);
+        let (px, py) = (
+            x.parse::<f64>().unwrap_or(0.0),
+            y.parse::<f64>().unwrap_or(0.0),
+        );
+        #[allow(clippy::cast_precision_loss, reason = "a label's length")]
+        let width = texts
+            .iter()
+            .map(|t| unescaped_len(t) as f64)
+            .fold(0.0, f64::max)
+            * FONT
+            * CHAR_WIDTH;
+        #[allow(clippy::cast_precision_loss, reason = "a few lines")]
+        let height = texts.len() as f64 * LINE;
+        let left = px + radius + 1.0;
+        // The box's top: the first line's baseline is a font size below.
+        let mut top = match side {
+            LabelSide::Right => py - FONT / 2.0 - 0.5,
+            LabelSide::Above => py - radius - 1.0 - height,
+            LabelSide::Below => py + radius + 0.5,
+        };
+        let wanted = top;
+        loop {
+            let right = left + width;
+            let bottom = top + height;
+            let covered = self
+                .boxes
+                .iter()
+                .filter(|b| left < b[2] && b[0] < right && top < b[3] && b[1] < bottom)
+                .map(|b| b[3])
+                .fold(f64::NEG_INFINITY, f64::max);
+            if covered == f64::NEG_INFINITY {
+                break;
+            }
+            top = covered + 0.5;
+        }
+        self.boxes.push([left, top, left + width, top + height]);
+        let _ = write!(
+            out,
+            r#"<g class="{class}"><circle cx="{x}" cy="{y}" r="{}" fill="{colour}"/>"#,
+            tenth(radius)
+        );
+        if top != wanted {
+            let _ = write!(
+                out,
+                r#"<line x1="{x}" y1="{y}" x2="{}" y2="{}" stroke="{colour}" stroke-width="0.2"/>"#,
+                tenth(left),
+                tenth(top + 1.0)
+            );
+        }
+        for (line, text) in texts.iter().enumerate() {
+            #[allow(clippy::cast_precision_loss, reason = "a few lines")]
+            let baseline = top + FONT + line as f64 * LINE;
+            let _ = write!(
+                out,
+                r#"<text x="{}" y="{}" font-size="{}" fill="{colour}">{text}</text>"#,
+                tenth(left),
+                tenth(baseline),
+                tenth(FONT)
+            );
+        }
+        out.push_str("</g>\n");
+    }
+}
+
+/// How many characters `text` shows, its entities (`&amp;`) one each.
+fn unescaped_len(text: &str) -> usize {
+    text.replace("&amp;", "&")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .chars()
+        .count()
 }
 
 /// The robot at `pose`: its outline and a stroke the way it faces.
@@ -197,4 +395,117 @@ fn escape(text: &str) -> String {
     text.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::room::file::parse;
+    use crate::room::geometry::Point;
+
+    const ROOM: &str =
+        "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]\n[robot]\nx = 100\ny = 100\n";
+
+    fn pose(x: f64) -> Pose {
+        Pose {
+            at: Point::new(x, 100.0),
+            heading: 0.0,
+        }
+    }
+
+    /// Each label's box (left, top, right, bottom) from the picture's
+    /// text: a character as wide as the font at most, the line as tall.
+    fn boxes(svg: &str) -> Vec<([f64; 4], String)> {
+        let number = |text: &str, key: &str| -> f64 {
+            let start = text.find(key).expect(key) + key.len();
+            text[start..start + text[start..].find('"').expect("a quote")]
+                .parse()
+                .expect("a number")
+        };
+        svg.split("<text ")
+            .skip(1)
+            .map(|text| {
+                let (x, y, size) = (
+                    number(text, "x=\""),
+                    number(text, "y=\""),
+                    number(text, "font-size=\""),
+                );
+                let words =
+                    &text[text.find('>').expect(">") + 1..text.find("</text>").expect("</text>")];
+                let width = words.chars().count() as f64 * size * 0.5;
+                (
+                    [x, y - size * 0.8, x + width, y + size * 0.2],
+                    words.to_owned(),
+                )
+            })
+            .collect()
+    }
+
+    /// The hostile tester's finding: the labels of commands sent at one
+    /// pose, and the time marks of a robot standing still, were drawn on
+    /// one point, each over the other. The robot drives 10 cm in 1.5 s,
+    /// then stands 4.5 s; four commands arrive while it stands, two
+    /// at one moment, and a bump is felt there.
+    #[test]
+    fn no_label_covers_another() {
+        let layout = parse("room.toml", ROOM).expect("the room");
+        let mut trail = Trail::default();
+        for ms in 0..=1500u64 {
+            #[allow(clippy::cast_precision_loss, reason = "a test")]
+            trail
+                .poses
+                .push((ms * 1000, pose(100.0 + ms as f64 / 150.0)));
+        }
+        trail.poses.push((6_000_000, pose(110.0)));
+        trail.bumps.push((1_500_000, 0x10));
+        let commands: Vec<(u64, String)> = [
+            (1_200_000, "/1B"),
+            (2_000_000, "/8C+500100"),
+            (2_000_000, "/8D+500100"),
+            (3_000_000, "/1P"),
+        ]
+        .iter()
+        .map(|&(at, text)| (at, text.to_owned()))
+        .collect();
+        let svg = svg(&layout, &trail, &commands);
+        let labels = boxes(&svg);
+        assert_eq!(labels.len(), 1 + 1 + 1 + 4, "{svg}");
+        for (index, (a, first)) in labels.iter().enumerate() {
+            for (b, second) in &labels[index + 1..] {
+                let apart = a[2] <= b[0] || b[2] <= a[0] || a[3] <= b[1] || b[3] <= a[1];
+                assert!(apart, "`{first}` {a:?} covers `{second}` {b:?}:\n{svg}");
+            }
+        }
+        // The marks of seconds 2 to 6, where the robot stood, are one.
+        assert!(svg.contains(">1 s</text>"), "{svg}");
+        assert!(svg.contains(">2-6 s</text>"), "{svg}");
+        // Deterministic text: the same picture twice.
+        assert_eq!(svg, super::svg(&layout, &trail, &commands));
+    }
+
+    /// A drag (the robot put elsewhere) is a dashed jump between two
+    /// stretches of trail, not a stretch driven.
+    #[test]
+    fn a_jump_is_drawn_apart_from_the_trail() {
+        let layout = parse("room.toml", ROOM).expect("the room");
+        let mut trail = Trail::default();
+        trail.poses.push((0, pose(100.0)));
+        trail.poses.push((1000, pose(101.0)));
+        trail.jump(2000, pose(200.0));
+        trail.poses.push((3000, pose(201.0)));
+        let svg = svg(&layout, &trail, &[]);
+        assert_eq!(
+            svg.matches(r#"<polyline class="trail""#).count(),
+            2,
+            "{svg}"
+        );
+        assert!(
+            svg.contains(r#"<polyline class="trail" points="100.0,100.0 101.0,100.0""#),
+            "{svg}"
+        );
+        assert!(
+            svg.contains(r#"<line class="jump" x1="101.0" y1="100.0" x2="200.0" y2="100.0""#),
+            "{svg}"
+        );
+    }
 }

@@ -85,7 +85,21 @@ impl RoomView {
         path: &Path,
         commands: &[(u64, String)],
     ) -> Result<Vec<u8>, RasterError> {
-        let svg = self.svg(commands);
+        self.picture_of(path, &self.trail(), commands)
+    }
+
+    /// [`RoomView::picture_for`] with `trail` in place of the room's own
+    /// (a session's whole run, [`super::Trail::follow`]).
+    ///
+    /// # Errors
+    /// [`RasterError`] if a PNG cannot be made.
+    pub fn picture_of(
+        &self,
+        path: &Path,
+        trail: &super::Trail,
+        commands: &[(u64, String)],
+    ) -> Result<Vec<u8>, RasterError> {
+        let svg = super::picture::svg(self.layout(), trail, commands);
         if wants_png(path) {
             png(&svg)
         } else {

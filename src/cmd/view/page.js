@@ -12,7 +12,12 @@ let room = null;
 let world = null;
 let robot = null;
 let trail = null;
+let trailGroup = null;
+// [x, y, jump]: a jump is a point the robot was put at by a drag, not
+// driven to; the stretch into it is drawn dashed, not as trail.
 let trailPoints = [];
+// Where the stretch #trail draws begins in trailPoints.
+let stretchStart = 0;
 let pose = null;
 let paused = false;
 let dragging = null;
@@ -26,6 +31,25 @@ function el(name, attributes, parent) {
 
 function pointsText(points) {
   return points.map(([x, y]) => `${x},${y}`).join(" ");
+}
+
+// The trail: a polyline a driven stretch, a dashed line a jump; #trail
+// is the stretch the robot drives now.
+function drawTrail() {
+  if (!trailGroup) return;
+  trailGroup.textContent = "";
+  const stretch = (points) =>
+    el("polyline", { class: "trail", points: pointsText(points), fill: "none", stroke: "#06c", "stroke-width": 0.5 }, trailGroup);
+  stretchStart = 0;
+  trailPoints.forEach(([x, y, jump], index) => {
+    if (!jump || index === 0) return;
+    stretch(trailPoints.slice(stretchStart, index));
+    const [fromX, fromY] = trailPoints[index - 1];
+    el("line", { class: "jump", x1: fromX, y1: fromY, x2: x, y2: y, stroke: "#06c", "stroke-width": 0.5, "stroke-dasharray": "1.5 1.5" }, trailGroup);
+    stretchStart = index;
+  });
+  trail = stretch(trailPoints.slice(stretchStart));
+  trail.id = "trail";
 }
 
 function send(message) {
@@ -101,9 +125,9 @@ function drawRoom(r) {
     shape.dataset.index = index;
     shape.addEventListener("pointerdown", (event) => startDrag(event, { obstacle: index, shape, o }));
   });
-  trail = el("polyline", { id: "trail", fill: "none", stroke: "#06c", "stroke-width": 0.5 }, world);
+  trailGroup = el("g", { id: "trails" }, world);
   trailPoints = keptTrail;
-  trail.setAttribute("points", pointsText(trailPoints));
+  drawTrail();
   drawRobot(r.body);
 }
 
@@ -211,9 +235,12 @@ function showState(s) {
   document.getElementById("motors").textContent = `left ${s.motors[0]}, right ${s.motors[1]} steps`;
   for (const line of s.console) note(line.kind, line.text);
   if (s.trail.length && trail) {
-    for (const [x, y] of s.trail) trailPoints.push([x, y]);
-    if (trailPoints.length > 50000) trailPoints = trailPoints.slice(-40000);
-    trail.setAttribute("points", pointsText(trailPoints));
+    const jumps = new Set(s.jumps || []);
+    s.trail.forEach(([x, y], index) => trailPoints.push([x, y, jumps.has(index)]));
+    const trimmed = trailPoints.length > 50000;
+    if (trimmed) trailPoints = trailPoints.slice(-40000);
+    if (jumps.size || trimmed) drawTrail();
+    else trail.setAttribute("points", pointsText(trailPoints.slice(stretchStart)));
   }
   if (s.pose) {
     pose = s.pose;

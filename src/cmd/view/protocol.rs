@@ -194,6 +194,9 @@ pub(crate) enum Outgoing<'a> {
         trail_from: usize,
         /// New trail points: [x, y, ms].
         trail: Vec<[f64; 3]>,
+        /// The points of `trail` (indices into it) the robot was put at by
+        /// a drag rather than driven to: the stretch into each is a jump.
+        jumps: Vec<usize>,
         /// New console lines.
         console: Vec<&'a ConsoleLine>,
     },
@@ -304,11 +307,12 @@ impl Client {
         if let Some(last) = console.last() {
             self.console = last.seq;
         }
+        let (trail, jumps) = self.thin(&trail);
         let message = Outgoing::State {
             state: &frame.state,
             trail_from,
-            #[allow(clippy::cast_precision_loss, reason = "robot time in ms")]
-            trail: self.thin(&trail),
+            trail,
+            jumps,
             console,
         };
         // Serialized here: the frame's borrow ends with this call.
@@ -317,21 +321,27 @@ impl Client {
 
     /// The poses as points half a centimetre apart at least (the room
     /// looks every millisecond: the picture needs far fewer), the last
-    /// one always: [x, y, ms].
-    fn thin(&mut self, poses: &[(u64, Pose)]) -> Vec<[f64; 3]> {
+    /// one always, and each jump with the point before it: [x, y, ms];
+    /// and which of them are jumps.
+    fn thin(&mut self, poses: &[(u64, Pose, bool)]) -> (Vec<[f64; 3]>, Vec<usize>) {
         let mut points = Vec::new();
-        for (index, (cycle, pose)) in poses.iter().enumerate() {
+        let mut jumps = Vec::new();
+        for (index, &(cycle, pose, jump)) in poses.iter().enumerate() {
             let (x, y) = (pose.at.x, pose.at.y);
             let far = self
                 .drawn
                 .is_none_or(|(px, py)| (x - px) * (x - px) + (y - py) * (y - py) >= 0.25);
-            if far || index + 1 == poses.len() {
+            let before_jump = poses.get(index + 1).is_some_and(|next| next.2);
+            if far || jump || before_jump || index + 1 == poses.len() {
                 self.drawn = Some((x, y));
+                if jump {
+                    jumps.push(points.len());
+                }
                 #[allow(clippy::cast_precision_loss, reason = "robot time in ms")]
-                points.push([tenth(x), tenth(y), *cycle as f64 / 1000.0]);
+                points.push([tenth(x), tenth(y), cycle as f64 / 1000.0]);
             }
         }
-        points
+        (points, jumps)
     }
 }
 
