@@ -341,6 +341,14 @@ fn a_step_that_writes_into_the_stub_is_refused() {
             debug.read(stub.address, code_len).expect("read"),
             stub.bytes[..code_len]
         );
+        // Going on would run it too: refused, the robot still stopped.
+        match debug.resume() {
+            Err(StubError::Refused { reason, .. }) => {
+                assert!(reason.contains(&format!("${target:04X}")), "{reason}");
+            }
+            other => panic!("not refused: {other:?}"),
+        }
+        assert_eq!(debug.stopped().map(|r| r.pc), Some(0x0409));
         debug
             .write_verified(0x0080, &[0x00, 0x05])
             .expect("elsewhere");

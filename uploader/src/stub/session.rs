@@ -991,7 +991,31 @@ impl<T: Transport> RobotDebug<T> {
     ///
     /// # Errors
     /// [`StubError::Refused`] while running; the line's errors.
+    ///
+    /// The instruction at the PC is run on the host first: one that
+    /// writes into the stub is refused ([`StubError::Refused`]), the
+    /// robot left stopped (going on, it would overwrite the stub it is
+    /// served by).
     pub fn resume(&mut self) -> StubResult<()> {
+        let Some(registers) = self.stopped else {
+            return Err(not_stopped("continue"));
+        };
+        let stub = self.stub.clone();
+        let the_stubs = |at: u16| stub.contains(at);
+        let unwritable = |at: u16| at > platform::map::RAM_END;
+        let mut read = |at: u16| -> StubResult<u8> { Ok(self.read_as_program(at, 1)?[0]) };
+        let writes = match host_step::step(registers, &mut read, &the_stubs, &unwritable)? {
+            Step::Host(effects) => effects.writes,
+            Step::Robot(writes) => writes,
+        };
+        for (at, _) in writes {
+            self.refuse_stub_write(at, &format!("continuing from ${:04X}", registers.pc))?;
+        }
+        self.go_on()
+    }
+
+    /// [`RobotDebug::resume`] without the look at the instruction.
+    fn go_on(&mut self) -> StubResult<()> {
         let Some(registers) = self.stopped else {
             return Err(not_stopped("continue"));
         };
@@ -1084,7 +1108,7 @@ impl<T: Transport> RobotDebug<T> {
         // on (a `JSR` into the ROM that ends the answer, `JMP CMD_DONE`)
         // and stop there later, or at another breakpoint.
         self.temporary.extend(temporary);
-        self.resume()?;
+        self.go_on()?;
         self.wait_event(wait)
     }
 
@@ -1143,7 +1167,7 @@ impl<T: Transport> RobotDebug<T> {
         Err(StubError::Refused {
             what: what.into(),
             reason: format!(
-                "it writes ${at:04X}, in the debug stub (${:04X}-${:04X}, where the image left RAM free), which would break it with the robot in it: `quit` and attach again with the image claiming the RAM it writes (so the stub goes elsewhere), or set a breakpoint after it and continue once the stub is not needed there",
+                "it writes ${at:04X}, in the debug stub (${:04X}-${:04X}, RAM the image does not claim), which would break the stub the robot is stopped in (a continue would too, and is refused): `quit` (the breakpoints are taken out and the hook given back before the robot goes on), then make the image claim the RAM it writes (a `.bss` or `.res` there) so that the stub goes elsewhere, upload it and attach again",
                 self.stub.address,
                 u32::from(self.stub.address) + self.stub.bytes.len() as u32 - 1
             ),
@@ -1316,7 +1340,7 @@ impl<T: Transport> RobotDebug<T> {
             self.remove_breakpoint(address)?;
         }
         if self.stopped.is_some() {
-            self.resume()?;
+            self.go_on()?;
             let _ = self.wait_event(self.margin)?;
         }
         let hook = self.hook;
