@@ -441,7 +441,7 @@ impl RobotMonitor {
                 let value = self.eval(d, &expr)?;
                 bytes.push(u8::try_from(value).map_err(|_| usage(&format!("{word} is no byte")))?);
             }
-            d.write_verified(address, &bytes).map_err(failure)?;
+            d.write_as_program(address, &bytes).map_err(failure)?;
             return Ok(format!(
                 "${address:04X}: {} (read back)\n",
                 uploader::stub::error_hex(&bytes)
@@ -458,7 +458,7 @@ impl RobotMonitor {
             None => 16,
         };
         let len = len.min(0x1_0000 - usize::from(address));
-        let bytes = d.read(address, len).map_err(failure)?;
+        let bytes = d.read_as_program(address, len).map_err(failure)?;
         let mut text = String::new();
         for (i, row) in bytes.chunks(16).enumerate() {
             let at = address.wrapping_add(16 * i as u16);
@@ -488,7 +488,7 @@ impl RobotMonitor {
             None => 8,
         };
         let len = (count * 3).min(0x1_0000 - usize::from(address));
-        let bytes = d.read(address, len).map_err(failure)?;
+        let bytes = d.read_as_program(address, len).map_err(failure)?;
         let mut text = String::new();
         for line in isa::Disassembler::new(&bytes, address).take(count) {
             let shown = line.display_with(|at| self.symbols.label(at));
@@ -548,7 +548,7 @@ impl RobotMonitor {
                 return value.map_err(|error| Failure::Usage(error.to_string()));
             }
             for at in missing {
-                let byte = d.read(at, 1).map_err(failure)?[0];
+                let byte = d.read_as_program(at, 1).map_err(failure)?[0];
                 snapshot.memory.borrow_mut().insert(at, byte);
             }
         }

@@ -32,6 +32,7 @@ PTR     = SZP                   ; two bytes: kept at a stop, given back
 
 ; ---- a breakpoint's JSR lands here
 entry:  php
+        cld                     ; the program's D would make the sums BCD (RTI gives it back)
         sta r_a
         stx r_x
         sty r_y

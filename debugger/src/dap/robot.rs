@@ -456,7 +456,8 @@ impl RobotSession {
         })
     }
 
-    /// `readMemory`: through the stub at a stop, `/7R` while running.
+    /// `readMemory`: through the stub at a stop, `/7R` while running; as
+    /// the program sees it (a breakpoint's `JSR` hidden).
     fn read_memory(&mut self, args: &Arguments<'_>) -> Result<Value, String> {
         let start = self.address(args, "readMemory")?;
         let count = args.integer("count")?.unwrap_or(0).clamp(0, MAX_READ);
@@ -467,7 +468,7 @@ impl RobotSession {
             Vec::new()
         } else {
             self.robot()?
-                .read(start, len)
+                .read_as_program(start, len)
                 .map_err(|e| failure(e).message())?
         };
         let mut body = json!({
@@ -497,7 +498,7 @@ impl RobotSession {
             return Err("writeMemory: the bytes run past $FFFF".into());
         }
         self.robot()?
-            .write_verified(start, &bytes)
+            .write_as_program(start, &bytes)
             .map_err(|e| failure(e).message())?;
         Ok(json!({"bytesWritten": bytes.len()}))
     }

@@ -139,6 +139,9 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         signal_hook::consts::SIGHUP,
         signal_hook::consts::SIGTERM,
     ])?;
+    // A wait for the robot (a continue's, a step's) ends at the signal
+    // too, not only the next line read.
+    robot.set_interrupt(std::sync::Arc::clone(&ended));
     let session = converse(&mut robot, &mut monitor, &mut input, &mut out, &ended);
     // Given back whatever ended the conversation (an unwritable terminal
     // too), before its error is said.

@@ -105,6 +105,20 @@ pub enum StubError {
         found: String,
     },
 
+    /// A signal (Ctrl-C, a `kill`) came while the host waited for the
+    /// robot.
+    #[error("interrupted while waiting for {waiting}")]
+    #[diagnostic(
+        code(uploader::stub::interrupted),
+        help(
+            "the session ends as `quit` does: the breakpoints are taken out and the hook given back, if the robot still answers"
+        )
+    )]
+    Interrupted {
+        /// What was waited for.
+        waiting: String,
+    },
+
     /// What the robot cannot do, and why.
     #[error("{what} is refused on the robot: {reason}")]
     #[diagnostic(code(uploader::stub::refused))]

@@ -9,8 +9,10 @@
 //! instruction; what it would have done is done to it. Instructions that
 //! push (`JSR`, `PHA`, `PHP`, `BRK`) are left to the patching step: the
 //! stub serves the host on the stack below the robot's S, where a push
-//! would go. So are instructions that touch the stub's bytes or the two
-//! zero-page bytes it points with (it gives them back when it goes on).
+//! would go. So are instructions that read the stub's bytes or write
+//! outside RAM. Either way the host has run the instruction first, so
+//! the caller knows every byte it writes (and refuses a step that would
+//! write over the stub or a breakpoint's `JSR`).
 
 use std::collections::BTreeMap;
 
@@ -30,8 +32,19 @@ pub struct Effects {
     pub writes: Vec<(u16, u8)>,
 }
 
+/// What became of a step.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Step {
+    /// The host did it: what it did, to be given back to the robot.
+    Host(Effects),
+    /// Left to the robot (the patching step): the bytes the instruction
+    /// writes outside the stack, as far as the host ran it (none for a
+    /// push, whose bytes go to the stack).
+    Robot(Vec<(u16, u8)>),
+}
+
 /// The robot's memory as the instruction sees it: reads through `read`
-/// (once per address), writes kept; what the host cannot do refused.
+/// (once per address), writes kept; what the host cannot do marked.
 struct LineBus<'a> {
     read: &'a mut dyn FnMut(u16) -> StubResult<u8>,
     unreadable: &'a dyn Fn(u16) -> bool,
@@ -53,8 +66,8 @@ impl LineBus<'_> {
             return byte;
         }
         if (self.unreadable)(address) {
+            // Read all the same: a write after it goes where it says.
             self.trouble.get_or_insert(Trouble::Refused);
-            return 0;
         }
         match (self.read)(address) {
             Ok(byte) => {
@@ -77,7 +90,6 @@ impl Bus for LineBus<'_> {
     fn write(&mut self, address: u16, value: u8, _cycle: u64) {
         if (0x0100..0x0200).contains(&address) || (self.unwritable)(address) {
             self.trouble.get_or_insert(Trouble::Refused);
-            return;
         }
         self.seen.insert(address, value);
         self.writes.push((address, value));
@@ -95,9 +107,9 @@ impl Bus for LineBus<'_> {
 
 /// Runs the instruction at `registers.pc` on the host, reading the
 /// robot's memory with `read` (which gives the instruction's own bytes as
-/// the program has them, not a breakpoint's `JSR`). `Ok(None)` when the
-/// host cannot do it (a push, a JAM, a read `unreadable` or a write
-/// `unwritable` or in the stack page refuses): the caller patches instead.
+/// the program has them, not a breakpoint's `JSR`). [`Step::Robot`] when
+/// the host cannot do it (a push, a JAM, a read `unreadable` or a write
+/// `unwritable` or in the stack page): the caller patches instead.
 ///
 /// # Errors
 /// The line's errors from `read`.
@@ -106,7 +118,7 @@ pub fn step(
     read: &mut dyn FnMut(u16) -> StubResult<u8>,
     unreadable: &dyn Fn(u16) -> bool,
     unwritable: &dyn Fn(u16) -> bool,
-) -> StubResult<Option<Effects>> {
+) -> StubResult<Step> {
     let pc = registers.pc;
     let opcode = read(pc)?;
     let info = isa::opcode(opcode);
@@ -116,7 +128,7 @@ pub fn step(
             Mnemonic::Jsr | Mnemonic::Pha | Mnemonic::Php | Mnemonic::Brk
         )
     {
-        return Ok(None);
+        return Ok(Step::Robot(Vec::new()));
     }
     let mut bus = LineBus {
         read,
@@ -133,10 +145,17 @@ pub fn step(
     cpu.step(&mut bus);
     match bus.trouble {
         Some(Trouble::Line(error)) => return Err(error),
-        Some(Trouble::Refused) => return Ok(None),
+        Some(Trouble::Refused) => {
+            let writes = bus
+                .writes
+                .into_iter()
+                .filter(|(address, _)| !(0x0100..0x0200).contains(address))
+                .collect();
+            return Ok(Step::Robot(writes));
+        }
         None => {}
     }
-    Ok(Some(Effects {
+    Ok(Step::Host(Effects {
         registers: Registers {
             pc: cpu.pc,
             a: cpu.a,
@@ -167,6 +186,13 @@ mod tests {
 
     /// Steps the instruction `code` at $0400 in RAM holding `ram` pairs.
     fn run(code: &[u8], ram: &[(u16, u8)], at: Registers) -> Option<Effects> {
+        match step_it(code, ram, at) {
+            Step::Host(effects) => Some(effects),
+            Step::Robot(_) => None,
+        }
+    }
+
+    fn step_it(code: &[u8], ram: &[(u16, u8)], at: Registers) -> Step {
         let mut memory = [0u8; 0x10000];
         memory[0x0400..0x0400 + code.len()].copy_from_slice(code);
         for &(address, value) in ram {
@@ -238,5 +264,24 @@ mod tests {
         ] {
             assert_eq!(run(code, &[], registers(0x0400)), None, "{why}");
         }
+    }
+
+    #[test]
+    fn a_step_left_to_the_robot_says_what_it_writes() {
+        // INC $F0 reads a byte it may not (the stub's, here): left to the
+        // robot, with both of its writes named.
+        assert_eq!(
+            step_it(&[0xE6, 0xF0], &[(0x00F0, 4)], registers(0x0400)),
+            Step::Robot(vec![(0x00F0, 4), (0x00F0, 5)])
+        );
+        // A write outside RAM too, and the stack's bytes are not named.
+        assert_eq!(
+            step_it(&[0x8D, 0x00, 0x90], &[], registers(0x0400)),
+            Step::Robot(vec![(0x9000, 0x10)])
+        );
+        assert_eq!(
+            step_it(&[0x48], &[], registers(0x0400)),
+            Step::Robot(Vec::new())
+        );
     }
 }

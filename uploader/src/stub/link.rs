@@ -29,6 +29,9 @@ pub struct StubPlan {
     pub code_end: u16,
     /// The stop frame's block: `S`, PC low, high, A, X, Y, P, S.
     pub regs: u16,
+    /// The program's two bytes of `zero_page`, kept there at a stop
+    /// (the stub points with them meanwhile) and given back when it goes on.
+    pub saved_zp: u16,
     /// The staged patch: address low, high, three bytes.
     pub stage: u16,
     /// The trampolines: eight of [`TRAMPOLINE_LEN`] bytes.
@@ -96,6 +99,7 @@ impl StubPlan {
             previous,
             code_end: label("code_end")?,
             regs: label("regs")?,
+            saved_zp: label("saved_zp")?,
             stage: label("stage")?,
             tramps: label("tramps")?,
             zero_page,

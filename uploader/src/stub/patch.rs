@@ -46,6 +46,41 @@ impl Patch {
             .map(|offset| self.displaced[usize::from(offset)])
     }
 
+    /// The patch with the program's byte at `address` (one it displaced)
+    /// changed to `value`, in its record and its trampoline's copy, or why
+    /// the copy could no longer run in the trampoline: an instruction
+    /// that would run past its bytes into the `JMP` back, or a branch
+    /// (which reads the PC).
+    ///
+    /// # Errors
+    /// The reason, for a refusal.
+    pub fn with_byte(&self, address: u16, value: u8) -> Result<Patch, String> {
+        let offset = usize::from(
+            self.offset_of(address)
+                .ok_or_else(|| format!("${address:04X} is not among its bytes"))?,
+        );
+        let mut changed = self.clone();
+        changed.displaced[offset] = value;
+        changed.trampoline[offset] = value;
+        let mut at = 0;
+        while at < changed.displaced.len() {
+            let here = self.address.wrapping_add(at as u16);
+            let instruction = Instruction::decode(&changed.displaced[at..], here)
+                .ok_or_else(|| {
+                    format!(
+                        "the instruction at ${here:04X} would then run past the bytes its trampoline holds"
+                    )
+                })?;
+            if instruction.opcode.mode == AddressingMode::Relative {
+                return Err(format!(
+                    "the instruction at ${here:04X} would then be a branch ({instruction}), which cannot run from a trampoline"
+                ));
+            }
+            at += usize::from(instruction.len());
+        }
+        Ok(changed)
+    }
+
     /// Whether `address` is one of the displaced bytes after the first.
     #[must_use]
     pub fn covers_inside(&self, address: u16) -> bool {

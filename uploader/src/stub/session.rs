@@ -14,13 +14,15 @@
 
 use std::collections::BTreeMap;
 use std::ops::RangeInclusive;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use romlib::protocol::Command;
 
 use super::error::{StubError, StubResult, hex};
 use super::frame::{self, Heard, IN_MAX};
-use super::host_step;
+use super::host_step::{self, Step};
 use super::link::{StubPlan, TRAMPOLINE_LEN, TRAMPOLINES};
 use super::patch::{self, JSR, Patch};
 use crate::client::Client;
@@ -64,6 +66,14 @@ const ROM_PIECE: usize = 32;
 /// Bytes a stopped stub is asked for at once.
 const READ_CHUNK: usize = 64;
 
+/// Garbled frames, or frames and pieces of text that are neither a stop
+/// nor an answer, taken while waiting for one before the wait gives up:
+/// a robot that sends garbage for ever must not hold the host for ever.
+const STRIKES: u32 = 8;
+
+/// How often a wait looks at the interrupt flag.
+const SLICE: Duration = Duration::from_millis(100);
+
 /// A debugger attached to a robot.
 #[derive(Debug)]
 pub struct RobotDebug<T> {
@@ -88,6 +98,8 @@ pub struct RobotDebug<T> {
     starts: Option<Vec<u16>>,
     /// A step's breakpoints, taken out at the next stop.
     temporary: Vec<u16>,
+    /// Set by a signal: a wait for the robot ends at once.
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// What attach found of an earlier session that ended without detaching
@@ -187,6 +199,7 @@ impl<T: Transport> RobotDebug<T> {
             recovery: Recovery::default(),
             starts: None,
             temporary: Vec::new(),
+            interrupt: None,
         };
         let stopped = debug.probe()?.is_some();
         if stopped {
@@ -856,32 +869,83 @@ impl<T: Transport> RobotDebug<T> {
 
     /// Waits up to `wait` for an answer or a stop.
     ///
+    /// `wait` runs from the last thing heard; after [`STRIKES`] garbled
+    /// frames (each answered with a slash, which makes a stub send its
+    /// stop frame again) or pieces that are neither a stop nor an answer,
+    /// it gives up with [`StubError::Garbled`]; the interrupt flag
+    /// ([`RobotDebug::set_interrupt`]) ends it at once.
+    ///
     /// # Errors
-    /// The line's errors.
+    /// The line's errors, [`StubError::Garbled`],
+    /// [`StubError::Interrupted`].
     pub fn wait_event(&mut self, wait: Duration) -> StubResult<Reply> {
+        let asked = "a stop or an answer";
+        let mut deadline = self.client.transport().now() + wait;
+        let mut strikes = 0;
+        let mut last = String::new();
         loop {
-            match self.next_heard(wait)? {
-                None => return Ok(Reply::Silent),
+            if self
+                .interrupt
+                .as_ref()
+                .is_some_and(|flag| flag.load(Ordering::Relaxed))
+            {
+                return Err(StubError::Interrupted {
+                    waiting: asked.into(),
+                });
+            }
+            if strikes >= STRIKES {
+                return Err(StubError::Garbled {
+                    asked: asked.into(),
+                    expected:
+                        "a stop frame with a good sum, or an answer through its carriage return"
+                            .into(),
+                    found: format!("{strikes} times something else, the last {last}"),
+                });
+            }
+            let now = self.client.transport().now();
+            if now >= deadline {
+                return Ok(Reply::Silent);
+            }
+            let heard = self.next_heard((deadline - now).min(SLICE))?;
+            if heard.is_some() {
+                deadline = self.client.transport().now() + wait;
+            }
+            match heard {
+                None => {}
                 Some(Heard::Text(text)) => {
                     // An answer begun before a stop ends after it.
                     self.partial.extend_from_slice(&text);
                     if text.last() == Some(&b'\r') {
                         return Ok(Reply::Answer(std::mem::take(&mut self.partial)));
                     }
+                    strikes += 1;
+                    last = text.escape_ascii().to_string();
                 }
                 Some(Heard::Frame(payload)) => {
                     if let Some(registers) = self.take_stop(&payload) {
                         self.drop_temporary()?;
                         return Ok(Reply::Stopped(registers));
                     }
+                    strikes += 1;
+                    last = format!("frame {}", hex(&payload));
                 }
-                Some(Heard::BadFrame(_)) => {
+                Some(Heard::BadFrame(bytes)) => {
                     // A stop frame that came garbled: a slash makes the
                     // stub send it again.
                     self.client.send_raw(b"/")?;
+                    strikes += 1;
+                    last = format!("garbled frame {}", hex(&bytes));
                 }
             }
         }
+    }
+
+    /// A flag a signal sets: while it is set, a wait for the robot (a
+    /// continue's, a step's, a command's) ends at once with
+    /// [`StubError::Interrupted`]. [`RobotDebug::detach`] does not look at
+    /// it: it gives the robot back all the same.
+    pub fn set_interrupt(&mut self, flag: Arc<AtomicBool>) {
+        self.interrupt = Some(flag);
     }
 
     /// Changes the registers of the stopped robot (the PC is where
@@ -927,7 +991,31 @@ impl<T: Transport> RobotDebug<T> {
     ///
     /// # Errors
     /// [`StubError::Refused`] while running; the line's errors.
+    ///
+    /// The instruction at the PC is run on the host first: one that
+    /// writes into the stub is refused ([`StubError::Refused`]), the
+    /// robot left stopped (going on, it would overwrite the stub it is
+    /// served by).
     pub fn resume(&mut self) -> StubResult<()> {
+        let Some(registers) = self.stopped else {
+            return Err(not_stopped("continue"));
+        };
+        let stub = self.stub.clone();
+        let the_stubs = |at: u16| stub.contains(at);
+        let unwritable = |at: u16| at > platform::map::RAM_END;
+        let mut read = |at: u16| -> StubResult<u8> { Ok(self.read_as_program(at, 1)?[0]) };
+        let writes = match host_step::step(registers, &mut read, &the_stubs, &unwritable)? {
+            Step::Host(effects) => effects.writes,
+            Step::Robot(writes) => writes,
+        };
+        for (at, _) in writes {
+            self.refuse_stub_write(at, &format!("continuing from ${:04X}", registers.pc))?;
+        }
+        self.go_on()
+    }
+
+    /// [`RobotDebug::resume`] without the look at the instruction.
+    fn go_on(&mut self) -> StubResult<()> {
         let Some(registers) = self.stopped else {
             return Err(not_stopped("continue"));
         };
@@ -1020,48 +1108,188 @@ impl<T: Transport> RobotDebug<T> {
         // on (a `JSR` into the ROM that ends the answer, `JMP CMD_DONE`)
         // and stop there later, or at another breakpoint.
         self.temporary.extend(temporary);
-        self.resume()?;
+        self.go_on()?;
         self.wait_event(wait)
     }
 
     /// A step the host does for the robot (see [`host_step`]): the
-    /// instruction's bytes as the program has them (a breakpoint's
-    /// displaced ones, not its `JSR`), its writes written and verified,
-    /// the registers set. `None` when it is one for the patching step: a
-    /// push, or a write outside RAM (an I/O register reads back other
-    /// than written), into the stub, its zero page or a patched byte.
+    /// instruction's bytes and the memory it reads as the program has
+    /// them (a breakpoint's displaced bytes, not its `JSR`; the stub's
+    /// zero page from where the stub keeps the program's), its writes
+    /// given back the same way ([`RobotDebug::write_as_program`]), the
+    /// registers set. `None` when it is one for the patching step: a
+    /// push, a write outside RAM (an I/O register reads back other than
+    /// written), a read of the stub's bytes.
+    ///
+    /// The host runs the instruction first either way, so a step that
+    /// would write over the stub, or (left to the robot) over a
+    /// breakpoint's bytes, is refused before anything is written.
     fn step_on_host(&mut self, registers: Registers) -> StubResult<Option<Reply>> {
-        // Taken out of `self`, which the reads below borrow.
-        let patches: Vec<Patch> = self
-            .breakpoints
-            .values()
-            .map(|(patch, _)| patch.clone())
-            .collect();
-        let displaced = |at: u16| patches.iter().find_map(|patch| patch.displaced_at(at));
         let stub = self.stub.clone();
-        // The stub's bytes and its zero-page pointer hold the stub's
-        // values at a stop, not the program's.
-        let the_stubs = |at: u16| {
-            stub.contains(at)
-                || at == u16::from(stub.zero_page)
-                || at == u16::from(stub.zero_page.wrapping_add(1))
-        };
-        let unwritable =
-            |at: u16| the_stubs(at) || at > platform::map::RAM_END || displaced(at).is_some();
-        let mut read = |at: u16| -> StubResult<u8> {
-            if let Some(byte) = displaced(at) {
-                return Ok(byte);
+        let the_stubs = |at: u16| stub.contains(at);
+        let unwritable = |at: u16| at > platform::map::RAM_END;
+        let mut read = |at: u16| -> StubResult<u8> { Ok(self.read_as_program(at, 1)?[0]) };
+        let step = host_step::step(registers, &mut read, &the_stubs, &unwritable)?;
+        let what = format!("a step from ${:04X}", registers.pc);
+        match step {
+            Step::Robot(writes) => {
+                for &(at, _) in &writes {
+                    self.refuse_stub_write(at, &what)?;
+                    if let Some((patch, _)) = self
+                        .breakpoints
+                        .values()
+                        .find(|(p, _)| p.offset_of(at).is_some())
+                    {
+                        return Err(StubError::Refused {
+                            what,
+                            reason: format!(
+                                "the instruction writes ${at:04X}, among the bytes the breakpoint at ${:04X} displaced, and the robot would run it with the JSR there (it would write over the JSR or the trampoline's copy): delete that breakpoint, then step",
+                                patch.address
+                            ),
+                        });
+                    }
+                }
+                Ok(None)
             }
-            Ok(self.read(at, 1)?[0])
-        };
-        let Some(effects) = host_step::step(registers, &mut read, &the_stubs, &unwritable)? else {
-            return Ok(None);
-        };
-        for &(at, value) in &effects.writes {
-            self.write_verified(at, &[value])?;
+            Step::Host(effects) => {
+                self.apply_as_program(&effects.writes, &what)?;
+                self.set_registers(effects.registers)?;
+                Ok(Some(Reply::Stopped(effects.registers)))
+            }
         }
-        self.set_registers(effects.registers)?;
-        Ok(Some(Reply::Stopped(effects.registers)))
+    }
+
+    /// [`StubError::Refused`] for a write into the stub's bytes.
+    fn refuse_stub_write(&self, at: u16, what: &str) -> StubResult<()> {
+        if !self.stub.contains(at) {
+            return Ok(());
+        }
+        Err(StubError::Refused {
+            what: what.into(),
+            reason: format!(
+                "it writes ${at:04X}, in the debug stub (${:04X}-${:04X}, RAM the image does not claim), which would break the stub the robot is stopped in (a continue would too, and is refused): `quit` (the breakpoints are taken out and the hook given back before the robot goes on), then make the image claim the RAM it writes (a `.bss` or `.res` there) so that the stub goes elsewhere, upload it and attach again",
+                self.stub.address,
+                u32::from(self.stub.address) + self.stub.bytes.len() as u32 - 1
+            ),
+        })
+    }
+
+    /// Where the program's byte at `at` is kept while stopped, when it is
+    /// not at `at`: the stub's zero page is the stub's at a stop, the
+    /// program's two bytes wait in `saved_zp`.
+    fn kept_at(&self, at: u16) -> u16 {
+        let zero_page = u16::from(self.stub.zero_page);
+        if self.stopped.is_some() && (zero_page..=zero_page + 1).contains(&at) {
+            self.stub.saved_zp + (at - zero_page)
+        } else {
+            at
+        }
+    }
+
+    /// Reads `len` bytes at `address` as the program sees them (as a
+    /// debugger hides its breakpoints): a breakpoint's `JSR` shows the
+    /// program's bytes under it, and at a stop the stub's two zero-page
+    /// bytes show the program's values the stub keeps.
+    ///
+    /// # Errors
+    /// As [`RobotDebug::read`].
+    pub fn read_as_program(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
+        let mut bytes = self.read(address, len)?;
+        for (i, byte) in bytes.iter_mut().enumerate() {
+            let at = address.wrapping_add(i as u16);
+            // Past the JSR's three bytes the code holds the program's own.
+            if let Some(program) = self.breakpoints.values().find_map(|(patch, _)| {
+                patch
+                    .offset_of(at)
+                    .filter(|&offset| offset < 3)
+                    .map(|offset| patch.displaced[usize::from(offset)])
+            }) {
+                *byte = program;
+            }
+        }
+        let kept: Vec<(usize, u16)> = (0..len)
+            .filter_map(|i| {
+                let at = address.wrapping_add(i as u16);
+                let kept = self.kept_at(at);
+                (kept != at).then_some((i, kept))
+            })
+            .collect();
+        for (i, at) in kept {
+            bytes[i] = self.read(at, 1)?[0];
+        }
+        Ok(bytes)
+    }
+
+    /// Writes `bytes` at `address` as the program would (each read back):
+    /// a byte under a breakpoint's `JSR` goes to its trampoline's copy
+    /// (and the record put back when it is removed), the `JSR` kept; at a
+    /// stop the stub's zero page to where the stub keeps the program's.
+    ///
+    /// # Errors
+    /// [`StubError::Refused`] for a write into the stub, or a byte under
+    /// a `JSR` that would make its trampoline's copy run otherwise (see
+    /// [`Patch::with_byte`]); nothing is written then. The line's errors,
+    /// [`StubError::Verify`].
+    pub fn write_as_program(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        let writes: Vec<(u16, u8)> = bytes
+            .iter()
+            .enumerate()
+            .map(|(i, &byte)| (address.wrapping_add(i as u16), byte))
+            .collect();
+        self.apply_as_program(&writes, &format!("a write at ${address:04X}"))
+    }
+
+    /// [`RobotDebug::write_as_program`] for writes in order (`what` names
+    /// them in a refusal).
+    fn apply_as_program(&mut self, writes: &[(u16, u8)], what: &str) -> StubResult<()> {
+        // All planned first: a refusal writes nothing.
+        let mut patches: BTreeMap<u16, Patch> = BTreeMap::new();
+        let mut plain: Vec<(u16, u8)> = Vec::new();
+        for &(at, value) in writes {
+            self.refuse_stub_write(at, what)?;
+            let covering = self
+                .breakpoints
+                .iter()
+                .find(|(_, (patch, _))| patch.offset_of(at).is_some())
+                .map(|(&address, (patch, _))| (address, patch.clone()));
+            if let Some((address, patch)) = covering {
+                let current = patches.remove(&address).unwrap_or(patch);
+                let changed = current.with_byte(at, value).map_err(|reason| StubError::Refused {
+                    what: what.into(),
+                    reason: format!(
+                        "it writes ${value:02X} at ${at:04X}, among the bytes the breakpoint at ${address:04X} displaced (they run from its trampoline), and {reason}: delete that breakpoint first"
+                    ),
+                })?;
+                if changed.offset_of(at).is_some_and(|offset| offset >= 3) {
+                    // Past the JSR the code holds the program's bytes too.
+                    plain.push((at, value));
+                }
+                patches.insert(address, changed);
+                continue;
+            }
+            plain.push((self.kept_at(at), value));
+        }
+        for (address, patch) in patches {
+            let Some(slot) = self.breakpoints.get(&address).map(|(_, slot)| *slot) else {
+                continue;
+            };
+            let len = patch.displaced.len();
+            self.write_verified(self.stub.trampoline(slot), &patch.trampoline[..len])?;
+            self.breakpoints.insert(address, (patch, slot));
+        }
+        // Runs of consecutive bytes in one write each.
+        let mut i = 0;
+        while i < plain.len() {
+            let mut run = vec![plain[i].1];
+            while i + run.len() < plain.len()
+                && plain[i + run.len()].0 == plain[i].0.wrapping_add(run.len() as u16)
+            {
+                run.push(plain[i + run.len()].1);
+            }
+            self.write_verified(plain[i].0, &run)?;
+            i += run.len();
+        }
+        Ok(())
     }
 
     /// The step's breakpoints, taken out at a stop.
@@ -1097,6 +1325,8 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// The line's errors.
     pub fn detach(mut self) -> StubResult<Client<T>> {
+        // A signal that ended the session must not cut its detach short.
+        self.interrupt = None;
         if self.stopped.is_none() {
             // A stop nobody saw (its frame lost, or unread): the stub
             // answers a frame only when it runs.
@@ -1110,7 +1340,7 @@ impl<T: Transport> RobotDebug<T> {
             self.remove_breakpoint(address)?;
         }
         if self.stopped.is_some() {
-            self.resume()?;
+            self.go_on()?;
             let _ = self.wait_event(self.margin)?;
         }
         let hook = self.hook;
