@@ -48,28 +48,6 @@ pub fn svg(layout: &Layout, trail: &Trail, commands: &[(u64, String)]) -> String
     let at = |p: Point| format!("{},{}", tenth(p.x), tenth(max_y + min_y - p.y));
     let list = |ps: &[Point]| ps.iter().map(|&p| at(p)).collect::<Vec<_>>().join(" ");
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="{} {} {} {}" width="{}" height="{}">"#,
-        tenth(min_x),
-        tenth(min_y),
-        tenth(max_x - min_x),
-        tenth(max_y - min_y),
-        tenth((max_x - min_x) * 3.0),
-        tenth((max_y - min_y) * 3.0),
-    );
-    let _ = writeln!(
-        out,
-        "<title>the robot's path (centimetres, north up)</title>"
-    );
-    let _ = writeln!(
-        out,
-        r##"<rect x="{}" y="{}" width="{}" height="{}" fill="#fafafa"/>"##,
-        tenth(min_x),
-        tenth(min_y),
-        tenth(max_x - min_x),
-        tenth(max_y - min_y)
-    );
     if let Some(walls) = &layout.walls {
         let _ = writeln!(
             out,
@@ -186,6 +164,45 @@ pub fn svg(layout: &Layout, trail: &Trail, commands: &[(u64, String)]) -> String
     let last = trail.poses.last().map_or(layout.start, |&(_, pose)| pose);
     robot(&mut out, layout, last, &at);
     out.push_str("</svg>\n");
+    // The view box holds the room and every label (a label laid below
+    // others may reach past the room's edge).
+    let (min_x, min_y, max_x, max_y) =
+        labels
+            .boxes
+            .iter()
+            .fold((min_x, min_y, max_x, max_y), |(x0, y0, x1, y1), b| {
+                (
+                    x0.min(b[0] - 1.0),
+                    y0.min(b[1] - 1.0),
+                    x1.max(b[2] + 1.0),
+                    y1.max(b[3] + 1.0),
+                )
+            });
+    let body = out;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="{} {} {} {}" width="{}" height="{}">"#,
+        tenth(min_x),
+        tenth(min_y),
+        tenth(max_x - min_x),
+        tenth(max_y - min_y),
+        tenth((max_x - min_x) * 3.0),
+        tenth((max_y - min_y) * 3.0),
+    );
+    let _ = writeln!(
+        out,
+        "<title>the robot's path (centimetres, north up)</title>"
+    );
+    let _ = writeln!(
+        out,
+        r##"<rect x="{}" y="{}" width="{}" height="{}" fill="#fafafa"/>"##,
+        tenth(min_x),
+        tenth(min_y),
+        tenth(max_x - min_x),
+        tenth(max_y - min_y)
+    );
+    out.push_str(&body);
     out
 }
 
@@ -246,6 +263,10 @@ fn runs(marks: &[u64]) -> String {
     parts.join(", ")
 }
 
+/// The most lines one mark's label has: past them, the rest are counted
+/// in its last line (a thousand commands sent where the robot stands
+/// would otherwise stack a thousand lines down the picture).
+const MAX_LINES: usize = 6;
 /// A label's font size, in the picture's units (centimetres).
 const FONT: f64 = 4.0;
 /// The height of a line of labels: the font and a little space.
@@ -289,6 +310,21 @@ impl Labels {
         texts: &[String],
         side: LabelSide,
     ) {
+        let summary;
+        let texts = if texts.len() > MAX_LINES {
+            summary = texts[..MAX_LINES - 1]
+                .iter()
+                .cloned()
+                .chain([format!(
+                    "and {} more, the last {}",
+                    texts.len() - (MAX_LINES - 1),
+                    texts[texts.len() - 1]
+                )])
+                .collect::<Vec<_>>();
+            &summary[..]
+        } else {
+            texts
+        };
         let (x, y) = split(point);
         let (px, py) = (
             x.parse::<f64>().unwrap_or(0.0),
@@ -481,6 +517,66 @@ mod tests {
         assert!(svg.contains(">2-6 s</text>"), "{svg}");
         // Deterministic text: the same picture twice.
         assert_eq!(svg, super::svg(&layout, &trail, &commands));
+    }
+
+    /// The view box, from the picture's header: left, top, right, bottom.
+    fn view_box(svg: &str) -> [f64; 4] {
+        let start = svg.find("viewBox=\"").expect("a view box") + 9;
+        let numbers: Vec<f64> = svg[start..start + svg[start..].find('"').expect("a quote")]
+            .split(' ')
+            .map(|n| n.parse().expect("a number"))
+            .collect();
+        [
+            numbers[0],
+            numbers[1],
+            numbers[0] + numbers[2],
+            numbers[1] + numbers[3],
+        ]
+    }
+
+    /// The hostile tester's finding: a thousand commands sent where the
+    /// robot stood stacked a thousand lines down to y = 5100, far outside
+    /// the picture. One mark's label has a few lines and counts the rest;
+    /// labels laid below others (a robot creeping, a command at each
+    /// step) make the picture taller, never fall outside it.
+    #[test]
+    fn every_label_lies_inside_the_picture() {
+        let layout = parse("room.toml", ROOM).expect("the room");
+        let mut trail = Trail::default();
+        trail.poses.push((0, pose(100.0)));
+        let still: Vec<(u64, String)> = (0..1000u64)
+            .map(|i| (i * 10_000, "/1B".to_owned()))
+            .collect();
+        let svg = svg(&layout, &trail, &still);
+        let labels = boxes(&svg);
+        assert_eq!(labels.len(), MAX_LINES, "{svg}");
+        assert!(
+            labels[MAX_LINES - 1]
+                .1
+                .starts_with("and 995 more, the last /1B at 9.990 s"),
+            "{svg}"
+        );
+        let mut creeping = Trail::default();
+        let mut sent = Vec::new();
+        for step in 0..200u64 {
+            #[allow(clippy::cast_precision_loss, reason = "a test")]
+            creeping
+                .poses
+                .push((step * 100_000, pose(100.0 + step as f64 * 0.5)));
+            sent.push((step * 100_000, format!("/1P {step}")));
+        }
+        for svg in [svg, super::svg(&layout, &creeping, &sent)] {
+            let inside = view_box(&svg);
+            for (b, text) in boxes(&svg) {
+                assert!(
+                    inside[0] <= b[0]
+                        && inside[1] <= b[1]
+                        && b[2] <= inside[2]
+                        && b[3] <= inside[3],
+                    "`{text}` {b:?} outside the view box {inside:?}"
+                );
+            }
+        }
     }
 
     /// A drag (the robot put elsewhere) is a dashed jump between two
