@@ -185,15 +185,22 @@ fn main() {
             "the full upload with default options: {full_ratio:.3}x, target 1.15x"
         ));
     }
-    if delta_ratio > 1.0 {
-        missed.push(format!(
-            "the one-byte change: {:.3} s of robot time, target 1 s",
-            delta.device_time.as_secs_f64()
-        ));
+    // `scorpion upload` keeps what it overwrites: the goal is for what
+    // users run, so both one-byte figures are held to it.
+    for (name, report) in [
+        ("the one-byte change", &delta),
+        ("the one-byte change keeping for undo", &kept_delta),
+    ] {
+        if report.device_time.as_secs_f64() > 1.0 {
+            missed.push(format!(
+                "{name}: {:.3} s of robot time, target 1 s",
+                report.device_time.as_secs_f64()
+            ));
+        }
     }
     println!();
     println!(
-        "  targets: ROM only within 1.1x of the ROM-only bound ({:.3} s); the loader, line at 19200, within 1.15x of the line-rate bound ({:.3} s); a one-byte change within 1 s",
+        "  targets: ROM only within 1.1x of the ROM-only bound ({:.3} s); the loader, line at 19200, within 1.15x of the line-rate bound ({:.3} s); a one-byte change within 1 s, kept for undo or not",
         rom_bound.as_secs_f64() * 1.1,
         line_bound.as_secs_f64() * 1.15
     );

@@ -8,6 +8,7 @@
 //! cargo run -p uploader --release --example trace -- 9600    # the loader at 9600 throughout
 //! cargo run -p uploader --release --example trace -- rom     # the ROM's commands only
 //! cargo run -p uploader --release --example trace -- delta   # one byte changed, once installed
+//! cargo run -p uploader --release --example trace -- undo    # the same, keeping for `--undo` (as `scorpion upload`)
 //! cargo run -p uploader --release --example trace -- small   # 109 bytes, as the README's main job
 //! ```
 //!
@@ -80,6 +81,14 @@ impl<T: Transport> Transport for Log<T> {
     }
 }
 
+/// Keeps what an upload overwrote, as `scorpion upload` does for `--undo`
+/// (the file aside).
+struct Undo;
+
+impl uploader::Keep for Undo {
+    fn keep(&mut self, _overwritten: &uploader::Backup) {}
+}
+
 /// A command for the timeline: frames by size, the rest as text.
 fn describe(bytes: &[u8]) -> String {
     if bytes.starts_with(b"/1L") && bytes.len() > 9 {
@@ -93,7 +102,7 @@ fn main() -> uploader::Result<()> {
     let mode = std::env::args().nth(1);
     let (loader, fast_baud) = match mode.as_deref() {
         Some("rom") => (LoaderChoice::Never, None),
-        Some("delta") => (LoaderChoice::Auto, Some(uploader::FAST_BAUD)),
+        Some("delta" | "undo") => (LoaderChoice::Auto, Some(uploader::FAST_BAUD)),
         Some("9600") => (LoaderChoice::Always, None),
         _ => (LoaderChoice::Always, Some(uploader::FAST_BAUD)),
     };
@@ -117,12 +126,17 @@ fn main() -> uploader::Result<()> {
         },
         0,
     );
-    if mode.as_deref() == Some("delta") {
+    let keeping = mode.as_deref() == Some("undo");
+    if matches!(mode.as_deref(), Some("delta" | "undo")) {
         uploader::upload(&mut client, &image, &options, &mut NoProgress)?;
         client.transport().entries.clear();
         image = one_byte_changed(&image, 1000);
     }
-    let report = uploader::upload(&mut client, &image, &options, &mut NoProgress)?;
+    let report = if keeping {
+        uploader::upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut Undo)?
+    } else {
+        uploader::upload(&mut client, &image, &options, &mut NoProgress)?
+    };
     let log = client.into_transport();
 
     // Answer characters arrive in bursts; print each burst once.

@@ -39,16 +39,18 @@ fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
 /// A range's index and the robot's sum of it.
 type Differs = (usize, u16);
 
-/// The ranges of `ranges` whose robot sum differs from the host's, and
-/// the robot's sums of `first` (asked first, in the same batch).
+/// The ranges of `ranges` whose robot sum differs from the host's, the
+/// robot's sums of `first` (asked first, in the same batch), and every
+/// range asked with the robot's sum of it.
 fn differ<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     ranges: &[(Range, &[u8])],
-) -> Result<(Vec<Differs>, Vec<u16>)> {
+) -> Result<(Vec<Differs>, Vec<u16>, Vec<(Range, u16)>)> {
     let mut asked: Vec<Range> = first.to_vec();
     asked.extend(ranges.iter().map(|(range, _)| *range));
     let mut found = robot_sums(client, &asked)?;
+    let known = asked.iter().copied().zip(found.iter().copied()).collect();
     let rest = found.split_off(first.len());
     let wrong = ranges
         .iter()
@@ -57,11 +59,23 @@ fn differ<T: Transport>(
         .filter(|(_, ((_, bytes), found))| fletcher16(bytes) != *found)
         .map(|(i, (_, found))| (i, found))
         .collect();
-    Ok((wrong, found))
+    Ok((wrong, found, known))
 }
 
 /// A range of the image and the robot's sum of what it holds there.
 pub(crate) type Held = (Area, u16);
+
+/// What the sums of an upload found, before anything was written.
+pub(crate) struct Summed {
+    /// The ranges of the image to write, each with the robot's sum of
+    /// what it holds there.
+    pub held: Vec<Held>,
+    /// The robot's sums of the ranges asked first.
+    pub first: Vec<u16>,
+    /// Every range asked, with the robot's sum of it: what a later sum
+    /// of the same memory, still unwritten, can be put together from.
+    pub known: Vec<(Range, u16)>,
+}
 
 /// The ranges of `image` the robot does not hold, merged where they
 /// touch; empty when it holds every byte. The loader's `sums` must be
@@ -73,7 +87,7 @@ pub(crate) fn differing<T: Transport>(
     client: &mut Client<T>,
     image: &UploadImage,
 ) -> Result<Vec<Area>> {
-    Ok(merged(&differing_and(client, &[], image)?.0))
+    Ok(merged(&differing_and(client, &[], image)?.held))
 }
 
 /// The ranges of `image` the robot does not hold, each with the robot's
@@ -88,9 +102,9 @@ pub(crate) fn differing_and<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     image: &UploadImage,
-) -> Result<(Vec<Held>, Vec<u16>)> {
+) -> Result<Summed> {
     let coarse = split(image.areas(), COARSE);
-    let (wrong, sums) = differ(client, first, &coarse)?;
+    let (wrong, sums, mut known) = differ(client, first, &coarse)?;
     let held = |range: &(Range, &[u8]), sum: u16| {
         (
             Area {
@@ -101,20 +115,37 @@ pub(crate) fn differing_and<T: Transport>(
         )
     };
     if wrong.len() * 2 > coarse.len() {
-        let out = wrong
+        let held = wrong
             .iter()
             .map(|&(i, sum)| held(&coarse[i], sum))
             .collect();
-        return Ok((out, sums));
+        return Ok(Summed {
+            held,
+            first: sums,
+            known,
+        });
     }
-    let pieces: Vec<Area> = wrong.iter().map(|&(i, _)| held(&coarse[i], 0).0).collect();
+    // A range no longer than a fine one is summed already: asking again
+    // would get the same answer.
+    let (short, long): (Vec<Differs>, Vec<Differs>) =
+        wrong.iter().partition(|&&(i, _)| coarse[i].1.len() <= FINE);
+    let pieces: Vec<Area> = long.iter().map(|&(i, _)| held(&coarse[i], 0).0).collect();
     let fine = split(&pieces, FINE);
-    let out = differ(client, &[], &fine)?
-        .0
+    let mut out: Vec<Held> = short
         .iter()
-        .map(|&(i, sum)| held(&fine[i], sum))
+        .map(|&(i, sum)| held(&coarse[i], sum))
         .collect();
-    Ok((out, sums))
+    if !fine.is_empty() {
+        let (wrong_fine, _, known_fine) = differ(client, &[], &fine)?;
+        out.extend(wrong_fine.iter().map(|&(i, sum)| held(&fine[i], sum)));
+        known.extend(known_fine);
+    }
+    out.sort_by_key(|(area, _)| area.address);
+    Ok(Summed {
+        held: out,
+        first: sums,
+        known,
+    })
 }
 
 /// Every range of `image` (coarse), each with the robot's sum of what it
@@ -127,13 +158,14 @@ pub(crate) fn all_and<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     image: &UploadImage,
-) -> Result<(Vec<Held>, Vec<u16>)> {
+) -> Result<Summed> {
     let coarse = split(image.areas(), COARSE);
     let mut asked: Vec<Range> = first.to_vec();
     asked.extend(coarse.iter().map(|(range, _)| *range));
     let mut found = robot_sums(client, &asked)?;
+    let known = asked.iter().copied().zip(found.iter().copied()).collect();
     let rest = found.split_off(first.len());
-    let out = coarse
+    let held = coarse
         .iter()
         .zip(rest)
         .map(|(((address, _), bytes), sum)| {
@@ -146,7 +178,11 @@ pub(crate) fn all_and<T: Transport>(
             )
         })
         .collect();
-    Ok((out, found))
+    Ok(Summed {
+        held,
+        first: found,
+        known,
+    })
 }
 
 /// The ranges of `held`, merged where they touch.

@@ -133,12 +133,27 @@ pub(crate) fn read_hooks<T: Transport>(
 /// # Errors
 /// The client's.
 pub(crate) fn read_word<T: Transport>(client: &mut Client<T>, address: u16) -> Result<Option<u16>> {
+    read_word_expecting(client, address, None)
+}
+
+/// Reads a little-endian word as [`read_word`] does, but a first answer
+/// that is `expected` is taken at once: for a wrong word to pass, noise
+/// would have to turn the robot's digits into exactly the expected ones.
+/// Anything else is read until two answers agree.
+///
+/// # Errors
+/// The client's.
+pub(crate) fn read_word_expecting<T: Transport>(
+    client: &mut Client<T>,
+    address: u16,
+    expected: Option<u16>,
+) -> Result<Option<u16>> {
     let span = ReadSpan::new(address, 2)?;
     let mut previous = None;
     for _ in 0..client.config().question_attempts.max(2) * 2 {
         if let Answer::Memory(bytes) = client.ask(&Command::ReadMemory(span))? {
             let word = u16::from_le_bytes([bytes[0], bytes[1]]);
-            if previous == Some(word) {
+            if previous == Some(word) || (previous.is_none() && expected == Some(word)) {
                 return Ok(Some(word));
             }
             previous = Some(word);

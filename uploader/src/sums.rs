@@ -41,6 +41,48 @@ pub fn fletcher16(bytes: &[u8]) -> u16 {
 /// A range of robot memory: first address and length (up to `$10000`).
 pub(crate) type Range = (u16, usize);
 
+/// The sum of two ranges, one after the other, from their sums (`second`
+/// over `second_len` bytes): the first sums add, and every byte of the
+/// second range adds the first range's first sum to the running sum once
+/// more.
+#[must_use]
+pub(crate) fn fletcher16_joined(first: u16, second: u16, second_len: usize) -> u16 {
+    let [first_a, second_a] = first.to_be_bytes();
+    let [first_b, second_b] = second.to_be_bytes();
+    // Mod 256: only the length's low byte counts.
+    let times = (second_len & 0xFF) as u8;
+    u16::from_be_bytes([
+        first_a.wrapping_add(first_b),
+        second_a
+            .wrapping_add(first_a.wrapping_mul(times))
+            .wrapping_add(second_b),
+    ])
+}
+
+/// The robot's sum of `range`, put together from `known` sums of ranges
+/// that tile it exactly (each taken from the robot at the same moment as
+/// far as the range goes: before anything was written); `None` where they
+/// do not.
+#[must_use]
+pub(crate) fn joined_from(known: &[(Range, u16)], (address, len): Range) -> Option<u16> {
+    let end = usize::from(address) + len;
+    let mut at = usize::from(address);
+    let mut sum = fletcher16(&[]);
+    while at < end {
+        // The longest known range starting here that stays inside.
+        let (&(_, part_len), &part) = known
+            .iter()
+            .filter(|((start, part_len), _)| {
+                usize::from(*start) == at && *part_len > 0 && at + part_len <= end
+            })
+            .map(|(range, sum)| (range, sum))
+            .max_by_key(|((_, part_len), _)| *part_len)?;
+        sum = fletcher16_joined(sum, part, part_len);
+        at += part_len;
+    }
+    Some(sum)
+}
+
 /// The question for one range.
 pub(crate) fn question((address, len): Range) -> Vec<u8> {
     // A length of $10000 cannot be asked; nothing asks for it.
@@ -121,6 +163,40 @@ mod tests {
         let mut swapped = bytes.clone();
         swapped.swap(3, 4);
         assert_ne!(fletcher16(&swapped), sum, "a swap");
+    }
+
+    #[test]
+    fn sums_of_parts_join_into_the_sum_of_the_whole() {
+        let bytes: Vec<u8> = (0..700u32).map(|i| (i * 37 % 251) as u8).collect();
+        for cut in [0usize, 1, 31, 256, 300, 699, 700] {
+            let (a, b) = bytes.split_at(cut);
+            assert_eq!(
+                fletcher16_joined(fletcher16(a), fletcher16(b), b.len()),
+                fletcher16(&bytes),
+                "cut at {cut}"
+            );
+        }
+        let known: Vec<(Range, u16)> =
+            [(0x400u16, 256usize), (0x500, 256), (0x600, 32), (0x620, 32)]
+                .iter()
+                .map(|&(address, len)| {
+                    let start = usize::from(address - 0x400);
+                    ((address, len), fletcher16(&bytes[start..start + len]))
+                })
+                .collect();
+        assert_eq!(
+            joined_from(&known, (0x400, 576)),
+            Some(fletcher16(&bytes[..576]))
+        );
+        assert_eq!(
+            joined_from(&known, (0x500, 288)),
+            Some(fletcher16(&bytes[256..544]))
+        );
+        // A gap, a range that runs past what is known, one that starts
+        // inside a known range: asked of the robot instead.
+        assert_eq!(joined_from(&known, (0x400, 600)), None);
+        assert_eq!(joined_from(&known, (0x410, 16)), None);
+        assert_eq!(joined_from(&known, (0x400, 0)), Some(fletcher16(&[])));
     }
 
     #[test]

@@ -12,7 +12,7 @@ use romlib::installed::{self, ENTRY_LEN, Installed, TakenHook};
 use romlib::protocol::{Answer, Command, ReadSpan, WordWrite};
 
 use crate::client::Client;
-use crate::hooks::{read_word, write_word_verified};
+use crate::hooks::{read_word, read_word_expecting, write_word_verified};
 use crate::image::{Area, RomProfile, UploadImage};
 use crate::transport::Transport;
 use crate::{Error, Result};
@@ -125,7 +125,7 @@ pub(crate) fn prepare<T: Transport>(
     profile: &RomProfile,
     image: &UploadImage,
     replace: bool,
-    max_writes: u32,
+    (max_writes, hooks): (u32, &[(HookKind, u16)]),
 ) -> Result<Option<Plan>> {
     let Some(table) = profile.table else {
         return Ok(None);
@@ -147,13 +147,16 @@ pub(crate) fn prepare<T: Transport>(
         });
     }
     let mut replaced = false;
+    let mut known = hooks;
     for old in &read.installed {
         match old.overlap(image.extents()) {
             None => kept.push(old.clone()),
             Some(_) if old.id == id && old.extents == image.extents() => reused = Some(old.clone()),
             Some(_) if replace => {
                 replaced = true;
-                remove(client, profile, &read.installed, old, max_writes)?;
+                remove(client, profile, (&read.installed, known), old, max_writes)?;
+                // The hooks may have moved: read from here on.
+                known = &[];
                 // Its flags are cleared now, verified.
                 read.flags[old.slot..old.slot + old.entries()].fill(0);
             }
@@ -326,7 +329,7 @@ fn differs<T: Transport>(
 fn remove<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
-    everyone: &[Installed],
+    (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     old: &Installed,
     max_writes: u32,
 ) -> Result<()> {
@@ -334,7 +337,7 @@ fn remove<T: Transport>(
         return Ok(());
     };
     for hook in &old.hooks {
-        unlink(client, profile, everyone, *hook, max_writes)?;
+        unlink(client, profile, (everyone, hooks), *hook, max_writes)?;
     }
     // Clearing its flags bytes frees its entries.
     let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();
@@ -345,16 +348,20 @@ fn remove<T: Transport>(
 
 /// Re-points whatever jumps to `hook.handler` at where that extension
 /// fell through: the hook's own operand, or the chain slot of the extension
-/// before it. Nothing to do where it is not in the chain.
+/// before it. Nothing to do where it is not in the chain. `hooks`: the
+/// hooks' targets as the upload read them (until two answers agreed), so
+/// the chain is followed from there without reading them again.
 fn unlink<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
-    everyone: &[Installed],
+    (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     hook: TakenHook,
     max_writes: u32,
 ) -> Result<()> {
+    // Mostly the only extension on its hook: its slot holds the ROM's
+    // target, taken at the first answer that says so.
     let after = match hook.chain {
-        Some(slot) => read_word(client, slot)?,
+        Some(slot) => read_word_expecting(client, slot, profile.reset_target(hook.kind))?,
         None => profile.reset_target(hook.kind),
     };
     let Some(after) = after else {
@@ -363,7 +370,17 @@ fn unlink<T: Transport>(
             target: hook.handler,
         });
     };
-    let chain = walk(client, profile, everyone, hook.kind, Some(hook.handler))?;
+    let from_hook = hooks
+        .iter()
+        .find(|(kind, _)| *kind == hook.kind)
+        .map(|&(_, target)| target);
+    let chain = walk(
+        client,
+        profile,
+        everyone,
+        (hook.kind, from_hook),
+        Some(hook.handler),
+    )?;
     match chain.last() {
         Some(&(pointer, target)) if target == hook.handler => {
             write_word_verified(client, pointer, after.to_le_bytes(), max_writes)
@@ -384,25 +401,31 @@ pub fn chain_of<T: Transport>(
     everyone: &[Installed],
     kind: HookKind,
 ) -> Result<Vec<u16>> {
-    let chain = walk(client, profile, everyone, kind, None)?;
+    let chain = walk(client, profile, everyone, (kind, None), None)?;
     Ok(chain.into_iter().map(|(_, target)| target).collect())
 }
 
 /// Follows `kind`'s chain from the hook: each pointer (the hook's operand,
 /// then installed chain slots) with the target it holds, read until two
 /// answers agree, up to `until` or the first target no installed
-/// extension owns; at most one step per extension.
+/// extension owns; at most one step per extension. `from_hook`: the
+/// hook's target where it was read already (two answers agreeing).
 fn walk<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     everyone: &[Installed],
-    kind: HookKind,
+    (kind, from_hook): (HookKind, Option<u16>),
     until: Option<u16>,
 ) -> Result<Vec<(u16, u16)>> {
     let mut steps = Vec::new();
     let mut pointer = profile.hook_address(kind) + 1;
+    let mut known = from_hook;
     for _ in 0..=everyone.len() {
-        let Some(target) = read_word(client, pointer)? else {
+        let read = match known.take() {
+            Some(target) => Some(target),
+            None => read_word(client, pointer)?,
+        };
+        let Some(target) = read else {
             break;
         };
         steps.push((pointer, target));

@@ -344,7 +344,13 @@ pub fn upload_keeping<T: Transport>(
     }
     // What is installed: an overlap is refused (or, with `replace`, the old
     // extension leaves its chains first, which changes the hooks).
-    let mut plan = table::prepare(client, profile, image, options.replace, options.max_writes)?;
+    let mut plan = table::prepare(
+        client,
+        profile,
+        image,
+        options.replace,
+        (options.max_writes, &hooks_now),
+    )?;
     // What an undo puts back: the hooks and the table as found (the table
     // as `prepare` read it, flags and the entries in use: no more reads).
     let mut kept = keep.wanted().then(|| Backup {
@@ -500,15 +506,16 @@ pub fn upload_keeping<T: Transport>(
                 // A reset while the sums are asked unhooks the loader: it
                 // is restored and they are asked again.
                 let mut tries = 0;
-                let (todo, found) = loop {
+                let summed = loop {
                     let asked = if options.delta {
                         delta::differing_and(client, &first, &image)
                     } else if kept.is_some() {
                         delta::all_and(client, &first, &image)
                     } else {
-                        crate::sums::robot_sums(client, &first).map(|found| {
-                            let all = image.areas().iter().map(|area| (area.clone(), 0));
-                            (all.collect(), found)
+                        crate::sums::robot_sums(client, &first).map(|found| delta::Summed {
+                            held: image.areas().iter().map(|area| (area.clone(), 0)).collect(),
+                            known: first.iter().copied().zip(found.iter().copied()).collect(),
+                            first: found,
                         })
                     };
                     match asked {
@@ -520,6 +527,11 @@ pub fn upload_keeping<T: Transport>(
                         Err(error) => return Err(error),
                     }
                 };
+                let delta::Summed {
+                    held: todo,
+                    first: found,
+                    known,
+                } = summed;
                 let mut found = found.into_iter();
                 if let Some((_, expected)) = rom {
                     fingerprint::check_whole(profile, expected, found.next().unwrap_or(0))?;
@@ -532,7 +544,8 @@ pub fn upload_keeping<T: Transport>(
                         fingerprint::check_jump_table(client, &profile)?;
                     }
                 }
-                kept_file = keep_summed(client, profile, kept.take(), &todo, &image, keep)?;
+                kept_file =
+                    keep_summed(client, profile, kept.take(), (&todo, &known), &image, keep)?;
                 let todo = delta::merged(&todo);
                 written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
                 (rewrites, passes) =
@@ -731,7 +744,7 @@ fn keep_summed<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     kept: Option<Backup>,
-    held: &[delta::Held],
+    (held, known): (&[delta::Held], &[(crate::sums::Range, u16)]),
     image: &UploadImage,
     keep: &mut dyn Keep,
 ) -> Result<Option<Backup>> {
@@ -759,16 +772,28 @@ fn keep_summed<T: Transport>(
         });
     }
     // The code the kept hooks go back to, summed on the robot (the loader's
-    // `sums` is hooked here): an undo checks it is still there.
+    // `sums` is hooked here): an undo checks it is still there. Nothing is
+    // written yet, so a range the sums asked already tile is put together
+    // from their answers; only the rest is asked.
     let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
-    let sums = crate::sums::robot_sums(client, &ranges)?;
+    let joined: Vec<Option<u16>> = ranges
+        .iter()
+        .map(|&range| crate::sums::joined_from(known, range))
+        .collect();
+    let unknown: Vec<crate::sums::Range> = ranges
+        .iter()
+        .zip(&joined)
+        .filter(|(_, sum)| sum.is_none())
+        .map(|(range, _)| *range)
+        .collect();
+    let mut asked = crate::sums::robot_sums(client, &unknown)?.into_iter();
     kept.witnesses = ranges
         .iter()
-        .zip(sums)
+        .zip(joined)
         .map(|(&(address, len), sum)| crate::backup::Witness {
             address,
             len: len as u16,
-            sum,
+            sum: sum.or_else(|| asked.next()).unwrap_or(0),
         })
         .collect();
     keep.keep(&kept);
