@@ -39,6 +39,9 @@ fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
 /// A range's index and the robot's sum of it.
 type Differs = (usize, u16);
 
+/// Ranges with the robot's sums of them.
+pub(crate) type Known = Vec<(Range, u16)>;
+
 /// The ranges of `ranges` whose robot sum differs from the host's, the
 /// robot's sums of `first` (asked first, in the same batch), and every
 /// range asked with the robot's sum of it.
@@ -46,7 +49,7 @@ fn differ<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     ranges: &[(Range, &[u8])],
-) -> Result<(Vec<Differs>, Vec<u16>, Vec<(Range, u16)>)> {
+) -> Result<(Vec<Differs>, Vec<u16>, Known)> {
     let mut asked: Vec<Range> = first.to_vec();
     asked.extend(ranges.iter().map(|(range, _)| *range));
     let mut found = robot_sums(client, &asked)?;
@@ -74,7 +77,7 @@ pub(crate) struct Summed {
     pub first: Vec<u16>,
     /// Every range asked, with the robot's sum of it: what a later sum
     /// of the same memory, still unwritten, can be put together from.
-    pub known: Vec<(Range, u16)>,
+    pub known: Known,
 }
 
 /// The ranges of `image` the robot does not hold, merged where they
