@@ -27,6 +27,13 @@ pub enum ScriptError {
         help: Option<String>,
     },
 
+    /// A mistake at a place in a world file (docs/WORLD.md): a TOML
+    /// mistake, an unknown key, a value out of range, a shape that cannot
+    /// be.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    World(Box<WorldMistake>),
+
     /// The script file cannot be read.
     #[error("cannot read the script {file}: {message}")]
     #[diagnostic(code(cards::read))]
@@ -60,6 +67,30 @@ pub struct Located {
     /// What to do about it, where that is clear.
     #[help]
     pub help: Option<String>,
+}
+
+/// A [`Located`] failure in a world file rather than a script: the same
+/// place, line and caret, under its own code (`cards::world`).
+#[derive(Debug, thiserror::Error)]
+#[error(transparent)]
+pub struct WorldMistake(pub Located);
+
+impl miette::Diagnostic for WorldMistake {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        Some(Box::new("cards::world"))
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.0.help()
+    }
+
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        self.0.source_code()
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        self.0.labels()
+    }
 }
 
 /// The byte offset of `line:column` (both from 1, the column in

@@ -34,7 +34,7 @@ mod world;
 
 pub use card::ScriptCard;
 pub use clock::{CALL_COST, OPERATIONS_PER_MICROSECOND};
-pub use error::{Located, ScriptError};
+pub use error::{Located, ScriptError, WorldMistake};
 pub use printed::{MAX_PRINTED_BYTES, MAX_PRINTED_LINES, Printed};
 pub use room::{Room, RoomView};
 pub use sandbox::{MAX_FUNCTIONS, MAX_VARIABLES, OPERATION_BUDGET};

@@ -9,7 +9,7 @@ use toml::Spanned;
 use super::drive::{Drive, Pose};
 use super::geometry::{PI, Point, Shape, inside_polygon, segment_distance2};
 use super::live;
-use crate::error::{Located, ScriptError, offset_of};
+use crate::error::{Located, ScriptError, WorldMistake, offset_of};
 
 /// A floor line the ground trackers see.
 #[derive(Debug, Clone, PartialEq)]
@@ -178,8 +178,19 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
         located(name, text, span, message, help)
     };
     let file: WorldFile = toml::from_str(text).map_err(|error| {
+        let span = error.span().unwrap_or(0..0);
+        // An integer past i64 reaches serde as an i128 no f64 field
+        // takes: the parser's words name types the user never wrote.
+        if error.message().contains("as i128") {
+            let written = text.get(span.clone()).unwrap_or("").trim();
+            return at(
+                span,
+                format!("{written} is out of range: no setting of a world file is that large"),
+                "coordinates are centimetres, at most 100000 (1 km) either way; docs/WORLD.md gives every setting's range",
+            );
+        }
         at(
-            error.span().unwrap_or(0..0),
+            span,
             error.message().trim().to_owned(),
             "docs/WORLD.md lists the keys of a world file",
         )
@@ -232,6 +243,26 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
     };
     let polygon = |spanned: &PointsFile, what: &str| {
         let corners = points(spanned, 3, what)?;
+        // Two corners at one place make an edge of no length, which every
+        // other edge would be said to cross.
+        let all_at_one = corners.iter().all(|corner| *corner == corners[0]);
+        if let Some(i) = (0..corners.len())
+            .find(|&i| !all_at_one && corners[i] == corners[(i + 1) % corners.len()])
+        {
+            let next = (i + 1) % corners.len();
+            return Err(at(
+                spanned.span(),
+                format!(
+                    "{what}: edge {} has no length: corners {} and {} are both at [{}, {}]",
+                    i + 1,
+                    i + 1,
+                    next + 1,
+                    corners[i].x,
+                    corners[i].y
+                ),
+                "give each corner once (the last corner joins the first by itself)",
+            ));
+        }
         if let Some((first, second)) = crossing_edges(&corners) {
             let edge = |i: usize| {
                 let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
@@ -240,7 +271,7 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
             return Err(at(
                 spanned.span(),
                 format!(
-                    "{what} crosses itself: edges {} and {} cross",
+                    "{what}: edges {} and {} cross (the outline crosses itself)",
                     edge(first),
                     edge(second)
                 ),
@@ -703,7 +734,7 @@ fn located(
         .end
         .saturating_sub(span.start)
         .max(usize::from(start < text.len()));
-    ScriptError::Script(Box::new(Located {
+    ScriptError::World(Box::new(WorldMistake(Located {
         file: name.to_owned(),
         line,
         column,
@@ -711,12 +742,26 @@ fn located(
         source_code: miette::NamedSource::new(name, text.to_owned()),
         at: miette::SourceSpan::from((start, len.min(text.len() - start))),
         help: Some(help.to_owned()),
-    }))
+    })))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A world file's mistake is no script's: its own code, its place.
+    #[test]
+    fn a_world_files_mistake_has_its_own_code() {
+        use miette::Diagnostic;
+        let error = parse("world.toml", "walls = [[0, 0], [1, 1]]\n").expect_err("refused");
+        let code = error.code().map(|code| code.to_string());
+        assert_eq!(code.as_deref(), Some("cards::world"), "{error}");
+        assert!(
+            error.help().is_some() && error.labels().is_some(),
+            "{error:?}"
+        );
+        assert!(error.to_string().starts_with("world.toml:1:9: "), "{error}");
+    }
 
     /// A world file's mistakes, each with the error it must give.
     #[test]
