@@ -95,6 +95,44 @@ pub fn svg(layout: &Layout, trail: &Trail, commands: &[(u64, String)]) -> String
     // still through several seconds, commands sent together), and a
     // label that would cover one laid before goes below it.
     let mut labels = Labels::default();
+    // Nor does a label cover the robot where it ends or an obstacle: their
+    // boxes are taken before any label is laid (the walls and the trail
+    // run through everything, and are not).
+    let flip = |y: f64| max_y + min_y - y;
+    let last = trail.poses.last().map_or(layout.start, |&(_, pose)| pose);
+    let reach = layout.body.radius;
+    labels.blocked.push([
+        last.at.x - reach,
+        flip(last.at.y) - reach,
+        last.at.x + reach,
+        flip(last.at.y) + reach,
+    ]);
+    for shape in &layout.obstacles {
+        labels.blocked.push(match shape {
+            Shape::Circle { centre, radius } => [
+                centre.x - radius,
+                flip(centre.y) - radius,
+                centre.x + radius,
+                flip(centre.y) + radius,
+            ],
+            Shape::Polygon(corners) => corners.iter().fold(
+                [
+                    f64::INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::NEG_INFINITY,
+                ],
+                |b, p| {
+                    [
+                        b[0].min(p.x),
+                        b[1].min(flip(p.y)),
+                        b[2].max(p.x),
+                        b[3].max(flip(p.y)),
+                    ]
+                },
+            ),
+        });
+    }
     let end = trail.poses.last().map_or(0, |&(at, _)| at);
     let mut times: Vec<(String, Vec<u64>)> = Vec::new();
     let mut mark = MARK_EVERY;
@@ -161,7 +199,6 @@ pub fn svg(layout: &Layout, trail: &Trail, commands: &[(u64, String)]) -> String
             LabelSide::Below,
         );
     }
-    let last = trail.poses.last().map_or(layout.start, |&(_, pose)| pose);
     robot(&mut out, layout, last, &at);
     out.push_str("</svg>\n");
     // The view box holds the room and every label (a label laid below
@@ -288,10 +325,14 @@ enum LabelSide {
 }
 
 /// The labels laid so far (their boxes: left, top, right, bottom in the
-/// picture's units), so that each new one is laid clear of them.
+/// picture's units), so that each new one is laid clear of them and of
+/// what else it must not cover.
 #[derive(Debug, Default)]
 struct Labels {
     boxes: Vec<[f64; 4]>,
+    /// Boxes of what is drawn besides labels and must stay readable (the
+    /// robot, obstacles).
+    blocked: Vec<[f64; 4]>,
 }
 
 impl Labels {
@@ -353,6 +394,7 @@ impl Labels {
             let covered = self
                 .boxes
                 .iter()
+                .chain(&self.blocked)
                 .filter(|b| left < b[2] && b[0] < right && top < b[3] && b[1] < bottom)
                 .map(|b| b[3])
                 .fold(f64::NEG_INFINITY, f64::max);
@@ -575,6 +617,55 @@ mod tests {
                         && b[3] <= inside[3],
                     "`{text}` {b:?} outside the view box {inside:?}"
                 );
+            }
+        }
+    }
+
+    /// The new user's finding: labels were laid clear of each other only,
+    /// and crossed the robot's outline and the obstacles. A robot that
+    /// drives up to a post, is bumped and stands there, commands sent at
+    /// every stage.
+    #[test]
+    fn no_label_covers_the_robot_or_an_obstacle() {
+        let room = "walls = [[0, 0], [300, 0], [300, 200], [0, 200]]\n\
+            [[obstacle]]\ncircle = { x = 148, y = 100, radius = 8 }\n\
+            [[obstacle]]\npolygon = [[100, 120], [130, 120], [130, 140], [100, 140]]\n\
+            [robot]\nx = 100\ny = 100\n";
+        let layout = parse("room.toml", room).expect("the room");
+        let mut trail = Trail::default();
+        for ms in 0..=3000u64 {
+            #[allow(clippy::cast_precision_loss, reason = "a test")]
+            trail
+                .poses
+                .push((ms * 1000, pose(100.0 + (ms.min(1500) as f64) / 60.0)));
+        }
+        trail.bumps.push((1_500_000, 0x01));
+        let commands: Vec<(u64, String)> = (0..12u64)
+            .map(|i| (i * 250_000, format!("/1P {i}")))
+            .collect();
+        let svg = svg(&layout, &trail, &commands);
+        let last = trail.poses.last().expect("a pose").1.at;
+        let [x0, y0, x1, y1] = view_box(&svg);
+        let flip = |y: f64| (y0 + y1) - y;
+        let _ = x0 + x1;
+        let r = layout.body.radius;
+        let drawn: Vec<([f64; 4], &str)> = vec![
+            (
+                [last.x - r, flip(last.y) - r, last.x + r, flip(last.y) + r],
+                "the robot",
+            ),
+            (
+                [140.0, flip(100.0) - 8.0, 156.0, flip(100.0) + 8.0],
+                "the post",
+            ),
+            ([100.0, flip(140.0), 130.0, flip(120.0)], "the box"),
+        ];
+        let labels = boxes(&svg);
+        assert!(labels.len() >= 8, "{svg}");
+        for (a, text) in &labels {
+            for (b, what) in &drawn {
+                let apart = a[2] <= b[0] || b[2] <= a[0] || a[3] <= b[1] || b[3] <= a[1];
+                assert!(apart, "`{text}` {a:?} covers {what} {b:?}:\n{svg}");
             }
         }
     }
