@@ -390,15 +390,8 @@ fn an_image_launched_runs_to_a_breakpoint_by_line() {
 #[test]
 fn a_breakpoint_on_a_line_that_calls_a_built_in_macro_stops_there() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let made = crate::scorpion(dir.path(), &["new", "myext"]);
-    assert!(made.status.success(), "{}", crate::transcript(&made));
-    let project = dir.path().join("myext");
-    let text = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
-    let chain = text
-        .lines()
-        .position(|l| l.trim() == "SCORPION_CHAIN_UNKNOWN")
-        .expect("the chain line")
-        + 1;
+    let (project, text) = crate::new_project(dir.path());
+    let chain = crate::lines_with(&text, "SCORPION_CHAIN_UNKNOWN")[0];
     let mut c = Client::start();
     c.request("initialize", json!({"adapterID": "scorpion"}));
     let launch = c.request(

@@ -87,15 +87,8 @@ fn a_robot_that_breaks_fails_the_session() {
 #[test]
 fn a_line_that_calls_a_built_in_macro_takes_a_breakpoint() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let made = scorpion(dir.path(), &["new", "myext"]);
-    assert!(made.status.success(), "{}", transcript(&made));
-    let project = dir.path().join("myext");
-    let text = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
-    let chain = text
-        .lines()
-        .position(|l| l.trim() == "SCORPION_CHAIN_UNKNOWN")
-        .expect("the chain line")
-        + 1;
+    let (project, text) = crate::new_project(dir.path());
+    let chain = crate::lines_with(&text, "SCORPION_CHAIN_UNKNOWN")[0];
     let output = scorpion_with_input(
         Some(&project),
         &["debug"],

@@ -61,6 +61,25 @@ pub(crate) fn build_example(dir: &std::path::Path, source: &str, output: &str, e
     assert!(built.status.success(), "{}", transcript(&built));
 }
 
+/// `scorpion new myext` in `dir`: the project's directory and its
+/// `src/myext.s`.
+pub(crate) fn new_project(dir: &std::path::Path) -> (std::path::PathBuf, String) {
+    let made = scorpion(dir, &["new", "myext"]);
+    assert!(made.status.success(), "{}", transcript(&made));
+    let project = dir.join("myext");
+    let source = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    (project, source)
+}
+
+/// The numbers (from 1) of the lines of `text` that contain `what`.
+pub(crate) fn lines_with(text: &str, what: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| line.contains(what))
+        .map(|(index, _)| index + 1)
+        .collect()
+}
+
 /// Exit code, stdout and stderr as one text, for snapshots.
 pub(crate) fn transcript(output: &Output) -> String {
     format!(

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::{scorpion, transcript};
+use crate::{lines_with, scorpion, transcript};
 
 fn example(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -140,14 +140,6 @@ fn copy_dir(from: &Path, to: &Path) {
 }
 
 /// The 1-based numbers of the lines of `text` that contain `what`.
-fn lines_with(text: &str, what: &str) -> Vec<usize> {
-    text.lines()
-        .enumerate()
-        .filter(|(_, line)| line.contains(what))
-        .map(|(index, _)| index + 1)
-        .collect()
-}
-
 fn stdout(output: &std::process::Output) -> String {
     String::from_utf8_lossy(&output.stdout).into_owned()
 }
@@ -162,10 +154,7 @@ fn stdout(output: &std::process::Output) -> String {
 #[test]
 fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let created = scorpion(dir.path(), &["new", "myext"]);
-    assert!(created.status.success(), "{}", transcript(&created));
-    let project = dir.path().join("myext");
-    let source = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let (project, source) = crate::new_project(dir.path());
     let branches = lines_with(&source, "bne not_mine");
     assert_eq!(branches.len(), 2, "{source}");
 
@@ -255,10 +244,7 @@ fn a_branch_never_taken_is_named_until_a_transcript_takes_it() {
 #[test]
 fn a_built_in_macros_cycles_are_the_calling_lines() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let created = scorpion(dir.path(), &["new", "myext"]);
-    assert!(created.status.success(), "{}", transcript(&created));
-    let project = dir.path().join("myext");
-    let source = std::fs::read_to_string(project.join("src/myext.s")).expect("the source");
+    let (project, source) = crate::new_project(dir.path());
     let chain = lines_with(&source, "SCORPION_CHAIN_UNKNOWN");
     assert_eq!(chain.len(), 1, "{source}");
     let expect = project.join("tests/myext.expect");

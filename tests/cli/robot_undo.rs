@@ -52,6 +52,20 @@ fn ok(dir: &std::path::Path, line: &[&str], args: &[&str]) -> String {
     text
 }
 
+/// A pty robot at 19200 baud with two extensions uploaded in `dir`, one
+/// after the other: `first.elf` (200 bytes at $0C00), then `ext.elf`
+/// (`len` bytes at $0400), which chains to the first.
+fn two_installed(dir: &std::path::Path, len: usize) -> Sim {
+    let first = extension_at(0x0C00, 200, None);
+    std::fs::write(dir.join("first.elf"), first).expect("the image");
+    std::fs::write(dir.join("ext.elf"), extension_at(0x0400, len, None)).expect("the image");
+    let sim = Sim::start(dir, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(dir, &line, &["upload", "first.elf", "--no-dry-run"]);
+    ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    sim
+}
+
 /// F4': the undo file's witness covered the extension's BSS, so an undo
 /// was refused once the new image had run. It covers code alone now: the
 /// undo works after `/1Q` changed the count, and the robot answers as
@@ -180,17 +194,9 @@ fn restore_force_onto_another_rom_goes_through_and_says_what_it_overrides() {
 #[test]
 fn a_second_identical_upload_beside_another_extension_writes_nothing() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    std::fs::write(
-        dir.path().join("other.elf"),
-        extension_at(0x0C00, 200, None),
-    )
-    .expect("the image");
-    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 700, None)).expect("the image");
-    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let sim = two_installed(dir.path(), 700);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
     let d = dir.path();
-    ok(d, &line, &["upload", "other.elf", "--no-dry-run"]);
-    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
     let text = ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
     assert!(text.contains("0 bytes written in 0 ranges"), "{text}");
     assert!(text.contains("through the RAM loader"), "{text}");
@@ -317,17 +323,9 @@ fn an_undo_file_whose_hook_goes_to_memory_it_neither_holds_nor_witnesses_is_refu
 #[test]
 fn the_undo_of_a_chained_extension_goes_back_to_the_first() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    std::fs::write(
-        dir.path().join("first.elf"),
-        extension_at(0x0C00, 200, None),
-    )
-    .expect("the image");
-    std::fs::write(dir.path().join("ext.elf"), extension_at(0x0400, 300, None)).expect("the image");
-    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let sim = two_installed(dir.path(), 300);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
     let d = dir.path();
-    ok(d, &line, &["upload", "first.elf", "--no-dry-run"]);
-    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
     let kept = std::fs::read(d.join("scorpion-last-upload.undo")).expect("the undo file");
     let kept = uploader::Backup::decode("kept", &kept).expect("it reads");
     assert!(
