@@ -30,9 +30,36 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             uploader::chain_of(&mut client, &profile, &everyone, kind)?,
         ));
     }
+    let mut text = listing(&everyone, &chains);
+    // A chain that ends at no extension's handler may end at a debug stub
+    // a killed session left: the user must hear of it here, before an
+    // upload refuses it.
+    for (kind, targets) in &chains {
+        let Some(&last) = targets.last() else {
+            continue;
+        };
+        let owned = everyone
+            .iter()
+            .flat_map(|image| image.hooks.iter())
+            .any(|hook| hook.kind == *kind && hook.handler == last);
+        if owned || profile.reset_target(*kind) == Some(last) {
+            continue;
+        }
+        if let Some(stub) = uploader::stub::left::at_target(&mut client, &profile, last)? {
+            let _ = writeln!(
+                text,
+                "{}: ${last:04X} is a debug stub left hooked at ${:04X}-${:04X} (chaining to ${:04X}): a debug session did not detach, and its breakpoints may still be in the code\n  to take it out: `scorpion debug --port {} --image ELF` (the image it debugged), then `quit`; or reset the robot",
+                kind.rom_symbol(),
+                stub.address,
+                stub.code_end.wrapping_sub(1),
+                stub.previous,
+                client.transport().name(),
+            );
+        }
+    }
     std::io::stdout()
         .lock()
-        .write_all(listing(&everyone, &chains).as_bytes())
+        .write_all(text.as_bytes())
         .into_diagnostic()?;
     Ok(ExitCode::SUCCESS)
 }

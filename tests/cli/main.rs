@@ -23,6 +23,7 @@ mod read;
 mod robot;
 mod robot_dap;
 mod robot_debug;
+mod robot_left_stub;
 mod robot_recovery;
 mod robot_undo;
 mod room_path;
