@@ -51,7 +51,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 "{}: ${last:04X} is a debug stub left hooked at ${:04X}-${:04X} (chaining to ${:04X}): a debug session did not detach, and its breakpoints may still be in the code\n  to take it out: `scorpion debug --port {} --image ELF` (the image it debugged), then `quit`; or reset the robot",
                 kind.rom_symbol(),
                 stub.address,
-                stub.code_end.wrapping_sub(1),
+                stub.end,
                 stub.previous,
                 client.transport().name(),
             );

@@ -32,11 +32,13 @@ fn ask_at_a_robot_stopped_in_a_left_stub_says_so() {
 
 /// F5: a monitor killed while the robot runs leaves its stub hooked;
 /// `installed` names it (its range, what it chains to, as the upload's
-/// refusal gives them) and what to run.
+/// refusal gives them) and what to run; the range is the one the session
+/// gave when it attached (two sizes were given before: code alone, and
+/// code with its data).
 #[test]
 fn installed_names_a_stub_a_killed_monitor_left_hooked() {
     let (dir, sim) = readme_handler_on_a_pty_robot();
-    killed_monitor(dir.path(), &sim, "break show\n", "breakpoint 1:");
+    let attached = killed_monitor(dir.path(), &sim, "break show\n", "breakpoint 1:");
     let output = scorpion(dir.path(), &["installed", "--port", &sim.path]);
     let printed = transcript(&output);
     assert!(output.status.success(), "{printed}");
@@ -54,6 +56,11 @@ fn installed_names_a_stub_a_killed_monitor_left_hooked() {
     let said = printed.split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(said.contains("debug stub left hooked at"), "{printed}");
     assert!(said.contains(range), "{range}: {printed}");
+    // One size for the stub: the session that left it gave the same.
+    assert!(
+        attached.contains(&format!("the stub at {range},")),
+        "{range}: {attached}"
+    );
     assert!(
         said.contains(&format!("scorpion debug --port {}", sim.path)),
         "{printed}"

@@ -23,6 +23,8 @@ pub struct LeftStub {
     pub handler: u16,
     /// The end of its code (exclusive).
     pub code_end: u16,
+    /// Its last byte, data included: the extent every message gives.
+    pub end: u16,
     /// What it chains to.
     pub previous: u16,
 }
@@ -49,7 +51,7 @@ pub fn at_target<T: Transport>(
     let Some(address) = target.checked_sub(offset) else {
         return Ok(None);
     };
-    let Some((pattern, handler)) = left_pattern(profile, address) else {
+    let Some((pattern, handler, whole)) = left_pattern(profile, address) else {
         return Ok(None);
     };
     let matches = |found: &[u8], expected: &[Option<u8>]| {
@@ -74,6 +76,7 @@ pub fn at_target<T: Transport>(
         address,
         handler,
         code_end: address.wrapping_add(pattern.len() as u16),
+        end: address.wrapping_add(whole as u16).wrapping_sub(1),
         previous,
     }))
 }
@@ -101,7 +104,7 @@ pub(crate) fn refuse_hooked<T: Transport>(
                 port: client.transport().name(),
                 hook: kind.rom_symbol(),
                 stub: stub.address,
-                end: stub.code_end.wrapping_sub(1),
+                end: stub.end,
                 previous: stub.previous,
             });
         }

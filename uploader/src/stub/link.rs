@@ -231,9 +231,13 @@ fn free_zero_page(
 /// `profile`, a byte `None` where it depends on what else it was linked
 /// with (its zero page, the target it chains to), and its handler's
 /// address: what the robot holds at `address` when a session left its
-/// stub there. `None` when no stub links there (the profile lacks the
-/// ROM's services, the address is out of reach).
-pub(crate) fn left_pattern(profile: &RomProfile, address: u16) -> Option<(Vec<Option<u8>>, u16)> {
+/// stub there, and its whole length (code and data: what a session's
+/// messages give as its extent). `None` when no stub links there (the
+/// profile lacks the ROM's services, the address is out of reach).
+pub(crate) fn left_pattern(
+    profile: &RomProfile,
+    address: u16,
+) -> Option<(Vec<Option<u8>>, u16, usize)> {
     let services = profile.loader_services?;
     // Two links that differ in every byte of the zero page and the chain.
     let (one, linked) = link(address, services, 0x10, 0x1234).ok()?;
@@ -246,13 +250,13 @@ pub(crate) fn left_pattern(profile: &RomProfile, address: u16) -> Option<(Vec<Op
         .zip(&two[..len])
         .map(|(&a, &b)| (a == b).then_some(a))
         .collect();
-    Some((pattern, handler))
+    Some((pattern, handler, one.len()))
 }
 
 /// Where the stub's handler lies from its start (the same wherever it is
 /// linked).
 pub(crate) fn handler_offset(profile: &RomProfile) -> Option<u16> {
     let start = *profile.user_ram.start();
-    let (_, handler) = left_pattern(profile, start)?;
+    let (_, handler, _) = left_pattern(profile, start)?;
     handler.checked_sub(start)
 }
