@@ -13,8 +13,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::mpsc::{RecvTimeoutError, channel};
 use std::time::Duration;
 
-use common::stub::attach;
-use isa::objfmt::{HookKind, HookRecord};
+use common::stub::{attach, hooked_at_0400};
 use uploader::stub::{Reply, StubError};
 use uploader::{Area, UploadImage};
 
@@ -41,18 +40,7 @@ fn handler(letter: u8, code: &[u8]) -> UploadImage {
     let mut bytes = vec![0x4C, 0x21, 0xFF, 0xC9, letter, 0xD0, 0xF9];
     bytes.extend_from_slice(code);
     bytes.resize(0x81, 0xEA);
-    UploadImage::new(
-        vec![Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0403,
-            chain: Some(0x0401),
-        }],
-    )
-    .expect("an image")
+    hooked_at_0400(bytes)
 }
 
 /// `/1U` answers 09 + 01 added in decimal, `10`:

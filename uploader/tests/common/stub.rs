@@ -29,6 +29,13 @@ pub(crate) fn handler() -> UploadImage {
     ];
     bytes.resize(0x81, 0xEA);
     bytes[0x80] = 0x42;
+    hooked_at_0400(bytes)
+}
+
+/// `bytes` as one area at $0400 hooked on HOOK_UNKNOWN, the handler at
+/// $0403 and the chain slot at $0401 (the `JMP` at $0400), the layout
+/// every stub test's handler has.
+pub(crate) fn hooked_at_0400(bytes: Vec<u8>) -> UploadImage {
     UploadImage::new(
         vec![Area {
             address: 0x0400,
