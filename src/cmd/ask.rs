@@ -99,7 +99,10 @@ impl Robot {
                 if raw.is_empty() {
                     return Ok(None);
                 }
-                if stopped_in_stub(&raw) {
+                // A robot a killed debug session left at a breakpoint
+                // answers every line with the stub's stop frame: calling
+                // that a garbled answer would send the user after the cable.
+                if uploader::stopped_in_stub(&raw) {
                     return Err(uploader::Error::StoppedInDebugStub {
                         port: transport.name(),
                     }
@@ -109,15 +112,6 @@ impl Robot {
             }
         }
     }
-}
-
-/// Whether `raw` holds the debug stub's stop frame (its start, the
-/// length 8 and `S`, docs/PROTOCOL.md section 5): a robot a killed debug
-/// session left at a breakpoint answers every line with it, and calling
-/// that a garbled answer sends the user after the cable.
-fn stopped_in_stub(raw: &[u8]) -> bool {
-    raw.windows(3)
-        .any(|three| three == [uploader::stub::frame::SOF_OUT, 8, b'S'])
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {

@@ -740,8 +740,10 @@ pub(crate) fn pieces(address: u16, len: usize, size: u8) -> impl Iterator<Item =
 
 /// Whether `heard` holds the debug stub's stop frame: its start, the
 /// length 8 and `S` (docs/PROTOCOL.md, section 5), which no answer of
-/// the ROM's has (its answers are printable ASCII).
-fn stopped_in_stub(heard: &[u8]) -> bool {
+/// the ROM's has (its answers are printable ASCII). Public for what hears
+/// the line without a [`Client`] (`scorpion ask`'s extension commands).
+#[must_use]
+pub fn stopped_in_stub(heard: &[u8]) -> bool {
     heard
         .windows(3)
         .any(|three| three == [crate::stub::frame::SOF_OUT, 8, b'S'])

@@ -43,7 +43,7 @@ pub mod transport;
 mod upload;
 
 pub use backup::{Backup, Keep, MAGIC, NoKeep, Witness, backup, backup_ranges, restore};
-pub use client::{Client, ClientConfig, ClientStats};
+pub use client::{Client, ClientConfig, ClientStats, stopped_in_stub};
 pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, human_duration};
 pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};

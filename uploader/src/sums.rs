@@ -70,12 +70,11 @@ pub(crate) fn joined_from(known: &[(Range, u16)], (address, len): Range) -> Opti
     let mut sum = fletcher16(&[]);
     while at < end {
         // The longest known range starting here that stays inside.
-        let (&(_, part_len), &part) = known
+        let &((_, part_len), part) = known
             .iter()
             .filter(|((start, part_len), _)| {
                 usize::from(*start) == at && *part_len > 0 && at + part_len <= end
             })
-            .map(|(range, sum)| (range, sum))
             .max_by_key(|((_, part_len), _)| *part_len)?;
         sum = fletcher16_joined(sum, part, part_len);
         at += part_len;
