@@ -127,6 +127,12 @@ impl Installed {
         }
     }
 
+    /// Whether `address` is in memory it owns.
+    #[must_use]
+    pub fn contains(&self, address: u16) -> bool {
+        self.extents.iter().any(|extent| extent.contains(&address))
+    }
+
     /// Table entries needed.
     #[must_use]
     pub fn entries(&self) -> usize {

@@ -68,10 +68,8 @@ pub(crate) fn check<T: Transport>(
             if at_reset(kind, target) {
                 break;
             }
-            let is_loader = leftover.is_some_and(|loader| {
-                kind == HookKind::Unknown
-                    && [loader.sums, loader.frames, loader.rate].contains(&target)
-            });
+            let is_loader =
+                leftover.is_some_and(|loader| loader.left_hooked(kind, target, &others));
             let next = if is_loader {
                 profile.reset_target(kind)
             } else if image.contains(target) {
@@ -87,10 +85,7 @@ pub(crate) fn check<T: Transport>(
                         .or(profile.reset_target(kind)),
                     None => profile.reset_target(kind),
                 }
-            } else if let Some(old) = replaced
-                .iter()
-                .find(|old| old.extents.iter().any(|extent| extent.contains(&target)))
-            {
+            } else if let Some(old) = replaced.iter().find(|old| old.contains(target)) {
                 match old.hooks.iter().find(|hook| hook.kind == kind) {
                     Some(hook) => match hook.chain {
                         Some(slot) => read_word(client, slot)?,

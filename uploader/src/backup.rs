@@ -440,7 +440,7 @@ fn hooked_extents(
         .map(|&(_, target)| {
             let extents = installed
                 .iter()
-                .filter(|entry| entry.extents.iter().any(|extent| extent.contains(&target)))
+                .filter(|entry| entry.contains(target))
                 .flat_map(|entry| entry.extents.iter().cloned())
                 .collect();
             (target, extents)

@@ -51,10 +51,7 @@ pub(crate) fn refusal<T: Transport>(
                 ended = true;
                 break;
             }
-            let Some(owner) = others
-                .iter()
-                .find(|other| other.extents.iter().any(|extent| extent.contains(&target)))
-            else {
+            let Some(owner) = others.iter().find(|other| other.contains(target)) else {
                 return Ok(Some(format!(
                     "{} leads to ${target:04X}, code no entry of the table of installed extensions names (its extent is unknown): the loader could overwrite it",
                     kind.rom_symbol()

@@ -27,6 +27,8 @@ use isa::objfmt::HookKind;
 use linker::{Image, ImageSymbol};
 use platform::{acia, map};
 
+use romlib::installed::Installed;
+
 use crate::image::{Area, RomProfile, Services, UploadImage};
 use crate::transport::char_time;
 use crate::{Error, Result};
@@ -210,6 +212,17 @@ impl Loader {
     /// Whether `address` is in the loader.
     pub(crate) fn contains(&self, address: u16) -> bool {
         self.image.contains(address)
+    }
+
+    /// Whether a hook of `kind` at `target` is this loader left hooked by
+    /// an upload that failed: one of its entries, and in no extension the
+    /// table lists (`installed`), since the loader is never placed over
+    /// one: an extension that happens to start where an entry would be
+    /// is that extension.
+    pub(crate) fn left_hooked(&self, kind: HookKind, target: u16, installed: &[Installed]) -> bool {
+        kind == HookKind::Unknown
+            && [self.sums, self.frames, self.rate].contains(&target)
+            && !installed.iter().any(|other| other.contains(target))
     }
 
     /// Whether the loader's code or zero page meets `extent` (an installed

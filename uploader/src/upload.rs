@@ -364,12 +364,13 @@ pub fn upload_keeping<T: Transport>(
     if options.replace {
         hooks_now = read_hooks(client, profile)?;
     }
+    let others = plan.as_ref().map_or(&[][..], |plan| plan.others.as_slice());
     let mut initial = Vec::new();
     for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
-        let loader = leftover.as_ref().filter(|loader| {
-            kind == HookKind::Unknown && [loader.sums, loader.frames, loader.rate].contains(&target)
-        });
+        let loader = leftover
+            .as_ref()
+            .filter(|loader| loader.left_hooked(kind, target, others));
         if image.contains(target) || loader.is_some() {
             // An earlier copy of this image, probably: the hook goes back
             // to where that fell through (its chain slot), so the chain
@@ -386,7 +387,9 @@ pub fn upload_keeping<T: Transport>(
             };
             let fallthrough = match slot {
                 Some(slot) => read_word(client, slot)?.filter(|&to| {
-                    !image.contains(to) && leftover.as_ref().is_none_or(|l| !l.contains(to))
+                    !image.contains(to)
+                        && (others.iter().any(|other| other.contains(to))
+                            || leftover.as_ref().is_none_or(|l| !l.contains(to)))
                 }),
                 None => None,
             };

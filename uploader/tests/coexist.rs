@@ -220,3 +220,31 @@ proptest! {
         }
     }
 }
+
+/// Found by the property test below in CI: an extension installed where
+/// the next upload's RAM loader would have one of its entries was taken
+/// for that loader left hooked by a failed upload, and the hook went back
+/// to the ROM: the new extension's chain skipped it and it stopped
+/// answering.
+#[test]
+fn an_extension_where_a_loader_entry_would_be_stays_in_the_chain() {
+    let next = answering(0x0400, 22, b'H');
+    let options = options(false);
+    let rates = (9600, options.fast_baud.unwrap_or(9600));
+    let plan = uploader::loader_plan(&options.profile, &next, rates)
+        .expect("the loader links")
+        .expect("the Scorpion's ROM has a loader");
+    for entry in [plan.rate_handler, plan.frames_handler, plan.sums_handler] {
+        let (result, transport) = run(robot(), &answering(entry, 22, b'A'), &options);
+        result.expect("the first goes in");
+        let (result, transport) = run(transport, &next, &options);
+        result.expect("the second goes in beside it");
+        let memory = transport.robot().robot().board().memory();
+        assert_eq!(word(memory, HOOK_UNKNOWN + 1), 0x0400);
+        assert_eq!(word(memory, 0x0400 + 20), entry, "chained to the first");
+        let (answer, transport) = ask(transport, b'H');
+        assert_eq!(answer.as_deref(), Some("H"));
+        let (answer, _) = ask(transport, b'A');
+        assert_eq!(answer.as_deref(), Some("A"), "the first at ${entry:04X}");
+    }
+}
