@@ -62,7 +62,7 @@ const SLASH: u8 = b'/';
 
 /// The user zero page the loader keeps its state in (`LZP` in
 /// `loader.s`): the key, two sums, the five header bytes.
-const ZERO_PAGE_LEN: u8 = 8;
+pub(crate) const ZERO_PAGE_LEN: u8 = 8;
 
 /// The 6551's control register (`ACIA_CTRL` in the ROM's `hardware.inc`).
 pub(crate) const ACIA_CONTROL: u16 = map::ACIA + acia::reg::CONTROL;
@@ -90,7 +90,7 @@ pub(crate) struct Loader {
     /// is in (it falls into `frames`, which falls into `rate`).
     pub(crate) sums: u16,
     /// The first of its zero-page bytes.
-    zero_page: u8,
+    pub(crate) zero_page: u8,
 }
 
 /// Where the RAM loader goes for an upload, and what it is: for tests

@@ -20,8 +20,8 @@ use romlib::protocol::{Answer, Command, Extension, ReadSpan};
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::client::Client;
 use crate::hooks::{read_hook, switch_hook};
-use crate::image::{RomProfile, UploadImage};
-use crate::loader::{Loader, rate_toggle};
+use crate::image::{Area, RomProfile, UploadImage};
+use crate::loader::{Loader, ZERO_PAGE_LEN, rate_toggle};
 use crate::progress::{Event, NoProgress, Phase, Progress};
 use crate::summed::{Summed, write_summed};
 use crate::transport::{Transport, char_time};
@@ -67,6 +67,13 @@ pub(crate) struct Session {
     pub(crate) maybe_resident: bool,
     /// Times the loader was restored.
     pub(crate) recoveries: u32,
+    /// Whether what the loader overwrites is read first (for an undo).
+    pub(crate) keep_under: bool,
+    /// What the loader's code and zero page held before it was written
+    /// (only what was read: see [`Session::keep_under`]).
+    under: Vec<Area>,
+    /// Whether the zero page is in `under` already.
+    zero_page_kept: bool,
 }
 
 impl Session {
@@ -94,6 +101,9 @@ impl Session {
             wrote: false,
             maybe_resident: true,
             recoveries: 0,
+            keep_under: false,
+            under: Vec::new(),
+            zero_page_kept: false,
         }
     }
 
@@ -158,7 +168,17 @@ impl Session {
         // A loader left in RAM by an earlier upload at the same place (the
         // usual case when an extension is uploaded again after an edit)
         // only needs verifying: reading it back costs less than writing it.
-        let mut start = if self.maybe_resident && self.resident(client)? {
+        let seen = if self.maybe_resident {
+            self.read_rate(client)?
+        } else {
+            None
+        };
+        let rate = self.loader.rate_part()?;
+        let resident = seen.as_deref() == Some(&rate.areas()[0].bytes[..]);
+        if self.keep_under {
+            self.under = self.read_under(client, resident, seen.as_deref())?;
+        }
+        let mut start = if resident {
             Start::Resident
         } else {
             self.wrote = true;
@@ -189,21 +209,69 @@ impl Session {
         Ok(())
     }
 
-    /// Whether `rate` reads back as linked (one read; anything else, a lost
-    /// answer included, says no): the loader is probably in RAM already.
-    fn resident<T: Transport>(&self, client: &mut Client<T>) -> Result<bool> {
+    /// What `rate`'s place holds (one read; `None` for a lost or garbled
+    /// answer): `rate` as linked means the loader is probably in RAM
+    /// already.
+    fn read_rate<T: Transport>(&self, client: &mut Client<T>) -> Result<Option<Vec<u8>>> {
         let rate = self.loader.rate_part()?;
         let area = &rate.areas()[0];
         let Ok(span) = ReadSpan::new(area.address, area.bytes.len() as u8) else {
-            return Ok(false);
+            return Ok(None);
         };
         match client.ask(&Command::ReadMemory(span)) {
-            Ok(Answer::Memory(bytes)) => Ok(bytes == area.bytes),
+            Ok(Answer::Memory(bytes)) => Ok(Some(bytes)),
             Ok(_) | Err(Error::Protocol(_) | Error::NoAnswer { .. } | Error::WrongBaud { .. }) => {
-                Ok(false)
+                Ok(None)
             }
             Err(error) => Err(error),
         }
+    }
+
+    /// What the loader's code is about to overwrite, read until two
+    /// answers agree (nothing when it was found in RAM, `resident`: an
+    /// earlier upload left it, and that is what was there). `seen` is the
+    /// one answer `read_rate` had for the start of that place: a second
+    /// read that agrees is taken at once, as is RAM that reads as zeros at
+    /// the first answer (the virtual robot's, or a fresh one's), with the
+    /// trust a delta upload puts in a sum.
+    fn read_under<T: Transport>(
+        &self,
+        client: &mut Client<T>,
+        resident: bool,
+        seen: Option<&[u8]>,
+    ) -> Result<Vec<Area>> {
+        if resident {
+            return Ok(Vec::new());
+        }
+        let address = self.loader.address();
+        let expected: Vec<Option<u8>> = (0..self.loader.len())
+            .map(|at| Some(seen.and_then(|seen| seen.get(at).copied()).unwrap_or(0)))
+            .collect();
+        Ok(vec![Area {
+            address,
+            bytes: client.read_expecting(address, &expected)?,
+        }])
+    }
+
+    /// The loader's zero page as it was, read until two answers agree,
+    /// once (a recovery finds it written by `frames`): read after `/1F`,
+    /// at the fast rate, where nothing of the loader that touches it
+    /// (`frames`, `sums`) has run yet; `rate` does not.
+    fn keep_zero_page<T: Transport>(&mut self, client: &mut Client<T>) -> Result<()> {
+        if !self.keep_under || self.zero_page_kept {
+            return Ok(());
+        }
+        let address = u16::from(self.loader.zero_page);
+        let bytes = client.read_memory(address, usize::from(ZERO_PAGE_LEN))?;
+        self.under.push(Area { address, bytes });
+        self.zero_page_kept = true;
+        Ok(())
+    }
+
+    /// What the loader overwrote, as [`Session::keep_under`] asked (empty
+    /// once taken).
+    pub(crate) fn take_under(&mut self) -> Vec<Area> {
+        std::mem::take(&mut self.under)
     }
 
     /// Verifies (or writes) the loader and hooks it, switching the line
@@ -230,10 +298,12 @@ impl Session {
                     // base rate, and no later recovery tries again.
                     self.fast = None;
                 }
+                self.keep_zero_page(client)?;
                 let part = self.loader.frames_part()?;
                 self.put_then_check_rom(client, &part, start)?;
             }
             _ => {
+                self.keep_zero_page(client)?;
                 let part = self.loader.rom_part()?;
                 self.put_then_check_rom(client, &part, start)?;
             }

@@ -478,9 +478,14 @@ pub fn upload_keeping<T: Transport>(
                 .first()
                 .is_none_or(|flags| flags.bytes.iter().any(|&flag| flag != 0))
         });
+        // An undo puts back what the loader overwrites too.
+        running.keep_under = kept.is_some();
         let result = running
             .install(client, progress)
             .and_then(|()| {
+                if let Some(kept) = kept.as_mut() {
+                    kept.areas.extend(running.take_under());
+                }
                 if !running.has_sums() {
                     // A small image: written whole, read back byte by byte.
                     kept_file = keep_old(client, profile, kept.take(), &image, keep)?;

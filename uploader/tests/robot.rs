@@ -224,21 +224,57 @@ fn an_upload_keeps_what_it_overwrote_and_restoring_that_undoes_it() {
     };
     let mut client = uploader::client(robot(), &options.profile);
     upload(&mut client, &first, &options, &mut NoProgress).expect("the first upload");
-    let before = user_memory_but_the_loaders(client.transport().robot());
+    let before = user_memory(client.transport().robot());
 
     let second = one_byte_changed(&first, 700);
     let mut kept = Kept::default();
     upload_keeping(&mut client, &second, &options, &mut NoProgress, &mut kept)
         .expect("the second upload");
-    assert!(user_memory_but_the_loaders(client.transport().robot()) != before);
+    assert!(user_memory(client.transport().robot()) != before);
     let kept = kept.0.expect("kept");
     restore(&mut client, &kept, &options, &mut NoProgress).expect("the undo");
+    // The loader's zero page included, which it wrote as it ran.
     assert_eq!(
-        first_difference(
-            &user_memory_but_the_loaders(client.transport().robot()),
-            &before
-        ),
+        first_difference(&user_memory(client.transport().robot()), &before),
         None
     );
     assert_done(client.into_transport(), &first, "undone");
+}
+
+/// hostile7's F1: the first upload to a robot writes the RAM loader at
+/// the top of user RAM, over whatever the owner had there; its undo put
+/// back the extension's place, not the loader's.
+#[test]
+fn an_undo_puts_back_what_the_ram_loader_overwrote() {
+    let image = extension(1024, 8);
+    let options = UploadOptions::default();
+    let mut transport = robot();
+    let board = transport.robot_mut().robot_mut().board_mut();
+    let pattern = |len: usize, seed: usize| -> Vec<u8> {
+        (0..len).map(|i| ((i * 7 + seed) % 251) as u8 | 1).collect()
+    };
+    board.load(0x0400, &pattern(0x0B40, 3)).expect("RAM");
+    board.load(0x0030, &pattern(0xD0, 5)).expect("RAM");
+    let before = user_memory(transport.robot());
+    let mut client = uploader::client(transport, &options.profile);
+    let mut kept = Kept::default();
+    let report = upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept)
+        .expect("the upload");
+    let loader = report.loader.expect("through the RAM loader");
+    let memory = client.transport().robot().robot().board().memory();
+    let place = usize::from(loader.address)..usize::from(loader.address) + loader.len;
+    assert!(
+        memory[place.clone()] != before[place.start - 0x0400 + 0xD6..][..place.len()],
+        "the loader was written over the pattern"
+    );
+    let kept = kept.0.expect("kept");
+    restore(&mut client, &kept, &options, &mut NoProgress).expect("the undo");
+    let after = user_memory(client.transport().robot());
+    if let Some(at) = first_difference(&after, &before) {
+        panic!(
+            "differs at offset {at} of the dump: {:02X?} was {:02X?}",
+            &after[at..(at + 8).min(after.len())],
+            &before[at..(at + 8).min(before.len())]
+        );
+    }
 }
