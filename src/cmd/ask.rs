@@ -17,8 +17,10 @@ use crate::cmd::{ports, sim};
 ///
 /// Commands are written as on the line: `/1P`, `/8C+501000`, `/7R020010`.
 /// Instructions print nothing; an extension's command prints its answer if
-/// one comes within --timeout. `--port emu` talks to the virtual Scorpion
-/// in this process.
+/// one comes within --timeout, and is a failure when none comes (the ROM
+/// ignores a command no extension owns) unless --allow-silence says the
+/// extension's command is an instruction. `--port emu` talks to the
+/// virtual Scorpion in this process.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     #[command(flatten)]
@@ -29,6 +31,10 @@ pub(crate) struct Args {
     /// How long an extension's command may take to answer, in milliseconds.
     #[arg(long, default_value_t = 500, value_name = "MS")]
     timeout: u64,
+    /// An extension's command that answers nothing within --timeout is not
+    /// a failure (an extension's instruction).
+    #[arg(long)]
+    allow_silence: bool,
     /// With `--port emu`: a linked image to load first (repeatable); in a
     /// project its images are built and loaded when none is given.
     #[arg(long = "image", value_name = "ELF")]
@@ -112,6 +118,43 @@ impl Robot {
             }
         }
     }
+
+    /// Where `HOOK_UNKNOWN` goes now (`None` where the line did not say).
+    fn unknown_hook_target(&mut self, profile: &uploader::RomProfile) -> Option<u16> {
+        let at = profile.hook_address(isa::objfmt::HookKind::Unknown) + 1;
+        match self {
+            Robot::Virtual(robot, _) => {
+                let memory = robot.robot().board().memory();
+                let at = usize::from(at);
+                Some(u16::from_le_bytes([*memory.get(at)?, *memory.get(at + 1)?]))
+            }
+            Robot::Serial(client) => client
+                .read_memory(at, 2)
+                .ok()
+                .map(|bytes| u16::from_le_bytes([bytes[0], bytes[1]])),
+        }
+    }
+}
+
+/// The failure of an extension's command that got no answer: whether any
+/// extension is hooked at all says which of the two usual reasons it is.
+fn no_answer(
+    robot: &mut Robot,
+    profile: &uploader::RomProfile,
+    command: &Command,
+    timeout: u64,
+) -> miette::Report {
+    let rom = profile.reset_target(isa::objfmt::HookKind::Unknown);
+    match robot.unknown_hook_target(profile) {
+        Some(target) if Some(target) == rom => miette::miette!(
+            help = "upload one with `scorpion upload`; on the virtual robot, `--image ELF` or a project's images",
+            "`{command}`: no answer within {timeout} ms: no extension is installed (HOOK_UNKNOWN goes to the ROM's own ${target:04X}, which ignores commands it does not know)"
+        ),
+        _ => miette::miette!(
+            help = "`scorpion installed` lists what the robot has; --allow-silence accepts an extension's instruction, which answers nothing; --timeout MS waits longer",
+            "`{command}`: no answer within {timeout} ms: no installed extension answered it"
+        ),
+    }
 }
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
@@ -138,12 +181,18 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let transport = ports::open_resolved(&resolved, &[])?;
         Robot::Serial(Client::new(transport, ClientConfig::default()))
     };
+    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
     let timeout = Duration::from_millis(args.timeout);
     let mut out = std::io::stdout().lock();
     for command in &args.commands {
         let answer = robot
             .exchange(command, timeout)
             .wrap_err_with(|| format!("`{command}`"))?;
+        let silent = answer.is_none() && matches!(command, Command::Extension(_));
+        if silent && !args.allow_silence {
+            out.flush().into_diagnostic()?;
+            return Err(no_answer(&mut robot, &profile, command, args.timeout));
+        }
         if args.decode {
             write!(out, "{}", decode(command, answer.as_ref())).into_diagnostic()?;
         } else if let Some(answer) = answer {

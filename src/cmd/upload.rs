@@ -295,6 +295,10 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
             ", through the RAM loader (${:04X}, {} bytes) at {} baud",
             loader.address, loader.len, loader.baud
         );
+    } else if report.without_loader.is_none() {
+        // Chosen (`--loader auto`: faster for an image this small) or
+        // asked for (`--loader never`): said, so no one looks for it.
+        text.push_str(", with the ROM's own commands (/9W, /7R)");
     }
     let written: usize = report.written.iter().map(|range| range.1).sum();
     if written < report.bytes {

@@ -30,6 +30,7 @@ fn ask_decodes_every_answer_form() {
         "--port",
         "emu",
         "--decode",
+        "--allow-silence",
         "/2E1",
         "/2G1",
         "/4C+20",
@@ -67,4 +68,9 @@ fn ask_needs_the_virtual_robot_for_images() {
 #[test]
 fn ask_reports_a_missing_port() {
     insta::assert_snapshot!(ask(&["--port", "/dev/no-such-scorpion", "/1P"]));
+}
+
+#[test]
+fn ask_fails_when_an_extensions_command_gets_no_answer() {
+    insta::assert_snapshot!(ask(&["--port", "emu", "/1X", "/1Q", "/1P"]));
 }

@@ -186,6 +186,52 @@ fn upload_with_a_card_rehearses_it_then_uploads_to_the_real_port() {
     assert_eq!(stdout(&asked), "A57\n", "{}", transcript(&asked));
 }
 
+/// fresh6's F2: `ask` of an extension's command that nobody answered
+/// printed nothing and exited 0. It fails now, saying whether any
+/// extension is installed at all; `--allow-silence` accepts an
+/// extension's instruction.
+#[test]
+fn ask_fails_when_no_answer_came_and_says_why() {
+    let adc = Adc::new();
+    let robot = Pty::with_adc_card();
+    let ask = |args: &[&str]| {
+        let mut all = vec!["ask", "--port", &robot.path];
+        all.extend_from_slice(args);
+        adc.run(&adc.project(), &all, &[])
+    };
+    let fresh = ask(&["/2A1"]);
+    assert_eq!(fresh.status.code(), Some(1), "{}", transcript(&fresh));
+    let text = transcript(&fresh);
+    assert!(
+        text.contains("`/2A1`: no answer within 500 ms: no extension is installed"),
+        "{text}"
+    );
+    let built = adc.run(&adc.project(), &["build"], &[]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let uploaded = adc.run(
+        &adc.project(),
+        &["upload", "target/scorpion/adc.elf", "--port", &robot.path],
+        &[],
+    );
+    assert!(uploaded.status.success(), "{}", transcript(&uploaded));
+    // The first answers; the second is nobody's: the third is not sent.
+    let asked = ask(&["/2A1", "/1Q", "/1X"]);
+    assert_eq!(asked.status.code(), Some(1), "{}", transcript(&asked));
+    assert_eq!(String::from_utf8_lossy(&asked.stdout), "A57\n");
+    let text = transcript(&asked);
+    assert!(
+        text.contains("`/1Q`: no answer within 500 ms: no installed extension answered it"),
+        "{text}"
+    );
+    let allowed = ask(&["--allow-silence", "--timeout", "100", "/1Q", "/1X"]);
+    assert_eq!(allowed.status.code(), Some(0), "{}", transcript(&allowed));
+    assert!(
+        String::from_utf8_lossy(&allowed.stdout).starts_with('X'),
+        "{}",
+        transcript(&allowed)
+    );
+}
+
 /// The matrix for the port: `upload`, `ask`, `installed`, `read` and
 /// `test --port` find the robot from each source (only `test --port`
 /// did, and `upload`, `ask`, `installed` said `--port` was required).

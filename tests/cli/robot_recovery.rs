@@ -284,7 +284,10 @@ fn an_upload_over_a_killed_monitors_stub_is_refused_until_debug_cleans_up() {
     assert!(output.status.success(), "{}", transcript(&output));
     let output = scorpion(dir.path(), &upload);
     assert!(output.status.success(), "{}", transcript(&output));
-    let output = scorpion(dir.path(), &["ask", "/1Z", "--port", &sim.path]);
+    let output = scorpion(
+        dir.path(),
+        &["ask", "/1Z", "--allow-silence", "--port", &sim.path],
+    );
     assert!(output.status.success(), "{}", transcript(&output));
     answers(dir.path(), &sim);
 }

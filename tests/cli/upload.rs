@@ -173,6 +173,7 @@ fn end_to_end_through_a_pseudo_terminal_to_scorpion_sim() {
             "ask",
             "--port",
             &sim.path,
+            "--allow-silence",
             "/9W20001020",
             "/9K20000002",
             "/1Q",
