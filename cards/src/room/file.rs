@@ -246,12 +246,13 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
         // Two corners at one place make an edge of no length, which every
         // other edge would be said to cross.
         let all_at_one = corners.iter().all(|corner| *corner == corners[0]);
+        let list = spanned.get_ref();
         if let Some(i) = (0..corners.len())
             .find(|&i| !all_at_one && corners[i] == corners[(i + 1) % corners.len()])
         {
             let next = (i + 1) % corners.len();
             return Err(at(
-                spanned.span(),
+                list[i.max(next)].span(),
                 format!(
                     "{what}: edge {} has no length: corners {} and {} are both at [{}, {}]",
                     i + 1,
@@ -261,6 +262,26 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
                     corners[i].y
                 ),
                 "give each corner once (the last corner joins the first by itself)",
+            ));
+        }
+        // Two corners apart at one place: the outline touches itself
+        // there, which the crossing check would name as two edges.
+        let repeated = (0..corners.len()).find_map(|j| {
+            (0..j)
+                .find(|&i| !all_at_one && corners[i] == corners[j])
+                .map(|i| (i, j))
+        });
+        if let Some((i, j)) = repeated {
+            return Err(at(
+                list[j].span(),
+                format!(
+                    "{what}: corners {} and {} are both at [{}, {}] (the outline touches itself there)",
+                    i + 1,
+                    j + 1,
+                    corners[i].x,
+                    corners[i].y
+                ),
+                "an outline goes round once: give each corner once, in order round the polygon",
             ));
         }
         if let Some((first, second)) = crossing_edges(&corners) {
