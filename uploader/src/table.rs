@@ -38,6 +38,10 @@ pub(crate) struct Plan {
     /// Whether the robot may hold much of the image already: the table
     /// lists an earlier copy of it, or an extension it replaces.
     pub(crate) held_maybe: bool,
+    /// Other extensions' chain slots re-pointed to take an extension out
+    /// of its chain, as they were (what an undo puts back; a hook's own
+    /// operand is the undo's hooks, switched last).
+    pub(crate) unlinked: Vec<Area>,
 }
 
 /// Reads what the robot has installed (nothing, for a ROM without a table).
@@ -148,13 +152,30 @@ pub(crate) fn prepare<T: Transport>(
     }
     let mut replaced = false;
     let mut known = hooks;
+    let mut unlinked = Vec::new();
     for old in &read.installed {
         match old.overlap(image.extents()) {
             None => kept.push(old.clone()),
-            Some(_) if old.id == id && old.extents == image.extents() => reused = Some(old.clone()),
+            Some(_) if old.id == id && old.extents == image.extents() => {
+                // An earlier copy behind another extension in its chain:
+                // taken out there, or the hook, pointed at it again, would
+                // lead round the chain back to it for ever. (At the head,
+                // the upload points the hook past it itself.)
+                for hook in &old.hooks {
+                    let context = (&read.installed[..], known);
+                    unlinked.extend(unlink(client, profile, context, *hook, max_writes, false)?);
+                }
+                reused = Some(old.clone());
+            }
             Some(_) if replace => {
                 replaced = true;
-                remove(client, profile, (&read.installed, known), old, max_writes)?;
+                unlinked.extend(remove(
+                    client,
+                    profile,
+                    (&read.installed, known),
+                    old,
+                    max_writes,
+                )?);
                 // The hooks may have moved: read from here on.
                 known = &[];
                 // Its flags are cleared now, verified.
@@ -187,6 +208,7 @@ pub(crate) fn prepare<T: Transport>(
         found,
         held_maybe: replaced || reused.is_some(),
         others: kept,
+        unlinked,
     }))
 }
 
@@ -322,7 +344,8 @@ fn differs<T: Transport>(
 
 /// Takes `old` out of every chain it is in (the pointer that jumps to its
 /// handler, the hook or another extension's chain slot, re-pointed at
-/// where `old` fell through, verified), then clears its entries.
+/// where `old` fell through, verified), then clears its entries. Returns
+/// the chain slots it re-pointed, as they were.
 ///
 /// # Errors
 /// The client's, [`Error::VerifyFailed`].
@@ -332,32 +355,52 @@ fn remove<T: Transport>(
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     old: &Installed,
     max_writes: u32,
-) -> Result<()> {
+) -> Result<Vec<Area>> {
     let Some((table, _)) = profile.table else {
-        return Ok(());
+        return Ok(Vec::new());
     };
+    let mut slots = Vec::new();
     for hook in &old.hooks {
-        unlink(client, profile, (everyone, hooks), *hook, max_writes)?;
+        slots.extend(unlink(
+            client,
+            profile,
+            (everyone, hooks),
+            *hook,
+            max_writes,
+            true,
+        )?);
     }
     // Clearing its flags bytes frees its entries.
     let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();
     let freed = vec![0u8; now.len()];
     let at = installed::flags_address(table, old.slot);
-    write_verified(client, at, &freed, &now, max_writes)
+    write_verified(client, at, &freed, &now, max_writes)?;
+    Ok(slots)
 }
 
 /// Re-points whatever jumps to `hook.handler` at where that extension
-/// fell through: the hook's own operand, or the chain slot of the extension
-/// before it. Nothing to do where it is not in the chain. `hooks`: the
-/// hooks' targets as the upload read them (until two answers agreed), so
-/// the chain is followed from there without reading them again.
+/// fell through: the hook's own operand (only `at_head`), or the chain
+/// slot of the extension before it. Nothing to do where it is not in the
+/// chain. `hooks`: the hooks' targets as the upload read them (until two
+/// answers agreed), so the chain is followed from there without reading
+/// them again. Returns the chain slot it re-pointed, as it was (not the
+/// hook: an undo switches hooks itself, last).
 fn unlink<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     hook: TakenHook,
     max_writes: u32,
-) -> Result<()> {
+    at_head: bool,
+) -> Result<Option<Area>> {
+    let head = profile.hook_address(hook.kind) + 1;
+    let from_hook = hooks
+        .iter()
+        .find(|(kind, _)| *kind == hook.kind)
+        .map(|&(_, target)| target);
+    if !at_head && from_hook == Some(hook.handler) {
+        return Ok(None);
+    }
     // Mostly the only extension on its hook: its slot holds the ROM's
     // target, taken at the first answer that says so.
     let after = match hook.chain {
@@ -370,10 +413,6 @@ fn unlink<T: Transport>(
             target: hook.handler,
         });
     };
-    let from_hook = hooks
-        .iter()
-        .find(|(kind, _)| *kind == hook.kind)
-        .map(|&(_, target)| target);
     let chain = walk(
         client,
         profile,
@@ -382,10 +421,14 @@ fn unlink<T: Transport>(
         Some(hook.handler),
     )?;
     match chain.last() {
-        Some(&(pointer, target)) if target == hook.handler => {
-            write_word_verified(client, pointer, after.to_le_bytes(), max_writes)
+        Some(&(pointer, target)) if target == hook.handler && (at_head || pointer != head) => {
+            write_word_verified(client, pointer, after.to_le_bytes(), max_writes)?;
+            Ok((pointer != head).then(|| Area {
+                address: pointer,
+                bytes: target.to_le_bytes().to_vec(),
+            }))
         }
-        _ => Ok(()),
+        _ => Ok(None),
     }
 }
 

@@ -361,6 +361,10 @@ pub fn upload_keeping<T: Transport>(
         rom: crate::backup::profile_rom(profile),
         ..Backup::default()
     });
+    // Chain slots of other extensions `prepare` re-pointed, as they were.
+    let unlinked = plan
+        .as_ref()
+        .map_or_else(Vec::new, |plan| plan.unlinked.clone());
     if options.replace {
         hooks_now = read_hooks(client, profile)?;
     }
@@ -488,7 +492,7 @@ pub fn upload_keeping<T: Transport>(
                 }
                 if !running.has_sums() {
                     // A small image: written whole, read back byte by byte.
-                    kept_file = keep_old(client, profile, kept.take(), &image, keep)?;
+                    kept_file = keep_old(client, profile, kept.take(), (&image, &unlinked), keep)?;
                     written = whole(&image);
                     let mut body = Body::new(&image, Writer::Frames);
                     body.plan_writes(client.transport().baud(), progress);
@@ -552,8 +556,14 @@ pub fn upload_keeping<T: Transport>(
                         fingerprint::check_jump_table(client, &profile)?;
                     }
                 }
-                kept_file =
-                    keep_summed(client, profile, kept.take(), (&todo, &known), &image, keep)?;
+                kept_file = keep_summed(
+                    client,
+                    profile,
+                    kept.take(),
+                    (&todo, &known),
+                    (&image, &unlinked),
+                    keep,
+                )?;
                 let todo = delta::merged(&todo);
                 written = todo.iter().map(|a| (a.address, a.bytes.len())).collect();
                 (rewrites, passes) =
@@ -601,7 +611,7 @@ pub fn upload_keeping<T: Transport>(
         }
         session = Some(running);
     } else {
-        kept_file = keep_old(client, profile, kept.take(), &image, keep)?;
+        kept_file = keep_old(client, profile, kept.take(), (&image, &unlinked), keep)?;
         written = whole(&image);
         let body;
         // The jump table is compared while the image goes in (the return
@@ -698,7 +708,7 @@ fn keep_old<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     kept: Option<Backup>,
-    image: &UploadImage,
+    (image, unlinked): (&UploadImage, &[Area]),
     keep: &mut dyn Keep,
 ) -> Result<Option<Backup>> {
     let Some(mut kept) = kept else {
@@ -719,10 +729,40 @@ fn keep_old<T: Transport>(
             bytes,
         });
     }
+    overlay(&mut kept.areas, unlinked);
     let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
     kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
     Ok(Some(kept))
+}
+
+/// Puts the chain slots `prepare` re-pointed into what is kept, as they
+/// were before: over the bytes read since where an area read holds them
+/// (an extension replaced in place of the one before it), else as areas
+/// of their own.
+fn overlay(areas: &mut Vec<Area>, unlinked: &[Area]) {
+    for slot in unlinked {
+        let mut alone = Vec::new();
+        for (offset, &byte) in slot.bytes.iter().enumerate() {
+            let address = slot.address.wrapping_add(offset as u16);
+            let holder = areas
+                .iter_mut()
+                .find(|area| area.address <= address && usize::from(address) < area.end() as usize);
+            match holder {
+                Some(area) => area.bytes[usize::from(address - area.address)] = byte,
+                None => alone.push((address, byte)),
+            }
+        }
+        for (address, byte) in alone {
+            match areas.last_mut() {
+                Some(last) if last.end() == u32::from(address) => last.bytes.push(byte),
+                _ => areas.push(Area {
+                    address,
+                    bytes: vec![byte],
+                }),
+            }
+        }
+    }
 }
 
 /// What an upload kept, once it has finished: with the sum of the
@@ -753,7 +793,7 @@ fn keep_summed<T: Transport>(
     profile: &RomProfile,
     kept: Option<Backup>,
     (held, known): (&[delta::Held], &[(crate::sums::Range, u16)]),
-    image: &UploadImage,
+    (image, unlinked): (&UploadImage, &[Area]),
     keep: &mut dyn Keep,
 ) -> Result<Option<Backup>> {
     let Some(mut kept) = kept else {
@@ -779,6 +819,7 @@ fn keep_summed<T: Transport>(
             bytes,
         });
     }
+    overlay(&mut kept.areas, unlinked);
     // The code the kept hooks go back to, summed on the robot (the loader's
     // `sums` is hooked here): an undo checks it is still there. Nothing is
     // written yet, so a range the sums asked already tile is put together

@@ -145,6 +145,8 @@ struct Step {
     base: u16,
     len: usize,
     replace: bool,
+    /// An installed extension uploaded again instead (fresh7's F5).
+    again: Option<proptest::sample::Index>,
 }
 
 fn step() -> impl Strategy<Value = Step> {
@@ -152,8 +154,14 @@ fn step() -> impl Strategy<Value = Step> {
         prop_oneof![USER_RAM_START..USER_RAM_END - 0x40, 0x1000u16..0x1400],
         22usize..120,
         any::<bool>(),
+        proptest::option::weighted(0.25, any::<proptest::sample::Index>()),
     )
-        .prop_map(|(base, len, replace)| Step { base, len, replace })
+        .prop_map(|(base, len, replace, again)| Step {
+            base,
+            len,
+            replace,
+            again,
+        })
 }
 
 proptest! {
@@ -167,31 +175,39 @@ proptest! {
         // The model: what should be installed, (letter, first, last).
         let mut model: Vec<(u8, u16, u16)> = Vec::new();
         for (index, step) in steps.iter().enumerate() {
-            let letter = LETTERS[index % LETTERS.len()];
-            let last = (u32::from(step.base) + step.len as u32 - 1).min(0xFFFF) as u16;
-            if step.base <= USER_RAM_END && last > USER_RAM_END {
-                continue; // past user RAM: refused by the profile, not this test's business
-            }
-            let image = answering(step.base, step.len, letter);
-            let overlapping: Vec<usize> = model
-                .iter()
-                .enumerate()
-                .filter(|(_, (_, first, end))| *first <= last && step.base <= *end)
-                .map(|(i, _)| i)
-                .collect();
-            let (result, back) = run(transport, &image, &options(step.replace));
-            transport = back;
-            if overlapping.is_empty() || step.replace {
-                prop_assert!(result.is_ok(), "step {index} {step:?}: {result:?}");
-                for i in overlapping.into_iter().rev() {
-                    model.remove(i);
-                }
-                model.push((letter, step.base, last));
+            if let Some(which) = step.again.filter(|_| !model.is_empty()) {
+                let (letter, first, last) = model[which.index(model.len())];
+                let image = answering(first, usize::from(last - first) + 1, letter);
+                let (result, back) = run(transport, &image, &options(step.replace));
+                transport = back;
+                prop_assert!(result.is_ok(), "again {step:?}: {result:?}");
             } else {
-                prop_assert!(
-                    matches!(result, Err(Error::Robot(romlib::Error::Overlap { .. }))),
-                    "step {index} {step:?}: {result:?}"
-                );
+                let letter = LETTERS[index % LETTERS.len()];
+                let last = (u32::from(step.base) + step.len as u32 - 1).min(0xFFFF) as u16;
+                if step.base <= USER_RAM_END && last > USER_RAM_END {
+                    continue; // past user RAM: refused by the profile, not this test's business
+                }
+                let image = answering(step.base, step.len, letter);
+                let overlapping: Vec<usize> = model
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, (_, first, end))| *first <= last && step.base <= *end)
+                    .map(|(i, _)| i)
+                    .collect();
+                let (result, back) = run(transport, &image, &options(step.replace));
+                transport = back;
+                if overlapping.is_empty() || step.replace {
+                    prop_assert!(result.is_ok(), "step {index} {step:?}: {result:?}");
+                    for i in overlapping.into_iter().rev() {
+                        model.remove(i);
+                    }
+                    model.push((letter, step.base, last));
+                } else {
+                    prop_assert!(
+                        matches!(result, Err(Error::Robot(romlib::Error::Overlap { .. }))),
+                        "step {index} {step:?}: {result:?}"
+                    );
+                }
             }
             // A command nobody owns, then each installed one's.
             let (answer, back) = ask(transport, b'Z' + 1);
@@ -246,5 +262,117 @@ fn an_extension_where_a_loader_entry_would_be_stays_in_the_chain() {
         assert_eq!(answer.as_deref(), Some("H"));
         let (answer, _) = ask(transport, b'A');
         assert_eq!(answer.as_deref(), Some("A"), "the first at ${entry:04X}");
+    }
+}
+
+/// The chain from `HOOK_UNKNOWN` to the ROM, each handler once: a loop
+/// (a handler met twice) fails.
+fn chain(memory: &[u8], slots: &[(u16, u16)]) -> Vec<u16> {
+    let mut seen = Vec::new();
+    let mut target = word(memory, HOOK_UNKNOWN + 1);
+    while target != BAD_COMMAND {
+        assert!(
+            !seen.contains(&target),
+            "a loop: {seen:04X?} then ${target:04X}"
+        );
+        seen.push(target);
+        let slot = slots
+            .iter()
+            .find(|&&(handler, _)| handler == target)
+            .map(|&(_, slot)| slot)
+            .unwrap_or_else(|| panic!("${target:04X} is no handler"));
+        target = word(memory, slot);
+    }
+    seen
+}
+
+/// fresh7's F5: the same image uploaded again while another extension
+/// was chained ahead of it: its chain slot took the head, which led back
+/// to it, and the next unknown command went round for ever.
+#[test]
+fn the_same_image_again_behind_another_leaves_no_loop() {
+    let first = answering(0x0400, 30, b'A');
+    let second = answering(0x0800, 30, b'H');
+    let slots = [(0x0400, 0x0400 + 20), (0x0800, 0x0800 + 20)];
+    let (result, transport) = run(robot(), &first, &options(false));
+    result.expect("first");
+    let (result, transport) = run(transport, &second, &options(false));
+    result.expect("second");
+    let (result, transport) = run(transport, &first, &options(false));
+    result.expect("the first again");
+    let memory = transport.robot().robot().board().memory();
+    assert_eq!(chain(memory, &slots), vec![0x0400, 0x0800]);
+    let (answer, transport) = ask(transport, b'Z' + 1);
+    assert_eq!(answer, None);
+    let (answer, transport) = ask(transport, b'A');
+    assert_eq!(answer.as_deref(), Some("A"));
+    let (answer, _) = ask(transport, b'H');
+    assert_eq!(answer.as_deref(), Some("H"));
+}
+
+#[derive(Default)]
+struct Kept(Option<uploader::Backup>);
+
+impl uploader::Keep for Kept {
+    fn keep(&mut self, overwritten: &uploader::Backup) {
+        self.0 = Some(overwritten.clone());
+    }
+}
+
+/// fresh7's F6, hostile9's F9: `--replace` of an extension in the middle
+/// of a chain re-points the chain slot of the one before it; the undo
+/// did not keep that slot, and the replaced extension, put back, was out
+/// of the chain.
+#[test]
+fn undoing_a_replacement_in_the_middle_of_a_chain_puts_the_chain_back() {
+    let slots = [
+        (0x0400, 0x0400 + 20),
+        (0x0800, 0x0800 + 20),
+        (0x0C00, 0x0C00 + 20),
+    ];
+    let mut transport = robot();
+    for (base, letter) in [(0x0400, b'A'), (0x0800, b'H'), (0x0C00, b'I')] {
+        let (result, back) = run(transport, &answering(base, 30, letter), &options(false));
+        result.expect("installed");
+        transport = back;
+    }
+    let user = |transport: &VirtualTransport| {
+        let memory = transport.robot().robot().board().memory();
+        let mut kept = memory[0x0200..0x0206].to_vec();
+        kept.extend_from_slice(&memory[0x0400..0x1000]);
+        kept
+    };
+    let before = user(&transport);
+    assert_eq!(
+        chain(transport.robot().robot().board().memory(), &slots),
+        vec![0x0C00, 0x0800, 0x0400]
+    );
+    let options = options(true);
+    let mut client = uploader::client(transport, &options.profile);
+    let mut kept = Kept::default();
+    uploader::upload_keeping(
+        &mut client,
+        &answering(0x0800, 30, b'J'),
+        &options,
+        &mut uploader::NoProgress,
+        &mut kept,
+    )
+    .expect("the middle one replaced");
+    let kept = kept.0.expect("kept");
+    uploader::restore(&mut client, &kept, &options, &mut uploader::NoProgress).expect("undone");
+    let transport = client.into_transport();
+    assert_eq!(
+        chain(transport.robot().robot().board().memory(), &slots),
+        vec![0x0C00, 0x0800, 0x0400]
+    );
+    assert!(
+        user(&transport) == before,
+        "the hooks and user RAM as before"
+    );
+    let mut transport = transport;
+    for letter in [b'A', b'H', b'I'] {
+        let (answer, back) = ask(transport, letter);
+        assert_eq!(answer, Some(char::from(letter).to_string()));
+        transport = back;
     }
 }
