@@ -805,6 +805,17 @@ fn split_for_loader(
     };
     let code = plan.code.address..=(plan.code.end() - 1) as u16;
     let zp = u16::from(*plan.zero_page.start())..=u16::from(*plan.zero_page.end());
+    // The loader runs only where the file puts back every byte it
+    // overwrites, code and zero page: else a restore (an undo, which holds
+    // only what its upload wrote) would leave it there, over the owner's
+    // RAM or an installed extension nobody then puts back.
+    if !code
+        .clone()
+        .chain(zp.clone())
+        .all(|address| whole.contains(address))
+    {
+        return Ok((None, Some(whole.clone())));
+    }
     let before = cut(whole, &[code.clone(), zp.clone()]);
     let after = keep_only(whole, &[code, zp]);
     Ok((before, after))

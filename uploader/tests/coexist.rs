@@ -376,3 +376,45 @@ fn undoing_a_replacement_in_the_middle_of_a_chain_puts_the_chain_back() {
         transport = back;
     }
 }
+
+/// hostile9's F2 and F3: an undo ran its own RAM loader at the top of
+/// user RAM, over bytes its file does not hold (here an installed
+/// extension, which then answered nothing, its hook restored to it), and
+/// left it there. A restore uses the loader only where it puts back every
+/// byte the loader overwrites.
+#[test]
+fn an_undo_leaves_no_loader_over_what_its_file_does_not_hold() {
+    let (result, mut transport) = run(robot(), &answering(0x0EC0, 40, b'A'), &options(false));
+    result.expect("an extension at the top of user RAM");
+    let pattern: Vec<u8> = (0..0x0800u32).map(|i| (i * 7 % 251) as u8 | 1).collect();
+    let board = transport.robot_mut().robot_mut().board_mut();
+    board.load(0x0400, &pattern).expect("RAM");
+    let user = |transport: &VirtualTransport| {
+        let memory = transport.robot().robot().board().memory();
+        let mut kept = memory[0x0030..0x0100].to_vec();
+        kept.extend_from_slice(&memory[0x0200..0x0206]);
+        kept.extend_from_slice(&memory[0x0400..0x1000]);
+        kept
+    };
+    let before = user(&transport);
+    let defaults = UploadOptions::default();
+    let mut client = uploader::client(transport, &defaults.profile);
+    let mut kept = Kept::default();
+    uploader::upload_keeping(
+        &mut client,
+        &answering(0x0400, 0x0800, b'H'),
+        &defaults,
+        &mut uploader::NoProgress,
+        &mut kept,
+    )
+    .expect("a large upload beside it");
+    let kept = kept.0.expect("kept");
+    uploader::restore(&mut client, &kept, &defaults, &mut uploader::NoProgress).expect("undone");
+    let transport = client.into_transport();
+    let after = user(&transport);
+    if let Some(at) = (0..after.len()).find(|&i| after[i] != before[i]) {
+        panic!("differs at offset {at} of the dump");
+    }
+    let (answer, _) = ask(transport, b'A');
+    assert_eq!(answer.as_deref(), Some("A"));
+}
