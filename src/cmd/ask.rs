@@ -150,9 +150,13 @@ fn no_answer(
             help = "upload one with `scorpion upload`; on the virtual robot, `--image ELF` or a project's images",
             "`{command}`: no answer within {timeout} ms: no extension is installed (HOOK_UNKNOWN goes to the ROM's own ${target:04X}, which ignores commands it does not know)"
         ),
-        _ => miette::miette!(
+        Some(_) => miette::miette!(
             help = "`scorpion installed` lists what the robot has; --allow-silence accepts an extension's instruction, which answers nothing; --timeout MS waits longer",
             "`{command}`: no answer within {timeout} ms: no installed extension answered it"
+        ),
+        None => miette::miette!(
+            help = "is the robot on, its cable in, and its DIP switches at the --baud rate?",
+            "`{command}`: no answer within {timeout} ms, and no answer to a read of HOOK_UNKNOWN either: the robot answers nothing"
         ),
     }
 }

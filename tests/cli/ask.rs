@@ -74,3 +74,18 @@ fn ask_reports_a_missing_port() {
 fn ask_fails_when_an_extensions_command_gets_no_answer() {
     insta::assert_snapshot!(ask(&["--port", "emu", "/1X", "/1Q", "/1P"]));
 }
+
+/// fresh7's F2, hostile9's F10: a robot that answers nothing at all was
+/// told as "no installed extension answered it".
+#[test]
+fn ask_of_a_robot_that_answers_nothing_says_so() {
+    use serialport::SerialPort;
+    let (_master, slave) = serialport::TTYPort::pair().expect("a pseudo-terminal pair");
+    let path = slave.name().expect("the slave's path");
+    let text = ask(&["--port", &path, "--timeout", "100", "/1Q"]);
+    assert!(text.starts_with("exit: 1"), "{text}");
+    assert!(
+        text.contains("`/1Q`: no answer within 100 ms, and no answer to a read of HOOK_UNKNOWN either: the robot answers nothing"),
+        "{text}"
+    );
+}
