@@ -799,17 +799,42 @@ fn keep_summed<T: Transport>(
     let Some(mut kept) = kept else {
         return Ok(None);
     };
+    let covered = |kept: &Backup, area: &Area| {
+        kept.areas
+            .iter()
+            .any(|old| old.address <= area.address && area.end() <= old.end())
+    };
+    // The sum of zeros is also that of a run of one even byte (Fletcher-16
+    // sums modulo 256: 256 bytes of $EA, a NOP sled, sum to nothing). A
+    // second sum, of all but the first byte, tells them apart: over an odd
+    // count no run of one byte but zero sums to nothing.
+    let twice: Vec<crate::sums::Range> = held
+        .iter()
+        .filter(|(area, sum)| {
+            *sum == fletcher16(&[]) && area.bytes.len() % 2 == 0 && !covered(&kept, area)
+        })
+        .map(|(area, _)| (area.address + 1, area.bytes.len() - 1))
+        .collect();
+    let second: std::collections::HashMap<u16, u16> = if twice.is_empty() {
+        std::collections::HashMap::new()
+    } else {
+        twice
+            .iter()
+            .map(|&(address, _)| address - 1)
+            .zip(crate::sums::robot_sums(client, &twice)?)
+            .collect()
+    };
     for (area, sum) in held {
         let len = area.bytes.len();
-        let covered = kept
-            .areas
-            .iter()
-            .any(|old| old.address <= area.address && area.end() <= old.end());
-        if covered {
+        if covered(&kept, area) {
             continue;
         }
         let zeros = vec![0; len];
-        let bytes = if fletcher16(&zeros) == *sum {
+        let nothing = fletcher16(&zeros) == *sum
+            && second
+                .get(&area.address)
+                .is_none_or(|&sum| sum == fletcher16(&zeros[1..]));
+        let bytes = if nothing {
             zeros
         } else {
             read_summed(client, area.address, len, *sum)?

@@ -278,3 +278,30 @@ fn an_undo_puts_back_what_the_ram_loader_overwrote() {
         );
     }
 }
+
+/// hostile9's F1: 256 bytes of one even byte ($EA, a NOP sled; $20,
+/// spaces) sum as zeros do, and were kept as zeros without a read: the
+/// undo wrote zeros over them.
+#[test]
+fn an_undo_puts_back_a_run_of_one_even_byte() {
+    for fill in [0xEA, 0x20] {
+        let image = extension(1024, 8);
+        let options = UploadOptions::default();
+        let mut transport = robot();
+        let board = transport.robot_mut().robot_mut().board_mut();
+        board.load(0x0400, &[fill; 0x0B40]).expect("RAM");
+        let before = user_memory(transport.robot());
+        let mut client = uploader::client(transport, &options.profile);
+        let mut kept = Kept::default();
+        upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept)
+            .expect("the upload");
+        let kept = kept.0.expect("kept");
+        restore(&mut client, &kept, &options, &mut NoProgress).expect("the undo");
+        let after = user_memory(client.transport().robot());
+        assert_eq!(
+            first_difference(&after, &before),
+            None,
+            "${fill:02X} put back"
+        );
+    }
+}
