@@ -171,3 +171,87 @@ fn a_breakpoint_on_a_chain_slot_jmp_displaces_and_restores_the_robots_bytes() {
     );
     assert_eq!(debug.compare_with_image().expect("read"), None);
 }
+
+/// Two extensions installed: `handler()` at $0400 (`/1Q`) and one at
+/// $0800 answering `/1H` with `H24`.
+fn two_installed() -> (UploadImage, UploadImage, Client<VirtualTransport>) {
+    let first = handler();
+    let mut bytes = vec![
+        0x4C, 0x21, 0xFF, 0xC9, b'H', 0xD0, 0xF9, 0xA9, b'H', 0x20, 0x00, 0xFF, 0xAD, 0x80, 0x08,
+        0x20, 0x03, 0xFF, 0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF,
+    ];
+    bytes.resize(0x81, 0xEA);
+    bytes[0x80] = 0x24;
+    let second = UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0800,
+            bytes,
+        }],
+        vec![isa::objfmt::HookRecord {
+            kind: isa::objfmt::HookKind::Unknown,
+            handler: 0x0803,
+            chain: Some(0x0801),
+        }],
+    )
+    .expect("an image");
+    let profile = RomProfile::reference();
+    let options = uploader::UploadOptions {
+        loader: uploader::LoaderChoice::Never,
+        ..uploader::UploadOptions::default()
+    };
+    let mut client = uploader::client(
+        VirtualTransport::new(romlib::VirtualScorpion::new()),
+        &profile,
+    );
+    for image in [&first, &second] {
+        uploader::upload(&mut client, image, &options, &mut uploader::NoProgress)
+            .expect("installed");
+    }
+    (first, second, client)
+}
+
+/// fresh7's F4: a session with image A killed with a breakpoint in A
+/// (the robot running, then stopped at it); the next session came with
+/// image B (installed beside A), cleaned up only what B's bytes showed,
+/// and left A's `JSR` into the stub, where `/1Q` then stopped with no host
+/// to serve it. Every breakpoint the stub's trampolines say was left is
+/// taken out, in any installed extension.
+#[test]
+fn a_session_with_another_image_takes_out_what_the_first_left() {
+    for stop in [false, true] {
+        let (first, second, client) = two_installed();
+        let profile = RomProfile::reference();
+        let mut session = RobotDebug::attach(client, &profile, first.clone()).expect("attaches");
+        session.set_breakpoint(AT, &[]).expect("set");
+        if stop {
+            let reply = session.command(b"/1Q", WAIT).expect("sent");
+            assert!(matches!(reply, Reply::Stopped(_)), "{reply:?}");
+        }
+        let client = session.abandon();
+        let mut other = reattach(client, &second);
+        assert!(
+            other.recovery().removed.contains(&AT),
+            "{:?}",
+            other.recovery()
+        );
+        if stop {
+            assert!(other.stopped().is_some(), "found stopped");
+            other.resume().expect("continue");
+            assert_eq!(
+                other.wait_event(WAIT).expect("an answer"),
+                Reply::Answer(b"42\r".to_vec())
+            );
+        }
+        assert_eq!(
+            other.command(b"/1Q", WAIT).expect("sent"),
+            Reply::Answer(b"Q42\r".to_vec()),
+            "stopped first: {stop}"
+        );
+        assert_eq!(
+            other.command(b"/1H", WAIT).expect("sent"),
+            Reply::Answer(b"H24\r".to_vec())
+        );
+        let memory = detached_memory(other);
+        assert_eq!(&memory[0x0400..0x0481], &first.areas()[0].bytes[..]);
+    }
+}

@@ -255,7 +255,13 @@ impl<T: Transport> RobotDebug<T> {
             target
         };
         debug.stub = StubPlan::place_beside(profile, &debug.image, previous, &taken)?;
-        let leftovers = debug.check_image()?;
+        let mut leftovers = debug.check_image()?;
+        if stopped || debug.recovery.hooked {
+            // A session with another image may have left breakpoints in
+            // its own extension, which this image's bytes do not show.
+            let elsewhere = debug.left_elsewhere(&taken)?;
+            leftovers.extend(elsewhere);
+        }
         let stub = debug.stub.clone();
         if debug.stopped.is_some() {
             // The stub runs: its data (the stop's registers) is kept.
@@ -464,6 +470,40 @@ impl<T: Transport> RobotDebug<T> {
     /// displaced, as the robot held them: its trampoline's copy in the
     /// stub (the displaced bytes, then `JMP` past them), found by that
     /// `JMP` and the image's bytes but for the chain slots' (`slot_bytes`).
+    /// Breakpoints an earlier session left outside this image (a session
+    /// with another image installed beside it), with the bytes they
+    /// displaced: each found by a trampoline of the stub (the displaced
+    /// instructions, then a `JMP` back past them) whose place, in memory an
+    /// installed extension owns (`taken`), still holds the `JSR` into the
+    /// stub. Read before the stub is written again.
+    fn left_elsewhere(&mut self, taken: &[RangeInclusive<u16>]) -> StubResult<Vec<(u16, [u8; 3])>> {
+        let entry = self.stub.entry.to_le_bytes();
+        let call = [JSR, entry[0], entry[1]];
+        let len = TRAMPOLINE_LEN as usize;
+        let tramps = self.read(self.stub.tramps, TRAMPOLINES * len)?;
+        let mut found: Vec<(u16, [u8; 3])> = Vec::new();
+        for copy in tramps.chunks(len) {
+            for displaced in 3..=len - 3 {
+                if copy[displaced] != patch::JMP {
+                    continue;
+                }
+                let back = u16::from_le_bytes([copy[displaced + 1], copy[displaced + 2]]);
+                let at = back.wrapping_sub(displaced as u16);
+                let owned = taken
+                    .iter()
+                    .any(|extent| extent.contains(&at) && extent.contains(&at.wrapping_add(2)));
+                if !owned || self.image.contains(at) || found.iter().any(|(seen, _)| *seen == at) {
+                    continue;
+                }
+                if self.read(at, 3)? == call {
+                    found.push((at, [copy[0], copy[1], copy[2]]));
+                    break;
+                }
+            }
+        }
+        Ok(found)
+    }
+
     fn displaced_copy(&mut self, address: u16, slot_bytes: &[u16]) -> StubResult<Vec<u8>> {
         let patch = patch::plan(address, &self.image, &[])?;
         let len = patch.displaced.len();
