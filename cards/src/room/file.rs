@@ -210,7 +210,7 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
         if numbers.iter().any(|v| !v.is_finite()) {
             return Err(at(
                 point.span(),
-                format!("{what} has a point that is not a number"),
+                format!("{what}: a point that is not a number"),
                 "points are [x, y] pairs in centimetres",
             ));
         }
@@ -311,7 +311,7 @@ pub fn parse(name: &str, text: &str) -> Result<Layout, ScriptError> {
         if area2 == 0.0 {
             return Err(at(
                 spanned.span(),
-                format!("{what} has no area: its corners are all on one line"),
+                format!("{what}: no area: the corners are all on one line"),
                 "give at least three corners that are not on one line (a post is a circle)",
             ));
         }
