@@ -117,7 +117,15 @@ pub(crate) fn differing_and<T: Transport>(
             sum,
         )
     };
-    if wrong.len() * 2 > coarse.len() {
+    // Most of a large image differs: written whole, no finer pass. The
+    // table entry, which an edited image always changes, and a range no
+    // longer than a fine one do not count (they would make half of a
+    // small image), nor does an image of one or two ranges (a finer pass
+    // costs less than writing 256 bytes).
+    let big = |i: usize| coarse[i].1.len() > FINE;
+    let ranges = (0..coarse.len()).filter(|&i| big(i)).count();
+    let differing = wrong.iter().filter(|&&(i, _)| big(i)).count();
+    if ranges > 2 && differing * 2 > ranges {
         let held = wrong
             .iter()
             .map(|&(i, sum)| held(&coarse[i], sum))

@@ -141,7 +141,16 @@ fn a_rom_differing_past_its_jump_table_is_refused_by_its_checksum() {
 
 #[test]
 fn a_one_byte_change_is_written_as_one_range_and_verified() {
-    let image = extension(2048, 5);
+    // Small images too (fresh7's F1: the table entry, which an edit always
+    // changes, counted as half of an image of one or two 256-byte ranges,
+    // and the whole image was written).
+    for (len, offset) in [(2048, 1000), (426, 300), (200, 100)] {
+        one_byte_change_of(len, offset);
+    }
+}
+
+fn one_byte_change_of(len: usize, offset: usize) {
+    let image = extension(len, 5);
     let options = UploadOptions {
         loader: LoaderChoice::Always,
         replace: true,
@@ -149,9 +158,8 @@ fn a_one_byte_change_is_written_as_one_range_and_verified() {
     };
     let mut client = uploader::client(robot(), &options.profile);
     let first = upload(&mut client, &image, &options, &mut NoProgress).expect("the first upload");
-    assert_eq!(first.written.iter().map(|r| r.1).sum::<usize>(), 2048 + 15);
+    assert_eq!(first.written.iter().map(|r| r.1).sum::<usize>(), len + 15);
 
-    let offset = 1000;
     let new = one_byte_changed(&image, offset);
     let report = upload(&mut client, &new, &options, &mut NoProgress).expect("the change");
     let address = 0x0400 + offset as u16;
