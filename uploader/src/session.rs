@@ -27,6 +27,10 @@ use crate::summed::{Summed, write_summed};
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
 
+/// Called with what the loader is about to overwrite, before its first
+/// write (the upload keeps it for an undo then).
+pub(crate) type BeforeWrite<'a, T> = dyn FnMut(&mut Client<T>, &[Area]) -> Result<()> + 'a;
+
 /// How often the loader is restored before the upload gives up.
 const MAX_RECOVERIES: u32 = 6;
 
@@ -155,6 +159,7 @@ impl Session {
         &mut self,
         client: &mut Client<T>,
         progress: &mut dyn Progress,
+        before_write: &mut BeforeWrite<'_, T>,
     ) -> Result<()> {
         progress.phase(Phase::Loader, self.loader.len());
         if let Some(fast) = self.fast {
@@ -177,6 +182,11 @@ impl Session {
         let resident = seen.as_deref() == Some(&rate.areas()[0].bytes[..]);
         if self.keep_under {
             self.under = self.read_under(client, resident, seen.as_deref())?;
+            if !self.under.is_empty() {
+                // Kept before the first write: a kill while the loader
+                // goes in leaves something to undo.
+                before_write(client, &self.under)?;
+            }
         }
         let mut start = if resident {
             Start::Resident
@@ -227,15 +237,16 @@ impl Session {
         }
     }
 
-    /// What the loader's code is about to overwrite, read until two
-    /// answers agree (nothing when it was found in RAM, `resident`: an
-    /// earlier upload left it, and that is what was there). `seen` is the
+    /// What the loader's code and zero page are about to overwrite, read
+    /// until two answers agree (nothing when it was found in RAM,
+    /// `resident`: an earlier upload left it, and that is what was there;
+    /// its zero page is then read after `/1F`, see `keep_zero_page`). `seen` is the
     /// one answer `read_rate` had for the start of that place: a second
     /// read that agrees is taken at once, as is RAM that reads as zeros at
     /// the first answer (the virtual robot's, or a fresh one's), with the
     /// trust a delta upload puts in a sum.
     fn read_under<T: Transport>(
-        &self,
+        &mut self,
         client: &mut Client<T>,
         resident: bool,
         seen: Option<&[u8]>,
@@ -247,10 +258,19 @@ impl Session {
         let expected: Vec<Option<u8>> = (0..self.loader.len())
             .map(|at| Some(seen.and_then(|seen| seen.get(at).copied()).unwrap_or(0)))
             .collect();
-        Ok(vec![Area {
+        let code = Area {
             address,
             bytes: client.read_expecting(address, &expected)?,
-        }])
+        };
+        // The zero page too, now: all of it is then kept before the first
+        // write (time matters less where the loader is written at all).
+        let zero_page = u16::from(self.loader.zero_page);
+        let state = Area {
+            address: zero_page,
+            bytes: client.read_expecting(zero_page, &[Some(0); ZERO_PAGE_LEN as usize])?,
+        };
+        self.zero_page_kept = true;
+        Ok(vec![code, state])
     }
 
     /// The loader's zero page as it was, read until two answers agree,

@@ -482,10 +482,22 @@ pub fn upload_keeping<T: Transport>(
                 .first()
                 .is_none_or(|flags| flags.bytes.iter().any(|&flag| flag != 0))
         });
-        // An undo puts back what the loader overwrites too.
+        // An undo puts back what the loader overwrites too, and can from
+        // before the loader is first written.
         running.keep_under = kept.is_some();
+        let mut before_write = |client: &mut Client<T>, under: &[Area]| -> Result<()> {
+            if let Some(kept) = kept.as_ref() {
+                let mut early = kept.clone();
+                early.areas.extend_from_slice(under);
+                overlay(&mut early.areas, &unlinked);
+                let ranges = crate::backup::kept_witness_ranges(profile, &early, &image);
+                early.witnesses = crate::backup::read_witnesses(client, &ranges)?;
+                keep.keep(&early);
+            }
+            Ok(())
+        };
         let result = running
-            .install(client, progress)
+            .install(client, progress, &mut before_write)
             .and_then(|()| {
                 if let Some(kept) = kept.as_mut() {
                     kept.areas.extend(running.take_under());

@@ -313,3 +313,52 @@ fn an_undo_puts_back_a_run_of_one_even_byte() {
         );
     }
 }
+
+/// hostile9's F6: an upload killed while the RAM loader went in left its
+/// code over the owner's RAM and no undo file (it was written once the
+/// image's sums were in). At every point the line dies, what was kept
+/// (if anything was written) puts the robot back byte for byte.
+#[test]
+fn an_upload_cut_anywhere_leaves_an_undo_that_puts_everything_back() {
+    use uploader::transport::{FaultConfig, FaultyTransport};
+    let image = extension(1024, 8);
+    let options = UploadOptions::default();
+    let pattern: Vec<u8> = (0..0x0B40u32).map(|i| (i * 13 % 251) as u8 | 1).collect();
+    let mut tried = 0;
+    for at in (40..2600).step_by(120) {
+        let mut transport = robot();
+        let board = transport.robot_mut().robot_mut().board_mut();
+        board.load(0x0400, &pattern).expect("RAM");
+        board.load(0x0030, &pattern[..0xD0]).expect("RAM");
+        let before = user_memory(transport.robot());
+        let config = FaultConfig {
+            stall_after: Some(at),
+            stall_for: None,
+            ..FaultConfig::none(3)
+        };
+        let mut client =
+            uploader::client(FaultyTransport::new(transport, config), &options.profile);
+        let mut kept = Kept::default();
+        let result = upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept);
+        let transport = client.into_transport().into_inner();
+        if result.is_ok() {
+            break;
+        }
+        tried += 1;
+        let changed = user_memory(transport.robot()) != before;
+        let Some(kept) = kept.0 else {
+            assert!(!changed, "cut after {at}: RAM changed and nothing kept");
+            continue;
+        };
+        let mut client = uploader::client(transport, &options.profile);
+        restore(&mut client, &kept, &options, &mut NoProgress)
+            .unwrap_or_else(|error| panic!("cut after {at}: the undo: {error}"));
+        let after = user_memory(client.transport().robot());
+        assert_eq!(
+            first_difference(&after, &before),
+            None,
+            "cut after {at} host characters"
+        );
+    }
+    assert!(tried > 5, "cut {tried} times");
+}
