@@ -362,3 +362,50 @@ fn an_upload_cut_anywhere_leaves_an_undo_that_puts_everything_back() {
     }
     assert!(tried > 5, "cut {tried} times");
 }
+
+/// hostile9's F7: an undo cut half way (killed, a dead line) could not be
+/// finished: the table it had put back no longer held the upload's entry,
+/// and the undo file was refused as "no longer on the robot". Cut
+/// anywhere, the same undo again finishes the job.
+#[test]
+fn an_undo_cut_anywhere_can_be_run_again_to_the_end() {
+    use uploader::transport::{FaultConfig, FaultyTransport};
+    let image = extension(1024, 8);
+    let options = UploadOptions::default();
+    let pattern: Vec<u8> = (0..0x0B40u32).map(|i| (i * 13 % 251) as u8 | 1).collect();
+    let mut cut = 0;
+    for at in (40..3000).step_by(150) {
+        let mut transport = robot();
+        let board = transport.robot_mut().robot_mut().board_mut();
+        board.load(0x0400, &pattern).expect("RAM");
+        board.load(0x0030, &pattern[..0xD0]).expect("RAM");
+        let before = user_memory(transport.robot());
+        let mut client = uploader::client(transport, &options.profile);
+        let mut kept = Kept::default();
+        upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept)
+            .expect("the upload");
+        let kept = kept.0.expect("kept");
+        let config = FaultConfig {
+            stall_after: Some(at),
+            stall_for: None,
+            ..FaultConfig::none(5)
+        };
+        let mut client = uploader::client(
+            FaultyTransport::new(client.into_transport(), config),
+            &options.profile,
+        );
+        let first = restore(&mut client, &kept, &options, &mut NoProgress);
+        let mut client = uploader::client(client.into_transport().into_inner(), &options.profile);
+        if first.is_err() {
+            cut += 1;
+            restore(&mut client, &kept, &options, &mut NoProgress)
+                .unwrap_or_else(|error| panic!("cut after {at}: again: {error}"));
+        }
+        let after = user_memory(client.transport().robot());
+        assert_eq!(first_difference(&after, &before), None, "cut after {at}");
+        if first.is_ok() {
+            break;
+        }
+    }
+    assert!(cut > 5, "cut {cut} times");
+}
