@@ -63,7 +63,13 @@ pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
     let transport = ports::open_resolved(&resolved, &[])?;
     let rom = crate::cmd::config::rom(&resolved)?;
     let profile = crate::cmd::config::profile(rom.as_ref())?;
-    restore_into(transport, profile, &backup, &args.file, args.force)
+    restore_into(
+        transport,
+        profile,
+        &backup,
+        &args.file,
+        (args.force, uploader::LoaderChoice::Auto),
+    )
 }
 
 /// Restores `backup` (from `file`) through `transport` into a robot with
@@ -73,11 +79,12 @@ pub(crate) fn restore_into(
     profile: uploader::RomProfile,
     backup: &Backup,
     file: &Path,
-    force_rom: bool,
+    (force_rom, loader): (bool, uploader::LoaderChoice),
 ) -> miette::Result<ExitCode> {
     let options = UploadOptions {
         profile,
         force_rom,
+        loader,
         ..UploadOptions::default()
     };
     let mut client = uploader::client(transport, &options.profile);

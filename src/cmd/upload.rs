@@ -350,8 +350,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let transport = ports::open_resolved(&resolved, &[])?;
         let rom = crate::cmd::config::rom(&resolved)?;
         let profile = crate::cmd::config::profile(rom.as_ref())?;
-        let code = crate::cmd::backup::restore_into(transport, profile, &backup, &path, false)
-            .map_err(|report| undo_refused(report, &path))?;
+        // `--loader never` (the help of a noisy line's failure) holds
+        // for the undo too.
+        let loader = args.options().loader;
+        let code =
+            crate::cmd::backup::restore_into(transport, profile, &backup, &path, (false, loader))
+                .map_err(|report| undo_refused(report, &path))?;
         // Marked used: a second undo says "already undone" rather than
         // comparing the robot with an upload no longer on it. Kept (as
         // `.undone`), not deleted: what was undone stays on disk.
