@@ -69,6 +69,7 @@ pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
         &backup,
         &args.file,
         (args.force, uploader::LoaderChoice::Auto),
+        None,
     )
 }
 
@@ -80,16 +81,30 @@ pub(crate) fn restore_into(
     backup: &Backup,
     file: &Path,
     (force_rom, loader): (bool, uploader::LoaderChoice),
+    started: Option<&Path>,
 ) -> miette::Result<ExitCode> {
+    // A restore of this file started before and stopped half way (the
+    // file `started` names is there): it may be finished.
+    let resume = started.is_some_and(Path::exists);
     let options = UploadOptions {
         profile,
         force_rom,
         loader,
+        resume,
         ..UploadOptions::default()
     };
+    if resume {
+        print(&format!(
+            "finishing the restore of {} that stopped half way",
+            file.display()
+        ));
+    }
     let mut client = uploader::client(transport, &options.profile);
-    let mut told = Overrides;
+    let mut told = Overrides { started };
     let reports = uploader::restore(&mut client, backup, &options, &mut told)?;
+    if let Some(started) = started {
+        let _ = std::fs::remove_file(started);
+    }
     let written: usize = reports
         .iter()
         .flat_map(|report| report.written.iter().map(|range| range.1))
@@ -103,16 +118,29 @@ pub(crate) fn restore_into(
     Ok(ExitCode::SUCCESS)
 }
 
-/// Says, as it happens, each ROM check `--force` overrode.
-struct Overrides;
+/// Says, as it happens, each ROM check `--force` overrode; marks the
+/// restore started (`started`) once its checks passed.
+struct Overrides<'a> {
+    started: Option<&'a Path>,
+}
 
-impl uploader::Progress for Overrides {
+impl uploader::Progress for Overrides<'_> {
     fn event(&mut self, event: &uploader::Event) {
-        if let uploader::Event::RomCheckOverridden { refusal } = event {
-            #[allow(clippy::print_stderr, reason = "the CLI warns")]
-            {
-                eprintln!("warning: --force overrides: {refusal}");
+        match event {
+            uploader::Event::RomCheckOverridden { refusal } => {
+                #[allow(clippy::print_stderr, reason = "the CLI warns")]
+                {
+                    eprintln!("warning: --force overrides: {refusal}");
+                }
             }
+            uploader::Event::RestoreStarted => {
+                if let Some(started) = self.started {
+                    // Best effort: without it a stopped undo is refused
+                    // again, as before, with nothing changed by the refusal.
+                    let _ = std::fs::write(started, b"");
+                }
+            }
+            _ => {}
         }
     }
 }

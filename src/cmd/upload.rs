@@ -353,9 +353,18 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         // `--loader never` (the help of a noisy line's failure) holds
         // for the undo too.
         let loader = args.options().loader;
-        let code =
-            crate::cmd::backup::restore_into(transport, profile, &backup, &path, (false, loader))
-                .map_err(|report| undo_refused(report, &path))?;
+        // Written once the undo's checks pass: an undo stopped after it
+        // (killed, a dead line) is finished by the next `--undo`.
+        let started = undoing_path(&path);
+        let code = crate::cmd::backup::restore_into(
+            transport,
+            profile,
+            &backup,
+            &path,
+            (false, loader),
+            Some(&started),
+        )
+        .map_err(|report| undo_refused(report, &path))?;
         // Marked used: a second undo says "already undone" rather than
         // comparing the robot with an upload no longer on it. Kept (as
         // `.undone`), not deleted: what was undone stays on disk.
@@ -419,6 +428,14 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
 }
 
 /// Where a used undo file is kept: `X.undo` becomes `X.undo.undone`.
+/// `NAME.undoing`: there while an undo of `NAME` has started and not
+/// finished.
+fn undoing_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".undoing");
+    PathBuf::from(name)
+}
+
 fn undone_path(path: &Path) -> PathBuf {
     let mut name = path.as_os_str().to_owned();
     name.push(".undone");

@@ -589,24 +589,27 @@ fn check_backup_rom<T: Transport>(
 
 /// Refuses a restore onto a robot whose memory under a hook's target (the
 /// table's entry of the hooked extension, or its code) no longer sums as
-/// it did when the backup was written, nor holds what the backup itself
-/// puts there (a restore of it that stopped half way).
+/// it did when the backup was written (nor, with `resume`, holds what the
+/// backup itself puts there: a restore of it that stopped half way).
 fn check_witnesses<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
     profile: &RomProfile,
+    resume: bool,
 ) -> Result<()> {
     let table = table_range(profile);
     for witness in &backup.witnesses {
         let bytes = client.read_memory(witness.address, usize::from(witness.len))?;
         let found = crate::sums::fletcher16(&bytes);
-        // What the file itself puts there: a restore that stopped half way
-        // (killed, a dead line) wrote it already, and finishing it is
-        // what the file is for.
+        // What the file itself puts there, where its restore stopped half
+        // way (killed, a dead line) and wrote it already: finishing it is
+        // what the file is for. Only then: a fresh robot's zeros may be
+        // what the file holds too.
         let held: Option<Vec<u8>> = (0..u32::from(witness.len))
             .map(|i| backup.byte_at(u32::from(witness.address) + i))
             .collect();
-        if found != witness.sum && held.as_ref() != Some(&bytes) {
+        let resumed = resume && held.as_ref() == Some(&bytes);
+        if found != witness.sum && !resumed {
             let in_table = table.is_some_and(|(at, len)| {
                 let start = usize::from(witness.address);
                 start >= usize::from(at) && start < usize::from(at) + len
@@ -683,7 +686,7 @@ pub fn restore<T: Transport>(
         Err(error @ Error::WrongRom { .. }) if options.force_rom => overridden.push(error),
         other => other?,
     }
-    check_witnesses(client, backup, profile)?;
+    check_witnesses(client, backup, profile, options.resume)?;
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
             refusal: error.to_string(),
@@ -693,6 +696,7 @@ pub fn restore<T: Transport>(
     if !overridden.is_empty() {
         memory.loader = LoaderChoice::Never;
     }
+    progress.event(&crate::progress::Event::RestoreStarted);
     for kind in HookKind::ALL {
         if let Some(to) = profile.reset_target(kind) {
             switch_hook(client, profile.hook_address(kind), to, options.max_writes)?;

@@ -90,6 +90,9 @@ pub enum Event {
         /// The refusal the check gave.
         refusal: String,
     },
+    /// A restore's checks passed: it writes from here on. One stopped
+    /// after this may be run again with [`crate::UploadOptions::resume`].
+    RestoreStarted,
 }
 
 /// Receives progress; every method has a no-op default.

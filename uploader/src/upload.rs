@@ -78,6 +78,10 @@ pub struct UploadOptions {
     /// may land elsewhere): [`crate::restore`] tells what it overrides,
     /// and an upload with it compares nothing of the ROM.
     pub force_rom: bool,
+    /// [`crate::restore`] of a file whose restore stopped half way (the
+    /// caller knows it started one): a witness whose memory holds what
+    /// the file itself puts there passes, since that restore wrote it.
+    pub resume: bool,
 }
 
 impl Default for UploadOptions {
@@ -92,6 +96,7 @@ impl Default for UploadOptions {
             replace: false,
             delta: true,
             force_rom: false,
+            resume: false,
         }
     }
 }

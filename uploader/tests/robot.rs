@@ -398,7 +398,11 @@ fn an_undo_cut_anywhere_can_be_run_again_to_the_end() {
         let mut client = uploader::client(client.into_transport().into_inner(), &options.profile);
         if first.is_err() {
             cut += 1;
-            restore(&mut client, &kept, &options, &mut NoProgress)
+            let resume = UploadOptions {
+                resume: true,
+                ..UploadOptions::default()
+            };
+            restore(&mut client, &kept, &resume, &mut NoProgress)
                 .unwrap_or_else(|error| panic!("cut after {at}: again: {error}"));
         }
         let after = user_memory(client.transport().robot());

@@ -69,6 +69,21 @@ pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::A
     // No `/1X` first: a robot left stopped in the stub answers none; attach
     // finds that out with a frame, and asks `/1X` of a running one.
     let client = uploader::client(transport, &profile);
+    // Reading the code twice and writing the stub with the ROM's commands
+    // takes seconds at 9600 baud: said, so a silent terminal is not taken
+    // for a hang.
+    let baud = resolved.baud.value;
+    let chars = code.len() * 4 + 600 * 6;
+    #[allow(
+        clippy::print_stderr,
+        reason = "progress of a long attach, before the session starts"
+    )]
+    {
+        eprintln!(
+            "attaching: comparing the robot's code with the image and writing the debug stub (about {} s at {baud} baud)",
+            (chars * 10).div_ceil(baud as usize).max(1)
+        );
+    }
     let robot = RobotDebug::attach(client, &profile, code)?;
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
     // A JSR where no instruction starts would cut one in two: the line
