@@ -314,6 +314,19 @@ fn an_undo_puts_back_a_run_of_one_even_byte() {
     }
 }
 
+/// A robot whose user RAM and user zero page hold a pattern with no zero
+/// in it (what an owner's RAM may hold: zeros hide nothing), and its user
+/// memory as it is.
+fn patterned_robot() -> (VirtualTransport, Vec<u8>) {
+    let pattern: Vec<u8> = (0..0x0B40u32).map(|i| (i * 13 % 251) as u8 | 1).collect();
+    let mut transport = robot();
+    let board = transport.robot_mut().robot_mut().board_mut();
+    board.load(0x0400, &pattern).expect("RAM");
+    board.load(0x0030, &pattern[..0xD0]).expect("RAM");
+    let before = user_memory(transport.robot());
+    (transport, before)
+}
+
 /// hostile9's F6: an upload killed while the RAM loader went in left its
 /// code over the owner's RAM and no undo file (it was written once the
 /// image's sums were in). At every point the line dies, what was kept
@@ -323,14 +336,9 @@ fn an_upload_cut_anywhere_leaves_an_undo_that_puts_everything_back() {
     use uploader::transport::{FaultConfig, FaultyTransport};
     let image = extension(1024, 8);
     let options = UploadOptions::default();
-    let pattern: Vec<u8> = (0..0x0B40u32).map(|i| (i * 13 % 251) as u8 | 1).collect();
     let mut tried = 0;
     for at in (40..2600).step_by(120) {
-        let mut transport = robot();
-        let board = transport.robot_mut().robot_mut().board_mut();
-        board.load(0x0400, &pattern).expect("RAM");
-        board.load(0x0030, &pattern[..0xD0]).expect("RAM");
-        let before = user_memory(transport.robot());
+        let (transport, before) = patterned_robot();
         let config = FaultConfig {
             stall_after: Some(at),
             stall_for: None,
@@ -372,14 +380,9 @@ fn an_undo_cut_anywhere_can_be_run_again_to_the_end() {
     use uploader::transport::{FaultConfig, FaultyTransport};
     let image = extension(1024, 8);
     let options = UploadOptions::default();
-    let pattern: Vec<u8> = (0..0x0B40u32).map(|i| (i * 13 % 251) as u8 | 1).collect();
     let mut cut = 0;
     for at in (40..3000).step_by(150) {
-        let mut transport = robot();
-        let board = transport.robot_mut().robot_mut().board_mut();
-        board.load(0x0400, &pattern).expect("RAM");
-        board.load(0x0030, &pattern[..0xD0]).expect("RAM");
-        let before = user_memory(transport.robot());
+        let (transport, before) = patterned_robot();
         let mut client = uploader::client(transport, &options.profile);
         let mut kept = Kept::default();
         upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept)
