@@ -670,7 +670,7 @@ pub fn restore<T: Transport>(
         memory.profile.check(&whole)?;
         Some(whole)
     };
-    check_hook_targets(backup, &memory.profile)?;
+    check_hook_targets(backup, &memory.profile, table_range(profile))?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
@@ -748,12 +748,27 @@ fn memory_options(options: &UploadOptions) -> UploadOptions {
 /// can be (a hook there stops the robot at its next command). A hook into
 /// RAM must go where the file restores memory or holds a witness
 /// ([`Error::UnwitnessedHook`]), so that the code it reaches is checked.
-fn check_hook_targets(backup: &Backup, profile: &crate::image::RomProfile) -> Result<()> {
+fn check_hook_targets(
+    backup: &Backup,
+    profile: &crate::image::RomProfile,
+    table: Option<(u16, usize)>,
+) -> Result<()> {
     for &(kind, target) in &backup.hooks {
-        let to_rom = profile.reset_target(kind) == Some(target)
-            || profile.rom.as_ref().is_some_and(|rom| {
-                u32::from(target) >= u32::from(rom.address) && u32::from(target) < rom.end()
+        let to_rom = profile.reset_target(kind) == Some(target);
+        if !to_rom && in_rom(profile, target) {
+            // A backup or an undo file only ever holds the ROM's own
+            // target: anywhere else in the ROM is its data or the middle
+            // of its code (hostile8's F1: a vector, a JMP's operand).
+            return Err(Error::BadImage {
+                reason: format!(
+                    "the backup points {} at ${target:04X}, inside the ROM but not where the ROM points it ({}): no extension's code is there; nothing was written",
+                    kind.rom_symbol(),
+                    profile
+                        .reset_target(kind)
+                        .map_or_else(|| "nowhere".to_owned(), |to| format!("${to:04X}"))
+                ),
             });
+        }
         let to_ram = profile.writable.iter().any(|range| range.contains(&target));
         if !to_rom && !to_ram {
             return Err(Error::BadImage {
@@ -779,6 +794,52 @@ fn check_hook_targets(backup: &Backup, profile: &crate::image::RomProfile) -> Re
                 target,
             });
         }
+        if !to_rom && !witnessed {
+            check_held_entry(backup, table, kind, target)?;
+        }
+    }
+    Ok(())
+}
+
+/// A hook into RAM the file itself restores must find there what starts
+/// an extension's handler (hostile8's F2, F3: a crafted file's hook into
+/// zeros, the table, or the last byte of what it holds): not the table of
+/// installed extensions, and a whole documented instruction other than
+/// `BRK`, every byte of it held by the file.
+fn check_held_entry(
+    backup: &Backup,
+    table: Option<(u16, usize)>,
+    kind: HookKind,
+    target: u16,
+) -> Result<()> {
+    let refuse = |why: String| {
+        Err(Error::BadImage {
+            reason: format!(
+                "the backup points {} at ${target:04X}, {why}: no handler starts there; nothing was written",
+                kind.rom_symbol()
+            ),
+        })
+    };
+    if let Some((at, len)) = table
+        && usize::from(target) >= usize::from(at)
+        && usize::from(target) < usize::from(at) + len
+    {
+        return refuse("in the table of installed extensions".into());
+    }
+    let first = backup.byte_at(u32::from(target)).unwrap_or(0);
+    let opcode = isa::opcode(first);
+    if !opcode.is_documented() || opcode.mnemonic == isa::Mnemonic::Brk {
+        return refuse(format!(
+            "which holds ${first:02X} (not an instruction a handler starts with)"
+        ));
+    }
+    let whole =
+        (0..u32::from(opcode.len())).all(|i| backup.byte_at(u32::from(target) + i).is_some());
+    if !whole {
+        return refuse(format!(
+            "where the file holds only part of the {}-byte instruction",
+            opcode.len()
+        ));
     }
     Ok(())
 }
@@ -999,7 +1060,7 @@ mod tests {
                 hooks: vec![(HookKind::Unknown, target)],
                 ..Backup::default()
             };
-            let said = check_hook_targets(&backup, &memory_options(&options).profile)
+            let said = check_hook_targets(&backup, &memory_options(&options).profile, None)
                 .expect_err("refused")
                 .to_string();
             assert!(said.contains(&format!("${target:04X}")), "{said}");
@@ -1018,7 +1079,7 @@ mod tests {
             ],
             ..Backup::default()
         };
-        assert!(check_hook_targets(&ram, &profile).is_ok());
+        assert!(check_hook_targets(&ram, &profile, table_range(&profile)).is_ok());
     }
 
     /// F6 (issue 27, round 6): a hook into RAM the file neither restores
@@ -1036,7 +1097,8 @@ mod tests {
             }],
             ..Backup::default()
         };
-        let error = check_hook_targets(&bare, &profile).expect_err("refused");
+        let error =
+            check_hook_targets(&bare, &profile, table_range(&profile)).expect_err("refused");
         assert!(
             matches!(
                 error,
@@ -1064,7 +1126,7 @@ mod tests {
             }],
             ..bare.clone()
         };
-        assert!(check_hook_targets(&witnessed, &profile).is_ok());
+        assert!(check_hook_targets(&witnessed, &profile, table_range(&profile)).is_ok());
         let held = Backup {
             areas: vec![Area {
                 address: 0x0700,
@@ -1072,7 +1134,82 @@ mod tests {
             }],
             ..bare
         };
-        assert!(check_hook_targets(&held, &profile).is_ok());
+        assert!(check_hook_targets(&held, &profile, table_range(&profile)).is_ok());
+    }
+
+    /// hostile8's F1-F3: crafted files (a valid checksum) whose hook goes
+    /// into the ROM's data, the middle of its code, zeros, the table of
+    /// installed extensions, or the last byte of what the file holds were
+    /// restored, exit 0, and the robot jammed at its next command.
+    #[test]
+    fn a_hook_at_no_handler_is_refused_before_the_line_is_used() {
+        let profile = RomProfile::reference();
+        let table = table_range(&profile);
+        let (table_at, _) = table.expect("the reference ROM has a table");
+        // As `restore` asks it: the table writable, with the memory.
+        let options = UploadOptions {
+            profile: profile.clone(),
+            ..UploadOptions::default()
+        };
+        let profile = memory_options(&options).profile;
+        let file = |hook: u16, areas: Vec<Area>| Backup {
+            areas,
+            hooks: vec![(HookKind::Unknown, hook)],
+            ..Backup::default()
+        };
+        let handler = vec![0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0];
+        let cases = [
+            (file(0xFF01, Vec::new()), "inside the ROM"),
+            (file(0xFFFC, Vec::new()), "inside the ROM"),
+            (
+                file(
+                    0x0030,
+                    vec![Area {
+                        address: 0x0030,
+                        bytes: vec![0; 16],
+                    }],
+                ),
+                "holds $00",
+            ),
+            (
+                file(
+                    table_at + 8,
+                    vec![Area {
+                        address: table_at,
+                        bytes: vec![0x20; 64],
+                    }],
+                ),
+                "in the table",
+            ),
+            (
+                file(
+                    0x0405,
+                    vec![Area {
+                        address: 0x0400,
+                        bytes: handler.clone(),
+                    }],
+                ),
+                "only part of the 2-byte instruction",
+            ),
+        ];
+        for (backup, why) in cases {
+            let hook = backup.hooks[0].1;
+            let said = check_hook_targets(&backup, &profile, table)
+                .expect_err("refused")
+                .to_string();
+            assert!(
+                said.contains(why) && said.contains(&format!("${hook:04X}")),
+                "{said}"
+            );
+        }
+        let good = file(
+            0x0403,
+            vec![Area {
+                address: 0x0400,
+                bytes: handler,
+            }],
+        );
+        assert!(check_hook_targets(&good, &profile, table).is_ok());
     }
 
     /// The handler of the extension the witness tests keep at $0400.
