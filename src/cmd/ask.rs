@@ -185,7 +185,6 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let transport = ports::open_resolved(&resolved, &[])?;
         Robot::Serial(Client::new(transport, ClientConfig::default()))
     };
-    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
     let timeout = Duration::from_millis(args.timeout);
     let mut out = std::io::stdout().lock();
     for command in &args.commands {
@@ -195,6 +194,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let silent = answer.is_none() && matches!(command, Command::Extension(_));
         if silent && !args.allow_silence {
             out.flush().into_diagnostic()?;
+            // The ROM's profile says where its hook goes: needed only here.
+            let rom = crate::cmd::config::rom(&resolved)?;
+            let profile = crate::cmd::config::profile(rom.as_ref())?;
             return Err(no_answer(&mut robot, &profile, command, args.timeout));
         }
         if args.decode {

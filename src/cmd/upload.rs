@@ -355,7 +355,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         let loader = args.options().loader;
         // Written once the undo's checks pass: an undo stopped after it
         // (killed, a dead line) is finished by the next `--undo`.
-        let started = undoing_path(&path);
+        let started = marked(&path, UNDOING);
         let code = crate::cmd::backup::restore_into(
             transport,
             profile,
@@ -368,7 +368,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         // Marked used: a second undo says "already undone" rather than
         // comparing the robot with an upload no longer on it. Kept (as
         // `.undone`), not deleted: what was undone stays on disk.
-        let used = undone_path(&path);
+        let used = marked(&path, UNDONE);
         if let Err(error) = std::fs::rename(&path, &used) {
             miette::bail!(
                 "undone, but cannot mark the undo file {} used (as {}): {error}",
@@ -406,7 +406,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 /// The undo file, read: a missing one is "nothing to undo"; a damaged
 /// one or something that is not a file says what is wrong with it.
 fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
-    let used = undone_path(path);
+    let used = marked(path, UNDONE);
     match hostfs::check(path, hostfs::BACKUP) {
         Err(error) if error.is_not_found() && used.is_file() => Err(miette::miette!(
             code = "upload::already_undone",
@@ -427,20 +427,19 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
     }
 }
 
-/// Where a used undo file is kept: `X.undo` becomes `X.undo.undone`.
-/// `NAME.undoing`: there while an undo of `NAME` has started and not
+/// The undo file `X.undo` marked: [`UNDONE`] where a used one is kept
+/// (`X.undo.undone`), [`UNDOING`] while an undo of it has started and not
 /// finished.
-fn undoing_path(path: &Path) -> PathBuf {
+fn marked(path: &Path, mark: &str) -> PathBuf {
     let mut name = path.as_os_str().to_owned();
-    name.push(".undoing");
+    name.push(mark);
     PathBuf::from(name)
 }
 
-fn undone_path(path: &Path) -> PathBuf {
-    let mut name = path.as_os_str().to_owned();
-    name.push(".undone");
-    PathBuf::from(name)
-}
+/// See [`marked`].
+const UNDONE: &str = ".undone";
+/// See [`marked`].
+const UNDOING: &str = ".undoing";
 
 /// An undo refused because the robot no longer holds what the undo file's
 /// upload put there, said as such: that upload is no longer on the robot.

@@ -587,6 +587,14 @@ fn check_backup_rom<T: Transport>(
     Ok(overridden)
 }
 
+/// Whether `address` is in `range` (an address and a length: the table's,
+/// as [`table_range`] gives it).
+fn within(range: Option<(u16, usize)>, address: u16) -> bool {
+    range.is_some_and(|(at, len)| {
+        usize::from(address) >= usize::from(at) && usize::from(address) < usize::from(at) + len
+    })
+}
+
 /// Refuses a restore onto a robot whose memory under a hook's target (the
 /// table's entry of the hooked extension, or its code) no longer sums as
 /// it did when the backup was written (nor, with `resume`, holds what the
@@ -605,15 +613,14 @@ fn check_witnesses<T: Transport>(
         // way (killed, a dead line) and wrote it already: finishing it is
         // what the file is for. Only then: a fresh robot's zeros may be
         // what the file holds too.
-        let held: Option<Vec<u8>> = (0..u32::from(witness.len))
-            .map(|i| backup.byte_at(u32::from(witness.address) + i))
-            .collect();
-        let resumed = resume && held.as_ref() == Some(&bytes);
-        if found != witness.sum && !resumed {
-            let in_table = table.is_some_and(|(at, len)| {
-                let start = usize::from(witness.address);
-                start >= usize::from(at) && start < usize::from(at) + len
-            });
+        let resumed = || {
+            let held: Option<Vec<u8>> = (0..u32::from(witness.len))
+                .map(|i| backup.byte_at(u32::from(witness.address) + i))
+                .collect();
+            held.as_ref() == Some(&bytes)
+        };
+        if found != witness.sum && !(resume && resumed()) {
+            let in_table = within(table, witness.address);
             return Err(Error::WitnessDiffers {
                 what: if in_table {
                     "the installed-extension table's entry a hook goes back to"
@@ -820,10 +827,7 @@ fn check_held_entry(
             ),
         })
     };
-    if let Some((at, len)) = table
-        && usize::from(target) >= usize::from(at)
-        && usize::from(target) < usize::from(at) + len
-    {
+    if within(table, target) {
         return refuse("in the table of installed extensions".into());
     }
     let first = backup.byte_at(u32::from(target)).unwrap_or(0);

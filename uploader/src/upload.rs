@@ -733,11 +733,7 @@ fn keep_old<T: Transport>(
     };
     for area in image.areas() {
         // The table entry: the whole table is kept already.
-        let covered = kept
-            .areas
-            .iter()
-            .any(|old| old.address <= area.address && area.end() <= old.end());
-        if covered {
+        if covered(&kept, area) {
             continue;
         }
         let bytes = client.read_memory(area.address, area.bytes.len())?;
@@ -751,6 +747,13 @@ fn keep_old<T: Transport>(
     kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
     Ok(Some(kept))
+}
+
+/// Whether `kept` holds all of `area` in one of its areas already.
+fn covered(kept: &Backup, area: &Area) -> bool {
+    kept.areas
+        .iter()
+        .any(|old| old.address <= area.address && area.end() <= old.end())
 }
 
 /// Puts the chain slots `prepare` re-pointed into what is kept, as they
@@ -816,11 +819,6 @@ fn keep_summed<T: Transport>(
     let Some(mut kept) = kept else {
         return Ok(None);
     };
-    let covered = |kept: &Backup, area: &Area| {
-        kept.areas
-            .iter()
-            .any(|old| old.address <= area.address && area.end() <= old.end())
-    };
     // The sum of zeros is also that of a run of one even byte (Fletcher-16
     // sums modulo 256: 256 bytes of $EA, a NOP sled, sum to nothing). A
     // second sum, of all but the first byte, tells them apart: over an odd
@@ -832,15 +830,12 @@ fn keep_summed<T: Transport>(
         })
         .map(|(area, _)| (area.address + 1, area.bytes.len() - 1))
         .collect();
-    let second: std::collections::HashMap<u16, u16> = if twice.is_empty() {
-        std::collections::HashMap::new()
-    } else {
-        twice
-            .iter()
-            .map(|&(address, _)| address - 1)
-            .zip(crate::sums::robot_sums(client, &twice)?)
-            .collect()
-    };
+    // None asked (no question goes out) where none sums as zeros.
+    let second: std::collections::HashMap<u16, u16> = twice
+        .iter()
+        .map(|&(address, _)| address - 1)
+        .zip(crate::sums::robot_sums(client, &twice)?)
+        .collect();
     for (area, sum) in held {
         let len = area.bytes.len();
         if covered(&kept, area) {

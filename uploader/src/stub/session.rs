@@ -466,10 +466,6 @@ impl<T: Transport> RobotDebug<T> {
         Ok(found)
     }
 
-    /// The bytes a breakpoint an earlier session left at `address`
-    /// displaced, as the robot held them: its trampoline's copy in the
-    /// stub (the displaced bytes, then `JMP` past them), found by that
-    /// `JMP` and the image's bytes but for the chain slots' (`slot_bytes`).
     /// Breakpoints an earlier session left outside this image (a session
     /// with another image installed beside it), with the bytes they
     /// displaced: each found by a trampoline of the stub (the displaced
@@ -504,6 +500,10 @@ impl<T: Transport> RobotDebug<T> {
         Ok(found)
     }
 
+    /// The bytes a breakpoint an earlier session left at `address`
+    /// displaced, as the robot held them: its trampoline's copy in the
+    /// stub (the displaced bytes, then `JMP` past them), found by that
+    /// `JMP` and the image's bytes but for the chain slots' (`slot_bytes`).
     fn displaced_copy(&mut self, address: u16, slot_bytes: &[u16]) -> StubResult<Vec<u8>> {
         let patch = patch::plan(address, &self.image, &[])?;
         let len = patch.displaced.len();
