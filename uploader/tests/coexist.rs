@@ -15,7 +15,7 @@ use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN, USER_RAM_END, USER_RAM_START};
 use uploader::transport::VirtualTransport;
 use uploader::{Area, Client, ClientConfig, Error, LoaderChoice, UploadImage, UploadOptions};
 
-use common::{robot, run};
+use common::{Kept, robot, run};
 
 /// An extension at `base`, `len` bytes (at least 22): `/1<letter>` answers
 /// `<letter>`; anything else falls through its chain slot.
@@ -308,15 +308,6 @@ fn the_same_image_again_behind_another_leaves_no_loop() {
     assert_eq!(answer.as_deref(), Some("A"));
     let (answer, _) = ask(transport, b'H');
     assert_eq!(answer.as_deref(), Some("H"));
-}
-
-#[derive(Default)]
-struct Kept(Option<uploader::Backup>);
-
-impl uploader::Keep for Kept {
-    fn keep(&mut self, overwritten: &uploader::Backup) {
-        self.0 = Some(overwritten.clone());
-    }
 }
 
 /// fresh7's F6, hostile9's F9: `--replace` of an extension in the middle

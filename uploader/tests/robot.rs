@@ -8,12 +8,12 @@
 
 mod common;
 
-use common::{assert_done, extension, one_byte_changed, options, robot, target};
+use common::{Kept, assert_done, extension, one_byte_changed, options, robot, target};
 use romlib::VirtualScorpion;
 use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
 use uploader::transport::VirtualTransport;
 use uploader::{
-    Backup, Error, FINE, Keep, LoaderChoice, NoProgress, UploadOptions, backup, restore, upload,
+    Backup, Error, FINE, LoaderChoice, NoProgress, UploadOptions, backup, restore, upload,
     upload_keeping,
 };
 
@@ -185,16 +185,6 @@ fn one_byte_change_of(len: usize, offset: usize) {
     upload(&mut client, &new, &options, &mut NoProgress).expect("the upload");
     let again = upload(&mut client, &new, &options, &mut NoProgress).expect("again");
     assert!(again.written.is_empty(), "{:?}", again.written);
-}
-
-/// Keeps what an upload overwrote.
-#[derive(Default)]
-struct Kept(Option<Backup>);
-
-impl Keep for Kept {
-    fn keep(&mut self, overwritten: &Backup) {
-        self.0 = Some(overwritten.clone());
-    }
 }
 
 #[test]

@@ -21,6 +21,17 @@ use uploader::{
     loader_plan, upload,
 };
 
+/// Keeps what an upload overwrote (the last file it handed over), for
+/// the tests that undo it.
+#[derive(Default)]
+pub(crate) struct Kept(pub(crate) Option<uploader::Backup>);
+
+impl uploader::Keep for Kept {
+    fn keep(&mut self, overwritten: &uploader::Backup) {
+        self.0 = Some(overwritten.clone());
+    }
+}
+
 /// The 8N1 control value for 9600 baud (emulator::board::acia).
 pub const CTRL_9600: u8 = 0x1E;
 
