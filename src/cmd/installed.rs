@@ -46,9 +46,14 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             continue;
         }
         if let Some(stub) = uploader::stub::left::at_target(&mut client, &profile, last)? {
+            let what = if last == stub.handler {
+                "is"
+            } else {
+                "lies inside the code of"
+            };
             let _ = writeln!(
                 text,
-                "{}: ${last:04X} is a debug stub left hooked at ${:04X}-${:04X} (chaining to ${:04X}): a debug session did not detach, and its breakpoints may still be in the code\n  to take it out: `scorpion debug --port {} --image ELF` (the image it debugged), then `quit`; or reset the robot",
+                "{}: ${last:04X} {what} a debug stub left hooked at ${:04X}-${:04X} (chaining to ${:04X}): a debug session did not detach, and its breakpoints may still be in the code\n  to take it out: `scorpion debug --port {} --image ELF` (the image it debugged), then `quit`; or reset the robot",
                 kind.rom_symbol(),
                 stub.address,
                 stub.end,

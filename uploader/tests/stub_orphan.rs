@@ -280,3 +280,55 @@ fn a_session_killed_with_a_breakpoint_on_a_chain_slot_jmp_is_cleaned_up_with_the
     let hook = usize::from(HOOK_UNKNOWN);
     assert_eq!(memory(&mut client)[hook..hook + 3], [0x4C, 0x03, 0x04]);
 }
+
+/// hostile8 F4: `HOOK_UNKNOWN` pointed by hand into a left stub's code,
+/// not at its handler, was not taken for the stub: an upload chained to
+/// it (the next unknown command ran the stub from the middle). Now the
+/// upload refuses it, and the session the refusal names takes it out and
+/// gives the hook back to what the stub chains to.
+#[test]
+fn a_hook_pointed_inside_a_stub_left_hooked_is_that_stub() {
+    let image = handler();
+    let stub = {
+        let client = uploaded(&[&image]);
+        attach(client, &image).stub().clone()
+    };
+    for target in [stub.handler + 1, stub.address, stub.code_end - 8] {
+        let mut client = killed_session(&image);
+        client
+            .transport()
+            .robot_mut()
+            .robot_mut()
+            .board_mut()
+            .load(HOOK_UNKNOWN + 1, &target.to_le_bytes())
+            .expect("RAM");
+        let before = written(&mut client);
+        let result = uploader::upload(&mut client, &image, &options(), &mut NoProgress);
+        refused_naming_the_stub(result, stub.address);
+        assert!(
+            written(&mut client) == before,
+            "${target:04X}: something was written"
+        );
+        let debug = attach(client, &image);
+        let recovery = debug.recovery().clone();
+        assert!(recovery.hooked, "${target:04X}: {recovery:?}");
+        assert_eq!(recovery.hooked_inside, Some(target));
+        assert_eq!(recovery.removed, [AT]);
+        assert!(
+            recovery.describe().contains(&format!("${target:04X}")),
+            "{}",
+            recovery.describe()
+        );
+        let mut client = debug.detach().expect("detached");
+        let hook = usize::from(HOOK_UNKNOWN);
+        assert_eq!(
+            memory(&mut client)[hook..hook + 3],
+            [0x4C, 0x03, 0x04],
+            "${target:04X}: the hook back at the image's handler"
+        );
+        uploader::upload(&mut client, &image, &options(), &mut NoProgress).expect("uploaded");
+        assert_eq!(ask(&mut client, b'Q'), Some(Answer::Text("Q42".into())));
+        let fresh = ask(&mut uploaded(&[&image]), b'Z');
+        assert_eq!(ask(&mut client, b'Z'), fresh, "${target:04X}: `/1Z`");
+    }
+}

@@ -8,7 +8,7 @@
 
 use isa::objfmt::HookKind;
 
-use super::link::{handler_offset, left_pattern};
+use super::link::left_pattern;
 use crate::client::Client;
 use crate::image::RomProfile;
 use crate::transport::Transport;
@@ -29,14 +29,23 @@ pub struct LeftStub {
     pub previous: u16,
 }
 
-/// Bytes of the handler compared first: one short question tells most
-/// targets from a stub.
+/// Bytes at the hook's target compared first: one short question tells
+/// most targets from a stub.
 const FIRST_LOOK: usize = 12;
 
-/// Whether `target` is the handler of a debug stub: the robot's bytes
-/// compared with the stub linked so that its handler is there, but for
-/// those that depend on its zero page and its chain. A short read of the
-/// handler first, the whole code only when that matches.
+/// Bytes of the stub's code (not its chain's or zero page's) that must
+/// agree before a target inside its code is looked at whole: fewer would
+/// send every target whose first byte is a `JMP` to a long read.
+const FEWEST_AGREEING: usize = 4;
+
+/// Whether `target` lies in the code of a debug stub: its handler (where
+/// a session hooks it), or anywhere else in its code (a hook pointed there
+/// by hand or by a glitch runs the stub's instructions from the middle,
+/// and chaining to it keeps the stub reachable all the same). The robot's
+/// bytes are compared with the stub linked where it would start, but for
+/// those that depend on its zero page and its chain: a short read at the
+/// target first, the whole code only where that agrees with some place in
+/// the stub's code.
 ///
 /// # Errors
 /// The line's errors.
@@ -45,40 +54,89 @@ pub fn at_target<T: Transport>(
     profile: &RomProfile,
     target: u16,
 ) -> Result<Option<LeftStub>> {
-    let Some(offset) = handler_offset(profile) else {
+    let Some(shape) = Shape::of(profile) else {
         return Ok(None);
     };
-    let Some(address) = target.checked_sub(offset) else {
-        return Ok(None);
-    };
-    let Some((pattern, handler, whole)) = left_pattern(profile, address) else {
-        return Ok(None);
-    };
-    let matches = |found: &[u8], expected: &[Option<u8>]| {
-        found.len() == expected.len()
-            && found
-                .iter()
-                .zip(expected)
-                .all(|(&byte, want)| want.is_none_or(|want| want == byte))
-    };
-    let from = usize::from(offset);
-    let first = &pattern[from..pattern.len().min(from + FIRST_LOOK)];
-    if handler != target || !matches(&client.read_memory(target, first.len())?, first) {
-        return Ok(None);
+    let look = FIRST_LOOK.min(0x1_0000 - usize::from(target));
+    let first = client.read_memory(target, look)?;
+    for into in shape.places_agreeing(&first) {
+        let Some(address) = target.checked_sub(into as u16) else {
+            continue;
+        };
+        let Some((pattern, handler, whole)) = left_pattern(profile, address) else {
+            continue;
+        };
+        let seen = first.len().min(pattern.len() - into);
+        if !agrees(&first[..seen], &pattern[into..into + seen]) {
+            continue;
+        }
+        let code = client.read_memory(address, pattern.len())?;
+        if !agrees(&code, &pattern) {
+            continue;
+        }
+        // Its last instruction is `JMP PREV`.
+        let previous = u16::from_le_bytes([code[code.len() - 2], code[code.len() - 1]]);
+        return Ok(Some(LeftStub {
+            address,
+            handler,
+            code_end: address.wrapping_add(pattern.len() as u16),
+            end: address.wrapping_add(whole as u16).wrapping_sub(1),
+            previous,
+        }));
     }
-    let code = client.read_memory(address, pattern.len())?;
-    if !matches(&code, &pattern) {
-        return Ok(None);
+    Ok(None)
+}
+
+/// Whether the robot's bytes agree with the pattern's (`None` agrees with
+/// any byte).
+fn agrees(found: &[u8], expected: &[Option<u8>]) -> bool {
+    found.len() == expected.len()
+        && found
+            .iter()
+            .zip(expected)
+            .all(|(&byte, want)| want.is_none_or(|want| want == byte))
+}
+
+/// The stub's code wherever it is linked: the bytes that depend on where
+/// it is, its zero page or its chain left open.
+struct Shape {
+    pattern: Vec<Option<u8>>,
+    /// Where its handler lies from its start.
+    handler: usize,
+}
+
+impl Shape {
+    fn of(profile: &RomProfile) -> Option<Shape> {
+        // Two places that differ in both bytes of every address.
+        let one = *profile.user_ram.start();
+        let two = one.checked_add(0x0101)?;
+        let (first, handler, _) = left_pattern(profile, one)?;
+        let (second, _, _) = left_pattern(profile, two)?;
+        let pattern = first
+            .iter()
+            .zip(&second)
+            .map(|(&a, &b)| if a == b { a } else { None })
+            .collect();
+        Some(Shape {
+            pattern,
+            handler: usize::from(handler - one),
+        })
     }
-    // Its last instruction is `JMP PREV`.
-    let previous = u16::from_le_bytes([code[code.len() - 2], code[code.len() - 1]]);
-    Ok(Some(LeftStub {
-        address,
-        handler,
-        code_end: address.wrapping_add(pattern.len() as u16),
-        end: address.wrapping_add(whole as u16).wrapping_sub(1),
-        previous,
-    }))
+
+    /// The places in the stub's code where `bytes` could start, the
+    /// handler first: those whose known bytes all agree, and at least
+    /// [`FEWEST_AGREEING`] of them.
+    fn places_agreeing(&self, bytes: &[u8]) -> Vec<usize> {
+        let others = (0..self.pattern.len()).filter(|&into| into != self.handler);
+        std::iter::once(self.handler)
+            .chain(others)
+            .filter(|&into| {
+                let seen = &self.pattern[into..self.pattern.len().min(into + bytes.len())];
+                let known = seen.iter().flatten().count();
+                agrees(&bytes[..seen.len()], seen) && known >= FEWEST_AGREEING
+            })
+            .collect()
+    }
 }
 
 /// Refuses when a hook of `hooks` leads to a debug stub a session left

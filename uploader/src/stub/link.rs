@@ -252,11 +252,3 @@ pub(crate) fn left_pattern(
         .collect();
     Some((pattern, handler, one.len()))
 }
-
-/// Where the stub's handler lies from its start (the same wherever it is
-/// linked).
-pub(crate) fn handler_offset(profile: &RomProfile) -> Option<u16> {
-    let start = *profile.user_ram.start();
-    let (_, handler, _) = left_pattern(profile, start)?;
-    handler.checked_sub(start)
-}

@@ -113,6 +113,11 @@ pub struct Recovery {
     pub stopped: Option<Registers>,
     /// The stub was still hooked on `HOOK_UNKNOWN`.
     pub hooked: bool,
+    /// Where `HOOK_UNKNOWN` pointed when that was inside the stub's code
+    /// but not its handler (by hand, or a glitch): hooked at the handler
+    /// again, so that the end of the session gives the hook back to what
+    /// the stub chains to.
+    pub hooked_inside: Option<u16>,
     /// `JSR`s into the stub left in the code: the image's bytes put back
     /// and read back.
     pub removed: Vec<u16>,
@@ -138,8 +143,14 @@ impl Recovery {
                 registers.pc
             ));
         }
-        if self.hooked {
-            parts.push("its stub was still hooked on HOOK_UNKNOWN (hooked again)".to_owned());
+        match (self.hooked, self.hooked_inside) {
+            (true, Some(at)) => parts.push(format!(
+                "HOOK_UNKNOWN led to ${at:04X}, inside its stub's code rather than to its handler (hooked at the handler again)"
+            )),
+            (true, None) => {
+                parts.push("its stub was still hooked on HOOK_UNKNOWN (hooked again)".to_owned());
+            }
+            (false, _) => {}
         }
         if !self.removed.is_empty() {
             let at: Vec<String> = self.removed.iter().map(|a| format!("${a:04X}")).collect();
@@ -220,11 +231,20 @@ impl<T: Transport> RobotDebug<T> {
         }
         let jump = debug.read(hook, 3)?;
         let target = u16::from_le_bytes([jump[1], jump[2]]);
-        if !stopped
+        let left = if !stopped
             && target != placed.handler
             && profile.reset_target(isa::objfmt::HookKind::Unknown) != Some(target)
-            && let Some(other) = super::left::at_target(&mut debug.client, profile, target)?
         {
+            super::left::at_target(&mut debug.client, profile, target)?
+        } else {
+            None
+        };
+        // A hook into the middle of this image's own stub is that stub
+        // hooked: chaining to it would make the new stub run itself.
+        debug.recovery.hooked_inside = left
+            .filter(|left| left.address == placed.address)
+            .map(|_| target);
+        if let Some(other) = left.filter(|left| left.address != placed.address) {
             // Chaining to it would keep it, and its breakpoints, reachable.
             return Err(StubError::Refused {
                 what: "attaching".into(),
@@ -241,7 +261,7 @@ impl<T: Transport> RobotDebug<T> {
         if debug.stopped.is_some() && !present {
             return Err(stopped_in_another_stub(placed.address));
         }
-        debug.recovery.hooked = target == placed.handler;
+        debug.recovery.hooked = target == placed.handler || debug.recovery.hooked_inside.is_some();
         let previous = if debug.recovery.hooked {
             if !present {
                 return Err(StubError::NotTheImage {
