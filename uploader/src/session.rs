@@ -195,7 +195,7 @@ impl Session {
             Start::Write
         };
         loop {
-            let error = match self.hook_loader(client, start) {
+            let error = match self.hook_loader(client, start, before_write) {
                 Ok(()) => break,
                 Err(error) if recoverable(&error) && self.recoveries < MAX_RECOVERIES => error,
                 Err(error) => return Err(error),
@@ -300,7 +300,12 @@ impl Session {
     /// hooked. Each part is hooked only once it and every part it falls
     /// into verified. The robot answers at the host's rate when this
     /// starts.
-    fn hook_loader<T: Transport>(&mut self, client: &mut Client<T>, start: Start) -> Result<()> {
+    fn hook_loader<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        start: Start,
+        before_write: &mut BeforeWrite<'_, T>,
+    ) -> Result<()> {
         match self.fast {
             Some(fast) if client.transport().baud() != fast => {
                 // `rate` found in RAM was read whole already, and ran on
@@ -320,12 +325,12 @@ impl Session {
                 }
                 self.keep_zero_page(client)?;
                 let part = self.loader.frames_part()?;
-                self.put_then_check_rom(client, &part, start)?;
+                self.verify_rom_part(client, &part, start, before_write)?;
             }
             _ => {
                 self.keep_zero_page(client)?;
                 let part = self.loader.rom_part()?;
-                self.put_then_check_rom(client, &part, start)?;
+                self.verify_rom_part(client, &part, start, before_write)?;
             }
         }
         self.target = client.transport().baud();
@@ -338,8 +343,65 @@ impl Session {
         if !self.with_sums {
             return Ok(());
         }
-        self.put_framed(client, &self.loader.sums_part()?, start)?;
+        let part = self.loader.sums_part()?;
+        if !self.resident_as_linked(client, &part, start, before_write)? {
+            self.put_framed(client, &part, start)?;
+        }
         switch_hook(client, self.hook, self.loader.sums, self.limits.max_writes)
+    }
+
+    /// [`Session::put_then_check_rom`], after [`Session::resident_as_linked`].
+    fn verify_rom_part<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        part: &UploadImage,
+        start: Start,
+        before_write: &mut BeforeWrite<'_, T>,
+    ) -> Result<()> {
+        if !self.resident_as_linked(client, part, start, before_write)? {
+            return self.put_then_check_rom(client, part, start);
+        }
+        if !self.with_sums {
+            self.check_rom(client)?;
+        }
+        Ok(())
+    }
+
+    /// Under [`Session::keep_under`], a part of a loader found in RAM is
+    /// read before it is verified, so that bytes changed since the upload
+    /// that left it (by hand, a glitch) are kept for the undo, and in its
+    /// file, before the verification writes over them. Whether the part
+    /// holds what it should (then it needs nothing more: that read was
+    /// the verification); `false` where there is nothing to keep.
+    fn resident_as_linked<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        part: &UploadImage,
+        start: Start,
+        before_write: &mut BeforeWrite<'_, T>,
+    ) -> Result<bool> {
+        if start != Start::Resident || !self.keep_under {
+            return Ok(false);
+        }
+        let mut changed = false;
+        for area in part.areas() {
+            let expected: Vec<Option<u8>> = area.bytes.iter().copied().map(Some).collect();
+            let held = client.read_expecting(area.address, &expected)?;
+            let differing = held.iter().zip(&area.bytes).enumerate();
+            let mut differing = differing.filter(|(_, (held, linked))| held != linked);
+            if let Some((first, _)) = differing.next() {
+                let last = differing.last().map_or(first, |(at, _)| at);
+                self.under.push(Area {
+                    address: area.address + first as u16,
+                    bytes: held[first..=last].to_vec(),
+                });
+                changed = true;
+            }
+        }
+        if changed {
+            before_write(client, &self.under)?;
+        }
+        Ok(!changed)
     }
 
     /// Puts a part of the loader in through the ROM's commands with the
@@ -514,7 +576,7 @@ impl Session {
             baud: rate,
         });
         self.recoveries += 1;
-        self.hook_loader(client, Start::Verify)
+        self.hook_loader(client, Start::Verify, &mut |_, _| Ok(()))
     }
 
     /// Carries the body in frames, checking and restoring the loader when

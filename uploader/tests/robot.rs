@@ -406,3 +406,40 @@ fn an_undo_cut_anywhere_can_be_run_again_to_the_end() {
     }
     assert!(cut > 5, "cut {cut} times");
 }
+
+/// hostile9's F4: a loader an earlier upload left in RAM, one byte of its
+/// place changed since (by hand, a glitch): the next upload's verification
+/// wrote the loader's byte over it without keeping it, and the undo left
+/// the loader's byte there.
+#[test]
+fn an_undo_puts_back_a_byte_changed_in_a_loader_left_in_ram() {
+    let image = extension(1024, 8);
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    let first = uploader::upload(&mut client, &image, &options, &mut NoProgress).expect("first");
+    let loader = first.loader.expect("through the RAM loader");
+    // One byte in each of the loader's last two parts (the first, `rate`,
+    // changed makes the loader be written whole, kept as ever).
+    let places = [loader.address + 40, loader.address + loader.len as u16 - 12];
+    let board = client.transport().robot_mut().robot_mut().board_mut();
+    for at in places {
+        let byte = board.memory()[usize::from(at)];
+        board.load(at, &[byte ^ 0x5A]).expect("RAM");
+    }
+    let before = user_memory(client.transport().robot());
+    let mut kept = Kept::default();
+    upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept)
+        .expect("the upload again");
+    let memory = client.transport().robot().robot().board().memory();
+    for at in places {
+        assert_ne!(
+            memory[usize::from(at)],
+            before[usize::from(at) - 0x0400 + 0xD6],
+            "${at:04X}: the loader's byte is back"
+        );
+    }
+    let kept = kept.0.expect("kept");
+    restore(&mut client, &kept, &options, &mut NoProgress).expect("the undo");
+    let after = user_memory(client.transport().robot());
+    assert_eq!(first_difference(&after, &before), None, "all put back");
+}
