@@ -69,19 +69,26 @@ pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::A
     // No `/1X` first: a robot left stopped in the stub answers none; attach
     // finds that out with a frame, and asks `/1X` of a running one.
     let client = uploader::client(transport, &profile);
-    // Reading the code twice and writing the stub with the ROM's commands
-    // takes seconds at 9600 baud: said, so a silent terminal is not taken
-    // for a hang.
-    let baud = resolved.baud.value;
-    let chars = code.len() * 4 + 600 * 6;
+    // Reading the code and writing the stub with the ROM's commands takes
+    // seconds at 9600 baud: said, so a silent terminal is not taken for a
+    // hang.
     #[allow(
         clippy::print_stderr,
         reason = "progress of a long attach, before the session starts"
     )]
-    {
+    if let Ok(stub) = uploader::stub::StubPlan::place(&profile, &code, 0) {
+        let seconds = |chars: usize| (chars * 10).div_ceil(resolved.baud.value as usize);
+        let (all, code_len) = (stub.bytes.len(), usize::from(stub.code_end - stub.address));
+        // Two characters a byte read, 5.5 written (`/9W`); the image's code
+        // read once, the frame that asks for a stopped stub twice (1.3 s).
+        let compared = code.len() * 2 + 1250 * resolved.baud.value as usize / 10_000;
+        let first = compared + code_len * 4 + all * 15 / 2 + all * 2;
+        let again = compared + code_len * 2 + (all - code_len) * 15 / 2 + all * 2;
         eprintln!(
-            "attaching: comparing the robot's code with the image and writing the debug stub (about {} s at {baud} baud)",
-            (chars * 10).div_ceil(baud as usize).max(1)
+            "attaching: comparing the robot's code with the image and writing the debug stub (about {} s at {} baud; {} s the first time on this robot)",
+            seconds(again),
+            resolved.baud.value,
+            seconds(first)
         );
     }
     let robot = RobotDebug::attach(client, &profile, code)?;

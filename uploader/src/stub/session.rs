@@ -255,7 +255,18 @@ impl<T: Transport> RobotDebug<T> {
             });
         }
         let code_len = usize::from(placed.code_end - placed.address);
-        let code = debug.read(placed.address, code_len)?;
+        let code = if debug.stopped.is_none() {
+            // Read once where it is there already (a session before this
+            // one put it there), as the stub but for `JMP PREV`'s operand.
+            let expected: Vec<Option<u8>> = placed.bytes[..code_len]
+                .iter()
+                .enumerate()
+                .map(|(i, &byte)| (i < code_len - 2).then_some(byte))
+                .collect();
+            debug.client.read_expecting(placed.address, &expected)?
+        } else {
+            debug.read(placed.address, code_len)?
+        };
         // The stub's code but for `JMP PREV`'s operand, its last two bytes.
         let present = code[..code_len - 2] == placed.bytes[..code_len - 2];
         if debug.stopped.is_some() && !present {
@@ -287,7 +298,12 @@ impl<T: Transport> RobotDebug<T> {
             // The stub runs: its data (the stop's registers) is kept.
             debug.write_verified(stub.address, &stub.bytes[..code_len])?;
         } else {
-            debug.rom_write_verified(stub.address, &stub.bytes)?;
+            let held: &[u8] = if stub.address == placed.address {
+                &code
+            } else {
+                &[]
+            };
+            debug.rom_write_over(stub.address, &stub.bytes, held)?;
         }
         debug.write_verified(hook + 1, &stub.handler.to_le_bytes())?;
         for (address, original) in leftovers {
@@ -595,11 +611,23 @@ impl<T: Transport> RobotDebug<T> {
     /// elsewhere: so the whole range is read once more after the last
     /// piece, and written again where it differs.
     fn rom_write_verified(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        self.rom_write_over(address, bytes, &[])
+    }
+
+    /// [`RobotDebug::rom_write_verified`] where the robot is known to hold
+    /// `held` from `address` (read already): pieces that hold their bytes
+    /// are not written (the read back at the end covers them all).
+    fn rom_write_over(&mut self, address: u16, bytes: &[u8], held: &[u8]) -> StubResult<()> {
         for (i, piece) in bytes.chunks(ROM_PIECE).enumerate() {
-            self.rom_write_piece(address.wrapping_add((i * ROM_PIECE) as u16), piece)?;
+            let start = i * ROM_PIECE;
+            if held.get(start..start + piece.len()) == Some(piece) {
+                continue;
+            }
+            self.rom_write_piece(address.wrapping_add(start as u16), piece)?;
         }
+        let expected: Vec<Option<u8>> = bytes.iter().copied().map(Some).collect();
         for _ in 0..ATTEMPTS {
-            let found = self.client.read_memory(address, bytes.len())?;
+            let found = self.client.read_expecting(address, &expected)?;
             if found == bytes {
                 return Ok(());
             }
@@ -642,7 +670,8 @@ impl<T: Transport> RobotDebug<T> {
                 }
                 self.client.send_raw(&text)?;
             }
-            let found = self.client.read_memory(address, bytes.len())?;
+            let expected: Vec<Option<u8>> = bytes.iter().copied().map(Some).collect();
+            let found = self.client.read_expecting(address, &expected)?;
             todo = (0..bytes.len())
                 .filter(|&i| found[i] != bytes[i])
                 .map(|i| (address.wrapping_add(i as u16), vec![bytes[i]]))
