@@ -390,7 +390,7 @@ impl Session {
             let differing = held.iter().zip(&area.bytes).enumerate();
             let mut differing = differing.filter(|(_, (held, linked))| held != linked);
             if let Some((first, _)) = differing.next() {
-                let last = differing.last().map_or(first, |(at, _)| at);
+                let last = differing.next_back().map_or(first, |(at, _)| at);
                 self.under.push(Area {
                     address: area.address + first as u16,
                     bytes: held[first..=last].to_vec(),
