@@ -45,7 +45,11 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
 /// environment's or the project's `[robot] port`), running `program`
 /// (its image; a directory: the project's images), the stub attached as
 /// `scorpion debug --port` attaches it.
-pub(crate) fn attach(program: &Path, port: &str) -> miette::Result<debugger::dap::Attached> {
+pub(crate) fn attach(
+    program: &Path,
+    port: &str,
+    say: &mut dyn FnMut(&str),
+) -> miette::Result<debugger::dap::Attached> {
     let (images, root) = if program.is_dir() {
         (Vec::new(), program.to_path_buf())
     } else {
@@ -59,7 +63,7 @@ pub(crate) fn attach(program: &Path, port: &str) -> miette::Result<debugger::dap
         images,
         ..debug::Args::default()
     };
-    let attached = debug::robot::attach(&args, port)?;
+    let attached = debug::robot::attach(&args, port, say)?;
     Ok(debugger::dap::Attached { root, ..attached })
 }
 

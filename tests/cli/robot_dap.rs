@@ -127,6 +127,15 @@ fn launched(dir: &std::path::Path, sim: &Sim) -> Client {
 fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
     let (dir, sim) = handler_on_a_pty_robot();
     let mut dap = launched(dir.path(), &sim);
+    // The seconds of the attach are said in the editor's console first.
+    let said = dap.event("output");
+    assert_eq!(said["body"]["category"], "console", "{said}");
+    assert!(
+        said["body"]["output"].as_str().is_some_and(
+            |text| text.starts_with(&format!("attaching to the robot on {}", sim.path))
+        ),
+        "{said}"
+    );
     // On the robot there is no going back and no data breakpoint.
     let capabilities = dap.event("capabilities");
     assert_eq!(
@@ -367,7 +376,8 @@ fn a_launch_says_what_it_cleaned_up_in_the_console_before_the_first_stop() {
     let mut dap = launched(dir.path(), &sim);
     let said = loop {
         let output = dap.event("output");
-        if output["body"]["category"] == "console" {
+        let text = output["body"]["output"].as_str().unwrap_or_default();
+        if output["body"]["category"] == "console" && !text.starts_with("attaching") {
             break output;
         }
     };

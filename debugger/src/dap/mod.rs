@@ -83,8 +83,10 @@ impl std::fmt::Debug for Attached {
 
 /// Attaches to the robot on `port` (empty: the project's `[robot] port`)
 /// running `program` (an image or a project's directory), or says why
-/// it cannot, in full.
-pub type Attacher = Box<dyn Fn(&Path, &str) -> miette::Result<Attached> + Send>;
+/// it cannot, in full; what a person waiting should know meanwhile (how
+/// long it takes) goes to the callback, for the editor's console.
+pub type Attacher =
+    Box<dyn Fn(&Path, &str, &mut dyn FnMut(&str)) -> miette::Result<Attached> + Send>;
 
 /// Builds the robot for `launch`'s `program` (a linked image or a
 /// project's directory), or says why it cannot, in full.

@@ -645,7 +645,13 @@ impl Session {
                 .as_ref()
                 .ok_or("this adapter cannot open a robot's port")?;
             self.busy.start(format!("attaching to the robot on {port}"));
-            let attached = attacher(Path::new(program), port).map_err(|e| format!("{e:?}"));
+            let outbox = &self.outbox;
+            let mut say = |said: &str| {
+                // A console line lost with the editor gone is no matter.
+                let _ = outbox.output("console", &format!("{said}\n"));
+            };
+            let attached =
+                attacher(Path::new(program), port, &mut say).map_err(|e| format!("{e:?}"));
             self.busy.end();
             attached
         })();

@@ -26,7 +26,13 @@ const NOTICE: std::time::Duration = std::time::Duration::from_millis(30);
 /// The robot on `port` (empty: the environment's or the project's)
 /// with the stub attached beside the images `args` names, the names of
 /// the ROM and the images, and the images (their sources from here).
-pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::Attached> {
+/// `say` hears what a person waiting should know (how long the attach
+/// takes), before the seconds it takes.
+pub(crate) fn attach(
+    args: &Args,
+    port: &str,
+    say: &mut dyn FnMut(&str),
+) -> miette::Result<debugger::dap::Attached> {
     // `--port` alone: the one the environment or the project names.
     let port = (!port.is_empty()).then(|| port.to_owned());
     let resolved = crate::cmd::config::resolve(&crate::cmd::config::flags(
@@ -68,28 +74,25 @@ pub(crate) fn attach(args: &Args, port: &str) -> miette::Result<debugger::dap::A
     let transport = ports::open_resolved(&resolved, &images)?;
     // No `/1X` first: a robot left stopped in the stub answers none; attach
     // finds that out with a frame, and asks `/1X` of a running one.
-    let client = uploader::client(transport, &profile);
+    let mut client = uploader::client(transport, &profile);
     // Reading the code and writing the stub with the ROM's commands takes
-    // seconds at 9600 baud: said, so a silent terminal is not taken for a
-    // hang.
-    #[allow(
-        clippy::print_stderr,
-        reason = "progress of a long attach, before the session starts"
-    )]
+    // seconds at 9600 baud: said, so a silent terminal (or editor) is not
+    // taken for a hang.
     if let Ok(stub) = uploader::stub::StubPlan::place(&profile, &code, 0) {
-        let seconds = |chars: usize| (chars * 10).div_ceil(resolved.baud.value as usize);
+        let baud = resolved.baud.value as usize;
+        let seconds = |chars: usize| (chars * 10).div_ceil(baud);
         let (all, code_len) = (stub.bytes.len(), usize::from(stub.code_end - stub.address));
         // Two characters a byte read, 5.5 written (`/9W`); the image's code
         // read once, the frame that asks for a stopped stub twice (1.3 s).
-        let compared = code.len() * 2 + 1250 * resolved.baud.value as usize / 10_000;
+        let compared = code.len() * 2 + 1250 * baud / 10_000;
         let first = compared + code_len * 4 + all * 15 / 2 + all * 2;
         let again = compared + code_len * 2 + (all - code_len) * 15 / 2 + all * 2;
-        eprintln!(
-            "attaching: comparing the robot's code with the image and writing the debug stub (about {} s at {} baud; {} s the first time on this robot)",
+        say(&format!(
+            "attaching to the robot on {}: comparing its code with the image and writing the debug stub (about {} s at {baud} baud; {} s the first time on this robot)",
+            client.transport().name(),
             seconds(again),
-            resolved.baud.value,
             seconds(first)
-        );
+        ));
     }
     let robot = RobotDebug::attach(client, &profile, code)?;
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
@@ -120,7 +123,15 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         symbols,
         images: linked,
         ..
-    } = attach(args, port)?;
+    } = attach(args, port, &mut |said| {
+        #[allow(
+            clippy::print_stderr,
+            reason = "progress of a long attach, before the session starts"
+        )]
+        {
+            eprintln!("{said}");
+        }
+    })?;
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
     let mut monitor = RobotMonitor::new(symbols, linked);
