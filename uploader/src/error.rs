@@ -204,6 +204,25 @@ pub enum Error {
         port: String,
     },
 
+    /// A hook's chain that comes back into the image: the image would
+    /// chain to code that jumps back into it, a loop the robot would run
+    /// for ever at its next unknown command.
+    #[error(
+        "{hook} leads {path}, back into the image: chained to it, the image would run in a loop at the robot's next unknown command; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::chain_comes_back),
+        help(
+            "the code at the start of that way jumps into an earlier copy of this image (an owner's JMP, a stub's chain): point {hook} back at the ROM (`scorpion restore` of a backup taken before, or reset the robot) and upload again"
+        )
+    )]
+    ChainComesBack {
+        /// The hook's name.
+        hook: &'static str,
+        /// The way, `$0600 -> $0400`.
+        path: String,
+    },
+
     /// A debug stub a session left hooked (its process killed before it
     /// detached): chaining to it would loop back to the image it debugged,
     /// and its breakpoints may still be in the code.

@@ -10,7 +10,7 @@ use crate::transport::Transport;
 use crate::{Error, Result};
 
 /// The `JMP` opcode every hook holds.
-const JMP: u8 = 0x4C;
+pub(crate) const JMP: u8 = 0x4C;
 
 /// Reads a hook's `JMP` target. One read is enough when it shows a target
 /// in `known` (a corrupted answer does not fake a particular address);

@@ -24,6 +24,7 @@ mod always;
 mod backup;
 mod beside;
 mod body;
+mod chain;
 mod client;
 mod delta;
 mod error;

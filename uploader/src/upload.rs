@@ -19,6 +19,7 @@ use romlib::protocol::{Command, Extension};
 
 use crate::backup::{Backup, Keep, NoKeep};
 use crate::body::{Body, Limits, RunEnd, Writer};
+use crate::chain;
 use crate::client::{Client, ClientConfig, spans};
 use crate::delta;
 use crate::fingerprint;
@@ -386,12 +387,15 @@ pub fn upload_keeping<T: Transport>(
             // behind it survives; else to the ROM's target. (The loader
             // falls through to nothing: it is only ever hooked in place of
             // the ROM's own target.)
+            // Only a hook at the image's handler is such a copy's: one
+            // into the middle of the image is into code this upload
+            // overwrites, whose chain slot, if any, is not there.
             let slot = match loader {
                 Some(_) => None,
                 None => image
                     .hooks()
                     .iter()
-                    .find(|record| record.kind == kind)
+                    .find(|record| record.kind == kind && record.handler == target)
                     .and_then(|record| record.chain),
             };
             let fallthrough = match slot {
@@ -400,6 +404,15 @@ pub fn upload_keeping<T: Transport>(
                         && (others.iter().any(|other| other.contains(to))
                             || leftover.as_ref().is_none_or(|l| !l.contains(to)))
                 }),
+                None => None,
+            };
+            // Nor is a way out one that comes back into the image.
+            let fallthrough = match fallthrough {
+                Some(to) => chain::comes_back(client, profile, others, (kind, to), &|at| {
+                    image.contains(at)
+                })?
+                .is_none()
+                .then_some(to),
                 None => None,
             };
             let Some(to) = fallthrough.or(profile.reset_target(kind)) else {
@@ -416,6 +429,16 @@ pub fn upload_keeping<T: Transport>(
                 to,
             });
             target = to;
+        } else if let Some(path) =
+            chain::comes_back(client, profile, others, (kind, target), &|at| {
+                image.contains(at)
+            })?
+        {
+            // Chaining the image to it would make a loop.
+            return Err(Error::ChainComesBack {
+                hook: kind.rom_symbol(),
+                path: path.to_string(),
+            });
         }
         initial.push((kind, target));
     }

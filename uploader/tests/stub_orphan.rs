@@ -4,7 +4,9 @@
 //! before anything is written (chaining to it made a loop); the stub goes
 //! where no installed extension and no RAM loader lies; a breakpoint a
 //! killed session left on a chain slot's `JMP` is taken out with the
-//! robot's bytes, not the image's.
+//! robot's bytes, not the image's. A hook whose chain comes back into
+//! what an upload or a session writes (hostile10's F2 to F4) is refused
+//! before anything is written.
 
 mod common;
 
@@ -331,4 +333,123 @@ fn a_hook_pointed_inside_a_stub_left_hooked_is_that_stub() {
         let fresh = ask(&mut uploaded(&[&image]), b'Z');
         assert_eq!(ask(&mut client, b'Z'), fresh, "${target:04X}: `/1Z`");
     }
+}
+
+/// Puts `bytes` into the robot's RAM at `at` as an owner (or a glitch)
+/// would, and points `HOOK_UNKNOWN` at `target`.
+fn by_hand(client: &mut Client<VirtualTransport>, at: u16, bytes: &[u8], target: u16) {
+    let board = client.transport().robot_mut().robot_mut().board_mut();
+    board.load(at, bytes).expect("RAM");
+    board
+        .load(HOOK_UNKNOWN + 1, &target.to_le_bytes())
+        .expect("RAM");
+}
+
+/// hostile10 F3: `HOOK_UNKNOWN` into the middle of the image's place
+/// (code nobody's table names) was taken for an earlier copy of the image
+/// and its "chain slot" read: the hook went to $0000 and the image chained
+/// there. Now the hook goes back to the ROM's target, and so does the chain.
+#[test]
+fn a_hook_into_the_middle_of_the_upload_goes_back_to_the_rom() {
+    let image = answering(0x0400, b'U');
+    let mut client = uploaded(&[]);
+    // `JMP BAD_COMMAND` at $0410, hooked.
+    by_hand(&mut client, 0x0410, &[0x4C, 0x21, 0xFF], 0x0410);
+    uploader::upload(&mut client, &image, &options(), &mut NoProgress).expect("uploaded");
+    let memory = memory(&mut client);
+    assert_eq!(memory[0x0413..0x0416], [0x4C, 0x21, 0xFF], "the chain slot");
+    assert_eq!(ask(&mut client, b'U'), Some(Answer::Text("U".into())));
+    let fresh = ask(&mut uploaded(&[&image]), b'Z');
+    assert_eq!(
+        ask(&mut client, b'Z'),
+        fresh,
+        "`/1Z` falls through to the ROM"
+    );
+}
+
+/// hostile10 F4: `HOOK_UNKNOWN` at an owner's `JMP` back into an earlier
+/// copy of the image: chained to it, the image jumped to itself for ever
+/// at the next unknown command (exit 0). Refused, nothing written.
+#[test]
+fn an_upload_whose_chain_comes_back_into_the_image_is_refused() {
+    let image = answering(0x0400, b'U');
+    let mut client = uploaded(&[&image]);
+    by_hand(&mut client, 0x0600, &[0x4C, 0x00, 0x04], 0x0600);
+    let before = written(&mut client);
+    let result = uploader::upload(&mut client, &image, &options(), &mut NoProgress);
+    match &result {
+        Err(error @ Error::ChainComesBack { path, .. }) => {
+            assert_eq!(path, "$0600 -> $0400", "{error}");
+            assert!(error.to_string().contains("HOOK_UNKNOWN"), "{error}");
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+    assert!(written(&mut client) == before, "something was written");
+    // The robot as it was: `/1U` still answers through the owner's JMP.
+    assert_eq!(ask(&mut client, b'U'), Some(Answer::Text("U".into())));
+}
+
+/// hostile10 F4, the stub's way: `HOOK_UNKNOWN` at the last instruction of
+/// a stub a killed session left (`JMP PREV`, to the image's handler) was
+/// neither taken for the stub nor followed: the image chained to it.
+#[test]
+fn an_upload_whose_chain_is_a_left_stubs_jmp_is_refused() {
+    let image = handler();
+    let client = uploaded(&[&image]);
+    let debug = attach(client, &image);
+    let stub = debug.stub().clone();
+    let mut client = debug.abandon();
+    by_hand(&mut client, stub.code_end - 3, &[], stub.code_end - 3);
+    let before = written(&mut client);
+    let result = uploader::upload(&mut client, &image, &options(), &mut NoProgress);
+    assert!(
+        matches!(
+            result,
+            Err(Error::ChainComesBack { .. } | Error::DebugStubHooked { .. })
+        ),
+        "{result:?}"
+    );
+    assert!(written(&mut client) == before, "something was written");
+}
+
+/// hostile10 F2: an owner's `JMP` into a stub an earlier session left in
+/// RAM (unhooked), hooked: the next session wrote its stub there and
+/// chained it to that `JMP`, a loop (the robot dead until reset). Attach
+/// refuses before it writes anything; the upload too, through the old
+/// stub's chain.
+#[test]
+fn an_attach_whose_chain_comes_back_into_the_stubs_place_is_refused() {
+    let image = handler();
+    let looped = || {
+        let client = uploaded(&[&image]);
+        let debug = attach(client, &image);
+        let stub = debug.stub().clone();
+        let mut client = debug.detach().expect("detached");
+        let [low, high] = stub.handler.to_le_bytes();
+        by_hand(&mut client, 0x0600, &[0x4C, low, high], 0x0600);
+        assert_eq!(ask(&mut client, b'Q'), Some(Answer::Text("Q42".into())));
+        (client, stub)
+    };
+    let (client, stub) = looped();
+    let result = RobotDebug::attach(client, &RomProfile::reference(), image.clone());
+    let Err(uploader::stub::StubError::Refused { reason, .. }) = result else {
+        panic!(
+            "not refused: {:?}",
+            result.map(|debug| debug.stub().clone())
+        );
+    };
+    assert!(
+        reason.contains(&format!("$0600 -> ${:04X}", stub.handler)),
+        "{reason}"
+    );
+    let (mut client, _) = looped();
+    let before = written(&mut client);
+    let result = uploader::upload(&mut client, &image, &options(), &mut NoProgress);
+    match &result {
+        Err(Error::ChainComesBack { path, .. }) => {
+            assert_eq!(path, &format!("$0600 -> ${:04X} -> $0403", stub.handler));
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+    assert!(written(&mut client) == before, "something was written");
 }
