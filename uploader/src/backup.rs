@@ -338,6 +338,8 @@ pub(crate) fn table_range(profile: &RomProfile) -> Option<(u16, usize)> {
 /// A line error, [`Error::Unreadable`], [`Error::NotAHook`].
 pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Backup> {
     let hooks = read_hooks(client, profile)?;
+    // Restored, a stub a session left hooked would be back with no host.
+    crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
     let mut areas = Vec::new();
     for (address, len) in backup_ranges(profile) {
         areas.push(Area {
@@ -678,6 +680,7 @@ pub fn restore<T: Transport>(
         Some(whole)
     };
     check_hook_targets(backup, &memory.profile, table_range(profile))?;
+    refuse_held_stub(backup, profile)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
@@ -803,6 +806,26 @@ fn check_hook_targets(
         }
         if !to_rom && !witnessed {
             check_held_entry(backup, table, kind, target)?;
+        }
+    }
+    Ok(())
+}
+
+/// A file taken while a debug session was attached (or had died) holds
+/// its stub hooked (hostile10's F1): restored, the stub would be back with
+/// no host, its breakpoints' `JSR`s live in the code.
+fn refuse_held_stub(backup: &Backup, profile: &RomProfile) -> Result<()> {
+    for &(kind, target) in &backup.hooks {
+        if kind != HookKind::Unknown || profile.reset_target(kind) == Some(target) {
+            continue;
+        }
+        let held = |at: u16| backup.byte_at(u32::from(at));
+        if let Some(stub) = crate::stub::left::held_at_target(profile, target, &held) {
+            return Err(Error::BackupHoldsDebugStub {
+                hook: kind.rom_symbol(),
+                stub: stub.address,
+                end: stub.end,
+            });
         }
     }
     Ok(())

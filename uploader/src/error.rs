@@ -223,6 +223,26 @@ pub enum Error {
         path: String,
     },
 
+    /// A backup whose `HOOK_UNKNOWN` leads to a debug stub it holds: taken
+    /// while a debug session was attached, or after one died.
+    #[error(
+        "the backup points {hook} at a debug stub it holds (${stub:04X}-${end:04X}): it was taken while a debug session was attached, or after one died; restored, the stub would be back with no host, its breakpoints in the code; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::backup_holds_debug_stub),
+        help(
+            "restore a backup taken with no debug session attached (`scorpion debug --port PORT --image ELF`, then `quit`, takes a session's stub out before a backup)"
+        )
+    )]
+    BackupHoldsDebugStub {
+        /// The hook's name.
+        hook: &'static str,
+        /// Where the stub starts.
+        stub: u16,
+        /// Its last byte, data included.
+        end: u16,
+    },
+
     /// A debug stub a session left hooked (its process killed before it
     /// detached): chaining to it would loop back to the image it debugged,
     /// and its breakpoints may still be in the code.

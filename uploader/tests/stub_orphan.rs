@@ -453,3 +453,45 @@ fn an_attach_whose_chain_comes_back_into_the_stubs_place_is_refused() {
     }
     assert!(written(&mut client) == before, "something was written");
 }
+
+/// hostile10 F1: a backup taken with a killed session's stub hooked held
+/// it, and restoring the file brought the stub back hooked with no host
+/// (and its breakpoint's `JSR`), exit 0. The backup is refused; a file
+/// that holds a stub hooked (taken before this, or crafted) is refused by
+/// the restore, with nothing written.
+#[test]
+fn a_backup_with_a_stub_hooked_is_refused_and_so_is_restoring_one() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let mut client = killed_session(&image);
+    let result = uploader::backup(&mut client, &profile);
+    assert!(
+        matches!(result, Err(Error::DebugStubHooked { .. })),
+        "{:?}",
+        result.map(|_| "a backup")
+    );
+    // A file as a backup taken then held it: the stub in RAM (a session
+    // detached leaves it there, unhooked), the hook pointed at it.
+    let client = uploaded(&[&image]);
+    let debug = attach(client, &image);
+    let stub = debug.stub().clone();
+    let mut client = debug.detach().expect("detached");
+    let mut saved = uploader::backup(&mut client, &profile).expect("a backup");
+    for hook in &mut saved.hooks {
+        if hook.0 == HookKind::Unknown {
+            hook.1 = stub.handler;
+        }
+    }
+    let before = written(&mut client);
+    match uploader::restore(&mut client, &saved, &options(), &mut NoProgress) {
+        Err(error @ Error::BackupHoldsDebugStub { .. }) => {
+            let said = error.to_string();
+            assert!(
+                said.contains(&format!("${:04X}", stub.address)) && said.contains("HOOK_UNKNOWN"),
+                "{said}"
+            );
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+    assert!(written(&mut client) == before, "something was written");
+}

@@ -54,11 +54,38 @@ pub fn at_target<T: Transport>(
     profile: &RomProfile,
     target: u16,
 ) -> Result<Option<LeftStub>> {
+    find(profile, target, &mut |at, len| {
+        client.read_memory(at, len).map(Some)
+    })
+}
+
+/// [`at_target`] in memory held elsewhere (a backup file's): `byte_at`
+/// says what it holds at an address, `None` where it holds nothing (no
+/// stub is found across a hole).
+pub(crate) fn held_at_target(
+    profile: &RomProfile,
+    target: u16,
+    byte_at: &dyn Fn(u16) -> Option<u8>,
+) -> Option<LeftStub> {
+    let mut read = |at: u16, len: usize| -> Result<Option<Vec<u8>>> {
+        Ok((0..len)
+            .map(|i| byte_at(at.wrapping_add(i as u16)))
+            .collect())
+    };
+    find(profile, target, &mut read).ok().flatten()
+}
+
+/// Reads `len` bytes at an address (`None`: not known there).
+type Read<'a> = dyn FnMut(u16, usize) -> Result<Option<Vec<u8>>> + 'a;
+
+fn find(profile: &RomProfile, target: u16, read: &mut Read<'_>) -> Result<Option<LeftStub>> {
     let Some(shape) = Shape::of(profile) else {
         return Ok(None);
     };
     let look = FIRST_LOOK.min(0x1_0000 - usize::from(target));
-    let first = client.read_memory(target, look)?;
+    let Some(first) = read(target, look)? else {
+        return Ok(None);
+    };
     for into in shape.places_agreeing(&first) {
         let Some(address) = target.checked_sub(into as u16) else {
             continue;
@@ -70,7 +97,9 @@ pub fn at_target<T: Transport>(
         if !agrees(&first[..seen], &pattern[into..into + seen]) {
             continue;
         }
-        let code = client.read_memory(address, pattern.len())?;
+        let Some(code) = read(address, pattern.len())? else {
+            continue;
+        };
         if !agrees(&code, &pattern) {
             continue;
         }
