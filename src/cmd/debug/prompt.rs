@@ -76,7 +76,7 @@ pub(crate) enum Input {
         history: Option<PathBuf>,
     },
     /// Plain lines (a script, a pipe).
-    Plain(std::io::StdinLock<'static>),
+    Plain(std::io::Stdin),
 }
 
 impl Input {
@@ -105,7 +105,7 @@ impl Input {
                 };
             }
         }
-        Input::Plain(std::io::stdin().lock())
+        Input::Plain(std::io::stdin())
     }
 
     /// Whether lines come from a terminal (else they are echoed, so that
@@ -147,7 +147,7 @@ impl Input {
                     "that line could not be read: {other}"
                 ))),
             },
-            Input::Plain(stdin) => plain_line(stdin),
+            Input::Plain(stdin) => plain_line(&mut stdin.lock()),
         }
     }
 }
@@ -188,6 +188,65 @@ fn plain_line(stdin: &mut impl BufRead) -> std::io::Result<Read> {
         Ok(line) => Read::Line(line),
         Err(_) => Read::Invalid("that line is not UTF-8 text; it was skipped".to_owned()),
     })
+}
+
+/// The monitor's input read on a thread of its own, a line when asked:
+/// a signal then ends a session whose read waits (a `kill` at the prompt,
+/// a pipe left open), where the read itself would wait for the next line.
+pub(crate) struct Reader {
+    ask: std::sync::mpsc::Sender<()>,
+    lines: std::sync::mpsc::Receiver<std::io::Result<Read>>,
+    terminal: bool,
+}
+
+impl Reader {
+    /// Reads `input` on a thread, `prompt` before each line.
+    pub(crate) fn start(mut input: Input, prompt: &'static str) -> Reader {
+        let terminal = input.is_terminal();
+        let (ask, asked) = std::sync::mpsc::channel::<()>();
+        let (send, lines) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            while asked.recv().is_ok() {
+                if send.send(input.read(prompt)).is_err() {
+                    break;
+                }
+            }
+        });
+        Reader {
+            ask,
+            lines,
+            terminal,
+        }
+    }
+
+    /// Whether lines come from a terminal.
+    pub(crate) fn is_terminal(&self) -> bool {
+        self.terminal
+    }
+
+    /// The next line; `None` once `ended` is set while it is awaited.
+    pub(crate) fn read(
+        &self,
+        ended: &std::sync::atomic::AtomicBool,
+    ) -> Option<std::io::Result<Read>> {
+        if self.ask.send(()).is_err() {
+            return Some(Ok(Read::End));
+        }
+        loop {
+            match self
+                .lines
+                .recv_timeout(std::time::Duration::from_millis(50))
+            {
+                Ok(read) => return Some(read),
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return Some(Ok(Read::End)),
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if ended.load(std::sync::atomic::Ordering::Relaxed) {
+                        return None;
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Where the history of a session in `root` is kept: the project's

@@ -14,7 +14,7 @@ use miette::{IntoDiagnostic, WrapErr};
 use uploader::stub::RobotDebug;
 
 use super::Args;
-use super::prompt::{Completion, Input, Read};
+use super::prompt::{Completion, Input, Read, Reader};
 use crate::cmd::ports;
 
 const PROMPT: &str = "(robot) ";
@@ -135,7 +135,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
     let mut monitor = RobotMonitor::new(symbols, linked);
-    let mut input = Input::new(
+    let input = Input::new(
         std::io::IsTerminal::is_terminal(&std::io::stdin()),
         completion,
         None,
@@ -175,7 +175,23 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     // A wait for the robot (a continue's, a step's) ends at the signal
     // too, not only the next line read.
     robot.set_interrupt(std::sync::Arc::clone(&ended));
-    let session = converse(&mut robot, &mut monitor, &mut input, &mut out, &ended);
+    // The terminal as it is now: a signal that ends the session while the
+    // line editor holds it raw leaves it so, for the shell after.
+    let terminal = input
+        .is_terminal()
+        .then(|| nix::sys::termios::tcgetattr(std::io::stdin()).ok())
+        .flatten();
+    let reader = Reader::start(input, PROMPT);
+    let session = converse(&mut robot, &mut monitor, &reader, &mut out, &ended);
+    if let Some(terminal) = &terminal
+        && ended.load(Ordering::Relaxed)
+    {
+        let _ = nix::sys::termios::tcsetattr(
+            std::io::stdin(),
+            nix::sys::termios::SetArg::TCSANOW,
+            terminal,
+        );
+    }
     // Given back whatever ended the conversation (an unwritable terminal
     // too), before its error is said.
     let detached = robot.detach();
@@ -198,7 +214,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
 fn converse<T: uploader::transport::Transport>(
     robot: &mut RobotDebug<T>,
     monitor: &mut RobotMonitor,
-    input: &mut Input,
+    input: &Reader,
     out: &mut impl Write,
     ended: &AtomicBool,
 ) -> miette::Result<bool> {
@@ -208,7 +224,12 @@ fn converse<T: uploader::transport::Transport>(
             write!(out, "{PROMPT}").into_diagnostic()?;
         }
         out.flush().into_diagnostic()?;
-        let line = match input.read(PROMPT).into_diagnostic()? {
+        let Some(read) = input.read(ended) else {
+            // A signal while the line was awaited.
+            writeln!(out).into_diagnostic()?;
+            break;
+        };
+        let line = match read.into_diagnostic()? {
             Read::Line(line) => line,
             Read::Interrupted => {
                 // rustyline read the key; the signal's flag is not set.
