@@ -45,6 +45,17 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         if owned || profile.reset_target(*kind) == Some(last) {
             continue;
         }
+        if let Some(place) = uploader::loader_left_at(&mut client, &profile, last)? {
+            let _ = writeln!(
+                text,
+                "{}: ${last:04X} is the RAM loader (${:04X}-${:04X}) an upload left hooked: it did not finish (killed, or its line failed); unknown commands other than the loader's own go to the ROM\n  `scorpion upload --undo --port {}` puts back what that upload overwrote, or upload again",
+                kind.rom_symbol(),
+                place.start(),
+                place.end(),
+                client.transport().name(),
+            );
+            continue;
+        }
         if let Some(stub) = uploader::stub::left::at_target(&mut client, &profile, last)? {
             let what = if last == stub.handler {
                 "is"

@@ -82,20 +82,84 @@ pub(crate) struct Args {
 }
 
 /// Writes what an upload overwrote to the undo file as soon as it is
-/// read, before the image's bytes go out.
+/// read, before the image's bytes go out; marks it [`UPLOADING`] until the
+/// upload has finished.
 struct UndoFile {
     path: PathBuf,
     failed: Option<miette::Report>,
+    /// Whether it was written (said if the upload is interrupted).
+    kept: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 impl uploader::Keep for UndoFile {
     fn keep(&mut self, overwritten: &uploader::Backup) {
+        // Marked first: an upload killed from here on has not finished,
+        // and the next one must not replace what the file keeps.
+        if let Err(error) = hostfs::write(&marked(&self.path, UPLOADING), b"") {
+            self.failed = Some(error.into());
+            return;
+        }
         // Its directory exists: `undo_file_writable` made the project's or
         // refused a missing one. Through a temporary file: an undo file is whole or the last one.
         if let Err(error) = hostfs::write(&self.path, &overwritten.encode()) {
             self.failed = Some(error.into());
+            return;
         }
+        self.kept.store(true, std::sync::atomic::Ordering::Relaxed);
     }
+}
+
+/// Says, on a signal (Ctrl-C, `kill`), what an interrupted upload left
+/// before the process ends as the signal would have ended it.
+fn say_when_interrupted(
+    undo: PathBuf,
+    kept: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> miette::Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .map_err(|error| miette::miette!("cannot watch for Ctrl-C: {error}"))?;
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            let said = if kept.load(std::sync::atomic::Ordering::Relaxed) {
+                format!(
+                    "interrupted: the upload did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` puts back what the robot held before it (kept in {}); or upload again",
+                    undo.display()
+                )
+            } else {
+                "interrupted before anything of the image was written; nothing that did not verify is hooked".to_owned()
+            };
+            #[allow(clippy::print_stderr, reason = "the CLI's last word")]
+            {
+                eprintln!("\n{said}");
+            }
+            std::process::exit(128 + signal);
+        }
+    });
+    Ok(())
+}
+
+/// Refuses an upload that would replace the undo file of one that did not
+/// finish (marked [`UPLOADING`]): that file keeps what the robot held
+/// before it, which nothing else does.
+fn refuse_unfinished(undo: &Path) -> miette::Result<()> {
+    let mark = marked(undo, UPLOADING);
+    if !mark.exists() {
+        return Ok(());
+    }
+    if !undo.is_file() {
+        // Nothing kept: the mark of an upload whose file went since.
+        let _ = std::fs::remove_file(&mark);
+        return Ok(());
+    }
+    Err(miette::miette!(
+        code = "upload::unfinished",
+        help = format!(
+            "`scorpion upload --undo` puts the robot back as it was before that upload, then upload again; or keep this upload's undo elsewhere (`--undo-file`); deleting {} gives that undo up",
+            mark.display()
+        ),
+        "the last upload did not finish (killed, or its line failed): {} keeps what the robot held before it, and this upload's undo file would replace it; nothing was sent",
+        undo.display()
+    ))
 }
 
 impl Args {
@@ -376,12 +440,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 used.display()
             );
         }
+        // An upload that did not finish is undone too.
+        let _ = std::fs::remove_file(marked(&path, UPLOADING));
         return Ok(code);
     }
     // The undo file is written during the upload: a FIFO or a device there
     // would block it half way, so it is refused before the robot is touched.
     if !resolved.is_emulated() {
         undo_file_writable(&args.undo_path(), args.undo_file.is_none())?;
+        refuse_unfinished(&args.undo_path())?;
     }
     match &args.image {
         Some(path) => upload_file(args, &resolved, path),
@@ -429,7 +496,7 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
 
 /// The undo file `X.undo` marked: [`UNDONE`] where a used one is kept
 /// (`X.undo.undone`), [`UNDOING`] while an undo of it has started and not
-/// finished.
+/// finished, [`UPLOADING`] while the upload that wrote it has not.
 fn marked(path: &Path, mark: &str) -> PathBuf {
     let mut name = path.as_os_str().to_owned();
     name.push(mark);
@@ -440,6 +507,8 @@ fn marked(path: &Path, mark: &str) -> PathBuf {
 const UNDONE: &str = ".undone";
 /// See [`marked`].
 const UNDOING: &str = ".undoing";
+/// See [`marked`]: an upload wrote the file and has not finished.
+const UPLOADING: &str = ".uploading";
 
 /// An undo refused because the robot no longer holds what the undo file's
 /// upload put there, said as such: that upload is no longer on the robot.
@@ -546,16 +615,22 @@ fn upload_file(
     let mut undo = UndoFile {
         path: args.undo_path(),
         failed: None,
+        kept: std::sync::Arc::default(),
     };
     // `emu` is a fresh virtual Scorpion for each command: nothing of it
     // outlives this one for an undo to put back.
     let result = if emulated {
         uploader::upload(&mut client, &image, &options, &mut bar)
     } else {
+        say_when_interrupted(undo.path.clone(), std::sync::Arc::clone(&undo.kept))?;
         uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
     };
     bar.bar.finish_and_clear();
     let report = result?;
+    if !emulated {
+        // Finished: the next upload may replace the undo file.
+        let _ = std::fs::remove_file(marked(&undo.path, UPLOADING));
+    }
     if let Some(error) = undo.failed {
         bar.say(&format!(
             "warning: cannot write the undo file {}: {error}",

@@ -343,3 +343,59 @@ fn the_undo_of_a_chained_extension_goes_back_to_the_first() {
     let text = ok(d, &line, &["read", "$0200", "3"]);
     assert!(text.contains("0200: 4C 03 0C"), "back to the first: {text}");
 }
+
+/// fresh10 F6: an upload interrupted (Ctrl-C) said nothing of what it
+/// left, and the next upload replaced its undo file, the only record of
+/// what the robot held before it. Now the interruption says so, the next
+/// upload is refused until `upload --undo` (which puts the robot back),
+/// and after that uploads go on.
+#[test]
+fn an_interrupted_upload_says_so_and_its_undo_file_is_not_replaced() {
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let dir = dir.path();
+    std::fs::write(dir.join("ext.elf"), extension_at(0x0400, 2048, None)).expect("the image");
+    let sim = Sim::start(dir, &[]);
+    let line = ["--port", sim.path.as_str()];
+    ok(dir, &line, &["read", "$0400", "2048", "-o", "before.bin"]);
+    let child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .args(["upload", "ext.elf", "--no-dry-run", "--port", &sim.path])
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("scorpion runs");
+    let undo = dir.join("scorpion-last-upload.undo");
+    let waited = std::time::Instant::now();
+    while !undo.exists() && waited.elapsed() < std::time::Duration::from_secs(30) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(undo.exists(), "no undo file within 30 s");
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let output = child.wait_with_output().expect("it ends");
+    let said = transcript(&output);
+    assert_eq!(output.status.code(), Some(130), "{said}");
+    assert!(
+        said.contains("interrupted: the upload did not finish")
+            && said.contains("scorpion upload --undo"),
+        "{said}"
+    );
+    let (success, said) = on(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    assert!(!success, "{said}");
+    assert!(said.contains("the last upload did not finish"), "{said}");
+    ok(dir, &line, &["upload", "--undo"]);
+    ok(dir, &line, &["read", "$0400", "2048", "-o", "after.bin"]);
+    assert!(
+        std::fs::read(dir.join("after.bin")).expect("a dump")
+            == std::fs::read(dir.join("before.bin")).expect("a dump"),
+        "the undo put the robot's RAM back"
+    );
+    ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+}

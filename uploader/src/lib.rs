@@ -54,7 +54,8 @@ pub use image::{
     UploadImage,
 };
 pub use loader::{
-    FAST_BAUD, FRAME_MAX, LoaderPlan, loader_estimate, loader_frame, loader_plan, rom_only_estimate,
+    FAST_BAUD, FRAME_MAX, LoaderPlan, loader_estimate, loader_frame, loader_left_at, loader_plan,
+    rom_only_estimate,
 };
 pub use progress::{Event, NoProgress, Phase, Progress};
 pub use sums::fletcher16;

@@ -29,7 +29,9 @@ use platform::{acia, map};
 
 use romlib::installed::Installed;
 
+use crate::client::Client;
 use crate::image::{Area, RomProfile, Services, UploadImage};
+use crate::transport::Transport;
 use crate::transport::char_time;
 use crate::{Error, Result};
 
@@ -131,6 +133,53 @@ pub fn loader_plan(
             zero_page: loader.zero_page..=loader.zero_page + (ZERO_PAGE_LEN - 1),
         }),
     )
+}
+
+/// Whether `target` (a hook's) is the RAM loader where an upload leaves
+/// it, at the top of user RAM: an upload that did not finish (killed, its
+/// line cut) leaves it hooked in place of the ROM's target. Its place when
+/// it is (the bytes there read and compared with the loader's).
+///
+/// # Errors
+/// The line's errors.
+pub fn loader_left_at<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    target: u16,
+) -> Result<Option<std::ops::RangeInclusive<u16>>> {
+    // An image at the start of user RAM leaves the loader its usual place.
+    let start = *profile.user_ram.start();
+    let probe = UploadImage::new(
+        vec![Area {
+            address: start,
+            bytes: vec![0],
+        }],
+        Vec::new(),
+    )?;
+    // Linked for a line raised to the fast rate, or kept at its own (a
+    // pseudo-terminal, `--fast-baud 0`): the switch's bytes differ.
+    let baud = client.transport().baud();
+    let mut held: Option<Vec<u8>> = None;
+    for rates in [(baud, FAST_BAUD), (baud, baud)] {
+        let Some(plan) = loader_plan(profile, &probe, rates)? else {
+            continue;
+        };
+        if ![plan.rate_handler, plan.frames_handler, plan.sums_handler].contains(&target) {
+            continue;
+        }
+        let code = &plan.code;
+        let from = usize::from(target - code.address);
+        let expected = &code.bytes[from..code.bytes.len().min(from + 8)];
+        if held.is_none() {
+            held = Some(client.read_memory(target, expected.len())?);
+        }
+        if held.as_deref() == Some(expected) {
+            return Ok(Some(
+                code.address..=code.address + (code.bytes.len() as u16 - 1),
+            ));
+        }
+    }
+    Ok(None)
 }
 
 impl Loader {

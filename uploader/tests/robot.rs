@@ -443,3 +443,44 @@ fn an_undo_puts_back_a_byte_changed_in_a_loader_left_in_ram() {
     let after = user_memory(client.transport().robot());
     assert_eq!(first_difference(&after, &before), None, "all put back");
 }
+
+/// fresh10 F6: an upload cut while its RAM loader was hooked left
+/// `HOOK_UNKNOWN` at an address nothing named (`installed` showed it bare).
+/// `loader_left_at` tells it for the loader; nothing else is taken for it.
+#[test]
+fn the_ram_loader_an_upload_cut_left_hooked_is_told() {
+    use uploader::transport::{FaultConfig, FaultyTransport};
+    let image = extension(1024, 8);
+    // The line kept at its rate, as on a pseudo-terminal: a robot left at
+    // the fast rate is found there first (`installed` probes it).
+    let options = UploadOptions {
+        fast_baud: None,
+        ..UploadOptions::default()
+    };
+    let mut told = 0;
+    for at in (200..2600).step_by(200) {
+        let config = FaultConfig {
+            stall_after: Some(at),
+            stall_for: None,
+            ..FaultConfig::none(3)
+        };
+        let mut client = uploader::client(FaultyTransport::new(robot(), config), &options.profile);
+        if uploader::upload(&mut client, &image, &options, &mut NoProgress).is_ok() {
+            break;
+        }
+        let transport = client.into_transport().into_inner();
+        let memory = transport.robot().robot().board().memory();
+        let hook = usize::from(romlib::symbols::HOOK_UNKNOWN);
+        let target = u16::from_le_bytes([memory[hook + 1], memory[hook + 2]]);
+        let mut client = uploader::client(transport, &options.profile);
+        let left = uploader::loader_left_at(&mut client, &options.profile, target).expect("read");
+        let rom = options.profile.reset_target(isa::objfmt::HookKind::Unknown);
+        if Some(target) == rom || target == 0x0400 {
+            assert_eq!(left, None, "cut after {at}: ${target:04X} is no loader");
+        } else {
+            assert!(left.is_some(), "cut after {at}: ${target:04X} not told");
+            told += 1;
+        }
+    }
+    assert!(told > 2, "told {told} times");
+}
