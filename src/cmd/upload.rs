@@ -95,7 +95,7 @@ impl uploader::Keep for UndoFile {
     fn keep(&mut self, overwritten: &uploader::Backup) {
         // Marked first: an upload killed from here on has not finished,
         // and the next one must not replace what the file keeps.
-        if let Err(error) = hostfs::write(&marked(&self.path, UPLOADING), b"") {
+        if let Err(error) = hostfs::write(marked(&self.path, UPLOADING), b"") {
             self.failed = Some(error.into());
             return;
         }
