@@ -109,8 +109,24 @@ pub(crate) fn restore_into(
         .iter()
         .flat_map(|report| report.written.iter().map(|range| range.1))
         .sum();
+    // Through the RAM loader, what it ran over goes back after it, with
+    // the ROM's commands: written whatever the robot held (fresh10 F3:
+    // an unchanged robot read as "188 written").
+    let after_loader: usize = match reports.as_slice() {
+        [_, after] => after.written.iter().map(|range| range.1).sum(),
+        _ => 0,
+    };
+    let written = match after_loader {
+        0 => format!("{written} written"),
+        all if all == written => {
+            format!("{written} written, all where the RAM loader ran, put back after it")
+        }
+        some => {
+            format!("{written} written, {some} of them where the RAM loader ran, put back after it")
+        }
+    };
     print(&format!(
-        "restored {} ({} bytes checked, {written} written, {} hooks), verified",
+        "restored {} ({} bytes checked, {written}, {} hooks), verified",
         file.display(),
         backup.len(),
         backup.hooks.len()

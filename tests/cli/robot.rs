@@ -292,6 +292,25 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         std::fs::read(dir.path().join("after.bak")).expect("a backup"),
         std::fs::read(dir.path().join("robot.bak")).expect("a backup"),
     );
+    // fresh10 F3: restored again onto a robot that holds it, the bytes
+    // written are said as the RAM loader's, not as changes found.
+    let output = scorpion(
+        dir.path(),
+        &[
+            "restore",
+            "robot.bak",
+            "--port",
+            &sim.path,
+            "--baud",
+            "19200",
+        ],
+    );
+    let said = transcript(&output);
+    assert!(output.status.success(), "{said}");
+    assert!(
+        said.contains("written, all where the RAM loader ran, put back after it"),
+        "{said}"
+    );
 }
 
 /// `scorpion ARGS` in `dir`, killed after `seconds` (exit status 124):
