@@ -137,6 +137,27 @@ impl RobotMonitor {
         self.eval(d, &expr)
     }
 
+    /// A breakpoint at `address` not set, as said: a refusal with the
+    /// nearest instruction after it that takes one, as a place to type
+    /// (the one a refusal advises may be refused in turn).
+    pub fn refused_breakpoint<T: Transport>(
+        &self,
+        d: &RobotDebug<T>,
+        address: u16,
+        error: StubError,
+    ) -> Failure {
+        let instead = matches!(error, StubError::Refused { .. })
+            .then(|| uploader::stub::patch::nearest(address, d.image(), &self.entries))
+            .flatten();
+        match (failure(error), instead) {
+            (Failure::Usage(said), Some(instead)) => Failure::Usage(format!(
+                "{said}\n  the nearest instruction after it that takes one: {} (`break ${instead:04X}`)",
+                self.place(instead)
+            )),
+            (other, _) => other,
+        }
+    }
+
     /// The name of `address` (a label or a source line), for a frame.
     #[must_use]
     pub fn place(&self, address: u16) -> String {
@@ -380,7 +401,9 @@ impl RobotMonitor {
                     .map_err(|_| usage(&format!("{after} is no address")))?
             }
         };
-        d.set_breakpoint(address, &self.entries).map_err(failure)?;
+        if let Err(error) = d.set_breakpoint(address, &self.entries) {
+            return Err(self.refused_breakpoint(d, address, error));
+        }
         let id = self.next_id;
         self.next_id += 1;
         self.breakpoints.insert(id, address);

@@ -393,3 +393,19 @@ fn the_stubs_zero_page_shows_and_takes_the_programs_bytes() {
         debug.detach().expect("detached");
     });
 }
+
+/// fresh10 F4: a breakpoint refused for the branch it would displace
+/// advised "the instruction after it", which was refused in turn. The
+/// refusal now names the nearest instruction that takes one.
+#[test]
+fn the_nearest_place_that_takes_a_breakpoint_is_found() {
+    use uploader::stub::patch::{nearest, plan};
+    let image = common::stub::handler();
+    // $0403 CMP #'Q', $0405 BNE: refused there.
+    assert!(plan(0x0403, &image, &[]).is_err());
+    // $0407 LDA #'Q' and $0409 JSR PUTCH: five bytes, no branch.
+    assert_eq!(nearest(0x0403, &image, &[]), Some(0x0407));
+    // With a line starting at $0409 the JSR at $0407 would cover it.
+    assert_eq!(nearest(0x0403, &image, &[0x0409]), Some(0x0409));
+    assert!(plan(0x0409, &image, &[0x0409]).is_ok());
+}

@@ -64,6 +64,20 @@ enum After {
 }
 
 impl RobotSession {
+    /// Lets the robot go as `disconnect` does (breakpoints out, a stopped
+    /// robot let go on, the hook given back), where no `disconnect` came:
+    /// the editor went away, or the adapter was told to stop.
+    ///
+    /// # Errors
+    /// What went wrong on the line, said.
+    pub fn let_go(&mut self) -> Result<(), String> {
+        self.running = false;
+        match self.robot.take() {
+            Some(robot) => robot.detach().map(|_| ()).map_err(|e| failure(e).message()),
+            None => Ok(()),
+        }
+    }
+
     /// A session on the `attached` robot.
     #[must_use]
     pub fn new(attached: super::Attached) -> RobotSession {
@@ -385,7 +399,13 @@ impl RobotSession {
                         self.breakpoints.insert(id, (path.clone(), at));
                         json!({"verified": true, "id": id, "instructionReference": format!("0x{at:04X}")})
                     }
-                    Err(error) => json!({"verified": false, "message": failure(error).message()}),
+                    Err(error) => {
+                        let said = match &self.robot {
+                            Some(robot) => self.monitor.refused_breakpoint(robot, at, error),
+                            None => failure(error),
+                        };
+                        json!({"verified": false, "message": said.message()})
+                    }
                 },
             };
             answer["line"] = json!(line);

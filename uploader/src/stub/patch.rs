@@ -153,6 +153,29 @@ pub fn plan(address: u16, image: &UploadImage, entries: &[u16]) -> StubResult<Pa
     })
 }
 
+/// Instructions looked at after a refused breakpoint for one that takes it.
+const NEAREST_LOOK: usize = 16;
+
+/// The first instruction after `address` in `image` where a breakpoint
+/// would not be refused ([`plan`] with `entries`), a few instructions on
+/// at most: what a refusal can offer instead of a place that would be
+/// refused too (fresh10 F4: "the instruction after it" was a branch's
+/// neighbour, refused in turn).
+#[must_use]
+pub fn nearest(address: u16, image: &UploadImage, entries: &[u16]) -> Option<u16> {
+    let mut at = address;
+    for _ in 0..NEAREST_LOOK {
+        let bytes: Vec<u8> = (0..3)
+            .map_while(|i| image.byte(at.wrapping_add(i)))
+            .collect();
+        at = Instruction::decode(&bytes, at)?.next_address();
+        if plan(at, image, entries).is_ok() {
+            return Some(at);
+        }
+    }
+    None
+}
+
 /// Where the instruction at `pc` (decoded from `read`) can go next, for a
 /// step: `Ok` the successors; the stack's bytes are read through `read`
 /// too (`RTS`, `RTI`). A `JSR` whose target is not in `image` (the ROM),

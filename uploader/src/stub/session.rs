@@ -598,6 +598,12 @@ impl<T: Transport> RobotDebug<T> {
         self.starts = Some(starts);
     }
 
+    /// The image the robot runs, as attached.
+    #[must_use]
+    pub fn image(&self) -> &UploadImage {
+        &self.image
+    }
+
     /// What attach found of an earlier session, and did about it.
     #[must_use]
     pub fn recovery(&self) -> &Recovery {
