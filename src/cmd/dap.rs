@@ -31,14 +31,36 @@ mod fuzz;
 pub(crate) struct Args {}
 
 pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
+    let stop = std::sync::Arc::new(debugger::dap::Stop::default());
+    let_go_on_signals(std::sync::Arc::clone(&stop))?;
     debugger::dap::serve_with(
         BufReader::new(std::io::stdin()),
         Box::new(BufWriter::new(std::io::stdout())),
         Box::new(launch),
         Some(Box::new(attach)),
+        &stop,
     )
     .into_diagnostic()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// An editor ends an adapter whose session went wrong with a signal: a
+/// robot on a port is let go first (breakpoints out, the hook given
+/// back), as at `disconnect`, then the process ends as the signal would
+/// have ended it.
+fn let_go_on_signals(stop: std::sync::Arc<debugger::dap::Stop>) -> miette::Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .map_err(|error| miette::miette!("cannot watch for signals: {error}"))?;
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            stop.ask();
+            // Breakpoints taken out one by one at 9600 baud: seconds.
+            stop.wait(std::time::Duration::from_secs(60));
+            std::process::exit(128 + signal);
+        }
+    });
+    Ok(())
 }
 
 /// `launch` or `attach` with `port`: the real robot there (empty: the

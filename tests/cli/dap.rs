@@ -23,7 +23,8 @@ const PATIENCE: Duration = Duration::from_secs(30);
 
 pub(crate) struct Client {
     child: Child,
-    input: ChildStdin,
+    /// `None` once closed, as by an editor that went away.
+    input: Option<ChildStdin>,
     /// Messages as the reader thread framed them, or why it could not.
     messages: Receiver<Result<Value, String>>,
     seq: i64,
@@ -96,7 +97,7 @@ impl Client {
         });
         Client {
             child,
-            input,
+            input: Some(input),
             messages,
             seq: 0,
             events: Vec::new(),
@@ -116,8 +117,9 @@ impl Client {
 
     /// Sends `bytes` as they are (a hostile client's framing).
     pub(crate) fn send_raw(&mut self, bytes: &[u8]) {
-        self.input.write_all(bytes).expect("write");
-        self.input.flush().expect("flush");
+        let input = self.input.as_mut().expect("the adapter's input is open");
+        input.write_all(bytes).expect("write");
+        input.flush().expect("flush");
     }
 
     /// The response to request `seq` (events meanwhile are kept).
@@ -129,6 +131,21 @@ impl Client {
             }
             self.events.push(message);
         }
+    }
+
+    /// Closes the adapter's input, as an editor that crashed does.
+    pub(crate) fn close_input(&mut self) {
+        self.input = None;
+    }
+
+    /// Sends the adapter a signal (`TERM`, `HUP`...), as an editor that
+    /// ends it does.
+    pub(crate) fn signal(&self, name: &str) {
+        let sent = Command::new("kill")
+            .args([&format!("-{name}"), &self.child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(sent.success(), "kill -{name}");
     }
 
     /// Waits for the adapter to end, at most `PATIENCE`; its success.

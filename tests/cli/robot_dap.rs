@@ -403,3 +403,65 @@ fn a_launch_says_what_it_cleaned_up_in_the_console_before_the_first_stop() {
     assert_eq!(bye["success"], true, "{bye}");
     assert!(dap.ends());
 }
+
+/// hostile10 F6: an adapter whose editor went away without `disconnect`
+/// (its input closed), or that the editor ended with a signal, left the
+/// robot stopped in the stub, or with the stub hooked and its breakpoints
+/// in the code (exit 0): the next command froze the robot. Now either lets
+/// the robot go as `disconnect` does.
+#[test]
+fn an_editor_gone_without_disconnect_lets_the_robot_go() {
+    for how in ["input closed", "TERM", "HUP"] {
+        let (dir, sim) = handler_on_a_pty_robot();
+        let mut dap = launched(dir.path(), &sim);
+        let path = dir.path().join("handler.s");
+        let set = dap.request(
+            "setBreakpoints",
+            json!({"source": {"path": path.to_str().expect("a path")},
+                   "breakpoints": [{"line": 6}]}),
+        );
+        assert_eq!(set["body"]["breakpoints"][0]["verified"], true, "{set}");
+        let done = dap.request("configurationDone", json!({}));
+        assert_eq!(done["success"], true, "{done}");
+        let sent = dap.request("evaluate", json!({"expression": "/1Q", "context": "repl"}));
+        assert_eq!(sent["success"], true, "{sent}");
+        let stopped = dap.event("stopped");
+        assert_eq!(stopped["body"]["reason"], "breakpoint", "{how}: {stopped}");
+        match how {
+            "input closed" => dap.close_input(),
+            signal => dap.signal(signal),
+        }
+        // Ended (its exit status is the signal's, or 0 at the end of input).
+        let _ = dap.ends();
+        let output = scorpion(
+            dir.path(),
+            &[
+                "read",
+                "$0400",
+                "129",
+                "-o",
+                "after.bin",
+                "--port",
+                &sim.path,
+            ],
+        );
+        assert!(output.status.success(), "{how}: {}", transcript(&output));
+        assert_eq!(
+            std::fs::read(dir.path().join("after.bin")).expect("a dump"),
+            handler_bytes(),
+            "{how}: the image's code, no JSR left"
+        );
+        let output = scorpion(
+            dir.path(),
+            &["read", "$0200", "3", "-o", "hook.bin", "--port", &sim.path],
+        );
+        assert!(output.status.success(), "{how}: {}", transcript(&output));
+        assert_eq!(
+            std::fs::read(dir.path().join("hook.bin")).expect("a dump"),
+            [0x4C, 0x03, 0x04],
+            "{how}: the hook given back"
+        );
+        let output = scorpion(dir.path(), &["ask", "/1Q", "--port", &sim.path]);
+        assert!(output.status.success(), "{how}: {}", transcript(&output));
+    }
+}

@@ -130,7 +130,48 @@ pub fn serve(
     output: Box<dyn Write + Send>,
     launcher: Launcher,
 ) -> Result<(), Error> {
-    serve_with(input, output, launcher, None)
+    serve_with(input, output, launcher, None, &Arc::default())
+}
+
+/// How often a robot's thread with nothing to do looks whether it is
+/// asked to stop.
+const STOP_LOOK: Duration = Duration::from_millis(100);
+
+/// How long the end of the session waits for a robot on a port to be let
+/// go (its breakpoints out at 9600 baud, a few seconds each at worst).
+const LETTING_GO: Duration = Duration::from_secs(60);
+
+/// Asks a session to end from outside its requests (a signal): a robot on
+/// a port is let go as at `disconnect`, and [`Stop::wait`] says when.
+#[derive(Debug, Default)]
+pub struct Stop {
+    asked: std::sync::atomic::AtomicBool,
+    done: std::sync::atomic::AtomicBool,
+}
+
+impl Stop {
+    /// Asks the session to end.
+    pub fn ask(&self) {
+        self.asked.store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+
+    fn asked(&self) -> bool {
+        self.asked.load(std::sync::atomic::Ordering::SeqCst)
+    }
+
+    fn done(&self) {
+        self.done.store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+
+    /// Waits (at most `limit`) until the session asked to end has let its
+    /// robot go; whether it has.
+    pub fn wait(&self, limit: Duration) -> bool {
+        let deadline = Instant::now() + limit;
+        while !self.done.load(std::sync::atomic::Ordering::SeqCst) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        self.done.load(std::sync::atomic::Ordering::SeqCst)
+    }
 }
 
 /// [`serve`], with `attacher` for a `launch` or `attach` that names a
@@ -143,12 +184,13 @@ pub fn serve_with(
     output: Box<dyn Write + Send>,
     launcher: Launcher,
     attacher: Option<Attacher>,
+    stop: &Arc<Stop>,
 ) -> Result<(), Error> {
     let outbox = Arc::new(Outbox::new(output));
     let busy = Arc::new(Busy::default());
     let (to_robot, requests) = mpsc::channel();
     let robot = {
-        let (outbox, busy) = (Arc::clone(&outbox), Arc::clone(&busy));
+        let (outbox, busy, stop) = (Arc::clone(&outbox), Arc::clone(&busy), Arc::clone(stop));
         // Scripts (Rhai) recurse deeply in a debug build: the robot's
         // thread gets the stack a script's deepest allowed call needs.
         // The session is made there: a real robot's line stays on it.
@@ -158,7 +200,7 @@ pub fn serve_with(
             .spawn(move || {
                 let mut session = Session::new(outbox, busy, launcher);
                 session.attacher = attacher;
-                robot_thread(session, &requests)
+                robot_thread(session, &requests, &stop)
             })
             .map_err(Error::Thread)?
     };
@@ -211,7 +253,10 @@ pub fn serve_with(
     // The robot's thread ends at its next look for requests; one that
     // does not come back is left to end with the process.
     let deadline = Instant::now() + STUCK;
-    while !robot.is_finished() && Instant::now() < deadline {
+    let letting_go = Instant::now() + LETTING_GO;
+    while !robot.is_finished()
+        && (Instant::now() < deadline || (busy.letting_go() && Instant::now() < letting_go))
+    {
         std::thread::sleep(Duration::from_millis(10));
     }
     if robot.is_finished() {
@@ -277,18 +322,34 @@ fn forward(
 
 /// The robot's thread: requests answered in turn; while the robot runs,
 /// a slice of robot time between looks for them.
-fn robot_thread(mut session: Session, requests: &Receiver<Request>) -> std::io::Result<()> {
+fn robot_thread(
+    mut session: Session,
+    requests: &Receiver<Request>,
+    stop: &Stop,
+) -> std::io::Result<()> {
     loop {
+        if stop.asked() {
+            session.end_of_requests();
+            stop.done();
+            return Ok(());
+        }
         let request = if session.running() {
             match requests.try_recv() {
                 Ok(request) => Some(request),
                 Err(TryRecvError::Empty) => None,
-                Err(TryRecvError::Disconnected) => return Ok(()),
+                Err(TryRecvError::Disconnected) => {
+                    session.end_of_requests();
+                    return Ok(());
+                }
             }
         } else {
-            match requests.recv() {
+            match requests.recv_timeout(STOP_LOOK) {
                 Ok(request) => Some(request),
-                Err(_) => return Ok(()),
+                Err(mpsc::RecvTimeoutError::Timeout) => None,
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    session.end_of_requests();
+                    return Ok(());
+                }
             }
         };
         if let Some(request) = request

@@ -33,6 +33,9 @@ const NOT_LAUNCHED: &str = "launch a program first";
 #[derive(Debug, Default)]
 pub struct Busy(Mutex<Option<(Instant, String)>>);
 
+/// What the robot's thread does at the end of the requests.
+const LETTING_GO: &str = "letting the robot go";
+
 impl Busy {
     fn start(&self, what: String) {
         if let Ok(mut busy) = self.0.lock() {
@@ -44,6 +47,14 @@ impl Busy {
         if let Ok(mut busy) = self.0.lock() {
             *busy = None;
         }
+    }
+
+    /// Whether the robot on a port is being let go (the process waits for
+    /// that before it ends).
+    pub fn letting_go(&self) -> bool {
+        self.0
+            .lock()
+            .is_ok_and(|busy| busy.as_ref().is_some_and(|(_, what)| what == LETTING_GO))
     }
 
     /// What it has been doing, and for how long; `None` when idle.
@@ -193,6 +204,19 @@ impl Session {
         }
         let text = String::from_utf8_lossy(received).replace('\r', "\n");
         self.outbox.output("stdout", &text)
+    }
+
+    /// The end of the requests with no `disconnect` (the editor went
+    /// away, or the adapter was told to stop): a robot on a port is let go
+    /// as `disconnect` lets it go, not left with the stub hooked and the
+    /// breakpoints in its code.
+    pub fn end_of_requests(&mut self) {
+        if let Some(robot) = self.robot.as_mut() {
+            self.busy.start(LETTING_GO.into());
+            // Nobody is left to be told of a line that failed.
+            let _ = robot.let_go();
+            self.busy.end();
+        }
     }
 
     /// Answers a request; false at `disconnect` (or `terminate`).
