@@ -109,28 +109,18 @@ impl uploader::Keep for UndoFile {
     }
 }
 
-/// Says, on a signal (Ctrl-C, `kill`), what an interrupted upload left
-/// before the process ends as the signal would have ended it.
-fn say_when_interrupted(
-    undo: PathBuf,
-    kept: std::sync::Arc<std::sync::atomic::AtomicBool>,
-) -> miette::Result<()> {
+/// Says, on a signal (Ctrl-C, `kill`), what an interrupted upload or undo
+/// left (`said`, asked then) before the process ends as the signal would
+/// have ended it.
+fn say_when_interrupted(said: impl Fn() -> String + Send + 'static) -> miette::Result<()> {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
         .map_err(|error| miette::miette!("cannot watch for Ctrl-C: {error}"))?;
     std::thread::spawn(move || {
         if let Some(signal) = signals.forever().next() {
-            let said = if kept.load(std::sync::atomic::Ordering::Relaxed) {
-                format!(
-                    "interrupted: the upload did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` puts back what the robot held before it (kept in {}); or upload again",
-                    undo.display()
-                )
-            } else {
-                "interrupted before anything of the image was written; nothing that did not verify is hooked".to_owned()
-            };
             #[allow(clippy::print_stderr, reason = "the CLI's last word")]
             {
-                eprintln!("\n{said}");
+                eprintln!("\n{}", said());
             }
             std::process::exit(128 + signal);
         }
@@ -138,10 +128,33 @@ fn say_when_interrupted(
     Ok(())
 }
 
+/// What an upload interrupted left: whether `kept` says its undo file
+/// (`undo`) was written.
+fn upload_interrupted(undo: &Path, kept: &std::sync::atomic::AtomicBool) -> String {
+    if kept.load(std::sync::atomic::Ordering::Relaxed) {
+        format!(
+            "interrupted: the upload did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` puts back what the robot held before it (kept in {}); then upload again",
+            undo.display()
+        )
+    } else {
+        "interrupted before anything of the image was written; nothing that did not verify is hooked".to_owned()
+    }
+}
+
 /// Refuses an upload that would replace the undo file of one that did not
 /// finish (marked [`UPLOADING`]): that file keeps what the robot held
 /// before it, which nothing else does.
 fn refuse_unfinished(undo: &Path) -> miette::Result<()> {
+    if marked(undo, UNDOING).exists() && undo.is_file() {
+        // fresh10 F10: a new undo file would take that undo's place, and
+        // the mark would then be taken for this one's.
+        return Err(miette::miette!(
+            code = "upload::undo_unfinished",
+            help = "`scorpion upload --undo` finishes it (the robot as it was before the upload it undoes), then upload again",
+            "an undo of {} started and did not finish (killed, or its line failed): the robot is half way back; nothing was sent",
+            undo.display()
+        ));
+    }
     let mark = marked(undo, UPLOADING);
     if !mark.exists() {
         return Ok(());
@@ -420,6 +433,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         // Written once the undo's checks pass: an undo stopped after it
         // (killed, a dead line) is finished by the next `--undo`.
         let started = marked(&path, UNDOING);
+        say_when_interrupted(|| {
+            "interrupted: the undo did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` finishes it".to_owned()
+        })?;
         let code = crate::cmd::backup::restore_into(
             transport,
             profile,
@@ -622,7 +638,8 @@ fn upload_file(
     let result = if emulated {
         uploader::upload(&mut client, &image, &options, &mut bar)
     } else {
-        say_when_interrupted(undo.path.clone(), std::sync::Arc::clone(&undo.kept))?;
+        let (path, kept) = (undo.path.clone(), std::sync::Arc::clone(&undo.kept));
+        say_when_interrupted(move || upload_interrupted(&path, &kept))?;
         uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
     };
     bar.bar.finish_and_clear();

@@ -399,3 +399,27 @@ fn an_interrupted_upload_says_so_and_its_undo_file_is_not_replaced() {
     );
     ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
 }
+
+/// fresh10 F10: an upload while an undo was half done replaced that
+/// undo's file, and the next `--undo` took the new file for the one half
+/// done. The upload is refused until the undo is finished.
+#[test]
+fn an_upload_while_an_undo_is_half_done_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let dir = dir.path();
+    std::fs::write(dir.join("ext.elf"), extension_at(0x0400, 200, None)).expect("the image");
+    let sim = Sim::start(dir, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    // What an undo killed after its checks leaves beside its file.
+    std::fs::write(dir.join("scorpion-last-upload.undo.undoing"), b"").expect("the mark");
+    let (success, said) = on(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    assert!(!success, "{said}");
+    assert!(
+        said.contains("started and did not finish") && said.contains("scorpion upload --undo"),
+        "{said}"
+    );
+    let said = ok(dir, &line, &["upload", "--undo"]);
+    assert!(said.contains("restored"), "{said}");
+    ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+}
