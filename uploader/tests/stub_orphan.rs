@@ -495,3 +495,26 @@ fn a_backup_with_a_stub_hooked_is_refused_and_so_is_restoring_one() {
     }
     assert!(written(&mut client) == before, "something was written");
 }
+
+/// fresh10 F14: after a `/1R` (the table cleared, the hooks back at the
+/// ROM, RAM kept) the image's code was still in RAM: attach took it,
+/// hooked the stub ahead of the ROM, and breakpoints were set that no
+/// command could reach. Refused, saying the image is not installed.
+#[test]
+fn an_image_in_ram_but_not_installed_is_refused() {
+    let image = handler();
+    let mut client = uploaded(&[&image]);
+    let command = Command::parse(b"/1R").expect("a command");
+    let _ = client.listen(&command).expect("the line works");
+    let result = RobotDebug::attach(client, &RomProfile::reference(), image.clone());
+    let Err(uploader::stub::StubError::Refused { reason, .. }) = result else {
+        panic!(
+            "not refused: {:?}",
+            result.map(|debug| debug.stub().clone())
+        );
+    };
+    assert!(
+        reason.contains("not installed") && reason.contains("$0403"),
+        "{reason}"
+    );
+}

@@ -28,6 +28,8 @@ use super::patch::{self, JSR, Patch};
 use crate::client::Client;
 use crate::image::{RomProfile, UploadImage};
 use crate::transport::{Transport, char_time};
+use isa::objfmt::HookKind;
+use romlib::installed::Installed;
 
 /// The registers at a stop.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -219,7 +221,7 @@ impl<T: Transport> RobotDebug<T> {
         } else {
             debug.client.probe()?;
         }
-        let taken = debug.taken(profile)?;
+        let (taken, installed) = debug.taken(profile)?;
         let placed = StubPlan::place_beside(profile, &debug.image, hook, &taken)?;
         debug.stub = placed.clone();
         if stopped {
@@ -310,6 +312,9 @@ impl<T: Transport> RobotDebug<T> {
                 ),
             });
         }
+        if debug.stopped.is_none() {
+            debug.refuse_unreachable(profile, &installed, previous)?;
+        }
         let mut leftovers = debug.check_image()?;
         if stopped || debug.recovery.hooked {
             // A session with another image may have left breakpoints in
@@ -337,23 +342,69 @@ impl<T: Transport> RobotDebug<T> {
         Ok(debug)
     }
 
+    /// Refuses an image that is in RAM but not installed (fresh10 F14: a
+    /// `/1R` cleared the table and the hooks, an upload did not finish):
+    /// none of its hooks' chains leads to its handler, so a breakpoint in
+    /// it would never be hit. `unknown` is what the stub will chain to.
+    fn refuse_unreachable(
+        &mut self,
+        profile: &RomProfile,
+        installed: &[Installed],
+        unknown: u16,
+    ) -> StubResult<()> {
+        let records: Vec<(HookKind, u16)> = self
+            .image
+            .hooks()
+            .iter()
+            .map(|record| (record.kind, record.handler))
+            .collect();
+        for (kind, handler) in records {
+            let target = if kind == HookKind::Unknown {
+                unknown
+            } else {
+                let jump = self.read(profile.hook_address(kind), 3)?;
+                u16::from_le_bytes([jump[1], jump[2]])
+            };
+            let reached = crate::chain::comes_back(
+                &mut self.client,
+                profile,
+                installed,
+                (kind, target),
+                &|at| at == handler,
+            )?;
+            if reached.is_none() {
+                return Err(StubError::Refused {
+                    what: "attaching".into(),
+                    reason: format!(
+                        "the image is in RAM but not installed: {}'s chain (from ${target:04X}) does not lead to its handler ${handler:04X}, so no breakpoint in it would be hit; upload it (`scorpion upload ELF --port PORT`) and attach again",
+                        kind.rom_symbol()
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// What the stub must not go over besides the image: the extensions
     /// the robot's table names (read from the robot) and the RAM loader's
     /// memory (an upload of the image puts it there, and may find it
     /// again).
-    fn taken(&mut self, profile: &RomProfile) -> StubResult<Vec<RangeInclusive<u16>>> {
-        let mut taken: Vec<RangeInclusive<u16>> =
-            crate::table::installed_with(profile, &mut |at, len| self.read(at, len))?
-                .into_iter()
-                .flat_map(|installed| installed.extents)
-                .collect();
+    fn taken(
+        &mut self,
+        profile: &RomProfile,
+    ) -> StubResult<(Vec<RangeInclusive<u16>>, Vec<Installed>)> {
+        let installed = crate::table::installed_with(profile, &mut |at, len| self.read(at, len))?;
+        let mut taken: Vec<RangeInclusive<u16>> = installed
+            .iter()
+            .flat_map(|installed| installed.extents.iter().cloned())
+            .collect();
         let rates = (self.client.transport().baud(), crate::loader::FAST_BAUD);
         if let Some(loader) = crate::loader::loader_plan(profile, &self.image, rates)? {
             let code = &loader.code;
             taken.push(code.address..=code.address.wrapping_add(code.bytes.len() as u16 - 1));
             taken.push(u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()));
         }
-        Ok(taken)
+        Ok((taken, installed))
     }
 
     /// Whether the robot is stopped in a stub, wherever it is: `Some`
