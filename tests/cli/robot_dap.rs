@@ -108,6 +108,20 @@ fn handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {
     (dir, sim)
 }
 
+/// The robot's code ($0400, the handler's 129 bytes) and `HOOK_UNKNOWN`,
+/// read on `sim`'s line.
+fn code_and_hook(dir: &std::path::Path, sim: &Sim) -> (Vec<u8>, Vec<u8>) {
+    let read = |at: &str, len: &str, file: &str| {
+        let output = scorpion(dir, &["read", at, len, "-o", file, "--port", &sim.path]);
+        assert!(output.status.success(), "{}", transcript(&output));
+        std::fs::read(dir.join(file)).expect("a dump")
+    };
+    (
+        read("$0400", "129", "after.bin"),
+        read("$0200", "3", "hook.bin"),
+    )
+}
+
 /// An adapter initialized and launched on `sim`'s robot with `dir`'s
 /// `ext.elf`.
 fn launched(dir: &std::path::Path, sim: &Sim) -> Client {
@@ -257,34 +271,11 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
 
     // The code is the image's again, but for the byte changed; the hook
     // is the handler's again.
-    let output = scorpion(
-        dir.path(),
-        &[
-            "read",
-            "$0400",
-            "129",
-            "-o",
-            "after.bin",
-            "--port",
-            &sim.path,
-        ],
-    );
-    assert!(output.status.success(), "{}", transcript(&output));
+    let (code, hook) = code_and_hook(dir.path(), &sim);
     let mut expected = handler_bytes();
     expected[0x80] = 0x99;
-    assert_eq!(
-        std::fs::read(dir.path().join("after.bin")).expect("a dump"),
-        expected
-    );
-    let output = scorpion(
-        dir.path(),
-        &["read", "$0200", "3", "-o", "hook.bin", "--port", &sim.path],
-    );
-    assert!(output.status.success(), "{}", transcript(&output));
-    assert_eq!(
-        std::fs::read(dir.path().join("hook.bin")).expect("a dump"),
-        [0x4C, 0x03, 0x04]
-    );
+    assert_eq!(code, expected);
+    assert_eq!(hook, [0x4C, 0x03, 0x04]);
 }
 
 #[test]
@@ -433,34 +424,13 @@ fn an_editor_gone_without_disconnect_lets_the_robot_go() {
         }
         // Ended (its exit status is the signal's, or 0 at the end of input).
         let _ = dap.ends();
-        let output = scorpion(
-            dir.path(),
-            &[
-                "read",
-                "$0400",
-                "129",
-                "-o",
-                "after.bin",
-                "--port",
-                &sim.path,
-            ],
-        );
-        assert!(output.status.success(), "{how}: {}", transcript(&output));
+        let (code, hook) = code_and_hook(dir.path(), &sim);
         assert_eq!(
-            std::fs::read(dir.path().join("after.bin")).expect("a dump"),
+            code,
             handler_bytes(),
             "{how}: the image's code, no JSR left"
         );
-        let output = scorpion(
-            dir.path(),
-            &["read", "$0200", "3", "-o", "hook.bin", "--port", &sim.path],
-        );
-        assert!(output.status.success(), "{how}: {}", transcript(&output));
-        assert_eq!(
-            std::fs::read(dir.path().join("hook.bin")).expect("a dump"),
-            [0x4C, 0x03, 0x04],
-            "{how}: the hook given back"
-        );
+        assert_eq!(hook, [0x4C, 0x03, 0x04], "{how}: the hook given back");
         let output = scorpion(dir.path(), &["ask", "/1Q", "--port", &sim.path]);
         assert!(output.status.success(), "{how}: {}", transcript(&output));
     }
