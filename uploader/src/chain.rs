@@ -9,6 +9,8 @@
 
 use std::fmt::Write as _;
 
+use emulator::{Bus, Cpu};
+use isa::Mnemonic;
 use isa::objfmt::HookKind;
 use romlib::installed::Installed;
 
@@ -80,10 +82,21 @@ pub(crate) fn comes_back<T: Transport>(
                 let bytes = client.read_memory(at, 3)?;
                 if bytes[0] == JMP {
                     Some(u16::from_le_bytes([bytes[1], bytes[2]]))
-                } else {
+                } else if let Some(stub) = crate::stub::left::at_target(client, profile, at)? {
                     // A debug stub (hooked or left in RAM by a session)
                     // goes on where its chain does.
-                    crate::stub::left::at_target(client, profile, at)?.map(|stub| stub.previous)
+                    Some(stub.previous)
+                } else {
+                    // Other code: run on the host over the robot's memory
+                    // as an unknown command would run it, to where it goes.
+                    let landing = |pc: u16| {
+                        inside(pc)
+                            || everyone
+                                .iter()
+                                .flat_map(|other| other.hooks.iter())
+                                .any(|hook| hook.kind == kind && hook.handler == pc)
+                    };
+                    run_to_landing(client, profile, at, &landing)?
                 }
             }
         };
@@ -93,4 +106,129 @@ pub(crate) fn comes_back<T: Transport>(
         }
     }
     Ok(None)
+}
+
+/// Instructions run on the host before code is taken to go nowhere this
+/// module can tell.
+const MOST_INSTRUCTIONS: usize = 256;
+
+/// Bytes read from the robot at once for the host's run.
+const CHUNK: usize = 16;
+
+/// Runs the code at `start` on the host, reading the robot's memory as it
+/// needs it (writes kept on the host), with the registers an unknown
+/// command brings (A a byte no handler takes), until the PC lands where
+/// `landing` says; `None` where it goes into the ROM or to memory an
+/// extension may not hold (the I/O page), calls or returns (`JSR`, `RTS`,
+/// `RTI`: a call is no chain's way, and may be a breakpoint a killed
+/// session left, which attaching takes out), or has run
+/// [`MOST_INSTRUCTIONS`].
+fn run_to_landing<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    start: u16,
+    landing: &dyn Fn(u16) -> bool,
+) -> Result<Option<u16>> {
+    let mut bus = ChainBus {
+        client,
+        profile,
+        seen: std::collections::BTreeMap::new(),
+        failed: None,
+        outside: false,
+    };
+    let mut cpu = Cpu::new();
+    cpu.set_idle_skip(false);
+    (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, 0xF0, start);
+    for _ in 0..MOST_INSTRUCTIONS {
+        let opcode = bus.byte(cpu.pc);
+        let info = isa::opcode(opcode);
+        if bus.outside
+            || info.cycles == 0
+            || matches!(
+                info.mnemonic,
+                Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk | Mnemonic::Jsr
+            )
+        {
+            break;
+        }
+        cpu.step(&mut bus);
+        if let Some(error) = bus.failed.take() {
+            return Err(error);
+        }
+        if bus.outside || !readable(profile, cpu.pc) {
+            break;
+        }
+        if landing(cpu.pc) {
+            return Ok(Some(cpu.pc));
+        }
+    }
+    Ok(None)
+}
+
+/// Whether `at` is memory an extension may hold (where the host reads
+/// the robot's bytes: never the I/O page, whose reads change it).
+fn readable(profile: &RomProfile, at: u16) -> bool {
+    profile.writable.iter().any(|range| range.contains(&at))
+        || profile
+            .user_zero_page
+            .as_ref()
+            .is_some_and(|zp| at <= 0xFF && zp.contains(&(at as u8)))
+}
+
+/// The robot's memory for [`run_to_landing`]: read through the line a
+/// chunk at a time, each byte once; writes kept on the host.
+struct ChainBus<'a, T: Transport> {
+    client: &'a mut Client<T>,
+    profile: &'a RomProfile,
+    seen: std::collections::BTreeMap<u16, u8>,
+    failed: Option<crate::Error>,
+    /// An access outside what may be read: the run ends there.
+    outside: bool,
+}
+
+impl<T: Transport> ChainBus<'_, T> {
+    fn byte(&mut self, address: u16) -> u8 {
+        if let Some(&byte) = self.seen.get(&address) {
+            return byte;
+        }
+        if !readable(self.profile, address) {
+            self.outside = true;
+            return 0;
+        }
+        let len = CHUNK.min(0x1_0000 - usize::from(address));
+        let len = (0..len)
+            .take_while(|&i| readable(self.profile, address.wrapping_add(i as u16)))
+            .count();
+        match self.client.read_memory(address, len) {
+            Ok(bytes) => {
+                for (i, byte) in bytes.into_iter().enumerate() {
+                    self.seen
+                        .entry(address.wrapping_add(i as u16))
+                        .or_insert(byte);
+                }
+                self.seen.get(&address).copied().unwrap_or(0)
+            }
+            Err(error) => {
+                self.failed.get_or_insert(error);
+                self.outside = true;
+                0
+            }
+        }
+    }
+}
+
+impl<T: Transport> Bus for ChainBus<'_, T> {
+    fn read(&mut self, address: u16, _cycle: u64) -> u8 {
+        self.byte(address)
+    }
+
+    fn write(&mut self, address: u16, value: u8, _cycle: u64) {
+        self.seen.insert(address, value);
+    }
+
+    fn dummy_read(&mut self, _address: u16, _cycle: u64) {}
+
+    fn peek(&self, address: u16) -> u8 {
+        self.seen.get(&address).copied().unwrap_or(0)
+    }
 }

@@ -518,3 +518,47 @@ fn an_image_in_ram_but_not_installed_is_refused() {
         "{reason}"
     );
 }
+
+/// hostile10 F7: only a `JMP` at the hook's target was followed: a `NOP`
+/// before it, a `JMP (ind)` or a branch made the loop again (exit 0).
+/// The code at the target is run on the host over the robot's memory to
+/// where it goes; an owner's handler that falls to the ROM still chains.
+#[test]
+fn code_that_comes_back_into_the_image_any_way_is_refused() {
+    let image = answering(0x0400, b'U');
+    for (what, code) in [
+        ("NOP; JMP $0400", &[0xEA, 0x4C, 0x00, 0x04][..]),
+        (
+            "JMP ($0608)",
+            &[0x6C, 0x08, 0x06, 0xEA, 0xEA, 0xEA, 0xEA, 0xEA, 0x00, 0x04][..],
+        ),
+        (
+            "CLC; BCC +1; .byte $50; NOP; JMP $0400",
+            &[0x18, 0x90, 0x01, 0x50, 0xEA, 0x4C, 0x00, 0x04][..],
+        ),
+    ] {
+        let mut client = uploaded(&[&image]);
+        by_hand(&mut client, 0x0600, code, 0x0600);
+        let before = written(&mut client);
+        let result = uploader::upload(&mut client, &image, &options(), &mut NoProgress);
+        assert!(
+            matches!(result, Err(Error::ChainComesBack { .. })),
+            "{what}: {result:?}"
+        );
+        assert!(
+            written(&mut client) == before,
+            "{what}: something was written"
+        );
+    }
+    // CMP #'W'; BNE +3; JMP CMD_DONE; JMP BAD_COMMAND: to the ROM.
+    let mut client = uploaded(&[]);
+    by_hand(
+        &mut client,
+        0x0600,
+        &[0xC9, b'W', 0xD0, 0x03, 0x4C, 0x1E, 0xFF, 0x4C, 0x21, 0xFF],
+        0x0600,
+    );
+    uploader::upload(&mut client, &image, &options(), &mut NoProgress).expect("uploaded");
+    assert_eq!(memory(&mut client)[0x0413..0x0416], [0x4C, 0x00, 0x06]);
+    assert_eq!(ask(&mut client, b'U'), Some(Answer::Text("U".into())));
+}
