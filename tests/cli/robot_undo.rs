@@ -423,3 +423,52 @@ fn an_upload_while_an_undo_is_half_done_is_refused() {
     assert!(said.contains("restored"), "{said}");
     ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
 }
+
+/// hostile10 F9: the undo file of a `--replace` by an image whose memory
+/// takes zero page (its table entry longer than the one it replaced) held
+/// the entry twice, and `upload --undo` refused the file whole.
+#[test]
+fn the_undo_of_a_replace_by_an_image_with_zero_page_works() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let dir = dir.path();
+    let handler = |zero_page: bool| {
+        format!(
+            "        .include \"scorpion.inc\"
+{}        .code
+        SCORPION_UNKNOWN_HANDLER
+        cmp #'V'
+        bne not_mine
+        lda #'V'
+        jsr PUTCH
+        jsr PUTEOL
+        jmp CMD_DONE
+not_mine:
+        SCORPION_CHAIN_UNKNOWN
+",
+            if zero_page {
+                "        .zeropage\nzp:     .res 2\n"
+            } else {
+                ""
+            }
+        )
+    };
+    for (name, zero_page) in [("plain", false), ("zp", true)] {
+        std::fs::write(dir.join(format!("{name}.s")), handler(zero_page)).expect("a source");
+        let output = scorpion(
+            dir,
+            &["build", &format!("{name}.s"), "-o", &format!("{name}.elf")],
+        );
+        assert!(output.status.success(), "{}", transcript(&output));
+    }
+    let sim = Sim::start(dir, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(dir, &line, &["upload", "plain.elf", "--no-dry-run"]);
+    let before = ok(dir, &line, &["installed"]);
+    ok(
+        dir,
+        &line,
+        &["upload", "zp.elf", "--no-dry-run", "--replace"],
+    );
+    ok(dir, &line, &["upload", "--undo"]);
+    assert_eq!(ok(dir, &line, &["installed"]), before);
+}

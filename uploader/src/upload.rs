@@ -754,6 +754,7 @@ fn keep_old<T: Transport>(
     let Some(mut kept) = kept else {
         return Ok(None);
     };
+    let first = kept.areas.len();
     for area in image.areas() {
         // The table entry: the whole table is kept already.
         if covered(&kept, area) {
@@ -765,11 +766,49 @@ fn keep_old<T: Transport>(
             bytes,
         });
     }
+    keep_oldest(&mut kept.areas, first);
     overlay(&mut kept.areas, unlinked);
     let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
     kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
     Ok(Some(kept))
+}
+
+/// Areas from `first` on (read as the upload goes) lose the bytes an area
+/// before them holds (the table as read before anything was written, which
+/// a replace has changed since): each address kept once, as it was first
+/// (hostile10 F9: a new entry longer than the one it replaced overlapped
+/// it, and the undo file was refused whole).
+fn keep_oldest(areas: &mut Vec<Area>, first: usize) {
+    let (older, newer) = areas.split_at(first);
+    let held = |address: u16| {
+        older
+            .iter()
+            .any(|area| area.address <= address && u32::from(address) < area.end())
+    };
+    let mut runs: Vec<Area> = Vec::new();
+    for area in newer {
+        let mut run: Option<Area> = None;
+        for (i, &byte) in area.bytes.iter().enumerate() {
+            let address = area.address.wrapping_add(i as u16);
+            if held(address) {
+                runs.extend(run.take());
+                continue;
+            }
+            match &mut run {
+                Some(run) => run.bytes.push(byte),
+                None => {
+                    run = Some(Area {
+                        address,
+                        bytes: vec![byte],
+                    });
+                }
+            }
+        }
+        runs.extend(run);
+    }
+    areas.truncate(first);
+    areas.extend(runs);
 }
 
 /// Whether `kept` holds all of `area` in one of its areas already.
@@ -859,6 +898,7 @@ fn keep_summed<T: Transport>(
         .map(|&(address, _)| address - 1)
         .zip(crate::sums::robot_sums(client, &twice)?)
         .collect();
+    let first = kept.areas.len();
     for (area, sum) in held {
         let len = area.bytes.len();
         if covered(&kept, area) {
@@ -879,6 +919,7 @@ fn keep_summed<T: Transport>(
             bytes,
         });
     }
+    keep_oldest(&mut kept.areas, first);
     overlay(&mut kept.areas, unlinked);
     // The code the kept hooks go back to, summed on the robot (the loader's
     // `sums` is hooked here): an undo checks it is still there. Nothing is
