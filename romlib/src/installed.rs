@@ -79,8 +79,9 @@ pub struct Installed {
     pub slot: usize,
 }
 
-/// A table that does not decode: an entry that continues nothing, or an
-/// extent that ends before it starts.
+/// A table that does not decode: an entry that continues nothing, an
+/// extent that ends before it starts, or a hook's handler or chain slot
+/// outside the entry's own memory.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("the table of installed extensions at ${address:04X} is damaged: {reason}")]
 pub struct DamagedTable {
@@ -262,6 +263,31 @@ pub fn decode<'a>(
             slot,
         });
     }
+    // A handler or a chain slot outside the image's own memory is no
+    // upload's: an upload that chained through it would jump to whatever
+    // two bytes lie there (hostile10 F12: the ROM, the table, an I/O
+    // register).
+    for one in &installed {
+        let within = |at: u16| one.extents.iter().any(|extent| extent.contains(&at));
+        let astray = one.hooks.iter().find(|hook| {
+            !within(hook.handler)
+                || hook
+                    .chain
+                    .is_some_and(|slot| !within(slot) || !within(slot.wrapping_add(1)))
+        });
+        if let Some(hook) = astray {
+            return Err(DamagedTable {
+                address: flags_address(table, one.slot),
+                reason: format!(
+                    "its {} handler (${:04X}) or chain slot ({}) lies outside its own memory",
+                    hook.kind.rom_symbol(),
+                    hook.handler,
+                    hook.chain
+                        .map_or_else(|| "none".to_owned(), |slot| format!("${slot:04X}"))
+                ),
+            });
+        }
+    }
     Ok(installed)
 }
 
@@ -408,6 +434,18 @@ mod tests {
         table[ENTRIES + ENTRY_LEN + 6] = 0x0F;
         let error = decode_table(TABLE, ENTRIES, &table).unwrap_err();
         assert!(error.reason.contains("ends before"), "{error}");
+        // hostile10 F12: a chain slot (or a handler) pointed by hand out
+        // of the image's memory: the ROM, the table, an I/O register.
+        for slot in [0xFF00u16, 0x0F88, 0xC010, 0x10FF] {
+            let mut image = sample();
+            image.hooks[0].chain = Some(slot);
+            let error = decode_table(TABLE, ENTRIES, &table_with(&image)).unwrap_err();
+            assert!(error.reason.contains("outside its own memory"), "{error}");
+        }
+        let mut image = sample();
+        image.hooks[1].handler = 0x2000;
+        let error = decode_table(TABLE, ENTRIES, &table_with(&image)).unwrap_err();
+        assert!(error.reason.contains("HOOK_LOOP"), "{error}");
     }
 
     #[test]
