@@ -8,6 +8,7 @@
 
 use std::cell::RefCell;
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::time::Duration;
 
 use emulator::Cpu;
@@ -89,6 +90,9 @@ pub struct RobotMonitor {
     breakpoints: BTreeMap<u32, u16>,
     next_id: u32,
     displays: Vec<Option<Expr>>,
+    /// The last command sent that nothing came back for in the time
+    /// waited: the robot answers in order, so the next answer may be its.
+    owed: Option<String>,
 }
 
 impl RobotMonitor {
@@ -104,6 +108,7 @@ impl RobotMonitor {
             breakpoints: BTreeMap::new(),
             next_id: 1,
             displays: Vec::new(),
+            owed: None,
         }
     }
 
@@ -320,6 +325,10 @@ impl RobotMonitor {
                     Heard::Stopped(_) => "(a stop not asked for) ",
                     _ => "(unasked) ",
                 };
+                if let Heard::Answer(_) = heard {
+                    // Most likely the answer the last silent command owed.
+                    self.owed = None;
+                }
                 Ok(Some(format!("{what}{}", self.heard(d, &heard)?)))
             }
         }
@@ -328,7 +337,20 @@ impl RobotMonitor {
     fn send<T: Transport>(&mut self, d: &mut RobotDebug<T>, text: &str) -> Result<String, Failure> {
         crate::line::command(text).map_err(Failure::Usage)?;
         let heard = d.command(text.as_bytes(), WAIT).map_err(failure)?;
-        Ok(format!("sent {text}\n{}", self.heard(d, &heard)?))
+        let mut said = format!("sent {text}\n{}", self.heard(d, &heard)?);
+        match (&heard, self.owed.take()) {
+            // fresh10 F23: a slow command's answer came after the next was
+            // sent, and was shown as that one's.
+            (Heard::Answer(_), Some(earlier)) => {
+                let _ = writeln!(
+                    said,
+                    "  (the robot answers in order: this may be the answer of {earlier}, which had not answered; this command's would follow)"
+                );
+            }
+            (Heard::Silent, _) => self.owed = Some(text.to_owned()),
+            _ => {}
+        }
+        Ok(said)
     }
 
     /// What came back, as text: an answer, a stop, or silence; then the

@@ -394,3 +394,57 @@ pub(crate) fn readme_handler_on_a_pty_robot() -> (tempfile::TempDir, Sim) {
     assert!(output.status.success(), "{}", transcript(&output));
     (dir, sim)
 }
+
+/// fresh10 F23: a command whose answer takes longer than the monitor
+/// waits (`/1J` here, about 3 s) answered after the next was sent, and
+/// that answer was shown as the next one's, without a word. The monitor
+/// now says the answer may be the earlier command's.
+#[test]
+fn an_answer_after_a_slow_command_is_said_to_be_maybe_its() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(
+        dir.path().join("slow.s"),
+        "        .include \"scorpion.inc\"
+        .code
+        SCORPION_UNKNOWN_HANDLER
+        cmp #'J'
+        bne not_mine
+        lda #12
+        sta count
+outer:  ldx #0
+middle: ldy #0
+inner:  dey
+        bne inner
+        dex
+        bne middle
+        dec count
+        bne outer
+        lda #'J'
+        jsr PUTCH
+        jsr PUTEOL
+        jmp CMD_DONE
+not_mine:
+        SCORPION_CHAIN_UNKNOWN
+        .bss
+count:  .res 1
+",
+    )
+    .expect("the source");
+    let built = scorpion(dir.path(), &["build", "slow.s", "-o", "slow.elf"]);
+    assert!(built.status.success(), "{}", transcript(&built));
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(
+        dir.path(),
+        &["upload", "slow.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion_with_input(
+        Some(dir.path()),
+        &["debug", "--port", &sim.path, "--image", "slow.elf"],
+        "/1J\n/1X\nquit\n",
+    );
+    let said = transcript(&output);
+    assert!(output.status.success(), "{said}");
+    assert!(said.contains("running (nothing came back"), "{said}");
+    assert!(said.contains("this may be the answer of /1J"), "{said}");
+}
