@@ -63,6 +63,12 @@ pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
     let transport = ports::open_resolved(&resolved, &[])?;
     let rom = crate::cmd::config::rom(&resolved)?;
     let profile = crate::cmd::config::profile(rom.as_ref())?;
+    let file = args.file.display().to_string();
+    crate::cmd::say_when_interrupted(move || {
+        format!(
+            "interrupted: the restore did not finish; nothing that did not verify is hooked\n  `scorpion restore {file}` again puts the rest back"
+        )
+    })?;
     restore_into(
         transport,
         profile,

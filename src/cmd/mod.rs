@@ -36,3 +36,24 @@ pub(crate) fn flag_on_signals(
     }
     Ok(flag)
 }
+
+/// Says, on a signal (Ctrl-C, `kill`), what an interrupted upload, undo
+/// or restore left (`said`, asked then) before the process ends as the signal would
+/// have ended it.
+pub(crate) fn say_when_interrupted(
+    said: impl Fn() -> String + Send + 'static,
+) -> miette::Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .map_err(|error| miette::miette!("cannot watch for Ctrl-C: {error}"))?;
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            #[allow(clippy::print_stderr, reason = "the CLI's last word")]
+            {
+                eprintln!("\n{}", said());
+            }
+            std::process::exit(128 + signal);
+        }
+    });
+    Ok(())
+}

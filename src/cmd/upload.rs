@@ -109,25 +109,6 @@ impl uploader::Keep for UndoFile {
     }
 }
 
-/// Says, on a signal (Ctrl-C, `kill`), what an interrupted upload or undo
-/// left (`said`, asked then) before the process ends as the signal would
-/// have ended it.
-fn say_when_interrupted(said: impl Fn() -> String + Send + 'static) -> miette::Result<()> {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
-        .map_err(|error| miette::miette!("cannot watch for Ctrl-C: {error}"))?;
-    std::thread::spawn(move || {
-        if let Some(signal) = signals.forever().next() {
-            #[allow(clippy::print_stderr, reason = "the CLI's last word")]
-            {
-                eprintln!("\n{}", said());
-            }
-            std::process::exit(128 + signal);
-        }
-    });
-    Ok(())
-}
-
 /// What an upload interrupted left: whether `kept` says its undo file
 /// (`undo`) was written.
 fn upload_interrupted(undo: &Path, kept: &std::sync::atomic::AtomicBool) -> String {
@@ -433,7 +414,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         // Written once the undo's checks pass: an undo stopped after it
         // (killed, a dead line) is finished by the next `--undo`.
         let started = marked(&path, UNDOING);
-        say_when_interrupted(|| {
+        crate::cmd::say_when_interrupted(|| {
             "interrupted: the undo did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` finishes it".to_owned()
         })?;
         let code = crate::cmd::backup::restore_into(
@@ -639,7 +620,7 @@ fn upload_file(
         uploader::upload(&mut client, &image, &options, &mut bar)
     } else {
         let (path, kept) = (undo.path.clone(), std::sync::Arc::clone(&undo.kept));
-        say_when_interrupted(move || upload_interrupted(&path, &kept))?;
+        crate::cmd::say_when_interrupted(move || upload_interrupted(&path, &kept))?;
         uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
     };
     bar.bar.finish_and_clear();

@@ -472,3 +472,47 @@ not_mine:
     ok(dir, &line, &["upload", "--undo"]);
     assert_eq!(ok(dir, &line, &["installed"]), before);
 }
+
+/// fresh10 F19: a restore interrupted (Ctrl-C) said nothing. It says what
+/// it left and how to finish; the restore run again does.
+#[test]
+fn an_interrupted_restore_says_so_and_runs_again() {
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let dir = dir.path();
+    std::fs::write(dir.join("ext.elf"), extension_at(0x0400, 2048, None)).expect("the image");
+    let sim = Sim::start(dir, &[]);
+    let line = ["--port", sim.path.as_str()];
+    ok(dir, &line, &["backup", "-o", "robot.bak"]);
+    ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .args(["restore", "robot.bak", "--port", &sim.path])
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("scorpion runs");
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    let output = child.wait_with_output().expect("it ends");
+    let said = transcript(&output);
+    assert_eq!(output.status.code(), Some(130), "{said}");
+    assert!(
+        said.contains("interrupted: the restore did not finish")
+            && said.contains("scorpion restore robot.bak"),
+        "{said}"
+    );
+    ok(dir, &line, &["restore", "robot.bak"]);
+    ok(dir, &line, &["backup", "-o", "after.bak"]);
+    assert!(
+        std::fs::read(dir.join("after.bak")).expect("a backup")
+            == std::fs::read(dir.join("robot.bak")).expect("a backup"),
+        "the robot as backed up"
+    );
+}
