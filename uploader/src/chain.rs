@@ -42,11 +42,12 @@ impl std::fmt::Display for Path {
     }
 }
 
-/// Follows `kind`'s chain from `target` through `JMP`s and installed
-/// extensions' chain slots (`everyone`), reading only memory an extension
-/// may hold; `Some` with the way when it comes to an address `inside`
-/// says is written now. The ROM's own target, the ROM, and code that does
-/// not jump end it (`None`).
+/// Follows `kind`'s chain from `target` through `JMP`s, installed
+/// extensions' chain slots (`everyone`), debug stubs' chains and other
+/// code run on the host ([`run_to_landing`]), reading only memory an
+/// extension may hold; `Some` with the way when it comes to an address
+/// `inside` says is written now. The ROM's own target, the ROM, and code
+/// whose way cannot be followed end it (`None`).
 ///
 /// # Errors
 /// The line's errors.
