@@ -351,35 +351,25 @@ fn the_undo_of_a_chained_extension_goes_back_to_the_first() {
 /// and after that uploads go on.
 #[test]
 fn an_interrupted_upload_says_so_and_its_undo_file_is_not_replaced() {
-    use std::process::{Command, Stdio};
     let dir = tempfile::tempdir().expect("temporary directory");
     let dir = dir.path();
     std::fs::write(dir.join("ext.elf"), extension_at(0x0400, 2048, None)).expect("the image");
     let sim = Sim::start(dir, &[]);
     let line = ["--port", sim.path.as_str()];
     ok(dir, &line, &["read", "$0400", "2048", "-o", "before.bin"]);
-    let child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
-        .args(["upload", "ext.elf", "--no-dry-run", "--port", &sim.path])
-        .current_dir(dir)
-        .env("NO_COLOR", "1")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("scorpion runs");
     let undo = dir.join("scorpion-last-upload.undo");
-    let waited = std::time::Instant::now();
-    while !undo.exists() && waited.elapsed() < std::time::Duration::from_secs(30) {
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    assert!(undo.exists(), "no undo file within 30 s");
-    std::thread::sleep(std::time::Duration::from_millis(300));
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(killed.success());
-    let output = child.wait_with_output().expect("it ends");
+    let output = interrupted(
+        dir,
+        &["upload", "ext.elf", "--no-dry-run", "--port", &sim.path],
+        &|| {
+            let waited = std::time::Instant::now();
+            while !undo.exists() && waited.elapsed() < std::time::Duration::from_secs(30) {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            assert!(undo.exists(), "no undo file within 30 s");
+            std::thread::sleep(std::time::Duration::from_millis(300));
+        },
+    );
     let said = transcript(&output);
     assert_eq!(output.status.code(), Some(130), "{said}");
     assert!(
@@ -477,7 +467,6 @@ not_mine:
 /// it left and how to finish; the restore run again does.
 #[test]
 fn an_interrupted_restore_says_so_and_runs_again() {
-    use std::process::{Command, Stdio};
     let dir = tempfile::tempdir().expect("temporary directory");
     let dir = dir.path();
     std::fs::write(dir.join("ext.elf"), extension_at(0x0400, 2048, None)).expect("the image");
@@ -485,22 +474,9 @@ fn an_interrupted_restore_says_so_and_runs_again() {
     let line = ["--port", sim.path.as_str()];
     ok(dir, &line, &["backup", "-o", "robot.bak"]);
     ok(dir, &line, &["upload", "ext.elf", "--no-dry-run"]);
-    let child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
-        .args(["restore", "robot.bak", "--port", &sim.path])
-        .current_dir(dir)
-        .env("NO_COLOR", "1")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("scorpion runs");
-    std::thread::sleep(std::time::Duration::from_secs(2));
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(killed.success());
-    let output = child.wait_with_output().expect("it ends");
+    let output = interrupted(dir, &["restore", "robot.bak", "--port", &sim.path], &|| {
+        std::thread::sleep(std::time::Duration::from_secs(2))
+    });
     let said = transcript(&output);
     assert_eq!(output.status.code(), Some(130), "{said}");
     assert!(
@@ -515,4 +491,26 @@ fn an_interrupted_restore_says_so_and_runs_again() {
             == std::fs::read(dir.join("robot.bak")).expect("a backup"),
         "the robot as backed up"
     );
+}
+
+/// `scorpion ARGS` in `dir`, sent a Ctrl-C (SIGINT) once `when` returns;
+/// what it printed and its status.
+fn interrupted(dir: &std::path::Path, args: &[&str], when: &dyn Fn()) -> std::process::Output {
+    use std::process::{Command, Stdio};
+    let child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("scorpion runs");
+    when();
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(killed.success());
+    child.wait_with_output().expect("it ends")
 }
