@@ -288,18 +288,14 @@ impl<T: Transport> RobotDebug<T> {
             target
         };
         debug.stub = StubPlan::place_beside(profile, &debug.image, previous, &taken)?;
-        let stub_place = debug.stub.address
-            ..=debug
-                .stub
-                .address
-                .wrapping_add(debug.stub.bytes.len() as u16 - 1);
+        let chained = debug.stub.clone();
         if debug.stopped.is_none()
             && let Some(path) = crate::chain::comes_back(
                 &mut debug.client,
                 profile,
                 &[],
                 (isa::objfmt::HookKind::Unknown, previous),
-                &|at| stub_place.contains(&at),
+                &|at| chained.contains(at),
             )?
         {
             // The stub would chain to code that jumps back into it.
@@ -307,8 +303,8 @@ impl<T: Transport> RobotDebug<T> {
                 what: "attaching".into(),
                 reason: format!(
                     "HOOK_UNKNOWN leads {path}, into where the stub goes (${:04X}-${:04X}): chained to it, the stub would run in a loop at the robot's next unknown command; point HOOK_UNKNOWN back at the ROM (`scorpion restore` of a backup taken before, or reset the robot), upload the image again and attach",
-                    stub_place.start(),
-                    stub_place.end()
+                    chained.address,
+                    u32::from(chained.address) + chained.bytes.len() as u32 - 1
                 ),
             });
         }
