@@ -303,7 +303,22 @@ impl RobotMonitor {
                 )));
             }
         };
-        Ok(Reply::Text(text))
+        Ok(Reply::Text(self.with_unasked(d, text)?))
+    }
+
+    /// `text`, then the stop that came while the command was busy on the
+    /// line (a breakpoint in code the control loop runs, hit while it was
+    /// set or while memory was read), if one did.
+    fn with_unasked<T: Transport>(
+        &mut self,
+        d: &mut RobotDebug<T>,
+        mut text: String,
+    ) -> Result<String, Failure> {
+        if let Some(registers) = d.take_unasked() {
+            text.push_str("(a stop not asked for) ");
+            text.push_str(&self.heard(d, &Heard::Stopped(registers))?);
+        }
+        Ok(text)
     }
 
     /// What the running robot said unasked within `wait` (a stop a step

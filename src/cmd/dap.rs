@@ -85,7 +85,8 @@ pub(crate) fn attach(
         images,
         ..debug::Args::default()
     };
-    let attached = debug::robot::attach(&args, port, say)?;
+    // The project is the program's, wherever the editor started us.
+    let attached = debug::robot::attach(&args, port, Some(&root), say)?;
     Ok(debugger::dap::Attached { root, ..attached })
 }
 

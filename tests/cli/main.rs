@@ -81,6 +81,23 @@ pub(crate) fn lines_with(text: &str, what: &str) -> Vec<usize> {
         .collect()
 }
 
+/// Copies the directory `from` into `to`, without its `target/` (an
+/// example, so that a test writes into a temporary directory, not the
+/// repository).
+pub(crate) fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for entry in std::fs::read_dir(from).expect("the example").flatten() {
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            if entry.file_name() != "target" {
+                copy_dir(&entry.path(), &target);
+            }
+        } else {
+            std::fs::copy(entry.path(), &target).expect("a copy");
+        }
+    }
+}
+
 /// Exit code, stdout and stderr as one text, for snapshots.
 pub(crate) fn transcript(output: &Output) -> String {
     format!(

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::{lines_with, scorpion, transcript};
+use crate::{copy_dir, lines_with, scorpion, transcript};
 
 fn example(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -121,22 +121,6 @@ fn a_workspace_is_profiled_member_by_member() {
         "{}",
         transcript(&output)
     );
-}
-
-/// Copies the directory `from` into `to` (an example, so that its tests
-/// write into a temporary directory, not the repository).
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("a directory");
-    for entry in std::fs::read_dir(from).expect("the example").flatten() {
-        let target = to.join(entry.file_name());
-        if entry.file_type().expect("a type").is_dir() {
-            if entry.file_name() != "target" {
-                copy_dir(&entry.path(), &target);
-            }
-        } else {
-            std::fs::copy(entry.path(), &target).expect("a copy");
-        }
-    }
 }
 
 /// The 1-based numbers of the lines of `text` that contain `what`.

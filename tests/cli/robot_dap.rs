@@ -435,3 +435,78 @@ fn an_editor_gone_without_disconnect_lets_the_robot_go() {
         assert!(output.status.success(), "{how}: {}", transcript(&output));
     }
 }
+
+/// fresh10 F21 in an editor: a breakpoint in code the control loop runs
+/// (examples/patrol's `rom`, the `JMP` on to the ROM's loop) took 35 s to
+/// be refused as line noise, though its `JSR` was in. Now it is verified
+/// and its stop comes as a `stopped` event, each `continue` stops there
+/// again, and with it cleared the robot goes on. The adapter runs outside
+/// the project (as an editor may start it): `program`, the project's
+/// directory, says where the project is.
+#[test]
+fn a_breakpoint_in_the_control_loops_handler_stops_there_in_an_editor() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = dir.path().join("patrol");
+    crate::copy_dir(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol"),
+        &project,
+    );
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let source = project.join("patrol.s");
+    let line = std::fs::read_to_string(&source)
+        .expect("the source")
+        .lines()
+        .position(|l| l.trim() == "rom:")
+        .expect("`rom:`")
+        + 2;
+    let mut dap = Client::start();
+    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
+    assert_eq!(init["success"], true, "{init}");
+    let launch = dap.request(
+        "launch",
+        json!({"program": project.to_str().expect("a path"), "port": sim.path}),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    let done = dap.request("configurationDone", json!({}));
+    assert_eq!(done["success"], true, "{done}");
+    let breakpoints = |lines: &[usize]| {
+        json!({"source": {"path": source.to_str().expect("a path")},
+               "breakpoints": lines.iter().map(|l| json!({"line": l})).collect::<Vec<_>>()})
+    };
+    let set = dap.request("setBreakpoints", breakpoints(&[line]));
+    assert_eq!(set["body"]["breakpoints"][0]["verified"], true, "{set}");
+    let id = set["body"]["breakpoints"][0]["id"].clone();
+    for _ in 0..2 {
+        let stopped = dap.event("stopped");
+        assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
+        assert_eq!(
+            stopped["body"]["hitBreakpointIds"],
+            json!([id]),
+            "{stopped}"
+        );
+        assert_eq!(dap.top_frame()["instructionPointerReference"], "0x104E");
+        let go = dap.request("continue", json!({"threadId": 1}));
+        assert_eq!(go["success"], true, "{go}");
+    }
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
+    let cleared = dap.request("setBreakpoints", breakpoints(&[]));
+    assert_eq!(cleared["success"], true, "{cleared}");
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+    let output = scorpion(&project, &["installed", "--port", &sim.path]);
+    let said = transcript(&output);
+    assert!(output.status.success(), "{said}");
+    assert!(!said.contains("debug stub"), "{said}");
+    let output = scorpion(&project, &["read", "--port", &sim.path, "$104E", "3"]);
+    assert!(
+        transcript(&output).contains("4C 24 FF"),
+        "{}",
+        transcript(&output)
+    );
+}

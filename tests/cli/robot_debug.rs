@@ -448,3 +448,59 @@ count:  .res 1
     assert!(said.contains("running (nothing came back"), "{said}");
     assert!(said.contains("this may be the answer of /1J"), "{said}");
 }
+
+/// fresh10 F21: a breakpoint in code the control loop runs (examples/
+/// patrol's `HOOK_LOOP` handler: `rom` is its `JMP` on to the ROM's loop,
+/// run on every pass) was hit before the patch was read back; the stop
+/// frames were taken for line noise, the breakpoint forgotten, and `quit`
+/// left the robot stopped in the stub. Now the stop is told, `continue`
+/// stops there again, and `quit` gives the robot back with the code as
+/// the image has it.
+#[test]
+fn a_breakpoint_in_the_control_loops_handler_stops_there_and_quit_lets_go() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = dir.path().join("patrol");
+    crate::copy_dir(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol"),
+        &project,
+    );
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion_with_input(
+        Some(&project),
+        &["debug", "--port", &sim.path],
+        "break rom\ninfo\ncontinue\nregs\nquit\n",
+    );
+    let printed = transcript(&output);
+    assert!(output.status.success(), "{printed}");
+    let mut from = 0;
+    for expected in [
+        "breakpoint 1: $",
+        "(rom)",
+        "(a stop not asked for) stopped: breakpoint 1, $",
+        "breakpoint 1: $",
+        "stopped: breakpoint 1, $",
+        "PC=$",
+        "detached",
+    ] {
+        let at = printed[from..]
+            .find(expected)
+            .unwrap_or_else(|| panic!("`{expected}` after byte {from}:\n{printed}"));
+        from += at + expected.len();
+    }
+    // The robot runs and answers, the JMP at `rom` is the image's again.
+    let output = scorpion(&project, &["installed", "--port", &sim.path]);
+    let said = transcript(&output);
+    assert!(output.status.success(), "{said}");
+    assert!(
+        said.contains("HOOK_LOOP: $1000 (") && !said.contains("debug stub"),
+        "{said}"
+    );
+    let output = scorpion(&project, &["read", "--port", &sim.path, "$104E", "3"]);
+    assert!(
+        transcript(&output).contains("4C 24 FF"),
+        "{}",
+        transcript(&output)
+    );
+}

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::{scorpion, scorpion_with_input, transcript};
+use crate::{copy_dir, scorpion, scorpion_with_input, transcript};
 
 /// The example room, copied into `dir`.
 fn room(dir: &Path) {
@@ -151,21 +151,6 @@ fn the_line_follower_follows_its_curved_line_to_the_end() {
         "{}",
         transcript(&output)
     );
-}
-
-/// Copies the directory `from` into `to`, without its `target/`.
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("a directory");
-    for entry in std::fs::read_dir(from).expect("the example").flatten() {
-        let target = to.join(entry.file_name());
-        if entry.file_type().expect("a type").is_dir() {
-            if entry.file_name() != "target" {
-                copy_dir(&entry.path(), &target);
-            }
-        } else {
-            std::fs::copy(entry.path(), &target).expect("a copy");
-        }
-    }
 }
 
 /// A picture into a directory that does not exist is refused before the

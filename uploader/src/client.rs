@@ -90,6 +90,10 @@ pub struct Client<T> {
     robot_free: Duration,
     last_rx: Duration,
     stats: ClientStats,
+    /// Whether the debug stub's stop frame was heard since the exchange
+    /// began: a breakpoint in code the robot runs on its own (a
+    /// `HOOK_LOOP` handler) stops it between two questions.
+    heard_stop: bool,
 }
 
 /// Counters of one client's traffic.
@@ -120,6 +124,7 @@ impl<T: Transport> Client<T> {
             robot_free: now,
             last_rx: now,
             stats: ClientStats::default(),
+            heard_stop: false,
         }
     }
 
@@ -169,12 +174,27 @@ impl<T: Transport> Client<T> {
     /// Reads from the line, waiting up to `timeout`; records the time of
     /// the last byte.
     fn fill(&mut self, timeout: Duration) -> Result<usize> {
+        let before = self.rx.len();
         let count = self.transport.receive(&mut self.rx, timeout)?;
         if count > 0 {
             self.last_rx = self.transport.now();
             self.stats.received += count;
+            // The frame's start may have come with the last bytes.
+            self.heard_stop |= stopped_in_stub(&self.rx[before.saturating_sub(2)..]);
         }
         Ok(count)
+    }
+
+    /// Ends an exchange the stub's stop frame broke into: its questions
+    /// get no answer (a stopped robot reads frames only), so they are
+    /// dropped with what was heard.
+    fn stopped_now(&mut self) -> Error {
+        self.heard_stop = false;
+        self.in_flight.clear();
+        self.rx.clear();
+        Error::StoppedInDebugStub {
+            port: self.transport.name(),
+        }
     }
 
     /// Takes the next complete frame (through its carriage return).
@@ -446,9 +466,13 @@ impl<T: Transport> Client<T> {
         let timeout = self.answer_timeout(command, &bytes);
         self.drain()?;
         self.transport.clear_input()?;
+        self.heard_stop = false;
         self.send_raw(&bytes)?;
         let deadline = self.transport.now() + timeout;
         loop {
+            if self.heard_stop {
+                return Err(self.stopped_now());
+            }
             if let Some(frame) = self.take_frame() {
                 let answer = match command {
                     Command::Extension(_) => Answer::parse_text(&frame),
@@ -620,6 +644,7 @@ impl<T: Transport> Client<T> {
         // How often each address differed between two well-formed answers.
         let mut changes: std::collections::HashMap<u16, u32> = std::collections::HashMap::new();
         let mut pairs = 0u32;
+        self.heard_stop = false;
         while remaining > 0 {
             while let Some(&span) = todo.front() {
                 if !self.can_ask(span.count()) {
@@ -628,7 +653,11 @@ impl<T: Transport> Client<T> {
                 todo.pop_front();
                 self.ask_read(span)?;
             }
-            for outcome in self.poll(self.config.stall_limit)? {
+            let outcomes = self.poll(self.config.stall_limit)?;
+            if self.heard_stop {
+                return Err(self.stopped_now());
+            }
+            for outcome in outcomes {
                 match outcome {
                     Outcome::Answered { span, data, .. } => {
                         let offset = usize::from(span.address() - address);

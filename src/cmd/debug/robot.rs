@@ -5,6 +5,7 @@
 //! takes every breakpoint out and gives the hook back.
 
 use std::io::Write;
+use std::path::Path;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -23,24 +24,24 @@ const PROMPT: &str = "(robot) ";
 /// robot said unasked.
 const NOTICE: std::time::Duration = std::time::Duration::from_millis(30);
 
-/// The robot on `port` (empty: the environment's or the project's)
-/// with the stub attached beside the images `args` names, the names of
+/// The robot on `port` (empty: the environment's or the project's: the
+/// one in `here`, else in the working directory) with the stub attached beside the images `args` names, the names of
 /// the ROM and the images, and the images (their sources from here).
 /// `say` hears what a person waiting should know (how long the attach
 /// takes), before the seconds it takes.
 pub(crate) fn attach(
     args: &Args,
     port: &str,
+    here: Option<&Path>,
     say: &mut dyn FnMut(&str),
 ) -> miette::Result<debugger::dap::Attached> {
     // `--port` alone: the one the environment or the project names.
     let port = (!port.is_empty()).then(|| port.to_owned());
-    let resolved = crate::cmd::config::resolve(&crate::cmd::config::flags(
-        port.as_ref(),
-        args.baud,
-        &args.rig,
-        args.rom.as_ref(),
-    ))?;
+    let flags = crate::cmd::config::flags(port.as_ref(), args.baud, &args.rig, args.rom.as_ref());
+    let resolved = match here {
+        Some(here) => crate::cmd::config::resolve_in(&flags, here)?,
+        None => crate::cmd::config::resolve(&flags)?,
+    };
     let images = crate::cmd::config::images(&resolved, &args.images)?.images;
     if images.is_empty() {
         return Err(miette::miette!(
@@ -123,7 +124,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         symbols,
         images: linked,
         ..
-    } = attach(args, port, &mut |said| {
+    } = attach(args, port, None, &mut |said| {
         #[allow(
             clippy::print_stderr,
             reason = "progress of a long attach, before the session starts"

@@ -100,6 +100,11 @@ pub struct RobotDebug<T> {
     starts: Option<Vec<u16>>,
     /// A step's breakpoints, taken out at the next stop.
     temporary: Vec<u16>,
+    /// A stop that came while the host was busy with something else (a
+    /// breakpoint in code the robot runs on its own, hit while a patch
+    /// was read back): told by the next [`RobotDebug::poll`] or
+    /// [`RobotDebug::wait_event`], or [`RobotDebug::take_unasked`].
+    unasked: Option<Registers>,
     /// Set by a signal: a wait for the robot ends at once.
     interrupt: Option<Arc<AtomicBool>>,
 }
@@ -212,6 +217,7 @@ impl<T: Transport> RobotDebug<T> {
             recovery: Recovery::default(),
             starts: None,
             temporary: Vec::new(),
+            unasked: None,
             interrupt: None,
         };
         let stopped = debug.probe()?.is_some();
@@ -423,7 +429,11 @@ impl<T: Transport> RobotDebug<T> {
                 }
                 match self.next_heard(deadline - now)? {
                     Some(Heard::Frame(reply)) => {
-                        if let [b'M', _, _, rest @ ..] = reply.as_slice() {
+                        if let [b'M', lo, hi, rest @ ..] = reply.as_slice() {
+                            if [*lo, *hi] != regs || rest.len() != 8 {
+                                // A late reply to an earlier request.
+                                continue;
+                            }
                             let registers = self.take_stop(rest);
                             self.stopped = None;
                             return Ok(Some(registers));
@@ -837,9 +847,19 @@ impl<T: Transport> RobotDebug<T> {
     /// stopped, else staged in the stub, read back, and copied by `/1@`.
     /// Reads them back either way.
     fn patch(&mut self, address: u16, bytes: [u8; 3]) -> StubResult<()> {
-        if self.stopped.is_some() {
-            return self.write_verified(address, &bytes);
+        if self.stopped.is_none() {
+            match self.patch_running(address, bytes) {
+                // Stopped on the way (by this very patch, it may be): the
+                // bytes go in through the stub, in one frame.
+                Err(error) => self.caught(error)?,
+                done => return done,
+            }
         }
+        self.write_verified(address, &bytes)
+    }
+
+    /// [`RobotDebug::patch`] while the robot runs.
+    fn patch_running(&mut self, address: u16, bytes: [u8; 3]) -> StubResult<()> {
         let at = address.to_le_bytes();
         let staged = [at[0], at[1], bytes[0], bytes[1], bytes[2]];
         let trampoline = self
@@ -879,7 +899,11 @@ impl<T: Transport> RobotDebug<T> {
     /// [`StubError::Verify`], the line's errors.
     pub fn write_verified(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
         if self.stopped.is_none() {
-            return self.rom_write_verified(address, bytes);
+            match self.rom_write_verified(address, bytes) {
+                // Stopped on the way: written through the stub below.
+                Err(error) => self.caught(error)?,
+                done => return done,
+            }
         }
         for (i, part) in bytes.chunks(IN_MAX - 4).enumerate() {
             let at = address.wrapping_add((i * (IN_MAX - 4)) as u16);
@@ -909,7 +933,10 @@ impl<T: Transport> RobotDebug<T> {
     /// The line's errors, a garbled reply.
     pub fn read(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
         if self.stopped.is_none() {
-            return Ok(self.client.read_memory(address, len)?);
+            match self.client.read_memory(address, len) {
+                Err(error) => self.caught(error.into())?,
+                done => return Ok(done?),
+            }
         }
         let mut out = Vec::with_capacity(len);
         while out.len() < len {
@@ -941,7 +968,23 @@ impl<T: Transport> RobotDebug<T> {
                 payload.len() * 2 + count + 16,
                 self.client.transport().baud(),
             ) + self.margin;
-            match self.next_heard(wait)? {
+            let deadline = self.client.transport().now() + wait;
+            let mut heard = None;
+            while let Some(left) = deadline.checked_sub(self.client.transport().now()) {
+                match self.next_heard(left)? {
+                    // A late reply to an earlier request (its stop frame
+                    // came first, say): the robot sends what it still owes
+                    // after the input is cleared. Ours follows it.
+                    Some(Heard::Frame(reply))
+                        if reply.first() == Some(&b'M')
+                            && (reply.len() != count + 3 || reply[1..3] != at.to_le_bytes()) => {}
+                    other => {
+                        heard = other;
+                        break;
+                    }
+                }
+            }
+            match heard {
                 Some(Heard::Frame(reply)) => {
                     let expected = [b'M', at.to_le_bytes()[0], at.to_le_bytes()[1]];
                     if reply.len() == count + 3 && reply[..3] == expected {
@@ -996,6 +1039,36 @@ impl<T: Transport> RobotDebug<T> {
         }
     }
 
+    /// Takes `error` for a stop when it is one: the stub's stop frame heard
+    /// by the ROM's commands of a running robot (a breakpoint in code the
+    /// control loop runs, hit between two of them). The registers are
+    /// asked for, the robot is stopped from now on, and the stop is kept
+    /// to be told ([`RobotDebug::take_unasked`]). Any other error is
+    /// given back.
+    fn caught(&mut self, error: StubError) -> StubResult<()> {
+        if self.stopped.is_some()
+            || !matches!(
+                error,
+                StubError::Line(crate::Error::StoppedInDebugStub { .. })
+            )
+        {
+            return Err(error);
+        }
+        let Some(registers) = self.probe_stopped()? else {
+            return Err(error);
+        };
+        self.stopped = Some(registers);
+        self.unasked = Some(registers);
+        self.drop_temporary()
+    }
+
+    /// The stop that came while the host was busy with something else
+    /// (setting or removing a breakpoint, reading or writing memory), not
+    /// told yet; taken, so it is told once.
+    pub fn take_unasked(&mut self) -> Option<Registers> {
+        self.unasked.take()
+    }
+
     /// Takes a stop frame's payload as the registers.
     fn take_stop(&mut self, payload: &[u8]) -> Option<Registers> {
         let [b'S', pcl, pch, a, x, y, p, s] = *payload else {
@@ -1045,6 +1118,9 @@ impl<T: Transport> RobotDebug<T> {
     /// The line's errors, [`StubError::Garbled`],
     /// [`StubError::Interrupted`].
     pub fn wait_event(&mut self, wait: Duration) -> StubResult<Reply> {
+        if let Some(registers) = self.unasked.take() {
+            return Ok(Reply::Stopped(registers));
+        }
         let asked = "a stop or an answer";
         let mut deadline = self.client.transport().now() + wait;
         let mut strikes = 0;
@@ -1186,6 +1262,7 @@ impl<T: Transport> RobotDebug<T> {
             return Err(not_stopped("continue"));
         };
         let to = self.resume_address(registers.pc).to_le_bytes();
+        self.unasked = None;
         self.rx.clear();
         self.client
             .send_raw(&frame::encode(&[b'C', to[0], to[1]]))?;
@@ -1475,6 +1552,9 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// The line's errors.
     pub fn poll(&mut self, wait: Duration) -> StubResult<Option<Reply>> {
+        if let Some(registers) = self.unasked.take() {
+            return Ok(Some(Reply::Stopped(registers)));
+        }
         if self.stopped.is_some() {
             return Ok(None);
         }
