@@ -504,3 +504,44 @@ fn a_breakpoint_in_the_control_loops_handler_stops_there_and_quit_lets_go() {
         transcript(&output)
     );
 }
+
+/// fresh10 F16: a session that cannot give the robot back at `quit` (the
+/// robot went astray, or here its line is gone) said what an upload
+/// says, "stalled mid-upload ... safe to retry". It says now that the
+/// session could not give the robot back, and what to do about it.
+#[test]
+fn a_quit_that_cannot_give_the_robot_back_says_so() {
+    use std::io::{BufRead as _, BufReader, Write as _};
+    use std::process::{Command, Stdio};
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+        .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
+        .current_dir(dir.path())
+        .env("NO_COLOR", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("scorpion runs");
+    let mut stdin = child.stdin.take().expect("its input");
+    stdin.write_all(b"break show\n/1Q\n").expect("the lines");
+    let mut stdout = BufReader::new(child.stdout.take().expect("its output"));
+    let mut seen = String::new();
+    while !seen.contains("PC=") {
+        let mut line = String::new();
+        let read = stdout.read_line(&mut line).expect("a line");
+        assert!(read > 0, "ended before the stop:\n{seen}");
+        seen.push_str(&line);
+    }
+    drop(sim);
+    stdin.write_all(b"quit\n").expect("quit");
+    drop(stdin);
+    let output = child.wait_with_output().expect("it ends");
+    let said = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{seen}{said}");
+    assert!(
+        said.contains("could not give the robot back") && said.contains("reset it"),
+        "{said}"
+    );
+    assert!(!said.contains("upload"), "{said}");
+}

@@ -195,9 +195,21 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     }
     // Given back whatever ended the conversation (an unwritable terminal
     // too), before its error is said.
+    let robot_port = robot.client().transport().name();
     let detached = robot.detach();
     let broken = session?;
-    detached?;
+    if let Err(error) = detached {
+        // The line's own help speaks of uploads ("safe to retry"): here a
+        // stub and breakpoints may be left on a robot that went astray.
+        return Err(miette::miette!(
+            code = "scorpion::debug::not_given_back",
+            help = format!(
+                "the stub may still be hooked and breakpoints' JSRs left in the code: if the robot answers no command, reset it (its hooks go back to the ROM); then `scorpion debug --port {}` with the same image finds what is left and takes it out",
+                robot_port
+            ),
+            "the session could not give the robot back: {error}"
+        ));
+    }
     // The terminal may be gone: what cannot be said is dropped.
     let _ = writeln!(
         out,

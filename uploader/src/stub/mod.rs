@@ -8,11 +8,13 @@
 //! - [`link`]: the stub linked where the image leaves room;
 //! - [`left`]: a stub a killed session left hooked, recognised;
 //! - [`frame`]: the stub's framing;
+//! - [`guard`]: what a person at a stop may change;
 //! - [`patch`]: what a breakpoint displaces, and where a step goes;
 //! - [`session`]: [`RobotDebug`], the debugger attached.
 
 pub mod error;
 pub mod frame;
+pub mod guard;
 pub mod host_step;
 pub mod left;
 pub mod link;

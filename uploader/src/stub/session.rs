@@ -22,6 +22,7 @@ use romlib::protocol::Command;
 
 use super::error::{StubError, StubResult, hex};
 use super::frame::{self, Heard, IN_MAX};
+use super::guard::{self, Guard};
 use super::host_step::{self, Step};
 use super::link::{StubPlan, TRAMPOLINE_LEN, TRAMPOLINES};
 use super::patch::{self, JSR, Patch};
@@ -107,6 +108,8 @@ pub struct RobotDebug<T> {
     unasked: Option<Registers>,
     /// Set by a signal: a wait for the robot ends at once.
     interrupt: Option<Arc<AtomicBool>>,
+    /// What a person's writes and registers may change.
+    guard: Guard,
 }
 
 /// What attach found of an earlier session that ended without detaching
@@ -219,6 +222,7 @@ impl<T: Transport> RobotDebug<T> {
             temporary: Vec::new(),
             unasked: None,
             interrupt: None,
+            guard: Guard::new(profile),
         };
         let stopped = debug.probe()?.is_some();
         if stopped {
@@ -1190,12 +1194,35 @@ impl<T: Transport> RobotDebug<T> {
         self.interrupt = Some(flag);
     }
 
-    /// Changes the registers of the stopped robot (the PC is where
-    /// `resume` goes on).
+    /// Changes the registers of the stopped robot, as a person asks (the
+    /// PC is where `resume` goes on).
     ///
     /// # Errors
-    /// [`StubError::Refused`] while running; the line's errors.
+    /// [`StubError::Refused`] while running, and for registers the robot
+    /// cannot go on with ([`Guard::refuse_registers`]: a PC where no
+    /// instruction is known, the decimal flag); the line's errors.
     pub fn set_registers(&mut self, registers: Registers) -> StubResult<()> {
+        let Some(old) = self.stopped else {
+            return Err(not_stopped("setting a register"));
+        };
+        if let Some(reason) = self.guard.refuse_registers(
+            &old,
+            &registers,
+            &self.image,
+            self.starts.as_deref(),
+            &self.stub,
+        ) {
+            return Err(StubError::Refused {
+                what: "setting the registers".into(),
+                reason,
+            });
+        }
+        self.put_registers(registers)
+    }
+
+    /// [`RobotDebug::set_registers`] unchecked: the registers a step done
+    /// on the host leaves (the program's own doing).
+    fn put_registers(&mut self, registers: Registers) -> StubResult<()> {
         let Some(old) = self.stopped else {
             return Err(not_stopped("setting a register"));
         };
@@ -1244,7 +1271,8 @@ impl<T: Transport> RobotDebug<T> {
         };
         let stub = self.stub.clone();
         let the_stubs = |at: u16| stub.contains(at);
-        let unwritable = |at: u16| at > platform::map::RAM_END;
+        let image = self.image.clone();
+        let unwritable = |at: u16| !guard::ram(at, &image);
         let mut read = |at: u16| -> StubResult<u8> { Ok(self.read_as_program(at, 1)?[0]) };
         let writes = match host_step::step(registers, &mut read, &the_stubs, &unwritable)? {
             Step::Host(effects) => effects.writes,
@@ -1370,7 +1398,8 @@ impl<T: Transport> RobotDebug<T> {
     fn step_on_host(&mut self, registers: Registers) -> StubResult<Option<Reply>> {
         let stub = self.stub.clone();
         let the_stubs = |at: u16| stub.contains(at);
-        let unwritable = |at: u16| at > platform::map::RAM_END;
+        let image = self.image.clone();
+        let unwritable = |at: u16| !guard::ram(at, &image);
         let mut read = |at: u16| -> StubResult<u8> { Ok(self.read_as_program(at, 1)?[0]) };
         let step = host_step::step(registers, &mut read, &the_stubs, &unwritable)?;
         let what = format!("a step from ${:04X}", registers.pc);
@@ -1396,7 +1425,7 @@ impl<T: Transport> RobotDebug<T> {
             }
             Step::Host(effects) => {
                 self.apply_as_program(&effects.writes, &what)?;
-                self.set_registers(effects.registers)?;
+                self.put_registers(effects.registers)?;
                 Ok(Some(Reply::Stopped(effects.registers)))
             }
         }
@@ -1469,17 +1498,25 @@ impl<T: Transport> RobotDebug<T> {
     /// stop the stub's zero page to where the stub keeps the program's.
     ///
     /// # Errors
-    /// [`StubError::Refused`] for a write into the stub, or a byte under
-    /// a `JSR` that would make its trampoline's copy run otherwise (see
-    /// [`Patch::with_byte`]); nothing is written then. The line's errors,
-    /// [`StubError::Verify`].
+    /// [`StubError::Refused`] for a write outside the program's RAM or
+    /// into the hooks or the table ([`Guard::refuse_write`]), into the
+    /// stub, or a byte under a `JSR` that would make its trampoline's
+    /// copy run otherwise (see [`Patch::with_byte`]); nothing is written
+    /// then. The line's errors, [`StubError::Verify`].
     pub fn write_as_program(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        let what = format!("a write at ${address:04X}");
+        for i in 0..bytes.len() {
+            let at = address.wrapping_add(i as u16);
+            if let Some(reason) = self.guard.refuse_write(at, &self.image) {
+                return Err(StubError::Refused { what, reason });
+            }
+        }
         let writes: Vec<(u16, u8)> = bytes
             .iter()
             .enumerate()
             .map(|(i, &byte)| (address.wrapping_add(i as u16), byte))
             .collect();
-        self.apply_as_program(&writes, &format!("a write at ${address:04X}"))
+        self.apply_as_program(&writes, &what)
     }
 
     /// [`RobotDebug::write_as_program`] for writes in order (`what` names

@@ -1,0 +1,137 @@
+//! What a person at a stop may change on the robot: memory the program
+//! owns, and registers the ROM can go on with. The virtual monitor knows
+//! every byte of its board; on the robot the host knows the board's RAM,
+//! the image it uploaded, the stub and the ROM's hooks and table, and
+//! refuses the rest before anything goes on the line (fresh10 F16, F17;
+//! hostile11 F1).
+
+use std::ops::RangeInclusive;
+
+use romlib::installed::{TABLE, TABLE_LEN};
+
+use super::link::StubPlan;
+use crate::image::{RomProfile, UploadImage};
+
+/// The decimal flag in P.
+const DECIMAL: u8 = 0x08;
+
+/// The robot's memory as the host knows it, for the writes and the
+/// registers a person asks for.
+#[derive(Debug, Clone)]
+pub struct Guard {
+    /// `HOOK_UNKNOWN`'s and `HOOK_LOOP`'s `JMP`s.
+    hooks: [RangeInclusive<u16>; 2],
+    /// The ROM's table of installed extensions.
+    table: RangeInclusive<u16>,
+}
+
+impl Guard {
+    /// The guard of a robot with `profile`'s ROM.
+    #[must_use]
+    pub fn new(profile: &RomProfile) -> Guard {
+        let jmp = |at: u16| at..=at.wrapping_add(2);
+        Guard {
+            hooks: [jmp(profile.hook_unknown), jmp(profile.hook_loop)],
+            table: TABLE..=TABLE + (TABLE_LEN as u16 - 1),
+        }
+    }
+
+    /// Why a write at `at` by a person is refused, if it is: only RAM the
+    /// program owns is written (the board's RAM and the image's own
+    /// memory), not the hooks or the table (an upload changes those, each
+    /// verified before it is reached), nor the ROM, the I/O page or the
+    /// KIM bus beyond the image (a card's registers may sit there, and a
+    /// write may start its hardware).
+    #[must_use]
+    pub fn refuse_write(&self, at: u16, image: &UploadImage) -> Option<String> {
+        if let Some(hook) = self.hooks.iter().position(|hook| hook.contains(&at)) {
+            let name = ["HOOK_UNKNOWN", "HOOK_LOOP"][hook];
+            return Some(format!(
+                "${at:04X} is in {name}'s JMP, which the session needs to take its breakpoints out and give the hook back; an upload changes the hooks, each verified before it is reached"
+            ));
+        }
+        if self.table.contains(&at) {
+            return Some(format!(
+                "${at:04X} is in the ROM's table of installed extensions (${:04X}-${:04X}), which uploads, undo and `installed` read: an upload changes it, verified",
+                self.table.start(),
+                self.table.end()
+            ));
+        }
+        if ram(at, image) {
+            return None;
+        }
+        Some(format!(
+            "${at:04X} is {}: the robot's monitor writes RAM only (the board's, to ${:04X}, and the image's own memory)",
+            region(at),
+            platform::map::RAM_END
+        ))
+    }
+
+    /// Why the registers `new` are refused where the robot is stopped
+    /// with `old`, if they are: a PC that is no instruction the host knows
+    /// (inside the stub, inside an instruction of the image, or in memory
+    /// that is not the image's or the ROM's), or the decimal flag set (the
+    /// ROM turns bytes into hex digits with `ADC`, so every answer of a
+    /// robot going on in decimal mode is wrong).
+    #[must_use]
+    pub fn refuse_registers(
+        &self,
+        old: &super::Registers,
+        new: &super::Registers,
+        image: &UploadImage,
+        starts: Option<&[u16]>,
+        stub: &StubPlan,
+    ) -> Option<String> {
+        if new.p & DECIMAL != 0 && old.p & DECIMAL == 0 {
+            return Some(
+                "the decimal flag (D) set: the ROM makes its answers' hex digits with ADC, so in decimal mode every answer (each `/7R` read included) would come back wrong until a reset".into(),
+            );
+        }
+        let pc = new.pc;
+        if pc == old.pc {
+            return None;
+        }
+        if stub.contains(pc) {
+            return Some(format!(
+                "PC=${pc:04X} is in the debug stub (${:04X}-${:04X}): the robot would run the stub's code as the program's",
+                stub.address,
+                u32::from(stub.address) + stub.bytes.len() as u32 - 1
+            ));
+        }
+        if image.contains(pc) {
+            if starts.is_some_and(|starts| starts.binary_search(&pc).is_err()) {
+                return Some(format!(
+                    "no instruction of the image starts at ${pc:04X} (its line tables start a line at every instruction): the robot would run the middle of one"
+                ));
+            }
+            return None;
+        }
+        if pc >= platform::map::ROM_START {
+            return None;
+        }
+        Some(format!(
+            "PC=${pc:04X} is {}, where the image has no code: the robot would run whatever is there; set PC to an instruction of the image or the ROM",
+            region(pc)
+        ))
+    }
+}
+
+/// Whether `at` is RAM the program owns: the board's RAM, or the image's.
+#[must_use]
+pub fn ram(at: u16, image: &UploadImage) -> bool {
+    at <= platform::map::RAM_END || image.contains(at)
+}
+
+/// What the board has at `at`, for a refusal.
+fn region(at: u16) -> &'static str {
+    use platform::map::{IO_END, IO_START, KIM_BUS, ROM_START};
+    if at >= ROM_START {
+        "the ROM"
+    } else if (IO_START..=IO_END).contains(&at) {
+        "in the I/O page (the 6522's and the ACIA's registers, the drive and sense latches)"
+    } else if KIM_BUS.contains(&at) {
+        "on the KIM bus outside the image (a card's registers may sit there)"
+    } else {
+        "memory the board does not have"
+    }
+}
