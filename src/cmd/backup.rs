@@ -97,6 +97,7 @@ pub(crate) fn restore_into(
         force_rom,
         loader,
         resume,
+        undo: started.is_some(),
         ..UploadOptions::default()
     };
     if resume {

@@ -514,3 +514,58 @@ fn interrupted(dir: &std::path::Path, args: &[&str], when: &dyn Fn()) -> std::pr
     assert!(killed.success());
     child.wait_with_output().expect("it ends")
 }
+
+/// fresh10 F20: the undo of an older upload (its own undo file) also
+/// unhooked a later upload chained ahead of it, exit 0; and the undo of
+/// the later one then hooked code the first undo had taken away, and the
+/// robot hung at its next command (hostile11 F2). The older undo is
+/// refused now, naming the later extension, and nothing is written; in
+/// the order they were made, both undo.
+#[test]
+fn the_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(d.join("first.elf"), extension_at(0x0C00, 200, None)).expect("the image");
+    std::fs::write(d.join("ext.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(d, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(
+        d,
+        &line,
+        &[
+            "upload",
+            "first.elf",
+            "--no-dry-run",
+            "--undo-file",
+            "u1.undo",
+        ],
+    );
+    ok(
+        d,
+        &line,
+        &[
+            "upload",
+            "ext.elf",
+            "--no-dry-run",
+            "--undo-file",
+            "u2.undo",
+        ],
+    );
+    let hooks = ok(d, &line, &["read", "$0200", "3"]);
+    let (refused, said) = on(d, &line, &["upload", "--undo", "--undo-file", "u1.undo"]);
+    assert!(!refused, "{said}");
+    assert!(
+        said.contains("uploader::undo_not_last")
+            && said.contains("HOOK_UNKNOWN leads first to $0403 (extension ")
+            && said.contains("nothing was written"),
+        "{said}"
+    );
+    assert_eq!(ok(d, &line, &["read", "$0200", "3"]), hooks, "unchanged");
+    assert!(d.join("u1.undo").exists(), "the file is kept for later");
+    ok(d, &line, &["upload", "--undo", "--undo-file", "u2.undo"]);
+    let text = ok(d, &line, &["read", "$0200", "3"]);
+    assert!(text.contains("0200: 4C 03 0C"), "back to the first: {text}");
+    ok(d, &line, &["upload", "--undo", "--undo-file", "u1.undo"]);
+    let text = ok(d, &line, &["read", "$0200", "3"]);
+    assert!(text.contains("0200: 4C 21 FF"), "back to the ROM: {text}");
+}

@@ -684,6 +684,9 @@ pub fn restore<T: Transport>(
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
+    if options.undo {
+        refuse_later_uploads(client, backup, profile, &hooks)?;
+    }
     // A debug stub a killed session left hooked: its breakpoints are not
     // the backup's to take out.
     crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
@@ -726,6 +729,7 @@ pub fn restore<T: Transport>(
             reports.push(upload(client, &image, &rom, progress)?);
         }
     }
+    crate::chain::check_restored(client, profile, &backup.hooks)?;
     for &(kind, target) in &backup.hooks {
         switch_hook(
             client,
@@ -735,6 +739,53 @@ pub fn restore<T: Transport>(
         )?;
     }
     Ok(reports)
+}
+
+/// An undo puts a hook back where it was before the upload it undoes: so
+/// the hook must lead now to that upload's image (memory the file puts
+/// back), to where the file puts it anyway, or to the ROM (a reset, an
+/// undo stopped half way). Anywhere else, a later upload was chained
+/// ahead, and the undo would unhook it (fresh10 F20; hostile11 F2, where
+/// the undo of that later upload then hooked code the first undo had
+/// taken away).
+fn refuse_later_uploads<T: Transport>(
+    client: &mut Client<T>,
+    backup: &Backup,
+    profile: &RomProfile,
+    hooks: &[(HookKind, u16)],
+) -> Result<()> {
+    for &(kind, target) in &backup.hooks {
+        let Some(current) = hooks
+            .iter()
+            .find(|(this, _)| *this == kind)
+            .map(|&(_, current)| current)
+        else {
+            continue;
+        };
+        let put_back = backup.byte_at(u32::from(current)).is_some();
+        if current == target
+            || put_back
+            || profile.reset_target(kind) == Some(current)
+            || in_rom(profile, current)
+        {
+            continue;
+        }
+        let owner = crate::table::read_installed(client, profile)
+            .ok()
+            .and_then(|everyone| {
+                everyone
+                    .into_iter()
+                    .find(|entry| entry.contains(current))
+                    .map(|entry| format!(" (extension {:06X})", entry.id))
+            })
+            .unwrap_or_default();
+        return Err(Error::UndoNotLast {
+            hook: kind.rom_symbol(),
+            current,
+            owner,
+        });
+    }
+    Ok(())
 }
 
 /// The options a restore writes memory with: the table is written as
@@ -793,6 +844,15 @@ fn check_hook_targets(
         // marks the target first): a hook into RAM that neither covers was
         // made by something else, and nothing would be checked there
         // before the robot jumps in.
+        if !to_rom && within(table, target) {
+            // Witnessed or held, the table is data (hostile10 F14).
+            return Err(Error::BadImage {
+                reason: format!(
+                    "the backup points {} at ${target:04X}, in the table of installed extensions: no handler starts there; nothing was written",
+                    kind.rom_symbol()
+                ),
+            });
+        }
         let held = backup.byte_at(u32::from(target)).is_some();
         let witnessed = backup.witnesses.iter().any(|witness| {
             u32::from(witness.address) <= u32::from(target)
@@ -805,7 +865,7 @@ fn check_hook_targets(
             });
         }
         if !to_rom && !witnessed {
-            check_held_entry(backup, table, kind, target)?;
+            check_held_entry(backup, kind, target)?;
         }
     }
     Ok(())
@@ -833,15 +893,10 @@ fn refuse_held_stub(backup: &Backup, profile: &RomProfile) -> Result<()> {
 
 /// A hook into RAM the file itself restores must find there what starts
 /// an extension's handler (hostile8's F2, F3: a crafted file's hook into
-/// zeros, the table, or the last byte of what it holds): not the table of
-/// installed extensions, and a whole documented instruction other than
-/// `BRK`, every byte of it held by the file.
-fn check_held_entry(
-    backup: &Backup,
-    table: Option<(u16, usize)>,
-    kind: HookKind,
-    target: u16,
-) -> Result<()> {
+/// zeros, the table, or the last byte of what it holds; the table is
+/// refused before, with witnessed targets): a whole documented
+/// instruction other than `BRK`, every byte of it held by the file.
+fn check_held_entry(backup: &Backup, kind: HookKind, target: u16) -> Result<()> {
     let refuse = |why: String| {
         Err(Error::BadImage {
             reason: format!(
@@ -850,9 +905,6 @@ fn check_held_entry(
             ),
         })
     };
-    if within(table, target) {
-        return refuse("in the table of installed extensions".into());
-    }
     let first = backup.byte_at(u32::from(target)).unwrap_or(0);
     let opcode = isa::opcode(first);
     if !opcode.is_documented() || opcode.mnemonic == isa::Mnemonic::Brk {
@@ -1206,6 +1258,19 @@ mod tests {
                         bytes: vec![0x20; 64],
                     }],
                 ),
+                "in the table",
+            ),
+            // hostile10 F14: witnessed (an undo file's witness of the
+            // entry), the table is no handler either.
+            (
+                Backup {
+                    witnesses: vec![Witness {
+                        address: table_at + 8,
+                        len: 15,
+                        sum: 0,
+                    }],
+                    ..file(table_at + 8, Vec::new())
+                },
                 "in the table",
             ),
             (

@@ -14,11 +14,11 @@ use isa::Mnemonic;
 use isa::objfmt::HookKind;
 use romlib::installed::Installed;
 
-use crate::Result;
 use crate::client::Client;
 use crate::hooks::{JMP, read_word};
 use crate::image::RomProfile;
 use crate::transport::Transport;
+use crate::{Error, Result};
 
 /// Jumps followed at most: a longer run is a loop of the robot's own
 /// (it already hangs there), not one through what is written now.
@@ -58,19 +58,56 @@ pub(crate) fn comes_back<T: Transport>(
     (kind, target): (HookKind, u16),
     inside: &dyn Fn(u16) -> bool,
 ) -> Result<Option<Path>> {
-    let mut path = Vec::new();
+    Ok(
+        match follow(client, profile, everyone, (kind, target), &|at, _| {
+            inside(at)
+        })? {
+            End::Inside(path) => Some(path),
+            _ => None,
+        },
+    )
+}
+
+/// How a chain followed from a hook's target ends.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum End {
+    /// At an address the caller named: the way there.
+    Inside(Path),
+    /// At code that stops the CPU (a `JAM`, a `BRK` whose interrupt
+    /// handler returns into the middle of nothing): the way there.
+    Stops(Path),
+    /// In the ROM, or somewhere this module cannot follow (a call, a
+    /// return, a run longer than it looks).
+    Elsewhere,
+}
+
+/// The walk of [`comes_back`], ending where `inside(at, way)` says (`way`:
+/// the addresses gone through before `at`), or at code that stops the
+/// CPU.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn follow<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+    inside: &dyn Fn(u16, &[u16]) -> bool,
+) -> Result<End> {
+    let mut path: Vec<u16> = Vec::new();
     let mut at = target;
     for _ in 0..MOST_STEPS {
-        path.push(at);
-        if inside(at) {
-            return Ok(Some(Path(path)));
+        if inside(at, &path) {
+            path.push(at);
+            return Ok(End::Inside(Path(path)));
         }
+        path.push(at);
         let readable = profile
             .writable
             .iter()
             .any(|range| range.contains(&at) && range.contains(&at.saturating_add(2)));
         if profile.reset_target(kind) == Some(at) || !readable {
-            return Ok(None);
+            return Ok(End::Elsewhere);
         }
         let slot = everyone
             .iter()
@@ -91,22 +128,104 @@ pub(crate) fn comes_back<T: Transport>(
                     // Other code: run on the host over the robot's memory
                     // as an unknown command would run it, to where it goes.
                     let landing = |pc: u16| {
-                        inside(pc)
+                        inside(pc, &path)
                             || everyone
                                 .iter()
                                 .flat_map(|other| other.hooks.iter())
                                 .any(|hook| hook.kind == kind && hook.handler == pc)
                     };
-                    run_to_landing(client, profile, at, &landing)?
+                    match run_to_landing(client, profile, at, &landing)? {
+                        Landing::At(pc) => Some(pc),
+                        Landing::Stops(pc) => {
+                            path.push(pc);
+                            return Ok(End::Stops(Path(path)));
+                        }
+                        Landing::Elsewhere => None,
+                    }
                 }
             }
         };
         match next {
             Some(next) => at = next,
-            None => return Ok(None),
+            None => return Ok(End::Elsewhere),
         }
     }
-    Ok(None)
+    Ok(End::Elsewhere)
+}
+
+/// After a restore wrote its memory (the hooks still at the ROM's
+/// targets): each hook the file points into RAM, followed over what the
+/// robot now holds, must neither come back to where it has been (a loop
+/// the robot would run for ever), nor reach code that stops the CPU, nor
+/// be the other hook's handler in the table (hostile10 F10, F14).
+///
+/// # Errors
+/// [`Error::RestoreChainBroken`]; the line's errors.
+pub(crate) fn check_restored<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    hooks: &[(HookKind, u16)],
+) -> Result<()> {
+    let targets: Vec<(HookKind, u16)> = hooks
+        .iter()
+        .copied()
+        .filter(|&(kind, target)| {
+            profile.reset_target(kind) != Some(target)
+                && profile.writable.iter().any(|range| range.contains(&target))
+        })
+        .collect();
+    if targets.is_empty() {
+        return Ok(());
+    }
+    let everyone = crate::table::read_installed(client, profile)?;
+    for (kind, target) in targets {
+        let broken = |why: &'static str, path: String| Error::RestoreChainBroken {
+            hook: kind.rom_symbol(),
+            target,
+            why,
+            path,
+        };
+        let handlers = |of: &dyn Fn(HookKind) -> bool| {
+            everyone
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .any(|hook| of(hook.kind) && hook.handler == target)
+        };
+        if handlers(&|other| other != kind) && !handlers(&|this| this == kind) {
+            return Err(broken(
+                "is the other hook's handler in the table of installed extensions",
+                format!("${target:04X}"),
+            ));
+        }
+        match follow(client, profile, &everyone, (kind, target), &|at, way| {
+            way.contains(&at)
+        })? {
+            End::Inside(path) => {
+                return Err(broken(
+                    "comes back to where it has been, a loop the robot would run for ever",
+                    path.to_string(),
+                ));
+            }
+            End::Stops(path) => {
+                return Err(broken(
+                    "reaches code that stops the CPU (a BRK or a JAM)",
+                    path.to_string(),
+                ));
+            }
+            End::Elsewhere => {}
+        }
+    }
+    Ok(())
+}
+
+/// Where [`run_to_landing`] ended.
+enum Landing {
+    /// Where the caller's `landing` said.
+    At(u16),
+    /// At an instruction that stops the CPU (`JAM`) or a `BRK`.
+    Stops(u16),
+    /// Anywhere else (see [`run_to_landing`]).
+    Elsewhere,
 }
 
 /// Instructions run on the host before code is taken to go nowhere this
@@ -119,7 +238,9 @@ const CHUNK: usize = 16;
 /// Runs the code at `start` on the host, reading the robot's memory as it
 /// needs it (writes kept on the host), with the registers an unknown
 /// command brings (A a byte no handler takes), until the PC lands where
-/// `landing` says; `None` where it goes into the ROM or to memory an
+/// `landing` says; [`Landing::Stops`] at a `JAM` or a `BRK` (the ROM's
+/// interrupt handler returns from a `BRK`, two bytes on: no handler's
+/// way); [`Landing::Elsewhere`] where it goes into the ROM or to memory an
 /// extension may not hold (the I/O page), calls or returns (`JSR`, `RTS`,
 /// `RTI`: a call is no chain's way, and may be a breakpoint a killed
 /// session left, which attaching takes out), or has run
@@ -129,7 +250,7 @@ fn run_to_landing<T: Transport>(
     profile: &RomProfile,
     start: u16,
     landing: &dyn Fn(u16) -> bool,
-) -> Result<Option<u16>> {
+) -> Result<Landing> {
     let mut bus = ChainBus {
         client,
         profile,
@@ -142,14 +263,17 @@ fn run_to_landing<T: Transport>(
     (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, 0xF0, start);
     for _ in 0..MOST_INSTRUCTIONS {
         let opcode = bus.byte(cpu.pc);
+        if let Some(error) = bus.failed.take() {
+            return Err(error);
+        }
         let info = isa::opcode(opcode);
-        if bus.outside
-            || info.cycles == 0
-            || matches!(
-                info.mnemonic,
-                Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk | Mnemonic::Jsr
-            )
-        {
+        if bus.outside {
+            break;
+        }
+        if info.cycles == 0 || info.mnemonic == Mnemonic::Brk {
+            return Ok(Landing::Stops(cpu.pc));
+        }
+        if matches!(info.mnemonic, Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Jsr) {
             break;
         }
         cpu.step(&mut bus);
@@ -160,10 +284,10 @@ fn run_to_landing<T: Transport>(
             break;
         }
         if landing(cpu.pc) {
-            return Ok(Some(cpu.pc));
+            return Ok(Landing::At(cpu.pc));
         }
     }
-    Ok(None)
+    Ok(Landing::Elsewhere)
 }
 
 /// Whether `at` is memory an extension may hold (where the host reads

@@ -223,6 +223,50 @@ pub enum Error {
         path: String,
     },
 
+    /// An undo of an upload that is no longer the last on a hook: the
+    /// hook leads first to code the undo file does not put back.
+    #[error(
+        "{hook} leads first to ${current:04X}{owner}, which this undo does not take out: an upload after the one it undoes was chained ahead of it, and the undo would unhook that too; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::undo_not_last),
+        help(
+            "undo the later upload first (`scorpion upload --undo --undo-file FILE` with its undo file), or take the extension out with `scorpion upload --replace`"
+        )
+    )]
+    UndoNotLast {
+        /// The hook's name.
+        hook: &'static str,
+        /// Where it leads now.
+        current: u16,
+        /// ` (extension ID)` when the robot's table names it.
+        owner: String,
+    },
+
+    /// A restore whose hook would lead into code that loops, stops the
+    /// CPU, or is the other hook's handler: the file is not what `backup`
+    /// or an upload wrote (edited by hand, or damaged with its checksum
+    /// made again).
+    #[error(
+        "the file points {hook} at ${target:04X}, and that way {why} ({path}): the memory was restored and verified, but {hook} is left at the ROM's target"
+    )]
+    #[diagnostic(
+        code(uploader::restore_chain_broken),
+        help(
+            "the robot answers as it would with that extension not hooked; the file was not written as `backup` or an upload writes one (edited by hand?): restore another, or upload the extension again"
+        )
+    )]
+    RestoreChainBroken {
+        /// The hook's name.
+        hook: &'static str,
+        /// The file's target for it.
+        target: u16,
+        /// What is wrong with the way.
+        why: &'static str,
+        /// The way, `$0600 -> $0400`.
+        path: String,
+    },
+
     /// A backup whose `HOOK_UNKNOWN` leads to a debug stub it holds: taken
     /// while a debug session was attached, or after one died.
     #[error(

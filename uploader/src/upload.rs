@@ -83,6 +83,11 @@ pub struct UploadOptions {
     /// caller knows it started one): a witness whose memory holds what
     /// the file itself puts there passes, since that restore wrote it.
     pub resume: bool,
+    /// [`crate::restore`] of an upload's undo file: refused while a
+    /// hook leads first to code the file does not put back (a later
+    /// upload chained ahead of the one undone, which the undo would
+    /// unhook too).
+    pub undo: bool,
 }
 
 impl Default for UploadOptions {
@@ -98,6 +103,7 @@ impl Default for UploadOptions {
             delta: true,
             force_rom: false,
             resume: false,
+            undo: false,
         }
     }
 }

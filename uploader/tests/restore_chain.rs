@@ -1,0 +1,151 @@
+//! Where a restore's hooks lead. A file made by hand (its checksum made
+//! again) whose hook's way loops or stops the CPU had it hooked, exit 0
+//! (hostile10 F10); an undo of an upload that a later one was chained
+//! ahead of unhooked that later one too, and the later one's undo then
+//! hooked code the first undo had taken away (fresh10 F20, hostile11 F2).
+
+mod common;
+
+use common::{Kept, extension, robot};
+use isa::objfmt::{HookKind, HookRecord};
+use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
+use uploader::{
+    Area, Error, NoProgress, UploadImage, UploadOptions, backup, restore, upload, upload_keeping,
+};
+
+fn hook(client: &mut uploader::Client<uploader::transport::VirtualTransport>) -> u16 {
+    let memory = client.transport().robot().robot().board().memory();
+    let at = usize::from(HOOK_UNKNOWN);
+    u16::from_le_bytes([memory[at + 1], memory[at + 2]])
+}
+
+#[test]
+fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
+    let image = extension(512, 3);
+    let options = UploadOptions::default();
+    for (code, at, why) in [
+        // JMP to itself.
+        (vec![0x4C, 0x00, 0x06], 0x0600, "comes back"),
+        // BCC to itself, run on the host.
+        (vec![0x90, 0xFE], 0x0600, "comes back"),
+        // NOP NOP JAM.
+        (vec![0xEA, 0xEA, 0x02], 0x0600, "stops the CPU"),
+        // The extension's handler (JMP $0400, its chain slot), whose slot
+        // the file points back at the handler: a loop through the table.
+        (vec![0x4C, 0x00, 0x04], 0x0403, "comes back"),
+    ] {
+        let mut client = uploader::client(robot(), &options.profile);
+        upload(&mut client, &image, &options, &mut NoProgress).expect("an extension installed");
+        let mut file = backup(&mut client, &options.profile).expect("a backup");
+        let mut put = |address: u16, bytes: &[u8]| {
+            for area in &mut file.areas {
+                let start = usize::from(address).wrapping_sub(usize::from(area.address));
+                if start + bytes.len() <= area.bytes.len() {
+                    area.bytes[start..start + bytes.len()].copy_from_slice(bytes);
+                    return;
+                }
+            }
+            panic!("${address:04X} is not in the backup");
+        };
+        put(0x0600, &code);
+        if at == 0x0403 {
+            // The chain slot at $0401 sent to the handler itself.
+            put(0x0401, &[0x03, 0x04]);
+        }
+        file.hooks = vec![
+            (HookKind::Unknown, at),
+            (HookKind::Loop, romlib::symbols::ROM_LOOP),
+        ];
+        file.witnesses.clear();
+        let error =
+            restore(&mut client, &file, &options, &mut NoProgress).expect_err("the way is refused");
+        let said = error.to_string();
+        assert!(
+            matches!(error, Error::RestoreChainBroken { .. }) && said.contains(why),
+            "{code:02X?}: {said}"
+        );
+        assert_eq!(hook(&mut client), BAD_COMMAND, "left at the ROM's target");
+        assert!(client.probe().is_ok(), "the robot answers");
+    }
+}
+
+/// An extension of 64 bytes at `base`, handler at `base + 3` falling
+/// through to its chain slot, `base + 1`.
+fn extension_at(base: u16) -> UploadImage {
+    let [lo, hi] = base.to_le_bytes();
+    let mut bytes = vec![0x4C, 0x00, 0x00, 0x4C, lo, hi];
+    bytes.resize(64, 0xEA);
+    UploadImage::new(
+        vec![Area {
+            address: base,
+            bytes,
+        }],
+        vec![HookRecord {
+            kind: HookKind::Unknown,
+            handler: base + 3,
+            chain: Some(base + 1),
+        }],
+    )
+    .expect("an image")
+}
+
+#[test]
+fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
+    let options = UploadOptions::default();
+    let undo = UploadOptions {
+        undo: true,
+        ..options.clone()
+    };
+    let mut client = uploader::client(robot(), &options.profile);
+    let (first, second) = (extension_at(0x0500), extension_at(0x0800));
+    let mut kept_first = Kept::default();
+    upload_keeping(
+        &mut client,
+        &first,
+        &options,
+        &mut NoProgress,
+        &mut kept_first,
+    )
+    .expect("the first");
+    let mut kept_second = Kept::default();
+    upload_keeping(
+        &mut client,
+        &second,
+        &options,
+        &mut NoProgress,
+        &mut kept_second,
+    )
+    .expect("the second");
+    let (kept_first, kept_second) = (kept_first.0.expect("kept"), kept_second.0.expect("kept"));
+    // The hooks, and user RAM with the table.
+    let held = |client: &mut uploader::Client<uploader::transport::VirtualTransport>| {
+        let memory = client.transport().robot().robot().board().memory();
+        [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
+    };
+    let before = held(&mut client);
+    let error = restore(&mut client, &kept_first, &undo, &mut NoProgress)
+        .expect_err("the later upload is ahead of it");
+    assert!(
+        matches!(
+            error,
+            Error::UndoNotLast {
+                current: 0x0803,
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert!(error.to_string().contains("$0803 (extension "), "{error}");
+    assert!(held(&mut client) == before, "nothing written");
+    // In the order they were made, both undo.
+    restore(&mut client, &kept_second, &undo, &mut NoProgress).expect("the later one");
+    assert_eq!(hook(&mut client), 0x0503);
+    restore(&mut client, &kept_first, &undo, &mut NoProgress).expect("then the first");
+    assert_eq!(hook(&mut client), BAD_COMMAND);
+    // A backup restores the robot whole: what is hooked now goes.
+    let mut client = uploader::client(robot(), &options.profile);
+    let empty = backup(&mut client, &options.profile).expect("a backup");
+    upload(&mut client, &first, &options, &mut NoProgress).expect("installed");
+    restore(&mut client, &empty, &options, &mut NoProgress).expect("a backup is not an undo");
+    assert_eq!(hook(&mut client), BAD_COMMAND);
+}
