@@ -81,6 +81,20 @@ pub const DIVISORS: [u16; 16] = [
     0, 2304, 1536, 1048, 856, 768, 384, 192, 96, 64, 48, 32, 24, 16, 12, 6,
 ];
 
+/// The 6551's standard rates as people name them (its control codes 1 to
+/// 15 in order; 110 and 135 are 109.92 and 134.58 exactly).
+pub const RATES: [u32; 15] = [
+    50, 75, 110, 135, 150, 300, 600, 1200, 1800, 2400, 3600, 4800, 7200, 9600, 19200,
+];
+
+/// [`RATES`] as a sentence names them: `50, 75, ... 9600 or 19200`.
+#[must_use]
+pub fn rates_text() -> String {
+    let named: Vec<String> = RATES.iter().map(u32::to_string).collect();
+    let (last, rest) = named.split_last().expect("rates");
+    format!("{} or {last}", rest.join(", "))
+}
+
 /// The control-register baud code for a standard rate, if the 6551 has it:
 /// the code whose rate is within 2% of `bits_per_second` either way (what a
 /// 16x-sampling UART receives over a 10-bit character).
@@ -101,24 +115,7 @@ mod tests {
 
     #[test]
     fn the_standard_rates_have_the_datasheets_codes() {
-        let table = [
-            (50, 1),
-            (75, 2),
-            (110, 3),
-            (135, 4),
-            (150, 5),
-            (300, 6),
-            (600, 7),
-            (1200, 8),
-            (1800, 9),
-            (2400, 10),
-            (3600, 11),
-            (4800, 12),
-            (7200, 13),
-            (9600, 14),
-            (19200, 15),
-        ];
-        for (rate, code) in table {
+        for (code, rate) in (1u8..).zip(RATES) {
             assert_eq!(baud_code(rate), Some(code), "{rate} baud");
         }
         assert_eq!(baud_code(38400), None);

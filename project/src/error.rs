@@ -147,7 +147,7 @@ pub enum Error {
         /// Where it came from (flag, variable, file and line).
         origin: String,
         /// What it must be.
-        expected: &'static str,
+        expected: String,
     },
 
     /// An environment variable whose value cannot be used.

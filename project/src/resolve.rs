@@ -291,15 +291,20 @@ impl Resolved {
                 what: "port",
                 value: port.value.clone(),
                 origin: port.origin.to_string(),
-                expected: "a serial port (/dev/ttyUSB0) or `emu`",
+                expected: "a serial port (/dev/ttyUSB0) or `emu`".into(),
             });
         }
-        if baud.value == 0 {
+        // The robot's 6551 runs at its standard rates only: any other is
+        // a slip (hostile10 F15: `--baud 1` went on to a silent line).
+        if platform::acia::baud_code(baud.value).is_none() {
             return Err(Error::Setting {
                 what: "baud",
                 value: baud.value.to_string(),
                 origin: baud.origin.to_string(),
-                expected: "a baud rate (9600)",
+                expected: format!(
+                    "a rate the robot's 6551 runs at ({})",
+                    platform::acia::rates_text()
+                ),
             });
         }
 

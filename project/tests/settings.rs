@@ -43,3 +43,22 @@ fn an_empty_port_is_refused_where_it_was_written() {
     );
     assert!(resolve(None, "[robot]\nport = \"emu\"\n").is_ok());
 }
+
+/// hostile10 F15: `--baud 1` and `4000000000` were taken, and went on to
+/// a silent line; the robot's 6551 runs at its standard rates only.
+#[test]
+fn a_rate_the_robots_acia_cannot_run_at_is_refused_where_it_was_written() {
+    for rate in ["1", "4000000000", "38400", "9000"] {
+        let error = resolve(Some(rate), "").expect_err("refused");
+        let said = error.to_string();
+        assert!(
+            said.contains("SCORPION_BAUD") && said.contains("6551"),
+            "{rate}: {said}"
+        );
+    }
+    let error = resolve(None, "[robot]\nbaud = 115200\n").expect_err("refused");
+    assert!(error.to_string().contains("config.toml"), "{error}");
+    for rate in ["300", "2400", "19200"] {
+        assert!(resolve(Some(rate), "").is_ok(), "{rate}");
+    }
+}

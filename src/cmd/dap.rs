@@ -72,7 +72,7 @@ pub(crate) fn attach(
     port: &str,
     say: &mut dyn FnMut(&str),
 ) -> miette::Result<debugger::dap::Attached> {
-    let (images, root) = if program.is_dir() {
+    let (images, here) = if program.is_dir() {
         (Vec::new(), program.to_path_buf())
     } else {
         let dir = program
@@ -86,8 +86,7 @@ pub(crate) fn attach(
         ..debug::Args::default()
     };
     // The project is the program's, wherever the editor started us.
-    let attached = debug::robot::attach(&args, port, Some(&root), say)?;
-    Ok(debugger::dap::Attached { root, ..attached })
+    debug::robot::attach(&args, port, Some(&here), say)
 }
 
 /// `launch`: the robot with `program` (an image, or a project's

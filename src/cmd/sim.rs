@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use emulator::board::{CPU_HZ, acia};
+use emulator::board::CPU_HZ;
 use miette::{Context, IntoDiagnostic};
 use romlib::VirtualScorpion;
 
@@ -95,12 +95,8 @@ pub(crate) fn robot(
         None => VirtualScorpion::new(),
     };
     if !robot.set_baud(baud) {
-        let rates: Vec<String> = (1u8..16)
-            .filter_map(acia::code_rate)
-            .map(|rate| format!("{}", rate.bits_per_second()))
-            .collect();
         miette::bail!(
-            help = format!("the 6551's rates: {}", rates.join(", ")),
+            help = format!("the 6551's rates: {}", platform::acia::rates_text()),
             "the Scorpion's 6551 cannot run at {baud} baud"
         );
     }

@@ -57,7 +57,7 @@ pub(crate) struct Args {
     loader: Loader,
     /// The rate the loader switches the line to for the transfer; 0 keeps
     /// --baud (for a line whose far end cannot follow).
-    #[arg(long, default_value_t = uploader::FAST_BAUD, value_name = "BAUD")]
+    #[arg(long, default_value_t = uploader::FAST_BAUD, value_name = "BAUD", value_parser = fast_baud)]
     fast_baud: u32,
     /// Characters sent ahead of an answer not yet received; 0 waits for
     /// each answer. By default the reference ROM's receive buffer, less one
@@ -395,6 +395,22 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
     text
 }
 
+/// `--fast-baud`: 0, or a rate the robot's 6551 runs at (hostile10 F15:
+/// `--fast-baud 1` was taken, and the upload said "at 19200 baud").
+fn fast_baud(text: &str) -> Result<u32, String> {
+    let rate: u32 = text
+        .parse()
+        .map_err(|_| format!("`{text}` is no baud rate"))?;
+    if rate == 0 || platform::acia::baud_code(rate).is_some() {
+        Ok(rate)
+    } else {
+        Err(format!(
+            "the robot's 6551 does not run at {rate} baud: give 0 (keep --baud) or one of its rates ({})",
+            platform::acia::rates_text()
+        ))
+    }
+}
+
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // One resolution for the line and the virtual robot: the port and
     // rate from the flags, the environment, the per-user file or the
@@ -624,7 +640,18 @@ fn upload_file(
         uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
     };
     bar.bar.finish_and_clear();
-    let report = result?;
+    let report = match result {
+        Ok(report) => report,
+        // fresh11 F6: a line that failed half way left the undo file
+        // marked, and nothing said so.
+        Err(error) if !emulated && undo.kept.load(std::sync::atomic::Ordering::Relaxed) => {
+            return Err(miette::Report::new(error).wrap_err(format!(
+                "the upload did not finish; nothing that did not verify is hooked; what the robot held before it is kept in {} (marked {UPLOADING}): `scorpion upload --undo` puts it back",
+                undo.path.display()
+            )));
+        }
+        Err(error) => return Err(error.into()),
+    };
     if !emulated {
         // Finished: the next upload may replace the undo file.
         let _ = std::fs::remove_file(marked(&undo.path, UPLOADING));

@@ -621,3 +621,48 @@ fn exception_breakpoint_for_a_cards_fault() {
     );
     end(c);
 }
+
+/// fresh11 F2: on the virtual robot `evaluate` took only a label or an
+/// address ("no label `A`"), where the robot's adapter and the monitor's
+/// `print` take any expression: an editor's watch of `A` or `[ADDR]`
+/// worked on hardware and failed in the emulator. A label still shows its
+/// byte as before.
+#[test]
+fn evaluate_takes_the_monitors_expressions() {
+    let puthex = line_of("jsr PUTHEX", 0);
+    let mut c = launched(&adc(), &["/2A1"], |c| {
+        c.request(
+            "setBreakpoints",
+            json!({"source": {"path": source()}, "breakpoints": [{"line": puthex}]}),
+        );
+    });
+    let stop = continue_to_stop(&mut c);
+    assert_eq!(stop["reason"], "breakpoint", "{stop}");
+    let evaluate = |c: &mut Client, expression: &str| {
+        let answer = c.request(
+            "evaluate",
+            json!({"expression": expression, "context": "watch"}),
+        );
+        ok(&answer)["result"]
+            .as_str()
+            .unwrap_or_default()
+            .to_owned()
+    };
+    assert_eq!(evaluate(&mut c, "A"), "$57 (87)");
+    assert_eq!(evaluate(&mut c, "A+1"), "$58 (88)");
+    let pc = evaluate(&mut c, "PC");
+    assert!(pc.starts_with('$'), "{pc}");
+    assert_eq!(
+        evaluate(&mut c, "[$FFFC]"),
+        "$00 (0)",
+        "the reset vector's low byte"
+    );
+    let byte = evaluate(&mut c, "$FFFD");
+    assert_eq!(byte, "$F0 at $FFFD", "an address shows its byte, as before");
+    let said = refused(&c.request(
+        "evaluate",
+        json!({"expression": "nosuchlabel", "context": "watch"}),
+    ));
+    assert!(said.contains("nosuchlabel"), "{said}");
+    end(c);
+}

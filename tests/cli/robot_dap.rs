@@ -510,3 +510,52 @@ fn a_breakpoint_in_the_control_loops_handler_stops_there_in_an_editor() {
         transcript(&output)
     );
 }
+
+/// fresh11 F3: with DEBUGGING.md's robot config (`program`, the image
+/// in the project's `target/scorpion/`, and `port`), the frames named
+/// `target/scorpion/src/myext.s`, which does not exist: the sources were
+/// taken from the image's directory, not the project's root as the
+/// virtual robot's launch takes them.
+#[test]
+fn a_robot_launch_on_a_projects_image_names_the_projects_sources() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, source) = crate::new_project(dir.path());
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let line = crate::lines_with(&source, "jsr PUTCH")[0];
+    let path = project.join("src/myext.s");
+    let mut dap = Client::start();
+    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
+    assert_eq!(init["success"], true, "{init}");
+    let image = project.join("target/scorpion/myext.elf");
+    let launch = dap.request(
+        "launch",
+        json!({"program": image.to_str().expect("a path"), "port": sim.path}),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    let set = dap.request(
+        "setBreakpoints",
+        json!({"source": {"path": path.to_str().expect("a path")},
+               "breakpoints": [{"line": line}]}),
+    );
+    assert_eq!(set["body"]["breakpoints"][0]["verified"], true, "{set}");
+    let done = dap.request("configurationDone", json!({}));
+    assert_eq!(done["success"], true, "{done}");
+    let sent = dap.request("evaluate", json!({"expression": "/1V", "context": "repl"}));
+    assert_eq!(sent["success"], true, "{sent}");
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
+    let frame = dap.top_frame();
+    assert_eq!(
+        frame["source"]["path"],
+        path.to_str().expect("a path"),
+        "{frame}"
+    );
+    assert_eq!(frame["line"], line, "{frame}");
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+}

@@ -569,3 +569,40 @@ fn the_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
     let text = ok(d, &line, &["read", "$0200", "3"]);
     assert!(text.contains("0200: 4C 21 FF"), "back to the ROM: {text}");
 }
+
+/// fresh11 F6: an OS whose `HOOK_LOOP` handler never goes on to the
+/// ROM's loop silenced the robot once hooked; the upload blamed the cable
+/// (on the rehearsal too, where there is none), and did not say that its
+/// undo file was left marked. Both name the handler now, and the upload
+/// on the robot says where what it overwrote is kept.
+#[test]
+fn a_loop_handler_that_never_goes_on_is_named_and_the_undo_file_told() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(
+        d.join("hog.s"),
+        ".include \"scorpion.inc\"\n.data\npasses: .byte 0\n.code\nSCORPION_LOOP_HANDLER\ntick:\n        inc passes\n        jmp tick\n",
+    )
+    .expect("the source");
+    let built = scorpion(
+        d,
+        &["build", "hog.s", "-o", "hog.elf", "--target", "scorpion-os"],
+    );
+    assert!(built.status.success(), "{}", transcript(&built));
+    let sim = Sim::start(d, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let (done, said) = on(d, &line, &["upload", "hog.elf"]);
+    assert!(!done, "{said}");
+    assert!(
+        said.contains("rehearsal") && said.contains("uploader::loop_handler_silent"),
+        "{said}"
+    );
+    let (done, said) = on(d, &line, &["upload", "hog.elf", "--no-dry-run"]);
+    assert!(!done, "{said}");
+    assert!(
+        said.contains("uploader::loop_handler_silent")
+            && said.contains("scorpion-last-upload.undo (marked .uploading)")
+            && said.contains("`scorpion upload --undo` puts it back"),
+        "{said}"
+    );
+}

@@ -344,7 +344,8 @@ fn refuses_what_it_cannot_upload_safely() {
     );
     assert_eq!(output.status.code(), Some(1));
     assert!(
-        transcript(&output).contains("no 12345 baud rate"),
+        transcript(&output)
+            .contains("baud = \"12345\" (flag --baud) is not a rate the robot's 6551 runs at"),
         "{}",
         transcript(&output)
     );
@@ -462,4 +463,29 @@ fn an_overlapping_upload_is_refused_and_replace_swaps_the_extension() {
     let listed = scorpion(dir.path(), &["installed", "--port", port]);
     let text = transcript(&listed);
     assert_eq!(text.matches("extension ").count(), 1, "{text}");
+}
+
+/// hostile10 F15: `--fast-baud 1` was taken (and the upload said "at
+/// 19200 baud"): a rate the robot's 6551 lacks is refused before anything.
+#[test]
+fn a_fast_rate_the_robots_acia_lacks_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("ext.elf"), extension_elf(100)).expect("write the image");
+    for rate in ["1", "300000"] {
+        let output = scorpion(
+            dir.path(),
+            &["upload", "ext.elf", "--port", "emu", "--fast-baud", rate],
+        );
+        assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));
+        assert!(
+            transcript(&output).contains(&format!("does not run at {rate} baud")),
+            "{}",
+            transcript(&output)
+        );
+    }
+    let output = scorpion(
+        dir.path(),
+        &["upload", "ext.elf", "--port", "emu", "--fast-baud", "0"],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
 }

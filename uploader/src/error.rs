@@ -223,6 +223,25 @@ pub enum Error {
         path: String,
     },
 
+    /// The robot stopped answering once `HOOK_LOOP` was pointed at the
+    /// image's handler: that handler does not come back to the ROM's
+    /// loop, and the robot reads no command while it runs.
+    #[error(
+        "the robot stopped answering once HOOK_LOOP was pointed at the image's handler (${handler:04X}): {cause}"
+    )]
+    #[diagnostic(
+        code(uploader::loop_handler_silent),
+        help(
+            "a HOOK_LOOP handler must end by going on to the ROM's loop (`SCORPION_CHAIN_LOOP`), every pass; while it does not, the robot reads no command. The image was verified before it was hooked; reset the robot (its hooks go back to the ROM), and try the image with `scorpion run` or `scorpion debug` on the virtual Scorpion"
+        )
+    )]
+    LoopHandlerSilent {
+        /// The image's `HOOK_LOOP` handler.
+        handler: u16,
+        /// What the line said.
+        cause: Box<Error>,
+    },
+
     /// An undo of an upload that is no longer the last on a hook: the
     /// hook leads first to code the undo file does not put back.
     #[error(

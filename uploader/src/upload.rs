@@ -1255,7 +1255,22 @@ fn install_hooks<T: Transport>(
             },
         });
     }
-    settle_hooks(client, &wanted, options.max_writes)?;
+    if let Err(error) = settle_hooks(client, &wanted, options.max_writes) {
+        // fresh11 F6: an OS's loop handler that never goes on to the
+        // ROM's loop silences the robot the moment it is hooked; the
+        // line's own help would blame the cable.
+        let looping = hooks.iter().find(|hook| hook.kind == HookKind::Loop);
+        return Err(match (error, looping) {
+            (
+                cause @ (Error::NoAnswer { .. } | Error::Stalled { .. } | Error::Unreadable { .. }),
+                Some(hook),
+            ) => Error::LoopHandlerSilent {
+                handler: hook.handler,
+                cause: Box::new(cause),
+            },
+            (error, _) => error,
+        });
+    }
     if ours.is_some() {
         progress.event(&Event::LoaderRemoved);
     }

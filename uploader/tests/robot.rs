@@ -484,3 +484,42 @@ fn the_ram_loader_an_upload_cut_left_hooked_is_told() {
     }
     assert!(told > 2, "told {told} times");
 }
+
+/// fresh11 F6: an OS whose `HOOK_LOOP` handler never goes on to the
+/// ROM's loop (`tick: INC passes / JMP tick`, `SCORPION_CHAIN_LOOP`
+/// forgotten) silences the robot the moment it is hooked. The upload
+/// said what a dead cable says; it names the handler now.
+#[test]
+fn a_loop_handler_that_never_goes_on_is_named_when_the_robot_goes_silent() {
+    use isa::objfmt::{HookKind, HookRecord};
+    let image = uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0400,
+            bytes: vec![0xEE, 0x80, 0x04, 0x4C, 0x00, 0x04, 0x4C, 0x24, 0xFF],
+        }],
+        vec![HookRecord {
+            kind: HookKind::Loop,
+            handler: 0x0400,
+            chain: Some(0x0407),
+        }],
+    )
+    .expect("an image");
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    let error = upload(&mut client, &image, &options, &mut NoProgress).expect_err("silent");
+    assert!(
+        matches!(
+            error,
+            Error::LoopHandlerSilent {
+                handler: 0x0400,
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert!(
+        error
+            .to_string()
+            .contains("HOOK_LOOP was pointed at the image's handler ($0400)")
+    );
+}

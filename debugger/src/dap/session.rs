@@ -406,13 +406,16 @@ impl Session {
                     crate::line::command(expression)?;
                     debugger.send(expression.as_bytes());
                     format!("sent {expression}")
-                } else {
-                    let address = debugger
-                        .symbols()
-                        .address(expression)
-                        .map_err(|e| e.to_string())?;
+                } else if let Ok(address) = debugger.symbols().address(expression) {
                     let byte = emulator::Bus::peek(&debugger.robot().robot().bus, address);
                     format!("${byte:02X} at ${address:04X}")
+                } else {
+                    // Registers, `[ADDR]`, arithmetic: as the monitor's
+                    // `print` (and the robot's adapter) take them
+                    // (fresh11 F2).
+                    let value = crate::monitor::evaluate(debugger, expression)
+                        .map_err(|failure| failure.message())?;
+                    crate::monitor::shown_value(value)
                 };
                 Some(json!({"result": result, "variablesReference": 0}))
             }

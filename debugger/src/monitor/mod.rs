@@ -479,7 +479,7 @@ fn pointed(error: &crate::expr::ParseError, offset: usize) -> String {
 }
 
 /// The value of the expression `text` now.
-fn evaluate(d: &Debugger, text: &str) -> Result<i64, Failure> {
+pub(crate) fn evaluate(d: &Debugger, text: &str) -> Result<i64, Failure> {
     let parsed = expression(d, text, 0)?;
     parsed
         .eval(d)
@@ -505,7 +505,7 @@ fn mem_len(d: &Debugger, word: &str) -> Result<u64, Failure> {
 }
 
 /// `$2F (47)`: a value in hexadecimal and decimal.
-fn shown_value(value: i64) -> String {
+pub(crate) fn shown_value(value: i64) -> String {
     let hex = crate::expr::show(value);
     if hex.starts_with('$') {
         format!("{hex} ({value})")

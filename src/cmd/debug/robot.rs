@@ -114,7 +114,13 @@ pub(crate) fn attach(
         robot,
         symbols,
         images: linked,
-        root: std::path::PathBuf::from("."),
+        // Sources are named from the project's root, as the virtual
+        // robot's launch names them (fresh11 F3: from an image's own
+        // directory, `target/scorpion/src/...` did not exist).
+        root: resolved.project.as_ref().map_or_else(
+            || here.unwrap_or(Path::new(".")).to_path_buf(),
+            |project| project.root.clone(),
+        ),
     })
 }
 
