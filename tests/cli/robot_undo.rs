@@ -606,3 +606,26 @@ fn a_loop_handler_that_never_goes_on_is_named_and_the_undo_file_told() {
         "{said}"
     );
 }
+
+/// fresh11 F8: `scorpion test --port` on a project with room lines
+/// (examples/linefollow) said the robot had no room because the project
+/// had no world file, which it has. On a port the room cannot be seen,
+/// and the message says that, and that the rehearsal checked them.
+#[test]
+fn room_lines_on_a_port_are_refused_for_what_they_are() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = dir.path().join("linefollow");
+    crate::copy_dir(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/linefollow"),
+        &project,
+    );
+    let sim = Sim::start(dir.path(), &[]);
+    let (passed, said) = on(&project, &["--port", sim.path.as_str()], &["test"]);
+    assert!(!passed, "{said}");
+    assert!(
+        said.contains("seen through its line alone")
+            && said.contains("no line of this transcript was sent"),
+        "{said}"
+    );
+    assert!(!said.contains("world = "), "{said}");
+}

@@ -86,6 +86,12 @@ fn registers_the_robot_cannot_go_on_with_are_refused() {
         (0xC010, "the I/O page"),
         (stub.entry, "in the debug stub"),
         (0x040D, "no instruction of the image starts at $040D"),
+        // fresh11 F9: the reset code, and the middle of a service's JMP.
+        (0xF000, "not one of its service entries"),
+        (
+            romlib::symbols::CMD_DONE + 1,
+            "not one of its service entries",
+        ),
     ] {
         refused(debug.set_registers(Registers { pc, ..registers }), why);
     }

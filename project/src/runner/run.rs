@@ -725,7 +725,11 @@ fn run_transcript<T: Transport>(
     let mismatches = match room {
         None => {
             if let Some(line) = transcript.first_room_line() {
-                return Err(indent(&rendered(transcript::no_room(&shown, line))));
+                let refused = match clock {
+                    Clock::Line => transcript::no_room_on_port(&shown, line),
+                    Clock::Robot => transcript::no_room(&shown, line),
+                };
+                return Err(indent(&rendered(refused)));
             }
             transcript
                 .expectations()

@@ -83,6 +83,21 @@ pub fn read_commands(path: &Path, shown: &str) -> Result<Expectations> {
     Ok(transcript.expectations())
 }
 
+/// The error of a room line (`wait`, `pose`, `bumped`) on a real robot,
+/// whose room the host cannot see (fresh11 F8: the message told the user
+/// to add the world file the project had).
+#[must_use]
+pub fn no_room_on_port(shown: &str, line: usize) -> Error {
+    Error::BadTranscript(Box::new(BadTranscript {
+        shown: shown.to_owned(),
+        line,
+        reason: "a robot on a port is seen through its line alone: `wait`, `pose` and `bumped` \
+                 are checked on the virtual Scorpion in the project's room (`scorpion test` \
+                 without --port, the rehearsal of this run); no line of this transcript was sent"
+            .into(),
+    }))
+}
+
 /// The error of a room line (`wait`, `pose`, `bumped`) where the robot
 /// has no room to see it in.
 #[must_use]

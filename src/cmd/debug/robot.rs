@@ -210,7 +210,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         return Err(miette::miette!(
             code = "scorpion::debug::not_given_back",
             help = format!(
-                "the stub may still be hooked and breakpoints' JSRs left in the code: if the robot answers no command, reset it (its hooks go back to the ROM); then `scorpion debug --port {}` with the same image finds what is left and takes it out",
+                "the stub may still be hooked and breakpoints' JSRs left in the code: if the robot answers no command, reset it (its hooks go back to the ROM); then `scorpion debug --port {}` with the same image finds what is left and takes it out (if the reset unhooked the image, it says so: upload the image again, which writes its code whole)",
                 robot_port
             ),
             "the session could not give the robot back: {error}"

@@ -23,6 +23,9 @@ pub struct Guard {
     hooks: [RangeInclusive<u16>; 2],
     /// The ROM's table of installed extensions.
     table: RangeInclusive<u16>,
+    /// The ROM's service jump table (a `JMP` every three bytes): the
+    /// only places in the ROM a PC is set to.
+    services: Option<RangeInclusive<u16>>,
 }
 
 impl Guard {
@@ -33,6 +36,7 @@ impl Guard {
         Guard {
             hooks: [jmp(profile.hook_unknown), jmp(profile.hook_loop)],
             table: TABLE..=TABLE + (TABLE_LEN as u16 - 1),
+            services: profile.jump_table.first().cloned(),
         }
     }
 
@@ -69,8 +73,9 @@ impl Guard {
 
     /// Why the registers `new` are refused where the robot is stopped
     /// with `old`, if they are: a PC that is no instruction the host knows
-    /// (inside the stub, inside an instruction of the image, or in memory
-    /// that is not the image's or the ROM's), or the decimal flag set (the
+    /// (inside the stub, inside an instruction of the image, in the ROM
+    /// but not at one of its service entries, or in memory that is not
+    /// the image's or the ROM's), or the decimal flag set (the
     /// ROM turns bytes into hex digits with `ADC`, so every answer of a
     /// robot going on in decimal mode is wrong).
     #[must_use]
@@ -107,7 +112,18 @@ impl Guard {
             return None;
         }
         if pc >= platform::map::ROM_START {
-            return None;
+            // fresh11 F9: `set PC $F000` ran the reset code with the stub
+            // hooked; a service (`CMD_DONE`, to skip the handler) is the
+            // ROM's way in.
+            let service = self
+                .services
+                .as_ref()
+                .is_some_and(|services| services.contains(&pc) && (pc - services.start()) % 3 == 0);
+            return (!service).then(|| format!(
+                "PC=${pc:04X} is in the ROM but not one of its service entries (its jump table, ${:04X}-${:04X}: `CMD_DONE` ends the command): the robot would run the middle of the ROM with the stub hooked",
+                self.services.as_ref().map_or(0, |s| *s.start()),
+                self.services.as_ref().map_or(0, |s| *s.end())
+            ));
         }
         Some(format!(
             "PC=${pc:04X} is {}, where the image has no code: the robot would run whatever is there; set PC to an instruction of the image or the ROM",
