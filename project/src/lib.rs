@@ -13,6 +13,7 @@
 //!   go through a [`runner::Progress`] and at the end as a
 //!   [`runner::Report`].
 //! - [`template`]: a new project, as `scorpion new` makes it.
+//! - [`undo`]: the undo file an upload to a robot keeps.
 //!
 //! Nothing here prints or exits: callers show [`Error`]s and the runner's
 //! reports with miette.
@@ -24,6 +25,7 @@ pub mod resolve;
 pub mod runner;
 mod spans;
 pub mod template;
+pub mod undo;
 mod validate;
 
 pub use error::{Error, Located};

@@ -17,6 +17,7 @@ use uploader::{
 
 use crate::cmd::ports;
 use scorpion_project::runner::transcript::{self, Clock, TranscriptFailed};
+use scorpion_project::undo::{UNDOING, UNDONE, UPLOADING, UndoFile, marked};
 
 /// Upload a linked image (`scorpion link` or `scorpion build` output) into
 /// the robot with its own RAM-write commands: every byte verified with
@@ -81,34 +82,6 @@ pub(crate) struct Args {
     undo_file: Option<PathBuf>,
 }
 
-/// Writes what an upload overwrote to the undo file as soon as it is
-/// read, before the image's bytes go out; marks it [`UPLOADING`] until the
-/// upload has finished.
-struct UndoFile {
-    path: PathBuf,
-    failed: Option<miette::Report>,
-    /// Whether it was written (said if the upload is interrupted).
-    kept: std::sync::Arc<std::sync::atomic::AtomicBool>,
-}
-
-impl uploader::Keep for UndoFile {
-    fn keep(&mut self, overwritten: &uploader::Backup) {
-        // Marked first: an upload killed from here on has not finished,
-        // and the next one must not replace what the file keeps.
-        if let Err(error) = hostfs::write(marked(&self.path, UPLOADING), b"") {
-            self.failed = Some(error.into());
-            return;
-        }
-        // Its directory exists: `undo_file_writable` made the project's or
-        // refused a missing one. Through a temporary file: an undo file is whole or the last one.
-        if let Err(error) = hostfs::write(&self.path, &overwritten.encode()) {
-            self.failed = Some(error.into());
-            return;
-        }
-        self.kept.store(true, std::sync::atomic::Ordering::Relaxed);
-    }
-}
-
 /// What an upload interrupted left: whether `kept` says its undo file
 /// (`undo`) was written.
 fn upload_interrupted(undo: &Path, kept: &std::sync::atomic::AtomicBool) -> String {
@@ -163,11 +136,7 @@ impl Args {
             return path.clone();
         }
         match scorpion_project::Project::here() {
-            Ok(project) => project
-                .root
-                .join("target")
-                .join("scorpion")
-                .join("last-upload.undo"),
+            Ok(project) => scorpion_project::undo::in_project(&project.root),
             Err(_) => PathBuf::from("scorpion-last-upload.undo"),
         }
     }
@@ -507,22 +476,6 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
     }
 }
 
-/// The undo file `X.undo` marked: [`UNDONE`] where a used one is kept
-/// (`X.undo.undone`), [`UNDOING`] while an undo of it has started and not
-/// finished, [`UPLOADING`] while the upload that wrote it has not.
-fn marked(path: &Path, mark: &str) -> PathBuf {
-    let mut name = path.as_os_str().to_owned();
-    name.push(mark);
-    PathBuf::from(name)
-}
-
-/// See [`marked`].
-const UNDONE: &str = ".undone";
-/// See [`marked`].
-const UNDOING: &str = ".undoing";
-/// See [`marked`]: an upload wrote the file and has not finished.
-const UPLOADING: &str = ".uploading";
-
 /// An undo refused because the robot no longer holds what the undo file's
 /// upload put there, said as such: that upload is no longer on the robot.
 fn undo_refused(report: miette::Report, path: &Path) -> miette::Report {
@@ -625,11 +578,7 @@ fn upload_file(
     let transport = ports::open_resolved(resolved, &[])?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
-    let mut undo = UndoFile {
-        path: args.undo_path(),
-        failed: None,
-        kept: std::sync::Arc::default(),
-    };
+    let mut undo = UndoFile::new(args.undo_path());
     // `emu` is a fresh virtual Scorpion for each command: nothing of it
     // outlives this one for an undo to put back.
     let result = if emulated {
@@ -644,7 +593,7 @@ fn upload_file(
         Ok(report) => report,
         // fresh11 F6: a line that failed half way left the undo file
         // marked, and nothing said so.
-        Err(error) if !emulated && undo.kept.load(std::sync::atomic::Ordering::Relaxed) => {
+        Err(error) if !emulated && undo.written() => {
             return Err(miette::Report::new(error).wrap_err(format!(
                 "the upload did not finish; nothing that did not verify is hooked; what the robot held before it is kept in {} (marked {UPLOADING}): `scorpion upload --undo` puts it back",
                 undo.path.display()
@@ -654,7 +603,7 @@ fn upload_file(
     };
     if !emulated {
         // Finished: the next upload may replace the undo file.
-        let _ = std::fs::remove_file(marked(&undo.path, UPLOADING));
+        undo.finished_upload();
     }
     if let Some(error) = undo.failed {
         bar.say(&format!(

@@ -629,3 +629,29 @@ fn room_lines_on_a_port_are_refused_for_what_they_are() {
     );
     assert!(!said.contains("world = "), "{said}");
 }
+
+/// fresh10 F22: `scorpion test --port` uploaded to the robot and kept no
+/// undo file (README: every upload keeps what it overwrote). It keeps the
+/// project's, and `upload --undo` puts the robot back.
+#[test]
+fn test_on_a_port_keeps_the_projects_undo_file() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    let before = ok(&project, &line, &["read", "$0200", "3"]);
+    let tested = ok(&project, &line, &["test"]);
+    assert!(tested.contains("upload myext ... ok"), "{tested}");
+    let undo = project.join("target/scorpion/last-upload.undo");
+    assert!(undo.is_file(), "{tested}");
+    assert!(
+        !project
+            .join("target/scorpion/last-upload.undo.uploading")
+            .exists(),
+        "finished"
+    );
+    assert_ne!(ok(&project, &line, &["read", "$0200", "3"]), before);
+    let undone = ok(&project, &line, &["upload", "--undo"]);
+    assert!(undone.contains("restored"), "{undone}");
+    assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);
+}

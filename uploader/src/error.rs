@@ -232,7 +232,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::loop_handler_silent),
         help(
-            "a HOOK_LOOP handler must end by going on to the ROM's loop (`SCORPION_CHAIN_LOOP`), every pass; while it does not, the robot reads no command. The image was verified before it was hooked; reset the robot (its hooks go back to the ROM), and try the image with `scorpion run` or `scorpion debug` on the virtual Scorpion"
+            "a HOOK_LOOP handler must end by going on to the ROM's loop (`SCORPION_CHAIN_LOOP`), every pass; while it does not, the robot reads no command. The image was verified before it was hooked; a robot left so is reset (its hooks go back to the ROM). `scorpion debug --image IMAGE` runs it on the virtual Scorpion, where Ctrl-C during `continue` shows where it loops"
         )
     )]
     LoopHandlerSilent {

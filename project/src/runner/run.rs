@@ -23,6 +23,8 @@ use romlib::VirtualScorpion;
 use uploader::transport::{Exchanged, Observed, SerialTransport, VirtualTransport};
 use uploader::{Client, ClientConfig, Expectations, Mismatch, RomProfile, Transport, UploadImage};
 
+use crate::undo::{self, UndoFile};
+
 use super::build::{Built, SNAPSHOT_KINDS, build};
 use super::calls;
 use super::error::{Error, FrontEnd, PathWithoutRoom, Result, WorkspacePort};
@@ -619,20 +621,43 @@ impl Run<'_, '_, '_> {
             replace: self.options.replace,
             ..uploader::UploadOptions::default()
         };
+        // A real robot's uploads keep what they overwrote, as `scorpion
+        // upload`'s do, in the project's undo file (fresh10 F22: none was
+        // kept); `emu` is a fresh virtual Scorpion with nothing to undo.
+        let mut undo = (port != EMU).then(|| UndoFile::new(undo::in_project(&project.root)));
         for image in built {
             let name = format!("upload {}", image.name);
             self.start(&name);
+            if let Some(why) = undo.as_ref().and_then(|undo| undo_refused(&undo.path)) {
+                self.record_result(&name, Err(why));
+                return Ok(());
+            }
             let upload = UploadImage::try_from(&image.linked.image)?;
-            let uploaded =
-                uploader::upload(&mut client, &upload, &options, &mut uploader::NoProgress)
-                    .map_err(|source| Error::UploadImage {
-                        image: image.name.clone(),
-                        source: Box::new(source),
-                    });
+            let uploaded = match undo.as_mut() {
+                Some(undo) => uploader::upload_keeping(
+                    &mut client,
+                    &upload,
+                    &options,
+                    &mut uploader::NoProgress,
+                    undo,
+                ),
+                None => uploader::upload(&mut client, &upload, &options, &mut uploader::NoProgress),
+            }
+            .map_err(|source| Error::UploadImage {
+                image: image.name.clone(),
+                source: Box::new(source),
+            });
             if let Err(error) = uploaded {
                 // A failed upload is a failed test, said like the others;
                 // the transcripts would only test what the robot had.
                 let mut why = indent(&rendered(error));
+                if let Some(undo) = undo.as_ref().filter(|undo| undo.written()) {
+                    why.push_str(&format!(
+                        "    (what the robot held before it is kept in {} (marked {}): `scorpion upload --undo` puts it back)\n",
+                        undo.path.display(),
+                        undo::UPLOADING
+                    ));
+                }
                 if !self.options.replace {
                     why.push_str(
                         "    (`scorpion test --port --replace` replaces what the robot has there)\n",
@@ -640,6 +665,19 @@ impl Run<'_, '_, '_> {
                 }
                 self.record_result(&name, Err(why));
                 return Ok(());
+            }
+            if let Some(undo) = &undo {
+                undo.finished_upload();
+                if let Some(error) = &undo.failed {
+                    self.record_result(
+                        &name,
+                        Err(indent(&format!(
+                            "uploaded, but its undo file {} could not be written: {error}\n",
+                            undo.path.display()
+                        ))),
+                    );
+                    return Ok(());
+                }
             }
             self.record_result(&name, Ok(Passed::Ok));
         }
@@ -711,6 +749,19 @@ fn wait<T: Transport>(client: &mut Client<T>, time: Duration) -> uploader::Resul
 /// a line of the failure. With a `room`, its room lines are checked and
 /// each command is added to `commands` with its robot time (for the
 /// picture of the path).
+/// Why an upload may not write the project's undo file at `path` now
+/// (an unfinished upload or undo keeps what the robot held), with its
+/// directory made.
+fn undo_refused(path: &Path) -> Option<String> {
+    if let Some(why) = undo::unfinished(path) {
+        return Some(indent(&format!("{why}; nothing was sent\n")));
+    }
+    let parent = path.parent()?;
+    std::fs::create_dir_all(parent)
+        .err()
+        .map(|error| indent(&format!("cannot make {}: {error}\n", parent.display())))
+}
+
 fn run_transcript<T: Transport>(
     project: &Project,
     path: &Path,

@@ -1,0 +1,109 @@
+//! The undo file every upload to a robot keeps (`scorpion upload`, and
+//! `scorpion test --port`'s uploads): what the upload overwrote, written
+//! as soon as it is read, marked while the upload or an undo of it has
+//! not finished, so that no later upload replaces the only record of
+//! what the robot held.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Marks a used undo file (`X.undo.undone`), kept rather than deleted.
+pub const UNDONE: &str = ".undone";
+/// Marks an undo file whose undo started and has not finished.
+pub const UNDOING: &str = ".undoing";
+/// Marks an undo file whose upload wrote it and has not finished.
+pub const UPLOADING: &str = ".uploading";
+
+/// The undo file at `path` marked with `mark` (one of [`UNDONE`],
+/// [`UNDOING`], [`UPLOADING`]).
+#[must_use]
+pub fn marked(path: &Path, mark: &str) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(mark);
+    PathBuf::from(name)
+}
+
+/// A project's undo file: `target/scorpion/last-upload.undo`.
+#[must_use]
+pub fn in_project(root: &Path) -> PathBuf {
+    root.join("target")
+        .join("scorpion")
+        .join("last-upload.undo")
+}
+
+/// Why an upload may not replace the undo file at `path` now, if it may
+/// not: an undo of it half done, or the upload that wrote it unfinished
+/// (the file keeps what the robot held before it, which nothing else
+/// does).
+#[must_use]
+pub fn unfinished(path: &Path) -> Option<String> {
+    if !path.is_file() {
+        return None;
+    }
+    if marked(path, UNDOING).exists() {
+        return Some(format!(
+            "an undo of {} started and did not finish (killed, or its line failed): the robot is half way back; `scorpion upload --undo` finishes it",
+            path.display()
+        ));
+    }
+    marked(path, UPLOADING).exists().then(|| {
+        format!(
+            "the upload that wrote {} did not finish (killed, or its line failed); the file keeps what the robot held before it: `scorpion upload --undo` puts that back",
+            path.display()
+        )
+    })
+}
+
+/// Writes what an upload overwrote to the undo file as soon as it is
+/// read, before the image's bytes go out; marks it [`UPLOADING`] until
+/// [`UndoFile::finished_upload`].
+#[derive(Debug)]
+pub struct UndoFile {
+    /// Where it is written.
+    pub path: PathBuf,
+    /// Why it could not be written, if it could not.
+    pub failed: Option<hostfs::Error>,
+    /// Whether it was written (said if the upload is interrupted).
+    pub kept: Arc<AtomicBool>,
+}
+
+impl UndoFile {
+    /// An undo file to be written at `path`.
+    #[must_use]
+    pub fn new(path: PathBuf) -> UndoFile {
+        UndoFile {
+            path,
+            failed: None,
+            kept: Arc::default(),
+        }
+    }
+
+    /// Whether it was written.
+    #[must_use]
+    pub fn written(&self) -> bool {
+        self.kept.load(Ordering::Relaxed)
+    }
+
+    /// The upload finished: the next one may replace the file.
+    pub fn finished_upload(&self) {
+        let _ = std::fs::remove_file(marked(&self.path, UPLOADING));
+    }
+}
+
+impl uploader::Keep for UndoFile {
+    fn keep(&mut self, overwritten: &uploader::Backup) {
+        // Marked first: an upload killed from here on has not finished,
+        // and the next one must not replace what the file keeps.
+        if let Err(error) = hostfs::write(marked(&self.path, UPLOADING), b"") {
+            self.failed = Some(error);
+            return;
+        }
+        // Through a temporary file: an undo file is whole or the last one.
+        if let Err(error) = hostfs::write(&self.path, &overwritten.encode()) {
+            self.failed = Some(error);
+            return;
+        }
+        self.kept.store(true, Ordering::Relaxed);
+    }
+}
