@@ -31,7 +31,7 @@ commands on the robot (addresses and values are expressions, as in the monitor):
   delete N             the image's bytes put back and read back
   info                 the breakpoints and displays
   continue             let the stopped handler go on; its answer or the next stop (c)
-  step | next          one instruction (next: a JSR with its subroutine)      (s, n)
+  step | next          one instruction (next, nexti: a JSR with its subroutine) (s, n)
   regs                 the registers at the stop                                  (r)
   set REG VALUE        a register or flag at the stop (PC: where it goes on)
   mem ADDR [LEN] | mem ADDR BYTE... | poke ADDR BYTE...
@@ -42,7 +42,8 @@ commands on the robot (addresses and values are expressions, as in the monitor):
   dis [ADDR] [N]       N instructions from ADDR (the PC)                          (d)
   help, quit (q)       quit removes the breakpoints and the stub's hook
 refused on the robot: back, reverse-continue, who-wrote (a robot cannot be re-run),
-watch (no data breakpoints), break in the ROM, if/hits/log (a JSR always stops)";
+watch (no data breakpoints), break in the ROM, if/hits/log (a JSR always stops),
+finish/until (break where it should stop), trace, bt, list";
 
 /// Where the images' instructions start, when their line tables say so
 /// (a built image starts a source line at every instruction; its labels
@@ -226,13 +227,13 @@ impl RobotMonitor {
                 let heard = d.wait_event(WAIT).map_err(failure)?;
                 self.heard(d, &heard)?
             }
-            "step" | "s" | "stepi" | "si" | "next" | "n" => {
+            "step" | "s" | "stepi" | "si" | "next" | "n" | "nexti" | "ni" => {
                 if !rest.is_empty() {
                     return Err(usage(
                         "step takes no count on the robot: each step patches and unpatches over the line",
                     ));
                 }
-                let over = matches!(verb, "next" | "n");
+                let over = matches!(verb, "next" | "n" | "nexti" | "ni");
                 let heard = d.step(&self.entries, over, WAIT).map_err(failure)?;
                 let mut text = self.heard(d, &heard)?;
                 if matches!(heard, Heard::Answer(_)) {
@@ -288,7 +289,7 @@ impl RobotMonitor {
             "finish" | "f" | "until" | "u" => {
                 return Err(refused(
                     verb,
-                    "not on the robot: set a breakpoint where it should stop and `continue`",
+                    "where the code returns or a line ends may be in the ROM, which cannot be patched: set a breakpoint where it should stop and `continue`",
                 ));
             }
             "trace" | "bumpers" | "bt" | "list" | "l" => {

@@ -80,6 +80,9 @@ fn what_a_robot_cannot_do_is_refused_with_the_reason() {
         ("regs", "needs a stop"),
         ("set A 1", "needs a stop"),
         ("print A", "registers are known only at a stop"),
+        // fresh11 F7: said as a reason, not "refused on the robot: not on
+        // the robot".
+        ("finish", "which cannot be patched"),
     ] {
         let why = refusal(&mut m, &mut d, line);
         assert!(why.contains(reason), "`{line}`: {why}");
@@ -122,7 +125,8 @@ fn a_step_whose_stop_comes_after_the_answer_shows_both() {
     text(&mut m, &mut d, "break $0412");
     let shown = text(&mut m, &mut d, "/1Q");
     assert!(shown.contains("stopped: breakpoint 1, $0412"), "{shown}");
-    let shown = text(&mut m, &mut d, "next");
+    // fresh11 F7: `nexti`, as the docs' table names it, is `next`.
+    let shown = text(&mut m, &mut d, "nexti");
     assert!(shown.contains("answer: Q42\nstopped: $0415"), "{shown}");
     assert!(text(&mut m, &mut d, "regs").contains("PC=$0415"));
 }

@@ -28,8 +28,9 @@ pub(crate) struct Args {
     /// Print each answer field by field.
     #[arg(long)]
     decode: bool,
-    /// How long an extension's command may take to answer, in milliseconds.
-    #[arg(long, default_value_t = 500, value_name = "MS")]
+    /// How long an extension's command may take to answer, in milliseconds
+    /// (at least 1).
+    #[arg(long, default_value_t = 500, value_name = "MS", value_parser = clap::value_parser!(u64).range(1..))]
     timeout: u64,
     /// An extension's command that answers nothing within --timeout is not
     /// a failure (an extension's instruction).

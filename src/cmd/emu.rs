@@ -89,6 +89,14 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 fn run_image(args: &RunArgs) -> miette::Result<ExitCode> {
     let image = hostfs::read(&args.image, hostfs::RAW_IMAGE)
         .wrap_err_with(|| format!("cannot read {}", args.image.display()))?;
+    // fresh11 F11: an ELF's header ran as code.
+    if image.starts_with(b"\x7fELF") {
+        miette::bail!(
+            help = "`scorpion debug --image FILE` runs a linked image on the virtual Scorpion; `scorpion link --format bin` makes raw bytes for `emu run`",
+            "{} is an ELF file: `emu run` runs raw 6502 bytes, and would run its header as code",
+            args.image.display()
+        );
+    }
     let mut machine = RamMachine::with_image(args.load, &image)
         .wrap_err_with(|| format!("cannot load {}", args.image.display()))?;
     machine.reset();

@@ -89,3 +89,20 @@ fn ask_of_a_robot_that_answers_nothing_says_so() {
         "{text}"
     );
 }
+
+/// fresh11 F5: `--timeout 0` was taken (and then no extension "answered"
+/// in no time); a wait of at least 1 ms is asked for.
+#[test]
+fn a_timeout_of_zero_is_refused() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let output = scorpion(
+        dir.path(),
+        &["ask", "--port", "emu", "--timeout", "0", "/1X"],
+    );
+    assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));
+    assert!(
+        transcript(&output).contains("--timeout"),
+        "{}",
+        transcript(&output)
+    );
+}

@@ -215,3 +215,19 @@ fn bad_input_gets_a_clear_error() {
     assert_eq!(bad_cycles.status.code(), Some(2));
     insta::assert_snapshot!("emu_bad_cycles", transcript(&bad_cycles));
 }
+
+/// fresh11 F11: `emu run` of a linked image (an ELF) ran its header as
+/// code; it is refused, saying what runs one.
+#[test]
+fn emu_run_refuses_an_elf_file() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    std::fs::write(dir.path().join("image.elf"), b"\x7fELF\x01\x01\x01\0rest").expect("write");
+    let output = scorpion(dir.path(), &["emu", "run", "image.elf"]);
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    assert!(
+        transcript(&output).contains("image.elf is an ELF file")
+            && transcript(&output).contains("scorpion debug --image"),
+        "{}",
+        transcript(&output)
+    );
+}
