@@ -964,51 +964,50 @@ impl<T: Transport> RobotDebug<T> {
             }
         );
         let mut last = None;
-        for _ in 0..ATTEMPTS {
-            self.rx.clear();
-            self.client.transport().clear_input()?;
+        for attempt in 0..ATTEMPTS {
+            // Only before the first: a retry's clear would cut in two the
+            // replies still on their way (hostile11 F4), and garble the
+            // next; late ones are told apart by their address.
+            if attempt == 0 {
+                self.rx.clear();
+                self.client.transport().clear_input()?;
+            }
             self.client.send_raw(&frame::encode(payload))?;
             let wait = char_time(
                 payload.len() * 2 + count + 16,
                 self.client.transport().baud(),
             ) + self.margin;
             let deadline = self.client.transport().now() + wait;
-            let mut heard = None;
             while let Some(left) = deadline.checked_sub(self.client.transport().now()) {
                 match self.next_heard(left)? {
-                    // A late reply to an earlier request (its stop frame
-                    // came first, say): the robot sends what it still owes
-                    // after the input is cleared. Ours follows it.
-                    Some(Heard::Frame(reply))
-                        if reply.first() == Some(&b'M')
-                            && (reply.len() != count + 3 || reply[1..3] != at.to_le_bytes()) => {}
-                    other => {
-                        heard = other;
+                    Some(Heard::Frame(reply)) => {
+                        let expected = [b'M', at.to_le_bytes()[0], at.to_le_bytes()[1]];
+                        if reply.len() == count + 3 && reply[..3] == expected {
+                            return Ok(reply[3..].to_vec());
+                        }
+                        // A late reply to an earlier request (its stop
+                        // frame came first, say): ours follows it.
+                        if reply.first() == Some(&b'M') {
+                            continue;
+                        }
+                        last = Some(if reply.first() == Some(&b'S') {
+                            // The stop frame again: it took our bytes for
+                            // a command.
+                            ("`M` and the address".to_owned(), hex(&reply))
+                        } else {
+                            (format!("{} {count} bytes", hex(&expected)), hex(&reply))
+                        });
                         break;
                     }
-                }
-            }
-            match heard {
-                Some(Heard::Frame(reply)) => {
-                    let expected = [b'M', at.to_le_bytes()[0], at.to_le_bytes()[1]];
-                    if reply.len() == count + 3 && reply[..3] == expected {
-                        return Ok(reply[3..].to_vec());
+                    // The rest of a reply cut in two, or noise: the reply
+                    // may still come whole.
+                    Some(Heard::BadFrame(bytes) | Heard::Text(bytes)) => {
+                        last = Some((
+                            "a frame with a good sum".into(),
+                            bytes.escape_ascii().to_string(),
+                        ));
                     }
-                    if reply.first() == Some(&b'S') {
-                        // The stop frame again: it took our bytes for a command.
-                        last = Some(("`M` and the address".to_owned(), hex(&reply)));
-                        continue;
-                    }
-                    last = Some((format!("{} {count} bytes", hex(&expected)), hex(&reply)));
-                }
-                Some(Heard::BadFrame(bytes) | Heard::Text(bytes)) => {
-                    last = Some((
-                        "a frame with a good sum".into(),
-                        bytes.escape_ascii().to_string(),
-                    ));
-                }
-                None => {
-                    last = None;
+                    None => break,
                 }
             }
         }
