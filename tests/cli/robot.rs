@@ -527,3 +527,32 @@ fn undo_file_errors_say_what_is_wrong_and_rom_read_refuses_an_extension_base() {
     assert!(text.contains("$0400-$0657"), "{text}");
     assert!(!dir.path().join("rom.elf").exists());
 }
+
+/// hostile11 F3: another program reading the robot's port (a terminal
+/// left open, a modem manager's probe) took the bytes a poll announced,
+/// and every command then waited in `read` for ever. Reads return now
+/// when nothing is there: the command ends, one way or the other.
+#[test]
+fn a_second_reader_on_the_port_does_not_hang_a_command() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let sim = Sim::start(dir.path(), &[]);
+    let mut thief = std::process::Command::new("cat")
+        .arg(&sim.path)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("cat runs");
+    let asked = std::process::Command::new("timeout")
+        .args([
+            "60",
+            env!("CARGO_BIN_EXE_scorpion"),
+            "ask",
+            "--port",
+            &sim.path,
+        ])
+        .args(["/1P", "/1X", "/1P", "/1X", "/1P", "/1X"])
+        .output()
+        .expect("timeout runs");
+    let _ = thief.kill();
+    let _ = thief.wait();
+    assert_ne!(asked.status.code(), Some(124), "{}", transcript(&asked));
+}

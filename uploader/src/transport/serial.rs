@@ -60,14 +60,25 @@ impl SerialTransport {
     /// # Errors
     /// [`Error::PortBusy`], [`Error::PortNotFound`] or [`Error::Port`].
     pub fn open(path: &str, baud: u32) -> Result<Self> {
-        let port = serialport::new(path, baud)
+        let builder = serialport::new(path, baud)
             .data_bits(DataBits::Eight)
             .parity(Parity::None)
             .stop_bits(StopBits::One)
             .flow_control(FlowControl::None)
-            .timeout(Duration::from_millis(10))
-            .open()
-            .map_err(|error| open_error(path, error))?;
+            .timeout(Duration::from_millis(10));
+        #[cfg(unix)]
+        let port: Box<dyn SerialPort> = {
+            let native = builder
+                .open_native()
+                .map_err(|error| open_error(path, error))?;
+            never_block(&native).map_err(|error| Error::Port {
+                port: path.into(),
+                message: format!("cannot make its reads return when nothing is there: {error}"),
+            })?;
+            Box::new(native)
+        };
+        #[cfg(not(unix))]
+        let port = builder.open().map_err(|error| open_error(path, error))?;
         Ok(SerialTransport {
             port,
             path: path.into(),
@@ -84,6 +95,27 @@ impl SerialTransport {
             source,
         }
     }
+}
+
+/// Makes a read return what is there, even nothing (VMIN and VTIME 0;
+/// raw mode's VMIN 1 waits for a byte): another program reading the port
+/// (a terminal left open, a modem manager's probe) can take the bytes a
+/// poll announced, and a read that then waited would wait for ever
+/// (hostile11 F3). Writes are not changed.
+#[cfg(unix)]
+#[allow(
+    unsafe_code,
+    reason = "serialport's TTYPort gives its descriptor only as a raw fd (no AsFd); it is borrowed for two termios calls while the port lives"
+)]
+fn never_block(port: &serialport::TTYPort) -> nix::Result<()> {
+    use nix::sys::termios::{SetArg, SpecialCharacterIndices, tcgetattr, tcsetattr};
+    use std::os::fd::{AsRawFd, BorrowedFd};
+    // SAFETY: the descriptor is the port's, open for as long as `port`.
+    let fd = unsafe { BorrowedFd::borrow_raw(port.as_raw_fd()) };
+    let mut termios = tcgetattr(fd)?;
+    termios.control_chars[SpecialCharacterIndices::VMIN as usize] = 0;
+    termios.control_chars[SpecialCharacterIndices::VTIME as usize] = 0;
+    tcsetattr(fd, SetArg::TCSANOW, &termios)
 }
 
 impl Transport for SerialTransport {
