@@ -559,3 +559,52 @@ fn a_robot_launch_on_a_projects_image_names_the_projects_sources() {
     assert_eq!(bye["success"], true, "{bye}");
     assert!(dap.ends());
 }
+
+/// fresh10 F18: with `port`, the launch's `stopOnEntry` and `commands`
+/// (DEBUGGING.md's own editor configs have them) were ignored with no
+/// word. The commands are sent at `configurationDone`, each answer as
+/// output, until one stops at a breakpoint; `stopOnEntry` is said to be
+/// impossible on a robot.
+#[test]
+fn a_robot_launch_sends_its_commands_and_says_it_cannot_stop_on_entry() {
+    let (dir, sim) = handler_on_a_pty_robot();
+    let mut dap = Client::start();
+    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
+    assert_eq!(init["success"], true, "{init}");
+    let program = dir.path().join("ext.elf");
+    let launch = dap.request(
+        "launch",
+        json!({"program": program.to_str().expect("a path"), "port": sim.path,
+               "stopOnEntry": true, "commands": ["/1X", "/1Q", "/1P"]}),
+    );
+    assert_eq!(launch["success"], true, "{launch}");
+    let path = dir.path().join("handler.s");
+    // Line 6 is `show: lda value`, at $040C.
+    let set = dap.request(
+        "setBreakpoints",
+        json!({"source": {"path": path.to_str().expect("a path")},
+               "breakpoints": [{"line": 6}]}),
+    );
+    assert_eq!(set["body"]["breakpoints"][0]["verified"], true, "{set}");
+    let done = dap.request("configurationDone", json!({}));
+    assert_eq!(done["success"], true, "{done}");
+    let mut heard = String::new();
+    while !heard.contains("not sent") {
+        let output = dap.event("output");
+        heard.push_str(output["body"]["output"].as_str().unwrap_or_default());
+    }
+    assert!(
+        heard.contains("stopOnEntry: a robot cannot be stopped"),
+        "{heard}"
+    );
+    assert!(heard.contains("X00"), "the first command's answer: {heard}");
+    assert!(heard.contains("/1P not sent"), "{heard}");
+    let stopped = dap.event("stopped");
+    assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
+    assert_eq!(dap.top_frame()["instructionPointerReference"], "0x040C");
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
+}

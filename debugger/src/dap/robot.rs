@@ -44,6 +44,10 @@ pub struct RobotSession {
     /// answered): the next stop that no breakpoint of the client's made is
     /// where the step ended.
     stepping: bool,
+    /// The launch's `stopOnEntry`.
+    stop_on_entry: bool,
+    /// The launch's `commands`, sent at `configurationDone`.
+    commands: Vec<String>,
 }
 
 impl std::fmt::Debug for RobotSession {
@@ -60,6 +64,9 @@ enum After {
     Nothing,
     Run,
     Heard(Heard, &'static str),
+    /// `configurationDone` on a running robot: the launch's `stopOnEntry`
+    /// and `commands` are seen to.
+    Configured,
     Exit,
 }
 
@@ -95,7 +102,59 @@ impl RobotSession {
             next_id: 1,
             running: false,
             stepping: false,
+            stop_on_entry: false,
+            commands: Vec::new(),
         }
+    }
+
+    /// The launch's `stopOnEntry` and `commands` (fresh10 F18: both were
+    /// ignored on a port, with no word).
+    pub fn configure(&mut self, stop_on_entry: bool, commands: Vec<String>) {
+        self.stop_on_entry = stop_on_entry;
+        self.commands = commands;
+    }
+
+    /// At `configurationDone` on a running robot: `stopOnEntry` said to
+    /// be impossible, and `commands` sent down the line in order, each
+    /// answer as output, until one stops the robot.
+    fn configured(&mut self, outbox: &Outbox) -> std::io::Result<()> {
+        self.running = true;
+        if self.stop_on_entry {
+            outbox.output(
+                "console",
+                "stopOnEntry: a robot cannot be stopped from its line (its control loop runs on; the stub runs only when a breakpoint's JSR calls it): set a breakpoint where it should stop\n",
+            )?;
+        }
+        let commands = std::mem::take(&mut self.commands);
+        for (i, command) in commands.iter().enumerate() {
+            let sent = crate::line::command(command).and_then(|_| {
+                self.robot()?
+                    .command(command.as_bytes(), WAIT)
+                    .map_err(|e| failure(e).message())
+            });
+            match sent {
+                Ok(heard) => {
+                    self.heard(outbox, &heard, "breakpoint")?;
+                    if matches!(heard, Heard::Stopped(_)) {
+                        if i + 1 < commands.len() {
+                            outbox.output(
+                                "console",
+                                &format!(
+                                    "`commands`: {} not sent, the robot is stopped at a breakpoint\n",
+                                    commands[i + 1..].join(" ")
+                                ),
+                            )?;
+                        }
+                        break;
+                    }
+                }
+                Err(why) => {
+                    outbox.output("stderr", &format!("`commands`: {command}: {why}\n"))?;
+                    break;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// What attach found of a session that did not detach and cleaned up
@@ -155,6 +214,7 @@ impl RobotSession {
             After::Nothing => {}
             After::Run => self.running = true,
             After::Heard(heard, reason) => self.heard(outbox, &heard, reason)?,
+            After::Configured => self.configured(outbox)?,
             After::Exit => return Ok(false),
         }
         Ok(true)
@@ -263,7 +323,7 @@ impl RobotSession {
                     None,
                     match self.robot()?.stopped() {
                         Some(registers) => After::Heard(Heard::Stopped(registers), "entry"),
-                        None => After::Run,
+                        None => After::Configured,
                     },
                 ));
             }

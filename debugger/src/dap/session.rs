@@ -660,7 +660,10 @@ impl Session {
             command: &request.command,
             map: &request.arguments,
         };
-        let attached = (|| -> Result<super::Attached, String> {
+        let attached = (|| -> Result<(super::Attached, bool, Vec<String>), String> {
+            // Read first: a launch that names them wrongly attaches nothing.
+            let stop_on_entry = args.boolean("stopOnEntry")?.unwrap_or(false);
+            let commands = args.strings("commands")?.unwrap_or_default();
             let port = args
                 .string("port")?
                 .ok_or("`port` is the robot's serial port (empty: the project's)")?;
@@ -680,11 +683,12 @@ impl Session {
             let attached =
                 attacher(Path::new(program), port, &mut say).map_err(|e| format!("{e:?}"));
             self.busy.end();
-            attached
+            Ok((attached?, stop_on_entry, commands))
         })();
         match attached {
-            Ok(attached) => {
-                let robot = super::robot::RobotSession::new(attached);
+            Ok((attached, stop_on_entry, commands)) => {
+                let mut robot = super::robot::RobotSession::new(attached);
+                robot.configure(stop_on_entry, commands);
                 let recovery = robot.recovery();
                 self.robot = Some(robot);
                 self.debugger = None;
