@@ -59,9 +59,14 @@ pub(crate) fn comes_back<T: Transport>(
     inside: &dyn Fn(u16) -> bool,
 ) -> Result<Option<Path>> {
     Ok(
-        match follow(client, profile, everyone, (kind, target), &|at, _| {
-            inside(at)
-        })? {
+        match follow(
+            client,
+            profile,
+            everyone,
+            (kind, target),
+            &|at, _| inside(at),
+            false,
+        )? {
             End::Inside(path) => Some(path),
             _ => None,
         },
@@ -76,6 +81,11 @@ pub(crate) enum End {
     /// At code that stops the CPU (a `JAM`, a `BRK` whose interrupt
     /// handler returns into the middle of nothing): the way there.
     Stops(Path),
+    /// Where no extension's code can be: in the ROM but not at the hook's
+    /// own target, or in memory no extension may hold (the ROM's own RAM,
+    /// the I/O page): the way there. Told only where asked
+    /// ([`follow`]'s `strict`).
+    Strays(Path),
     /// In the ROM, or somewhere this module cannot follow (a call, a
     /// return, a run longer than it looks).
     Elsewhere,
@@ -93,6 +103,7 @@ pub(crate) fn follow<T: Transport>(
     everyone: &[Installed],
     (kind, target): (HookKind, u16),
     inside: &dyn Fn(u16, &[u16]) -> bool,
+    strict: bool,
 ) -> Result<End> {
     let mut path: Vec<u16> = Vec::new();
     let mut at = target;
@@ -106,8 +117,15 @@ pub(crate) fn follow<T: Transport>(
             .writable
             .iter()
             .any(|range| range.contains(&at) && range.contains(&at.saturating_add(2)));
-        if profile.reset_target(kind) == Some(at) || !readable {
+        if profile.reset_target(kind) == Some(at) {
             return Ok(End::Elsewhere);
+        }
+        if !readable {
+            return Ok(if strict {
+                End::Strays(Path(path))
+            } else {
+                End::Elsewhere
+            });
         }
         let slot = everyone
             .iter()
@@ -197,9 +215,14 @@ pub(crate) fn check_restored<T: Transport>(
                 format!("${target:04X}"),
             ));
         }
-        match follow(client, profile, &everyone, (kind, target), &|at, way| {
-            way.contains(&at)
-        })? {
+        match follow(
+            client,
+            profile,
+            &everyone,
+            (kind, target),
+            &|at, way| way.contains(&at),
+            true,
+        )? {
             End::Inside(path) => {
                 return Err(broken(
                     "comes back to where it has been, a loop the robot would run for ever",
@@ -209,6 +232,12 @@ pub(crate) fn check_restored<T: Transport>(
             End::Stops(path) => {
                 return Err(broken(
                     "reaches code that stops the CPU (a BRK or a JAM)",
+                    path.to_string(),
+                ));
+            }
+            End::Strays(path) => {
+                return Err(broken(
+                    "leads where no extension's code is (the ROM's own RAM or I/O, or the ROM but not its own target for the hook)",
                     path.to_string(),
                 ));
             }

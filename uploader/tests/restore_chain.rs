@@ -23,16 +23,26 @@ fn hook(client: &mut uploader::Client<uploader::transport::VirtualTransport>) ->
 fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
     let image = extension(512, 3);
     let options = UploadOptions::default();
-    for (code, at, why) in [
+    for (code, at, slot, why) in [
         // JMP to itself.
-        (vec![0x4C, 0x00, 0x06], 0x0600, "comes back"),
+        (vec![0x4C, 0x00, 0x06], 0x0600, None, "comes back"),
         // BCC to itself, run on the host.
-        (vec![0x90, 0xFE], 0x0600, "comes back"),
+        (vec![0x90, 0xFE], 0x0600, None, "comes back"),
         // NOP NOP JAM.
-        (vec![0xEA, 0xEA, 0x02], 0x0600, "stops the CPU"),
+        (vec![0xEA, 0xEA, 0x02], 0x0600, None, "stops the CPU"),
         // The extension's handler (JMP $0400, its chain slot), whose slot
         // the file points back at the handler: a loop through the table.
-        (vec![0x4C, 0x00, 0x04], 0x0403, "comes back"),
+        (vec![], 0x0403, Some(0x0403), "comes back"),
+        // hostile11 F7: the slot sent into the ROM's own RAM (its command
+        // buffer), to a ROM subroutine, to the ROM's reset.
+        (vec![], 0x0403, Some(0x0300), "where no extension's code is"),
+        (
+            vec![],
+            0x0403,
+            Some(romlib::symbols::PUTCH),
+            "where no extension's code is",
+        ),
+        (vec![], 0x0403, Some(0xFF27), "where no extension's code is"),
     ] {
         let mut client = uploader::client(robot(), &options.profile);
         upload(&mut client, &image, &options, &mut NoProgress).expect("an extension installed");
@@ -48,9 +58,8 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
             panic!("${address:04X} is not in the backup");
         };
         put(0x0600, &code);
-        if at == 0x0403 {
-            // The chain slot at $0401 sent to the handler itself.
-            put(0x0401, &[0x03, 0x04]);
+        if let Some(slot) = slot {
+            put(0x0401, &slot.to_le_bytes());
         }
         file.hooks = vec![
             (HookKind::Unknown, at),
@@ -62,7 +71,7 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
         let said = error.to_string();
         assert!(
             matches!(error, Error::RestoreChainBroken { .. }) && said.contains(why),
-            "{code:02X?}: {said}"
+            "{code:02X?} {slot:04X?}: {said}"
         );
         assert_eq!(hook(&mut client), BAD_COMMAND, "left at the ROM's target");
         assert!(client.probe().is_ok(), "the robot answers");

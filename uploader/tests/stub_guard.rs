@@ -56,17 +56,28 @@ fn writes_outside_the_programs_ram_are_refused_before_anything_is_sent() {
         (HOOK_UNKNOWN + 2, "HOOK_UNKNOWN's JMP"),
         (HOOK_LOOP + 1, "HOOK_LOOP's JMP"),
         (TABLE, "table of installed extensions"),
+        // hostile11 F6: the image's chain slot, and the ROM's own RAM (its
+        // receive ring's head, its buffer, the stack).
+        (0x0401, "chain slot of the image's HOOK_UNKNOWN handler"),
+        (0x0402, "chain slot"),
+        (0x0000, "RAM the ROM leaves to extensions"),
+        (0x0300, "RAM the ROM leaves to extensions"),
+        (0x01F0, "RAM the ROM leaves to extensions"),
     ] {
         refused(debug.write_as_program(at, &[0x00]), why);
     }
     // A run that ends in the hook is refused whole.
     refused(
         debug.write_as_program(HOOK_UNKNOWN - 2, &[1, 2, 3]),
-        "HOOK_UNKNOWN",
+        "$01FE is the ROM's own RAM",
+    );
+    refused(
+        debug.write_as_program(0x0F3E, &[1, 2, 3, 4]),
+        "$0F40 is the ROM's own RAM",
     );
     assert_eq!(debug.read(HOOK_UNKNOWN - 2, 5).expect("read"), before);
-    // The program's RAM: the board's, and the image's data.
-    debug.write_as_program(0x0300, &[0x12]).expect("board RAM");
+    // The program's RAM: the ROM's user RAM, and the image's data.
+    debug.write_as_program(0x0600, &[0x12]).expect("user RAM");
     debug
         .write_as_program(0x0480, &[0x77])
         .expect("the image's");
@@ -86,12 +97,13 @@ fn registers_the_robot_cannot_go_on_with_are_refused() {
         (0xC010, "the I/O page"),
         (stub.entry, "in the debug stub"),
         (0x040D, "no instruction of the image starts at $040D"),
-        // fresh11 F9: the reset code, and the middle of a service's JMP.
-        (0xF000, "not one of its service entries"),
-        (
-            romlib::symbols::CMD_DONE + 1,
-            "not one of its service entries",
-        ),
+        // fresh11 F9: the reset code, and the middle of a service's JMP;
+        // hostile11 F5: a subroutine (GETHEX, PUTCH), whose RTS jammed
+        // the CPU.
+        (0xF000, "not one of the entries that end a handler"),
+        (romlib::symbols::CMD_DONE + 1, "not one of the entries"),
+        (romlib::symbols::GETHEX, "not one of the entries"),
+        (romlib::symbols::PUTCH, "not one of the entries"),
     ] {
         refused(debug.set_registers(Registers { pc, ..registers }), why);
     }

@@ -23,9 +23,14 @@ pub struct Guard {
     hooks: [RangeInclusive<u16>; 2],
     /// The ROM's table of installed extensions.
     table: RangeInclusive<u16>,
-    /// The ROM's service jump table (a `JMP` every three bytes): the
-    /// only places in the ROM a PC is set to.
-    services: Option<RangeInclusive<u16>>,
+    /// The ROM's entries that do not return (`CMD_DONE`, and the hooks'
+    /// own targets, `BAD_COMMAND` and the control loop): the only places
+    /// in the ROM a PC is set to. A subroutine's `RTS` would return on the
+    /// handler's stack, where nothing called it (hostile11 F5).
+    ends: Vec<u16>,
+    /// The RAM the ROM leaves to extensions: its user zero page and user
+    /// RAM.
+    user: Vec<RangeInclusive<u16>>,
 }
 
 impl Guard {
@@ -36,16 +41,34 @@ impl Guard {
         Guard {
             hooks: [jmp(profile.hook_unknown), jmp(profile.hook_loop)],
             table: TABLE..=TABLE + (TABLE_LEN as u16 - 1),
-            services: profile.jump_table.first().cloned(),
+            ends: profile
+                .loader_services
+                .as_ref()
+                .map(|services| services.cmd_done)
+                .into_iter()
+                .chain(
+                    profile
+                        .reset_targets
+                        .into_iter()
+                        .flat_map(|(unknown, main)| [unknown, main]),
+                )
+                .collect(),
+            user: profile
+                .user_zero_page
+                .iter()
+                .map(|zp| u16::from(*zp.start())..=u16::from(*zp.end()))
+                .chain(std::iter::once(profile.user_ram.clone()))
+                .collect(),
         }
     }
 
     /// Why a write at `at` by a person is refused, if it is: only RAM the
-    /// program owns is written (the board's RAM and the image's own
-    /// memory), not the hooks or the table (an upload changes those, each
-    /// verified before it is reached), nor the ROM, the I/O page or the
-    /// KIM bus beyond the image (a card's registers may sit there, and a
-    /// write may start its hardware).
+    /// program owns is written (the ROM's user zero page and user RAM, and
+    /// the image's own memory), not the hooks, the table or the image's
+    /// chain slots (an upload sets those, each verified before it is
+    /// reached), nor the ROM's own RAM (its receive ring, its stack), the
+    /// ROM, the I/O page or the KIM bus beyond the image (a card's
+    /// registers may sit there, and a write may start its hardware).
     #[must_use]
     pub fn refuse_write(&self, at: u16, image: &UploadImage) -> Option<String> {
         if let Some(hook) = self.hooks.iter().position(|hook| hook.contains(&at)) {
@@ -61,23 +84,38 @@ impl Guard {
                 self.table.end()
             ));
         }
-        if ram(at, image) {
+        if let Some(hook) = image.hooks().iter().find(|hook| {
+            hook.chain
+                .is_some_and(|slot| at == slot || at == slot.wrapping_add(1))
+        }) {
+            return Some(format!(
+                "${at:04X} is in the chain slot of the image's {} handler (${:04X}), which the upload set to where the hook went before it, verified: written by hand, it sends every command the image does not take anywhere",
+                hook.kind.rom_symbol(),
+                hook.handler
+            ));
+        }
+        if image.contains(at) || self.user.iter().any(|range| range.contains(&at)) {
             return None;
         }
+        let users: Vec<String> = self
+            .user
+            .iter()
+            .map(|range| format!("${:04X}-${:04X}", range.start(), range.end()))
+            .collect();
         Some(format!(
-            "${at:04X} is {}: the robot's monitor writes RAM only (the board's, to ${:04X}, and the image's own memory)",
+            "${at:04X} is {}: the robot's monitor writes the RAM the ROM leaves to extensions ({}) and the image's own memory only",
             region(at),
-            platform::map::RAM_END
+            users.join(", ")
         ))
     }
 
     /// Why the registers `new` are refused where the robot is stopped
     /// with `old`, if they are: a PC that is no instruction the host knows
     /// (inside the stub, inside an instruction of the image, in the ROM
-    /// but not at one of its service entries, or in memory that is not
-    /// the image's or the ROM's), or the decimal flag set (the
-    /// ROM turns bytes into hex digits with `ADC`, so every answer of a
-    /// robot going on in decimal mode is wrong).
+    /// but not at an entry that ends a handler, or in memory that is not
+    /// the image's or the ROM's), or the decimal flag set (the ROM turns
+    /// bytes into hex digits with `ADC`, so every answer of a robot going
+    /// on in decimal mode is wrong).
     #[must_use]
     pub fn refuse_registers(
         &self,
@@ -113,20 +151,18 @@ impl Guard {
         }
         if pc >= platform::map::ROM_START {
             // fresh11 F9: `set PC $F000` ran the reset code with the stub
-            // hooked; a service (`CMD_DONE`, to skip the handler) is the
-            // ROM's way in.
-            let service = self
-                .services
-                .as_ref()
-                .is_some_and(|services| services.contains(&pc) && (pc - services.start()) % 3 == 0);
-            return (!service).then(|| format!(
-                "PC=${pc:04X} is in the ROM but not one of its service entries (its jump table, ${:04X}-${:04X}: `CMD_DONE` ends the command): the robot would run the middle of the ROM with the stub hooked",
-                self.services.as_ref().map_or(0, |s| *s.start()),
-                self.services.as_ref().map_or(0, |s| *s.end())
+            // hooked; hostile11 F5: a subroutine's RTS jammed the CPU.
+            if self.ends.contains(&pc) {
+                return None;
+            }
+            let ends: Vec<String> = self.ends.iter().map(|at| format!("${at:04X}")).collect();
+            return Some(format!(
+                "PC=${pc:04X} is in the ROM but not one of the entries that end a handler ({}: `CMD_DONE`, and the unknown command's and the control loop's own): anywhere else the robot runs the middle of the ROM, or a subroutine whose RTS returns where nothing called it",
+                ends.join(", ")
             ));
         }
         Some(format!(
-            "PC=${pc:04X} is {}, where the image has no code: the robot would run whatever is there; set PC to an instruction of the image or the ROM",
+            "PC=${pc:04X} is {}, where the image has no code: the robot would run whatever is there; set PC to an instruction of the image, or `CMD_DONE` to end the command",
             region(pc)
         ))
     }
@@ -147,6 +183,8 @@ fn region(at: u16) -> &'static str {
         "in the I/O page (the 6522's and the ACIA's registers, the drive and sense latches)"
     } else if KIM_BUS.contains(&at) {
         "on the KIM bus outside the image (a card's registers may sit there)"
+    } else if at <= platform::map::RAM_END {
+        "the ROM's own RAM (its variables, the stack, the receive ring, the command buffer)"
     } else {
         "memory the board does not have"
     }

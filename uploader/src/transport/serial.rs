@@ -126,12 +126,11 @@ impl Transport for SerialTransport {
     fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> Result<usize> {
         // A zero timeout would block forever on some platforms: poll briefly.
         let timeout = timeout.max(Duration::from_millis(1));
+        // Not "cannot open": the port was open; now it is gone (a closed
+        // pty, an adapter unplugged).
         self.port
             .set_timeout(timeout)
-            .map_err(|error| Error::Port {
-                port: self.path.clone(),
-                message: error.description,
-            })?;
+            .map_err(|error| self.io(std::io::Error::other(error.description)))?;
         match self.port.read(&mut self.buffer) {
             Ok(count) => {
                 into.extend_from_slice(&self.buffer[..count]);
