@@ -357,7 +357,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::stalled),
         help(
-            "the robot stopped answering mid-upload (power, cable, or a crash); nothing that did not verify was hooked, so it is safe to retry"
+            "the robot stopped answering (power, cable, or a crash); nothing that did not verify was hooked, so the command is safe to run again"
         )
     )]
     Stalled {
