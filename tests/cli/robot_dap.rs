@@ -125,16 +125,27 @@ fn code_and_hook(dir: &std::path::Path, sim: &Sim) -> (Vec<u8>, Vec<u8>) {
 /// An adapter initialized and launched on `sim`'s robot with `dir`'s
 /// `ext.elf`.
 fn launched(dir: &std::path::Path, sim: &Sim) -> Client {
+    let program = dir.join("ext.elf");
+    launched_with(json!({"program": program.to_str().expect("a path"), "port": sim.path}))
+}
+
+/// An adapter initialized and launched with `arguments`.
+fn launched_with(arguments: serde_json::Value) -> Client {
     let mut dap = Client::start();
     let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
     assert_eq!(init["success"], true, "{init}");
-    let program = dir.join("ext.elf");
-    let launch = dap.request(
-        "launch",
-        json!({"program": program.to_str().expect("a path"), "port": sim.path}),
-    );
+    let launch = dap.request("launch", arguments);
     assert_eq!(launch["success"], true, "{launch}");
     dap
+}
+
+/// Lets the stopped robot go on, then disconnects; the adapter ends.
+fn continue_and_disconnect(mut dap: Client) {
+    let go = dap.request("continue", json!({"threadId": 1}));
+    assert_eq!(go["success"], true, "{go}");
+    let bye = dap.request("disconnect", json!({}));
+    assert_eq!(bye["success"], true, "{bye}");
+    assert!(dap.ends());
 }
 
 #[test]
@@ -350,11 +361,7 @@ fn a_step_that_ran_on_stops_with_the_reason_step() {
             heard.push_str(output["body"]["output"].as_str().unwrap_or_default());
         }
     }
-    let go = dap.request("continue", json!({"threadId": 1}));
-    assert_eq!(go["success"], true, "{go}");
-    let bye = dap.request("disconnect", json!({}));
-    assert_eq!(bye["success"], true, "{bye}");
-    assert!(dap.ends());
+    continue_and_disconnect(dap);
 }
 
 /// Issue 27, round 6: a launch that cleans up after a monitor killed at a
@@ -388,11 +395,7 @@ fn a_launch_says_what_it_cleaned_up_in_the_console_before_the_first_stop() {
         said["seq"].as_i64().expect("a seq") < stopped["seq"].as_i64().expect("a seq"),
         "the sentence before the stop: {said} {stopped}"
     );
-    let go = dap.request("continue", json!({"threadId": 1}));
-    assert_eq!(go["success"], true, "{go}");
-    let bye = dap.request("disconnect", json!({}));
-    assert_eq!(bye["success"], true, "{bye}");
-    assert!(dap.ends());
+    continue_and_disconnect(dap);
 }
 
 /// hostile10 F6: an adapter whose editor went away without `disconnect`
@@ -461,14 +464,8 @@ fn a_breakpoint_in_the_control_loops_handler_stops_there_in_an_editor() {
         .position(|l| l.trim() == "rom:")
         .expect("`rom:`")
         + 2;
-    let mut dap = Client::start();
-    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
-    assert_eq!(init["success"], true, "{init}");
-    let launch = dap.request(
-        "launch",
-        json!({"program": project.to_str().expect("a path"), "port": sim.path}),
-    );
-    assert_eq!(launch["success"], true, "{launch}");
+    let mut dap =
+        launched_with(json!({"program": project.to_str().expect("a path"), "port": sim.path}));
     let done = dap.request("configurationDone", json!({}));
     assert_eq!(done["success"], true, "{done}");
     let breakpoints = |lines: &[usize]| {
@@ -525,15 +522,9 @@ fn a_robot_launch_on_a_projects_image_names_the_projects_sources() {
     assert!(output.status.success(), "{}", transcript(&output));
     let line = crate::lines_with(&source, "jsr PUTCH")[0];
     let path = project.join("src/myext.s");
-    let mut dap = Client::start();
-    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
-    assert_eq!(init["success"], true, "{init}");
     let image = project.join("target/scorpion/myext.elf");
-    let launch = dap.request(
-        "launch",
-        json!({"program": image.to_str().expect("a path"), "port": sim.path}),
-    );
-    assert_eq!(launch["success"], true, "{launch}");
+    let mut dap =
+        launched_with(json!({"program": image.to_str().expect("a path"), "port": sim.path}));
     let set = dap.request(
         "setBreakpoints",
         json!({"source": {"path": path.to_str().expect("a path")},
@@ -553,11 +544,7 @@ fn a_robot_launch_on_a_projects_image_names_the_projects_sources() {
         "{frame}"
     );
     assert_eq!(frame["line"], line, "{frame}");
-    let go = dap.request("continue", json!({"threadId": 1}));
-    assert_eq!(go["success"], true, "{go}");
-    let bye = dap.request("disconnect", json!({}));
-    assert_eq!(bye["success"], true, "{bye}");
-    assert!(dap.ends());
+    continue_and_disconnect(dap);
 }
 
 /// fresh10 F18: with `port`, the launch's `stopOnEntry` and `commands`
@@ -568,16 +555,9 @@ fn a_robot_launch_on_a_projects_image_names_the_projects_sources() {
 #[test]
 fn a_robot_launch_sends_its_commands_and_says_it_cannot_stop_on_entry() {
     let (dir, sim) = handler_on_a_pty_robot();
-    let mut dap = Client::start();
-    let init = dap.request("initialize", json!({"adapterID": "scorpion"}));
-    assert_eq!(init["success"], true, "{init}");
     let program = dir.path().join("ext.elf");
-    let launch = dap.request(
-        "launch",
-        json!({"program": program.to_str().expect("a path"), "port": sim.path,
-               "stopOnEntry": true, "commands": ["/1X", "/1Q", "/1P"]}),
-    );
-    assert_eq!(launch["success"], true, "{launch}");
+    let mut dap = launched_with(json!({"program": program.to_str().expect("a path"),
+        "port": sim.path, "stopOnEntry": true, "commands": ["/1X", "/1Q", "/1P"]}));
     let path = dir.path().join("handler.s");
     // Line 6 is `show: lda value`, at $040C.
     let set = dap.request(
@@ -602,9 +582,5 @@ fn a_robot_launch_sends_its_commands_and_says_it_cannot_stop_on_entry() {
     let stopped = dap.event("stopped");
     assert_eq!(stopped["body"]["reason"], "breakpoint", "{stopped}");
     assert_eq!(dap.top_frame()["instructionPointerReference"], "0x040C");
-    let go = dap.request("continue", json!({"threadId": 1}));
-    assert_eq!(go["success"], true, "{go}");
-    let bye = dap.request("disconnect", json!({}));
-    assert_eq!(bye["success"], true, "{bye}");
-    assert!(dap.ends());
+    continue_and_disconnect(dap);
 }

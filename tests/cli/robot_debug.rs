@@ -273,28 +273,9 @@ fn a_breakpoint_inside_an_instruction_or_twice_at_one_place_is_refused() {
 /// at the terminal, that never came and the robot stayed stopped): at once.
 #[test]
 fn a_signal_at_a_stop_gives_the_robot_back() {
-    use std::io::{BufRead as _, BufReader, Write as _};
-    use std::process::{Command, Stdio};
+    use std::process::Command;
     let (dir, sim) = readme_handler_on_a_pty_robot();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
-        .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
-        .current_dir(dir.path())
-        .env("NO_COLOR", "1")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("scorpion runs");
-    let mut stdin = child.stdin.take().expect("its input");
-    stdin.write_all(b"break show\n/1Q\n").expect("the lines");
-    let mut stdout = BufReader::new(child.stdout.take().expect("its output"));
-    let mut seen = String::new();
-    while !seen.contains("PC=") {
-        let mut line = String::new();
-        let read = stdout.read_line(&mut line).expect("a line");
-        assert!(read > 0, "ended before the stop:\n{seen}");
-        seen.push_str(&line);
-    }
+    let (mut child, stdin, mut stdout, mut seen) = stopped_at_show(dir.path(), &sim);
     let killed = Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()
@@ -511,12 +492,42 @@ fn a_breakpoint_in_the_control_loops_handler_stops_there_and_quit_lets_go() {
 /// session could not give the robot back, and what to do about it.
 #[test]
 fn a_quit_that_cannot_give_the_robot_back_says_so() {
+    use std::io::Write as _;
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    let (child, mut stdin, _stdout, seen) = stopped_at_show(dir.path(), &sim);
+    drop(sim);
+    stdin.write_all(b"quit\n").expect("quit");
+    drop(stdin);
+    let output = child.wait_with_output().expect("it ends");
+    let said = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{seen}{said}");
+    assert!(
+        said.contains("could not give the robot back") && said.contains("reset it"),
+        "{said}"
+    );
+    assert!(
+        !said.contains("mid-upload") && !said.contains("safe to retry"),
+        "{said}"
+    );
+}
+
+/// `scorpion debug --port` on `sim` with `dir`'s `ext.elf`, its input
+/// and output piped, stopped at `show` by `/1Q`: the process, its input,
+/// its output, and what it printed up to the registers.
+fn stopped_at_show(
+    dir: &std::path::Path,
+    sim: &Sim,
+) -> (
+    std::process::Child,
+    std::process::ChildStdin,
+    std::io::BufReader<std::process::ChildStdout>,
+    String,
+) {
     use std::io::{BufRead as _, BufReader, Write as _};
     use std::process::{Command, Stdio};
-    let (dir, sim) = readme_handler_on_a_pty_robot();
     let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
         .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
-        .current_dir(dir.path())
+        .current_dir(dir)
         .env("NO_COLOR", "1")
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
@@ -533,18 +544,5 @@ fn a_quit_that_cannot_give_the_robot_back_says_so() {
         assert!(read > 0, "ended before the stop:\n{seen}");
         seen.push_str(&line);
     }
-    drop(sim);
-    stdin.write_all(b"quit\n").expect("quit");
-    drop(stdin);
-    let output = child.wait_with_output().expect("it ends");
-    let said = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success(), "{seen}{said}");
-    assert!(
-        said.contains("could not give the robot back") && said.contains("reset it"),
-        "{said}"
-    );
-    assert!(
-        !said.contains("mid-upload") && !said.contains("safe to retry"),
-        "{said}"
-    );
+    (child, stdin, stdout, seen)
 }
