@@ -335,6 +335,45 @@ fn a_hook_pointed_inside_a_stub_left_hooked_is_that_stub() {
     }
 }
 
+/// hostile10 F11: the hook at the left stub's own `JMP PREV` (its code's
+/// last instruction) or in its data, where a few bytes cannot tell a
+/// stub: the clean-up attach refused ("leads into where the stub goes"),
+/// and the killed session's breakpoint stayed in the code. The code where
+/// this image's stub goes is taken as its stub, hooked.
+#[test]
+fn a_hook_at_a_left_stubs_last_jump_or_its_data_is_that_stub() {
+    let image = handler();
+    let stub = {
+        let client = uploaded(&[&image]);
+        attach(client, &image).stub().clone()
+    };
+    let data = stub.code_end + 4;
+    assert!(stub.contains(data));
+    for target in [stub.code_end - 3, data] {
+        let mut client = killed_session(&image);
+        client
+            .transport()
+            .robot_mut()
+            .robot_mut()
+            .board_mut()
+            .load(HOOK_UNKNOWN + 1, &target.to_le_bytes())
+            .expect("RAM");
+        let debug = attach(client, &image);
+        let recovery = debug.recovery().clone();
+        assert!(recovery.hooked, "${target:04X}: {recovery:?}");
+        assert_eq!(recovery.hooked_inside, Some(target));
+        assert_eq!(recovery.removed, [AT]);
+        let mut client = debug.detach().expect("detached");
+        let hook = usize::from(HOOK_UNKNOWN);
+        assert_eq!(
+            memory(&mut client)[hook..hook + 3],
+            [0x4C, 0x03, 0x04],
+            "${target:04X}: the hook back at the image's handler"
+        );
+        assert_eq!(ask(&mut client, b'Q'), Some(Answer::Text("Q42".into())));
+    }
+}
+
 /// Puts `bytes` into the robot's RAM at `at` as an owner (or a glitch)
 /// would, and points `HOOK_UNKNOWN` at `target`.
 fn by_hand(client: &mut Client<VirtualTransport>, at: u16, bytes: &[u8], target: u16) {

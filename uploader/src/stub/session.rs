@@ -284,6 +284,16 @@ impl<T: Transport> RobotDebug<T> {
         if debug.stopped.is_some() && !present {
             return Err(stopped_in_another_stub(placed.address));
         }
+        if debug.recovery.hooked_inside.is_none()
+            && target != placed.handler
+            && present
+            && placed.contains(target)
+        {
+            // hostile10 F11: the hook at the stub's own `JMP PREV` or its
+            // data, which a few bytes there cannot tell as a stub's: the
+            // code where this image's stub goes is its stub, hooked.
+            debug.recovery.hooked_inside = Some(target);
+        }
         debug.recovery.hooked = target == placed.handler || debug.recovery.hooked_inside.is_some();
         let previous = if debug.recovery.hooked {
             if !present {
