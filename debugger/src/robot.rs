@@ -94,6 +94,11 @@ pub struct RobotMonitor {
     /// The last command sent that nothing came back for in the time
     /// waited: the robot answers in order, so the next answer may be its.
     owed: Option<String>,
+    /// The last command, when it was a step: what an empty line repeats.
+    repeat: Option<String>,
+    /// Where the images' source paths start (a stop names the user's
+    /// line, not a built-in include's).
+    root: std::path::PathBuf,
 }
 
 impl RobotMonitor {
@@ -110,7 +115,14 @@ impl RobotMonitor {
             next_id: 1,
             displays: Vec::new(),
             owed: None,
+            repeat: None,
+            root: std::path::PathBuf::from("."),
         }
+    }
+
+    /// Where the images' source paths start (by default, here).
+    pub fn set_root(&mut self, root: std::path::PathBuf) {
+        self.root = root;
     }
 
     /// Where code may be jumped to (labels and source lines): a step's
@@ -183,10 +195,29 @@ impl RobotMonitor {
         d: &mut RobotDebug<T>,
         line: &str,
     ) -> Result<Reply, Failure> {
+        // Enter on an empty line repeats the last step, as the virtual
+        // monitor's does (fresh10 F13).
+        let repeated;
+        let line = if line.trim().is_empty() {
+            match self.repeat.clone() {
+                Some(step) => {
+                    repeated = step;
+                    repeated.as_str()
+                }
+                None => return Ok(Reply::Text(String::new())),
+            }
+        } else {
+            line
+        };
         let mut words = line.split_whitespace();
         let Some(verb) = words.next() else {
             return Ok(Reply::Text(String::new()));
         };
+        self.repeat = matches!(
+            verb,
+            "step" | "s" | "stepi" | "si" | "next" | "n" | "nexti" | "ni"
+        )
+        .then(|| verb.to_owned());
         let rest: Vec<&str> = words.collect();
         let after = line[verb.len()..].trim();
         let text = match verb {
@@ -388,8 +419,17 @@ impl RobotMonitor {
                     .find(|(_, at)| **at == registers.pc)
                     .map(|(id, _)| format!("breakpoint {id}, "))
                     .unwrap_or_default();
+                // The source line too (fresh11 F7): `list` and `bt` are
+                // refused on the robot, so the stop says where it is.
+                let is_users = |file: &str| hostfs::is_users_source(&self.root, file);
+                let line = self
+                    .images
+                    .iter()
+                    .find_map(|image| image.user_source_of(u32::from(registers.pc), &is_users))
+                    .map(|(file, line)| format!(" at {file}:{line}"))
+                    .unwrap_or_default();
                 format!(
-                    "stopped: {id}{}\n  {}\n",
+                    "stopped: {id}{}{line}\n  {}\n",
                     self.place(registers.pc),
                     show_registers(registers)
                 )

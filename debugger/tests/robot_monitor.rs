@@ -150,3 +150,20 @@ fn a_stop_while_idle_is_noticed() {
     );
     assert!(text(&mut m, &mut d, "regs").contains("PC=$040C"));
 }
+
+/// fresh10 F13: Enter on an empty line repeats the last step, as in the
+/// virtual monitor; after any other command it does nothing.
+#[test]
+fn an_empty_line_repeats_the_last_step() {
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $040C");
+    assert!(text(&mut m, &mut d, "/1Q").contains("stopped: breakpoint 1, $040C"));
+    assert!(text(&mut m, &mut d, "step").contains("stopped: $040F"));
+    let again = text(&mut m, &mut d, "");
+    assert!(
+        again.contains("answer: Q42") || again.contains("stopped"),
+        "{again}"
+    );
+    assert!(text(&mut m, &mut d, "info").contains("breakpoint 1"));
+    assert_eq!(text(&mut m, &mut d, ""), "");
+}

@@ -460,6 +460,8 @@ fn a_breakpoint_in_the_control_loops_handler_stops_there_and_quit_lets_go() {
         "breakpoint 1: $",
         "(rom)",
         "(a stop not asked for) stopped: breakpoint 1, $",
+        // fresh11 F7: the stop names its source line.
+        " at patrol.s:",
         "breakpoint 1: $",
         "stopped: breakpoint 1, $",
         "PC=$",

@@ -94,9 +94,11 @@ impl RobotSession {
             images,
             root,
         } = attached;
+        let mut monitor = RobotMonitor::new(symbols, images);
+        monitor.set_root(root.clone());
         RobotSession {
             robot: Some(robot),
-            monitor: RobotMonitor::new(symbols, images),
+            monitor,
             root,
             breakpoints: BTreeMap::new(),
             next_id: 1,

@@ -129,7 +129,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         mut robot,
         symbols,
         images: linked,
-        ..
+        root,
     } = attach(args, port, None, &mut |said| {
         #[allow(
             clippy::print_stderr,
@@ -142,6 +142,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
     let mut monitor = RobotMonitor::new(symbols, linked);
+    monitor.set_root(root);
     let input = Input::new(
         std::io::IsTerminal::is_terminal(&std::io::stdin()),
         completion,
