@@ -32,27 +32,48 @@ pub fn in_project(root: &Path) -> PathBuf {
         .join("last-upload.undo")
 }
 
-/// Why an upload may not replace the undo file at `path` now, if it may
-/// not: an undo of it half done, or the upload that wrote it unfinished
-/// (the file keeps what the robot held before it, which nothing else
-/// does).
+/// What has not finished with an undo file, so that no upload may replace
+/// it: it keeps what the robot held, which nothing else does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unfinished {
+    /// An undo of it started and did not finish: the robot is half way
+    /// back.
+    Undo,
+    /// The upload that wrote it did not finish.
+    Upload,
+}
+
+impl Unfinished {
+    /// What it is, for a sentence about the undo file at `path`.
+    #[must_use]
+    pub fn said(self, path: &Path) -> String {
+        match self {
+            Unfinished::Undo => format!(
+                "an undo of {} started and did not finish (killed, or its line failed): the robot is half way back",
+                path.display()
+            ),
+            Unfinished::Upload => format!(
+                "the last upload did not finish (killed, or its line failed): {} keeps what the robot held before it",
+                path.display()
+            ),
+        }
+    }
+}
+
+/// Whether an upload may not replace the undo file at `path` now, and
+/// why. A mark whose file went since is dropped: nothing is kept.
 #[must_use]
-pub fn unfinished(path: &Path) -> Option<String> {
+pub fn unfinished(path: &Path) -> Option<Unfinished> {
     if !path.is_file() {
+        let _ = std::fs::remove_file(marked(path, UPLOADING));
         return None;
     }
     if marked(path, UNDOING).exists() {
-        return Some(format!(
-            "an undo of {} started and did not finish (killed, or its line failed): the robot is half way back; `scorpion upload --undo` finishes it",
-            path.display()
-        ));
+        return Some(Unfinished::Undo);
     }
-    marked(path, UPLOADING).exists().then(|| {
-        format!(
-            "the upload that wrote {} did not finish (killed, or its line failed); the file keeps what the robot held before it: `scorpion upload --undo` puts that back",
-            path.display()
-        )
-    })
+    marked(path, UPLOADING)
+        .exists()
+        .then_some(Unfinished::Upload)
 }
 
 /// Writes what an upload overwrote to the undo file as soon as it is

@@ -17,7 +17,7 @@ use uploader::{
 
 use crate::cmd::ports;
 use scorpion_project::runner::transcript::{self, Clock, TranscriptFailed};
-use scorpion_project::undo::{UNDOING, UNDONE, UPLOADING, UndoFile, marked};
+use scorpion_project::undo::{UNDOING, UNDONE, UPLOADING, UndoFile, Unfinished, marked};
 
 /// Upload a linked image (`scorpion link` or `scorpion build` output) into
 /// the robot with its own RAM-write commands: every byte verified with
@@ -99,34 +99,26 @@ fn upload_interrupted(undo: &Path, kept: &std::sync::atomic::AtomicBool) -> Stri
 /// finish (marked [`UPLOADING`]): that file keeps what the robot held
 /// before it, which nothing else does.
 fn refuse_unfinished(undo: &Path) -> miette::Result<()> {
-    if marked(undo, UNDOING).exists() && undo.is_file() {
+    match scorpion_project::undo::unfinished(undo) {
+        None => Ok(()),
         // fresh10 F10: a new undo file would take that undo's place, and
         // the mark would then be taken for this one's.
-        return Err(miette::miette!(
+        Some(what @ Unfinished::Undo) => Err(miette::miette!(
             code = "upload::undo_unfinished",
             help = "`scorpion upload --undo` finishes it (the robot as it was before the upload it undoes), then upload again",
-            "an undo of {} started and did not finish (killed, or its line failed): the robot is half way back; nothing was sent",
-            undo.display()
-        ));
+            "{}; nothing was sent",
+            what.said(undo)
+        )),
+        Some(what @ Unfinished::Upload) => Err(miette::miette!(
+            code = "upload::unfinished",
+            help = format!(
+                "`scorpion upload --undo` puts the robot back as it was before that upload, then upload again; or keep this upload's undo elsewhere (`--undo-file`); deleting {} gives that undo up",
+                marked(undo, UPLOADING).display()
+            ),
+            "{}, and this upload's undo file would replace it; nothing was sent",
+            what.said(undo)
+        )),
     }
-    let mark = marked(undo, UPLOADING);
-    if !mark.exists() {
-        return Ok(());
-    }
-    if !undo.is_file() {
-        // Nothing kept: the mark of an upload whose file went since.
-        let _ = std::fs::remove_file(&mark);
-        return Ok(());
-    }
-    Err(miette::miette!(
-        code = "upload::unfinished",
-        help = format!(
-            "`scorpion upload --undo` puts the robot back as it was before that upload, then upload again; or keep this upload's undo elsewhere (`--undo-file`); deleting {} gives that undo up",
-            mark.display()
-        ),
-        "the last upload did not finish (killed, or its line failed): {} keeps what the robot held before it, and this upload's undo file would replace it; nothing was sent",
-        undo.display()
-    ))
 }
 
 impl Args {

@@ -753,8 +753,11 @@ fn wait<T: Transport>(client: &mut Client<T>, time: Duration) -> uploader::Resul
 /// (an unfinished upload or undo keeps what the robot held), with its
 /// directory made.
 fn undo_refused(path: &Path) -> Option<String> {
-    if let Some(why) = undo::unfinished(path) {
-        return Some(indent(&format!("{why}; nothing was sent\n")));
+    if let Some(what) = undo::unfinished(path) {
+        return Some(indent(&format!(
+            "{}: `scorpion upload --undo` first; nothing was sent\n",
+            what.said(path)
+        )));
     }
     let parent = path.parent()?;
     std::fs::create_dir_all(parent)
