@@ -21,10 +21,13 @@ use uploader::{Area, RomProfile, UploadImage};
 const WAIT: Duration = Duration::from_secs(1);
 
 fn stopped_at_show() -> (UploadImage, RobotDebug<VirtualTransport>, Registers) {
-    let image = handler();
+    let mut image = handler();
+    // As a build's sections say: code to $0417, then data ($0480).
+    image.set_code(vec![0x0400..=0x0417]);
     let mut debug = attach(&image);
+    // The labels count as starts: the chain slot's ($0401) and `value`'s.
     debug.set_instruction_starts(vec![
-        0x0400, 0x0403, 0x0405, 0x0407, 0x0409, 0x040C, 0x040F, 0x0412, 0x0415,
+        0x0400, 0x0401, 0x0403, 0x0405, 0x0407, 0x0409, 0x040C, 0x040F, 0x0412, 0x0415, 0x0480,
     ]);
     debug.set_breakpoint(0x040C, &[]).expect("set");
     let Reply::Stopped(registers) = debug.command(b"/1Q", WAIT).expect("sent") else {
@@ -97,6 +100,10 @@ fn registers_the_robot_cannot_go_on_with_are_refused() {
         (0xC010, "the I/O page"),
         (stub.entry, "in the debug stub"),
         (0x040D, "no instruction of the image starts at $040D"),
+        // hostile12 F1: the chain slot (the operand of the JMP at $0400),
+        // labelled, and the image's data.
+        (0x0401, "in a chain slot"),
+        (0x0480, "data of the image"),
         // fresh11 F9: the reset code, and the middle of a service's JMP;
         // hostile11 F5: a subroutine (GETHEX, PUTCH), whose RTS jammed
         // the CPU.

@@ -142,6 +142,22 @@ impl Guard {
             ));
         }
         if image.contains(pc) {
+            // hostile12 F1: a label counts as an instruction's start, and
+            // the chain slot's has one (the operand of `JMP PREV`).
+            let slot = image.hooks().iter().any(|hook| {
+                hook.chain
+                    .is_some_and(|slot| pc == slot || pc == slot.wrapping_add(1))
+            });
+            if slot || !image.is_code(pc) {
+                return Some(format!(
+                    "${pc:04X} is {} of the image, not one of its instructions: the robot would run the middle of one, or data",
+                    if slot {
+                        "in a chain slot (a JMP's operand)"
+                    } else {
+                        "data"
+                    }
+                ));
+            }
             if starts.is_some_and(|starts| starts.binary_search(&pc).is_err()) {
                 return Some(format!(
                     "no instruction of the image starts at ${pc:04X} (its line tables start a line at every instruction): the robot would run the middle of one"
