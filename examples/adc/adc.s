@@ -1,5 +1,5 @@
 ; adc.s: /2An reads channel n (0-7) of the ADC card at $9000 and answers
-; Ahh, the reading in hex.
+; Ahh, the reading in hex, or A-- when no card answers.
 ;
 ; The card (examples/adc/adc.rhai is its model for the virtual Scorpion):
 ;
@@ -39,12 +39,31 @@ read_channel:
 @channel:
         ora #$80                ; start, no interrupt
         sta ADC_CONTROL
+        ldx #0                  ; 256 looks, about 2.8 ms: 28 conversions
 @wait:  bit ADC_STATUS          ; bit 6 into V: a result waits
-        bvc @wait
+        bvs @result
+        dex
+        bne @wait
+        beq no_card             ; nothing came: a robot without the card
+@result:
+        bmi no_card             ; converting and done at once: no card there
         lda #'A'
         jsr PUTCH
         lda ADC_DATA
         jsr PUTHEX
+        jsr PUTEOL
+        jmp CMD_DONE
+
+; Without the card STATUS reads whatever is at $9001: plain RAM on the
+; virtual Scorpion, the floating bus ($90) or pull-ups ($FF) on a real one.
+; That is never a result, or both bits at once. Answer A-- rather than wait
+; for ever with the robot's control loop stopped.
+no_card:
+        lda #'A'
+        jsr PUTCH
+        lda #'-'
+        jsr PUTCH
+        jsr PUTCH
         jsr PUTEOL
         jmp CMD_DONE
 

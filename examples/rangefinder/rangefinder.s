@@ -42,9 +42,17 @@ rangefinder:
 
         lda #1
         sta RANGER_CONTROL      ; ping
+        ldx #0                  ; 12 x 256 looks of 11 cycles: 34 ms, past
+        ldy #12                 ; the card's 25 ms with no echo
 @wait:  bit RANGER_STATUS       ; a round trip takes 58 us per centimetre;
-        bmi @wait               ; interrupts keep receiving meanwhile
+        bpl @measured           ; interrupts keep receiving meanwhile
+        dex
+        bne @wait
+        dey
+        bne @wait
+        beq @silent             ; still measuring: no card there
 
+@measured:
         lda #'U'
         jsr PUTCH
         lda RANGER_STATUS
@@ -54,6 +62,12 @@ rangefinder:
         ldy RANGER_HI
         jsr PUTDEC4
         jmp @done
+; Without the card STATUS reads whatever the bus floats to on a real robot
+; (bit 7 set: measuring for ever); answer as for no echo rather than hold the
+; robot's control loop.
+@silent:
+        lda #'U'
+        jsr PUTCH
 @nothing:
         lda #'-'
         ldx #4

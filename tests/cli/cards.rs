@@ -59,23 +59,16 @@ fn ask_on_the_virtual_scorpion_takes_cards_too() {
         &["--target", "scorpion-ext"],
     );
     let card = format!("{}@A000", example("adc/adc.rhai"));
-    // The extension reads $9000; the card moved to $A000 is not there.
+    // The extension reads $9000; the card moved to $A000 is not there, and
+    // the extension says so rather than wait for it.
     let output = scorpion(
         dir.path(),
         &[
-            "ask",
-            "--port",
-            "emu",
-            "--image",
-            "adc.elf",
-            "--card",
-            &card,
-            "--timeout",
-            "50",
-            "/2A0",
+            "ask", "--port", "emu", "--image", "adc.elf", "--card", &card, "/2A0", "/1X",
         ],
     );
-    assert_ne!(output.status.code(), Some(0), "{}", transcript(&output));
+    assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
+    assert_eq!(String::from_utf8_lossy(&output.stdout), "A--\nX00\n");
     let card = example("adc/adc.rhai");
     let output = scorpion(
         dir.path(),
@@ -85,6 +78,45 @@ fn ask_on_the_virtual_scorpion_takes_cards_too() {
     );
     assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
     assert_eq!(String::from_utf8_lossy(&output.stdout), "AC0\nA57\n");
+}
+
+/// fresh11 F10: an extension for a card, on a robot without the card,
+/// answers "nothing" within a few milliseconds and the robot goes on. What
+/// the card's status register reads without the card: RAM on the virtual
+/// robot (as it was left), the floating bus or pull-ups on a real one.
+#[test]
+fn the_card_examples_answer_on_a_robot_without_their_card() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    build_example(
+        dir.path(),
+        "adc/adc.s",
+        "adc.elf",
+        &["--target", "scorpion-ext"],
+    );
+    build_example(
+        dir.path(),
+        "rangefinder/rangefinder.s",
+        "rangefinder.elf",
+        &["--target", "scorpion-ext"],
+    );
+    // ADC STATUS at $9001: as left (0), the bus floating ($90), pull-ups.
+    let (code, text) = sim_in(
+        dir.path(),
+        &["--image", "adc.elf"],
+        "/2A0\n/9W90009090\n/2A1\n/9W9000FFFF\n/2A7\n/1X\n",
+    );
+    assert_eq!(code, 0, "{text}");
+    assert_eq!(text.matches("A--\n").count(), 3, "{text}");
+    assert!(text.contains("X00"), "{text}");
+    // The rangefinder's STATUS at $8001 floating with bit 7 set: "no echo".
+    let (code, text) = sim_in(
+        dir.path(),
+        &["--image", "rangefinder.elf"],
+        "/9W80008080\n/1U\n/1X\n",
+    );
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("U----\n"), "{text}");
+    assert!(text.contains("X00"), "{text}");
 }
 
 #[test]

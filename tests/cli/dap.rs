@@ -260,14 +260,14 @@ fn a_dap_session_on_the_adc_example() {
     // loop's breakpoint, in, out.
     c.request(
         "setBreakpoints",
-        json!({"source": {"path": source}, "breakpoints": [{"line": 45}]}),
+        json!({"source": {"path": source}, "breakpoints": [{"line": 51}]}),
     );
     assert_eq!(
         c.request("continue", json!({"threadId": 1}))["success"],
         true
     );
     assert_eq!(c.event("stopped")["body"]["reason"], "breakpoint");
-    assert_eq!(c.top_frame()["line"], 45, "jsr PUTCH");
+    assert_eq!(c.top_frame()["line"], 51, "jsr PUTCH");
     assert_eq!(c.request("stepIn", json!({"threadId": 1}))["success"], true);
     c.event("stopped");
     let trace = c.request("stackTrace", json!({"threadId": 1}));
@@ -282,7 +282,7 @@ fn a_dap_session_on_the_adc_example() {
     );
     // The caller's frame is where it called, as gdb and editors show it
     // (and as the monitor's `bt` does), not the line the call returns to.
-    assert_eq!(frames[1]["line"], 45, "the line of the JSR: {trace}");
+    assert_eq!(frames[1]["line"], 51, "the line of the JSR: {trace}");
     assert!(
         frames[0]["source"].is_null(),
         "the ROM has no source here: {trace}"
@@ -292,14 +292,14 @@ fn a_dap_session_on_the_adc_example() {
         true
     );
     c.event("stopped");
-    assert_eq!(c.top_frame()["line"], 46);
-    // Back to the last breakpoint hit (line 45), then on.
+    assert_eq!(c.top_frame()["line"], 52);
+    // Back to the last breakpoint hit (line 51), then on.
     assert_eq!(
         c.request("reverseContinue", json!({"threadId": 1}))["success"],
         true
     );
     assert_eq!(c.event("stopped")["body"]["reason"], "breakpoint");
-    assert_eq!(c.top_frame()["line"], 45);
+    assert_eq!(c.top_frame()["line"], 51);
 
     // The card's registers, as memory.
     let memory = c.request(

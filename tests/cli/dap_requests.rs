@@ -312,7 +312,7 @@ fn function_data_and_instruction_breakpoints() {
     let pc = c.top_frame()["instructionPointerReference"].clone();
     let listing = ok(&c.request(
         "disassemble",
-        json!({"memoryReference": pc, "instructionCount": 8}),
+        json!({"memoryReference": pc, "instructionCount": 10}),
     ))
     .clone();
     let call = listing["instructions"]

@@ -164,16 +164,16 @@ fn breaks_at_a_source_line_and_lists_the_source_there() {
     let output = scorpion_with_input(
         Some(&adc),
         &["debug"],
-        "break adc.s:43\n/2A1\ncontinue\nlist\nbreak adc.s:2\n",
+        "break adc.s:44\n/2A1\ncontinue\nlist\nbreak adc.s:2\n",
     );
     assert_eq!(output.status.code(), Some(0), "{}", transcript(&output));
     let text = String::from_utf8_lossy(&output.stdout).into_owned();
     assert!(
-        text.contains("breakpoint 1: $041E (read_channel+$1E)"),
+        text.contains("breakpoint 1: $0420 (read_channel+$20)"),
         "{text}"
     );
-    assert!(text.contains("  adc.s:43:         bvc @wait"), "{text}");
-    assert!(text.contains("> adc.s:43           bvc @wait"), "{text}");
+    assert!(text.contains("  adc.s:44:         bvs @result"), "{text}");
+    assert!(text.contains("> adc.s:44           bvs @result"), "{text}");
     assert!(text.contains("error: no code came from adc.s:2"), "{text}");
 }
 

@@ -145,13 +145,13 @@ fn a_monitor_session_at_a_terminal() {
     tmux.type_line("break read_channel if A == 'A' && [CMDBUF+1] == '1'");
     tmux.wait_for("breakpoint 1: $0400 (read_channel) if A == 'A'", 1);
     // A log point where the reading is in A.
-    tmux.type_line("break adc.s:47 log channel {[CMDBUF+1] - '0'} read {A}");
-    tmux.wait_for("log point 2: $0428", 1);
+    tmux.type_line("break adc.s:53 log channel {[CMDBUF+1] - '0'} read {A}");
+    tmux.wait_for("log point 2: $0431", 1);
     tmux.type_line("/2A0");
     tmux.type_line("continue");
     let screen = tmux.wait_for("< AC0\\r", 1);
     assert!(
-        screen.contains("log 2 at $0428 (read_channel+$28): channel $00 read $C0"),
+        screen.contains("log 2 at $0431 (read_channel+$31): channel $00 read $C0"),
         "{screen}"
     );
     assert!(!screen.contains("breakpoint 1 ("), "{screen}");
@@ -160,9 +160,9 @@ fn a_monitor_session_at_a_terminal() {
     tmux.wait_for("breakpoint 1 ($0400 (read_channel))", 1);
 
     // A register set that changes the robot's answer.
-    tmux.type_line("break adc.s:47 if A == $57");
+    tmux.type_line("break adc.s:53 if A == $57");
     tmux.type_line("continue");
-    tmux.wait_for("breakpoint 3 ($0428", 1);
+    tmux.wait_for("breakpoint 3 ($0431", 1);
     tmux.type_line("set A $05");
     tmux.wait_for("A = $05", 1);
     tmux.type_line("delete 3");

@@ -70,7 +70,7 @@ fn the_adc_extension_profiled_by_routine_command_and_line() {
         .lines()
         .find(|line| line.starts_with("adc.s:"))
         .unwrap_or_else(|| panic!("no adc.s line in:\n{report}"));
-    assert!(hot.starts_with("adc.s:42 "), "{hot}");
+    assert!(hot.starts_with("adc.s:43 "), "{hot}");
     let runs: u64 = hot
         .split_whitespace()
         .nth(1)
