@@ -55,12 +55,13 @@ pub fn instruction_starts(images: &[linker::Image]) -> Option<Vec<u16>> {
     if images.iter().all(|image| image.lines.entries.is_empty()) {
         return None;
     }
-    Some(jump_targets(images))
+    Some(starts_of(images))
 }
 
-/// The images' labels and source lines' addresses, sorted.
-fn jump_targets(images: &[linker::Image]) -> Vec<u16> {
-    let mut entries: Vec<u16> = images
+/// The images' labels and source lines' addresses, sorted: where every
+/// instruction starts (the line tables start a line at each).
+fn starts_of(images: &[linker::Image]) -> Vec<u16> {
+    let mut starts: Vec<u16> = images
         .iter()
         .flat_map(|image| {
             let labels = image
@@ -75,9 +76,55 @@ fn jump_targets(images: &[linker::Image]) -> Vec<u16> {
             labels.chain(lines).collect::<Vec<_>>()
         })
         .collect();
-    entries.sort_unstable();
-    entries.dedup();
-    entries
+    starts.sort_unstable();
+    starts.dedup();
+    starts
+}
+
+/// Where code may be jumped to, which a breakpoint's `JSR` must not
+/// cover past its first instruction: the images' labels, and the target
+/// of every branch, `JMP` and `JSR` among their instructions (decoded
+/// where the line tables start one). Not every source line: a `JSR` over
+/// an instruction of two bytes and the next is fine where nothing jumps
+/// to that next one (fresh10 F4b: in `scorpion new`'s handler only
+/// `jsr PUTCH` took a breakpoint, and no step could leave it).
+fn jump_targets(images: &[linker::Image]) -> Vec<u16> {
+    let mut targets: Vec<u16> = images
+        .iter()
+        .flat_map(|image| {
+            image
+                .symbols
+                .iter()
+                .filter_map(|symbol| u16::try_from(symbol.value).ok())
+        })
+        .collect();
+    for image in images {
+        let byte = |at: u16| {
+            image.areas.iter().find_map(|area| {
+                let offset = usize::try_from(u32::from(at).checked_sub(area.run)?).ok()?;
+                area.bytes.get(offset).copied()
+            })
+        };
+        for entry in &image.lines.entries {
+            let Ok(at) = u16::try_from(entry.offset) else {
+                continue;
+            };
+            let bytes: Vec<u8> = (0..3).map_while(|i| byte(at.wrapping_add(i))).collect();
+            let Some(instruction) = isa::Instruction::decode(&bytes, at) else {
+                continue;
+            };
+            let jumps = matches!(
+                instruction.opcode.mnemonic,
+                isa::Mnemonic::Jmp | isa::Mnemonic::Jsr
+            ) && instruction.opcode.mode == isa::AddressingMode::Absolute;
+            if jumps || instruction.opcode.mode == isa::AddressingMode::Relative {
+                targets.extend(instruction.target());
+            }
+        }
+    }
+    targets.sort_unstable();
+    targets.dedup();
+    targets
 }
 
 /// What the monitor keeps on a robot between commands.
@@ -85,7 +132,8 @@ fn jump_targets(images: &[linker::Image]) -> Vec<u16> {
 pub struct RobotMonitor {
     symbols: Symbols,
     images: Vec<linker::Image>,
-    /// Where code may be jumped to: labels and source lines.
+    /// Where code may be jumped to: labels and the targets of branches,
+    /// jumps and calls.
     entries: Vec<u16>,
     /// Breakpoints by number.
     breakpoints: BTreeMap<u32, u16>,
@@ -125,8 +173,8 @@ impl RobotMonitor {
         self.root = root;
     }
 
-    /// Where code may be jumped to (labels and source lines): a step's
-    /// successors are looked for there.
+    /// Where code may be jumped to (labels and the targets of branches,
+    /// jumps and calls), which a breakpoint's `JSR` must not cover.
     #[must_use]
     pub fn entries(&self) -> &[u16] {
         &self.entries

@@ -167,3 +167,79 @@ fn an_empty_line_repeats_the_last_step() {
     assert!(text(&mut m, &mut d, "info").contains("breakpoint 1"));
     assert_eq!(text(&mut m, &mut d, ""), "");
 }
+
+/// `scorpion new`'s handler, as the template writes it.
+const NEW_HANDLER: &str = "        .include \"scorpion.inc\"
+VERSION = $01
+        .code
+        SCORPION_UNKNOWN_HANDLER
+handler:
+        cpx #1
+        bne not_mine
+        cmp #'V'
+        bne not_mine
+        jsr PUTCH
+        lda #VERSION
+        jsr PUTHEX
+        jsr PUTEOL
+        jmp CMD_DONE
+not_mine:
+        SCORPION_CHAIN_UNKNOWN
+";
+
+/// fresh10 F4b: in the template's handler only `jsr PUTCH` took a
+/// breakpoint (every instruction starts a source line, and each line was
+/// taken for a jump target), so no step could leave it. A `JSR` may cover
+/// an instruction nothing jumps to: from `jsr PUTCH` the steps go line by
+/// line to the answer, and `lda #VERSION` takes a breakpoint too; the
+/// branches and what they go to are still refused.
+#[test]
+fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
+    use std::collections::BTreeMap;
+    let options = assembler::Options {
+        builtin_includes: BTreeMap::from([(
+            "scorpion.inc".to_owned(),
+            romlib::SCORPION_INC.as_bytes().to_vec(),
+        )]),
+        ..assembler::Options::default()
+    };
+    let source = assembler::MemorySource::new().with("new.s", NEW_HANDLER);
+    let assembly = assembler::assemble(&source, std::path::Path::new("new.s"), &options)
+        .expect("the template assembles");
+    let linked = romlib::link_against_rom("new.s", &assembly.object, "scorpion-ext")
+        .expect("the template links");
+    let mut robot = VirtualScorpion::new();
+    robot.load_image(&linked).expect("loads");
+    let symbols = debugger::Symbols::new(&robot, std::slice::from_ref(&linked));
+    let image = UploadImage::try_from(&linked).expect("an image");
+    let profile = RomProfile::reference();
+    let client = uploader::client(VirtualTransport::new(robot), &profile);
+    let mut d = RobotDebug::attach(client, &profile, image).expect("attaches");
+    let images = vec![linked];
+    if let Some(starts) = debugger::robot::instruction_starts(&images) {
+        d.set_instruction_starts(starts);
+    }
+    let mut m = RobotMonitor::new(symbols, images);
+
+    // The branches (and so the handler's first two lines) still cannot be.
+    assert!(refusal(&mut m, &mut d, "break handler").contains("branch"));
+    text(&mut m, &mut d, "break handler+8");
+    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 1, $0408"));
+    let shown = text(&mut m, &mut d, "step");
+    assert!(
+        shown.contains("stopped: $040B"),
+        "jsr PUTCH stepped over: {shown}"
+    );
+    let shown = text(&mut m, &mut d, "step");
+    assert!(shown.contains("stopped: $040D"), "lda #VERSION: {shown}");
+    assert!(text(&mut m, &mut d, "regs").contains("A=$01"));
+    let shown = text(&mut m, &mut d, "next");
+    assert!(shown.contains("stopped: $0410"), "jsr PUTHEX: {shown}");
+    let shown = text(&mut m, &mut d, "continue");
+    assert!(shown.contains("V01"), "{shown}");
+    // A breakpoint on the two-byte `lda #VERSION` itself.
+    text(&mut m, &mut d, "delete 1");
+    text(&mut m, &mut d, "break handler+$B");
+    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 2, $040B"));
+    assert!(text(&mut m, &mut d, "continue").contains("V01"));
+}

@@ -92,7 +92,7 @@ impl Patch {
 /// outside the image (the ROM cannot be patched), an instruction that
 /// reads the PC (a relative branch) among those displaced, or a displaced
 /// instruction after the first that code may jump to (`entries`: the
-/// image's labels and line-table addresses).
+/// image's labels and the targets of its branches, jumps and calls).
 ///
 /// # Errors
 /// [`StubError::Refused`] with the reason.
@@ -130,7 +130,7 @@ pub fn plan(address: u16, image: &UploadImage, entries: &[u16]) -> StubResult<Pa
         }
         if at != address && entries.contains(&at) {
             return Err(refuse(format!(
-                "the JSR would cover ${at:04X}, an instruction some code may jump to (a label or a source line starts there); put the breakpoint there instead"
+                "the JSR would cover ${at:04X}, an instruction some code may jump to (a label is there, or a branch, jump or call goes there); put the breakpoint there instead"
             )));
         }
         for i in 0..u16::from(instruction.len()) {

@@ -785,7 +785,7 @@ impl<T: Transport> RobotDebug<T> {
     }
 
     /// Sets a breakpoint at `address`; `entries` are the addresses code
-    /// may jump to (labels, source lines), which a patch must not cover
+    /// may jump to (labels, the targets of branches, jumps and calls), which a patch must not cover
     /// past its first instruction.
     ///
     /// # Errors
