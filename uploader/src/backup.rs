@@ -380,7 +380,7 @@ pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16,
     let mut marked = vec![false; 0x1_0000];
     for (target, extents) in hooked_extents(profile, backup) {
         if extents.is_empty() {
-            mark_window(&mut marked, profile, target, None);
+            mark_window(&mut marked, profile, (target, WITNESS_WINDOW), None);
         } else {
             for extent in extents {
                 marked[usize::from(*extent.start())..=usize::from(*extent.end())].fill(true);
@@ -406,7 +406,7 @@ pub(crate) fn kept_witness_ranges(
     let mut marked = vec![false; 0x1_0000];
     for (target, extents) in hooked_extents(profile, kept) {
         let home = extents.iter().find(|extent| extent.contains(&target));
-        mark_window(&mut marked, profile, target, home);
+        mark_window(&mut marked, profile, (target, WITNESS_WINDOW), home);
         for extent in &extents {
             for address in extent.clone() {
                 if image.contains(address) {
@@ -423,6 +423,84 @@ pub(crate) fn kept_witness_ranges(
         }
     }
     unmarked_but_held(marked, kept)
+}
+
+/// How many bytes at a hook's target an undo file kept before the image's
+/// bytes go out witnesses: the handler's first instruction, at least.
+/// Until the file is kept again, whole, nothing of the code the hooks go
+/// back to has changed, and the file holds the table entries that say
+/// whose code it is; each byte read at the base rate costs robot time
+/// (the one-byte change's second).
+const EARLY_WITNESS_WINDOW: u16 = 4;
+
+/// The first [`EARLY_WITNESS_WINDOW`] bytes at each hook of `backup` that
+/// a restore points into RAM (within the extension that holds it), less
+/// what the backup holds: what an undo file kept before any byte of the
+/// image is written needs.
+pub(crate) fn hook_windows(profile: &RomProfile, backup: &Backup) -> Vec<(u16, usize)> {
+    let mut marked = vec![false; 0x1_0000];
+    for (target, extents) in hooked_extents(profile, backup) {
+        let home = extents.iter().find(|extent| extent.contains(&target));
+        mark_window(&mut marked, profile, (target, EARLY_WITNESS_WINDOW), home);
+    }
+    unmarked_but_held(marked, backup)
+}
+
+/// Witnesses of [`hook_windows`], each range read once however often an
+/// upload keeps its undo file again before its next change.
+#[derive(Debug, Default)]
+pub(crate) struct EarlyWitnesses(Vec<Witness>);
+
+impl EarlyWitnesses {
+    /// Hands `keep` what an upload changed so far (`backup`: the hooks and
+    /// the table as found, the chain slots re-pointed, what the loader
+    /// overwrote), with the witnesses of its hooks' windows: called before
+    /// each change made before the image's bytes go out (hostile10 F5).
+    ///
+    /// A window that holds what `image` loads there (an edited extension
+    /// uploaded again over itself, the usual case) is read once, as the
+    /// bytes an upload expects are (`Client::read_expecting`).
+    pub(crate) fn keep<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        (profile, image): (&RomProfile, &UploadImage),
+        mut backup: Backup,
+        keep: &mut dyn Keep,
+    ) -> Result<()> {
+        let mut witnesses = Vec::new();
+        for (address, len) in hook_windows(profile, &backup) {
+            let known = self
+                .0
+                .iter()
+                .find(|witness| witness.address == address && usize::from(witness.len) == len);
+            let witness = match known {
+                Some(witness) => *witness,
+                None => {
+                    let slots: Vec<u16> = image
+                        .hooks()
+                        .iter()
+                        .filter_map(|record| record.chain)
+                        .flat_map(|slot| [slot, slot.wrapping_add(1)])
+                        .collect();
+                    let expected: Vec<Option<u8>> = (0..len)
+                        .map(|i| address.wrapping_add(i as u16))
+                        .map(|at| image.byte(at).filter(|_| !slots.contains(&at)))
+                        .collect();
+                    let witness = Witness {
+                        address,
+                        len: len as u16,
+                        sum: crate::sums::fletcher16(&client.read_expecting(address, &expected)?),
+                    };
+                    self.0.push(witness);
+                    witness
+                }
+            };
+            witnesses.push(witness);
+        }
+        backup.witnesses = witnesses;
+        keep.keep(&backup);
+        Ok(())
+    }
 }
 
 /// Each hook of `backup` that a restore points into RAM: its target and
@@ -456,7 +534,7 @@ fn hooked_extents(
 fn mark_window(
     marked: &mut [bool],
     profile: &RomProfile,
-    target: u16,
+    (target, window): (u16, u16),
     home: Option<&std::ops::RangeInclusive<u16>>,
 ) {
     let end = profile
@@ -464,7 +542,7 @@ fn mark_window(
         .iter()
         .find(|range| range.contains(&target))
         .map_or(target, |range| *range.end());
-    let end = end.min(target.saturating_add(WITNESS_WINDOW - 1));
+    let end = end.min(target.saturating_add(window - 1));
     let end = home.map_or(end, |home| end.min(*home.end()));
     marked[usize::from(target)..=usize::from(end)].fill(true);
 }

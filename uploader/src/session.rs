@@ -182,11 +182,10 @@ impl Session {
         let resident = seen.as_deref() == Some(&rate.areas()[0].bytes[..]);
         if self.keep_under {
             self.under = self.read_under(client, resident, seen.as_deref())?;
-            if !self.under.is_empty() {
-                // Kept before the first write: a kill while the loader
-                // goes in leaves something to undo.
-                before_write(client, &self.under)?;
-            }
+            // Kept before the first change (a hook switched to a loader
+            // found in RAM is one): a kill from here on leaves something to
+            // undo.
+            before_write(client, &self.under)?;
         }
         let mut start = if resident {
             Start::Resident
@@ -277,7 +276,11 @@ impl Session {
     /// once (a recovery finds it written by `frames`): read after `/1F`,
     /// at the fast rate, where nothing of the loader that touches it
     /// (`frames`, `sums`) has run yet; `rate` does not.
-    fn keep_zero_page<T: Transport>(&mut self, client: &mut Client<T>) -> Result<()> {
+    fn keep_zero_page<T: Transport>(
+        &mut self,
+        client: &mut Client<T>,
+        before_write: &mut BeforeWrite<'_, T>,
+    ) -> Result<()> {
         if !self.keep_under || self.zero_page_kept {
             return Ok(());
         }
@@ -285,7 +288,8 @@ impl Session {
         let bytes = client.read_memory(address, usize::from(ZERO_PAGE_LEN))?;
         self.under.push(Area { address, bytes });
         self.zero_page_kept = true;
-        Ok(())
+        // In the file before `frames` runs and uses it.
+        before_write(client, &self.under)
     }
 
     /// What the loader overwrote, as [`Session::keep_under`] asked (empty
@@ -323,12 +327,12 @@ impl Session {
                     // base rate, and no later recovery tries again.
                     self.fast = None;
                 }
-                self.keep_zero_page(client)?;
+                self.keep_zero_page(client, before_write)?;
                 let part = self.loader.frames_part()?;
                 self.verify_rom_part(client, &part, start, before_write)?;
             }
             _ => {
-                self.keep_zero_page(client)?;
+                self.keep_zero_page(client, before_write)?;
                 let part = self.loader.rom_part()?;
                 self.verify_rom_part(client, &part, start, before_write)?;
             }

@@ -31,6 +31,9 @@ pub(crate) struct Plan {
     /// The table as it was read, before anything changed it: its flags
     /// and the entries in use (what an undo puts back).
     pub(crate) found: Vec<Area>,
+    /// The hooks as `prepare` left them: as found, but for those it
+    /// pointed past an extension it took out (each write verified).
+    pub(crate) hooks: Vec<(HookKind, u16)>,
     /// The extensions that stay installed beside the image (neither
     /// replaced nor an earlier copy of it): where the RAM loader must not
     /// go, and what a hook into them is known to be.
@@ -119,6 +122,24 @@ fn read_table_with<E: From<Error>>(
     Ok(Some(table))
 }
 
+/// Called before each write [`prepare`] makes (it unhooks an extension it
+/// replaces, or an earlier copy behind another in its chain), with the
+/// table as found and the chain slot about to be re-pointed, as it was
+/// (`None` for a hook's own operand or the flags): so that what an undo
+/// needs is kept before the robot changes (hostile10 F5).
+pub(crate) type BeforeUnhook<'a, T> =
+    dyn FnMut(&mut Client<T>, &[Area], Option<Area>) -> Result<()> + 'a;
+
+/// What the writes of [`prepare`] share: the write limit, the table as
+/// found and the call before each write, and the hooks as the writes
+/// leave them (each written and verified, so known without a read).
+struct Unhooking<'a, 'b, T> {
+    max_writes: u32,
+    found: Vec<Area>,
+    before: &'a mut BeforeUnhook<'b, T>,
+    hooks: Vec<(HookKind, u16)>,
+}
+
 /// Reads the table and decides: an installed image that overlaps `image`
 /// is an error, unless it is an earlier copy of the same image (its slot
 /// is reused) or `replace` is set (it is taken out of its chains and its
@@ -130,6 +151,7 @@ pub(crate) fn prepare<T: Transport>(
     image: &UploadImage,
     replace: bool,
     (max_writes, hooks): (u32, &[(HookKind, u16)]),
+    before: &mut BeforeUnhook<'_, T>,
 ) -> Result<Option<Plan>> {
     let Some(table) = profile.table else {
         return Ok(None);
@@ -150,6 +172,12 @@ pub(crate) fn prepare<T: Transport>(
             bytes: read.entries.1.clone(),
         });
     }
+    let mut writes = Unhooking {
+        max_writes,
+        found,
+        before,
+        hooks: hooks.to_vec(),
+    };
     let mut replaced = false;
     let mut known = hooks;
     let mut unlinked = Vec::new();
@@ -163,7 +191,7 @@ pub(crate) fn prepare<T: Transport>(
                 // the upload points the hook past it itself.)
                 for hook in &old.hooks {
                     let context = (&read.installed[..], known);
-                    unlinked.extend(unlink(client, profile, context, *hook, max_writes, false)?);
+                    unlinked.extend(unlink(client, profile, context, *hook, &mut writes, false)?);
                 }
                 reused = Some(old.clone());
             }
@@ -174,7 +202,7 @@ pub(crate) fn prepare<T: Transport>(
                     profile,
                     (&read.installed, known),
                     old,
-                    max_writes,
+                    &mut writes,
                 )?);
                 // The hooks may have moved: read from here on.
                 known = &[];
@@ -205,7 +233,8 @@ pub(crate) fn prepare<T: Transport>(
         table,
         entry,
         current_flags,
-        found,
+        found: writes.found,
+        hooks: writes.hooks,
         held_maybe: replaced || reused.is_some(),
         others: kept,
         unlinked,
@@ -354,7 +383,7 @@ fn remove<T: Transport>(
     profile: &RomProfile,
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     old: &Installed,
-    max_writes: u32,
+    writes: &mut Unhooking<'_, '_, T>,
 ) -> Result<Vec<Area>> {
     let Some((table, _)) = profile.table else {
         return Ok(Vec::new());
@@ -366,7 +395,7 @@ fn remove<T: Transport>(
             profile,
             (everyone, hooks),
             *hook,
-            max_writes,
+            writes,
             true,
         )?);
     }
@@ -374,7 +403,8 @@ fn remove<T: Transport>(
     let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();
     let freed = vec![0u8; now.len()];
     let at = installed::flags_address(table, old.slot);
-    write_verified(client, at, &freed, &now, max_writes)?;
+    (writes.before)(client, &writes.found, None)?;
+    write_verified(client, at, &freed, &now, writes.max_writes)?;
     Ok(slots)
 }
 
@@ -390,7 +420,7 @@ fn unlink<T: Transport>(
     profile: &RomProfile,
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     hook: TakenHook,
-    max_writes: u32,
+    writes: &mut Unhooking<'_, '_, T>,
     at_head: bool,
 ) -> Result<Option<Area>> {
     let head = profile.hook_address(hook.kind) + 1;
@@ -422,11 +452,20 @@ fn unlink<T: Transport>(
     )?;
     match chain.last() {
         Some(&(pointer, target)) if target == hook.handler && (at_head || pointer != head) => {
-            write_word_verified(client, pointer, after.to_le_bytes(), max_writes)?;
-            Ok((pointer != head).then(|| Area {
+            let slot = (pointer != head).then(|| Area {
                 address: pointer,
                 bytes: target.to_le_bytes().to_vec(),
-            }))
+            });
+            (writes.before)(client, &writes.found, slot.clone())?;
+            write_word_verified(client, pointer, after.to_le_bytes(), writes.max_writes)?;
+            if pointer == head {
+                for (kind, target) in &mut writes.hooks {
+                    if *kind == hook.kind {
+                        *target = after;
+                    }
+                }
+            }
+            Ok(slot)
         }
         _ => Ok(None),
     }

@@ -17,7 +17,7 @@ use std::time::Duration;
 use isa::objfmt::HookKind;
 use romlib::protocol::{Command, Extension};
 
-use crate::backup::{Backup, Keep, NoKeep};
+use crate::backup::{Backup, EarlyWitnesses, Keep, NoKeep};
 use crate::body::{Body, Limits, RunEnd, Writer};
 use crate::chain;
 use crate::client::{Client, ClientConfig, spans};
@@ -356,12 +356,33 @@ pub fn upload_keeping<T: Transport>(
     }
     // What is installed: an overlap is refused (or, with `replace`, the old
     // extension leaves its chains first, which changes the hooks).
+    // Before `prepare` unhooks anything, the undo file holds the hooks and
+    // the table as found and a witness of the code each hook leads to
+    // (only that: nothing of the image is written before the file is kept
+    // again, whole, in `before_write`), then each chain slot re-pointed.
+    let mut witnesses = EarlyWitnesses::default();
+    let mut slots: Vec<Area> = Vec::new();
+    let mut before_unhook = |client: &mut Client<T>, found: &[Area], slot: Option<Area>| {
+        if !keep.wanted() {
+            return Ok(());
+        }
+        slots.extend(slot);
+        let mut backup = Backup {
+            areas: found.to_vec(),
+            hooks: hooks_now.clone(),
+            rom: crate::backup::profile_rom(profile),
+            ..Backup::default()
+        };
+        overlay(&mut backup.areas, &slots);
+        witnesses.keep(client, (profile, image), backup, keep)
+    };
     let mut plan = table::prepare(
         client,
         profile,
         image,
         options.replace,
         (options.max_writes, &hooks_now),
+        &mut before_unhook,
     )?;
     // What an undo puts back: the hooks and the table as found (the table
     // as `prepare` read it, flags and the entries in use: no more reads).
@@ -377,7 +398,9 @@ pub fn upload_keeping<T: Transport>(
     let unlinked = plan
         .as_ref()
         .map_or_else(Vec::new, |plan| plan.unlinked.clone());
-    if options.replace {
+    if let Some(plan) = plan.as_ref() {
+        hooks_now.clone_from(&plan.hooks);
+    } else if options.replace {
         hooks_now = read_hooks(client, profile)?;
     }
     let others = plan.as_ref().map_or(&[][..], |plan| plan.others.as_slice());
@@ -428,6 +451,16 @@ pub fn upload_keeping<T: Transport>(
                 });
             };
             check_entries_once(client, profile, &mut entries_checked)?;
+            if let Some(kept) = kept.as_ref() {
+                let context = (profile, image);
+                keep_early(
+                    client,
+                    context,
+                    kept,
+                    (&[], &unlinked),
+                    (&mut witnesses, keep),
+                )?;
+            }
             switch_hook(client, address, to, options.max_writes)?;
             progress.event(&Event::HookDisarmed {
                 kind,
@@ -467,6 +500,16 @@ pub fn upload_keeping<T: Transport>(
     if let Some(plan) = plan.as_mut() {
         if plan.frees_first() {
             check_entries_once(client, profile, &mut entries_checked)?;
+            if let Some(kept) = kept.as_ref() {
+                let context = (profile, &image);
+                keep_early(
+                    client,
+                    context,
+                    kept,
+                    (&[], &unlinked),
+                    (&mut witnesses, keep),
+                )?;
+            }
         }
         plan.free_first(client, options.max_writes)?;
         entry = Some(plan.entry_area());
@@ -520,15 +563,16 @@ pub fn upload_keeping<T: Transport>(
         // before the loader is first written.
         running.keep_under = kept.is_some();
         let mut before_write = |client: &mut Client<T>, under: &[Area]| -> Result<()> {
-            if let Some(kept) = kept.as_ref() {
-                let mut early = kept.clone();
-                early.areas.extend_from_slice(under);
-                overlay(&mut early.areas, &unlinked);
-                let ranges = crate::backup::kept_witness_ranges(profile, &early, &image);
-                early.witnesses = crate::backup::read_witnesses(client, &ranges)?;
-                keep.keep(&early);
+            match kept.as_ref() {
+                Some(kept) => keep_early(
+                    client,
+                    (profile, &image),
+                    kept,
+                    (under, &unlinked),
+                    (&mut witnesses, keep),
+                ),
+                None => Ok(()),
             }
-            Ok(())
         };
         let result = running
             .install(client, progress, &mut before_write)
@@ -815,6 +859,24 @@ fn keep_oldest(areas: &mut Vec<Area>, first: usize) {
     }
     areas.truncate(first);
     areas.extend(runs);
+}
+
+/// Hands `keep` what an upload has changed so far, before its next change
+/// and before any byte of the image goes out: `kept` (the hooks and the
+/// table as found) with what the loader overwrote (`under`) and the chain
+/// slots `prepare` re-pointed (`unlinked`). Its witnesses are of the
+/// hooks' windows only: the code they lead to is all as it was.
+fn keep_early<T: Transport>(
+    client: &mut Client<T>,
+    context: (&RomProfile, &UploadImage),
+    kept: &Backup,
+    (under, unlinked): (&[Area], &[Area]),
+    (witnesses, keep): (&mut EarlyWitnesses, &mut dyn Keep),
+) -> Result<()> {
+    let mut early = kept.clone();
+    early.areas.extend_from_slice(under);
+    overlay(&mut early.areas, unlinked);
+    witnesses.keep(client, context, early, keep)
 }
 
 /// Whether `kept` holds all of `area` in one of its areas already.

@@ -361,6 +361,79 @@ fn an_upload_cut_anywhere_leaves_an_undo_that_puts_everything_back() {
     assert!(tried > 5, "cut {tried} times");
 }
 
+/// hostile10's F5: `upload --replace` took the installed extension out of
+/// its chain and freed its entry before any undo file existed; killed
+/// there, the extension was gone and nothing could bring it back. Cut
+/// anywhere, what was kept puts the robot back as it was, the replaced
+/// extension hooked and listed.
+#[test]
+fn a_replace_cut_anywhere_leaves_an_undo_that_puts_the_old_extension_back() {
+    let old = extension(1024, 8);
+    cut_anywhere_then_undo(&old, &one_byte_changed(&old, 1000));
+}
+
+/// The same image again (its hook disarmed first, the RAM loader found
+/// where the first upload left it and hooked): cut anywhere, undone.
+#[test]
+fn the_same_upload_again_cut_anywhere_leaves_an_undo_that_puts_it_back() {
+    let old = extension(1024, 8);
+    cut_anywhere_then_undo(&old, &old);
+}
+
+/// Uploads `old` to a patterned robot, then `new` over it with `replace`,
+/// cutting the line after each of many host characters; whatever was kept
+/// must put the robot back as `old` left it.
+fn cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::UploadImage) {
+    use uploader::transport::{FaultConfig, FaultyTransport};
+    let options = UploadOptions {
+        replace: true,
+        ..UploadOptions::default()
+    };
+    let installed = || {
+        let (transport, _) = patterned_robot();
+        let (result, transport) = common::run(transport, old, &options);
+        result.expect("the first upload");
+        let before = user_memory(transport.robot());
+        (transport, before)
+    };
+    let mut tried = 0;
+    for at in (20..1400).step_by(40) {
+        let (transport, before) = installed();
+        let config = FaultConfig {
+            stall_after: Some(at),
+            stall_for: None,
+            ..FaultConfig::none(5)
+        };
+        let mut client =
+            uploader::client(FaultyTransport::new(transport, config), &options.profile);
+        let mut kept = Kept::default();
+        let result = upload_keeping(&mut client, new, &options, &mut NoProgress, &mut kept);
+        let transport = client.into_transport().into_inner();
+        if result.is_ok() {
+            break;
+        }
+        tried += 1;
+        let changed = user_memory(transport.robot()) != before;
+        let Some(kept) = kept.0 else {
+            assert!(
+                !changed,
+                "cut after {at}: the robot changed and nothing kept"
+            );
+            continue;
+        };
+        let mut client = uploader::client(transport, &options.profile);
+        restore(&mut client, &kept, &options, &mut NoProgress)
+            .unwrap_or_else(|error| panic!("cut after {at}: the undo: {error}"));
+        let after = user_memory(client.transport().robot());
+        assert_eq!(
+            first_difference(&after, &before),
+            None,
+            "cut after {at} host characters"
+        );
+    }
+    assert!(tried > 5, "cut {tried} times");
+}
+
 /// hostile9's F7: an undo cut half way (killed, a dead line) could not be
 /// finished: the table it had put back no longer held the upload's entry,
 /// and the undo file was refused as "no longer on the robot". Cut
