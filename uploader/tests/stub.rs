@@ -394,3 +394,57 @@ fn a_second_attach_writes_none_of_the_stubs_code() {
         "the whole stub as linked"
     );
 }
+
+/// `/1Q` calls a subroutine of the image:
+///
+/// ```text
+/// $0403  CMP #'Q'
+/// $0405  BNE $0400
+/// $0407  JSR $0413      ; show: the breakpoint's JSR displaces this one
+/// $040A  JSR PUTCH
+/// $040D  JSR PUTEOL
+/// $0410  JMP CMD_DONE
+/// $0413  LDA #'T'       ; getval
+/// $0415  RTS
+/// ```
+fn calls_a_subroutine() -> uploader::UploadImage {
+    let mut bytes = vec![
+        0x4C, 0x21, 0xFF, 0xC9, b'Q', 0xD0, 0xF9, 0x20, 0x13, 0x04, 0x20, 0x00, 0xFF, 0x20, 0x09,
+        0xFF, 0x4C, 0x1E, 0xFF, 0xA9, b'T', 0x60,
+    ];
+    bytes.resize(0x81, 0xEA);
+    common::stub::hooked_at_0400(bytes)
+}
+
+/// fresh10 F15: a `JSR` a breakpoint displaced runs from its trampoline,
+/// so the subroutine's `RTS` came back into the stub: the step out
+/// stopped at an address with no name, one more step to get home. The
+/// stop is where the program goes on, after its `JSR`.
+#[test]
+fn a_step_out_of_a_subroutine_called_at_a_breakpoint_stops_after_the_call() {
+    let image = calls_a_subroutine();
+    let mut debug = attach(&image);
+    debug
+        .set_breakpoint(0x0407, &[])
+        .expect("the JSR displaced");
+    let reply = debug.command(b"/1Q", WAIT).expect("sent");
+    let Reply::Stopped(at) = reply else {
+        panic!("no stop: {reply:?}");
+    };
+    assert_eq!(at.pc, 0x0407);
+    let mut pcs = Vec::new();
+    for _ in 0..3 {
+        let Reply::Stopped(after) = debug.step(&[], false, WAIT).expect("step") else {
+            panic!("the step did not stop: {pcs:04X?}");
+        };
+        pcs.push(after.pc);
+    }
+    assert_eq!(pcs, [0x0413, 0x0415, 0x040A], "in, LDA, out: {pcs:04X?}");
+    debug.resume().expect("continue");
+    assert_eq!(
+        debug.wait_event(WAIT).expect("an answer"),
+        Reply::Answer(b"T\r".to_vec())
+    );
+    debug.remove_breakpoint(0x0407).expect("removed");
+    assert_eq!(debug.compare_with_image().expect("read"), None);
+}

@@ -1249,6 +1249,24 @@ impl<T: Transport> RobotDebug<T> {
         Ok(())
     }
 
+    /// The program's address for `pc` in a breakpoint's trampoline: its
+    /// displaced instructions and the `JMP` back stand for the program's
+    /// bytes from the breakpoint on (the `JMP` for the instruction after
+    /// them). A `JSR` a breakpoint displaced runs from the trampoline, so
+    /// its subroutine's `RTS` comes back there (fresh10 F15: a step out of
+    /// it stopped in the stub, at an address with no name); the stop is
+    /// where the program goes on. [`RobotDebug::resume_address`] maps back.
+    fn program_pc(&self, pc: u16) -> u16 {
+        self.breakpoints
+            .values()
+            .find_map(|(patch, slot)| {
+                let offset = pc.checked_sub(self.stub.trampoline(*slot))?;
+                (usize::from(offset) <= patch.displaced.len())
+                    .then(|| patch.address.wrapping_add(offset))
+            })
+            .unwrap_or(pc)
+    }
+
     /// Where the stopped robot goes on: a breakpoint's address is its
     /// trampoline (the displaced instructions, then back).
     fn resume_address(&self, pc: u16) -> u16 {
@@ -1434,8 +1452,10 @@ impl<T: Transport> RobotDebug<T> {
             }
             Step::Host(effects) => {
                 self.apply_as_program(&effects.writes, &what)?;
-                self.put_registers(effects.registers)?;
-                Ok(Some(Reply::Stopped(effects.registers)))
+                let mut registers = effects.registers;
+                registers.pc = self.program_pc(registers.pc);
+                self.put_registers(registers)?;
+                Ok(Some(Reply::Stopped(registers)))
             }
         }
     }
