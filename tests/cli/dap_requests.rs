@@ -175,6 +175,8 @@ fn initialize_advertises_exactly_the_requests_answered() {
         .collect();
     assert_eq!(filters, ["jam", "brk", "card"]);
     assert_eq!(c.request("terminate", json!({}))["success"], true);
+    // The client is told the debuggee ended (fresh11's nit: it was not).
+    assert_eq!(c.event("terminated")["event"], "terminated");
     assert!(c.ends());
 }
 

@@ -217,7 +217,14 @@ impl RobotSession {
             After::Run => self.running = true,
             After::Heard(heard, reason) => self.heard(outbox, &heard, reason)?,
             After::Configured => self.configured(outbox)?,
-            After::Exit => return Ok(false),
+            After::Exit => {
+                // `terminate` ends the debuggee; the client is told so
+                // (a `disconnect` needs no event).
+                if request.command == "terminate" {
+                    outbox.event("terminated", None)?;
+                }
+                return Ok(false);
+            }
         }
         Ok(true)
     }

@@ -263,7 +263,14 @@ impl Session {
             Then::NothingBefore => {
                 self.stopped("step", Some("no breakpoint was hit before here".into()))?;
             }
-            Then::Exit => return Ok(false),
+            Then::Exit => {
+                // `terminate` ends the debuggee; the client is told so
+                // (a `disconnect` needs no event).
+                if request.command == "terminate" {
+                    self.outbox.event("terminated", None)?;
+                }
+                return Ok(false);
+            }
         }
         Ok(true)
     }
