@@ -549,7 +549,8 @@ impl RobotMonitor {
                 "`{name}` is no register or flag: A X Y S P PC C Z I D V N"
             ))
         })?;
-        let mut registers = stopped(d, "set")?;
+        let old = stopped(d, "set")?;
+        let mut registers = old;
         let expr = self.parse(&value.join(" "))?;
         let value = self.eval(d, &expr)?;
         let value = u16::try_from(value)
@@ -563,7 +564,9 @@ impl RobotMonitor {
             a: cpu.a,
             x: cpu.x,
             y: cpu.y,
-            p: cpu.p(),
+            // B and the unused bit as the stop had them (PHP's): they are
+            // no flags, and `set P` leaves them as shown.
+            p: (cpu.p() & !0x30) | (old.p & 0x30),
             s: cpu.s,
         };
         d.set_registers(registers).map_err(failure)?;

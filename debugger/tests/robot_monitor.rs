@@ -243,3 +243,23 @@ fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
     assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 2, $040B"));
     assert!(text(&mut m, &mut d, "continue").contains("V01"));
 }
+
+/// fresh11's nit: at a stop P shows B and the unused bit as the stub's
+/// `PHP` pushed them ($30); `set P $01` showed $21, `set P $31` too. They
+/// are no flags: `set` leaves them as the stop showed them.
+#[test]
+fn set_p_keeps_b_as_the_stop_showed_it() {
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $040C");
+    assert!(text(&mut m, &mut d, "/1Q").contains("stopped: breakpoint 1, $040C"));
+    let p = |text: &str| text.split("P=").nth(1).map(|p| p[..3].to_owned());
+    let shown = p(&text(&mut m, &mut d, "regs")).expect("P");
+    assert_eq!(&shown[..2], "$3", "B and the unused bit at a stop: {shown}");
+    assert_eq!(
+        p(&text(&mut m, &mut d, "set P $01")).as_deref(),
+        Some("$31")
+    );
+    assert_eq!(p(&text(&mut m, &mut d, "regs")).as_deref(), Some("$31"));
+    assert_eq!(p(&text(&mut m, &mut d, "set C 0")).as_deref(), Some("$30"));
+    assert!(text(&mut m, &mut d, "continue").contains("Q42"));
+}
