@@ -268,6 +268,14 @@ impl RobotMonitor {
         .then(|| verb.to_owned());
         let rest: Vec<&str> = words.collect();
         let after = line[verb.len()..].trim();
+        // A command that needs a stop, while the robot seems to run: the
+        // stop's frame may have been lost on the line. Looked for (one
+        // frame to the stub), told first, then the command runs.
+        let mut found = String::new();
+        if NEEDS_A_STOP.contains(&verb) && d.stopped().is_none() {
+            d.look_for_stop().map_err(failure)?;
+            found = self.with_unasked(d, found)?;
+        }
         let text = match verb {
             "help" | "h" | "?" => format!("{HELP}\n"),
             "quit" | "q" | "exit" => return Ok(Reply::Quit),
@@ -383,7 +391,7 @@ impl RobotMonitor {
                 )));
             }
         };
-        Ok(Reply::Text(self.with_unasked(d, text)?))
+        Ok(Reply::Text(found + &self.with_unasked(d, text)?))
     }
 
     /// `text`, then the stop that came while the command was busy on the
@@ -757,6 +765,13 @@ pub fn show_registers(r: &Registers) -> String {
         r.pc, r.a, r.x, r.y, r.s, r.p
     )
 }
+
+/// The commands that need the robot stopped: before them a stop whose
+/// frame was lost is looked for.
+const NEEDS_A_STOP: [&str; 14] = [
+    "continue", "c", "run", "step", "s", "stepi", "si", "next", "n", "nexti", "ni", "regs", "r",
+    "set",
+];
 
 fn stopped<T: Transport>(d: &RobotDebug<T>, what: &str) -> Result<Registers, Failure> {
     d.stopped().ok_or_else(|| {

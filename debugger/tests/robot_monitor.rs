@@ -263,3 +263,37 @@ fn set_p_keeps_b_as_the_stop_showed_it() {
     assert_eq!(p(&text(&mut m, &mut d, "set C 0")).as_deref(), Some("$30"));
     assert!(text(&mut m, &mut d, "continue").contains("Q42"));
 }
+
+/// hostile10 F8: a stop whose frame was lost on the line (here read and
+/// thrown away, as a dropped byte garbles it) left the monitor taking the
+/// robot for running: `regs`, `step` and `continue` were refused. Before a
+/// command that needs a stop the monitor asks the stub, tells the stop,
+/// and runs the command.
+#[test]
+fn a_stop_whose_frame_was_lost_is_found_before_a_command_that_needs_one() {
+    use uploader::Transport as _;
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $040C");
+    d.client().transport().send(b"/1Q").expect("sent");
+    let mut lost = Vec::new();
+    while d
+        .client()
+        .transport()
+        .receive(&mut lost, std::time::Duration::from_millis(300))
+        .expect("the line")
+        > 0
+    {}
+    assert!(
+        lost.contains(&0xF0),
+        "the stop frame came and was lost: {lost:02X?}"
+    );
+    let shown = text(&mut m, &mut d, "regs");
+    assert!(
+        shown.contains("(a stop not asked for) stopped: breakpoint 1, $040C"),
+        "{shown}"
+    );
+    assert!(shown.contains("PC=$040C"), "{shown}");
+    // The `Q` went with the lost frame; the rest of the answer comes.
+    let shown = text(&mut m, &mut d, "continue");
+    assert!(shown.contains("answer: 42"), "{shown}");
+}

@@ -471,6 +471,29 @@ impl<T: Transport> RobotDebug<T> {
         Ok(None)
     }
 
+    /// Looks for a stop the host did not hear (its frame lost on a noisy
+    /// line): while the host takes the robot for running, one frame to the
+    /// stub, which only a stopped stub answers. A stop found is kept to be
+    /// told ([`RobotDebug::take_unasked`]) and the step's temporary
+    /// breakpoints come out, as at any stop (hostile10 F8: `regs`, `step`
+    /// and `continue` were refused as "running" at a stop whose frame lost
+    /// a byte).
+    ///
+    /// # Errors
+    /// The line's errors; a stop in another stub.
+    pub fn look_for_stop(&mut self) -> StubResult<Option<Registers>> {
+        if let Some(registers) = self.stopped {
+            return Ok(Some(registers));
+        }
+        let Some(registers) = self.probe_stopped()? else {
+            return Ok(None);
+        };
+        self.stopped = Some(registers);
+        self.drop_temporary()?;
+        self.unasked = Some(registers);
+        Ok(Some(registers))
+    }
+
     /// Whether the robot is stopped in this stub: its registers.
     fn probe_stopped(&mut self) -> StubResult<Option<Registers>> {
         match self.probe()? {
