@@ -488,9 +488,7 @@ impl<T: Transport> RobotDebug<T> {
         let Some(registers) = self.probe_stopped()? else {
             return Ok(None);
         };
-        self.stopped = Some(registers);
-        self.drop_temporary()?;
-        self.unasked = Some(registers);
+        self.found_stop(registers)?;
         Ok(Some(registers))
     }
 
@@ -884,15 +882,31 @@ impl<T: Transport> RobotDebug<T> {
     /// stopped, else staged in the stub, read back, and copied by `/1@`.
     /// Reads them back either way.
     fn patch(&mut self, address: u16, bytes: [u8; 3]) -> StubResult<()> {
-        if self.stopped.is_none() {
-            match self.patch_running(address, bytes) {
-                // Stopped on the way (by this very patch, it may be): the
-                // bytes go in through the stub, in one frame.
-                Err(error) => self.caught(error)?,
-                done => return done,
-            }
+        // Stopped on the way (by this very patch, it may be): the bytes go
+        // in through the stub, in one frame.
+        if let Some(()) = self.while_running(|d| d.patch_running(address, bytes))? {
+            return Ok(());
         }
         self.write_verified(address, &bytes)
+    }
+
+    /// `running` done while the robot runs, when it does: `None` when it
+    /// is stopped, or a stop came on the way ([`RobotDebug::caught`]), for
+    /// the caller to do it through the stub instead.
+    fn while_running<R>(
+        &mut self,
+        running: impl FnOnce(&mut Self) -> StubResult<R>,
+    ) -> StubResult<Option<R>> {
+        if self.stopped.is_some() {
+            return Ok(None);
+        }
+        match running(self) {
+            Ok(done) => Ok(Some(done)),
+            Err(error) => {
+                self.caught(error)?;
+                Ok(None)
+            }
+        }
     }
 
     /// [`RobotDebug::patch`] while the robot runs.
@@ -935,12 +949,8 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// [`StubError::Verify`], the line's errors.
     pub fn write_verified(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
-        if self.stopped.is_none() {
-            match self.rom_write_verified(address, bytes) {
-                // Stopped on the way: written through the stub below.
-                Err(error) => self.caught(error)?,
-                done => return done,
-            }
+        if let Some(()) = self.while_running(|d| d.rom_write_verified(address, bytes))? {
+            return Ok(());
         }
         for (i, part) in bytes.chunks(IN_MAX - 4).enumerate() {
             let at = address.wrapping_add((i * (IN_MAX - 4)) as u16);
@@ -969,11 +979,8 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// The line's errors, a garbled reply.
     pub fn read(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
-        if self.stopped.is_none() {
-            match self.client.read_memory(address, len) {
-                Err(error) => self.caught(error.into())?,
-                done => return Ok(done?),
-            }
+        if let Some(bytes) = self.while_running(|d| Ok(d.client.read_memory(address, len)?))? {
+            return Ok(bytes);
         }
         let mut out = Vec::with_capacity(len);
         while out.len() < len {
@@ -1093,6 +1100,13 @@ impl<T: Transport> RobotDebug<T> {
         let Some(registers) = self.probe_stopped()? else {
             return Err(error);
         };
+        self.found_stop(registers)
+    }
+
+    /// A stop the host came upon rather than waited for: the robot is
+    /// stopped from now on, the stop kept to be told, and a step's
+    /// temporary breakpoints taken out, as at any stop.
+    fn found_stop(&mut self, registers: Registers) -> StubResult<()> {
         self.stopped = Some(registers);
         self.unasked = Some(registers);
         self.drop_temporary()
