@@ -39,8 +39,9 @@ pub(crate) struct Args {
     #[command(flatten)]
     line: ports::Line,
     /// Commands and the answers they must produce (`/1Q => QHELLO`, one a
-    /// line, `#` comments): checked on the rehearsal, and with `--port emu`
-    /// again after the upload.
+    /// line, `#` comments): checked on the rehearsal (a virtual Scorpion
+    /// with this image alone; never sent to a real robot), and with
+    /// `--port emu` again after the upload.
     #[arg(long, value_name = "FILE")]
     expect: Option<PathBuf>,
     /// Skip the rehearsal on the virtual Scorpion.
@@ -356,6 +357,25 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
     text
 }
 
+/// A note for each hook the image falls through to another extension
+/// on: the rehearsal's robot had this image alone, so the expectations
+/// were met without the extensions chained behind it on the robot
+/// (fresh10 F11: `/1W => nothing` passed, and the robot answered `W99`).
+fn others_not_rehearsed(report: &uploader::UploadReport, profile: &uploader::RomProfile) -> String {
+    let mut text = String::new();
+    for hook in &report.hooks {
+        if profile.reset_target(hook.kind) != Some(hook.previous) {
+            let _ = writeln!(
+                text,
+                "note: on the robot {} falls through to ${:04X}, another extension the rehearsal did not have: the expectations were met without it",
+                hook.kind.rom_symbol(),
+                hook.previous
+            );
+        }
+    }
+    text
+}
+
 /// `--fast-baud`: 0, or a rate the robot's 6551 runs at (hostile10 F15:
 /// `--fast-baud 1` was taken, and the upload said "at 19200 baud").
 fn fast_baud(text: &str) -> Result<u32, String> {
@@ -523,6 +543,13 @@ fn upload_file(
     let baud = resolved.baud.value;
     let emulated = resolved.is_emulated();
     let mut out = String::new();
+    // fresh10 F11: the pair uploaded with a zero exit and nothing checked.
+    if args.no_dry_run && expectations.is_some() && !emulated {
+        return Err(miette::miette!(
+            help = "drop --no-dry-run to check them on the rehearsal, or drop --expect; nothing was sent to the robot",
+            "--expect is checked on the rehearsal, which --no-dry-run skips (expectations are never sent to a real robot)"
+        ));
+    }
 
     // The rehearsal: the same upload into a virtual Scorpion, then the
     // expectations, before the robot is touched. (Into `emu` without
@@ -605,6 +632,9 @@ fn upload_file(
     }
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
+    if !emulated && expectations.is_some() {
+        out.push_str(&others_not_rehearsed(&report, profile));
+    }
     if emulated && let Some(expectations) = &expectations {
         let lines = check_expectations(
             expectations,

@@ -48,6 +48,20 @@ impl Drop for Sim {
     }
 }
 
+/// examples/patrol (an OS with both hooks) copied into `dir` and uploaded
+/// to a fresh pty robot: the project's directory and the robot.
+pub(crate) fn patrol_on_a_pty_robot(dir: &std::path::Path) -> (std::path::PathBuf, Sim) {
+    let project = dir.join("patrol");
+    crate::copy_dir(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol"),
+        &project,
+    );
+    let sim = Sim::start(dir, &[]);
+    let output = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    (project, sim)
+}
+
 /// An extension of `len` bytes at $0400 (`JMP chain`, a handler that falls
 /// through, filler), with the byte at `changed` (if any) altered.
 fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
@@ -555,4 +569,52 @@ fn a_second_reader_on_the_port_does_not_hang_a_command() {
     let _ = thief.kill();
     let _ = thief.wait();
     assert_ne!(asked.status.code(), Some(124), "{}", transcript(&asked));
+}
+
+/// fresh10 F11: `--expect` on a port is checked on a rehearsal with the
+/// image alone; where the image chains to another extension on the robot,
+/// the upload says the expectations were met without it. And with
+/// `--no-dry-run` they would be checked nowhere: refused.
+#[test]
+fn expectations_on_a_port_say_what_the_rehearsal_lacked() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    std::fs::write(dir.path().join("a.elf"), extension_at(0x0400, 64, None)).expect("an image");
+    std::fs::write(dir.path().join("b.elf"), extension_at(0x0600, 64, None)).expect("an image");
+    std::fs::write(dir.path().join("ok.expect"), "/1X => X00\n").expect("expectations");
+    let sim = Sim::start(dir.path(), &[]);
+    let port = sim.path.as_str();
+    let output = scorpion(
+        dir.path(),
+        &["upload", "a.elf", "--no-dry-run", "--port", port],
+    );
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion(
+        dir.path(),
+        &["upload", "b.elf", "--expect", "ok.expect", "--port", port],
+    );
+    let text = transcript(&output);
+    assert!(output.status.success(), "{text}");
+    assert!(
+        text.contains("note: on the robot HOOK_UNKNOWN falls through to $0403, another extension the rehearsal did not have"),
+        "{text}"
+    );
+    let output = scorpion(
+        dir.path(),
+        &[
+            "upload",
+            "b.elf",
+            "--expect",
+            "ok.expect",
+            "--no-dry-run",
+            "--replace",
+            "--port",
+            port,
+        ],
+    );
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("--expect is checked on the rehearsal, which --no-dry-run skips"),
+        "{text}"
+    );
 }

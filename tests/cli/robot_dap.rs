@@ -449,14 +449,7 @@ fn an_editor_gone_without_disconnect_lets_the_robot_go() {
 #[test]
 fn a_breakpoint_in_the_control_loops_handler_stops_there_in_an_editor() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    let project = dir.path().join("patrol");
-    crate::copy_dir(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol"),
-        &project,
-    );
-    let sim = Sim::start(dir.path(), &[]);
-    let output = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
-    assert!(output.status.success(), "{}", transcript(&output));
+    let (project, sim) = crate::robot::patrol_on_a_pty_robot(dir.path());
     let source = project.join("patrol.s");
     let line = std::fs::read_to_string(&source)
         .expect("the source")

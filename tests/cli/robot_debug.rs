@@ -440,14 +440,7 @@ count:  .res 1
 #[test]
 fn a_breakpoint_in_the_control_loops_handler_stops_there_and_quit_lets_go() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    let project = dir.path().join("patrol");
-    crate::copy_dir(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/patrol"),
-        &project,
-    );
-    let sim = Sim::start(dir.path(), &[]);
-    let output = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
-    assert!(output.status.success(), "{}", transcript(&output));
+    let (project, sim) = crate::robot::patrol_on_a_pty_robot(dir.path());
     let output = scorpion_with_input(
         Some(&project),
         &["debug", "--port", &sim.path],
