@@ -141,3 +141,146 @@ fn lost_bytes_leave_nothing_unverified_reached() {
     }
     assert!(finished > 0, "no session got through the noise");
 }
+
+/// A line that garbles the `@` answering each `/1@` (the robot obeyed it).
+struct GarbledCopy {
+    inner: VirtualTransport,
+    garble: bool,
+}
+
+impl Transport for GarbledCopy {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        if bytes.windows(3).any(|w| w == b"/1@") {
+            self.garble = true;
+        }
+        self.inner.send(bytes)
+    }
+    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
+        let start = into.len();
+        let n = self.inner.receive(into, timeout)?;
+        if self.garble
+            && let Some(at) = into[start..].iter().position(|&b| b == b'@')
+        {
+            into[start + at] = 0;
+            self.garble = false;
+        }
+        Ok(n)
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn now(&self) -> Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        self.inner.clear_input()
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+}
+
+/// hostile10 F13: a garbled answer to the `/1@` that put a breakpoint's
+/// `JSR` in ended `break` with an error, the `JSR` in the code and no
+/// record of it: every `continue` stopped there again and `quit` left it
+/// in, the robot stopped. The read back tells: the breakpoint is set.
+#[test]
+fn a_garbled_answer_to_the_copy_of_a_patch_is_not_taken_for_a_failure() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let transport = GarbledCopy {
+        inner: robot(&image),
+        garble: false,
+    };
+    let client = uploader::client(transport, &profile);
+    let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    debug
+        .set_breakpoint(0x040C, &[])
+        .expect("set, the answer garbled");
+    let reply = debug.command(b"/1Q", Duration::from_secs(1)).expect("sent");
+    assert!(
+        matches!(reply, uploader::stub::Reply::Stopped(r) if r.pc == 0x040C),
+        "{reply:?}"
+    );
+    debug.remove_breakpoint(0x040C).expect("removed");
+    debug.resume().expect("goes on");
+    let client = debug.detach().expect("detached");
+    let _ = client;
+}
+
+/// A line that loses the start of the `n`th go-on (`C`) frame.
+struct LostGoOn {
+    inner: VirtualTransport,
+    seen: u32,
+    lose: u32,
+}
+
+impl Transport for LostGoOn {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        if bytes.first() == Some(&0xF1) && bytes.get(1..5) == Some(b"0343") {
+            self.seen += 1;
+            if self.seen == self.lose {
+                return self.inner.send(&bytes[1..]);
+            }
+        }
+        self.inner.send(bytes)
+    }
+    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
+        self.inner.receive(into, timeout)
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn now(&self) -> Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        self.inner.clear_input()
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+}
+
+/// hostile10 F8: after a step done on the host (`LDA $0480` at the
+/// breakpoint), the `C` frame lost: the robot stays stopped. The stop
+/// found then is where the host had the robot, after the `LDA`, with its
+/// A; going on from there answers once.
+#[test]
+fn a_lost_go_on_after_a_step_leaves_the_stop_where_the_host_had_it() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let transport = LostGoOn {
+        inner: robot(&image),
+        seen: 0,
+        lose: 1,
+    };
+    let client = uploader::client(transport, &profile);
+    let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    debug.set_breakpoint(0x040C, &[]).expect("set");
+    let wait = Duration::from_secs(1);
+    assert!(matches!(
+        debug.command(b"/1Q", wait).expect("sent"),
+        uploader::stub::Reply::Stopped(r) if r.pc == 0x040C
+    ));
+    let stepped = debug.step(&[], false, wait).expect("LDA on the host");
+    assert!(
+        matches!(stepped, uploader::stub::Reply::Stopped(r) if r.pc == 0x040F && r.a == 0x42),
+        "{stepped:?}"
+    );
+    debug.resume().expect("the C goes out, and is lost");
+    assert_eq!(
+        debug.wait_event(wait).expect("the line"),
+        uploader::stub::Reply::Silent
+    );
+    let found = debug
+        .look_for_stop()
+        .expect("the line")
+        .expect("still stopped");
+    assert_eq!((found.pc, found.a), (0x040F, 0x42), "{found:?}");
+    debug.resume().expect("goes on");
+    assert_eq!(
+        debug.wait_event(wait).expect("an answer"),
+        uploader::stub::Reply::Answer(b"Q42\r".to_vec())
+    );
+}

@@ -13,6 +13,16 @@ pub const SOF_IN: u8 = 0xF1;
 /// The longest payload the stub takes (`BUFLEN` in `stub.s`).
 pub const IN_MAX: usize = 40;
 
+/// The most bytes the host asks the stub for in one read.
+pub const READ_MAX: usize = 64;
+
+/// The longest payload from the stub: `M`, the address and a read of
+/// [`READ_MAX`] bytes (a stop is 8, a NAK 1). Each starts with `M`, `S`
+/// or `N`, all above it: a frame whose length byte was lost claims more,
+/// and is taken for noise at once rather than waited for while it
+/// swallows the frames after it (hostile10 F13).
+pub const OUT_MAX: usize = 3 + READ_MAX;
+
 /// A frame to the stub carrying `payload` (1 to [`IN_MAX`] bytes):
 /// [`SOF_IN`], then the length, the payload and the sum, each byte as two
 /// upper-case hex digits (so a frame never holds a slash, and a robot not
@@ -52,16 +62,26 @@ pub fn take(rx: &mut Vec<u8>) -> Option<Heard> {
     let first = *rx.first()?;
     if first == SOF_OUT {
         let len = usize::from(*rx.get(1)?);
+        if len == 0 || len > OUT_MAX {
+            return Some(Heard::BadFrame(rx.drain(..1).collect()));
+        }
         if rx.len() < len + 3 {
             return None;
         }
-        let bytes: Vec<u8> = rx.drain(..len + 3).collect();
-        let sum = bytes[1..].iter().fold(0u8, |sum, &b| sum.wrapping_add(b));
-        return Some(if sum == 0 {
-            Heard::Frame(bytes[2..2 + len].to_vec())
-        } else {
-            Heard::BadFrame(bytes)
-        });
+        let sum = rx[1..len + 3]
+            .iter()
+            .fold(0u8, |sum, &b| sum.wrapping_add(b));
+        if sum == 0 {
+            let bytes: Vec<u8> = rx.drain(..len + 3).collect();
+            return Some(Heard::Frame(bytes[2..2 + len].to_vec()));
+        }
+        // A byte lost here made this frame take in the start of the next:
+        // that one is read from its own start.
+        let cut = rx[1..len + 3]
+            .iter()
+            .position(|&b| b == SOF_OUT)
+            .map_or(len + 3, |at| at + 1);
+        return Some(Heard::BadFrame(rx.drain(..cut).collect()));
     }
     // Text runs to its carriage return, or to a frame's start (the answer
     // lost its end).
@@ -70,4 +90,69 @@ pub fn take(rx: &mut Vec<u8>) -> Option<Heard> {
         return Some(Heard::Text(rx.drain(..end).collect()));
     }
     Some(Heard::Text(rx.drain(..=end).collect()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `M`, $0418 and one byte ($42), as the stub sends it.
+    fn reply() -> Vec<u8> {
+        let payload = [b'M', 0x18, 0x04, 0x42];
+        let sum = payload
+            .iter()
+            .fold(4u8, |sum, &b| sum.wrapping_add(b))
+            .wrapping_neg();
+        let mut frame = vec![SOF_OUT, 4];
+        frame.extend_from_slice(&payload);
+        frame.push(sum);
+        frame
+    }
+
+    fn heard(mut rx: Vec<u8>) -> Vec<Heard> {
+        std::iter::from_fn(|| take(&mut rx)).collect()
+    }
+
+    #[test]
+    fn a_whole_frame_and_an_answer_are_told_apart() {
+        let mut rx = reply();
+        rx.extend_from_slice(b"Q42\r");
+        assert_eq!(
+            heard(rx),
+            [
+                Heard::Frame(vec![b'M', 0x18, 0x04, 0x42]),
+                Heard::Text(b"Q42\r".to_vec())
+            ]
+        );
+    }
+
+    /// hostile10 F13: the length byte lost, `M` (77) was taken for the
+    /// length, and the replies to the next ten requests were swallowed
+    /// waiting for 80 bytes.
+    #[test]
+    fn a_frame_that_lost_its_length_does_not_swallow_the_next() {
+        let mut rx = reply();
+        rx.remove(1);
+        rx.extend(reply());
+        let heard = heard(rx);
+        assert_eq!(
+            heard.last(),
+            Some(&Heard::Frame(vec![b'M', 0x18, 0x04, 0x42])),
+            "{heard:?}"
+        );
+    }
+
+    /// A byte lost inside: the frame's sum took the next frame's start.
+    #[test]
+    fn a_frame_that_lost_a_byte_inside_does_not_swallow_the_next() {
+        let mut rx = reply();
+        rx.remove(4);
+        rx.extend(reply());
+        let heard = heard(rx);
+        assert_eq!(
+            heard.last(),
+            Some(&Heard::Frame(vec![b'M', 0x18, 0x04, 0x42])),
+            "{heard:?}"
+        );
+    }
 }
