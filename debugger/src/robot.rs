@@ -217,11 +217,23 @@ impl RobotMonitor {
             .flatten();
         match (failure(error), instead) {
             (Failure::Usage(said), Some(instead)) => Failure::Usage(format!(
-                "{said}\n  the nearest instruction after it that takes one: {} (`break ${instead:04X}`)",
-                self.place(instead)
+                "{said}\n  the nearest instruction after it that takes one: {}{} (`break ${instead:04X}`)",
+                self.place(instead),
+                self.user_line(instead)
             )),
             (other, _) => other,
         }
+    }
+
+    /// ` at FILE:LINE`, the user's source line `address` came from (not a
+    /// built-in include's); empty where none did.
+    fn user_line(&self, address: u16) -> String {
+        let is_users = |file: &str| hostfs::is_users_source(&self.root, file);
+        self.images
+            .iter()
+            .find_map(|image| image.user_source_of(u32::from(address), &is_users))
+            .map(|(file, line)| format!(" at {file}:{line}"))
+            .unwrap_or_default()
     }
 
     /// The name of `address` (a label or a source line), for a frame.
@@ -477,13 +489,7 @@ impl RobotMonitor {
                     .unwrap_or_default();
                 // The source line too (fresh11 F7): `list` and `bt` are
                 // refused on the robot, so the stop says where it is.
-                let is_users = |file: &str| hostfs::is_users_source(&self.root, file);
-                let line = self
-                    .images
-                    .iter()
-                    .find_map(|image| image.user_source_of(u32::from(registers.pc), &is_users))
-                    .map(|(file, line)| format!(" at {file}:{line}"))
-                    .unwrap_or_default();
+                let line = self.user_line(registers.pc);
                 format!(
                     "stopped: {id}{}{line}\n  {}\n",
                     self.place(registers.pc),

@@ -222,7 +222,12 @@ fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
     let mut m = RobotMonitor::new(symbols, images);
 
     // The branches (and so the handler's first two lines) still cannot be.
-    assert!(refusal(&mut m, &mut d, "break handler").contains("branch"));
+    let refused = refusal(&mut m, &mut d, "break handler");
+    assert!(refused.contains("branch"), "{refused}");
+    assert!(
+        refused.contains("that takes one: $0408 (handler+$8) at new.s:10"),
+        "the line to break on instead: {refused}"
+    );
     text(&mut m, &mut d, "break handler+8");
     assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 1, $0408"));
     let shown = text(&mut m, &mut d, "step");
