@@ -640,8 +640,11 @@ fn test_on_a_port_keeps_the_projects_undo_file() {
     let sim = Sim::start(dir.path(), &[]);
     let line = ["--port", sim.path.as_str()];
     let before = ok(&project, &line, &["read", "$0200", "3"]);
-    let tested = ok(&project, &line, &["test"]);
+    let tested = ok(&project, &line, &["test", "--timing"]);
     assert!(tested.contains("upload myext ... ok"), "{tested}");
+    // The rehearsal's figures are said to be its, beside the robot's.
+    assert!(tested.contains("transcripts rehearsed: "), "{tested}");
+    assert!(tested.contains("; on the robot: "), "{tested}");
     let undo = project.join("target/scorpion/last-upload.undo");
     assert!(undo.is_file(), "{tested}");
     assert!(

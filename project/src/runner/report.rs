@@ -114,6 +114,9 @@ pub struct Report {
     pub robot_time: Duration,
     /// Wall time they took (robots set up and images loaded included).
     pub wall_time: Duration,
+    /// With a port: the wall time the transcripts took on the robot there
+    /// (the two above are the rehearsal's).
+    pub port_time: Option<Duration>,
 }
 
 impl Report {

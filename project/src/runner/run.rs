@@ -686,6 +686,7 @@ impl Run<'_, '_, '_> {
         } else {
             Clock::Line
         };
+        let started = Instant::now();
         for path in project.transcripts() {
             let name = format!("transcript {}", relative(project, &path));
             if !self.selects(&name) {
@@ -697,6 +698,7 @@ impl Run<'_, '_, '_> {
             let result = run_transcript(project, &path, &mut client, clock, None, &mut Vec::new());
             self.record_result(&name, result.map(|()| Passed::Ok));
         }
+        *self.report.port_time.get_or_insert_default() += started.elapsed();
         Ok(())
     }
 }
