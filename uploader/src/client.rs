@@ -89,6 +89,9 @@ pub struct Client<T> {
     host_free: Duration,
     robot_free: Duration,
     last_rx: Duration,
+    /// Questions were lost since the last byte came: asking again keeps
+    /// the stall's clock running.
+    losing: bool,
     stats: ClientStats,
     /// Whether the debug stub's stop frame was heard since the exchange
     /// began: a breakpoint in code the robot runs on its own (a
@@ -123,6 +126,7 @@ impl<T: Transport> Client<T> {
             host_free: now,
             robot_free: now,
             last_rx: now,
+            losing: false,
             stats: ClientStats::default(),
             heard_stop: false,
         }
@@ -178,6 +182,7 @@ impl<T: Transport> Client<T> {
         let count = self.transport.receive(&mut self.rx, timeout)?;
         if count > 0 {
             self.last_rx = self.transport.now();
+            self.losing = false;
             self.stats.received += count;
             // The frame's start may have come with the last bytes.
             self.heard_stop |= stopped_in_stub(&self.rx[before.saturating_sub(2)..]);
@@ -236,6 +241,13 @@ impl<T: Transport> Client<T> {
     /// Sends a `/7R` question into the pipeline; its answer comes back
     /// through [`Client::poll`].
     pub(crate) fn ask_read(&mut self, span: ReadSpan) -> Result<u64> {
+        // A stall is a wait with answers due: it starts with the first
+        // question after a quiet spell, not at the last byte this client
+        // read (the debug stub's frames are read past it, for minutes
+        // maybe); questions asked again after losses keep its clock.
+        if self.in_flight.is_empty() && !self.losing {
+            self.last_rx = self.last_rx.max(self.transport.now());
+        }
         let command = Command::ReadMemory(span);
         let bytes = command.encode();
         self.send_raw(&bytes)?;
@@ -281,6 +293,7 @@ impl<T: Transport> Client<T> {
             }
             self.in_flight.pop_front();
             self.stats.lost += 1;
+            self.losing = true;
             outcomes.push(Outcome::Lost {
                 span: oldest.span,
                 tag: oldest.tag,

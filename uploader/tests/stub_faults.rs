@@ -284,3 +284,63 @@ fn a_lost_go_on_after_a_step_leaves_the_stop_where_the_host_had_it() {
         uploader::stub::Reply::Answer(b"Q42\r".to_vec())
     );
 }
+
+/// A line that loses one character of the first `/7R` for the hooks.
+struct LostDigit {
+    inner: VirtualTransport,
+    done: bool,
+}
+
+impl Transport for LostDigit {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        if !self.done && bytes.starts_with(b"/7R0200") {
+            self.done = true;
+            let mut cut = bytes.to_vec();
+            cut.remove(4);
+            return self.inner.send(&cut);
+        }
+        self.inner.send(bytes)
+    }
+    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
+        self.inner.receive(into, timeout)
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn now(&self) -> Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        self.inner.clear_input()
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+}
+
+/// A `/7R` that lost a digit leaves the ROM waiting for the rest: the
+/// question is asked again, not waited on until the line is called
+/// stalled. Even after a long debug session whose frames the client did
+/// not read itself (hostile10 F13: `quit` said "nothing received for
+/// 8.25 s" at the first question after the robot went on).
+#[test]
+fn a_read_that_lost_a_digit_is_asked_again() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let mut client = uploader::client(
+        LostDigit {
+            inner: robot(&image),
+            done: false,
+        },
+        &profile,
+    );
+    // Ten seconds on the line, read past the client (as the stub's frames
+    // are).
+    let mut elsewhere = Vec::new();
+    client
+        .transport()
+        .receive(&mut elsewhere, Duration::from_secs(10))
+        .expect("the line");
+    let hook = client.read_memory(0x0200, 3).expect("read again");
+    assert_eq!(hook[0], 0x4C);
+}
