@@ -299,11 +299,14 @@ impl RobotMonitor {
                     return Err(usage("delete N (watchpoints are refused on the robot)"));
                 };
                 let id: u32 = n.parse().map_err(|_| usage("delete N"))?;
-                let address = self
+                let address = *self
                     .breakpoints
-                    .remove(&id)
+                    .get(&id)
                     .ok_or_else(|| usage(&format!("no breakpoint {id}")))?;
+                // Forgotten once out: a removal the line cut short leaves it
+                // listed, to be deleted again (or taken out at `quit`).
                 d.remove_breakpoint(address).map_err(failure)?;
+                self.breakpoints.remove(&id);
                 format!("deleted breakpoint {id}: ${address:04X} holds the image's bytes again\n")
             }
             "info" => {
