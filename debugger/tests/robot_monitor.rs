@@ -168,25 +168,6 @@ fn an_empty_line_repeats_the_last_step() {
     assert_eq!(text(&mut m, &mut d, ""), "");
 }
 
-/// `scorpion new`'s handler, as the template writes it.
-const NEW_HANDLER: &str = "        .include \"scorpion.inc\"
-VERSION = $01
-        .code
-        SCORPION_UNKNOWN_HANDLER
-handler:
-        cpx #1
-        bne not_mine
-        cmp #'V'
-        bne not_mine
-        jsr PUTCH
-        lda #VERSION
-        jsr PUTHEX
-        jsr PUTEOL
-        jmp CMD_DONE
-not_mine:
-        SCORPION_CHAIN_UNKNOWN
-";
-
 /// fresh10 F4b: in the template's handler only `jsr PUTCH` took a
 /// breakpoint (every instruction starts a source line, and each line was
 /// taken for a jump target), so no step could leave it. A `JSR` may cover
@@ -196,6 +177,10 @@ not_mine:
 #[test]
 fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
     use std::collections::BTreeMap;
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let root = dir.path().join("new");
+    scorpion_project::template::create(&root, "new", scorpion_project::template::Kind::Extension)
+        .expect("the template");
     let options = assembler::Options {
         builtin_includes: BTreeMap::from([(
             "scorpion.inc".to_owned(),
@@ -203,7 +188,8 @@ fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
         )]),
         ..assembler::Options::default()
     };
-    let source = assembler::MemorySource::new().with("new.s", NEW_HANDLER);
+    let source = std::fs::read(root.join("src/new.s")).expect("its source");
+    let source = assembler::MemorySource::new().with("new.s", source);
     let assembly = assembler::assemble(&source, std::path::Path::new("new.s"), &options)
         .expect("the template assembles");
     let linked = romlib::link_against_rom("new.s", &assembly.object, "scorpion-ext")
@@ -225,7 +211,7 @@ fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
     let refused = refusal(&mut m, &mut d, "break handler");
     assert!(refused.contains("branch"), "{refused}");
     assert!(
-        refused.contains("that takes one: $0408 (handler+$8) at new.s:10"),
+        refused.contains("that takes one: $0408 (handler+$8) at new.s:19"),
         "the line to break on instead: {refused}"
     );
     text(&mut m, &mut d, "break handler+8");

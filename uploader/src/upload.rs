@@ -403,6 +403,18 @@ pub fn upload_keeping<T: Transport>(
     } else if options.replace {
         hooks_now = read_hooks(client, profile)?;
     }
+    // Kept again before each change the upload makes before its bytes go
+    // out: a hook disarmed, a table entry freed.
+    let mut before_change = |client: &mut Client<T>, image: &UploadImage| match kept.as_ref() {
+        Some(kept) => keep_early(
+            client,
+            (profile, image),
+            kept,
+            (&[], &unlinked),
+            (&mut witnesses, keep),
+        ),
+        None => Ok(()),
+    };
     let others = plan.as_ref().map_or(&[][..], |plan| plan.others.as_slice());
     let mut initial = Vec::new();
     for (kind, mut target) in hooks_now {
@@ -451,16 +463,7 @@ pub fn upload_keeping<T: Transport>(
                 });
             };
             check_entries_once(client, profile, &mut entries_checked)?;
-            if let Some(kept) = kept.as_ref() {
-                let context = (profile, image);
-                keep_early(
-                    client,
-                    context,
-                    kept,
-                    (&[], &unlinked),
-                    (&mut witnesses, keep),
-                )?;
-            }
+            before_change(client, image)?;
             switch_hook(client, address, to, options.max_writes)?;
             progress.event(&Event::HookDisarmed {
                 kind,
@@ -500,16 +503,7 @@ pub fn upload_keeping<T: Transport>(
     if let Some(plan) = plan.as_mut() {
         if plan.frees_first() {
             check_entries_once(client, profile, &mut entries_checked)?;
-            if let Some(kept) = kept.as_ref() {
-                let context = (profile, &image);
-                keep_early(
-                    client,
-                    context,
-                    kept,
-                    (&[], &unlinked),
-                    (&mut witnesses, keep),
-                )?;
-            }
+            before_change(client, &image)?;
         }
         plan.free_first(client, options.max_writes)?;
         entry = Some(plan.entry_area());

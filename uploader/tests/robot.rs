@@ -323,42 +323,12 @@ fn patterned_robot() -> (VirtualTransport, Vec<u8>) {
 /// (if anything was written) puts the robot back byte for byte.
 #[test]
 fn an_upload_cut_anywhere_leaves_an_undo_that_puts_everything_back() {
-    use uploader::transport::{FaultConfig, FaultyTransport};
-    let image = extension(1024, 8);
-    let options = UploadOptions::default();
-    let mut tried = 0;
-    for at in (40..2600).step_by(120) {
-        let (transport, before) = patterned_robot();
-        let config = FaultConfig {
-            stall_after: Some(at),
-            stall_for: None,
-            ..FaultConfig::none(3)
-        };
-        let mut client =
-            uploader::client(FaultyTransport::new(transport, config), &options.profile);
-        let mut kept = Kept::default();
-        let result = upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept);
-        let transport = client.into_transport().into_inner();
-        if result.is_ok() {
-            break;
-        }
-        tried += 1;
-        let changed = user_memory(transport.robot()) != before;
-        let Some(kept) = kept.0 else {
-            assert!(!changed, "cut after {at}: RAM changed and nothing kept");
-            continue;
-        };
-        let mut client = uploader::client(transport, &options.profile);
-        restore(&mut client, &kept, &options, &mut NoProgress)
-            .unwrap_or_else(|error| panic!("cut after {at}: the undo: {error}"));
-        let after = user_memory(client.transport().robot());
-        assert_eq!(
-            first_difference(&after, &before),
-            None,
-            "cut after {at} host characters"
-        );
-    }
-    assert!(tried > 5, "cut {tried} times");
+    cut_anywhere_then_undo(
+        &patterned_robot,
+        &extension(1024, 8),
+        &UploadOptions::default(),
+        (40..2600).step_by(120),
+    );
 }
 
 /// hostile10's F5: `upload --replace` took the installed extension out of
@@ -369,7 +339,7 @@ fn an_upload_cut_anywhere_leaves_an_undo_that_puts_everything_back() {
 #[test]
 fn a_replace_cut_anywhere_leaves_an_undo_that_puts_the_old_extension_back() {
     let old = extension(1024, 8);
-    cut_anywhere_then_undo(&old, &one_byte_changed(&old, 1000));
+    replaced_cut_anywhere_then_undo(&old, &one_byte_changed(&old, 1000));
 }
 
 /// The same image again (its hook disarmed first, the RAM loader found
@@ -377,14 +347,12 @@ fn a_replace_cut_anywhere_leaves_an_undo_that_puts_the_old_extension_back() {
 #[test]
 fn the_same_upload_again_cut_anywhere_leaves_an_undo_that_puts_it_back() {
     let old = extension(1024, 8);
-    cut_anywhere_then_undo(&old, &old);
+    replaced_cut_anywhere_then_undo(&old, &old);
 }
 
-/// Uploads `old` to a patterned robot, then `new` over it with `replace`,
-/// cutting the line after each of many host characters; whatever was kept
-/// must put the robot back as `old` left it.
-fn cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::UploadImage) {
-    use uploader::transport::{FaultConfig, FaultyTransport};
+/// Uploads `old` to a patterned robot, then `new` over it with `replace`
+/// ([`cut_anywhere_then_undo`]).
+fn replaced_cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::UploadImage) {
     let options = UploadOptions {
         replace: true,
         ..UploadOptions::default()
@@ -396,9 +364,23 @@ fn cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::UploadIma
         let before = user_memory(transport.robot());
         (transport, before)
     };
+    cut_anywhere_then_undo(&installed, new, &options, (20..1400).step_by(40));
+}
+
+/// Uploads `image` with `options` to the robot `robot` makes (with its
+/// user memory as it is), the line cut after each of `cuts` host
+/// characters; whatever was kept must put the robot back as it was, and
+/// where nothing was kept nothing may have changed.
+fn cut_anywhere_then_undo(
+    robot: &dyn Fn() -> (VirtualTransport, Vec<u8>),
+    image: &uploader::UploadImage,
+    options: &UploadOptions,
+    cuts: impl Iterator<Item = usize>,
+) {
+    use uploader::transport::{FaultConfig, FaultyTransport};
     let mut tried = 0;
-    for at in (20..1400).step_by(40) {
-        let (transport, before) = installed();
+    for at in cuts {
+        let (transport, before) = robot();
         let config = FaultConfig {
             stall_after: Some(at),
             stall_for: None,
@@ -407,7 +389,7 @@ fn cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::UploadIma
         let mut client =
             uploader::client(FaultyTransport::new(transport, config), &options.profile);
         let mut kept = Kept::default();
-        let result = upload_keeping(&mut client, new, &options, &mut NoProgress, &mut kept);
+        let result = upload_keeping(&mut client, image, options, &mut NoProgress, &mut kept);
         let transport = client.into_transport().into_inner();
         if result.is_ok() {
             break;
@@ -422,7 +404,7 @@ fn cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::UploadIma
             continue;
         };
         let mut client = uploader::client(transport, &options.profile);
-        restore(&mut client, &kept, &options, &mut NoProgress)
+        restore(&mut client, &kept, options, &mut NoProgress)
             .unwrap_or_else(|error| panic!("cut after {at}: the undo: {error}"));
         let after = user_memory(client.transport().robot());
         assert_eq!(

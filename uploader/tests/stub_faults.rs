@@ -142,28 +142,23 @@ fn lost_bytes_leave_nothing_unverified_reached() {
     assert!(finished > 0, "no session got through the noise");
 }
 
-/// A line that garbles the `@` answering each `/1@` (the robot obeyed it).
-struct GarbledCopy {
+/// The virtual robot's line with a test's hand in it: `sent` may change
+/// what the host sends, `heard` what it receives (the bytes just come).
+struct Meddled<S, H> {
     inner: VirtualTransport,
-    garble: bool,
+    sent: S,
+    heard: H,
 }
 
-impl Transport for GarbledCopy {
+impl<S: FnMut(&[u8]) -> Vec<u8>, H: FnMut(&mut [u8])> Transport for Meddled<S, H> {
     fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
-        if bytes.windows(3).any(|w| w == b"/1@") {
-            self.garble = true;
-        }
-        self.inner.send(bytes)
+        let bytes = (self.sent)(bytes);
+        self.inner.send(&bytes)
     }
     fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
         let start = into.len();
         let n = self.inner.receive(into, timeout)?;
-        if self.garble
-            && let Some(at) = into[start..].iter().position(|&b| b == b'@')
-        {
-            into[start + at] = 0;
-            self.garble = false;
-        }
+        (self.heard)(&mut into[start..]);
         Ok(n)
     }
     fn baud(&self) -> u32 {
@@ -188,9 +183,25 @@ impl Transport for GarbledCopy {
 fn a_garbled_answer_to_the_copy_of_a_patch_is_not_taken_for_a_failure() {
     let image = handler();
     let profile = RomProfile::reference();
-    let transport = GarbledCopy {
+    // The `@` answering the `/1@` garbled (the robot obeyed it).
+    let garble = std::rc::Rc::new(std::cell::Cell::new(false));
+    let copied = std::rc::Rc::clone(&garble);
+    let transport = Meddled {
         inner: robot(&image),
-        garble: false,
+        sent: move |bytes: &[u8]| {
+            if bytes.windows(3).any(|w| w == b"/1@") {
+                copied.set(true);
+            }
+            bytes.to_vec()
+        },
+        heard: move |bytes: &mut [u8]| {
+            if garble.get()
+                && let Some(at) = bytes.iter().position(|&b| b == b'@')
+            {
+                bytes[at] = 0;
+                garble.set(false);
+            }
+        },
     };
     let client = uploader::client(transport, &profile);
     let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
@@ -208,40 +219,6 @@ fn a_garbled_answer_to_the_copy_of_a_patch_is_not_taken_for_a_failure() {
     let _ = client;
 }
 
-/// A line that loses the start of the `n`th go-on (`C`) frame.
-struct LostGoOn {
-    inner: VirtualTransport,
-    seen: u32,
-    lose: u32,
-}
-
-impl Transport for LostGoOn {
-    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
-        if bytes.first() == Some(&0xF1) && bytes.get(1..5) == Some(b"0343") {
-            self.seen += 1;
-            if self.seen == self.lose {
-                return self.inner.send(&bytes[1..]);
-            }
-        }
-        self.inner.send(bytes)
-    }
-    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
-        self.inner.receive(into, timeout)
-    }
-    fn baud(&self) -> u32 {
-        self.inner.baud()
-    }
-    fn now(&self) -> Duration {
-        self.inner.now()
-    }
-    fn clear_input(&mut self) -> uploader::Result<()> {
-        self.inner.clear_input()
-    }
-    fn name(&self) -> String {
-        self.inner.name()
-    }
-}
-
 /// hostile10 F8: after a step done on the host (`LDA $0480` at the
 /// breakpoint), the `C` frame lost: the robot stays stopped. The stop
 /// found then is where the host had the robot, after the `LDA`, with its
@@ -250,10 +227,18 @@ impl Transport for LostGoOn {
 fn a_lost_go_on_after_a_step_leaves_the_stop_where_the_host_had_it() {
     let image = handler();
     let profile = RomProfile::reference();
-    let transport = LostGoOn {
+    // The first go-on (`C`) frame loses its start.
+    let mut lost = false;
+    let transport = Meddled {
         inner: robot(&image),
-        seen: 0,
-        lose: 1,
+        sent: move |bytes: &[u8]| {
+            if !lost && bytes.first() == Some(&0xF1) && bytes.get(1..5) == Some(b"0343") {
+                lost = true;
+                return bytes[1..].to_vec();
+            }
+            bytes.to_vec()
+        },
+        heard: |_: &mut [u8]| {},
     };
     let client = uploader::client(transport, &profile);
     let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
@@ -285,39 +270,6 @@ fn a_lost_go_on_after_a_step_leaves_the_stop_where_the_host_had_it() {
     );
 }
 
-/// A line that loses one character of the first `/7R` for the hooks.
-struct LostDigit {
-    inner: VirtualTransport,
-    done: bool,
-}
-
-impl Transport for LostDigit {
-    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
-        if !self.done && bytes.starts_with(b"/7R0200") {
-            self.done = true;
-            let mut cut = bytes.to_vec();
-            cut.remove(4);
-            return self.inner.send(&cut);
-        }
-        self.inner.send(bytes)
-    }
-    fn receive(&mut self, into: &mut Vec<u8>, timeout: Duration) -> uploader::Result<usize> {
-        self.inner.receive(into, timeout)
-    }
-    fn baud(&self) -> u32 {
-        self.inner.baud()
-    }
-    fn now(&self) -> Duration {
-        self.inner.now()
-    }
-    fn clear_input(&mut self) -> uploader::Result<()> {
-        self.inner.clear_input()
-    }
-    fn name(&self) -> String {
-        self.inner.name()
-    }
-}
-
 /// A `/7R` that lost a digit leaves the ROM waiting for the rest: the
 /// question is asked again, not waited on until the line is called
 /// stalled. Even after a long debug session whose frames the client did
@@ -327,13 +279,21 @@ impl Transport for LostDigit {
 fn a_read_that_lost_a_digit_is_asked_again() {
     let image = handler();
     let profile = RomProfile::reference();
-    let mut client = uploader::client(
-        LostDigit {
-            inner: robot(&image),
-            done: false,
+    // The first `/7R` of the hooks loses a digit.
+    let mut done = false;
+    let transport = Meddled {
+        inner: robot(&image),
+        sent: move |bytes: &[u8]| {
+            let mut bytes = bytes.to_vec();
+            if !done && bytes.starts_with(b"/7R0200") {
+                done = true;
+                bytes.remove(4);
+            }
+            bytes
         },
-        &profile,
-    );
+        heard: |_: &mut [u8]| {},
+    };
+    let mut client = uploader::client(transport, &profile);
     // Ten seconds on the line, read past the client (as the stub's frames
     // are).
     let mut elsewhere = Vec::new();
