@@ -408,3 +408,29 @@ fn a_world_or_card_fault_in_ask_is_shown_at_its_place() {
         "{stderr}"
     );
 }
+
+/// hostile13 F1: a card script that failed while `scorpion test` ran a
+/// transcript (`read` returning a string): the transcript failed with
+/// `AFF`, not a word of the script. Its place and fault are said.
+#[test]
+fn a_card_script_failing_in_a_transcript_is_named_by_scorpion_test() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let project = dir.path().join("adc");
+    crate::copy_dir(Path::new(&example("adc")), &project);
+    let script = project.join("adc.rhai");
+    let text = std::fs::read_to_string(&script).expect("the card");
+    let broken = text.replace(
+        "    irq(false);\n    this.result\n}",
+        "    irq(false);\n    \"str\"\n}",
+    );
+    assert_ne!(broken, text, "the card's read changed");
+    std::fs::write(&script, broken).expect("written");
+    let output = scorpion(&project, &["test"]);
+    let printed = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{printed}");
+    assert!(
+        printed.contains("(the card at $9000 failed: adc.rhai:")
+            && printed.contains("`read` returned a string for register 2, not a byte)"),
+        "{printed}"
+    );
+}

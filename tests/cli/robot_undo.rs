@@ -645,6 +645,11 @@ fn test_on_a_port_keeps_the_projects_undo_file() {
     // The rehearsal's figures are said to be its, beside the robot's.
     assert!(tested.contains("transcripts rehearsed: "), "{tested}");
     assert!(tested.contains("; on the robot: "), "{tested}");
+    // fresh13 F1: what stays on the robot is said, and how to take it out.
+    assert!(
+        tested.contains("left installed on the robot: myext; `scorpion upload --undo`"),
+        "{tested}"
+    );
     let undo = project.join("target/scorpion/last-upload.undo");
     assert!(undo.is_file(), "{tested}");
     assert!(
@@ -657,4 +662,27 @@ fn test_on_a_port_keeps_the_projects_undo_file() {
     let undone = ok(&project, &line, &["upload", "--undo"]);
     assert!(undone.contains("restored"), "{undone}");
     assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);
+}
+
+/// fresh13 F3: examples/adc tested on a robot without its card: the
+/// transcript fails there (`A--`), and the failure says the rehearsal had
+/// the project's card, which the robot may lack.
+#[test]
+fn a_transcript_failing_on_a_port_names_the_cards_the_rehearsal_had() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = dir.path().join("adc");
+    crate::copy_dir(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc"),
+        &project,
+    );
+    // Started outside the project: a robot without the card.
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(&project, &["test", "--port", &sim.path]);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("answered `A--`, expected `AC0`"), "{text}");
+    assert!(
+        text.contains("(the rehearsal passed with the project's cards on the KIM bus: adc.rhai;"),
+        "{text}"
+    );
 }

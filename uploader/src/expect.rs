@@ -232,7 +232,14 @@ impl Expectations {
                                 Required::Exactly(text) => text.clone(),
                                 _ => "an answer".into(),
                             },
-                            format!("no valid answer ({error})"),
+                            match &error {
+                                // The script's place and what went wrong
+                                // (hostile13 F1: only "the card failed").
+                                crate::Error::Robot(romlib::Error::Card { message, .. }) => {
+                                    format!("no valid answer ({error}: {message})")
+                                }
+                                _ => format!("no valid answer ({error})"),
+                            },
                         );
                         None
                     }

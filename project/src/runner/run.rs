@@ -696,6 +696,12 @@ impl Run<'_, '_, '_> {
             // The robot on a port is seen through its line alone: the
             // room lines were checked in the rehearsal, and are refused here.
             let result = run_transcript(project, &path, &mut client, clock, None, &mut Vec::new());
+            // fresh13 F3: the rehearsal had the project's cards; a robot
+            // that answers otherwise may lack one.
+            let result = result.map_err(|why| match cards_hint(setup, port) {
+                Some(hint) => format!("{why}{hint}"),
+                None => why,
+            });
             self.record_result(&name, result.map(|()| Passed::Ok));
         }
         *self.report.port_time.get_or_insert_default() += started.elapsed();
@@ -873,6 +879,24 @@ fn client<T: Transport>(transport: T) -> Client<T> {
 
 /// What every virtual robot of a run is made of, read once: the line's
 /// rate, the project's ROM profile, its cards and surroundings.
+/// For a transcript that failed on a robot on a port: the cards the
+/// rehearsal had on its KIM bus, which the robot may lack.
+fn cards_hint(setup: &Setup, port: &str) -> Option<String> {
+    if port == EMU || setup.rig.cards.is_empty() {
+        return None;
+    }
+    let cards: Vec<String> = setup
+        .rig
+        .cards
+        .iter()
+        .map(|card| card.path.display().to_string())
+        .collect();
+    Some(format!(
+        "    (the rehearsal passed with the project's cards on the KIM bus: {}; does the robot have them, at the same addresses?)\n",
+        cards.join(", ")
+    ))
+}
+
 struct Setup {
     baud: u32,
     rom: Option<(String, linker::Image)>,

@@ -27,6 +27,8 @@ pub struct VirtualTransport {
     opened: u64,
     /// Actions and the cycle each is due, earliest last.
     actions: Vec<(u64, Action)>,
+    /// A failure of the robot's run whose bytes were handed over first.
+    failed: Option<Error>,
 }
 
 impl std::fmt::Debug for VirtualTransport {
@@ -57,6 +59,7 @@ impl VirtualTransport {
             baud,
             opened,
             actions: Vec::new(),
+            failed: None,
         }
     }
 
@@ -138,9 +141,20 @@ impl Transport for VirtualTransport {
         loop {
             // The robot runs until the first byte reaches the host, which
             // looks at it at once: no slicing, so no slice to wait out.
+            if let Some(error) = self.failed.take() {
+                return Err(error);
+            }
             let ran = self.run(deadline);
             let bytes = self.robot.receive();
             if !bytes.is_empty() {
+                // A failure in the same run (a card's script) is told at
+                // the next read, not lost with the bytes (hostile13 F1).
+                if let Err(error) = ran {
+                    self.failed = Some(match error {
+                        romlib::Error::Jam { pc, opcode } => Error::RobotJammed { pc, opcode },
+                        other => Error::Robot(other),
+                    });
+                }
                 into.extend_from_slice(&bytes);
                 return Ok(bytes.len());
             }
