@@ -303,6 +303,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             started.elapsed().as_secs_f64()
         );
     }
+    // fresh13 F1: the images stay on the robot, and nothing said so; each
+    // run's uploads keep the project's undo file anew.
+    if !report.left_installed.is_empty() {
+        let _ = writeln!(
+            out,
+            "left installed on the robot: {}; `scorpion upload --undo` puts back what it held before this run's uploads (each run keeps its own undo file, so run it before testing again to get back to the robot as it was before)",
+            report.left_installed.join(", ")
+        );
+    }
     if let Some(filter) = &filter {
         if report.passed + report.failed == 0 {
             miette::bail!(
@@ -317,21 +326,6 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         );
     } else {
         let _ = writeln!(out, "{} passed, {} failed", report.passed, report.failed);
-    }
-    // fresh13 F1: the images stay on the robot, and nothing said so; each
-    // run's uploads keep the project's undo file anew.
-    let uploaded: Vec<&str> = report
-        .tests
-        .iter()
-        .filter(|test| !test.outcome.failed())
-        .filter_map(|test| test.name.strip_prefix("upload "))
-        .collect();
-    if !uploaded.is_empty() && args.port.as_deref() != Some("emu") {
-        let _ = writeln!(
-            out,
-            "left installed on the robot: {}; `scorpion upload --undo` puts back what it held before this run's uploads (each run keeps its own undo file, so run it before testing again to get back to the robot as it was before)",
-            uploaded.join(", ")
-        );
     }
     Ok(if report.success() {
         ExitCode::SUCCESS

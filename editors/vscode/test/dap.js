@@ -180,7 +180,7 @@ const log = (what) => console.log(`dap: ${what}`);
     assert.equal(third.line, sec);
     log(`conditional breakpoint at adc.s:${third.line}`);
 
-    const call = (await dc.send('disassemble', { memoryReference: third.instructionPointerReference, instructionCount: 12 }))
+    const call = (await dc.send('disassemble', { memoryReference: third.instructionPointerReference, instructionCount: 20 }))
       .body.instructions.find((i) => i.instruction.startsWith('JSR'));
     await dc.send('setInstructionBreakpoints', { breakpoints: [{ instructionReference: call.address }] });
     // The log point's lines, among the robot's own output.

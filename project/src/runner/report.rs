@@ -117,6 +117,8 @@ pub struct Report {
     /// With a port: the wall time the transcripts took on the robot there
     /// (the two above are the rehearsal's).
     pub port_time: Option<Duration>,
+    /// The images uploaded to a robot on a real port, which stay there.
+    pub left_installed: Vec<String>,
 }
 
 impl Report {

@@ -680,6 +680,9 @@ impl Run<'_, '_, '_> {
                 }
             }
             self.record_result(&name, Ok(Passed::Ok));
+            if port != EMU {
+                self.report.left_installed.push(image.name.clone());
+            }
         }
         let clock = if port == EMU {
             Clock::Robot
