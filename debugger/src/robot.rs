@@ -64,21 +64,25 @@ fn starts_of(images: &[linker::Image]) -> Vec<u16> {
     let mut starts: Vec<u16> = images
         .iter()
         .flat_map(|image| {
-            let labels = image
-                .symbols
-                .iter()
-                .filter_map(|symbol| u16::try_from(symbol.value).ok());
             let lines = image
                 .lines
                 .entries
                 .iter()
                 .filter_map(|entry| u16::try_from(entry.offset).ok());
-            labels.chain(lines).collect::<Vec<_>>()
+            labels(image).chain(lines)
         })
         .collect();
     starts.sort_unstable();
     starts.dedup();
     starts
+}
+
+/// The addresses `image`'s symbols name.
+fn labels(image: &linker::Image) -> impl Iterator<Item = u16> + '_ {
+    image
+        .symbols
+        .iter()
+        .filter_map(|symbol| u16::try_from(symbol.value).ok())
 }
 
 /// Where code may be jumped to, which a breakpoint's `JSR` must not
@@ -89,15 +93,7 @@ fn starts_of(images: &[linker::Image]) -> Vec<u16> {
 /// to that next one (fresh10 F4b: in `scorpion new`'s handler only
 /// `jsr PUTCH` took a breakpoint, and no step could leave it).
 fn jump_targets(images: &[linker::Image]) -> Vec<u16> {
-    let mut targets: Vec<u16> = images
-        .iter()
-        .flat_map(|image| {
-            image
-                .symbols
-                .iter()
-                .filter_map(|symbol| u16::try_from(symbol.value).ok())
-        })
-        .collect();
+    let mut targets: Vec<u16> = images.iter().flat_map(labels).collect();
     for image in images {
         let byte = |at: u16| {
             image.areas.iter().find_map(|area| {

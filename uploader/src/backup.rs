@@ -467,6 +467,7 @@ impl EarlyWitnesses {
         mut backup: Backup,
         keep: &mut dyn Keep,
     ) -> Result<()> {
+        let slots = image.chain_slot_bytes();
         let mut witnesses = Vec::new();
         for (address, len) in hook_windows(profile, &backup) {
             let known = self
@@ -476,12 +477,6 @@ impl EarlyWitnesses {
             let witness = match known {
                 Some(witness) => *witness,
                 None => {
-                    let slots: Vec<u16> = image
-                        .hooks()
-                        .iter()
-                        .filter_map(|record| record.chain)
-                        .flat_map(|slot| [slot, slot.wrapping_add(1)])
-                        .collect();
                     let expected: Vec<Option<u8>> = (0..len)
                         .map(|i| address.wrapping_add(i as u16))
                         .map(|at| image.byte(at).filter(|_| !slots.contains(&at)))

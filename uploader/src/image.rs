@@ -157,6 +157,17 @@ impl UploadImage {
         }
     }
 
+    /// The addresses of its chain slots' bytes, which the upload fills
+    /// (with where each hook went before) rather than the image.
+    #[must_use]
+    pub fn chain_slot_bytes(&self) -> Vec<u16> {
+        self.hooks
+            .iter()
+            .filter_map(|record| record.chain)
+            .flat_map(|slot| [slot, slot.wrapping_add(1)])
+            .collect()
+    }
+
     /// Its id in the table of installed extensions (24 bits of a hash of
     /// its loaded bytes as linked, chain slots unfilled).
     #[must_use]

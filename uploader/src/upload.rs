@@ -367,14 +367,13 @@ pub fn upload_keeping<T: Transport>(
             return Ok(());
         }
         slots.extend(slot);
-        let mut backup = Backup {
-            areas: found.to_vec(),
-            hooks: hooks_now.clone(),
-            rom: crate::backup::profile_rom(profile),
-            ..Backup::default()
-        };
-        overlay(&mut backup.areas, &slots);
-        witnesses.keep(client, (profile, image), backup, keep)
+        keep_early(
+            client,
+            (profile, image),
+            &as_found(profile, found.to_vec(), &hooks_now),
+            (&[], &slots),
+            (&mut witnesses, keep),
+        )
     };
     let mut plan = table::prepare(
         client,
@@ -386,13 +385,11 @@ pub fn upload_keeping<T: Transport>(
     )?;
     // What an undo puts back: the hooks and the table as found (the table
     // as `prepare` read it, flags and the entries in use: no more reads).
-    let mut kept = keep.wanted().then(|| Backup {
-        areas: plan
+    let mut kept = keep.wanted().then(|| {
+        let found = plan
             .as_ref()
-            .map_or_else(Vec::new, |plan| plan.found.clone()),
-        hooks: hooks_now.clone(),
-        rom: crate::backup::profile_rom(profile),
-        ..Backup::default()
+            .map_or_else(Vec::new, |plan| plan.found.clone());
+        as_found(profile, found, &hooks_now)
     });
     // Chain slots of other extensions `prepare` re-pointed, as they were.
     let unlinked = plan
@@ -853,6 +850,18 @@ fn keep_oldest(areas: &mut Vec<Area>, first: usize) {
     }
     areas.truncate(first);
     areas.extend(runs);
+}
+
+/// What an undo of an upload starts from: the table (`found`) and the
+/// hooks as the upload found them, with the ROM's bytes it was checked
+/// against.
+fn as_found(profile: &RomProfile, found: Vec<Area>, hooks: &[(HookKind, u16)]) -> Backup {
+    Backup {
+        areas: found,
+        hooks: hooks.to_vec(),
+        rom: crate::backup::profile_rom(profile),
+        ..Backup::default()
+    }
 }
 
 /// Hands `keep` what an upload has changed so far, before its next change

@@ -880,8 +880,6 @@ fn client<T: Transport>(transport: T) -> Client<T> {
     )
 }
 
-/// What every virtual robot of a run is made of, read once: the line's
-/// rate, the project's ROM profile, its cards and surroundings.
 /// For a transcript that failed on a robot on a port: the cards the
 /// rehearsal had on its KIM bus, which the robot may lack.
 fn cards_hint(setup: &Setup, port: &str) -> Option<String> {
@@ -900,6 +898,8 @@ fn cards_hint(setup: &Setup, port: &str) -> Option<String> {
     ))
 }
 
+/// What every virtual robot of a run is made of, read once: the line's
+/// rate, the project's ROM profile, its cards and surroundings.
 struct Setup {
     baud: u32,
     rom: Option<(String, linker::Image)>,

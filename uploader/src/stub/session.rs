@@ -521,10 +521,7 @@ impl<T: Transport> RobotDebug<T> {
         let call = [JSR, entry[0], entry[1]];
         let mut leftovers = Vec::new();
         let mut adopted = Vec::new();
-        let slot_bytes: Vec<u16> = slots
-            .iter()
-            .flat_map(|&slot| [slot, slot.wrapping_add(1)])
-            .collect();
+        let slot_bytes = self.image.chain_slot_bytes();
         for area in self.image.areas().to_vec() {
             let mut found = self.read_code(&area, &slots)?;
             // Only code is compared: the program may have changed its

@@ -115,6 +115,14 @@ impl VirtualTransport {
     }
 }
 
+/// A failure of the robot's run as the line's error.
+fn line_error(error: romlib::Error) -> Error {
+    match error {
+        romlib::Error::Jam { pc, opcode } => Error::RobotJammed { pc, opcode },
+        other => Error::Robot(other),
+    }
+}
+
 /// Emulated cycles to a duration.
 fn cycles_to_duration(cycles: u64) -> Duration {
     Duration::from_nanos(cycles.saturating_mul(1_000_000_000 / CPU_HZ))
@@ -138,33 +146,22 @@ impl Transport for VirtualTransport {
             .robot
             .cycles()
             .saturating_add(duration_to_cycles(timeout));
+        if let Some(error) = self.failed.take() {
+            return Err(error);
+        }
         loop {
             // The robot runs until the first byte reaches the host, which
             // looks at it at once: no slicing, so no slice to wait out.
-            if let Some(error) = self.failed.take() {
-                return Err(error);
-            }
-            let ran = self.run(deadline);
+            let ran = self.run(deadline).map_err(line_error);
             let bytes = self.robot.receive();
             if !bytes.is_empty() {
                 // A failure in the same run (a card's script) is told at
                 // the next read, not lost with the bytes (hostile13 F1).
-                if let Err(error) = ran {
-                    self.failed = Some(match error {
-                        romlib::Error::Jam { pc, opcode } => Error::RobotJammed { pc, opcode },
-                        other => Error::Robot(other),
-                    });
-                }
+                self.failed = ran.err();
                 into.extend_from_slice(&bytes);
                 return Ok(bytes.len());
             }
-            match ran {
-                Err(romlib::Error::Jam { pc, opcode }) => {
-                    return Err(Error::RobotJammed { pc, opcode });
-                }
-                Err(other) => return Err(Error::Robot(other)),
-                Ok(()) => {}
-            }
+            ran?;
             if self.robot.cycles() >= deadline {
                 return Ok(0);
             }
