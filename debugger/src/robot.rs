@@ -358,9 +358,18 @@ impl RobotMonitor {
                 if after.is_empty() {
                     self.displays(d)?
                 } else {
+                    if self.displays.iter().flatten().count() >= crate::monitor::DISPLAYS_MAX {
+                        return Err(usage(&format!(
+                            "at most {} expressions are displayed at once; `undisplay N` one first",
+                            crate::monitor::DISPLAYS_MAX
+                        )));
+                    }
                     let expr = self.parse(after)?;
+                    // fresh13 F2: shown at once, as on the virtual robot,
+                    // not only at the next stop.
+                    let value = self.shown(d, &expr)?;
                     self.displays.push(Some(expr));
-                    format!("display {}: {after}\n", self.displays.len())
+                    format!("display {}: {after} = {value}\n", self.displays.len())
                 }
             }
             "undisplay" => {
@@ -671,14 +680,20 @@ impl RobotMonitor {
             .filter_map(|(i, e)| e.clone().map(|e| (i + 1, e)))
             .collect();
         for (n, expr) in shown {
-            let value = match self.eval(d, &expr) {
-                Ok(value) => crate::expr::show(value),
-                Err(Failure::Usage(why)) => format!("({why})"),
-                Err(other) => return Err(other),
-            };
+            let value = self.shown(d, &expr)?;
             text.push_str(&format!("{n}: {expr} = {value}\n"));
         }
         Ok(text)
+    }
+
+    /// A displayed expression's value, or why it has none now (a register
+    /// while the robot runs).
+    fn shown<T: Transport>(&self, d: &mut RobotDebug<T>, expr: &Expr) -> Result<String, Failure> {
+        match self.eval(d, expr) {
+            Ok(value) => Ok(crate::expr::show(value)),
+            Err(Failure::Usage(why)) => Ok(format!("({why})")),
+            Err(other) => Err(other),
+        }
     }
 
     fn parse(&self, text: &str) -> Result<Expr, Failure> {

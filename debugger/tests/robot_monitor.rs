@@ -97,13 +97,21 @@ fn what_a_robot_cannot_do_is_refused_with_the_reason() {
 #[test]
 fn displays_are_read_while_it_runs_and_at_a_stop() {
     let (mut m, mut d) = attached();
+    // fresh13 F2: its value at once, read with /7R while the robot runs;
+    // a register's is said to wait for a stop.
+    text(&mut m, &mut d, "poke $0480 $5A");
     assert_eq!(
         text(&mut m, &mut d, "display [$0480]"),
-        "display 1: [$0480]\n"
+        "display 1: [$0480] = $5A\n"
     );
+    assert_eq!(
+        text(&mut m, &mut d, "display A"),
+        "display 2: A = (the robot is running: registers are known only at a stop)\n"
+    );
+    text(&mut m, &mut d, "undisplay 2");
     // Running: read with /7R after the command's answer.
     let shown = text(&mut m, &mut d, "/1Q");
-    assert!(shown.contains("answer: Q42\n1: [$0480] = $42"), "{shown}");
+    assert!(shown.contains("answer: Q5A\n1: [$0480] = $5A"), "{shown}");
     text(&mut m, &mut d, "poke $0480 $17");
     text(&mut m, &mut d, "break $040F");
     // At the stop: read through the stub, beside the registers.
@@ -114,6 +122,13 @@ fn displays_are_read_while_it_runs_and_at_a_stop() {
     assert_eq!(shown, "$2E\n");
     let shown = text(&mut m, &mut d, "continue");
     assert!(shown.contains("answer: Q17"), "{shown}");
+    // As many as the virtual robot's monitor shows, each read at every
+    // command: no more.
+    for _ in 1..64 {
+        text(&mut m, &mut d, "display [$0481]");
+    }
+    let why = refusal(&mut m, &mut d, "display [$0482]");
+    assert!(why.contains("at most 64 expressions"), "{why}");
 }
 
 /// The hostile tester's F5: `next` over `JSR PUTEOL` ends the answer

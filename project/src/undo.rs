@@ -87,6 +87,13 @@ pub struct UndoFile {
     pub failed: Option<hostfs::Error>,
     /// Whether it was written (said if the upload is interrupted).
     pub kept: Arc<AtomicBool>,
+    /// The finished undo file the upload found there, read before its
+    /// first keep (`None` until then): put back if the upload changes
+    /// nothing, since it goes further back than this upload's.
+    older: Option<Option<Vec<u8>>>,
+    /// Whether the last upload changed nothing and the undo file it found
+    /// was kept (see [`uploader::Keep::finished_unchanged`]).
+    pub kept_older: bool,
 }
 
 impl UndoFile {
@@ -97,6 +104,8 @@ impl UndoFile {
             path,
             failed: None,
             kept: Arc::default(),
+            older: None,
+            kept_older: false,
         }
     }
 
@@ -114,6 +123,12 @@ impl UndoFile {
 
 impl uploader::Keep for UndoFile {
     fn keep(&mut self, overwritten: &uploader::Backup) {
+        if self.older.is_none() {
+            // A file an upload or an undo did not finish is no undo to go
+            // back to (and the upload was refused before it started).
+            let finished = unfinished(&self.path).is_none();
+            self.older = Some(std::fs::read(&self.path).ok().filter(|_| finished));
+        }
         // Marked first: an upload killed from here on has not finished,
         // and the next one must not replace what the file keeps.
         if let Err(error) = hostfs::write(marked(&self.path, UPLOADING), b"") {
@@ -126,5 +141,37 @@ impl uploader::Keep for UndoFile {
             return;
         }
         self.kept.store(true, Ordering::Relaxed);
+    }
+
+    fn finished(&mut self, kept: &uploader::Backup) {
+        self.keep(kept);
+        self.older = None;
+        self.kept_older = false;
+    }
+
+    /// fresh13 F1: an upload that changed nothing (`test --port` again,
+    /// the same image uploaded again) keeps the undo file it found, so
+    /// that `--undo` still goes back to the robot as it was before the
+    /// upload that put the image there, not to "installed".
+    /// What the RAM loader went over this time, which the older file may
+    /// not hold, is added to it.
+    fn finished_unchanged(&mut self, kept: &uploader::Backup) {
+        let name = self.path.display().to_string();
+        let older = self
+            .older
+            .take()
+            .flatten()
+            .and_then(|older| uploader::Backup::decode(&name, &older).ok());
+        match older {
+            Some(older) => {
+                let both = older.going_further_back(kept);
+                match hostfs::write(&self.path, &both.encode()) {
+                    Ok(()) => self.kept_older = true,
+                    Err(error) => self.failed = Some(error),
+                }
+            }
+            None => self.keep(kept),
+        }
+        self.older = None;
     }
 }

@@ -303,13 +303,19 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             started.elapsed().as_secs_f64()
         );
     }
-    // fresh13 F1: the images stay on the robot, and nothing said so; each
-    // run's uploads keep the project's undo file anew.
+    // fresh13 F1: the images stay on the robot, and nothing said so. A run
+    // whose uploads changed nothing keeps the undo file it found; one that
+    // changed an image keeps what that upload overwrote.
     if !report.left_installed.is_empty() {
         let _ = writeln!(
             out,
-            "left installed on the robot: {}; `scorpion upload --undo` puts back what it held before this run's uploads (each run keeps its own undo file, so run it before testing again to get back to the robot as it was before)",
-            report.left_installed.join(", ")
+            "left installed on the robot: {}; `scorpion upload --undo` puts back what it held before {}",
+            report.left_installed.join(", "),
+            if report.kept_older_undo {
+                "the earlier run that put them there (this run changed nothing on it)"
+            } else {
+                "this run's uploads (a run that changes an image keeps a new undo file: undo before testing an edit to go back to the robot as it was)"
+            }
         );
     }
     if let Some(filter) = &filter {

@@ -632,6 +632,13 @@ fn upload_file(
     }
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
+    if undo.kept_older {
+        let _ = writeln!(
+            out,
+            "the robot held this image already, installed as it is now: {} still puts back what it held before the upload that put it there",
+            undo.path.display()
+        );
+    }
     if !emulated && expectations.is_some() {
         out.push_str(&others_not_rehearsed(&report, profile));
     }

@@ -659,6 +659,18 @@ fn test_on_a_port_keeps_the_projects_undo_file() {
         "finished"
     );
     assert_ne!(ok(&project, &line, &["read", "$0200", "3"]), before);
+    // fresh13 F1: tested again, unchanged: the undo file still goes back
+    // to the robot as it was before the first run, and says so.
+    let again = ok(&project, &line, &["test"]);
+    assert!(
+        again.contains("puts back what it held before the earlier run that put them there"),
+        "{again}"
+    );
+    let uploaded = ok(&project, &line, &["upload"]);
+    assert!(
+        uploaded.contains("the robot held this image already, installed as it is now"),
+        "{uploaded}"
+    );
     let undone = ok(&project, &line, &["upload", "--undo"]);
     assert!(undone.contains("restored"), "{undone}");
     assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);

@@ -82,6 +82,17 @@ pub trait Keep {
     fn finished(&mut self, kept: &Backup) {
         self.keep(kept);
     }
+
+    /// Called in place of [`Keep::finished`] when the upload left the
+    /// robot as it found it (the same image, installed as it was, the
+    /// hooks where they were: read back to be sure), but for the RAM
+    /// loader, which `kept` holds what it went over of: what an earlier
+    /// upload of it kept, with that ([`Backup::going_further_back`]),
+    /// undoes this one too and goes further back. By default,
+    /// [`Keep::finished`].
+    fn finished_unchanged(&mut self, kept: &Backup) {
+        self.finished(kept);
+    }
 }
 
 /// Keeps nothing (reads nothing).
@@ -619,6 +630,35 @@ fn backup_table(profile: &RomProfile, backup: &Backup) -> Vec<romlib::installed:
 }
 
 impl Backup {
+    /// What an undo of an upload and of one after it that changed nothing
+    /// on the robot ([`Keep::finished_unchanged`]) puts back: this, the
+    /// earlier upload's undo, with every byte `later` holds and this does
+    /// not (the RAM loader may have gone over memory the earlier upload
+    /// did not touch: as `later` found it, it is as it was before both).
+    /// The hooks, the witnesses and the ROM are this one's.
+    #[must_use]
+    pub fn going_further_back(mut self, later: &Backup) -> Backup {
+        let mut added: Vec<Area> = Vec::new();
+        for area in &later.areas {
+            for (offset, &byte) in area.bytes.iter().enumerate() {
+                let address = area.address.wrapping_add(offset as u16);
+                if self.byte_at(u32::from(address)).is_some() {
+                    continue;
+                }
+                match added.last_mut() {
+                    Some(last) if last.end() == u32::from(address) => last.bytes.push(byte),
+                    _ => added.push(Area {
+                        address,
+                        bytes: vec![byte],
+                    }),
+                }
+            }
+        }
+        self.areas.extend(added);
+        self.areas.sort_by_key(|area| area.address);
+        self
+    }
+
     /// The byte the backup holds at `address`, if it holds one.
     #[must_use]
     pub fn byte_at(&self, address: u32) -> Option<u8> {

@@ -41,6 +41,7 @@ mod sums;
 mod table;
 mod taper;
 pub mod transport;
+mod unchanged;
 mod upload;
 
 pub use backup::{Backup, Keep, MAGIC, NoKeep, Witness, backup, backup_ranges, restore};

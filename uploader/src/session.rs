@@ -143,6 +143,16 @@ impl Session {
         self.target
     }
 
+    /// Whether `address` is the loader's: its code (both parts) or its
+    /// state in the zero page.
+    pub(crate) fn owns(&self, address: u16) -> bool {
+        let start = u32::from(self.loader.address());
+        let code = start..start + self.loader.len() as u32;
+        let zero_page = u16::from(self.loader.zero_page);
+        code.contains(&u32::from(address))
+            || (zero_page..zero_page + u16::from(crate::loader::ZERO_PAGE_LEN)).contains(&address)
+    }
+
     /// The loader's first address and the size of what went in.
     pub(crate) fn placement(&self) -> (u16, usize) {
         let len = if self.with_sums {

@@ -166,6 +166,10 @@ pub struct UploadReport {
     /// byte went through the ROM's commands, none compared with the
     /// robot's by checksums.
     pub without_loader: Option<String>,
+    /// Whether the upload left the robot as it found it: the same image,
+    /// installed as it was, the hooks where they were (read back to be
+    /// sure; only decided when the upload kept what it overwrote).
+    pub unchanged: bool,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -732,8 +736,22 @@ pub fn upload_keeping<T: Transport>(
         written = whole(&image);
     }
 
+    let mut unchanged = false;
     if let Some(kept) = kept_file {
-        keep.finished(&finished(kept, entry));
+        let kept = finished(kept, entry);
+        let owns = |address: u16| session.as_ref().is_some_and(|s| s.owns(address));
+        unchanged = crate::unchanged::left_as_found(
+            client,
+            profile,
+            (&kept, &image),
+            !unlinked.is_empty(),
+            &owns,
+        );
+        if unchanged {
+            keep.finished_unchanged(&kept);
+        } else {
+            keep.finished(&kept);
+        }
     }
     let stats = client.stats();
     Ok(UploadReport {
@@ -756,6 +774,7 @@ pub fn upload_keeping<T: Transport>(
         }),
         written,
         without_loader,
+        unchanged,
     })
 }
 

@@ -277,6 +277,65 @@ fn an_undo_puts_back_what_the_ram_loader_overwrote() {
     }
 }
 
+/// fresh13 F1: the same image uploaded again changes nothing, and says
+/// so (read back on the robot), so that the undo kept by the upload that
+/// put it there, with what the RAM loader went over since, still puts the
+/// robot back as it was before both; an upload that changes anything (a
+/// byte of the image, a byte of it changed by hand since) does not say
+/// so. A small image (its first upload through the ROM's commands, the
+/// next through the loader), a bigger one, and the ROM's commands alone.
+#[test]
+fn the_same_image_uploaded_again_changes_nothing_and_the_first_undo_still_applies() {
+    let cases = [
+        (extension(24, 3), LoaderChoice::Auto),
+        (extension(1024, 8), LoaderChoice::Auto),
+        (extension(1024, 8), LoaderChoice::Never),
+    ];
+    for (image, loader) in cases {
+        let case = format!("{} bytes, {loader:?}", image.len());
+        let options = UploadOptions {
+            replace: true,
+            ..options(loader)
+        };
+        let (transport, before) = patterned_robot();
+        let mut client = uploader::client(transport, &options.profile);
+        let upload_again = |client: &mut uploader::Client<VirtualTransport>, image| {
+            let mut kept = Kept::default();
+            let report = upload_keeping(client, image, &options, &mut NoProgress, &mut kept)
+                .expect("the upload");
+            assert_eq!(report.unchanged, kept.1, "{case}: told as reported");
+            (report.unchanged, kept.0.expect("kept"))
+        };
+        let (unchanged, mut undo) = upload_again(&mut client, &image);
+        assert!(!unchanged, "{case}: the first upload changed the robot");
+        for _ in 0..2 {
+            let (unchanged, kept) = upload_again(&mut client, &image);
+            assert!(unchanged, "{case}: the same image again");
+            undo = undo.going_further_back(&kept);
+        }
+        restore(&mut client, &undo, &options, &mut NoProgress).expect("the first undo");
+        let after = user_memory(client.transport().robot());
+        assert_eq!(first_difference(&after, &before), None, "{case}");
+
+        // Installed again, then changed: by the image, by hand.
+        let (unchanged, _) = upload_again(&mut client, &image);
+        assert!(!unchanged, "{case}: put back in");
+        let changed = one_byte_changed(&image, image.len() / 2);
+        let (unchanged, _) = upload_again(&mut client, &changed);
+        assert!(!unchanged, "{case}: one byte of the image changed");
+        let (unchanged, _) = upload_again(&mut client, &image);
+        assert!(!unchanged, "{case}: and back");
+        let address = image.areas()[0].address + 10;
+        let byte = image.byte(address).expect("loaded");
+        let board = client.transport().robot_mut().robot_mut().board_mut();
+        board.load(address, &[byte ^ 0x40]).expect("RAM");
+        let (unchanged, _) = upload_again(&mut client, &image);
+        assert!(!unchanged, "{case}: a byte of it changed by hand");
+        let (unchanged, _) = upload_again(&mut client, &image);
+        assert!(unchanged, "{case}: the same image again, at the end");
+    }
+}
+
 /// hostile9's F1: 256 bytes of one even byte ($EA, a NOP sled; $20,
 /// spaces) sum as zeros do, and were kept as zeros without a read: the
 /// undo wrote zeros over them.

@@ -23,7 +23,7 @@ use counts::{
 pub const BUDGET: u64 = 1_000_000;
 
 /// The most `display` expressions shown at each stop.
-const DISPLAYS_MAX: usize = 64;
+pub(crate) const DISPLAYS_MAX: usize = 64;
 
 /// The monitor's commands, as `help` lists them.
 pub const HELP: &str = "\

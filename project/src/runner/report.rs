@@ -119,6 +119,9 @@ pub struct Report {
     pub port_time: Option<Duration>,
     /// The images uploaded to a robot on a real port, which stay there.
     pub left_installed: Vec<String>,
+    /// Whether every upload to that robot changed nothing on it, so the
+    /// project's undo file is still the one an earlier run kept.
+    pub kept_older_undo: bool,
 }
 
 impl Report {

@@ -681,6 +681,9 @@ impl Run<'_, '_, '_> {
             }
             self.record_result(&name, Ok(Passed::Ok));
             if port != EMU {
+                let first = self.report.left_installed.is_empty();
+                let kept_older = undo.as_ref().is_some_and(|undo| undo.kept_older);
+                self.report.kept_older_undo = kept_older && (first || self.report.kept_older_undo);
                 self.report.left_installed.push(image.name.clone());
             }
         }

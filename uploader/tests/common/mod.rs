@@ -22,13 +22,18 @@ use uploader::{
 };
 
 /// Keeps what an upload overwrote (the last file it handed over), for
-/// the tests that undo it.
+/// the tests that undo it, and whether the upload said it changed nothing.
 #[derive(Default)]
-pub(crate) struct Kept(pub(crate) Option<uploader::Backup>);
+pub(crate) struct Kept(pub(crate) Option<uploader::Backup>, pub(crate) bool);
 
 impl uploader::Keep for Kept {
     fn keep(&mut self, overwritten: &uploader::Backup) {
         self.0 = Some(overwritten.clone());
+    }
+
+    fn finished_unchanged(&mut self, kept: &uploader::Backup) {
+        self.keep(kept);
+        self.1 = true;
     }
 }
 

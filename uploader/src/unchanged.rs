@@ -1,0 +1,94 @@
+//! Whether an upload left the robot as it found it: the same image,
+//! installed as it was, its hooks where they were (fresh13 F1: a second
+//! `scorpion test --port` of an unchanged project kept a new undo file of
+//! "installed", and `--undo` no longer went back to the robot as it was
+//! before the first). Then what an earlier upload kept still undoes this
+//! one, and [`crate::Keep::finished_unchanged`] lets its keeper keep that.
+//!
+//! Decided on the robot, not guessed: a cheap look at what was kept
+//! (every kept byte the image loads must be the image's, no other
+//! extension's chain slot re-pointed) and only then the hooks and the kept
+//! bytes read back. An
+//! upload that wrote anything new never pays for the read.
+
+use crate::backup::Backup;
+use crate::client::Client;
+use crate::hooks::read_hooks;
+use crate::image::{RomProfile, UploadImage};
+use crate::transport::Transport;
+
+/// What the loader owns, which an upload through it always changes (its
+/// state in the zero page) or finds as it left it (its code): neither is
+/// the robot's own memory, so neither counts.
+pub(crate) type LoaderOwns<'a> = &'a dyn Fn(u16) -> bool;
+
+/// Whether the robot, after the upload of `image` (its chain slots filled
+/// and its table entry added, as written), holds what `kept` says it held
+/// before: every kept byte and every hook. `unlinked`: whether the upload
+/// re-pointed another extension's chain slot (a change in itself). The
+/// loader's bytes are not compared: it may have been written over the
+/// robot's memory this time, which `kept` holds as it was, and a keeper
+/// that goes back further keeps that too. A line that fails the reads
+/// answers "changed": the new undo file is then kept, which is always
+/// right.
+pub(crate) fn left_as_found<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    (kept, image): (&Backup, &UploadImage),
+    unlinked: bool,
+    loader_owns: LoaderOwns<'_>,
+) -> bool {
+    if unlinked {
+        return false;
+    }
+    // The robot's own bytes that were kept, in runs, with what they held.
+    let mut runs: Vec<(u16, Vec<Option<u8>>)> = Vec::new();
+    for area in &kept.areas {
+        for (offset, &byte) in area.bytes.iter().enumerate() {
+            let address = area.address.wrapping_add(offset as u16);
+            if loader_owns(address) {
+                continue;
+            }
+            if image.byte(address).is_some_and(|loaded| loaded != byte) {
+                // The upload wrote something else there.
+                return false;
+            }
+            match runs.last_mut() {
+                Some((start, bytes))
+                    if u32::from(*start) + bytes.len() as u32 == u32::from(address) =>
+                {
+                    bytes.push(Some(byte));
+                }
+                _ => runs.push((address, vec![Some(byte)])),
+            }
+        }
+    }
+    holds(client, profile, kept, &runs).unwrap_or(false)
+}
+
+/// Whether the robot's hooks are `kept`'s and `runs` hold their bytes.
+fn holds<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    kept: &Backup,
+    runs: &[(u16, Vec<Option<u8>>)],
+) -> crate::Result<bool> {
+    let mut hooks = read_hooks(client, profile)?;
+    let mut before = kept.hooks.clone();
+    hooks.sort_unstable();
+    before.sort_unstable();
+    if hooks != before {
+        return Ok(false);
+    }
+    for (address, expected) in runs {
+        let found = client.read_expecting(*address, expected)?;
+        if found
+            .iter()
+            .zip(expected)
+            .any(|(got, want)| Some(*got) != *want)
+        {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
