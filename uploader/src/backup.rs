@@ -22,7 +22,7 @@ use isa::objfmt::HookKind;
 
 use crate::client::Client;
 use crate::fingerprint;
-use crate::hooks::{read_hooks, switch_hook};
+use crate::hooks::{read_hooks, switch_hooks};
 use crate::image::{Area, RomProfile, UploadImage};
 use crate::loader::loader_plan;
 use crate::progress::Progress;
@@ -823,11 +823,11 @@ pub fn restore<T: Transport>(
         memory.loader = LoaderChoice::Never;
     }
     progress.event(&crate::progress::Event::RestoreStarted);
-    for kind in HookKind::ALL {
-        if let Some(to) = profile.reset_target(kind) {
-            switch_hook(client, profile.hook_address(kind), to, options.max_writes)?;
-        }
-    }
+    let to_rom: Vec<(HookKind, u16)> = HookKind::ALL
+        .into_iter()
+        .filter_map(|kind| profile.reset_target(kind).map(|to| (kind, to)))
+        .collect();
+    switch_hooks(client, profile, &to_rom, options.max_writes)?;
     let mut reports = Vec::new();
     if let Some(whole) = whole {
         let (through_loader, after) = split_for_loader(&memory, &whole, client.transport().baud())?;
@@ -843,14 +843,7 @@ pub fn restore<T: Transport>(
         }
     }
     crate::chain::check_restored(client, profile, &backup.hooks)?;
-    for &(kind, target) in &backup.hooks {
-        switch_hook(
-            client,
-            profile.hook_address(kind),
-            target,
-            options.max_writes,
-        )?;
-    }
+    switch_hooks(client, profile, &backup.hooks, options.max_writes)?;
     Ok(reports)
 }
 

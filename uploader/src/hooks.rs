@@ -226,6 +226,64 @@ pub(crate) fn switch_hook<T: Transport>(
     )
 }
 
+/// Points the hook at `address` to `target` as [`switch_hook`] does, but
+/// reads every RAM hook of the ROM back whole, the others as they were
+/// before (read first): a `/9W` to `HOOK_UNKNOWN`'s operand whose address
+/// digits noise changed lands on a hook's `JMP` opcode (`$0201` read as
+/// `$0200`, or `$0203`, `HOOK_LOOP`'s), and only a read of all of them
+/// finds that before the next unknown command, or the control loop's next
+/// pass, runs the byte there. The debug stub's attach and detach switch
+/// with this.
+pub(crate) fn switch_hook_among<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    address: u16,
+    target: u16,
+    max_writes: u32,
+) -> Result<()> {
+    let mut wanted = vec![Wanted {
+        address,
+        target,
+        also: None,
+        write: true,
+    }];
+    for (kind, now) in read_hooks(client, profile)? {
+        let other = profile.hook_address(kind);
+        if other != address {
+            wanted.push(Wanted {
+                address: other,
+                target: now,
+                also: None,
+                write: false,
+            });
+        }
+    }
+    settle_hooks(client, &wanted, max_writes)
+}
+
+/// Points each hook of `hooks` at its target, then reads them all back
+/// whole at once ([`settle_hooks`]): a restore's hooks, the last it writes.
+pub(crate) fn switch_hooks<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    hooks: &[(HookKind, u16)],
+    max_writes: u32,
+) -> Result<()> {
+    let wanted: Vec<Wanted> = hooks
+        .iter()
+        .map(|&(kind, target)| Wanted {
+            address: profile.hook_address(kind),
+            target,
+            also: None,
+            write: true,
+        })
+        .collect();
+    if wanted.is_empty() {
+        return Ok(());
+    }
+    settle_hooks(client, &wanted, max_writes)
+}
+
 /// Writes the hooks `wanted` says to (each operand with one `/9W`), then
 /// reads every hook in `wanted` back whole, opcode included (with one
 /// question when they lie within nine bytes, as on the reference ROM), and

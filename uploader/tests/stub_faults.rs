@@ -304,3 +304,51 @@ fn a_read_that_lost_a_digit_is_asked_again() {
     let hook = client.read_memory(0x0200, 3).expect("read again");
     assert_eq!(hook[0], 0x4C);
 }
+
+/// A `/9W` to `HOOK_UNKNOWN`'s operand whose address noise turned from
+/// `$0201` to `$0200` lands on the hook's `JMP` opcode. The read back of
+/// the operand alone put the operand right and left the opcode wrong: the
+/// next unknown command ran the byte there. Attach and detach read every
+/// hook back whole and put it right.
+#[test]
+fn a_hook_switch_that_landed_on_the_jmp_opcode_is_put_right() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let operand = format!("/9W{:04X}", HOOK_UNKNOWN + 1);
+    let opcode = format!("/9W{HOOK_UNKNOWN:04X}");
+    // The first switch (attach's), then the second (detach's).
+    for nth in [1, 2] {
+        let mut seen = 0;
+        let (operand, opcode) = (operand.clone(), opcode.clone());
+        let transport = Meddled {
+            inner: robot(&image),
+            sent: move |bytes: &[u8]| {
+                let text = String::from_utf8_lossy(bytes);
+                if text.contains(&operand) {
+                    seen += 1;
+                    if seen == nth {
+                        return text.replacen(&operand, &opcode, 1).into_bytes();
+                    }
+                }
+                bytes.to_vec()
+            },
+            heard: |_: &mut [u8]| {},
+        };
+        let client = uploader::client(transport, &profile);
+        let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+        let reply = debug.command(b"/1Q", Duration::from_secs(1)).expect("sent");
+        assert!(
+            matches!(&reply, uploader::stub::Reply::Answer(text) if text.starts_with(b"Q")),
+            "switch {nth}: {reply:?}"
+        );
+        let mut client = debug.detach().expect("detached");
+        let memory = client.transport().inner.robot().robot().board().memory();
+        let hook = usize::from(HOOK_UNKNOWN);
+        let [low, high] = image.hooks()[0].handler.to_le_bytes();
+        assert_eq!(
+            memory[hook..hook + 3],
+            [0x4C, low, high],
+            "switch {nth}: the hook's JMP, back at the image's handler"
+        );
+    }
+}

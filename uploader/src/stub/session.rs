@@ -115,6 +115,8 @@ pub struct RobotDebug<T> {
     interrupt: Option<Arc<AtomicBool>>,
     /// What a person's writes and registers may change.
     guard: Guard,
+    /// The ROM the image was linked against (its hooks, for detach).
+    profile: RomProfile,
 }
 
 /// What attach found of an earlier session that ended without detaching
@@ -228,6 +230,7 @@ impl<T: Transport> RobotDebug<T> {
             unasked: None,
             interrupt: None,
             guard: Guard::new(profile),
+            profile: profile.clone(),
         };
         let stopped = debug.probe()?.is_some();
         if stopped {
@@ -355,7 +358,17 @@ impl<T: Transport> RobotDebug<T> {
             };
             debug.rom_write_over(stub.address, &stub.bytes, held)?;
         }
-        debug.write_verified(hook + 1, &stub.handler.to_le_bytes())?;
+        if debug.stopped.is_some() {
+            debug.write_verified(hook + 1, &stub.handler.to_le_bytes())?;
+        } else {
+            crate::hooks::switch_hook_among(
+                &mut debug.client,
+                profile,
+                hook,
+                stub.handler,
+                ATTEMPTS,
+            )?;
+        }
         for (address, original) in leftovers {
             debug.patch(address, original)?;
             debug.recovery.removed.push(address);
@@ -1728,8 +1741,13 @@ impl<T: Transport> RobotDebug<T> {
         let hook = self.hook;
         let jump = self.client.read_memory(hook, 3)?;
         if u16::from_le_bytes([jump[1], jump[2]]) == self.stub.handler {
-            let previous = self.stub.previous.to_le_bytes();
-            self.rom_write_verified(hook + 1, &previous)?;
+            crate::hooks::switch_hook_among(
+                &mut self.client,
+                &self.profile,
+                hook,
+                self.stub.previous,
+                ATTEMPTS,
+            )?;
         }
         Ok(self.client)
     }
