@@ -109,7 +109,7 @@ impl Default for UploadOptions {
 }
 
 impl UploadOptions {
-    fn limits(&self) -> Limits {
+    pub(crate) fn limits(&self) -> Limits {
         Limits {
             max_writes: self.max_writes,
             max_passes: self.max_passes,
@@ -1222,7 +1222,7 @@ fn write_flags<T: Transport>(
 
 /// Whether the robot still answers after `error`: worth asking it to take
 /// the loader out.
-fn line_works(error: &Error) -> bool {
+pub(crate) fn line_works(error: &Error) -> bool {
     !recoverable(error)
         && !matches!(
             error,

@@ -142,6 +142,90 @@ fn lost_bytes_leave_nothing_unverified_reached() {
     assert!(finished > 0, "no session got through the noise");
 }
 
+/// A robot `image` was uploaded to (its table names it, the RAM loader
+/// is left in RAM), then a debugger attached through faults `config`.
+fn attached_after_an_upload(
+    image: &UploadImage,
+    config: FaultConfig,
+) -> (
+    Result<RobotDebug<FaultyTransport<VirtualTransport>>, String>,
+    Vec<u8>,
+) {
+    let profile = RomProfile::reference();
+    let mut client = uploader::client(common::robot(), &profile);
+    uploader::upload(
+        &mut client,
+        image,
+        &uploader::UploadOptions::default(),
+        &mut uploader::NoProgress,
+    )
+    .expect("uploaded");
+    let table = client.transport().robot().robot().board().memory()[EXTTAB].to_vec();
+    let transport = FaultyTransport::new(client.into_transport(), config);
+    let client = uploader::client(transport, &profile);
+    let attached = RobotDebug::attach(client, &profile, image.clone()).map_err(|e| e.to_string());
+    (attached, table)
+}
+
+/// The table of installed extensions (`EXTTAB`, docs/PROTOCOL.md).
+const EXTTAB: std::ops::Range<usize> =
+    romlib::symbols::EXTTAB as usize..romlib::symbols::EXTTAB as usize + 0x80;
+
+/// A session on a line that loses and changes bytes, on a robot the image
+/// was uploaded to: the stub goes in through the RAM loader's frames, and
+/// whatever the noise did, the table of installed extensions is as the
+/// upload left it and nothing unverified is reached (the noisy-line runs
+/// through a relay damaged the table, or jammed the CPU).
+#[test]
+fn noise_on_a_robot_the_image_was_uploaded_to_leaves_its_table_and_nothing_unverified() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let loader = uploader::loader_plan(&profile, &image, (9600, uploader::FAST_BAUD))
+        .expect("links")
+        .expect("room for the loader");
+    let mut finished = 0;
+    for seed in 0..12 {
+        let config = FaultConfig::noise(seed, 0.01, 0.01, 0.0);
+        let (attached, table) = attached_after_an_upload(&image, config);
+        let Ok(mut debug) = attached else {
+            continue;
+        };
+        let outcome = exercise(&mut debug);
+        finished += usize::from(outcome.is_ok());
+        let outcome = format!("seed {seed}: {outcome:?}");
+        let transport = debug.client().transport();
+        let memory = transport.inner_mut().robot().robot().board().memory();
+        // A `/1Q` whose Q noise made an R is the ROM's reset, which clears
+        // the entries' flags and nothing else.
+        let entries = romlib::installed::ENTRIES;
+        let table_now = &memory[EXTTAB];
+        let reset = table_now[..entries].iter().all(|&flag| flag == 0);
+        assert!(
+            table_now == &table[..] || (reset && table_now[entries..] == table[entries..]),
+            "the table ({outcome}): {table_now:02X?}, was {table:02X?}"
+        );
+        let hook = usize::from(HOOK_UNKNOWN);
+        let target = u16::from_le_bytes([memory[hook + 1], memory[hook + 2]]);
+        let loaders = [
+            loader.sums_handler,
+            loader.frames_handler,
+            loader.rate_handler,
+        ];
+        if loaders.contains(&target) {
+            // The attach gave up with the loader hooked: it is as linked.
+            let at = usize::from(loader.code.address);
+            assert_eq!(
+                memory[at..at + loader.code.bytes.len()],
+                loader.code.bytes[..],
+                "the loader hooked ({outcome})"
+            );
+        } else {
+            assert_safe(memory, &image, &outcome);
+        }
+    }
+    assert!(finished > 0, "no session got through the noise");
+}
+
 /// The virtual robot's line with a test's hand in it: `sent` may change
 /// what the host sends, `heard` what it receives (the bytes just come).
 struct Meddled<S, H> {
@@ -351,4 +435,56 @@ fn a_hook_switch_that_landed_on_the_jmp_opcode_is_put_right() {
             "switch {nth}: the hook's JMP, back at the image's handler"
         );
     }
+}
+
+/// The noisy-line sessions' damage (a table of installed extensions
+/// written over, a CPU jammed): the stub's six hundred bytes went in with
+/// three hundred `/9W`s, which carry no sum, and one whose address digits
+/// noise changed writes elsewhere. On a robot the image was uploaded to
+/// (its table names it), the stub goes in through the RAM loader's summed
+/// frames: a handful of `/9W`s are left, the hooks' switches. Then a
+/// session on a noisy line leaves the robot safe.
+#[test]
+fn the_stub_goes_in_through_the_ram_loaders_frames_not_the_roms_writes() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let mut client = uploader::client(common::robot(), &profile);
+    uploader::upload(
+        &mut client,
+        &image,
+        &uploader::UploadOptions::default(),
+        &mut uploader::NoProgress,
+    )
+    .expect("uploaded");
+    let writes = std::rc::Rc::new(std::cell::Cell::new(0usize));
+    let counted = std::rc::Rc::clone(&writes);
+    let transport = Meddled {
+        inner: client.into_transport(),
+        sent: move |bytes: &[u8]| {
+            let n = bytes
+                .windows(3)
+                .filter(|w| w == b"/9W" || w == b"/7W")
+                .count();
+            counted.set(counted.get() + n);
+            bytes.to_vec()
+        },
+        heard: |_: &mut [u8]| {},
+    };
+    let client = uploader::client(transport, &profile);
+    let debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    let stub = debug.stub().clone();
+    assert!(
+        writes.get() < 12,
+        "{} ROM writes for a stub of {} bytes",
+        writes.get(),
+        stub.bytes.len()
+    );
+    let mut client = debug.detach().expect("detached");
+    let memory = client.transport().inner.robot().robot().board().memory();
+    let at = usize::from(stub.address);
+    assert_eq!(
+        memory[at..at + usize::from(stub.code_end - stub.address)],
+        stub.bytes[..usize::from(stub.code_end - stub.address)],
+        "the stub's code, as linked"
+    );
 }

@@ -76,18 +76,33 @@ pub(crate) fn attach(
     // No `/1X` first: a robot left stopped in the stub answers none; attach
     // finds that out with a frame, and asks `/1X` of a running one.
     let mut client = uploader::client(transport, &profile);
-    // Reading the code and writing the stub with the ROM's commands takes
+    // Reading the code and writing the stub (through the RAM loader) takes
     // seconds at 9600 baud: said, so a silent terminal (or editor) is not
     // taken for a hang.
     if let Ok(stub) = uploader::stub::StubPlan::place(&profile, &code, 0) {
         let baud = resolved.baud.value as usize;
         let seconds = |chars: usize| (chars * 10).div_ceil(baud);
         let (all, code_len) = (stub.bytes.len(), usize::from(stub.code_end - stub.address));
-        // Two characters a byte read, 5.5 written (`/9W`); the image's code
-        // read once, the frame that asks for a stopped stub twice (1.3 s).
+        // Two characters a byte read, 5.5 written (`/9W`), about 1.5 in
+        // the RAM loader's frames with their sums; the image's code read
+        // once, the frame that asks for a stopped stub twice (1.3 s). The
+        // loader is read where an upload left it, written (`/9W`) the
+        // first time.
         let compared = code.len() * 2 + 1250 * baud / 10_000;
-        let first = compared + code_len * 4 + all * 15 / 2 + all * 2;
-        let again = compared + code_len * 2 + (all - code_len) * 15 / 2 + all * 2;
+        let loader = uploader::loader_plan(&profile, &code, (baud as u32, uploader::FAST_BAUD))
+            .ok()
+            .flatten()
+            .map(|plan| plan.code.bytes.len());
+        let (first, again) = match loader {
+            Some(loader) => (
+                compared + code_len * 2 + all * 3 / 2 + loader * 15 / 2 + loader * 2,
+                compared + code_len * 2 + (all - code_len) * 3 / 2 + loader * 2,
+            ),
+            None => (
+                compared + code_len * 4 + all * 15 / 2 + all * 2,
+                compared + code_len * 2 + (all - code_len) * 15 / 2 + all * 2,
+            ),
+        };
         say(&format!(
             "attaching to the robot on {}: comparing its code with the image and writing the debug stub (about {} s at {baud} baud; {} s the first time on this robot)",
             client.transport().name(),

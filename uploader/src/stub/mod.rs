@@ -10,7 +10,8 @@
 //! - [`frame`]: the stub's framing;
 //! - [`guard`]: what a person at a stop may change;
 //! - [`patch`]: what a breakpoint displaces, and where a step goes;
-//! - [`session`]: [`RobotDebug`], the debugger attached.
+//! - [`session`]: [`RobotDebug`], the debugger attached;
+//! - `summed`: the stub's code written through the RAM loader's frames.
 
 pub mod error;
 pub mod frame;
@@ -20,6 +21,7 @@ pub mod left;
 pub mod link;
 pub mod patch;
 pub mod session;
+mod summed;
 
 pub use error::{StubError, StubResult, hex as error_hex};
 pub use link::StubPlan;

@@ -119,6 +119,27 @@ pub struct RobotDebug<T> {
     profile: RomProfile,
 }
 
+/// The pieces of `bytes` (at `address`) that `held` (read there) does not
+/// hold, adjacent ones as one area.
+fn differing(address: u16, bytes: &[u8], held: &[u8]) -> Vec<crate::image::Area> {
+    let mut areas: Vec<crate::image::Area> = Vec::new();
+    for (i, piece) in bytes.chunks(ROM_PIECE).enumerate() {
+        let start = i * ROM_PIECE;
+        if held.get(start..start + piece.len()) == Some(piece) {
+            continue;
+        }
+        let at = address.wrapping_add(start as u16);
+        match areas.last_mut() {
+            Some(last) if last.end() == u32::from(at) => last.bytes.extend_from_slice(piece),
+            _ => areas.push(crate::image::Area {
+                address: at,
+                bytes: piece.to_vec(),
+            }),
+        }
+    }
+    areas
+}
+
 /// What attach found of an earlier session that ended without detaching
 /// (its process killed), and what it did: the earlier breakpoints are
 /// taken out, not adopted (their numbers and conditions died with that
@@ -196,10 +217,12 @@ impl<T: Transport> RobotDebug<T> {
     /// session that died is taken out (the image's bytes put back and
     /// read back), and a robot found stopped stays stopped, its PC at the
     /// image's instruction: [`RobotDebug::recovery`] says what was found.
-    /// Then the stub is linked where the image leaves room, written with
-    /// the ROM's commands and read back (only its code, through the stub's
-    /// frames, when it is the one running), and hooked into
-    /// `HOOK_UNKNOWN` ahead of what was there.
+    /// Then the stub is linked where the image leaves room, written
+    /// through the RAM loader's summed frames (with the ROM's commands,
+    /// read back, where the image leaves the loader no room; only its
+    /// code, through the stub's frames, when it is the one running), and
+    /// hooked into `HOOK_UNKNOWN` ahead of what was there, every hook read
+    /// back whole.
     ///
     /// # Errors
     /// The line's errors, [`StubError::NotTheImage`] (nothing written),
@@ -356,7 +379,17 @@ impl<T: Transport> RobotDebug<T> {
             } else {
                 &[]
             };
-            debug.rom_write_over(stub.address, &stub.bytes, held)?;
+            let todo = differing(stub.address, &stub.bytes, held);
+            let summed = !todo.is_empty()
+                && super::summed::write_summed(
+                    &mut debug.client,
+                    profile,
+                    (&debug.image, &installed),
+                    &todo,
+                )?;
+            if !summed {
+                debug.rom_write_over(stub.address, &stub.bytes, held)?;
+            }
         }
         if debug.stopped.is_some() {
             debug.write_verified(hook + 1, &stub.handler.to_le_bytes())?;

@@ -1,0 +1,71 @@
+//! The stub's code written through the RAM loader's frames, whose sum
+//! covers their address, rather than with the ROM's `/9W`, which has
+//! none: on a noisy line a `/9W` whose address digits changed writes two
+//! bytes elsewhere, and the stub's six hundred bytes took three hundred of
+//! them (a run at one byte in a hundred lost and one flipped left the
+//! table of installed extensions damaged). The loader an upload of the
+//! image left in RAM is verified by a read and used; where there is none,
+//! it is written first (a third as many `/9W`s as the stub), as an upload
+//! would. `HOOK_UNKNOWN` goes to the loader while the frames go in, and
+//! back to where it was after (read back whole).
+
+use isa::objfmt::HookKind;
+use romlib::installed::Installed;
+
+use crate::client::Client;
+use crate::hooks::read_hooks;
+use crate::image::{Area, RomProfile, UploadImage};
+use crate::loader::{FAST_BAUD, Loader};
+use crate::progress::NoProgress;
+use crate::session::Session;
+use crate::transport::Transport;
+use crate::upload::UploadOptions;
+
+/// Writes `areas` through the RAM loader placed for `image` (as an upload
+/// of it places it), verified by the robot's sums; `false`, with nothing
+/// written, when the image leaves the loader no room, the ROM lacks its
+/// services, or it may not go in beside the extensions `installed` (on
+/// one of them, or a hook leads to code no entry names, as an upload
+/// refuses it): the caller writes with the ROM's commands then.
+///
+/// # Errors
+/// The line's and the loader's errors; on a line that still works the
+/// loader is taken out first, `HOOK_UNKNOWN` back where it was.
+pub(super) fn write_summed<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    (image, installed): (&UploadImage, &[Installed]),
+    areas: &[Area],
+) -> crate::Result<bool> {
+    let base = client.transport().baud();
+    // Placed and linked as an upload's, so a loader one left is found: the
+    // line stays at its rate all the same (`None` for the fast one).
+    let Some(loader) = Loader::place(profile, image, (base, FAST_BAUD))? else {
+        return Ok(false);
+    };
+    let hooks = read_hooks(client, profile)?;
+    if crate::beside::refusal(client, profile, &hooks, installed, &loader)?.is_some() {
+        return Ok(false);
+    }
+    let Some(&(_, original)) = hooks.iter().find(|(kind, _)| *kind == HookKind::Unknown) else {
+        return Ok(false);
+    };
+    let limits = UploadOptions::default().limits();
+    let mut session = Session::new(loader, profile, original, (base, None), limits, true, None);
+    let mut progress = NoProgress;
+    let written = session
+        .install(client, &mut progress, &mut |_, _| Ok(()))
+        .and_then(|()| session.transfer_summed(client, areas, &mut progress));
+    match written {
+        Ok(_) => {
+            session.remove(client, &mut progress)?;
+            Ok(true)
+        }
+        Err(error) => {
+            if crate::upload::line_works(&error) {
+                let _ = session.remove(client, &mut progress);
+            }
+            Err(error)
+        }
+    }
+}
