@@ -479,6 +479,24 @@ fn huge_content_lengths_are_refused_and_the_session_goes_on() {
         let threads = c.request("threads", json!({}));
         assert_eq!(threads["success"], true, "{length}: {threads}");
     }
+    // hostile13: a request over the limit, its seq and command at its
+    // start, is answered, not only said.
+    let padding = " ".repeat(5_000_000);
+    c.send_body(&format!(
+        r#"{{"seq": 150, "type": "request", "command": "evaluate", "arguments": {{"expression": "A{padding}"}}}}"#
+    ));
+    let refused = c.response_to(150);
+    assert_eq!(
+        (&refused["success"], &refused["command"]),
+        (&json!(false), &json!("evaluate")),
+        "{refused}"
+    );
+    assert!(
+        refused["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("at most 4194304")),
+        "{refused}"
+    );
     assert_eq!(c.request("disconnect", json!({}))["success"], true);
     assert!(c.ends());
 }

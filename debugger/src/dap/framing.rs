@@ -24,6 +24,9 @@ pub const MAX_BODY: u64 = 4 << 20;
 /// for the next `Content-Length:` instead.
 const MAX_SKIP: u64 = 64 << 20;
 
+/// How much of a body too large to take is kept, to answer its request.
+pub const HEAD: u64 = 4096;
+
 /// The header that frames a message.
 const CONTENT_LENGTH: &[u8] = b"Content-Length:";
 
@@ -47,6 +50,10 @@ pub enum FrameError {
     TooLarge {
         /// Its `Content-Length`.
         length: u64,
+        /// Its first bytes (at most [`HEAD`]), where its `seq` and
+        /// `command` usually are: read when the body is skipped, so that the
+        /// request can still be answered.
+        head: Vec<u8>,
     },
     /// Bytes where a header should be: a message longer than its
     /// `Content-Length` said, or not framed at all.
@@ -172,16 +179,21 @@ impl<R: BufRead> FrameReader<R> {
     /// when that keeps the reader in step).
     fn body(&mut self, length: u64) -> std::io::Result<Result<Vec<u8>, FrameError>> {
         if length > MAX_BODY {
+            let mut head = Vec::new();
             if length <= MAX_SKIP {
-                let skipped =
-                    std::io::copy(&mut (&mut self.input).take(length), &mut std::io::sink())?;
+                let read = (&mut self.input).take(HEAD).read_to_end(&mut head)? as u64;
+                let skipped = read
+                    + std::io::copy(
+                        &mut (&mut self.input).take(length - read),
+                        &mut std::io::sink(),
+                    )?;
                 if skipped < length {
                     self.ended = true;
                 }
             } else {
                 self.lost = true;
             }
-            return Ok(Err(FrameError::TooLarge { length }));
+            return Ok(Err(FrameError::TooLarge { length, head }));
         }
         // Bounded by MAX_BODY, so the conversion holds.
         let mut body = Vec::with_capacity(usize::try_from(length).unwrap_or(0));
@@ -383,7 +395,8 @@ mod tests {
             read_all(input.as_bytes()),
             vec![
                 Err(FrameError::TooLarge {
-                    length: MAX_BODY + 10
+                    length: MAX_BODY + 10,
+                    head: b"x".repeat(4096),
                 }),
                 Ok("{}".to_owned())
             ]

@@ -217,6 +217,18 @@ pub fn serve_with(
         let body = match message {
             Ok(body) => body,
             Err(error) => {
+                // hostile13: a request too large to take was passed over
+                // with no response, and the client waited for one.
+                if let framing::FrameError::TooLarge { head, .. } = &error
+                    && let (Some(seq), command) = protocol::salvage(head)
+                {
+                    outbox.respond(
+                        seq,
+                        command.as_deref().unwrap_or_default(),
+                        Err(format!("{error}; the request was passed over")),
+                    )?;
+                    continue;
+                }
                 outbox.output(
                     "stderr",
                     &format!("scorpion dap: {error}; passed over, on to the next message\n"),

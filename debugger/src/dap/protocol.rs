@@ -104,8 +104,9 @@ pub fn parse(body: &[u8]) -> Incoming {
     })
 }
 
-/// `"seq": N` and `"command": "..."` read from a body that is not JSON.
-fn salvage(body: &[u8]) -> (Option<i64>, Option<String>) {
+/// `"seq": N` and `"command": "..."` read from a body that is not JSON
+/// (or the first bytes of one too large to take).
+pub(crate) fn salvage(body: &[u8]) -> (Option<i64>, Option<String>) {
     let text = String::from_utf8_lossy(body);
     let after = |key: &str| -> Option<String> {
         let at = text.find(&format!("\"{key}\""))? + key.len() + 2;
