@@ -488,3 +488,50 @@ fn the_stub_goes_in_through_the_ram_loaders_frames_not_the_roms_writes() {
         "the stub's code, as linked"
     );
 }
+
+/// The noisy-line run of seed 60: a reply whose length byte noise made
+/// larger (but no larger than a reply can be) waited for bytes that were
+/// the next replies, and swallowed them: eight attempts at a read failed
+/// on a line that carried every later reply whole. A reply that did not
+/// come whole by the time the host asks again is given up.
+#[test]
+fn a_reply_whose_length_grew_does_not_swallow_the_replies_after_it() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let armed = std::rc::Rc::new(std::cell::Cell::new(false));
+    let arm = std::rc::Rc::clone(&armed);
+    let mut length_next = false;
+    let transport = Meddled {
+        inner: robot(&image),
+        sent: |bytes: &[u8]| bytes.to_vec(),
+        // The byte after the first frame start once armed (the reply's
+        // length), however the bytes come in.
+        heard: move |bytes: &mut [u8]| {
+            for byte in bytes.iter_mut() {
+                match (armed.get(), length_next) {
+                    (true, true) => {
+                        *byte = 0x40;
+                        armed.set(false);
+                    }
+                    (true, false) => length_next = *byte == 0xF0,
+                    _ => {}
+                }
+            }
+        },
+    };
+    let client = uploader::client(transport, &profile);
+    let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    debug.set_breakpoint(AT, &[]).expect("set");
+    let reply = debug.command(b"/1Q", Duration::from_secs(1)).expect("sent");
+    assert!(
+        matches!(reply, uploader::stub::Reply::Stopped(_)),
+        "{reply:?}"
+    );
+    arm.set(true);
+    let bytes = debug
+        .read(0x0480, 1)
+        .expect("read, the first reply damaged");
+    assert_eq!(bytes, [0x42]);
+    debug.resume().expect("goes on");
+    debug.detach().expect("detached");
+}

@@ -92,6 +92,28 @@ pub fn take(rx: &mut Vec<u8>) -> Option<Heard> {
     Some(Heard::Text(rx.drain(..=end).collect()))
 }
 
+/// Gives up a frame at the front of `rx` that has not come whole (the
+/// host asks again: it never will). Its length byte may have been changed
+/// by noise into a larger one, and it would wait for the replies after it
+/// and swallow them (the noisy-line run of seed 60). What follows its
+/// start is read from the next frame's start. Returns the bytes given up.
+pub fn give_up_incomplete(rx: &mut Vec<u8>) -> Vec<u8> {
+    if rx.first() != Some(&SOF_OUT) {
+        return Vec::new();
+    }
+    let whole = rx
+        .get(1)
+        .is_some_and(|&len| rx.len() >= usize::from(len) + 3);
+    if whole {
+        return Vec::new();
+    }
+    let cut = rx[1..]
+        .iter()
+        .position(|&b| b == SOF_OUT)
+        .map_or(rx.len(), |at| at + 1);
+    rx.drain(..cut).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1076,6 +1076,8 @@ impl<T: Transport> RobotDebug<T> {
             if attempt == 0 {
                 self.rx.clear();
                 self.client.transport().clear_input()?;
+            } else {
+                frame::give_up_incomplete(&mut self.rx);
             }
             self.client.send_raw(&frame::encode(payload))?;
             let wait = char_time(
