@@ -535,3 +535,27 @@ fn a_reply_whose_length_grew_does_not_swallow_the_replies_after_it() {
     debug.resume().expect("goes on");
     debug.detach().expect("detached");
 }
+
+/// Seed 64 of the noisy-line runs: an attach whose line failed while the
+/// stub went in through the RAM loader left the loader hooked and said
+/// only "no answer"; the extensions' commands were dropped after. The
+/// loader is taken out where the line lets it, and where it does not,
+/// the error says it stays hooked and what to do.
+#[test]
+fn an_attach_whose_line_dies_in_the_loader_says_the_loader_stays_hooked() {
+    let image = handler();
+    let (clean, _) = attached_after_an_upload(&image, FaultConfig::none(3));
+    let sent = clean.expect("attaches").client().stats().sent;
+    let mut said = 0;
+    for at in (sent / 4..sent).step_by((sent / 40).max(1)) {
+        let config = FaultConfig {
+            stall_after: Some(at),
+            stall_for: None,
+            ..FaultConfig::none(3)
+        };
+        if let (Err(error), _) = attached_after_an_upload(&image, config) {
+            said += usize::from(error.contains("the loader stays hooked on HOOK_UNKNOWN"));
+        }
+    }
+    assert!(said > 0, "no cut left the loader hooked and said so");
+}

@@ -12,6 +12,25 @@ pub enum StubError {
     #[diagnostic(transparent)]
     Line(#[from] crate::Error),
 
+    /// Writing the stub through the RAM loader failed (the line), and the
+    /// loader could not be taken out of `HOOK_UNKNOWN` after: the robot
+    /// drops unknown commands until it is.
+    #[error(
+        "writing the debug stub through the RAM loader failed ({source}), and the loader stays hooked on HOOK_UNKNOWN (${hook:04X}): the robot drops the extensions' commands until it is taken out"
+    )]
+    #[diagnostic(
+        code(uploader::stub::loader_left),
+        help(
+            "nothing unverified is hooked; `scorpion upload` of the image finds the loader and takes it out (or reset the robot, which unhooks everything), then attach again; on a line this noisy, shorten or fix the cable first"
+        )
+    )]
+    LoaderLeft {
+        /// Why the write failed.
+        source: crate::Error,
+        /// Where `HOOK_UNKNOWN` is.
+        hook: u16,
+    },
+
     /// The stub does not link (a defect of this crate).
     #[error("the debug stub does not link at ${address:04X}: {message}")]
     #[diagnostic(code(uploader::stub::link))]

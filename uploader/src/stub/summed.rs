@@ -12,6 +12,7 @@
 use isa::objfmt::HookKind;
 use romlib::installed::Installed;
 
+use super::error::{StubError, StubResult};
 use crate::client::Client;
 use crate::hooks::read_hooks;
 use crate::image::{Area, RomProfile, UploadImage};
@@ -29,14 +30,16 @@ use crate::upload::UploadOptions;
 /// refuses it): the caller writes with the ROM's commands then.
 ///
 /// # Errors
-/// The line's and the loader's errors; on a line that still works the
-/// loader is taken out first, `HOOK_UNKNOWN` back where it was.
+/// The line's and the loader's errors, once the loader is taken out
+/// (`HOOK_UNKNOWN` back where it was); [`StubError::LoaderLeft`] when it
+/// could not be (seed 64 of the noisy-line runs: a frame the noise made
+/// longer held the loader until the line gave up).
 pub(super) fn write_summed<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     (image, installed): (&UploadImage, &[Installed]),
     areas: &[Area],
-) -> crate::Result<bool> {
+) -> StubResult<bool> {
     let base = client.transport().baud();
     // Placed and linked as an upload's, so a loader one left is found: the
     // line stays at its rate all the same (`None` for the fast one).
@@ -56,16 +59,13 @@ pub(super) fn write_summed<T: Transport>(
     let written = session
         .install(client, &mut progress, &mut |_, _| Ok(()))
         .and_then(|()| session.transfer_summed(client, areas, &mut progress));
-    match written {
-        Ok(_) => {
-            session.remove(client, &mut progress)?;
-            Ok(true)
-        }
-        Err(error) => {
-            if crate::upload::line_works(&error) {
-                let _ = session.remove(client, &mut progress);
-            }
-            Err(error)
-        }
+    let taken_out = session.remove(client, &mut progress);
+    match (written, taken_out) {
+        (Ok(_), Ok(())) => Ok(true),
+        (Err(error), Ok(())) => Err(error.into()),
+        (Ok(_), Err(error)) | (Err(error), Err(_)) => Err(StubError::LoaderLeft {
+            source: error,
+            hook: session.handler(),
+        }),
     }
 }
