@@ -559,3 +559,57 @@ fn an_attach_whose_line_dies_in_the_loader_says_the_loader_stays_hooked() {
     }
     assert!(said > 0, "no cut left the loader hooked and said so");
 }
+
+/// Seed 75 of the noisy-line runs: at `quit`, the go-on frame lost, then
+/// of the two frames that look for a stop one lost and one damaged (the
+/// stub answered `N`): the robot was taken for running and left stopped.
+/// An `N` is the stub, stopped: it is asked again.
+#[test]
+fn a_stub_that_answers_n_to_the_look_for_a_stop_is_taken_as_stopped() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let armed = std::rc::Rc::new(std::cell::Cell::new(false));
+    let arm = std::rc::Rc::clone(&armed);
+    let mut looks = 0;
+    let transport = Meddled {
+        inner: robot(&image),
+        sent: move |bytes: &[u8]| {
+            if !armed.get() || bytes.first() != Some(&0xF1) {
+                return bytes.to_vec();
+            }
+            if bytes.get(1..5) == Some(b"0343") {
+                // The go-on frame, lost.
+                return Vec::new();
+            }
+            if bytes.get(1..5) == Some(b"0452") {
+                looks += 1;
+                match looks {
+                    1 => return Vec::new(),
+                    2 => {
+                        let mut damaged = bytes.to_vec();
+                        let last = damaged.len() - 1;
+                        damaged[last] ^= 0x01;
+                        armed.set(false);
+                        return damaged;
+                    }
+                    _ => {}
+                }
+            }
+            bytes.to_vec()
+        },
+        heard: |_: &mut [u8]| {},
+    };
+    let client = uploader::client(transport, &profile);
+    let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    debug.set_breakpoint(AT, &[]).expect("set");
+    let reply = debug.command(b"/1Q", Duration::from_secs(1)).expect("sent");
+    assert!(
+        matches!(reply, uploader::stub::Reply::Stopped(_)),
+        "{reply:?}"
+    );
+    arm.set(true);
+    let mut client = debug.detach().expect("detached, the robot given back");
+    let memory = client.transport().inner.robot().robot().board().memory();
+    let at = usize::from(AT);
+    assert_ne!(memory[at], 0x20, "the breakpoint's JSR taken out");
+}

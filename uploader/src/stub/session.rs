@@ -480,7 +480,15 @@ impl<T: Transport> RobotDebug<T> {
     fn probe(&mut self) -> StubResult<Option<Option<Registers>>> {
         let regs = self.stub.regs.to_le_bytes();
         let payload = [b'R', regs[0], regs[1], 8];
-        for _ in 0..2 {
+        // Twice when nothing answers (a running robot ignores the frame);
+        // a stub's `N` says it is there, stopped: asked until it answers
+        // (seed 75 of the noisy-line runs: a lost frame, then an `N`, and
+        // `quit` took the robot for running and left it stopped).
+        let mut nak = false;
+        for attempt in 0..ATTEMPTS {
+            if attempt >= 2 && !nak {
+                break;
+            }
             self.rx.clear();
             self.client.transport().clear_input()?;
             self.client.send_raw(&frame::encode(&payload))?;
@@ -509,6 +517,7 @@ impl<T: Transport> RobotDebug<T> {
                         }
                         if reply == [b'N'] {
                             // A stub, which heard the frame damaged: again.
+                            nak = true;
                             break;
                         }
                         return Err(stopped_in_another_stub(self.stub.address));
@@ -519,6 +528,13 @@ impl<T: Transport> RobotDebug<T> {
             }
         }
         self.rx.clear();
+        if nak {
+            return Err(StubError::Garbled {
+                asked: "the registers of a stop (the stub answered `N`: it is stopped)".into(),
+                expected: "a frame with a good sum".into(),
+                found: "N".into(),
+            });
+        }
         Ok(None)
     }
 
