@@ -14,6 +14,19 @@ pub const UNDONE: &str = ".undone";
 pub const UNDOING: &str = ".undoing";
 /// Marks an undo file whose upload wrote it and has not finished.
 pub const UPLOADING: &str = ".uploading";
+/// The finished undo file an upload found, kept on disk until the upload
+/// has finished (hostile14 F2: an upload that changed nothing, killed
+/// before it knew, had written its own over it): after an undo of an
+/// upload that did not finish, it is the undo file again.
+pub const BEFORE: &str = ".before";
+
+/// After a successful undo of the file at `path` (marked used): an undo
+/// file that goes further back ([`BEFORE`], left by an upload that did
+/// not finish) becomes the undo file. Returns whether there was one.
+pub fn further_back(path: &Path) -> bool {
+    let before = marked(path, BEFORE);
+    before.is_file() && !path.exists() && std::fs::rename(&before, path).is_ok()
+}
 
 /// The undo file at `path` marked with `mark` (one of [`UNDONE`],
 /// [`UNDOING`], [`UPLOADING`]).
@@ -127,7 +140,17 @@ impl uploader::Keep for UndoFile {
             // A file an upload or an undo did not finish is no undo to go
             // back to (and the upload was refused before it started).
             let finished = unfinished(&self.path).is_none();
-            self.older = Some(std::fs::read(&self.path).ok().filter(|_| finished));
+            let older = std::fs::read(&self.path).ok().filter(|_| finished);
+            // On disk too, until this upload has finished: killed before
+            // it knew whether it changed anything, its own file would be
+            // the only one left.
+            let _ = std::fs::remove_file(marked(&self.path, BEFORE));
+            if let Some(older) = &older
+                && let Err(error) = hostfs::write(marked(&self.path, BEFORE), older)
+            {
+                self.failed = Some(error);
+            }
+            self.older = Some(older);
         }
         // Marked first: an upload killed from here on has not finished,
         // and the next one must not replace what the file keeps.
@@ -147,6 +170,7 @@ impl uploader::Keep for UndoFile {
         self.keep(kept);
         self.older = None;
         self.kept_older = false;
+        let _ = std::fs::remove_file(marked(&self.path, BEFORE));
     }
 
     /// fresh13 F1: an upload that changed nothing (`test --port` again,
@@ -155,13 +179,22 @@ impl uploader::Keep for UndoFile {
     /// upload that put the image there, not to "installed".
     /// What the RAM loader went over this time, which the older file may
     /// not hold, is added to it.
-    fn finished_unchanged(&mut self, kept: &uploader::Backup) {
+    fn finished_unchanged(&mut self, kept: &uploader::Backup, loader_went_over: &[uploader::Area]) {
         let name = self.path.display().to_string();
+        // hostile14 F1: where this upload's loader went over bytes the
+        // older file holds (put there since that upload), the older file
+        // would lose them: this upload's file is kept, as for a change.
         let older = self
             .older
             .take()
             .flatten()
-            .and_then(|older| uploader::Backup::decode(&name, &older).ok());
+            .and_then(|older| uploader::Backup::decode(&name, &older).ok())
+            .filter(|older| {
+                !loader_went_over.iter().any(|area| {
+                    (0..area.bytes.len())
+                        .any(|i| older.byte_at(u32::from(area.address) + i as u32).is_some())
+                })
+            });
         match older {
             Some(older) => {
                 let both = older.going_further_back(kept);
@@ -173,5 +206,98 @@ impl uploader::Keep for UndoFile {
             None => self.keep(kept),
         }
         self.older = None;
+        let _ = std::fs::remove_file(marked(&self.path, BEFORE));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use uploader::{Area, Backup, Keep};
+
+    fn backup(byte: u8) -> Backup {
+        Backup {
+            areas: vec![Area {
+                address: 0x0400,
+                bytes: vec![byte; 4],
+            }],
+            ..Backup::default()
+        }
+    }
+
+    fn held(path: &Path) -> Backup {
+        Backup::decode("undo", &std::fs::read(path).expect("the undo file")).expect("decodes")
+    }
+
+    /// hostile14 F2: an upload killed before it knew it changed nothing
+    /// had written its own undo file over the one it found, the only
+    /// record of the robot before the upload that put the image there.
+    /// That one waits beside it, and after the undo of the killed upload
+    /// it is the undo file again.
+    #[test]
+    fn the_undo_file_an_unfinished_upload_found_is_the_next_undo() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        hostfs::write(&path, &backup(1).encode()).expect("the older file");
+        let mut undo = UndoFile::new(path.clone());
+        undo.keep(&backup(2));
+        assert_eq!(
+            held(&path),
+            backup(2),
+            "this upload's, written before any change"
+        );
+        assert_eq!(
+            held(&marked(&path, BEFORE)),
+            backup(1),
+            "the one found, beside it"
+        );
+        // Killed here. The undo of this upload marks its file used.
+        drop(undo);
+        std::fs::rename(&path, marked(&path, UNDONE)).expect("marked used");
+        assert!(further_back(&path));
+        assert_eq!(
+            held(&path),
+            backup(1),
+            "the older file is the undo file again"
+        );
+        assert!(!marked(&path, BEFORE).exists());
+        assert!(!further_back(&path), "once");
+    }
+
+    /// A finished upload leaves nothing beside its file: a change keeps
+    /// its own, no change the older one with what the loader went over
+    /// (where the older holds nothing), and the older one's own bytes
+    /// where the loader went over bytes it holds is a change after all.
+    #[test]
+    fn a_finished_upload_leaves_one_undo_file() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        for (unchanged, over, kept) in [
+            (false, 0x0000, backup(2)),
+            (true, 0x0800, backup(1)),
+            (true, 0x0401, backup(2)),
+        ] {
+            hostfs::write(&path, &backup(1).encode()).expect("the older file");
+            let mut undo = UndoFile::new(path.clone());
+            undo.keep(&backup(2));
+            let over = [Area {
+                address: over,
+                bytes: vec![9],
+            }];
+            if unchanged {
+                undo.finished_unchanged(&backup(2), &over);
+            } else {
+                undo.finished(&backup(2));
+            }
+            assert_eq!(
+                held(&path),
+                kept,
+                "unchanged {unchanged}, loader over {:04X}",
+                over[0].address
+            );
+            assert_eq!(undo.kept_older, kept == backup(1));
+            assert!(!marked(&path, BEFORE).exists());
+            undo.finished_upload();
+        }
     }
 }

@@ -436,6 +436,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         }
         // An upload that did not finish is undone too.
         let _ = std::fs::remove_file(marked(&path, UPLOADING));
+        if scorpion_project::undo::further_back(&path) {
+            print(&format!(
+                "{} now holds the undo of the upload before that one (the one undone did not finish): `scorpion upload --undo` again puts back what the robot held before it\n",
+                path.display()
+            ));
+        }
         return Ok(code);
     }
     // The undo file is written during the upload: a FIFO or a device there

@@ -698,3 +698,58 @@ fn a_transcript_failing_on_a_port_names_the_cards_the_rehearsal_had() {
         "{text}"
     );
 }
+
+/// hostile14 F1: data written by hand where the first upload's RAM loader
+/// had run; the same upload again (its loader written over the data) kept
+/// the first upload's undo file, whose bytes there were from before it:
+/// the undo wrote them over the data, which was gone for good. Where the
+/// loader went over bytes the older file holds, the upload keeps its own.
+#[test]
+fn a_no_change_upload_whose_loader_went_over_data_keeps_an_undo_that_puts_it_back() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(
+        d.join("ext.elf"),
+        crate::robot::extension_at(0x0400, 600, None),
+    )
+    .expect("the image");
+    let sim = Sim::start(d, &[]);
+    let line = ["--port", sim.path.as_str()];
+    ok(
+        d,
+        &line,
+        &["upload", "ext.elf", "--no-dry-run", "--loader", "always"],
+    );
+    let installed = ok(d, &line, &["installed"]);
+    let loader = installed
+        .split("RAM loader ($")
+        .nth(1)
+        .and_then(|rest| rest.get(..4))
+        .map(str::to_owned);
+    // Where the loader ran: the top of user RAM ($0E8C on the reference
+    // ROM), whatever `installed` says of it.
+    let at = loader.unwrap_or_else(|| "0E8C".to_owned());
+    ok(
+        d,
+        &line,
+        &["ask", &format!("/9W{at}A1A2"), "--allow-silence"],
+    );
+    let data = ok(d, &line, &["read", &format!("${at}"), "2"]);
+    assert!(data.contains("A1 A2"), "{data}");
+    let again = ok(
+        d,
+        &line,
+        &["upload", "ext.elf", "--no-dry-run", "--loader", "always"],
+    );
+    assert!(
+        !again.contains("the robot held this image already"),
+        "{again}"
+    );
+    let undone = ok(d, &line, &["upload", "--undo"]);
+    assert!(undone.contains("restored"), "{undone}");
+    assert_eq!(
+        ok(d, &line, &["read", &format!("${at}"), "2"]),
+        data,
+        "the data put back"
+    );
+}

@@ -88,9 +88,12 @@ pub trait Keep {
     /// hooks where they were: read back to be sure), but for the RAM
     /// loader, which `kept` holds what it went over of: what an earlier
     /// upload of it kept, with that ([`Backup::going_further_back`]),
-    /// undoes this one too and goes further back. By default,
-    /// [`Keep::finished`].
-    fn finished_unchanged(&mut self, kept: &Backup) {
+    /// undoes this one too and goes further back, unless it holds bytes
+    /// where `loader_went_over` (the loader's code written this time over
+    /// other bytes, which an older file would put back as they were before
+    /// it, losing these). By default, [`Keep::finished`].
+    fn finished_unchanged(&mut self, kept: &Backup, loader_went_over: &[Area]) {
+        let _ = loader_went_over;
         self.finished(kept);
     }
 }

@@ -82,7 +82,7 @@ pub(crate) fn rate_toggle((base, fast): (u32, u32)) -> u8 {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct Loader {
     /// Its bytes: one area, `rate` first.
-    image: UploadImage,
+    pub(crate) image: UploadImage,
     /// `rate`'s address: where `HOOK_UNKNOWN` points while the line is
     /// switched.
     pub(crate) rate: u16,

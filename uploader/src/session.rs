@@ -153,6 +153,11 @@ impl Session {
             || (zero_page..zero_page + u16::from(crate::loader::ZERO_PAGE_LEN)).contains(&address)
     }
 
+    /// The loader's code byte at `address`, if its code is there.
+    pub(crate) fn code_byte(&self, address: u16) -> Option<u8> {
+        self.loader.image.byte(address)
+    }
+
     /// The loader's first address and the size of what went in.
     pub(crate) fn placement(&self) -> (u16, usize) {
         let len = if self.with_sums {

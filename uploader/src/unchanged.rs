@@ -14,7 +14,7 @@
 use crate::backup::Backup;
 use crate::client::Client;
 use crate::hooks::read_hooks;
-use crate::image::{RomProfile, UploadImage};
+use crate::image::{Area, RomProfile, UploadImage};
 use crate::transport::Transport;
 
 /// What the loader owns, which an upload through it always changes (its
@@ -91,4 +91,30 @@ fn holds<T: Transport>(
         }
     }
     Ok(true)
+}
+
+/// What `kept` held where the RAM loader's code is now and held other
+/// bytes before this upload: what the loader went over this time (not
+/// where an earlier upload left it). A keeper going further back
+/// ([`crate::Keep::finished_unchanged`]) must not lose it to an older
+/// file's bytes there (hostile14 F1: data written by hand where an
+/// earlier upload's loader had been).
+pub(crate) fn loader_went_over(kept: &Backup, code_byte: &dyn Fn(u16) -> Option<u8>) -> Vec<Area> {
+    let mut over: Vec<Area> = Vec::new();
+    for area in &kept.areas {
+        for (offset, &byte) in area.bytes.iter().enumerate() {
+            let address = area.address.wrapping_add(offset as u16);
+            if code_byte(address).is_none_or(|code| code == byte) {
+                continue;
+            }
+            match over.last_mut() {
+                Some(last) if last.end() == u32::from(address) => last.bytes.push(byte),
+                _ => over.push(Area {
+                    address,
+                    bytes: vec![byte],
+                }),
+            }
+        }
+    }
+    over
 }

@@ -748,7 +748,9 @@ pub fn upload_keeping<T: Transport>(
             &owns,
         );
         if unchanged {
-            keep.finished_unchanged(&kept);
+            let code_byte = |address: u16| session.as_ref().and_then(|s| s.code_byte(address));
+            let over = crate::unchanged::loader_went_over(&kept, &code_byte);
+            keep.finished_unchanged(&kept, &over);
         } else {
             keep.finished(&kept);
         }

@@ -31,7 +31,7 @@ impl uploader::Keep for Kept {
         self.0 = Some(overwritten.clone());
     }
 
-    fn finished_unchanged(&mut self, kept: &uploader::Backup) {
+    fn finished_unchanged(&mut self, kept: &uploader::Backup, _over: &[uploader::Area]) {
         self.keep(kept);
         self.1 = true;
     }
