@@ -303,3 +303,26 @@ fn a_stop_whose_frame_was_lost_is_found_before_a_command_that_needs_one() {
     let shown = text(&mut m, &mut d, "continue");
     assert!(shown.contains("answer: 42"), "{shown}");
 }
+
+/// hostile14 F3: while the robot runs, an expression that reads no
+/// register (`$A`, a character) is evaluated; one that reads a register is
+/// refused. F4: a display of many neighbouring bytes is read in spans, not
+/// one `/7R` a byte (18 s for a thousand bytes, at every command).
+#[test]
+fn expressions_read_what_they_need_while_the_robot_runs() {
+    let (mut m, mut d) = attached();
+    assert_eq!(text(&mut m, &mut d, "print $A"), "$0A\n");
+    assert_eq!(text(&mut m, &mut d, "print 'X' + 1"), "$59\n");
+    assert!(refusal(&mut m, &mut d, "print X + 1").contains("registers are known only at a stop"));
+    let sum: Vec<String> = (0..200).map(|i| format!("[${:04X}]", 0x0400 + i)).collect();
+    let sent = d.client().stats().sent;
+    let shown = text(&mut m, &mut d, &format!("display {}", sum.join("+")));
+    let cost = d.client().stats().sent - sent;
+    assert!(shown.starts_with("display 1: "), "{shown}");
+    // A question (`/7Raaaann`) per 99 bytes, not per byte (9 characters
+    // each: 1800 for the 200).
+    assert!(
+        cost < 60,
+        "{cost} characters sent for 200 neighbouring bytes"
+    );
+}

@@ -1323,6 +1323,16 @@ impl<T: Transport> RobotDebug<T> {
         self.interrupt = Some(flag);
     }
 
+    /// Whether the flag [`RobotDebug::set_interrupt`] gave is set: for
+    /// work of the caller's own that takes many questions (a display that
+    /// reads much memory).
+    #[must_use]
+    pub fn interrupted(&self) -> bool {
+        self.interrupt
+            .as_ref()
+            .is_some_and(|flag| flag.load(Ordering::Relaxed))
+    }
+
     /// Changes the registers of the stopped robot, as a person asks (the
     /// PC is where `resume` goes on).
     ///
