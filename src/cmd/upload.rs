@@ -233,7 +233,7 @@ impl Progress for Bar {
                 kind.rom_symbol()
             ),
             Event::HookDisarmed { kind, from, to } => format!(
-                "{} pointed into the upload (${from:04X}); pointed it at ${to:04X} first",
+                "{} pointed into the upload (${from:04X}); pointed it at ${to:04X} while the upload runs (it is hooked to the image again at the end)",
                 kind.rom_symbol()
             ),
             Event::LoaderRestored { baud, .. } => format!(

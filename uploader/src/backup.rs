@@ -879,6 +879,12 @@ fn refuse_later_uploads<T: Transport>(
         {
             continue;
         }
+        // fresh14 F3: the RAM loader the upload being undone hooked (found
+        // in RAM, so its file does not hold it) and left hooked, killed:
+        // verified code of that upload's, which the hooks leave first.
+        if crate::loader::loader_left_at(client, profile, current)?.is_some() {
+            continue;
+        }
         let owner = crate::table::read_installed(client, profile)
             .ok()
             .and_then(|everyone| {

@@ -401,6 +401,29 @@ fn a_replace_cut_anywhere_leaves_an_undo_that_puts_the_old_extension_back() {
     replaced_cut_anywhere_then_undo(&old, &one_byte_changed(&old, 1000));
 }
 
+/// fresh14 F3: a `--replace --full` cut while the RAM loader an earlier
+/// upload left in RAM was hooked: the undo was refused ("an upload after
+/// the one it undoes was chained ahead"), for a hook at the loader, which
+/// the file did not hold. Cut anywhere, undone.
+#[test]
+fn a_full_replace_cut_anywhere_leaves_an_undo_that_puts_the_old_extension_back() {
+    let old = extension(1024, 8);
+    let new = one_byte_changed(&old, 1000);
+    let options = UploadOptions {
+        replace: true,
+        delta: false,
+        ..UploadOptions::default()
+    };
+    let installed = || {
+        let (transport, _) = patterned_robot();
+        let (result, transport) = common::run(transport, &old, &options);
+        result.expect("the first upload");
+        let before = user_memory(transport.robot());
+        (transport, before)
+    };
+    cut_anywhere_then_undo(&installed, &new, &options, (10..2000).step_by(15));
+}
+
 /// The same image again (its hook disarmed first, the RAM loader found
 /// where the first upload left it and hooked): cut anywhere, undone.
 #[test]
@@ -635,5 +658,107 @@ fn a_loop_handler_that_never_goes_on_is_named_when_the_robot_goes_silent() {
         error
             .to_string()
             .contains("HOOK_LOOP was pointed at the image's handler ($0400)")
+    );
+}
+
+/// The virtual robot's line, dead for good once the host has sent
+/// `until` (the robot keeps running; nothing more reaches either end).
+struct DeadAfter {
+    inner: VirtualTransport,
+    until: Vec<u8>,
+    sent: Vec<u8>,
+    dead: bool,
+}
+
+impl uploader::transport::Transport for DeadAfter {
+    fn send(&mut self, bytes: &[u8]) -> uploader::Result<()> {
+        if self.dead {
+            return Ok(());
+        }
+        self.sent.extend_from_slice(bytes);
+        self.dead = self.sent.windows(self.until.len()).any(|w| w == self.until);
+        self.inner.send(bytes)
+    }
+    fn receive(
+        &mut self,
+        into: &mut Vec<u8>,
+        timeout: std::time::Duration,
+    ) -> uploader::Result<usize> {
+        let mut heard = Vec::new();
+        let n = self.inner.receive(&mut heard, timeout)?;
+        if self.dead {
+            return Ok(0);
+        }
+        into.extend_from_slice(&heard);
+        Ok(n)
+    }
+    fn baud(&self) -> u32 {
+        self.inner.baud()
+    }
+    fn set_baud(&mut self, baud: u32) -> uploader::Result<()> {
+        self.inner.set_baud(baud)
+    }
+    fn now(&self) -> std::time::Duration {
+        self.inner.now()
+    }
+    fn clear_input(&mut self) -> uploader::Result<()> {
+        self.inner.clear_input()
+    }
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+}
+
+/// fresh14 F3: a replace killed once it had hooked the RAM loader an
+/// earlier upload left in RAM (so its undo file does not hold the
+/// loader): the undo was refused, as if a later upload were chained
+/// ahead, and every way out with it. The loader is the upload's own.
+#[test]
+fn an_undo_takes_out_the_ram_loader_a_killed_upload_left_hooked() {
+    let old = extension(1024, 8);
+    let new = one_byte_changed(&old, 1000);
+    let options = UploadOptions {
+        replace: true,
+        delta: false,
+        ..UploadOptions::default()
+    };
+    let (transport, _) = patterned_robot();
+    let (result, transport) = common::run(transport, &old, &options);
+    result.expect("the first upload");
+    let before = user_memory(transport.robot());
+    let plan = uploader::loader_plan(&options.profile, &new, (9600, uploader::FAST_BAUD))
+        .expect("links")
+        .expect("room");
+    let [low, high] = plan.frames_handler.to_le_bytes();
+    let until = format!("/9W{:04X}{low:02X}{high:02X}", HOOK_UNKNOWN + 1).into_bytes();
+    let cut = DeadAfter {
+        inner: transport,
+        until,
+        sent: Vec::new(),
+        dead: false,
+    };
+    let mut client = uploader::client(cut, &options.profile);
+    let mut kept = Kept::default();
+    let result = upload_keeping(&mut client, &new, &options, &mut NoProgress, &mut kept);
+    assert!(result.is_err(), "the line died");
+    let transport = client.into_transport().inner;
+    let memory = transport.robot().robot().board().memory();
+    let hook = usize::from(HOOK_UNKNOWN);
+    let target = u16::from_le_bytes([memory[hook + 1], memory[hook + 2]]);
+    assert!(
+        [plan.frames_handler, plan.sums_handler].contains(&target),
+        "the loader hooked: ${target:04X}"
+    );
+    let mut client = uploader::client(transport, &options.profile);
+    let undo = UploadOptions {
+        undo: true,
+        ..options
+    };
+    restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("the undo");
+    let after = user_memory(client.transport().robot());
+    assert_eq!(
+        first_difference(&after, &before),
+        None,
+        "the old extension back"
     );
 }
