@@ -378,7 +378,7 @@ impl RobotMonitor {
                     Some(slot @ Some(_)) => *slot = None,
                     _ => return Err(usage(&format!("no display {n}"))),
                 }
-                format!("undisplay {n}\n")
+                format!("display {n} removed\n")
             }
             "dis" | "d" => self.dis(d, &rest)?,
             "watch" | "w" => {

@@ -108,7 +108,8 @@ fn displays_are_read_while_it_runs_and_at_a_stop() {
         text(&mut m, &mut d, "display A"),
         "display 2: A = (the robot is running: registers are known only at a stop)\n"
     );
-    text(&mut m, &mut d, "undisplay 2");
+    // fresh14 F4: said as the virtual monitor says it.
+    assert_eq!(text(&mut m, &mut d, "undisplay 2"), "display 2 removed\n");
     // Running: read with /7R after the command's answer.
     let shown = text(&mut m, &mut d, "/1Q");
     assert!(shown.contains("answer: Q5A\n1: [$0480] = $5A"), "{shown}");

@@ -107,6 +107,9 @@ pub struct UndoFile {
     /// Whether the last upload changed nothing and the undo file it found
     /// was kept (see [`uploader::Keep::finished_unchanged`]).
     pub kept_older: bool,
+    /// Why the undo file an upload that changed nothing found could not
+    /// be kept (damaged: it is replaced by this upload's).
+    pub older_damaged: Option<String>,
 }
 
 impl UndoFile {
@@ -119,6 +122,7 @@ impl UndoFile {
             kept: Arc::default(),
             older: None,
             kept_older: false,
+            older_damaged: None,
         }
     }
 
@@ -188,7 +192,14 @@ impl uploader::Keep for UndoFile {
             .older
             .take()
             .flatten()
-            .and_then(|older| uploader::Backup::decode(&name, &older).ok())
+            .and_then(|older| match uploader::Backup::decode(&name, &older) {
+                Ok(older) => Some(older),
+                Err(error) => {
+                    // hostile14 F5: said, not replaced without a word.
+                    self.older_damaged = Some(error.to_string());
+                    None
+                }
+            })
             .filter(|older| {
                 !loader_went_over.iter().any(|area| {
                     (0..area.bytes.len())
@@ -262,6 +273,23 @@ mod tests {
         );
         assert!(!marked(&path, BEFORE).exists());
         assert!(!further_back(&path), "once");
+    }
+
+    /// hostile14 F5: a damaged undo file found by an upload that changed
+    /// nothing was replaced without a word; it is said.
+    #[test]
+    fn a_damaged_undo_file_found_is_said_when_replaced() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        let mut damaged = backup(1).encode();
+        damaged.truncate(damaged.len() / 2);
+        hostfs::write(&path, &damaged).expect("the older file");
+        let mut undo = UndoFile::new(path.clone());
+        undo.keep(&backup(2));
+        undo.finished_unchanged(&backup(2), &[]);
+        assert_eq!(held(&path), backup(2));
+        assert!(!undo.kept_older);
+        assert!(undo.older_damaged.is_some());
     }
 
     /// A finished upload leaves nothing beside its file: a change keeps

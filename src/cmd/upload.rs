@@ -638,6 +638,13 @@ fn upload_file(
     }
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
+    if let Some(why) = &undo.older_damaged {
+        let _ = writeln!(
+            out,
+            "warning: the robot held this image already, but the undo file found ({}) was damaged ({why}): it is replaced by this upload's, which puts back the robot as this upload found it",
+            undo.path.display()
+        );
+    }
     if undo.kept_older {
         let _ = writeln!(
             out,

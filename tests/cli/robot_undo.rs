@@ -753,3 +753,22 @@ fn a_no_change_upload_whose_loader_went_over_data_keeps_an_undo_that_puts_it_bac
         "the data put back"
     );
 }
+
+/// fresh14 F5: `test --port` on a robot that answers nothing ended with
+/// "`scorpion test --port --replace` replaces what the robot has there":
+/// nothing was in the way. The hint comes only where something is.
+#[test]
+fn test_on_a_port_that_answers_nothing_gives_no_replace_hint() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let sim = Sim::start(dir.path(), &[]);
+    // The port is there; the robot behind it stands still.
+    let pid = nix::unistd::Pid::from_raw(i32::try_from(sim.child.id()).expect("a pid"));
+    nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGSTOP).expect("stopped");
+    let output = scorpion(&project, &["test", "--port", &sim.path]);
+    let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGCONT);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(text.contains("upload myext ... FAILED"), "{text}");
+    assert!(!text.contains("--replace"), "{text}");
+}

@@ -642,8 +642,14 @@ impl Run<'_, '_, '_> {
                     undo,
                 ),
                 None => uploader::upload(&mut client, &upload, &options, &mut uploader::NoProgress),
-            }
-            .map_err(|source| Error::UploadImage {
+            };
+            // fresh14 F5: the hint only where something installed is in
+            // the way, not after every failure (a robot that is not there).
+            let in_the_way = matches!(
+                uploaded,
+                Err(uploader::Error::Robot(_) | uploader::Error::HookInUse { .. })
+            );
+            let uploaded = uploaded.map_err(|source| Error::UploadImage {
                 image: image.name.clone(),
                 source: Box::new(source),
             });
@@ -658,7 +664,7 @@ impl Run<'_, '_, '_> {
                         undo::UPLOADING
                     ));
                 }
-                if !self.options.replace {
+                if !self.options.replace && in_the_way {
                     why.push_str(
                         "    (`scorpion test --port --replace` replaces what the robot has there)\n",
                     );
