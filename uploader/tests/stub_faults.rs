@@ -613,3 +613,51 @@ fn a_stub_that_answers_n_to_the_look_for_a_stop_is_taken_as_stopped() {
     let at = usize::from(AT);
     assert_ne!(memory[at], 0x20, "the breakpoint's JSR taken out");
 }
+
+/// Seed 111 of the noisy-line runs: a write frame whose two changed
+/// digits kept its sum (`20 09 FF` went in as `22 09 FD`): the read back
+/// in the stub's reply told, and the write ended in an error with the
+/// bytes wrong in the code; the next `continue` jammed the CPU on them.
+/// The write is sent again until it reads back right.
+#[test]
+fn a_write_whose_damage_kept_the_frames_sum_is_sent_again() {
+    let image = handler();
+    let profile = RomProfile::reference();
+    let armed = std::rc::Rc::new(std::cell::Cell::new(false));
+    let arm = std::rc::Rc::clone(&armed);
+    let armed_after = std::rc::Rc::clone(&armed);
+    let transport = Meddled {
+        inner: robot(&image),
+        sent: move |bytes: &[u8]| {
+            // `F1 07 57 ...`: a write of three bytes; its first data
+            // byte's low digit +2 and its last byte's low digit -2.
+            // (`F1`, then two digits each: length, `W`, address, count,
+            // the three bytes, the sum.)
+            if armed.get() && bytes.starts_with(b"\xF10757") && bytes.len() == 19 {
+                armed.set(false);
+                let mut damaged = bytes.to_vec();
+                damaged[12] += 2;
+                damaged[16] -= 2;
+                return damaged;
+            }
+            bytes.to_vec()
+        },
+        heard: |_: &mut [u8]| {},
+    };
+    let client = uploader::client(transport, &profile);
+    let mut debug = RobotDebug::attach(client, &profile, image.clone()).expect("attaches");
+    debug.set_breakpoint(AT, &[]).expect("set");
+    let reply = debug.command(b"/1Q", Duration::from_secs(1)).expect("sent");
+    assert!(
+        matches!(reply, uploader::stub::Reply::Stopped(_)),
+        "{reply:?}"
+    );
+    arm.set(true);
+    debug
+        .write_verified(0x0480, &[0x12, 0x20, 0x34])
+        .expect("written, once again");
+    assert!(!armed_after.get(), "the damage was done");
+    assert_eq!(debug.read(0x0480, 3).expect("read"), [0x12, 0x20, 0x34]);
+    debug.resume().expect("goes on");
+    debug.detach().expect("detached");
+}

@@ -1042,7 +1042,17 @@ impl<T: Transport> RobotDebug<T> {
                 part.len() as u8,
             ];
             payload.extend_from_slice(part);
-            let found = self.memory_exchange(&payload, at, part.len())?;
+            // The frame's sum misses two changes that cancel (a bit flipped
+            // the same way in two digits: 20 09 FF went in as 22 09 FD,
+            // seed 111 of the noisy-line runs, and a `continue` jammed the
+            // CPU on it): the read back tells, and the write is sent again.
+            let mut found = Vec::new();
+            for _ in 0..ATTEMPTS {
+                found = self.memory_exchange(&payload, at, part.len())?;
+                if found == part {
+                    break;
+                }
+            }
             if found != part {
                 return Err(StubError::Verify {
                     address: at,
