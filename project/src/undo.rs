@@ -110,6 +110,10 @@ pub struct UndoFile {
     /// Why the undo file an upload that changed nothing found could not
     /// be kept (damaged: it is replaced by this upload's).
     pub older_damaged: Option<String>,
+    /// Whether an upload through this keeper finished already (a project's
+    /// images, one after the other): the file found by the next is that
+    /// one's, which the next one's goes further back from, changed or not.
+    wrote: bool,
 }
 
 impl UndoFile {
@@ -123,6 +127,7 @@ impl UndoFile {
             older: None,
             kept_older: false,
             older_damaged: None,
+            wrote: false,
         }
     }
 
@@ -171,7 +176,20 @@ impl uploader::Keep for UndoFile {
     }
 
     fn finished(&mut self, kept: &uploader::Backup) {
-        self.keep(kept);
+        // hostile14 F6: the second image of a run wrote its own file over
+        // the first's, and the undo left the first installed. An upload
+        // after another through this keeper keeps both.
+        let earlier = if self.wrote {
+            self.older.clone().flatten()
+        } else {
+            None
+        };
+        let name = self.path.display().to_string();
+        match earlier.and_then(|earlier| uploader::Backup::decode(&name, &earlier).ok()) {
+            Some(earlier) => self.keep(&earlier.going_further_back(kept)),
+            None => self.keep(kept),
+        }
+        self.wrote = true;
         self.older = None;
         self.kept_older = false;
         let _ = std::fs::remove_file(marked(&self.path, BEFORE));
@@ -216,6 +234,7 @@ impl uploader::Keep for UndoFile {
             }
             None => self.keep(kept),
         }
+        self.wrote = true;
         self.older = None;
         let _ = std::fs::remove_file(marked(&self.path, BEFORE));
     }
@@ -273,6 +292,46 @@ mod tests {
         );
         assert!(!marked(&path, BEFORE).exists());
         assert!(!further_back(&path), "once");
+    }
+
+    /// hostile14 F6: a project's second image wrote its upload's undo file
+    /// over the first's; the undo left the first installed. Through one
+    /// keeper, the second's goes further back from the first's.
+    #[test]
+    fn the_images_of_one_run_keep_one_undo_of_them_all() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        hostfs::write(&path, &backup(7).encode()).expect("an older run's file");
+        let second = Backup {
+            areas: vec![
+                Area {
+                    address: 0x0400,
+                    bytes: vec![2; 4],
+                },
+                Area {
+                    address: 0x0500,
+                    bytes: vec![3; 2],
+                },
+            ],
+            ..Backup::default()
+        };
+        let mut undo = UndoFile::new(path.clone());
+        undo.keep(&backup(1));
+        undo.finished(&backup(1));
+        undo.finished_upload();
+        assert_eq!(
+            held(&path),
+            backup(1),
+            "a change: the older run's file replaced"
+        );
+        undo.keep(&second);
+        undo.finished(&second);
+        undo.finished_upload();
+        assert_eq!(
+            held(&path),
+            backup(1).going_further_back(&second),
+            "the first image's bytes as it found them, the second's beside"
+        );
     }
 
     /// hostile14 F5: a damaged undo file found by an upload that changed

@@ -451,16 +451,19 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         refuse_unfinished(&args.undo_path())?;
     }
     match &args.image {
-        Some(path) => upload_file(args, &resolved, path),
+        Some(path) => upload_file(args, &resolved, path, &mut UndoFile::new(args.undo_path())),
         None => {
             let Some(project) = &resolved.project else {
                 // None here, or a workspace: the error says which.
                 scorpion_project::Project::here()?;
                 miette::bail!("no project here");
             };
+            // One keeper for all the images: the undo file puts back what
+            // the robot held before the first (hostile14 F6).
+            let mut undo = UndoFile::new(args.undo_path());
             for spec in &project.file.images {
                 let (_, path) = scorpion_project::runner::build::build_to_target(project, spec)?;
-                let code = upload_file(args, &resolved, &path)?;
+                let code = upload_file(args, &resolved, &path, &mut undo)?;
                 if code != ExitCode::SUCCESS {
                     return Ok(code);
                 }
@@ -535,6 +538,7 @@ fn upload_file(
     args: &Args,
     resolved: &scorpion_project::Resolved,
     path: &PathBuf,
+    undo: &mut UndoFile,
 ) -> miette::Result<ExitCode> {
     let (linked, image) = read_image(path)?;
     let expectations = args.expect.as_deref().map(read_expectations).transpose()?;
@@ -603,7 +607,6 @@ fn upload_file(
     let transport = ports::open_resolved(resolved, &[])?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
-    let mut undo = UndoFile::new(args.undo_path());
     // `emu` is a fresh virtual Scorpion for each command: nothing of it
     // outlives this one for an undo to put back.
     let result = if emulated {
@@ -611,7 +614,7 @@ fn upload_file(
     } else {
         let (path, kept) = (undo.path.clone(), std::sync::Arc::clone(&undo.kept));
         crate::cmd::say_when_interrupted(move || upload_interrupted(&path, &kept))?;
-        uploader::upload_keeping(&mut client, &image, &options, &mut bar, &mut undo)
+        uploader::upload_keeping(&mut client, &image, &options, &mut bar, undo)
     };
     bar.bar.finish_and_clear();
     let report = match result {
@@ -630,7 +633,7 @@ fn upload_file(
         // Finished: the next upload may replace the undo file.
         undo.finished_upload();
     }
-    if let Some(error) = undo.failed {
+    if let Some(error) = undo.failed.take() {
         bar.say(&format!(
             "warning: cannot write the undo file {}: {error}",
             undo.path.display()
