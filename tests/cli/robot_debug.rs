@@ -205,6 +205,8 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         "answer: Q99",
         "deleted breakpoint 1",
         "detached",
+        // fresh14 F8: what stays in RAM, said as the session starts.
+        "stay in user RAM after `quit`, unhooked: no undo puts back what was there",
     ] {
         assert!(printed.contains(expected), "{expected}:\n{printed}");
     }
@@ -540,4 +542,19 @@ fn stopped_at_show(
         seen.push_str(&line);
     }
     (child, stdin, stdout, seen)
+}
+
+/// fresh14 F9: `debug --port` on a robot that never had the image said
+/// "the image is in RAM but not installed". The code is compared first:
+/// the first byte that differs is named, with the image's and the robot's.
+#[test]
+fn debug_on_a_robot_without_the_image_names_the_bytes_that_differ() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let sim = Sim::start(dir.path(), &[]);
+    let output = scorpion(&project, &["debug", "--port", &sim.path]);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert!(!text.contains("in RAM but not installed"), "{text}");
+    assert!(text.contains("not_the_image"), "{text}");
 }

@@ -167,7 +167,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     let stub = robot.stub().clone();
     writeln!(
         out,
-        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands",
+        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands\n  (the stub, and the RAM loader that wrote it, stay in user RAM after `quit`, unhooked: no undo puts back what was there; `scorpion backup` before a session keeps it)",
         robot.client().transport().name(),
         stub.address,
         u32::from(stub.address) + stub.bytes.len() as u32 - 1,

@@ -359,10 +359,13 @@ impl<T: Transport> RobotDebug<T> {
                 ),
             });
         }
+        // The image's code compared first: a robot that does not hold it is
+        // told so with the bytes that differ, not as "not installed"
+        // (fresh14 F9).
+        let mut leftovers = debug.check_image()?;
         if debug.stopped.is_none() {
             debug.refuse_unreachable(profile, &installed, previous)?;
         }
-        let mut leftovers = debug.check_image()?;
         if stopped || debug.recovery.hooked {
             // A session with another image may have left breakpoints in
             // its own extension, which this image's bytes do not show.
