@@ -327,3 +327,20 @@ fn expressions_read_what_they_need_while_the_robot_runs() {
         "{cost} characters sent for 200 neighbouring bytes"
     );
 }
+
+/// hostile14 F8: a display of memory the robot changes as it runs (a
+/// timer's counter here) hid the answer of every command after it behind
+/// "the bytes changed between reads". It is shown as changing, and the
+/// answer with it.
+#[test]
+fn a_display_of_changing_memory_does_not_hide_the_answer() {
+    let (mut m, mut d) = attached();
+    let shown = text(&mut m, &mut d, "display [$C004]");
+    assert!(
+        shown.starts_with("display 1: [$C004] = (changing: "),
+        "{shown}"
+    );
+    let shown = text(&mut m, &mut d, "/1Q");
+    assert!(shown.contains("answer: Q42"), "{shown}");
+    assert!(shown.contains("1: [$C004] = (changing: "), "{shown}");
+}
