@@ -440,9 +440,17 @@ pub fn upload_keeping<T: Transport>(
                     .find(|record| record.kind == kind && record.handler == target)
                     .and_then(|record| record.chain),
             };
+            // Nor where no extension's code can be (hostile14 F7: a slot
+            // damaged by hand to $0021, the ROM's zero page, re-chained
+            // and hooked there): the ROM's target then.
+            let may_be_code = |to: u16| {
+                profile.reset_target(kind) == Some(to)
+                    || profile.writable.iter().any(|range| range.contains(&to))
+            };
             let fallthrough = match slot {
                 Some(slot) => read_word(client, slot)?.filter(|&to| {
                     !image.contains(to)
+                        && may_be_code(to)
                         && (others.iter().any(|other| other.contains(to))
                             || leftover.as_ref().is_none_or(|l| !l.contains(to)))
                 }),

@@ -762,3 +762,25 @@ fn an_undo_takes_out_the_ram_loader_a_killed_upload_left_hooked() {
         "the old extension back"
     );
 }
+
+/// hostile14 F7: the chain slot of an installed extension damaged by hand
+/// to point into the ROM's zero page ($0021): the same upload again hooked
+/// the ROM's target meanwhile and then wrote $0021 back into the slot, so
+/// the next unknown command went there. A way out where no extension's
+/// code can be is not kept: the image falls through to the ROM.
+#[test]
+fn a_chain_slot_damaged_into_the_roms_zero_page_is_not_kept() {
+    let image = extension(64, 8);
+    let options = UploadOptions::default();
+    let (result, mut transport) = common::run(robot(), &image, &options);
+    result.expect("the first upload");
+    let slot = image.hooks()[0].chain.expect("a chain slot");
+    let board = transport.robot_mut().robot_mut().board_mut();
+    board.load(slot, &[0x21, 0x00]).expect("RAM");
+    let (result, transport) = common::run(transport, &image, &options);
+    result.expect("the same upload again");
+    let memory = transport.robot().robot().board().memory();
+    let at = usize::from(slot);
+    let to = u16::from_le_bytes([memory[at], memory[at + 1]]);
+    assert_eq!(to, BAD_COMMAND, "the slot falls through to the ROM");
+}
