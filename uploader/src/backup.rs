@@ -645,15 +645,8 @@ impl Backup {
         for area in &later.areas {
             for (offset, &byte) in area.bytes.iter().enumerate() {
                 let address = area.address.wrapping_add(offset as u16);
-                if self.byte_at(u32::from(address)).is_some() {
-                    continue;
-                }
-                match added.last_mut() {
-                    Some(last) if last.end() == u32::from(address) => last.bytes.push(byte),
-                    _ => added.push(Area {
-                        address,
-                        bytes: vec![byte],
-                    }),
+                if self.byte_at(u32::from(address)).is_none() {
+                    crate::delta::push(&mut added, address, &[byte]);
                 }
             }
         }

@@ -206,7 +206,7 @@ pub(crate) fn merged(held: &[Held]) -> Vec<Area> {
 }
 
 /// Appends a range, merged with the last one if it follows it.
-fn push(out: &mut Vec<Area>, address: u16, bytes: &[u8]) {
+pub(crate) fn push(out: &mut Vec<Area>, address: u16, bytes: &[u8]) {
     if let Some(last) = out.last_mut()
         && last.end() == u32::from(address)
     {

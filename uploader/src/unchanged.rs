@@ -107,13 +107,7 @@ pub(crate) fn loader_went_over(kept: &Backup, code_byte: &dyn Fn(u16) -> Option<
             if code_byte(address).is_none_or(|code| code == byte) {
                 continue;
             }
-            match over.last_mut() {
-                Some(last) if last.end() == u32::from(address) => last.bytes.push(byte),
-                _ => over.push(Area {
-                    address,
-                    bytes: vec![byte],
-                }),
-            }
+            crate::delta::push(&mut over, address, &[byte]);
         }
     }
     over

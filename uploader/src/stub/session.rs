@@ -128,14 +128,7 @@ fn differing(address: u16, bytes: &[u8], held: &[u8]) -> Vec<crate::image::Area>
         if held.get(start..start + piece.len()) == Some(piece) {
             continue;
         }
-        let at = address.wrapping_add(start as u16);
-        match areas.last_mut() {
-            Some(last) if last.end() == u32::from(at) => last.bytes.extend_from_slice(piece),
-            _ => areas.push(crate::image::Area {
-                address: at,
-                bytes: piece.to_vec(),
-            }),
-        }
+        crate::delta::push(&mut areas, address.wrapping_add(start as u16), piece);
     }
     areas
 }
