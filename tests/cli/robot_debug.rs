@@ -558,3 +558,61 @@ fn debug_on_a_robot_without_the_image_names_the_bytes_that_differ() {
     assert!(!text.contains("in RAM but not installed"), "{text}");
     assert!(text.contains("not_the_image"), "{text}");
 }
+
+/// fresh14 F7: in examples/adc, a step from `sta ADC_CONTROL` (a store to
+/// the card's register, which the host cannot do for the robot) was
+/// refused for good, since `ldx #0` after it is followed by the wait
+/// loop's line. The robot now runs it alone in a trampoline of the stub:
+/// the card starts, the steps go on through the loop, and the channel is
+/// answered.
+#[test]
+fn a_step_over_a_store_to_the_cards_register_runs_on_the_robot() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = dir.path().join("adc");
+    crate::copy_dir(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/adc"),
+        &project,
+    );
+    let sim = Sim::start(&project, &["--card", "adc.rhai"]);
+    let uploaded = scorpion(&project, &["upload", "--port", &sim.path, "--no-dry-run"]);
+    assert!(uploaded.status.success(), "{}", transcript(&uploaded));
+    let source = std::fs::read_to_string(project.join("adc.s")).expect("the source");
+    let line_of = |text: &str| {
+        1 + source
+            .lines()
+            .position(|l| l.trim_start().starts_with(text))
+            .unwrap_or_else(|| panic!("`{text}` in adc.s"))
+    };
+    let (start, store, count) = (
+        line_of("ora #$80"),
+        line_of("sta ADC_CONTROL"),
+        line_of("ldx #0"),
+    );
+    let output = scorpion_with_input(
+        Some(&project),
+        &["debug", "--port", &sim.path],
+        &format!("break adc.s:{start}\n/2A1\nstep\nstep\nstep\nstep\ncontinue\nquit\n"),
+    );
+    let printed = transcript(&output);
+    assert!(output.status.success(), "{printed}");
+    assert!(!printed.contains("refused"), "{printed}");
+    let mut from = 0;
+    for expected in [
+        format!("at adc.s:{start}"),
+        format!("at adc.s:{store}"),
+        format!("at adc.s:{count}"),
+        format!("at adc.s:{}", count + 1),
+        "P=$72".into(),
+        "answer: A".into(),
+        "detached".into(),
+    ] {
+        let at = printed[from..]
+            .find(&expected)
+            .unwrap_or_else(|| panic!("`{expected}` after byte {from}:\n{printed}"));
+        from += at + expected.len();
+    }
+    assert!(
+        !printed.contains("answer: A--"),
+        "the card answered: {printed}"
+    );
+}

@@ -30,6 +30,7 @@ use crate::client::Client;
 use crate::image::{RomProfile, UploadImage};
 use crate::transport::{Transport, char_time};
 use isa::objfmt::HookKind;
+use isa::{AddressingMode, Instruction, Mnemonic};
 use romlib::installed::Installed;
 
 /// The registers at a stop.
@@ -106,6 +107,10 @@ pub struct RobotDebug<T> {
     starts: Option<Vec<u16>>,
     /// A step's breakpoints, taken out at the next stop.
     temporary: Vec<u16>,
+    /// A step run alone in a trampoline: where its `JSR` back into the
+    /// stub is, and the program's address it stands for (the instruction
+    /// after the one stepped).
+    alone: Option<(u16, u16)>,
     /// A stop that came while the host was busy with something else (a
     /// breakpoint in code the robot runs on its own, hit while a patch
     /// was read back): told by the next [`RobotDebug::poll`] or
@@ -243,6 +248,7 @@ impl<T: Transport> RobotDebug<T> {
             recovery: Recovery::default(),
             starts: None,
             temporary: Vec::new(),
+            alone: None,
             unasked: None,
             interrupt: None,
             guard: Guard::new(profile),
@@ -1213,8 +1219,12 @@ impl<T: Transport> RobotDebug<T> {
         let [b'S', pcl, pch, a, x, y, p, s] = *payload else {
             return None;
         };
+        let pc = u16::from_le_bytes([pcl, pch]).wrapping_sub(2);
         let registers = Registers {
-            pc: u16::from_le_bytes([pcl, pch]).wrapping_sub(2),
+            pc: match self.alone {
+                Some((at, stands_for)) if at == pc => stands_for,
+                _ => pc,
+            },
             a,
             x,
             y,
@@ -1455,7 +1465,13 @@ impl<T: Transport> RobotDebug<T> {
         let Some(registers) = self.stopped else {
             return Err(not_stopped("continue"));
         };
-        let to = self.resume_address(registers.pc).to_le_bytes();
+        self.go_on_at(self.resume_address(registers.pc))
+    }
+
+    /// Lets the stopped robot go on at `to` with its registers.
+    fn go_on_at(&mut self, to: u16) -> StubResult<()> {
+        let to = to.to_le_bytes();
+        self.alone = None;
         self.unasked = None;
         self.rx.clear();
         self.client
@@ -1478,6 +1494,9 @@ impl<T: Transport> RobotDebug<T> {
             return Err(not_stopped("step"));
         };
         if let Some(stop) = self.step_on_host(registers)? {
+            return Ok(stop);
+        }
+        if let Some(stop) = self.step_alone(registers, wait)? {
             return Ok(stop);
         }
         let pc = registers.pc;
@@ -1597,6 +1616,52 @@ impl<T: Transport> RobotDebug<T> {
                 Ok(Some(Reply::Stopped(registers)))
             }
         }
+    }
+
+    /// A step the robot runs in a trampoline of the stub, alone: the
+    /// instruction's bytes (the program's), then `JSR` into the stub, so
+    /// that it stops right after it with nothing patched into the
+    /// program. For an instruction the host cannot do (a store to a
+    /// card's register, a push) whose neighbour cannot take a
+    /// breakpoint's `JSR` (fresh14 F7: `sta ADC_CONTROL` before a line of
+    /// its own). Only for instructions that go on to the next one and do
+    /// not read the PC: a branch, jump, call or return goes its own way
+    /// (`None`: the patching step), as when every trampoline is in use.
+    ///
+    /// The host has run the instruction first ([`RobotDebug::step_on_host`]),
+    /// so a write into the stub or a breakpoint's bytes is refused before.
+    fn step_alone(&mut self, registers: Registers, wait: Duration) -> StubResult<Option<Reply>> {
+        let pc = registers.pc;
+        let bytes = self.read_as_program(pc, 3)?;
+        let Some(instruction) = Instruction::decode(&bytes, pc) else {
+            return Ok(None);
+        };
+        let goes_its_own_way = matches!(
+            instruction.opcode.mnemonic,
+            Mnemonic::Jsr | Mnemonic::Jmp | Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk
+        ) || instruction.opcode.mode == AddressingMode::Relative
+            || instruction.opcode.cycles == 0;
+        if goes_its_own_way {
+            return Ok(None);
+        }
+        let used: Vec<usize> = self.breakpoints.values().map(|(_, slot)| *slot).collect();
+        let Some(slot) = (0..TRAMPOLINES).find(|slot| !used.contains(slot)) else {
+            return Ok(None);
+        };
+        let len = usize::from(instruction.len());
+        let trampoline = self.stub.trampoline(slot);
+        let entry = self.stub.entry.to_le_bytes();
+        let mut code = bytes[..len].to_vec();
+        code.extend_from_slice(&[JSR, entry[0], entry[1]]);
+        self.write_verified(trampoline, &code)?;
+        self.go_on_at(trampoline)?;
+        self.alone = Some((
+            trampoline.wrapping_add(len as u16),
+            instruction.next_address(),
+        ));
+        // The stop frame names the trampoline's `JSR`; it is told as the
+        // program's next instruction (`take_stop`), a frame sent again too.
+        Ok(Some(self.wait_event(wait)?))
     }
 
     /// [`StubError::Refused`] for a write into the stub's bytes.
