@@ -223,15 +223,24 @@ fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
     }
     let mut m = RobotMonitor::new(symbols, images);
 
-    // The branches (and so the handler's first two lines) still cannot be.
-    let refused = refusal(&mut m, &mut d, "break handler");
-    assert!(refused.contains("branch"), "{refused}");
-    assert!(
-        refused.contains("that takes one: $0408 (handler+$8) at new.s:19"),
-        "the line to break on instead: {refused}"
-    );
+    // fresh10 F4, fresh14 F7: the handler's first line, `cpx #1` and its
+    // `bne`, takes a breakpoint (the branch relocated in the trampoline),
+    // and steps line by line from there.
+    text(&mut m, &mut d, "break handler");
+    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 1, $0400"));
+    for to in ["$0402", "$0404", "$0406", "$0408"] {
+        let shown = text(&mut m, &mut d, "step");
+        assert!(shown.contains(&format!("stopped: {to}")), "{to}: {shown}");
+    }
+    assert!(text(&mut m, &mut d, "continue").contains("V01"));
+    // Another command goes down the chain, past the relocated branch.
+    assert!(text(&mut m, &mut d, "/1W").contains("stopped: breakpoint 1, $0400"));
+    let shown = text(&mut m, &mut d, "continue");
+    assert!(!shown.contains("V01"), "{shown}");
+    assert!(!shown.contains("stopped"), "{shown}");
+    text(&mut m, &mut d, "delete 1");
     text(&mut m, &mut d, "break handler+8");
-    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 1, $0408"));
+    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 2, $0408"));
     let shown = text(&mut m, &mut d, "step");
     assert!(
         shown.contains("stopped: $040B"),
@@ -245,9 +254,9 @@ fn the_new_templates_handler_steps_line_by_line_on_the_robot() {
     let shown = text(&mut m, &mut d, "continue");
     assert!(shown.contains("V01"), "{shown}");
     // A breakpoint on the two-byte `lda #VERSION` itself.
-    text(&mut m, &mut d, "delete 1");
+    text(&mut m, &mut d, "delete 2");
     text(&mut m, &mut d, "break handler+$B");
-    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 2, $040B"));
+    assert!(text(&mut m, &mut d, "/1V").contains("stopped: breakpoint 3, $040B"));
     assert!(text(&mut m, &mut d, "continue").contains("V01"));
 }
 

@@ -4,7 +4,8 @@
 ; hooked into HOOK_UNKNOWN ahead of what was there (PREV).
 ;
 ; A breakpoint at A is `JSR entry` over A's first three bytes; the
-; instructions it displaced run from a trampoline (`tramps`, written by
+; instructions it displaced (a branch as its opposite over a `JMP` to its
+; target) run from a trampoline (`tramps`, written by
 ; the host) that ends `JMP` back. At a stop the stub keeps A X Y P S and
 ; the return address, sends a stop frame and serves the host's frames
 ; through GETCH/PUTCH until one says where to go on: the handler or loop
@@ -289,4 +290,4 @@ olen:   .res 1
 dlen:   .res 1
 out:    .res 8
 buf:    .res BUFLEN
-tramps: .res 64                 ; eight trampolines of eight bytes
+tramps: .res 128                ; eight trampolines of sixteen bytes

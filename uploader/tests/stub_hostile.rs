@@ -394,18 +394,18 @@ fn the_stubs_zero_page_shows_and_takes_the_programs_bytes() {
     });
 }
 
-/// fresh10 F4: a breakpoint refused for the branch it would displace
-/// advised "the instruction after it", which was refused in turn. The
-/// refusal now names the nearest instruction that takes one.
+/// fresh10 F4: a refused breakpoint advised "the instruction after it",
+/// which was refused in turn. The refusal now names the nearest
+/// instruction that takes one.
 #[test]
 fn the_nearest_place_that_takes_a_breakpoint_is_found() {
     use uploader::stub::patch::{nearest, plan};
     let image = common::stub::handler();
-    // $0403 CMP #'Q', $0405 BNE: refused there.
-    assert!(plan(0x0403, &image, &[]).is_err());
-    // $0407 LDA #'Q' and $0409 JSR PUTCH: five bytes, no branch.
-    assert_eq!(nearest(0x0403, &image, &[]), Some(0x0407));
-    // With a line starting at $0409 the JSR at $0407 would cover it.
-    assert_eq!(nearest(0x0403, &image, &[0x0409]), Some(0x0409));
-    assert!(plan(0x0409, &image, &[0x0409]).is_ok());
+    // $0403 CMP #'Q', $0405 BNE: refused where a line starts at the BNE.
+    assert!(plan(0x0403, &image, &[0x0405]).is_err());
+    // $0405 BNE and $0407 LDA #'Q': four bytes, the branch relocated.
+    assert_eq!(nearest(0x0403, &image, &[0x0405]), Some(0x0405));
+    // With a line starting at $0407 too, the JSR at $0405 would cover it.
+    assert_eq!(nearest(0x0403, &image, &[0x0405, 0x0407]), Some(0x0407));
+    assert!(plan(0x0407, &image, &[0x0405, 0x0407]).is_ok());
 }

@@ -40,8 +40,9 @@ pub struct StubPlan {
     pub zero_page: u8,
 }
 
-/// Bytes of one trampoline: up to five displaced bytes and a `JMP`.
-pub const TRAMPOLINE_LEN: u16 = 8;
+/// Bytes of one trampoline: up to five displaced bytes, three more for
+/// each of at most two branches relocated, and a `JMP` (13 at most).
+pub const TRAMPOLINE_LEN: u16 = 16;
 
 /// Trampolines the stub holds: breakpoints at once, step's included.
 pub const TRAMPOLINES: usize = 8;

@@ -1,17 +1,39 @@
 //! What a breakpoint displaces: the whole instructions under the three
-//! bytes of its `JSR`, copied to a trampoline that ends `JMP` back, and
-//! the refusals where that would change what the code does. And where a
-//! step can go next, from the instruction table.
+//! bytes of its `JSR`, laid out in a trampoline that ends `JMP` back, and
+//! the refusals where that would change what the code does. A displaced
+//! branch reads the PC, so in the trampoline it becomes the opposite
+//! branch over a `JMP` to its target. And where a step can go next, from
+//! the instruction table.
 
 use isa::{AddressingMode, Instruction, Mnemonic};
 
 use super::error::{StubError, StubResult};
+use super::link::TRAMPOLINE_LEN;
 use crate::image::UploadImage;
 
 /// `JSR abs`.
 pub const JSR: u8 = 0x20;
 /// `JMP abs`.
 pub const JMP: u8 = 0x4C;
+
+/// What turns a branch into its opposite (`BNE` into `BEQ`, `BCC` into
+/// `BCS`, ...): the condition's sense is bit 5 of every branch opcode.
+const OPPOSITE: u8 = 0x20;
+
+/// A relocated branch in a trampoline: the opposite branch over the
+/// `JMP` to the target (`Bxx` + 3, then `JMP target`).
+const RELOCATED_LEN: u16 = 5;
+
+/// One displaced instruction's place in its trampoline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Piece {
+    /// Its offset among the displaced bytes (from the breakpoint).
+    pub program: u16,
+    /// Its offset in the trampoline.
+    pub trampoline: u16,
+    /// A branch, laid out as the opposite branch over a `JMP` to its target.
+    pub relocated: bool,
+}
 
 /// A breakpoint's patch: where, the bytes it replaces, the trampoline.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -20,8 +42,11 @@ pub struct Patch {
     pub address: u16,
     /// The image's bytes of the displaced instructions (3 to 5).
     pub displaced: Vec<u8>,
-    /// The trampoline: the displaced bytes, then `JMP` past them.
+    /// The trampoline: the displaced instructions (a branch relocated),
+    /// then `JMP` past them.
     pub trampoline: Vec<u8>,
+    /// Where each displaced instruction is in the trampoline, in order.
+    pub pieces: Vec<Piece>,
 }
 
 impl Patch {
@@ -32,11 +57,45 @@ impl Patch {
     }
 
     /// Where `address` is among the displaced bytes: its offset from the
-    /// first (the trampoline holds them in the same order), if it is one.
+    /// first, if it is one.
     #[must_use]
     pub fn offset_of(&self, address: u16) -> Option<u16> {
         let offset = address.checked_sub(self.address)?;
         (usize::from(offset) < self.displaced.len()).then_some(offset)
+    }
+
+    /// Where the program's instruction at `offset` (from the breakpoint)
+    /// is in the trampoline; the offset just past the displaced bytes is
+    /// the `JMP` back.
+    #[must_use]
+    pub fn trampoline_offset(&self, offset: u16) -> Option<u16> {
+        if usize::from(offset) == self.displaced.len() {
+            return Some(self.back());
+        }
+        self.pieces
+            .iter()
+            .find(|piece| piece.program == offset)
+            .map(|piece| piece.trampoline)
+    }
+
+    /// The program's offset (from the breakpoint) that the trampoline's
+    /// instruction at `offset` stands for; the `JMP` back stands for the
+    /// instruction after the displaced ones.
+    #[must_use]
+    pub fn program_offset(&self, offset: u16) -> Option<u16> {
+        if offset == self.back() {
+            return Some(self.displaced.len() as u16);
+        }
+        self.pieces
+            .iter()
+            .find(|piece| piece.trampoline == offset)
+            .map(|piece| piece.program)
+    }
+
+    /// The offset of the trampoline's `JMP` back.
+    #[must_use]
+    pub fn back(&self) -> u16 {
+        self.trampoline.len() as u16 - 3
     }
 
     /// The program's byte at `address`, if it is one the patch displaced.
@@ -47,10 +106,9 @@ impl Patch {
     }
 
     /// The patch with the program's byte at `address` (one it displaced)
-    /// changed to `value`, in its record and its trampoline's copy, or why
-    /// the copy could no longer run in the trampoline: an instruction
-    /// that would run past its bytes into the `JMP` back, or a branch
-    /// (which reads the PC).
+    /// changed to `value`, its trampoline laid out again, or why the
+    /// bytes could no longer run in the trampoline: an instruction that
+    /// would run past them into the `JMP` back, or a branch into them.
     ///
     /// # Errors
     /// The reason, for a refusal.
@@ -59,26 +117,9 @@ impl Patch {
             self.offset_of(address)
                 .ok_or_else(|| format!("${address:04X} is not among its bytes"))?,
         );
-        let mut changed = self.clone();
-        changed.displaced[offset] = value;
-        changed.trampoline[offset] = value;
-        let mut at = 0;
-        while at < changed.displaced.len() {
-            let here = self.address.wrapping_add(at as u16);
-            let instruction = Instruction::decode(&changed.displaced[at..], here)
-                .ok_or_else(|| {
-                    format!(
-                        "the instruction at ${here:04X} would then run past the bytes its trampoline holds"
-                    )
-                })?;
-            if instruction.opcode.mode == AddressingMode::Relative {
-                return Err(format!(
-                    "the instruction at ${here:04X} would then be a branch ({instruction}), which cannot run from a trampoline"
-                ));
-            }
-            at += usize::from(instruction.len());
-        }
-        Ok(changed)
+        let mut displaced = self.displaced.clone();
+        displaced[offset] = value;
+        lay_out(self.address, displaced)
     }
 
     /// Whether `address` is one of the displaced bytes after the first.
@@ -88,11 +129,111 @@ impl Patch {
     }
 }
 
+/// The patch of `displaced` (whole instructions) at `address`: each
+/// instruction copied into the trampoline, a branch as the opposite
+/// branch over a `JMP` to its target, then `JMP` past them; or why not.
+///
+/// # Errors
+/// The reason: an instruction that runs past `displaced`, or a branch to
+/// one of the bytes the `JSR` covers after the first (it would land
+/// inside the `JSR`).
+pub fn lay_out(address: u16, displaced: Vec<u8>) -> Result<Patch, String> {
+    let end = address.wrapping_add(displaced.len() as u16);
+    let mut trampoline = Vec::new();
+    let mut pieces = Vec::new();
+    let mut at = 0;
+    while at < displaced.len() {
+        let here = address.wrapping_add(at as u16);
+        let instruction = Instruction::decode(&displaced[at..], here).ok_or_else(|| {
+            format!("the instruction at ${here:04X} would run past the bytes its trampoline holds")
+        })?;
+        let len = usize::from(instruction.len());
+        let relocated = instruction.opcode.mode == AddressingMode::Relative;
+        pieces.push(Piece {
+            program: at as u16,
+            trampoline: trampoline.len() as u16,
+            relocated,
+        });
+        if relocated {
+            let target = instruction.target().unwrap_or(here);
+            if target != address && (address..end).contains(&target) {
+                return Err(format!(
+                    "the branch at ${here:04X} ({instruction}) goes to ${target:04X}, among the bytes the JSR covers"
+                ));
+            }
+            let [low, high] = target.to_le_bytes();
+            trampoline.extend_from_slice(&[displaced[at] ^ OPPOSITE, 3, JMP, low, high]);
+        } else {
+            trampoline.extend_from_slice(&displaced[at..at + len]);
+        }
+        at += len;
+    }
+    trampoline.push(JMP);
+    trampoline.extend_from_slice(&end.to_le_bytes());
+    debug_assert!(trampoline.len() <= usize::from(TRAMPOLINE_LEN));
+    Ok(Patch {
+        address,
+        displaced,
+        trampoline,
+        pieces,
+    })
+}
+
+/// What a trampoline in the robot's memory (`copy`, one slot's bytes)
+/// holds, read back into the breakpoint it was laid out for: its address
+/// and the program's bytes it displaced. `None` when the bytes are not a
+/// trampoline as [`lay_out`] makes them (a step's, an older layout's, or
+/// none at all).
+#[must_use]
+pub fn read_trampoline(copy: &[u8]) -> Option<(u16, Vec<u8>)> {
+    // The program's bytes, a relocated branch's as (opcode, target).
+    let mut program: Vec<(Vec<u8>, Option<u16>)> = Vec::new();
+    let mut length = 0usize;
+    let mut at = 0usize;
+    while length < 3 {
+        let rest = copy.get(at..)?;
+        let instruction = Instruction::decode(rest, 0)?;
+        if instruction.opcode.mode == AddressingMode::Relative {
+            let bytes = copy.get(at..at + usize::from(RELOCATED_LEN))?;
+            if bytes[1] != 3 || bytes[2] != JMP {
+                return None;
+            }
+            let target = u16::from_le_bytes([bytes[3], bytes[4]]);
+            program.push((vec![bytes[0] ^ OPPOSITE], Some(target)));
+            length += 2;
+            at += usize::from(RELOCATED_LEN);
+        } else {
+            let len = usize::from(instruction.len());
+            program.push((copy[at..at + len].to_vec(), None));
+            length += len;
+            at += len;
+        }
+    }
+    let back = copy.get(at..at + 3)?;
+    if back[0] != JMP {
+        return None;
+    }
+    let address = u16::from_le_bytes([back[1], back[2]]).wrapping_sub(length as u16);
+    let mut displaced = Vec::new();
+    for (bytes, target) in program {
+        displaced.extend_from_slice(&bytes);
+        if let Some(target) = target {
+            let next = address.wrapping_add(displaced.len() as u16 + 1);
+            let offset = i8::try_from(i32::from(target) - i32::from(next)).ok()?;
+            displaced.push(offset as u8);
+        }
+    }
+    // Laid out again, it must be the very bytes read.
+    let patch = lay_out(address, displaced).ok()?;
+    (copy.get(..patch.trampoline.len())? == patch.trampoline.as_slice())
+        .then_some((address, patch.displaced))
+}
+
 /// The patch for a breakpoint at `address` in `image`, or why not:
-/// outside the image (the ROM cannot be patched), an instruction that
-/// reads the PC (a relative branch) among those displaced, or a displaced
+/// outside the image (the ROM cannot be patched), a displaced
 /// instruction after the first that code may jump to (`entries`: the
-/// image's labels and the targets of its branches, jumps and calls).
+/// image's labels and the targets of its branches, jumps and calls), or a
+/// displaced branch into the bytes the `JSR` covers.
 ///
 /// # Errors
 /// [`StubError::Refused`] with the reason.
@@ -122,12 +263,6 @@ pub fn plan(address: u16, image: &UploadImage, entries: &[u16]) -> StubResult<Pa
                     "the instruction at ${at:04X} runs past the end of the uploaded code"
                 ))
             })?;
-        if instruction.opcode.mode == AddressingMode::Relative {
-            return Err(refuse(format!(
-                "the branch at ${at:04X} ({}) would be displaced, and a branch reads the PC; put the breakpoint on the instruction after it or at its target",
-                instruction
-            )));
-        }
         if at != address && entries.contains(&at) {
             return Err(refuse(format!(
                 "the JSR would cover ${at:04X}, an instruction some code may jump to (a label is there, or a branch, jump or call goes there); put the breakpoint there instead"
@@ -143,14 +278,7 @@ pub fn plan(address: u16, image: &UploadImage, entries: &[u16]) -> StubResult<Pa
         }
         at = instruction.next_address();
     }
-    let mut trampoline = displaced.clone();
-    trampoline.push(JMP);
-    trampoline.extend_from_slice(&at.to_le_bytes());
-    Ok(Patch {
-        address,
-        displaced,
-        trampoline,
-    })
+    lay_out(address, displaced).map_err(refuse)
 }
 
 /// Instructions looked at after a refused breakpoint for one that takes it.
@@ -238,4 +366,58 @@ pub fn successors(
         }
         _ => vec![next],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every shape a breakpoint can displace, laid out and read back from
+    /// a slot's bytes (the rest of the slot left as garbage).
+    #[test]
+    fn a_trampoline_reads_back_as_the_breakpoint_it_was_laid_out_for() {
+        for (address, displaced) in [
+            (0x0403, vec![0xC9, b'Q', 0xD0, 0xF9]), // CMP #, BNE back
+            (0x0409, vec![0xCA, 0xD0, 0xFD]),       // DEX, BNE to itself
+            (0x0500, vec![0xD0, 0x10, 0xF0, 0x80]), // two branches
+            (0x0600, vec![0x90, 0x7F, 0xAD, 0x00, 0x90]), // BCC, LDA abs
+            (0x0700, vec![0x20, 0x00, 0xFF]),       // JSR
+            (0x0800, vec![0xE8, 0x48, 0x68]),       // INX PHA PLA
+        ] {
+            let patch = lay_out(address, displaced.clone()).expect("laid out");
+            assert!(patch.trampoline.len() <= usize::from(TRAMPOLINE_LEN));
+            let mut slot = patch.trampoline.clone();
+            slot.resize(usize::from(TRAMPOLINE_LEN), 0x4C);
+            assert_eq!(
+                read_trampoline(&slot),
+                Some((address, displaced)),
+                "{patch:?}"
+            );
+            for piece in &patch.pieces {
+                assert_eq!(patch.program_offset(piece.trampoline), Some(piece.program));
+                assert_eq!(
+                    patch.trampoline_offset(piece.program),
+                    Some(piece.trampoline)
+                );
+            }
+        }
+        // A step's slot (an instruction, then JSR into the stub) is none.
+        assert_eq!(
+            read_trampoline(&[0xA9, 0x01, 0x20, 0x40, 0x0C, 0, 0, 0]),
+            None
+        );
+    }
+
+    #[test]
+    fn a_relocated_branch_is_its_opposite_over_a_jmp_to_its_target() {
+        let patch = lay_out(0x0403, vec![0xC9, b'Q', 0xD0, 0xF9]).expect("laid out");
+        assert_eq!(
+            patch.trampoline,
+            [0xC9, b'Q', 0xF0, 0x03, 0x4C, 0x00, 0x04, 0x4C, 0x07, 0x04]
+        );
+        assert_eq!(patch.program_offset(7), Some(4), "the JMP back");
+        // A branch into the bytes after the first is refused.
+        let refused = lay_out(0x0407, vec![0x90, 0x01, 0xA9, 0x00]).expect_err("refused");
+        assert!(refused.contains("$040A"), "{refused}");
+    }
 }

@@ -697,22 +697,17 @@ impl<T: Transport> RobotDebug<T> {
         let tramps = self.read(self.stub.tramps, TRAMPOLINES * len)?;
         let mut found: Vec<(u16, [u8; 3])> = Vec::new();
         for copy in tramps.chunks(len) {
-            for displaced in 3..=len - 3 {
-                if copy[displaced] != patch::JMP {
-                    continue;
-                }
-                let back = u16::from_le_bytes([copy[displaced + 1], copy[displaced + 2]]);
-                let at = back.wrapping_sub(displaced as u16);
-                let owned = taken
-                    .iter()
-                    .any(|extent| extent.contains(&at) && extent.contains(&at.wrapping_add(2)));
-                if !owned || self.image.contains(at) || found.iter().any(|(seen, _)| *seen == at) {
-                    continue;
-                }
-                if self.read(at, 3)? == call {
-                    found.push((at, [copy[0], copy[1], copy[2]]));
-                    break;
-                }
+            let Some((at, displaced)) = patch::read_trampoline(copy) else {
+                continue;
+            };
+            let owned = taken
+                .iter()
+                .any(|extent| extent.contains(&at) && extent.contains(&at.wrapping_add(2)));
+            if !owned || self.image.contains(at) || found.iter().any(|(seen, _)| *seen == at) {
+                continue;
+            }
+            if self.read(at, 3)? == call {
+                found.push((at, [displaced[0], displaced[1], displaced[2]]));
             }
         }
         Ok(found)
@@ -725,18 +720,19 @@ impl<T: Transport> RobotDebug<T> {
     fn displaced_copy(&mut self, address: u16, slot_bytes: &[u16]) -> StubResult<Vec<u8>> {
         let patch = patch::plan(address, &self.image, &[])?;
         let len = patch.displaced.len();
-        let back = address.wrapping_add(len as u16).to_le_bytes();
         let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
         tramps
             .chunks(TRAMPOLINE_LEN as usize)
-            .find(|copy| {
-                copy[len..len + 3] == [patch::JMP, back[0], back[1]]
+            .filter_map(patch::read_trampoline)
+            .find(|(at, copy)| {
+                *at == address
+                    && copy.len() == len
                     && (0..len).all(|k| {
                         slot_bytes.contains(&address.wrapping_add(k as u16))
                             || copy[k] == patch.displaced[k]
                     })
             })
-            .map(|copy| copy[..len].to_vec())
+            .map(|(_, copy)| copy)
             .ok_or_else(|| StubError::Refused {
                 what: "attaching".into(),
                 reason: format!(
@@ -1410,8 +1406,9 @@ impl<T: Transport> RobotDebug<T> {
             .values()
             .find_map(|(patch, slot)| {
                 let offset = pc.checked_sub(self.stub.trampoline(*slot))?;
-                (usize::from(offset) <= patch.displaced.len())
-                    .then(|| patch.address.wrapping_add(offset))
+                patch
+                    .program_offset(offset)
+                    .map(|offset| patch.address.wrapping_add(offset))
             })
             .unwrap_or(pc)
     }
@@ -1421,10 +1418,10 @@ impl<T: Transport> RobotDebug<T> {
     fn resume_address(&self, pc: u16) -> u16 {
         // A step done on the host can also leave the PC among the bytes
         // a breakpoint displaced: the trampoline holds them in order.
-        let displaced = self
-            .breakpoints
-            .values()
-            .find_map(|(patch, slot)| Some((patch.offset_of(pc)?, *slot)));
+        let displaced = self.breakpoints.values().find_map(|(patch, slot)| {
+            let offset = patch.offset_of(pc)?;
+            Some((patch.trampoline_offset(offset).unwrap_or(offset), *slot))
+        });
         match displaced {
             Some((offset, slot)) => self.stub.trampoline(slot) + offset,
             None => pc,
@@ -1786,8 +1783,7 @@ impl<T: Transport> RobotDebug<T> {
             let Some(slot) = self.breakpoints.get(&address).map(|(_, slot)| *slot) else {
                 continue;
             };
-            let len = patch.displaced.len();
-            self.write_verified(self.stub.trampoline(slot), &patch.trampoline[..len])?;
+            self.write_verified(self.stub.trampoline(slot), &patch.trampoline)?;
             self.breakpoints.insert(address, (patch, slot));
         }
         // Runs of consecutive bytes in one write each.
