@@ -306,6 +306,13 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // fresh13 F1: the images stay on the robot, and nothing said so. A run
     // whose uploads changed nothing keeps the undo file it found; one that
     // changed an image keeps what that upload overwrote.
+    // fresh14 F2: what `--replace` took out is named.
+    for (image, old) in &report.replaced {
+        let _ = writeln!(
+            out,
+            "took out {old} for {image}: it overlapped the image (--replace), and no longer answers"
+        );
+    }
     if !report.left_installed.is_empty() {
         let _ = writeln!(
             out,

@@ -338,6 +338,19 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
     for area in image.areas() {
         let _ = write!(text, "\n  ${:04X}-${:04X}", area.address, area.end() - 1);
     }
+    for old in &report.replaced {
+        let extents: Vec<String> = old
+            .extents
+            .iter()
+            .map(romlib::installed::extent_text)
+            .collect();
+        let _ = write!(
+            text,
+            "\n  took out extension {:06X} ({}): it overlapped the image (--replace), and no longer answers",
+            old.id,
+            extents.join(", ")
+        );
+    }
     if report.rewrites > 0 || report.lost_answers > 0 {
         let _ = write!(
             text,
@@ -633,7 +646,8 @@ fn upload_file(
         // Finished: the next upload may replace the undo file.
         undo.finished_upload();
     }
-    if let Some(error) = undo.failed.take() {
+    let undo_failed = undo.failed.take();
+    if let Some(error) = &undo_failed {
         bar.say(&format!(
             "warning: cannot write the undo file {}: {error}",
             undo.path.display()
@@ -641,6 +655,17 @@ fn upload_file(
     }
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
+    if !emulated && undo_failed.is_none() && !report.replaced.is_empty() {
+        let _ = writeln!(
+            out,
+            "  `scorpion upload --undo` puts back what the robot held before, {} included",
+            if report.replaced.len() == 1 {
+                "the extension taken out"
+            } else {
+                "the extensions taken out"
+            }
+        );
+    }
     if let Some(why) = &undo.older_damaged {
         let _ = writeln!(
             out,

@@ -687,6 +687,12 @@ fn test_on_a_port_replaces_an_earlier_build_only_when_asked() {
     assert_eq!(replaced.status.code(), Some(0), "{}", transcript(&replaced));
     let out = stdout(&replaced);
     assert!(out.contains("test upload adc ... ok"), "{out}");
+    // fresh14 F2: the earlier build taken out is named.
+    assert!(
+        out.contains("took out extension ")
+            && out.contains(" ($0400-$044F) for adc: it overlapped"),
+        "{out}"
+    );
     assert!(out.ends_with(" 0 failed\n"), "{out}");
 }
 

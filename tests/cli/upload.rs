@@ -451,11 +451,25 @@ fn an_overlapping_upload_is_refused_and_replace_swaps_the_extension() {
         text.contains("HOOK_UNKNOWN: $0400 (") && text.contains(") -> $FF21"),
         "{text}"
     );
+    let first_id = text
+        .split("extension ")
+        .nth(1)
+        .and_then(|rest| rest.split(':').next())
+        .expect("the first's id")
+        .to_owned();
     let replaced = scorpion(
         dir.path(),
         &["upload", "second.elf", "--port", port, "--replace"],
     );
-    assert_eq!(replaced.status.code(), Some(0), "{}", transcript(&replaced));
+    let said = transcript(&replaced);
+    assert_eq!(replaced.status.code(), Some(0), "{said}");
+    // fresh14 F2: the one taken out is named, and the way back.
+    assert!(
+        said.contains(&format!("took out extension {first_id} ($0400-$"))
+            && said.contains("no longer answers")
+            && said.contains("`scorpion upload --undo` puts back what the robot held before, the extension taken out"),
+        "{said}"
+    );
     let asked = scorpion(dir.path(), &["ask", "--port", port, "/9KF0000002", "/1U"]);
     let text = transcript(&asked);
     assert!(text.contains("K"), "the new command answers: {text}");

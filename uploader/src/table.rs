@@ -41,6 +41,9 @@ pub(crate) struct Plan {
     /// Whether the robot may hold much of the image already: the table
     /// lists an earlier copy of it, or an extension it replaces.
     pub(crate) held_maybe: bool,
+    /// The installed extensions `replace` took out (their chains and
+    /// entries), as the table described them.
+    pub(crate) replaced: Vec<Installed>,
     /// Other extensions' chain slots re-pointed to take an extension out
     /// of its chain, as they were (what an undo puts back; a hook's own
     /// operand is the undo's hooks, switched last).
@@ -178,7 +181,7 @@ pub(crate) fn prepare<T: Transport>(
         before,
         hooks: hooks.to_vec(),
     };
-    let mut replaced = false;
+    let mut replaced = Vec::new();
     let mut known = hooks;
     let mut unlinked = Vec::new();
     for old in &read.installed {
@@ -196,7 +199,7 @@ pub(crate) fn prepare<T: Transport>(
                 reused = Some(old.clone());
             }
             Some(_) if replace => {
-                replaced = true;
+                replaced.push(old.clone());
                 unlinked.extend(remove(
                     client,
                     profile,
@@ -235,7 +238,8 @@ pub(crate) fn prepare<T: Transport>(
         current_flags,
         found: writes.found,
         hooks: writes.hooks,
-        held_maybe: replaced || reused.is_some(),
+        held_maybe: !replaced.is_empty() || reused.is_some(),
+        replaced,
         others: kept,
         unlinked,
     }))

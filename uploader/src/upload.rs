@@ -170,6 +170,9 @@ pub struct UploadReport {
     /// installed as it was, the hooks where they were (read back to be
     /// sure; only decided when the upload kept what it overwrote).
     pub unchanged: bool,
+    /// The installed extensions `--replace` took out: they overlapped the
+    /// image, and no longer answer.
+    pub replaced: Vec<romlib::installed::Installed>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -764,6 +767,7 @@ pub fn upload_keeping<T: Transport>(
         }
     }
     let stats = client.stats();
+    let replaced = plan.map_or_else(Vec::new, |plan| plan.replaced);
     Ok(UploadReport {
         bytes,
         device_time: client.transport().now().saturating_sub(start),
@@ -785,6 +789,7 @@ pub fn upload_keeping<T: Transport>(
         written,
         without_loader,
         unchanged,
+        replaced,
     })
 }
 

@@ -122,6 +122,9 @@ pub struct Report {
     /// Whether every upload to that robot changed nothing on it, so the
     /// project's undo file is still the one an earlier run kept.
     pub kept_older_undo: bool,
+    /// What `--replace` took out on that robot, as the uploads said:
+    /// `extension 8C8390 ($0400-$044F)`, for the image that took its place.
+    pub replaced: Vec<(String, String)>,
 }
 
 impl Report {

@@ -649,6 +649,19 @@ impl Run<'_, '_, '_> {
                 uploaded,
                 Err(uploader::Error::Robot(_) | uploader::Error::HookInUse { .. })
             );
+            if let Ok(report) = &uploaded {
+                for old in &report.replaced {
+                    let extents: Vec<String> = old
+                        .extents
+                        .iter()
+                        .map(romlib::installed::extent_text)
+                        .collect();
+                    self.report.replaced.push((
+                        image.name.clone(),
+                        format!("extension {:06X} ({})", old.id, extents.join(", ")),
+                    ));
+                }
+            }
             let uploaded = uploaded.map_err(|source| Error::UploadImage {
                 image: image.name.clone(),
                 source: Box::new(source),
