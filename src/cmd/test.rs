@@ -306,6 +306,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     // fresh13 F1: the images stay on the robot, and nothing said so. A run
     // whose uploads changed nothing keeps the undo file it found; one that
     // changed an image keeps what that upload overwrote.
+    for (image, way) in &report.dropped {
+        let _ = writeln!(
+            out,
+            "warning: {way}, which is no way for a command to go (damaged by hand?): {image} falls through to the ROM's target instead"
+        );
+    }
     // fresh14 F2: what `--replace` took out is named.
     for (image, old) in &report.replaced {
         let _ = writeln!(

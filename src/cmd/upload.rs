@@ -236,6 +236,15 @@ impl Progress for Bar {
                 "{} pointed into the upload (${from:04X}); pointed it at ${to:04X} while the upload runs (it is hooked to the image again at the end)",
                 kind.rom_symbol()
             ),
+            Event::WayOutDropped {
+                kind,
+                from,
+                why,
+                path,
+            } => format!(
+                "warning: {} led to ${from:04X}, which {why} ({path}): the image falls through to the ROM's target instead",
+                kind.rom_symbol()
+            ),
             Event::LoaderRestored { baud, .. } => format!(
                 "warning: the RAM loader was lost (a reset?); restored, robot found at {baud} baud"
             ),

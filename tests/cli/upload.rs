@@ -268,10 +268,12 @@ fn a_failed_rehearsal_touches_nothing() {
 #[test]
 fn uploads_to_a_robot_with_another_rom_through_a_pseudo_terminal() {
     // The double's hooks point at $F123 and $F045, not the reference ROM's
-    // targets: the uploader takes them for installed extensions, keeps the
-    // loader out and chains to them. Its ROM's bytes are the reference
-    // ROM's (issue 27: a jump table that differs is refused, tested in
-    // robot.rs).
+    // targets. Its ROM's bytes are the reference ROM's (issue 27: a jump
+    // table that differs is refused, tested in robot.rs), where those are
+    // the middle of the ROM: no way for a command to go (hostile15 F2).
+    // The image falls through to the ROM's target instead and says so;
+    // HOOK_LOOP, which it does not take, is left alone. (The double runs
+    // no code: the ROM's commands carry the image.)
     let mut memory = memory();
     memory[usize::from(platform::map::ROM_START)..].copy_from_slice(romlib::ROM);
     let robot = PtyRobot::spawn(memory);
@@ -279,16 +281,31 @@ fn uploads_to_a_robot_with_another_rom_through_a_pseudo_terminal() {
     std::fs::write(dir.path().join("ext.elf"), extension_elf(600)).expect("write the image");
     let output = scorpion(
         dir.path(),
-        &["upload", "ext.elf", "--port", &robot.path, "--no-dry-run"],
+        &[
+            "upload",
+            "ext.elf",
+            "--port",
+            &robot.path,
+            "--no-dry-run",
+            "--loader",
+            "never",
+        ],
     );
     let text = transcript(&output);
     assert_eq!(output.status.code(), Some(0), "{text}");
     assert!(text.contains("uploaded and verified 600 bytes"), "{text}");
     assert!(!text.contains("rehearsed"), "{text}");
+    assert!(
+        text.contains(
+            "warning: HOOK_UNKNOWN led to $F123, which leads where no extension's code is"
+        ),
+        "{text}"
+    );
+    assert!(!text.contains("HOOK_LOOP led"), "{text}");
     let memory = robot.memory.lock().expect("the robot's memory");
     assert_eq!(
         &memory[0x0400..0x0406],
-        &[0x4C, 0x23, 0xF1, 0x4C, 0x00, 0x04]
+        &[0x4C, 0x21, 0xFF, 0x4C, 0x00, 0x04]
     );
     assert_eq!(&memory[0x0200..0x0203], &[0x4C, 0x03, 0x04]);
     assert_eq!(

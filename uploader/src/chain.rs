@@ -81,11 +81,15 @@ pub(crate) enum End {
     /// At code that stops the CPU (a `JAM`, a `BRK` whose interrupt
     /// handler returns into the middle of nothing): the way there.
     Stops(Path),
-    /// Where no extension's code can be: in the ROM but not at the hook's
-    /// own target, or in memory no extension may hold (the ROM's own RAM,
-    /// the I/O page): the way there. Told only where asked
+    /// Where no extension's code can be: in the ROM but not at one of
+    /// its entries ([`rom_entry`]), or in memory no extension may hold (the
+    /// ROM's own RAM, the I/O page): the way there. Told only where asked
     /// ([`follow`]'s `strict`).
     Strays(Path),
+    /// In a loop of code run on the host that never gets anywhere (the
+    /// same registers at the same place, nothing written between): the
+    /// way there, the loop's address last.
+    Loops(Path),
     /// In the ROM, or somewhere this module cannot follow (a call, a
     /// return, a run longer than it looks).
     Elsewhere,
@@ -121,7 +125,7 @@ pub(crate) fn follow<T: Transport>(
             return Ok(End::Elsewhere);
         }
         if !readable {
-            return Ok(if strict {
+            return Ok(if strict && !rom_entry(profile, at) {
                 End::Strays(Path(path))
             } else {
                 End::Elsewhere
@@ -153,10 +157,14 @@ pub(crate) fn follow<T: Transport>(
                                 .any(|hook| hook.kind == kind && hook.handler == pc)
                     };
                     match run_to_landing(client, profile, at, &landing)? {
-                        Landing::At(pc) => Some(pc),
+                        Landing::At(pc) | Landing::Left(pc) => Some(pc),
                         Landing::Stops(pc) => {
                             path.push(pc);
                             return Ok(End::Stops(Path(path)));
+                        }
+                        Landing::Loops(pc) => {
+                            path.push(pc);
+                            return Ok(End::Loops(Path(path)));
                         }
                         Landing::Elsewhere => None,
                     }
@@ -215,36 +223,99 @@ pub(crate) fn check_restored<T: Transport>(
                 format!("${target:04X}"),
             ));
         }
-        match follow(
-            client,
-            profile,
-            &everyone,
-            (kind, target),
-            &|at, way| way.contains(&at),
-            true,
-        )? {
-            End::Inside(path) => {
-                return Err(broken(
-                    "comes back to where it has been, a loop the robot would run for ever",
-                    path.to_string(),
-                ));
-            }
-            End::Stops(path) => {
-                return Err(broken(
-                    "reaches code that stops the CPU (a BRK or a JAM)",
-                    path.to_string(),
-                ));
-            }
-            End::Strays(path) => {
-                return Err(broken(
-                    "leads where no extension's code is (the ROM's own RAM or I/O, or the ROM but not its own target for the hook)",
-                    path.to_string(),
-                ));
-            }
-            End::Elsewhere => {}
+        if let Some((why, path)) = broken_way(client, profile, &everyone, (kind, target))? {
+            return Err(broken(why, path.to_string()));
         }
     }
     Ok(())
+}
+
+/// What a way out is, for a chain about to be made to it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Way {
+    /// It reaches the ROM's target or an entry of the ROM, or code whose
+    /// way cannot be told (a call, a return).
+    Fine,
+    /// It comes back into what `inside` names: the way there.
+    ComesBack(Path),
+    /// It is no way for a command to go: why, and the way there.
+    Broken(&'static str, Path),
+}
+
+/// Judges the chain of `kind` from `target`, followed over what the robot
+/// holds ([`follow`], strict): it comes back to where `inside` says (what
+/// is written now), or it is broken: it comes back to where it has been or
+/// loops (the robot would run for ever), reaches code that stops the CPU,
+/// or strays where no extension's code can be.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn judge_way<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+    inside: &dyn Fn(u16) -> bool,
+) -> Result<Way> {
+    Ok(
+        match follow(
+            client,
+            profile,
+            everyone,
+            (kind, target),
+            &|at, way| inside(at) || way.contains(&at),
+            true,
+        )? {
+            End::Inside(path) if path.0.last().is_some_and(|&at| inside(at)) => {
+                Way::ComesBack(path)
+            }
+            End::Inside(path) | End::Loops(path) => Way::Broken(
+                "comes back to where it has been, a loop the robot would run for ever",
+                path,
+            ),
+            End::Stops(path) => {
+                Way::Broken("reaches code that stops the CPU (a BRK or a JAM)", path)
+            }
+            End::Strays(path) => Way::Broken(
+                "leads where no extension's code is (the ROM's own RAM or I/O, or the ROM but not one of its entries)",
+                path,
+            ),
+            End::Elsewhere => Way::Fine,
+        },
+    )
+}
+
+/// Why the chain of `kind` from `target` is no way for a command to go
+/// ([`judge_way`] with nothing written now), if it is not.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn broken_way<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+) -> Result<Option<(&'static str, Path)>> {
+    Ok(
+        match judge_way(client, profile, everyone, (kind, target), &|_| false)? {
+            Way::Broken(why, path) => Some((why, path)),
+            Way::Fine | Way::ComesBack(_) => None,
+        },
+    )
+}
+
+/// Whether `at` in the ROM is a place a handler's way may go: the entries
+/// that do not return, `CMD_DONE` and the hooks' own targets
+/// (`BAD_COMMAND`, the control loop). Anywhere else runs the middle of the
+/// ROM, or a subroutine whose `RTS` returns where nothing called it.
+fn rom_entry(profile: &RomProfile, at: u16) -> bool {
+    profile
+        .loader_services
+        .as_ref()
+        .is_some_and(|services| services.cmd_done == at)
+        || profile
+            .reset_targets
+            .is_some_and(|(unknown, main)| at == unknown || at == main)
 }
 
 /// Where [`run_to_landing`] ended.
@@ -253,6 +324,12 @@ enum Landing {
     At(u16),
     /// At an instruction that stops the CPU (`JAM`) or a `BRK`.
     Stops(u16),
+    /// Gone by a jump or a branch to memory the host does not read (the
+    /// ROM, the ROM's own RAM, the I/O page): where.
+    Left(u16),
+    /// Back at a place with the registers it had there, nothing written
+    /// between: a loop that never ends.
+    Loops(u16),
     /// Anywhere else (see [`run_to_landing`]).
     Elsewhere,
 }
@@ -269,11 +346,13 @@ const CHUNK: usize = 16;
 /// command brings (A a byte no handler takes), until the PC lands where
 /// `landing` says; [`Landing::Stops`] at a `JAM` or a `BRK` (the ROM's
 /// interrupt handler returns from a `BRK`, two bytes on: no handler's
-/// way); [`Landing::Elsewhere`] where it goes into the ROM or to memory an
-/// extension may not hold (the I/O page), calls or returns (`JSR`, `RTS`,
-/// `RTI`: a call is no chain's way, and may be a breakpoint a killed
-/// session left, which attaching takes out), or has run
-/// [`MOST_INSTRUCTIONS`].
+/// way); [`Landing::Left`] where it goes into the ROM or to memory an
+/// extension may not hold (the I/O page); [`Landing::Loops`] back at a
+/// place with the same registers and nothing written between;
+/// [`Landing::Elsewhere`] where it reads memory it may not, calls or
+/// returns (`JSR`, `RTS`, `RTI`: a call is no chain's way, and may be a
+/// breakpoint a killed session left, which attaching takes out), or has
+/// run [`MOST_INSTRUCTIONS`].
 fn run_to_landing<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
@@ -286,10 +365,12 @@ fn run_to_landing<T: Transport>(
         seen: std::collections::BTreeMap::new(),
         failed: None,
         outside: false,
+        wrote: false,
     };
     let mut cpu = Cpu::new();
     cpu.set_idle_skip(false);
     (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, 0xF0, start);
+    let mut states = std::collections::HashSet::new();
     for _ in 0..MOST_INSTRUCTIONS {
         let opcode = bus.byte(cpu.pc);
         if let Some(error) = bus.failed.take() {
@@ -309,11 +390,20 @@ fn run_to_landing<T: Transport>(
         if let Some(error) = bus.failed.take() {
             return Err(error);
         }
-        if bus.outside || !readable(profile, cpu.pc) {
+        if bus.outside {
             break;
+        }
+        if !readable(profile, cpu.pc) {
+            return Ok(Landing::Left(cpu.pc));
         }
         if landing(cpu.pc) {
             return Ok(Landing::At(cpu.pc));
+        }
+        if std::mem::take(&mut bus.wrote) {
+            states.clear();
+        }
+        if !states.insert((cpu.pc, cpu.a, cpu.x, cpu.y, cpu.s, cpu.p())) {
+            return Ok(Landing::Loops(cpu.pc));
         }
     }
     Ok(Landing::Elsewhere)
@@ -338,6 +428,8 @@ struct ChainBus<'a, T: Transport> {
     failed: Option<crate::Error>,
     /// An access outside what may be read: the run ends there.
     outside: bool,
+    /// A write since the last look: the state of memory changed.
+    wrote: bool,
 }
 
 impl<T: Transport> ChainBus<'_, T> {
@@ -378,6 +470,7 @@ impl<T: Transport> Bus for ChainBus<'_, T> {
 
     fn write(&mut self, address: u16, value: u8, _cycle: u64) {
         self.seen.insert(address, value);
+        self.wrote = true;
     }
 
     fn dummy_read(&mut self, _address: u16, _cycle: u64) {}

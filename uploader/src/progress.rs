@@ -56,6 +56,19 @@ pub enum Event {
         /// Where it points now.
         to: u16,
     },
+    /// A way out the robot's chain held was no way for a command to go
+    /// (a hook or chain slot damaged by hand): the image falls through to
+    /// the ROM's target instead.
+    WayOutDropped {
+        /// Which hook.
+        kind: HookKind,
+        /// Where the way out led.
+        from: u16,
+        /// Why it is no way.
+        why: &'static str,
+        /// The way followed.
+        path: String,
+    },
     /// A hook now points at verified code.
     HookInstalled {
         /// Which hook.

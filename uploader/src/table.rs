@@ -441,12 +441,21 @@ fn unlink<T: Transport>(
         Some(slot) => read_word_expecting(client, slot, profile.reset_target(hook.kind))?,
         None => profile.reset_target(hook.kind),
     };
-    let Some(after) = after else {
+    let Some(mut after) = after else {
         return Err(Error::HookInUse {
             hook: hook.kind.rom_symbol(),
             target: hook.handler,
         });
     };
+    // hostile15 F1: a way out damaged by hand (into the stack, the I/O
+    // page, the middle of the ROM) is not passed on to the extension
+    // before it: that one falls through to the ROM instead.
+    if let Some(reset) = profile.reset_target(hook.kind)
+        && after != reset
+        && crate::chain::broken_way(client, profile, everyone, (hook.kind, after))?.is_some()
+    {
+        after = reset;
+    }
     let chain = walk(
         client,
         profile,

@@ -173,6 +173,10 @@ pub struct UploadReport {
     /// The installed extensions `--replace` took out: they overlapped the
     /// image, and no longer answer.
     pub replaced: Vec<romlib::installed::Installed>,
+    /// Ways out the robot's chains held that were no way for a command
+    /// to go (each hook and where it led): the image falls through to the
+    /// ROM's target instead.
+    pub dropped: Vec<(HookKind, u16)>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -421,6 +425,7 @@ pub fn upload_keeping<T: Transport>(
     };
     let others = plan.as_ref().map_or(&[][..], |plan| plan.others.as_slice());
     let mut initial = Vec::new();
+    let mut dropped = Vec::new();
     for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
         let loader = leftover
@@ -443,29 +448,36 @@ pub fn upload_keeping<T: Transport>(
                     .find(|record| record.kind == kind && record.handler == target)
                     .and_then(|record| record.chain),
             };
-            // Nor where no extension's code can be (hostile14 F7: a slot
-            // damaged by hand to $0021, the ROM's zero page, re-chained
-            // and hooked there): the ROM's target then.
-            let may_be_code = |to: u16| {
-                profile.reset_target(kind) == Some(to)
-                    || profile.writable.iter().any(|range| range.contains(&to))
-            };
             let fallthrough = match slot {
                 Some(slot) => read_word(client, slot)?.filter(|&to| {
                     !image.contains(to)
-                        && may_be_code(to)
                         && (others.iter().any(|other| other.contains(to))
                             || leftover.as_ref().is_none_or(|l| !l.contains(to)))
                 }),
                 None => None,
             };
-            // Nor is a way out one that comes back into the image.
+            // Nor is a way out one that comes back into the image, or one
+            // that is no way at all (hostile14 F7: a slot damaged by hand
+            // to $0021, the ROM's zero page, re-chained and hooked there;
+            // hostile15 F2: to code that stops the CPU): the ROM's target
+            // then.
             let fallthrough = match fallthrough {
-                Some(to) => chain::comes_back(client, profile, others, (kind, to), &|at| {
+                Some(to) => match chain::judge_way(client, profile, others, (kind, to), &|at| {
                     image.contains(at)
-                })?
-                .is_none()
-                .then_some(to),
+                })? {
+                    chain::Way::Fine => Some(to),
+                    chain::Way::ComesBack(_) => None,
+                    chain::Way::Broken(why, path) => {
+                        progress.event(&Event::WayOutDropped {
+                            kind,
+                            from: to,
+                            why,
+                            path: path.to_string(),
+                        });
+                        dropped.push((kind, to));
+                        None
+                    }
+                },
                 None => None,
             };
             let Some(to) = fallthrough.or(profile.reset_target(kind)) else {
@@ -483,16 +495,36 @@ pub fn upload_keeping<T: Transport>(
                 to,
             });
             target = to;
-        } else if let Some(path) =
-            chain::comes_back(client, profile, others, (kind, target), &|at| {
+        } else {
+            let takes = image.hooks().iter().any(|record| record.kind == kind);
+            match chain::judge_way(client, profile, others, (kind, target), &|at| {
                 image.contains(at)
-            })?
-        {
-            // Chaining the image to it would make a loop.
-            return Err(Error::ChainComesBack {
-                hook: kind.rom_symbol(),
-                path: path.to_string(),
-            });
+            })? {
+                chain::Way::Fine => {}
+                // Chaining the image to it would make a loop.
+                chain::Way::ComesBack(path) => {
+                    return Err(Error::ChainComesBack {
+                        hook: kind.rom_symbol(),
+                        path: path.to_string(),
+                    });
+                }
+                // hostile15 F2: a hook damaged by hand (into the ROM's zero
+                // page, the middle of the ROM, code that stops the CPU) is
+                // no way out for the image: it falls through to the ROM.
+                // A hook the image does not take is left as it is.
+                chain::Way::Broken(why, path) => {
+                    if let Some(to) = profile.reset_target(kind).filter(|_| takes) {
+                        progress.event(&Event::WayOutDropped {
+                            kind,
+                            from: target,
+                            why,
+                            path: path.to_string(),
+                        });
+                        dropped.push((kind, target));
+                        target = to;
+                    }
+                }
+            }
         }
         initial.push((kind, target));
     }
@@ -790,6 +822,7 @@ pub fn upload_keeping<T: Transport>(
         without_loader,
         unchanged,
         replaced,
+        dropped,
     })
 }
 

@@ -30,6 +30,29 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
         (vec![0x90, 0xFE], 0x0600, None, "comes back"),
         // NOP NOP JAM.
         (vec![0xEA, 0xEA, 0x02], 0x0600, None, "stops the CPU"),
+        // hostile15 F3: one instruction before the JMP hid where it goes:
+        // a loop, the ROM's zero page, the middle of the ROM.
+        (vec![0xEA, 0x4C, 0x01, 0x06], 0x0600, None, "comes back"),
+        (
+            vec![0xEA, 0x4C, 0x21, 0x00],
+            0x0600,
+            None,
+            "where no extension's code is",
+        ),
+        (
+            vec![0xEA, 0x4C, 0x00, 0xF8],
+            0x0600,
+            None,
+            "where no extension's code is",
+        ),
+        // A loop that counts but never gets out: the same registers
+        // again, nothing written between.
+        (
+            vec![0xA2, 0xF0, 0xE8, 0xD0, 0xFD, 0x90, 0xF9],
+            0x0600,
+            None,
+            "comes back",
+        ),
         // The extension's handler (JMP $0400, its chain slot), whose slot
         // the file points back at the handler: a loop through the table.
         (vec![], 0x0403, Some(0x0403), "comes back"),

@@ -125,6 +125,10 @@ pub struct Report {
     /// What `--replace` took out on that robot, as the uploads said:
     /// `extension 8C8390 ($0400-$044F)`, for the image that took its place.
     pub replaced: Vec<(String, String)>,
+    /// Ways out the robot's chains held that were no way for a command to
+    /// go (`HOOK_UNKNOWN led to $0021`), for the image that falls through
+    /// to the ROM instead.
+    pub dropped: Vec<(String, String)>,
 }
 
 impl Report {

@@ -650,6 +650,12 @@ impl Run<'_, '_, '_> {
                 Err(uploader::Error::Robot(_) | uploader::Error::HookInUse { .. })
             );
             if let Ok(report) = &uploaded {
+                for &(kind, from) in &report.dropped {
+                    self.report.dropped.push((
+                        image.name.clone(),
+                        format!("{} led to ${from:04X}", kind.rom_symbol()),
+                    ));
+                }
                 for old in &report.replaced {
                     let extents: Vec<String> = old
                         .extents
