@@ -18,7 +18,7 @@ use std::process::ExitCode;
 
 use miette::{Context, IntoDiagnostic};
 use scorpion_project::runner::{self, Decision, MemberReport, Mode, Outcome, Progress, Question};
-use scorpion_project::{Environment, Found};
+use scorpion_project::{Environment, Found, undo};
 
 /// The longest answer `--review` reads from a line.
 const ANSWER_MAX: u64 = 256;
@@ -242,6 +242,24 @@ impl Progress for Printer {
     }
 }
 
+/// What a run interrupted by a signal left: an upload to a robot that did
+/// not finish (its undo file still marked), or nothing half done.
+fn test_interrupted(undo_files: &[std::path::PathBuf]) -> String {
+    match undo_files
+        .iter()
+        .find(|path| undo::marked(path, undo::UPLOADING).exists())
+    {
+        Some(path) => format!(
+            "interrupted: an upload to the robot did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` puts back what the robot held before it (kept in {}); then test again",
+            path.display()
+        ),
+        None => {
+            "interrupted: no upload was under way; what is installed on a robot stays installed"
+                .to_owned()
+        }
+    }
+}
+
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let found = Found::here()?;
     if let Some(path) = &args.path {
@@ -273,6 +291,17 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         coverage: args.coverage,
         failed_write: None,
     };
+    // hostile15 F4: a run on a port killed during an upload said nothing
+    // of what it left; it says what `scorpion upload` says.
+    let undo_files: Vec<std::path::PathBuf> = match &found {
+        Found::Project(project) => vec![undo::in_project(&project.root)],
+        Found::Workspace(workspace) => workspace
+            .member_names()
+            .iter()
+            .map(|member| undo::in_project(&workspace.root.join(member)))
+            .collect(),
+    };
+    crate::cmd::say_when_interrupted(move || test_interrupted(&undo_files))?;
     let report = runner::run_tests(&found, &options, &mut printer)?;
     if let (true, Found::Project(project)) = (args.coverage, &found) {
         printer.write_coverage(&project.file.project.name);

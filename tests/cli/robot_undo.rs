@@ -772,3 +772,32 @@ fn test_on_a_port_that_answers_nothing_gives_no_replace_hint() {
     assert!(text.contains("upload myext ... FAILED"), "{text}");
     assert!(!text.contains("--replace"), "{text}");
 }
+
+/// hostile15 F4: `test --port` killed during its upload ended without a
+/// word of what it left (`scorpion upload` says it). It says the same now,
+/// and the undo puts the robot back.
+#[test]
+fn a_test_on_a_port_interrupted_during_its_upload_says_so() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    let before = ok(&project, &line, &["read", "$0200", "3"]);
+    let marked = project.join("target/scorpion/last-upload.undo.uploading");
+    let output = interrupted(&project, &["test", "--port", &sim.path], &|| {
+        let waited = std::time::Instant::now();
+        while !marked.exists() && waited.elapsed() < std::time::Duration::from_secs(60) {
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        assert!(marked.exists(), "no upload under way within 60 s");
+    });
+    let said = transcript(&output);
+    assert_eq!(output.status.code(), Some(130), "{said}");
+    assert!(
+        said.contains("interrupted: an upload to the robot did not finish")
+            && said.contains("`scorpion upload --undo` puts back what the robot held before it"),
+        "{said}"
+    );
+    ok(&project, &line, &["upload", "--undo"]);
+    assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);
+}
