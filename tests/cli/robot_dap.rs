@@ -161,6 +161,14 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
         ),
         "{said}"
     );
+    // fresh15 F3: what stays in RAM after it, as the monitor says it.
+    let said = dap.event("output");
+    assert!(
+        said["body"]["output"].as_str().is_some_and(|text| text
+            .starts_with("the debug stub is at $")
+            && text.contains("stay in user RAM after the session, unhooked; no undo puts back")),
+        "{said}"
+    );
     // On the robot there is no going back and no data breakpoint.
     let capabilities = dap.event("capabilities");
     assert_eq!(
@@ -375,7 +383,10 @@ fn a_launch_says_what_it_cleaned_up_in_the_console_before_the_first_stop() {
     let said = loop {
         let output = dap.event("output");
         let text = output["body"]["output"].as_str().unwrap_or_default();
-        if output["body"]["category"] == "console" && !text.starts_with("attaching") {
+        if output["body"]["category"] == "console"
+            && !text.starts_with("attaching")
+            && !text.starts_with("the debug stub is at")
+        {
             break output;
         }
     };

@@ -111,6 +111,14 @@ pub(crate) fn attach(
         ));
     }
     let robot = RobotDebug::attach(client, &profile, code)?;
+    // The monitor and an editor alike (fresh15 F3: the adapter said
+    // nothing of it).
+    let stub = robot.stub();
+    say(&format!(
+        "the debug stub is at ${:04X}-${:04X}: it, and the RAM loader that wrote it, stay in user RAM after the session, unhooked; no undo puts back what was there (`scorpion backup` before a session keeps it)",
+        stub.address,
+        u32::from(stub.address) + stub.bytes.len() as u32 - 1,
+    ));
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
     // A JSR where no instruction starts would cut one in two: the line
     // tables say where they start, for the monitor and DAP alike.
@@ -167,7 +175,7 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     let stub = robot.stub().clone();
     writeln!(
         out,
-        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands\n  (the stub, and the RAM loader that wrote it, stay in user RAM after `quit`, unhooked: no undo puts back what was there; `scorpion backup` before a session keeps it)",
+        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands",
         robot.client().transport().name(),
         stub.address,
         u32::from(stub.address) + stub.bytes.len() as u32 - 1,
