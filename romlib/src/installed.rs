@@ -109,6 +109,14 @@ pub fn image_id(bytes: impl IntoIterator<Item = u8>) -> u32 {
 }
 
 impl Installed {
+    /// `extension 8C8390 ($0400-$044F)`, as messages name an installed
+    /// image: its id and its memory.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let extents: Vec<String> = self.extents.iter().map(extent_text).collect();
+        format!("extension {:06X} ({})", self.id, extents.join(", "))
+    }
+
     /// An image about to be installed: its id, its memory, and the hooks
     /// its records take (its slot is set where it goes).
     #[must_use]

@@ -348,16 +348,10 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
         let _ = write!(text, "\n  ${:04X}-${:04X}", area.address, area.end() - 1);
     }
     for old in &report.replaced {
-        let extents: Vec<String> = old
-            .extents
-            .iter()
-            .map(romlib::installed::extent_text)
-            .collect();
         let _ = write!(
             text,
-            "\n  took out extension {:06X} ({}): it overlapped the image (--replace), and no longer answers",
-            old.id,
-            extents.join(", ")
+            "\n  took out {}: it overlapped the image (--replace), and no longer answers",
+            old.describe()
         );
     }
     if report.rewrites > 0 || report.lost_answers > 0 {

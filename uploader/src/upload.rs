@@ -468,13 +468,7 @@ pub fn upload_keeping<T: Transport>(
                     chain::Way::Fine => Some(to),
                     chain::Way::ComesBack(_) => None,
                     chain::Way::Broken(why, path) => {
-                        progress.event(&Event::WayOutDropped {
-                            kind,
-                            from: to,
-                            why,
-                            path: path.to_string(),
-                        });
-                        dropped.push((kind, to));
+                        drop_way(progress, &mut dropped, (kind, to), why, &path);
                         None
                     }
                 },
@@ -514,13 +508,7 @@ pub fn upload_keeping<T: Transport>(
                 // A hook the image does not take is left as it is.
                 chain::Way::Broken(why, path) => {
                     if let Some(to) = profile.reset_target(kind).filter(|_| takes) {
-                        progress.event(&Event::WayOutDropped {
-                            kind,
-                            from: target,
-                            why,
-                            path: path.to_string(),
-                        });
-                        dropped.push((kind, target));
+                        drop_way(progress, &mut dropped, (kind, target), why, &path);
                         target = to;
                     }
                 }
@@ -824,6 +812,24 @@ pub fn upload_keeping<T: Transport>(
         replaced,
         dropped,
     })
+}
+
+/// Says that the way out `from` of `kind` is no way (`why`, the way
+/// followed), and keeps it for the report.
+fn drop_way(
+    progress: &mut dyn Progress,
+    dropped: &mut Vec<(HookKind, u16)>,
+    (kind, from): (HookKind, u16),
+    why: &'static str,
+    path: &chain::Path,
+) {
+    progress.event(&Event::WayOutDropped {
+        kind,
+        from,
+        why,
+        path: path.to_string(),
+    });
+    dropped.push((kind, from));
 }
 
 /// Compares the robot's jump-table entries of the hooks' reset targets

@@ -6,12 +6,10 @@
 
 mod common;
 
-use common::{Kept, extension, robot};
-use isa::objfmt::{HookKind, HookRecord};
+use common::{Kept, extension, extension_at, robot};
+use isa::objfmt::HookKind;
 use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
-use uploader::{
-    Area, Error, NoProgress, UploadImage, UploadOptions, backup, restore, upload, upload_keeping,
-};
+use uploader::{Error, NoProgress, UploadOptions, backup, restore, upload, upload_keeping};
 
 fn hook(client: &mut uploader::Client<uploader::transport::VirtualTransport>) -> u16 {
     let memory = client.transport().robot().robot().board().memory();
@@ -99,26 +97,6 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
         assert_eq!(hook(&mut client), BAD_COMMAND, "left at the ROM's target");
         assert!(client.probe().is_ok(), "the robot answers");
     }
-}
-
-/// An extension of 64 bytes at `base`, handler at `base + 3` falling
-/// through to its chain slot, `base + 1`.
-fn extension_at(base: u16) -> UploadImage {
-    let [lo, hi] = base.to_le_bytes();
-    let mut bytes = vec![0x4C, 0x00, 0x00, 0x4C, lo, hi];
-    bytes.resize(64, 0xEA);
-    UploadImage::new(
-        vec![Area {
-            address: base,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: base + 3,
-            chain: Some(base + 1),
-        }],
-    )
-    .expect("an image")
 }
 
 #[test]

@@ -7,33 +7,13 @@
 
 mod common;
 
-use common::robot;
-use isa::objfmt::{HookKind, HookRecord};
+use common::{extension_at, robot};
+use isa::objfmt::HookKind;
 use romlib::protocol::Command;
 use romlib::symbols::{BAD_COMMAND, HOOK_UNKNOWN};
 use uploader::transport::VirtualTransport;
-use uploader::{Area, Client, UploadImage, UploadOptions, upload};
+use uploader::{Client, UploadOptions, upload};
 use uploader::{Event, Phase, Progress};
-
-/// An extension of 64 bytes at `base`: its handler at `base + 3` jumps
-/// to its chain slot's `JMP` at `base`.
-fn extension_at(base: u16) -> UploadImage {
-    let [lo, hi] = base.to_le_bytes();
-    let mut bytes = vec![0x4C, 0x00, 0x00, 0x4C, lo, hi];
-    bytes.resize(64, 0xEA);
-    UploadImage::new(
-        vec![Area {
-            address: base,
-            bytes,
-        }],
-        vec![HookRecord {
-            kind: HookKind::Unknown,
-            handler: base + 3,
-            chain: Some(base + 1),
-        }],
-    )
-    .expect("an image")
-}
 
 /// The ways out dropped, as the progress heard them.
 #[derive(Default)]

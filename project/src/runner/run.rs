@@ -657,15 +657,9 @@ impl Run<'_, '_, '_> {
                     ));
                 }
                 for old in &report.replaced {
-                    let extents: Vec<String> = old
-                        .extents
-                        .iter()
-                        .map(romlib::installed::extent_text)
-                        .collect();
-                    self.report.replaced.push((
-                        image.name.clone(),
-                        format!("extension {:06X} ({})", old.id, extents.join(", ")),
-                    ));
+                    self.report
+                        .replaced
+                        .push((image.name.clone(), old.describe()));
                 }
             }
             let uploaded = uploaded.map_err(|source| Error::UploadImage {

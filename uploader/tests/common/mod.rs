@@ -11,6 +11,26 @@
 mod image;
 pub(crate) mod stub;
 
+/// An extension of 64 bytes at `base`: its handler at `base + 3` jumps
+/// to its chain slot's `JMP` at `base` (it falls through).
+pub(crate) fn extension_at(base: u16) -> uploader::UploadImage {
+    let [lo, hi] = base.to_le_bytes();
+    let mut bytes = vec![0x4C, 0x00, 0x00, 0x4C, lo, hi];
+    bytes.resize(64, 0xEA);
+    uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: base,
+            bytes,
+        }],
+        vec![isa::objfmt::HookRecord {
+            kind: isa::objfmt::HookKind::Unknown,
+            handler: base + 3,
+            chain: Some(base + 1),
+        }],
+    )
+    .expect("an image")
+}
+
 pub(crate) use image::{extension, one_byte_changed};
 
 use romlib::VirtualScorpion;
