@@ -131,11 +131,16 @@ pub(crate) fn follow<T: Transport>(
                 End::Elsewhere
             });
         }
-        let slot = everyone
+        let handler = everyone
             .iter()
             .flat_map(|other| other.hooks.iter())
-            .find(|hook| hook.kind == kind && hook.handler == at)
-            .and_then(|hook| hook.chain);
+            .find(|hook| hook.kind == kind && hook.handler == at);
+        // hostile15 F7: into an installed extension but not at its
+        // handler: the middle of its code, where no chain goes.
+        if strict && handler.is_none() && everyone.iter().any(|other| other.contains(at)) {
+            return Ok(End::Strays(Path(path)));
+        }
+        let slot = handler.and_then(|hook| hook.chain);
         let next = match slot {
             Some(slot) => read_word(client, slot)?,
             None => {
@@ -277,7 +282,7 @@ pub(crate) fn judge_way<T: Transport>(
                 Way::Broken("reaches code that stops the CPU (a BRK or a JAM)", path)
             }
             End::Strays(path) => Way::Broken(
-                "leads where no extension's code is (the ROM's own RAM or I/O, or the ROM but not one of its entries)",
+                "leads where no extension's code is (the ROM's own RAM or I/O, the ROM but not one of its entries, or an installed extension but not its handler)",
                 path,
             ),
             End::Elsewhere => Way::Fine,

@@ -97,3 +97,60 @@ fn a_store_to_a_cards_register_before_a_loops_line_is_stepped_alone() {
     debug.remove_breakpoint(0x0407).expect("removed");
     assert_eq!(debug.compare_with_image().expect("read"), None);
 }
+
+/// hostile15 F6: a session that died (`kill -9`) with the robot stopped
+/// after a step run alone left it stopped at the trampoline's `JSR`, which
+/// the next session could neither show nor let go on (`continue` stopped
+/// there again). The trampoline's `JMP` after the `JSR` names the program's
+/// next instruction: the next session shows the stop there and goes on.
+#[test]
+fn a_session_that_died_after_a_step_alone_is_found_at_the_programs_next_instruction() {
+    let image = card_handler();
+    let mut debug = attach(&image);
+    debug.set_breakpoint(0x0407, &ENTRIES).expect("set");
+    let Reply::Stopped(_) = debug.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    step(&mut debug);
+    assert_eq!(step(&mut debug).pc, 0x040A, "PHA, alone");
+    let client = debug.abandon();
+    let mut again =
+        uploader::stub::RobotDebug::attach(client, &uploader::RomProfile::reference(), image)
+            .expect("attaches again");
+    let found = again.recovery().stopped.expect("found stopped");
+    assert_eq!(found.pc, 0x040A, "at the program's PLA: {found:?}");
+    assert_eq!(again.stopped().map(|r| r.pc), Some(0x040A));
+    again.resume().expect("continue");
+    assert_eq!(
+        again.wait_event(WAIT).expect("the answer"),
+        Reply::Answer(b"Q\r".to_vec())
+    );
+    again.detach().expect("detached");
+}
+
+/// hostile15 F5: with all eight trampolines holding breakpoints, a step
+/// that would run alone is refused, and now says how to free one.
+#[test]
+fn a_step_with_every_trampoline_taken_says_to_delete_a_breakpoint() {
+    let areas = card_handler().areas().to_vec();
+    let mut bytes = areas[0].bytes.clone();
+    bytes.resize(0x60, 0xEA);
+    let image = hooked_at_0400(bytes);
+    let mut debug = attach(&image);
+    debug.set_breakpoint(0x0409, &ENTRIES).expect("on the PHA");
+    for at in (0x0420..0x0440).step_by(4).take(7) {
+        debug.set_breakpoint(at, &ENTRIES).expect("on the NOPs");
+    }
+    let Reply::Stopped(at) = debug.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    assert_eq!(at.pc, 0x0409);
+    match debug.step(&ENTRIES, false, WAIT) {
+        Err(uploader::stub::StubError::Refused { reason, .. }) => {
+            assert!(reason.contains("delete one"), "{reason}");
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+    debug.remove_breakpoint(0x0438).expect("one freed");
+    assert_eq!(step(&mut debug).pc, 0x040A, "PHA, alone");
+}

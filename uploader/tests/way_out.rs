@@ -113,3 +113,27 @@ fn a_damaged_way_out_is_not_passed_on_to_the_extension_before() {
         answers_after_an_unknown_command(&mut client);
     }
 }
+
+/// hostile15 F7: a way out damaged into the middle of another installed
+/// extension (past its handler) was kept, and that extension's command then
+/// answered wrong. No chain goes into an extension but at its handler.
+#[test]
+fn a_way_out_into_the_middle_of_another_extension_is_dropped() {
+    let options = UploadOptions::default();
+    let (first, second) = (extension_at(0x0400), extension_at(0x0500));
+    let mut client = uploader::client(robot(), &options.profile);
+    for image in [&second, &first] {
+        upload(&mut client, image, &options, &mut Heard::default()).expect("installed");
+    }
+    assert_eq!(
+        word(&mut client, 0x0401),
+        0x0503,
+        "the first falls to the second"
+    );
+    poke(&mut client, 0x0401, &0x0505u16.to_le_bytes());
+    let mut heard = Heard::default();
+    upload(&mut client, &first, &options, &mut heard).expect("again");
+    assert_eq!(heard.0, [0x0505]);
+    assert_eq!(word(&mut client, 0x0401), BAD_COMMAND);
+    answers_after_an_unknown_command(&mut client);
+}

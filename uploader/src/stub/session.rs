@@ -266,9 +266,21 @@ impl<T: Transport> RobotDebug<T> {
         debug.stub = placed.clone();
         if stopped {
             let block = debug.read(placed.regs, 8)?;
-            let registers = debug
+            let mut registers = debug
                 .take_stop(&block)
                 .ok_or_else(|| stopped_in_another_stub(placed.address))?;
+            // hostile15 F6: stopped after a step run alone in a
+            // trampoline, whose session died: the program goes on where
+            // the trampoline's `JMP` after the `JSR` says.
+            let tramps = placed.tramps..placed.tramps + TRAMPOLINE_LEN * TRAMPOLINES as u16;
+            if tramps.contains(&registers.pc) {
+                let entry = placed.entry.to_le_bytes();
+                let code = debug.read(registers.pc, 6)?;
+                if code[..4] == [JSR, entry[0], entry[1], patch::JMP] {
+                    registers.pc = u16::from_le_bytes([code[4], code[5]]);
+                    debug.stopped = Some(registers);
+                }
+            }
             debug.recovery.stopped = Some(registers);
         }
         let jump = debug.read(hook, 3)?;
@@ -1493,9 +1505,13 @@ impl<T: Transport> RobotDebug<T> {
         if let Some(stop) = self.step_on_host(registers)? {
             return Ok(stop);
         }
-        if let Some(stop) = self.step_alone(registers, wait)? {
+        let alone = self.goes_on_alone(registers.pc)?;
+        if let Some((instruction, bytes)) = &alone
+            && let Some(stop) = self.step_alone(instruction, bytes, wait)?
+        {
             return Ok(stop);
         }
+        let alone = alone.is_some();
         let pc = registers.pc;
         let image = self.image.clone();
         let mut known: BTreeMap<u16, u8> = BTreeMap::new();
@@ -1511,6 +1527,15 @@ impl<T: Transport> RobotDebug<T> {
             Ok(byte)
         };
         let next = patch::successors(pc, registers.s, &image, over, &mut read)?;
+        // hostile15 F5: where the step would have run alone but for the
+        // trampolines, a refusal says how to free one.
+        let busy = if alone {
+            format!(
+                " (all {TRAMPOLINES} trampolines hold breakpoints: delete one, and the step runs the instruction alone in it)"
+            )
+        } else {
+            String::new()
+        };
         let mut temporary = Vec::new();
         for &to in &next {
             if self.breakpoints.contains_key(&to) {
@@ -1528,7 +1553,7 @@ impl<T: Transport> RobotDebug<T> {
                 return Err(StubError::Refused {
                     what: format!("a step from ${pc:04X}"),
                     reason: format!(
-                        "the next instruction, ${to:04X}, is among the bytes the breakpoint at ${:04X} displaced",
+                        "the next instruction, ${to:04X}, is among the bytes the breakpoint at ${:04X} displaced{busy}",
                         other.address
                     ),
                 });
@@ -1550,7 +1575,7 @@ impl<T: Transport> RobotDebug<T> {
                     StubError::Refused { reason, .. } => StubError::Refused {
                         what: format!("a step from ${pc:04X}"),
                         reason: format!(
-                            "it stops with a JSR (three bytes) on the next instruction, ${to:04X}, and that is refused: {reason}; set a breakpoint further on and continue"
+                            "it stops with a JSR (three bytes) on the next instruction, ${to:04X}, and that is refused: {reason}; set a breakpoint further on and continue{busy}"
                         ),
                     },
                     other => other,
@@ -1627,20 +1652,12 @@ impl<T: Transport> RobotDebug<T> {
     ///
     /// The host has run the instruction first ([`RobotDebug::step_on_host`]),
     /// so a write into the stub or a breakpoint's bytes is refused before.
-    fn step_alone(&mut self, registers: Registers, wait: Duration) -> StubResult<Option<Reply>> {
-        let pc = registers.pc;
-        let bytes = self.read_as_program(pc, 3)?;
-        let Some(instruction) = Instruction::decode(&bytes, pc) else {
-            return Ok(None);
-        };
-        let goes_its_own_way = matches!(
-            instruction.opcode.mnemonic,
-            Mnemonic::Jsr | Mnemonic::Jmp | Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk
-        ) || instruction.opcode.mode == AddressingMode::Relative
-            || instruction.opcode.cycles == 0;
-        if goes_its_own_way {
-            return Ok(None);
-        }
+    fn step_alone(
+        &mut self,
+        instruction: &Instruction,
+        bytes: &[u8],
+        wait: Duration,
+    ) -> StubResult<Option<Reply>> {
         let used: Vec<usize> = self.breakpoints.values().map(|(_, slot)| *slot).collect();
         let Some(slot) = (0..TRAMPOLINES).find(|slot| !used.contains(slot)) else {
             return Ok(None);
@@ -1648,8 +1665,11 @@ impl<T: Transport> RobotDebug<T> {
         let len = usize::from(instruction.len());
         let trampoline = self.stub.trampoline(slot);
         let entry = self.stub.entry.to_le_bytes();
+        let next = instruction.next_address().to_le_bytes();
         let mut code = bytes[..len].to_vec();
-        code.extend_from_slice(&[JSR, entry[0], entry[1]]);
+        // The `JMP` after the `JSR` says where the program goes on, for a
+        // session that finds the robot stopped here after this one died.
+        code.extend_from_slice(&[JSR, entry[0], entry[1], patch::JMP, next[0], next[1]]);
         self.write_verified(trampoline, &code)?;
         self.go_on_at(trampoline)?;
         self.alone = Some((
@@ -1659,6 +1679,22 @@ impl<T: Transport> RobotDebug<T> {
         // The stop frame names the trampoline's `JSR`; it is told as the
         // program's next instruction (`take_stop`), a frame sent again too.
         Ok(Some(self.wait_event(wait)?))
+    }
+
+    /// The instruction at `pc` (the program's bytes) if it can run alone
+    /// in a trampoline: one that goes on to the next and does not read
+    /// the PC.
+    fn goes_on_alone(&mut self, pc: u16) -> StubResult<Option<(Instruction, Vec<u8>)>> {
+        let bytes = self.read_as_program(pc, 3)?;
+        let Some(instruction) = Instruction::decode(&bytes, pc) else {
+            return Ok(None);
+        };
+        let goes_its_own_way = matches!(
+            instruction.opcode.mnemonic,
+            Mnemonic::Jsr | Mnemonic::Jmp | Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Brk
+        ) || instruction.opcode.mode == AddressingMode::Relative
+            || instruction.opcode.cycles == 0;
+        Ok((!goes_its_own_way).then_some((instruction, bytes)))
     }
 
     /// [`StubError::Refused`] for a write into the stub's bytes.
