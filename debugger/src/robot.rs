@@ -208,8 +208,11 @@ impl RobotMonitor {
         address: u16,
         error: StubError,
     ) -> Failure {
-        let instead = matches!(error, StubError::Refused { .. })
-            .then(|| uploader::stub::patch::nearest(address, d.image(), &self.entries))
+        // fresh15 F4: not where one is already, nor one whose bytes the
+        // breakpoints set would overlap.
+        let already = d.breakpoints().any(|at| at == address);
+        let instead = (matches!(error, StubError::Refused { .. }) && !already)
+            .then(|| self.nearest_free(d, address))
             .flatten();
         match (failure(error), instead) {
             (Failure::Usage(said), Some(instead)) => Failure::Usage(format!(
@@ -219,6 +222,27 @@ impl RobotMonitor {
             )),
             (other, _) => other,
         }
+    }
+
+    /// The first instruction after `address` that takes a breakpoint and
+    /// whose bytes no breakpoint set covers, a few instructions on at most.
+    fn nearest_free<T: Transport>(&self, d: &RobotDebug<T>, address: u16) -> Option<u16> {
+        use uploader::stub::patch::{nearest, plan};
+        let image = d.image();
+        let span = |at: u16| {
+            let len = plan(at, image, &self.entries).map_or(3, |p| p.displaced.len() as u32);
+            u32::from(at)..u32::from(at) + len
+        };
+        let set: Vec<std::ops::Range<u32>> = d.breakpoints().map(span).collect();
+        let mut at = address;
+        for _ in 0..16 {
+            at = nearest(at, image, &self.entries)?;
+            let here = span(at);
+            if !set.iter().any(|b| b.start < here.end && here.start < b.end) {
+                return Some(at);
+            }
+        }
+        None
     }
 
     /// ` at FILE:LINE`, the user's source line `address` came from (not a

@@ -353,3 +353,22 @@ fn a_display_of_changing_memory_does_not_hide_the_answer() {
     assert!(shown.contains("answer: Q42"), "{shown}");
     assert!(shown.contains("1: [$C004] = (changing: "), "{shown}");
 }
+
+/// fresh15 F4: a refused breakpoint's hint named a place a breakpoint was
+/// already at (refused in turn), and a breakpoint set twice got a hint.
+#[test]
+fn a_refused_breakpoints_hint_skips_the_breakpoints_set() {
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $0409");
+    let twice = refusal(&mut m, &mut d, "break $0409");
+    assert!(twice.contains("one is there already"), "{twice}");
+    assert!(!twice.contains("nearest"), "{twice}");
+    // LDA #'Q' and the JSR after it overlap the breakpoint on the JSR.
+    let overlap = refusal(&mut m, &mut d, "break $0407");
+    assert!(
+        overlap.contains("overlap the breakpoint at $0409"),
+        "{overlap}"
+    );
+    assert!(overlap.contains("(`break $040C`)"), "{overlap}");
+    text(&mut m, &mut d, "break $040C");
+}

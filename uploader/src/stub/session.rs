@@ -894,9 +894,7 @@ impl<T: Transport> RobotDebug<T> {
             reason,
         };
         if self.breakpoints.contains_key(&address) {
-            return Err(refuse(
-                "one is there already (its JSR would displace the JSR)".into(),
-            ));
+            return Err(refuse("one is there already".into()));
         }
         if let Some(starts) = &self.starts
             && self.image.contains(address)
