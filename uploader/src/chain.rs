@@ -90,6 +90,8 @@ pub(crate) enum End {
     /// same registers at the same place, nothing written between): the
     /// way there, the loop's address last.
     Loops(Path),
+    /// At a return the code pushed nothing for: the way there.
+    Returns(Path),
     /// In the ROM, or somewhere this module cannot follow (a call, a
     /// return, a run longer than it looks).
     Elsewhere,
@@ -170,6 +172,10 @@ pub(crate) fn follow<T: Transport>(
                         Landing::Loops(pc) => {
                             path.push(pc);
                             return Ok(End::Loops(Path(path)));
+                        }
+                        Landing::Returns(pc) => {
+                            path.push(pc);
+                            return Ok(End::Returns(Path(path)));
                         }
                         Landing::Elsewhere => None,
                     }
@@ -281,6 +287,10 @@ pub(crate) fn judge_way<T: Transport>(
             End::Stops(path) => {
                 Way::Broken("reaches code that stops the CPU (a BRK or a JAM)", path)
             }
+            End::Returns(path) => Way::Broken(
+                "returns where nothing called it (an RTS or RTI for which the code pushed nothing: a hook is entered by a JMP)",
+                path,
+            ),
             End::Strays(path) => Way::Broken(
                 "leads where no extension's code is (the ROM's own RAM or I/O, the ROM but not one of its entries, or an installed extension but not its handler)",
                 path,
@@ -335,13 +345,20 @@ enum Landing {
     /// Back at a place with the registers it had there, nothing written
     /// between: a loop that never ends.
     Loops(u16),
+    /// At an `RTS` or `RTI` that pulls more than the code pushed: it
+    /// returns where nothing called it.
+    Returns(u16),
     /// Anywhere else (see [`run_to_landing`]).
     Elsewhere,
 }
 
 /// Instructions run on the host before code is taken to go nowhere this
 /// module can tell.
-const MOST_INSTRUCTIONS: usize = 256;
+const MOST_INSTRUCTIONS: usize = 4096;
+
+/// The stack pointer a host run starts with: below it, what the handler
+/// pushes.
+const ENTRY_S: u8 = 0xF0;
 
 /// Bytes read from the robot at once for the host's run.
 const CHUNK: usize = 16;
@@ -354,10 +371,10 @@ const CHUNK: usize = 16;
 /// way); [`Landing::Left`] where it goes into the ROM or to memory an
 /// extension may not hold (the I/O page); [`Landing::Loops`] back at a
 /// place with the same registers and nothing written between;
-/// [`Landing::Elsewhere`] where it reads memory it may not, calls or
-/// returns (`JSR`, `RTS`, `RTI`: a call is no chain's way, and may be a
-/// breakpoint a killed session left, which attaching takes out), or has
-/// run [`MOST_INSTRUCTIONS`].
+/// [`Landing::Returns`] at a return it pushed nothing for;
+/// [`Landing::Elsewhere`] where it reads memory it may not, calls (`JSR`:
+/// a call is no chain's way, and may be a breakpoint a killed session
+/// left, which attaching takes out), or has run [`MOST_INSTRUCTIONS`].
 fn run_to_landing<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
@@ -374,7 +391,7 @@ fn run_to_landing<T: Transport>(
     };
     let mut cpu = Cpu::new();
     cpu.set_idle_skip(false);
-    (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, 0xF0, start);
+    (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, ENTRY_S, start);
     let mut states = std::collections::HashSet::new();
     for _ in 0..MOST_INSTRUCTIONS {
         let opcode = bus.byte(cpu.pc);
@@ -388,7 +405,17 @@ fn run_to_landing<T: Transport>(
         if info.cycles == 0 || info.mnemonic == Mnemonic::Brk {
             return Ok(Landing::Stops(cpu.pc));
         }
-        if matches!(info.mnemonic, Mnemonic::Rts | Mnemonic::Rti | Mnemonic::Jsr) {
+        // A handler is entered by a `JMP` (the ROM's dispatch, its loop):
+        // a return it pushed nothing for pops the ROM's stack (hostile15
+        // F9: a bare `RTS` jammed the CPU). One it pushed for (the
+        // jump-table idiom) is run.
+        if matches!(info.mnemonic, Mnemonic::Rts | Mnemonic::Rti) {
+            let pulled = if info.mnemonic == Mnemonic::Rts { 2 } else { 3 };
+            if u16::from(cpu.s) + pulled > u16::from(ENTRY_S) {
+                return Ok(Landing::Returns(cpu.pc));
+            }
+        }
+        if info.mnemonic == Mnemonic::Jsr {
             break;
         }
         cpu.step(&mut bus);

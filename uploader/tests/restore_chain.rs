@@ -43,6 +43,15 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
             None,
             "where no extension's code is",
         ),
+        // hostile15 F9: a loop whose X counts round (the same registers
+        // again after 256 passes), and a bare RTS.
+        (
+            vec![0xEA, 0xE8, 0x4C, 0x01, 0x06],
+            0x0600,
+            None,
+            "comes back",
+        ),
+        (vec![0x60], 0x0600, None, "returns where nothing called it"),
         // A loop that counts but never gets out: the same registers
         // again, nothing written between.
         (

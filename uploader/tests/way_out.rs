@@ -70,13 +70,21 @@ fn a_hook_damaged_by_hand_is_no_way_out_for_a_new_image() {
         assert_eq!(word(&mut client, HOOK_UNKNOWN + 1), 0x0403);
         answers_after_an_unknown_command(&mut client);
     }
-    // An owner's code that gets to the ROM's target is a way out.
-    let mut client = uploader::client(robot(), &options.profile);
-    poke(&mut client, 0x0700, &[0xEA, 0x4C, 0x21, 0xFF]);
-    poke(&mut client, HOOK_UNKNOWN + 1, &[0x00, 0x07]);
-    let report = upload(&mut client, &image, &options, &mut Heard::default()).expect("uploaded");
-    assert_eq!(word(&mut client, 0x0401), 0x0700, "kept");
-    assert!(report.dropped.is_empty());
+    // An owner's code that gets to the ROM's target is a way out: by a
+    // JMP after a delay of 512 instructions, or by the jump-table idiom
+    // (the target less one pushed, then RTS).
+    for code in [
+        &[0xA2, 0x00, 0xCA, 0xD0, 0xFD, 0x4C, 0x21, 0xFF][..],
+        &[0xA9, 0xFF, 0x48, 0xA9, 0x20, 0x48, 0x60][..],
+    ] {
+        let mut client = uploader::client(robot(), &options.profile);
+        poke(&mut client, 0x0700, code);
+        poke(&mut client, HOOK_UNKNOWN + 1, &[0x00, 0x07]);
+        let report =
+            upload(&mut client, &image, &options, &mut Heard::default()).expect("uploaded");
+        assert_eq!(word(&mut client, 0x0401), 0x0700, "kept: {code:02X?}");
+        assert!(report.dropped.is_empty(), "{code:02X?}");
+    }
 }
 
 /// hostile15 F1: with two extensions chained (the hook to the second, its

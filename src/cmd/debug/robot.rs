@@ -198,11 +198,19 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     // with the robot stopped in the stub or a JSR left in its code: each
     // ends the session at the next line read (or the end of input), and
     // the robot is given back as at `quit`.
-    let ended = crate::cmd::flag_on_signals(&[
+    let signals = [
         signal_hook::consts::SIGINT,
         signal_hook::consts::SIGHUP,
         signal_hook::consts::SIGTERM,
-    ])?;
+    ];
+    let ended = crate::cmd::flag_on_signals(&signals)?;
+    // Which one, for the exit status (hostile15 F8: a session a signal
+    // ended exited 0, as if every command had run).
+    let signal = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    for number in signals {
+        signal_hook::flag::register_usize(number, std::sync::Arc::clone(&signal), number as usize)
+            .into_diagnostic()?;
+    }
     // A wait for the robot (a continue's, a step's) ends at the signal
     // too, not only the next line read.
     robot.set_interrupt(std::sync::Arc::clone(&ended));
@@ -245,6 +253,14 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         out,
         "detached: the breakpoints taken out, HOOK_UNKNOWN given back"
     );
+    let number = signal.load(Ordering::Relaxed);
+    if ended.load(Ordering::Relaxed) && number != 0 {
+        let _ = writeln!(
+            out,
+            "interrupted (signal {number}): the session ended as `quit` ends it; the commands after were not run"
+        );
+        return Ok(ExitCode::from(128 + number as u8));
+    }
     Ok(if broken {
         ExitCode::FAILURE
     } else {
