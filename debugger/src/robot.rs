@@ -656,7 +656,7 @@ impl RobotMonitor {
             None => 16,
         };
         let len = len.min(0x1_0000 - usize::from(address));
-        let bytes = d.read_as_program(address, len).map_err(failure)?;
+        let bytes = read_for_person(d, address, len)?;
         let mut text = String::new();
         for (i, row) in bytes.chunks(16).enumerate() {
             let at = address.wrapping_add(16 * i as u16);
@@ -686,7 +686,7 @@ impl RobotMonitor {
             None => 8,
         };
         let len = (count * 3).min(0x1_0000 - usize::from(address));
-        let bytes = d.read_as_program(address, len).map_err(failure)?;
+        let bytes = read_for_person(d, address, len)?;
         let mut text = String::new();
         for line in isa::Disassembler::new(&bytes, address).take(count) {
             let shown = line.display_with(|at| self.symbols.label(at));
@@ -774,7 +774,7 @@ impl RobotMonitor {
                 if d.interrupted() {
                     return Err(usage("interrupted"));
                 }
-                let bytes = d.read_as_program(start, len).map_err(failure)?;
+                let bytes = read_for_person(d, start, len)?;
                 let mut memory = snapshot.memory.borrow_mut();
                 for (i, byte) in bytes.into_iter().enumerate() {
                     memory.insert(start.wrapping_add(i as u16), byte);
@@ -783,6 +783,22 @@ impl RobotMonitor {
         }
         Err(usage("the expression reads memory through too many levels"))
     }
+}
+
+/// `len` bytes at `address` as the program sees them, for a person (a
+/// `mem`, a `dis`, an expression's `[...]`): refused where a read would
+/// change a card's or the board's register ([`RobotDebug::refuse_read`]).
+fn read_for_person<T: Transport>(
+    d: &mut RobotDebug<T>,
+    address: u16,
+    len: usize,
+) -> Result<Vec<u8>, Failure> {
+    if let Some((_, reason)) = d.refuse_read(address, len) {
+        return Err(Failure::Usage(format!(
+            "a read of ${address:04X} ({len} bytes) is refused on the robot: {reason}"
+        )));
+    }
+    d.read_as_program(address, len).map_err(failure)
 }
 
 /// The most bytes read between two wanted ones rather than asking again.

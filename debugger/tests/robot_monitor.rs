@@ -337,21 +337,27 @@ fn expressions_read_what_they_need_while_the_robot_runs() {
     );
 }
 
-/// hostile14 F8: a display of memory the robot changes as it runs (a
-/// timer's counter here) hid the answer of every command after it behind
-/// "the bytes changed between reads". It is shown as changing, and the
-/// answer with it.
+/// hostile14 F8: a display of memory the robot changes as it runs (the
+/// head of the ROM's receive ring here, which every question moves) hid
+/// the answer of every command after it behind "the bytes changed between
+/// reads". It is shown as changing, and the answer with it.
 #[test]
 fn a_display_of_changing_memory_does_not_hide_the_answer() {
     let (mut m, mut d) = attached();
-    let shown = text(&mut m, &mut d, "display [$C004]");
+    let head = romlib::symbols::find("RXHEAD")
+        .expect("the ROM's RXHEAD")
+        .value;
+    let shown = text(&mut m, &mut d, &format!("display [${head:04X}]"));
     assert!(
-        shown.starts_with("display 1: [$C004] = (changing: "),
+        shown.starts_with(&format!("display 1: [${head:04X}] = (changing: ")),
         "{shown}"
     );
     let shown = text(&mut m, &mut d, "/1Q");
     assert!(shown.contains("answer: Q42"), "{shown}");
-    assert!(shown.contains("1: [$C004] = (changing: "), "{shown}");
+    assert!(
+        shown.contains(&format!("1: [${head:04X}] = (changing: ")),
+        "{shown}"
+    );
 }
 
 /// fresh15 F4: a refused breakpoint's hint named a place a breakpoint was
@@ -371,4 +377,30 @@ fn a_refused_breakpoints_hint_skips_the_breakpoints_set() {
     );
     assert!(overlap.contains("(`break $040C`)"), "{overlap}");
     text(&mut m, &mut d, "break $040C");
+}
+
+/// fresh15 F7: at a stop, `mem $9000 3` read the ADC card's result (a
+/// real bus read on the robot), which cleared its status, and the handler
+/// then answered "no card". Reads of the I/O page and of the KIM bus
+/// outside the image are refused, saying why; RAM and the ROM are read.
+#[test]
+fn reads_that_would_change_a_cards_registers_are_refused() {
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $040C");
+    assert!(text(&mut m, &mut d, "/1Q").contains("stopped: breakpoint 1"));
+    for line in ["mem $9000 3", "print [$9002]", "mem $C000", "mem $0FFF 2"] {
+        let why = refusal(&mut m, &mut d, line);
+        assert!(
+            why.contains("reading a register there can change it"),
+            "`{line}`: {why}"
+        );
+    }
+    // A display is kept, its value the reason.
+    let shown = text(&mut m, &mut d, "display [$C001]");
+    assert!(
+        shown.contains("reading a register there can change it"),
+        "{shown}"
+    );
+    assert!(text(&mut m, &mut d, "mem $0480 1").contains("$0480: 42"));
+    assert!(text(&mut m, &mut d, "mem $FF00 1").contains("$FF00: "));
 }

@@ -553,6 +553,13 @@ impl RobotSession {
         let len = usize::try_from(count)
             .unwrap_or(0)
             .min(0x1_0000 - usize::from(start));
+        // fresh15 F7: a memory view over a card's registers would read
+        // them (and change them): those bytes are unreadable.
+        let robot = self.robot()?;
+        let len = match robot.refuse_read(start, len) {
+            Some((at, _)) => usize::from(at.wrapping_sub(start)),
+            None => len,
+        };
         let bytes = if len == 0 {
             Vec::new()
         } else {

@@ -109,6 +109,24 @@ impl Guard {
         ))
     }
 
+    /// Why a read at `at` by a person is refused, if it is: a read of the
+    /// I/O page, or of the KIM bus outside the image, is a real bus read
+    /// on the robot, and a register there may change when read (fresh15
+    /// F7: reading the ADC card's result at a stop cleared its status, and
+    /// the handler then said "no card"). The virtual robot shows such
+    /// memory without reading it; the robot cannot.
+    #[must_use]
+    pub fn refuse_read(&self, at: u16, image: &UploadImage) -> Option<String> {
+        use platform::map::{IO_END, IO_START, KIM_BUS};
+        let device = (IO_START..=IO_END).contains(&at) || KIM_BUS.contains(&at);
+        (device && !image.contains(at)).then(|| {
+            format!(
+                "${at:04X} is {}, and reading a register there can change it (a status cleared, a result taken): the program would then read something else; the robot's monitor reads RAM, the ROM and the image's own memory only",
+                region(at)
+            )
+        })
+    }
+
     /// Why the registers `new` are refused where the robot is stopped
     /// with `old`, if they are: a PC that is no instruction the host knows
     /// (inside the stub, inside an instruction of the image, in the ROM

@@ -1722,6 +1722,18 @@ impl<T: Transport> RobotDebug<T> {
         }
     }
 
+    /// Why a person's read of `len` bytes at `address` is refused, if it
+    /// is ([`Guard::refuse_read`]): the first address refused, and why.
+    #[must_use]
+    pub fn refuse_read(&self, address: u16, len: usize) -> Option<(u16, String)> {
+        (0..len).find_map(|i| {
+            let at = address.wrapping_add(i as u16);
+            self.guard
+                .refuse_read(at, &self.image)
+                .map(|reason| (at, reason))
+        })
+    }
+
     /// Reads `len` bytes at `address` as the program sees them (as a
     /// debugger hides its breakpoints): a breakpoint's `JSR` shows the
     /// program's bytes under it, and at a stop the stub's two zero-page
