@@ -244,6 +244,12 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
         json!({"memoryReference": "0x0480", "count": 1}),
     );
     assert_eq!(read["body"]["data"], "mQ==", "{read}");
+    // fresh15 F7: a view running into the KIM bus does not read it.
+    let read = dap.request(
+        "readMemory",
+        json!({"memoryReference": "0x0FFE", "count": 4}),
+    );
+    assert_eq!(read["body"]["unreadableBytes"], 2, "{read}");
 
     // One instruction, LDA value: A holds the changed byte.
     let next = dap.request("next", json!({"threadId": 1}));
