@@ -48,7 +48,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         if let Some(place) = uploader::loader_left_at(&mut client, &profile, last)? {
             let _ = writeln!(
                 text,
-                "{}: ${last:04X} is the RAM loader (${:04X}-${:04X}) an upload or a restore left hooked: it did not finish (killed, or its line failed); unknown commands other than the loader's own go to the ROM\n  `scorpion upload --undo --port {}` puts back what an upload overwrote (after a restore: that restore again); then upload again",
+                "{}: ${last:04X} is the RAM loader (${:04X}-${:04X}) an upload, a restore or a debug session's attach left hooked: it did not finish (killed, or its line failed); unknown commands other than the loader's own go to the ROM\n  `scorpion upload --undo --port {}` puts back what an upload overwrote (after a restore: that restore again; after an attach, `scorpion upload` of the image takes the loader out and keeps the image); then upload again",
                 kind.rom_symbol(),
                 place.start(),
                 place.end(),
