@@ -34,6 +34,9 @@ pub(crate) type BeforeWrite<'a, T> = dyn FnMut(&mut Client<T>, &[Area]) -> Resul
 /// How often the loader is restored before the upload gives up.
 const MAX_RECOVERIES: u32 = 6;
 
+/// Looks for the loader after its sums went silent, before giving up.
+const ENSURE_ATTEMPTS: u32 = 3;
+
 /// Time the robot is given to obey `/1F` once its last character has
 /// arrived: the ROM's dispatch and `rate`'s toggle take well under a
 /// millisecond at 1 MHz.
@@ -649,7 +652,17 @@ impl Session {
                     return Ok(total);
                 }
                 Err(error) if recoverable(&error) => {
-                    self.ensure(client, progress).map_err(|_| error)?;
+                    // fresh15 F5: on a noisy line the look for the loader
+                    // can fail as the sums did; one failed look gave up
+                    // with the loader hooked.
+                    let mut ensured = self.ensure(client, progress);
+                    for _ in 1..ENSURE_ATTEMPTS {
+                        if ensured.is_ok() {
+                            break;
+                        }
+                        ensured = self.ensure(client, progress);
+                    }
+                    ensured.map_err(|_| error)?;
                     held_maybe = true;
                     total.passes += 1;
                 }

@@ -107,6 +107,8 @@ pub(crate) fn write_summed<T: Transport>(
     // write may have gone astray, so every range is summed again.
     let mut astray = held_maybe;
     let mut silent = 0;
+    // When the rounds that heard no sum began, for the error.
+    let mut silent_since = None;
     loop {
         if !ask.contains(&true) {
             if !astray {
@@ -152,6 +154,7 @@ pub(crate) fn write_summed<T: Transport>(
             .map(|&i| units[i].area.bytes.len())
             .max()
             .unwrap_or(0);
+        let asked_at = client.transport().now();
         let frames = client.batch(&entries, ANSWER_LEN, work(longest))?;
         let mut found: Vec<Option<u16>> = vec![None; units.len()];
         for (address, sum) in frames.iter().filter_map(|frame| parse(frame)) {
@@ -186,16 +189,19 @@ pub(crate) fn write_summed<T: Transport>(
         }
         if lost == asked.len() {
             silent += 1;
+            let now = client.transport().now();
+            let since = *silent_since.get_or_insert(asked_at);
             if silent >= SILENT_ROUNDS {
                 return Err(Error::NoAnswer {
                     port: client.transport().name(),
                     baud: client.transport().baud(),
                     question: "/9K".into(),
-                    waited: std::time::Duration::ZERO,
+                    waited: now.saturating_sub(since),
                 });
             }
         } else {
             silent = 0;
+            silent_since = None;
         }
     }
 }

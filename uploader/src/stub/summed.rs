@@ -22,6 +22,9 @@ use crate::session::Session;
 use crate::transport::Transport;
 use crate::upload::UploadOptions;
 
+/// Tries at taking the loader out before it is said to stay hooked.
+const REMOVE_ATTEMPTS: u32 = 3;
+
 /// Writes `areas` through the RAM loader placed for `image` (as an upload
 /// of it places it), verified by the robot's sums; `false`, with nothing
 /// written, when the image leaves the loader no room, the ROM lacks its
@@ -59,7 +62,14 @@ pub(super) fn write_summed<T: Transport>(
     let written = session
         .install(client, &mut progress, &mut |_, _| Ok(()))
         .and_then(|()| session.transfer_summed(client, areas, &mut progress));
-    let taken_out = session.remove(client, &mut progress);
+    // The loader must not stay hooked for one look a noisy line lost.
+    let mut taken_out = session.remove(client, &mut progress);
+    for _ in 1..REMOVE_ATTEMPTS {
+        if taken_out.is_ok() {
+            break;
+        }
+        taken_out = session.remove(client, &mut progress);
+    }
     match (written, taken_out) {
         (Ok(_), Ok(())) => Ok(true),
         (Err(error), Ok(())) => Err(error.into()),
