@@ -393,6 +393,7 @@ fn run_to_landing<T: Transport>(
     cpu.set_idle_skip(false);
     (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, ENTRY_S, start);
     let mut states = std::collections::HashSet::new();
+    let mut visited = std::collections::BTreeSet::new();
     for _ in 0..MOST_INSTRUCTIONS {
         let opcode = bus.byte(cpu.pc);
         if let Some(error) = bus.failed.take() {
@@ -416,8 +417,18 @@ fn run_to_landing<T: Transport>(
             }
         }
         if info.mnemonic == Mnemonic::Jsr {
+            // hostile16 F1: a call back into code this run has been
+            // through (`JSR` to itself) calls itself for ever.
+            let target = u16::from_le_bytes([
+                bus.byte(cpu.pc.wrapping_add(1)),
+                bus.byte(cpu.pc.wrapping_add(2)),
+            ]);
+            if target == start || visited.contains(&target) {
+                return Ok(Landing::Loops(target));
+            }
             break;
         }
+        visited.insert(cpu.pc);
         cpu.step(&mut bus);
         if let Some(error) = bus.failed.take() {
             return Err(error);

@@ -52,6 +52,8 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
             "comes back",
         ),
         (vec![0x60], 0x0600, None, "returns where nothing called it"),
+        // hostile16 F1: a call to itself, for ever.
+        (vec![0xEA, 0x20, 0x00, 0x06], 0x0600, None, "comes back"),
         // A loop that counts but never gets out: the same registers
         // again, nothing written between.
         (

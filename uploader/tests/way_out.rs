@@ -58,6 +58,7 @@ fn a_hook_damaged_by_hand_is_no_way_out_for_a_new_image() {
         (0xF800, &[][..]),
         (0x2121, &[][..]),
         (0x0700, &[0xEA, 0x4C, 0x01, 0x07][..]),
+        (0x0700, &[0x20, 0x00, 0x07][..]),
     ] {
         let mut client = uploader::client(robot(), &options.profile);
         poke(&mut client, 0x0700, code);
