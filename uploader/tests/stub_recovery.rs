@@ -255,3 +255,40 @@ fn a_session_with_another_image_takes_out_what_the_first_left() {
         assert_eq!(&memory[0x0400..0x0481], &first.areas()[0].bytes[..]);
     }
 }
+
+/// hostile16 F2: a session killed at a stop after a byte of the code was
+/// changed (`poke` into an instruction) left a robot the next session
+/// refused as "not the image", and every other command refused as stopped
+/// in the stub: only a reset helped. Found stopped, the robot's code is
+/// taken as it is (said), and it goes on.
+#[test]
+fn a_robot_found_stopped_with_its_code_changed_still_goes_on() {
+    let image = handler();
+    let mut debug = attach(&image);
+    debug.set_breakpoint(AT, &[]).expect("set");
+    let Reply::Stopped(_) = debug.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    // LDA #'Q' at $0407 made LDA #'Z' (its operand is code).
+    debug.write_verified(0x0408, b"Z").expect("poked");
+    let mut again = reattach(debug.abandon(), &image);
+    assert_eq!(again.recovery().changed, [0x0408]);
+    assert!(
+        again
+            .recovery()
+            .describe()
+            .contains("differs from the image in 1 bytes from $0408")
+    );
+    assert_eq!(again.stopped().map(|r| r.pc), Some(AT));
+    again.resume().expect("continue");
+    assert_eq!(
+        again.wait_event(WAIT).expect("the answer"),
+        Reply::Answer(b"42\r".to_vec()),
+        "the Q went out before the stop, to the session that died; the change shows at the next command"
+    );
+    assert_eq!(
+        again.command(b"/1Q", WAIT).expect("sent"),
+        Reply::Answer(b"Z42\r".to_vec())
+    );
+    again.detach().expect("detached");
+}

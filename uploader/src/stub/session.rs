@@ -157,6 +157,11 @@ pub struct Recovery {
     /// `JSR`s into the stub left in the code: the image's bytes put back
     /// and read back.
     pub removed: Vec<u16>,
+    /// Code bytes that differ from the image on a robot found stopped in
+    /// the stub (changed at a stop, or by the program): taken as the
+    /// robot's, so that the session can let it go on (hostile16 F2: the
+    /// robot was refused as "not the image" and stayed stopped for good).
+    pub changed: Vec<u16>,
 }
 
 impl Recovery {
@@ -187,6 +192,12 @@ impl Recovery {
                 parts.push("its stub was still hooked on HOOK_UNKNOWN (hooked again)".to_owned());
             }
             (false, _) => {}
+        }
+        if let Some(first) = self.changed.first() {
+            parts.push(format!(
+                "its code differs from the image in {} bytes from ${first:04X} (changed while it ran or at a stop): taken as the robot's, so that it can go on; upload the image again to put them back",
+                self.changed.len()
+            ));
         }
         if !self.removed.is_empty() {
             let at: Vec<String> = self.removed.iter().map(|a| format!("${a:04X}")).collect();
@@ -635,7 +646,18 @@ impl<T: Transport> RobotDebug<T> {
                     found[i] = area.bytes[i];
                 }
             }
-            if let Some(i) = (0..found.len()).find(|&i| code[i] && found[i] != area.bytes[i]) {
+            if self.stopped.is_some() {
+                // Found stopped in the stub: it must be let go on whatever
+                // its code now holds.
+                for i in (0..found.len()).filter(|&i| code[i] && found[i] != area.bytes[i]) {
+                    let at = area.address.wrapping_add(i as u16);
+                    self.recovery.changed.push(at);
+                    adopted.push((at, found[i]));
+                }
+            }
+            if self.stopped.is_none()
+                && let Some(i) = (0..found.len()).find(|&i| code[i] && found[i] != area.bytes[i])
+            {
                 let end = (i..found.len().min(i + 4))
                     .take_while(|&j| code[j])
                     .last()
