@@ -372,9 +372,10 @@ const CHUNK: usize = 16;
 /// extension may not hold (the I/O page); [`Landing::Loops`] back at a
 /// place with the same registers and nothing written between;
 /// [`Landing::Returns`] at a return it pushed nothing for;
-/// [`Landing::Elsewhere`] where it reads memory it may not, calls (`JSR`:
-/// a call is no chain's way, and may be a breakpoint a killed session
-/// left, which attaching takes out), or has run [`MOST_INSTRUCTIONS`].
+/// [`Landing::Elsewhere`] where it reads memory it may not, calls into
+/// the ROM (a service returns where the ROM decides), or has run
+/// [`MOST_INSTRUCTIONS`]. A call into RAM is followed; one back into code
+/// the run has been through is a loop.
 fn run_to_landing<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
@@ -426,7 +427,15 @@ fn run_to_landing<T: Transport>(
             if target == start || visited.contains(&target) {
                 return Ok(Landing::Loops(target));
             }
-            break;
+            // A call into the ROM (a service) returns where the ROM
+            // decides: the run ends there. One into memory no code may be
+            // in (the ROM's zero page) strays; one into RAM is followed.
+            if target >= platform::map::ROM_START {
+                break;
+            }
+            if !readable(profile, target) {
+                return Ok(Landing::Left(target));
+            }
         }
         visited.insert(cpu.pc);
         cpu.step(&mut bus);

@@ -54,6 +54,21 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
         (vec![0x60], 0x0600, None, "returns where nothing called it"),
         // hostile16 F1: a call to itself, for ever.
         (vec![0xEA, 0x20, 0x00, 0x06], 0x0600, None, "comes back"),
+        (vec![0x20, 0x00, 0x06], 0x0600, None, "comes back"),
+        // A call into the ROM's zero page; one to a subroutine that jumps
+        // back to the start.
+        (
+            vec![0x20, 0x21, 0x00],
+            0x0600,
+            None,
+            "where no extension's code is",
+        ),
+        (
+            vec![0x20, 0x06, 0x06, 0x4C, 0x00, 0x06, 0x4C, 0x00, 0x06],
+            0x0600,
+            None,
+            "comes back",
+        ),
         // A loop that counts but never gets out: the same registers
         // again, nothing written between.
         (
