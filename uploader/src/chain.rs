@@ -163,7 +163,7 @@ pub(crate) fn follow<T: Transport>(
                                 .flat_map(|other| other.hooks.iter())
                                 .any(|hook| hook.kind == kind && hook.handler == pc)
                     };
-                    match run_to_landing(client, profile, at, &landing)? {
+                    match run_to_landing(client, profile, at, &landing, strict)? {
                         Landing::At(pc) | Landing::Left(pc) => Some(pc),
                         Landing::Stops(pc) => {
                             path.push(pc);
@@ -374,13 +374,15 @@ const CHUNK: usize = 16;
 /// [`Landing::Returns`] at a return it pushed nothing for;
 /// [`Landing::Elsewhere`] where it reads memory it may not, calls into
 /// the ROM (a service returns where the ROM decides), or has run
-/// [`MOST_INSTRUCTIONS`]. A call into RAM is followed; one back into code
-/// the run has been through is a loop.
+/// [`MOST_INSTRUCTIONS`]. A call back into code the run has been through
+/// is a loop; `strict` (looking for a broken way), a call into RAM is
+/// followed, and one into memory no code may be in strays.
 fn run_to_landing<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     start: u16,
     landing: &dyn Fn(u16) -> bool,
+    strict: bool,
 ) -> Result<Landing> {
     let mut bus = ChainBus {
         client,
@@ -430,7 +432,10 @@ fn run_to_landing<T: Transport>(
             // A call into the ROM (a service) returns where the ROM
             // decides: the run ends there. One into memory no code may be
             // in (the ROM's zero page) strays; one into RAM is followed.
-            if target >= platform::map::ROM_START {
+            // Not looking for a broken way (attach's look for one back
+            // into the stub), a call ends the run: it may be a breakpoint
+            // a killed session left, which attaching takes out.
+            if target >= platform::map::ROM_START || !strict {
                 break;
             }
             if !readable(profile, target) {
