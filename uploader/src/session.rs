@@ -655,14 +655,7 @@ impl Session {
                     // fresh15 F5: on a noisy line the look for the loader
                     // can fail as the sums did; one failed look gave up
                     // with the loader hooked.
-                    let mut ensured = self.ensure(client, progress);
-                    for _ in 1..ENSURE_ATTEMPTS {
-                        if ensured.is_ok() {
-                            break;
-                        }
-                        ensured = self.ensure(client, progress);
-                    }
-                    ensured.map_err(|_| error)?;
+                    tried(ENSURE_ATTEMPTS, || self.ensure(client, progress)).map_err(|_| error)?;
                     held_maybe = true;
                     total.passes += 1;
                 }
@@ -764,6 +757,19 @@ impl Session {
     pub(crate) fn find<T: Transport>(&mut self, client: &mut Client<T>) -> Result<u32> {
         self.find_rate(client)
     }
+}
+
+/// `attempt` up to `times` times, until it succeeds: its last result. For
+/// looks a noisy line can fail one at a time.
+pub(crate) fn tried<R>(times: u32, mut attempt: impl FnMut() -> Result<R>) -> Result<R> {
+    let mut result = attempt();
+    for _ in 1..times {
+        if result.is_ok() {
+            break;
+        }
+        result = attempt();
+    }
+    result
 }
 
 /// Sends `/1F` once every answer is in (the 6551 must not be sending when

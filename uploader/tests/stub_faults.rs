@@ -167,6 +167,34 @@ fn attached_after_an_upload(
     (attached, table)
 }
 
+/// Attaches after an upload with the line going dead (for `stall_for`,
+/// `None`: for good) at about `places` points from a quarter of a clean
+/// attach's characters on (fault generator `seed`): the attaches that
+/// failed, each with the character count where the line died.
+fn stalled_attaches(
+    image: &UploadImage,
+    seed: u64,
+    places: usize,
+    stall_for: Option<Duration>,
+) -> Vec<(usize, String)> {
+    let (clean, _) = attached_after_an_upload(image, FaultConfig::none(seed));
+    let sent = clean.expect("attaches").client().stats().sent;
+    (sent / 4..sent)
+        .step_by((sent / places).max(1))
+        .filter_map(|at| {
+            let config = FaultConfig {
+                stall_after: Some(at),
+                stall_for,
+                ..FaultConfig::none(seed)
+            };
+            attached_after_an_upload(image, config)
+                .0
+                .err()
+                .map(|error| (at, error))
+        })
+        .collect()
+}
+
 /// The table of installed extensions (`EXTTAB`, docs/PROTOCOL.md).
 const EXTTAB: std::ops::Range<usize> =
     romlib::symbols::EXTTAB as usize..romlib::symbols::EXTTAB as usize + 0x80;
@@ -543,20 +571,10 @@ fn a_reply_whose_length_grew_does_not_swallow_the_replies_after_it() {
 /// the error says it stays hooked and what to do.
 #[test]
 fn an_attach_whose_line_dies_in_the_loader_says_the_loader_stays_hooked() {
-    let image = handler();
-    let (clean, _) = attached_after_an_upload(&image, FaultConfig::none(3));
-    let sent = clean.expect("attaches").client().stats().sent;
-    let mut said = 0;
-    for at in (sent / 4..sent).step_by((sent / 40).max(1)) {
-        let config = FaultConfig {
-            stall_after: Some(at),
-            stall_for: None,
-            ..FaultConfig::none(3)
-        };
-        if let (Err(error), _) = attached_after_an_upload(&image, config) {
-            said += usize::from(error.contains("the loader stays hooked on HOOK_UNKNOWN"));
-        }
-    }
+    let said = stalled_attaches(&handler(), 3, 40, None)
+        .iter()
+        .filter(|(_, error)| error.contains("the loader stays hooked on HOOK_UNKNOWN"))
+        .count();
     assert!(said > 0, "no cut left the loader hooked and said so");
 }
 
@@ -671,20 +689,11 @@ fn a_write_whose_damage_kept_the_frames_sum_is_sent_again() {
 /// (quiet for 5 s: 3 places of 30 fail, 19 before).
 #[test]
 fn an_attach_through_a_line_quiet_for_a_while_finishes() {
-    let image = handler();
-    let (clean, _) = attached_after_an_upload(&image, FaultConfig::none(5));
-    let sent = clean.expect("attaches").client().stats().sent;
-    let mut failed = Vec::new();
-    for at in (sent / 4..sent).step_by((sent / 30).max(1)) {
-        let config = FaultConfig {
-            stall_after: Some(at),
-            stall_for: Some(std::time::Duration::from_millis(STALL_MS)),
-            ..FaultConfig::none(5)
-        };
-        if let (Err(error), _) = attached_after_an_upload(&image, config) {
-            failed.push(format!("{at}: {error}"));
-        }
-    }
+    let quiet = Some(Duration::from_millis(STALL_MS));
+    let failed: Vec<String> = stalled_attaches(&handler(), 5, 30, quiet)
+        .iter()
+        .map(|(at, error)| format!("{at}: {error}"))
+        .collect();
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 

@@ -281,6 +281,35 @@ pub fn plan(address: u16, image: &UploadImage, entries: &[u16]) -> StubResult<Pa
     lay_out(address, displaced).map_err(refuse)
 }
 
+/// A step run alone in a trampoline: the instruction's `bytes`, `JSR` into
+/// the stub's `entry` (the stop right after it), then `JMP` to `next`,
+/// the program's next instruction, which says where the program goes on
+/// to a session that finds the robot stopped there ([`alone_next`]).
+#[must_use]
+pub fn alone(bytes: &[u8], entry: u16, next: u16) -> Vec<u8> {
+    let [entry_low, entry_high] = entry.to_le_bytes();
+    let [next_low, next_high] = next.to_le_bytes();
+    let mut code = bytes.to_vec();
+    code.extend_from_slice(&[JSR, entry_low, entry_high, JMP, next_low, next_high]);
+    code
+}
+
+/// Where the program goes on after a step run alone ([`alone`]), from the
+/// robot's bytes at the stop (its `JSR` into `entry`, then the `JMP`), if
+/// they are such a step's.
+#[must_use]
+pub fn alone_next(code: &[u8], entry: u16) -> Option<u16> {
+    let [entry_low, entry_high] = entry.to_le_bytes();
+    match *code {
+        [JSR, low, high, JMP, next_low, next_high, ..]
+            if [low, high] == [entry_low, entry_high] =>
+        {
+            Some(u16::from_le_bytes([next_low, next_high]))
+        }
+        _ => None,
+    }
+}
+
 /// Instructions looked at after a refused breakpoint for one that takes it.
 const NEAREST_LOOK: usize = 16;
 
@@ -406,6 +435,9 @@ mod tests {
             read_trampoline(&[0xA9, 0x01, 0x20, 0x40, 0x0C, 0, 0, 0]),
             None
         );
+        let step = alone(&[0x48], 0x0C40, 0x0406);
+        assert_eq!(alone_next(&step[1..], 0x0C40), Some(0x0406));
+        assert_eq!(alone_next(&step[1..], 0x0C41), None, "another stub's");
     }
 
     #[test]

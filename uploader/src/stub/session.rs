@@ -285,10 +285,9 @@ impl<T: Transport> RobotDebug<T> {
             // the trampoline's `JMP` after the `JSR` says.
             let tramps = placed.tramps..placed.tramps + TRAMPOLINE_LEN * TRAMPOLINES as u16;
             if tramps.contains(&registers.pc) {
-                let entry = placed.entry.to_le_bytes();
                 let code = debug.read(registers.pc, 6)?;
-                if code[..4] == [JSR, entry[0], entry[1], patch::JMP] {
-                    registers.pc = u16::from_le_bytes([code[4], code[5]]);
+                if let Some(next) = patch::alone_next(&code, placed.entry) {
+                    registers.pc = next;
                     debug.stopped = Some(registers);
                 }
             }
@@ -646,18 +645,16 @@ impl<T: Transport> RobotDebug<T> {
                     found[i] = area.bytes[i];
                 }
             }
+            let differs = |i: &usize| code[*i] && found[*i] != area.bytes[*i];
             if self.stopped.is_some() {
                 // Found stopped in the stub: it must be let go on whatever
                 // its code now holds.
-                for i in (0..found.len()).filter(|&i| code[i] && found[i] != area.bytes[i]) {
+                for i in (0..found.len()).filter(differs) {
                     let at = area.address.wrapping_add(i as u16);
                     self.recovery.changed.push(at);
                     adopted.push((at, found[i]));
                 }
-            }
-            if self.stopped.is_none()
-                && let Some(i) = (0..found.len()).find(|&i| code[i] && found[i] != area.bytes[i])
-            {
+            } else if let Some(i) = (0..found.len()).find(differs) {
                 let end = (i..found.len().min(i + 4))
                     .take_while(|&j| code[j])
                     .last()
@@ -939,9 +936,8 @@ impl<T: Transport> RobotDebug<T> {
                 )));
             }
         }
-        let used: Vec<usize> = self.breakpoints.values().map(|(_, slot)| *slot).collect();
-        let slot = (0..TRAMPOLINES)
-            .find(|slot| !used.contains(slot))
+        let slot = self
+            .free_trampoline()
             .ok_or_else(|| refuse(format!("the stub holds {TRAMPOLINES} breakpoints at once")))?;
         // The trampoline first, verified: the JSR can only reach it after.
         let trampoline = self.stub.trampoline(slot);
@@ -1678,18 +1674,12 @@ impl<T: Transport> RobotDebug<T> {
         bytes: &[u8],
         wait: Duration,
     ) -> StubResult<Option<Reply>> {
-        let used: Vec<usize> = self.breakpoints.values().map(|(_, slot)| *slot).collect();
-        let Some(slot) = (0..TRAMPOLINES).find(|slot| !used.contains(slot)) else {
+        let Some(slot) = self.free_trampoline() else {
             return Ok(None);
         };
         let len = usize::from(instruction.len());
         let trampoline = self.stub.trampoline(slot);
-        let entry = self.stub.entry.to_le_bytes();
-        let next = instruction.next_address().to_le_bytes();
-        let mut code = bytes[..len].to_vec();
-        // The `JMP` after the `JSR` says where the program goes on, for a
-        // session that finds the robot stopped here after this one died.
-        code.extend_from_slice(&[JSR, entry[0], entry[1], patch::JMP, next[0], next[1]]);
+        let code = patch::alone(&bytes[..len], self.stub.entry, instruction.next_address());
         self.write_verified(trampoline, &code)?;
         self.go_on_at(trampoline)?;
         self.alone = Some((
@@ -1699,6 +1689,12 @@ impl<T: Transport> RobotDebug<T> {
         // The stop frame names the trampoline's `JSR`; it is told as the
         // program's next instruction (`take_stop`), a frame sent again too.
         Ok(Some(self.wait_event(wait)?))
+    }
+
+    /// A trampoline no breakpoint holds, if there is one.
+    fn free_trampoline(&self) -> Option<usize> {
+        let used: Vec<usize> = self.breakpoints.values().map(|(_, slot)| *slot).collect();
+        (0..TRAMPOLINES).find(|slot| !used.contains(slot))
     }
 
     /// The instruction at `pc` (the program's bytes) if it can run alone

@@ -63,13 +63,8 @@ pub(super) fn write_summed<T: Transport>(
         .install(client, &mut progress, &mut |_, _| Ok(()))
         .and_then(|()| session.transfer_summed(client, areas, &mut progress));
     // The loader must not stay hooked for one look a noisy line lost.
-    let mut taken_out = session.remove(client, &mut progress);
-    for _ in 1..REMOVE_ATTEMPTS {
-        if taken_out.is_ok() {
-            break;
-        }
-        taken_out = session.remove(client, &mut progress);
-    }
+    let taken_out =
+        crate::session::tried(REMOVE_ATTEMPTS, || session.remove(client, &mut progress));
     match (written, taken_out) {
         (Ok(_), Ok(())) => Ok(true),
         (Err(error), Ok(())) => Err(error.into()),
