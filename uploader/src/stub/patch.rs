@@ -179,13 +179,16 @@ pub fn lay_out(address: u16, displaced: Vec<u8>) -> Result<Patch, String> {
     })
 }
 
-/// What a trampoline in the robot's memory (`copy`, one slot's bytes)
-/// holds, read back into the breakpoint it was laid out for: its address
-/// and the program's bytes it displaced. `None` when the bytes are not a
-/// trampoline as [`lay_out`] makes them (a step's, an older layout's, or
-/// none at all).
+/// What a trampoline in the robot's memory (`copy`, one slot's bytes, of
+/// the stub whose breakpoints call `entry`) holds, read back into the
+/// breakpoint it was laid out for: its address and the program's bytes
+/// it displaced. `None` when the bytes are not a trampoline as
+/// [`lay_out`] makes them: an older layout's, none at all, or a step's
+/// ([`alone`]), whose `JSR` into the stub no breakpoint displaces (a
+/// breakpoint is refused over another's `JSR`) but whose `JMP` after it
+/// reads as a breakpoint's way back.
 #[must_use]
-pub fn read_trampoline(copy: &[u8]) -> Option<(u16, Vec<u8>)> {
+pub fn read_trampoline(copy: &[u8], entry: u16) -> Option<(u16, Vec<u8>)> {
     // The program's bytes, a relocated branch's as (opcode, target).
     let mut program: Vec<(Vec<u8>, Option<u16>)> = Vec::new();
     let mut length = 0usize;
@@ -225,7 +228,9 @@ pub fn read_trampoline(copy: &[u8]) -> Option<(u16, Vec<u8>)> {
     }
     // Laid out again, it must be the very bytes read.
     let patch = lay_out(address, displaced).ok()?;
-    (copy.get(..patch.trampoline.len())? == patch.trampoline.as_slice())
+    let [low, high] = entry.to_le_bytes();
+    let calls_the_stub = patch.displaced.windows(3).any(|w| w == [JSR, low, high]);
+    (copy.get(..patch.trampoline.len())? == patch.trampoline.as_slice() && !calls_the_stub)
         .then_some((address, patch.displaced))
 }
 
@@ -418,7 +423,7 @@ mod tests {
             let mut slot = patch.trampoline.clone();
             slot.resize(usize::from(TRAMPOLINE_LEN), 0x4C);
             assert_eq!(
-                read_trampoline(&slot),
+                read_trampoline(&slot, 0x0C40),
                 Some((address, displaced)),
                 "{patch:?}"
             );
@@ -432,10 +437,11 @@ mod tests {
         }
         // A step's slot (an instruction, then JSR into the stub) is none.
         assert_eq!(
-            read_trampoline(&[0xA9, 0x01, 0x20, 0x40, 0x0C, 0, 0, 0]),
+            read_trampoline(&[0xA9, 0x01, 0x20, 0x40, 0x0C, 0, 0, 0], 0x0C40),
             None
         );
         let step = alone(&[0x48], 0x0C40, 0x0406);
+        assert_eq!(read_trampoline(&step, 0x0C40), None);
         assert_eq!(alone_next(&step[1..], 0x0C40), Some(0x0406));
         assert_eq!(alone_next(&step[1..], 0x0C41), None, "another stub's");
     }

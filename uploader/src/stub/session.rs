@@ -728,7 +728,7 @@ impl<T: Transport> RobotDebug<T> {
         let tramps = self.read(self.stub.tramps, TRAMPOLINES * len)?;
         let mut found: Vec<(u16, [u8; 3])> = Vec::new();
         for copy in tramps.chunks(len) {
-            let Some((at, displaced)) = patch::read_trampoline(copy) else {
+            let Some((at, displaced)) = patch::read_trampoline(copy, self.stub.entry) else {
                 continue;
             };
             let owned = taken
@@ -754,7 +754,7 @@ impl<T: Transport> RobotDebug<T> {
         let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
         tramps
             .chunks(TRAMPOLINE_LEN as usize)
-            .filter_map(patch::read_trampoline)
+            .filter_map(|copy| patch::read_trampoline(copy, self.stub.entry))
             .find(|(at, copy)| {
                 *at == address
                     && copy.len() == len
