@@ -92,8 +92,8 @@ pub(crate) enum End {
     Loops(Path),
     /// At a return the code pushed nothing for: the way there.
     Returns(Path),
-    /// In the ROM, or somewhere this module cannot follow (a call, a
-    /// return, a run longer than it looks).
+    /// In the ROM, or somewhere this module cannot follow (a call where
+    /// calls are not followed, a run longer than it looks).
     Elsewhere,
 }
 
