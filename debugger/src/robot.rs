@@ -794,8 +794,9 @@ fn read_for_person<T: Transport>(
     len: usize,
 ) -> Result<Vec<u8>, Failure> {
     if let Some((_, reason)) = d.refuse_read(address, len) {
+        let bytes = if len == 1 { "byte" } else { "bytes" };
         return Err(Failure::Usage(format!(
-            "a read of ${address:04X} ({len} bytes) is refused on the robot: {reason}"
+            "a read of ${address:04X} ({len} {bytes}) is refused on the robot: {reason}"
         )));
     }
     d.read_as_program(address, len).map_err(failure)
