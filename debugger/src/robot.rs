@@ -12,8 +12,8 @@ use std::fmt::Write as _;
 use std::time::Duration;
 
 use emulator::Cpu;
-use uploader::Transport;
 use uploader::stub::{Registers, Reply as Heard, RobotDebug, StubError};
+use uploader::{LiveRead, Transport};
 
 use crate::expr::{Expr, Machine, Register};
 use crate::monitor::{Failure, Reply};
@@ -375,8 +375,16 @@ impl RobotMonitor {
             "mem" | "m" | "poke" => self.mem(d, verb, &rest)?,
             "print" | "p" => {
                 let expr = self.parse(after)?;
-                let value = self.eval(d, &expr)?;
-                format!("{}\n", crate::expr::show(value))
+                match self.eval_live(d, &expr)? {
+                    (value, changing) if changing.is_empty() => {
+                        format!("{}\n", crate::expr::show(value))
+                    }
+                    (value, changing) => format!(
+                        "{} {}\n",
+                        crate::expr::show(value),
+                        changing_note(&changing)
+                    ),
+                }
             }
             "display" => {
                 if after.is_empty() {
@@ -656,11 +664,14 @@ impl RobotMonitor {
             None => 16,
         };
         let len = len.min(0x1_0000 - usize::from(address));
-        let bytes = read_for_person(d, address, len)?;
+        let read = read_for_person(d, address, len)?;
         let mut text = String::new();
-        for (i, row) in bytes.chunks(16).enumerate() {
+        for (i, row) in read.bytes.chunks(16).enumerate() {
             let at = address.wrapping_add(16 * i as u16);
             text.push_str(&format!("${at:04X}: {}\n", uploader::stub::error_hex(row)));
+        }
+        if !read.changing.is_empty() {
+            text.push_str(&format!("{}\n", changing_note(&read.changing)));
         }
         Ok(text)
     }
@@ -686,7 +697,7 @@ impl RobotMonitor {
             None => 8,
         };
         let len = (count * 3).min(0x1_0000 - usize::from(address));
-        let bytes = read_for_person(d, address, len)?;
+        let bytes = read_for_person(d, address, len)?.bytes;
         let mut text = String::new();
         for line in isa::Disassembler::new(&bytes, address).take(count) {
             let shown = line.display_with(|at| self.symbols.label(at));
@@ -713,20 +724,17 @@ impl RobotMonitor {
     /// A displayed expression's value, or why it has none now (a register
     /// while the robot runs).
     fn shown<T: Transport>(&self, d: &mut RobotDebug<T>, expr: &Expr) -> Result<String, Failure> {
-        match self.eval(d, expr) {
-            Ok(value) => Ok(crate::expr::show(value)),
+        // hostile14 F8, hostile16 F4: memory the robot writes as it runs
+        // (a counter) is a value that changes: shown as read at one
+        // moment, and said to change.
+        match self.eval_live(d, expr) {
+            Ok((value, changing)) if changing.is_empty() => Ok(crate::expr::show(value)),
+            Ok((value, changing)) => Ok(format!(
+                "{} {}",
+                crate::expr::show(value),
+                changing_note(&changing)
+            )),
             Err(Failure::Usage(why)) => Ok(format!("({why})")),
-            // hostile14 F8: memory the robot writes as it runs (a counter)
-            // is a value that changes, not a failure of the command whose
-            // answer it would hide.
-            Err(Failure::Line(error))
-                if matches!(
-                    *error,
-                    StubError::Line(uploader::Error::MemoryChanging { .. })
-                ) =>
-            {
-                Ok(format!("(changing: {error})"))
-            }
             Err(other) => Err(other),
         }
     }
@@ -745,12 +753,23 @@ impl RobotMonitor {
     /// An expression's value: its memory read from the robot (`/7R` while
     /// it runs, the stub at a stop), its registers the stop's.
     fn eval<T: Transport>(&self, d: &mut RobotDebug<T>, expr: &Expr) -> Result<i64, Failure> {
+        Ok(self.eval_live(d, expr)?.0)
+    }
+
+    /// [`Self::eval`], with the addresses it read that the program wrote
+    /// while they were read (sorted).
+    fn eval_live<T: Transport>(
+        &self,
+        d: &mut RobotDebug<T>,
+        expr: &Expr,
+    ) -> Result<(i64, Vec<u16>), Failure> {
         let snapshot = Snapshot {
             cpu: d.stopped().map(|r| cpu_of(&r)).unwrap_or_default(),
             registers_read: Cell::new(false),
             memory: RefCell::new(BTreeMap::new()),
             missing: RefCell::new(Vec::new()),
         };
+        let mut changing = std::collections::BTreeSet::new();
         // Each round reads what the last one found missing ([[x]] reads twice).
         for _ in 0..8 {
             let value = expr.eval(&snapshot);
@@ -763,7 +782,9 @@ impl RobotMonitor {
             }
             let mut missing: Vec<u16> = snapshot.missing.borrow_mut().drain(..).collect();
             if missing.is_empty() {
-                return value.map_err(|error| Failure::Usage(error.to_string()));
+                return value
+                    .map(|value| (value, changing.into_iter().collect()))
+                    .map_err(|error| Failure::Usage(error.to_string()));
             }
             missing.sort_unstable();
             missing.dedup();
@@ -774,9 +795,10 @@ impl RobotMonitor {
                 if d.interrupted() {
                     return Err(usage("interrupted"));
                 }
-                let bytes = read_for_person(d, start, len)?;
+                let read = read_for_person(d, start, len)?;
+                changing.extend(read.changing);
                 let mut memory = snapshot.memory.borrow_mut();
-                for (i, byte) in bytes.into_iter().enumerate() {
+                for (i, byte) in read.bytes.into_iter().enumerate() {
                     memory.insert(start.wrapping_add(i as u16), byte);
                 }
             }
@@ -788,18 +810,30 @@ impl RobotMonitor {
 /// `len` bytes at `address` as the program sees them, for a person (a
 /// `mem`, a `dis`, an expression's `[...]`): refused where a read would
 /// change a card's or the board's register ([`RobotDebug::refuse_read`]).
+///
+/// Memory the program writes as it runs (a counter) is read as it was at
+/// one moment, its addresses named in [`LiveRead::changing`]: a person
+/// watching a running robot wants its value, not a refusal.
 fn read_for_person<T: Transport>(
     d: &mut RobotDebug<T>,
     address: u16,
     len: usize,
-) -> Result<Vec<u8>, Failure> {
+) -> Result<LiveRead, Failure> {
     if let Some((_, reason)) = d.refuse_read(address, len) {
         let bytes = if len == 1 { "byte" } else { "bytes" };
         return Err(Failure::Usage(format!(
             "a read of ${address:04X} ({len} {bytes}) is refused on the robot: {reason}"
         )));
     }
-    d.read_as_program(address, len).map_err(failure)
+    d.read_live_as_program(address, len).map_err(failure)
+}
+
+/// What is said after a value read where the program writes as it runs.
+fn changing_note(changing: &[u16]) -> String {
+    format!(
+        "(changing: the robot wrote {} while it was read, as it runs; one moment's value)",
+        uploader::addresses_text(changing)
+    )
 }
 
 /// The most bytes read between two wanted ones rather than asking again.

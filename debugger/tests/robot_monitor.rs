@@ -340,22 +340,38 @@ fn expressions_read_what_they_need_while_the_robot_runs() {
 /// hostile14 F8: a display of memory the robot changes as it runs (the
 /// head of the ROM's receive ring here, which every question moves) hid
 /// the answer of every command after it behind "the bytes changed between
-/// reads". It is shown as changing, and the answer with it.
+/// reads". hostile16 F4: and it showed no value, though watching a value
+/// change is what a display is for. It is shown as one moment's value,
+/// said to change, and the answer with it; so are `print` and `mem`.
 #[test]
 fn a_display_of_changing_memory_does_not_hide_the_answer() {
     let (mut m, mut d) = attached();
     let head = romlib::symbols::find("RXHEAD")
         .expect("the ROM's RXHEAD")
         .value;
+    let changing = |shown: &str, before: &str| {
+        let value = shown
+            .split_once(before)
+            .map(|(_, after)| after)
+            .unwrap_or_else(|| panic!("no {before:?} in {shown}"));
+        assert!(
+            value.starts_with('$')
+                && value[3..].starts_with(&format!(
+                    " (changing: the robot wrote ${head:04X} while it was read"
+                )),
+            "{shown}"
+        );
+    };
     let shown = text(&mut m, &mut d, &format!("display [${head:04X}]"));
-    assert!(
-        shown.starts_with(&format!("display 1: [${head:04X}] = (changing: ")),
-        "{shown}"
-    );
+    changing(&shown, &format!("display 1: [${head:04X}] = "));
     let shown = text(&mut m, &mut d, "/1Q");
     assert!(shown.contains("answer: Q42"), "{shown}");
+    changing(&shown, &format!("1: [${head:04X}] = "));
+    let shown = text(&mut m, &mut d, &format!("print [${head:04X}]"));
+    changing(&shown, "");
+    let shown = text(&mut m, &mut d, &format!("mem ${head:04X} 2"));
     assert!(
-        shown.contains(&format!("1: [${head:04X}] = (changing: ")),
+        shown.contains(&format!("\n(changing: the robot wrote ${head:04X}")),
         "{shown}"
     );
 }

@@ -46,7 +46,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
     // A FIFO or a device is refused before the line is used.
     hostfs::check_writable(&args.output)?;
     let (mut client, profile) = ports::probed(&args.line)?;
-    let backup = uploader::backup(&mut client, &profile)?;
+    let (backup, changing) = uploader::backup_live(&mut client, &profile)?;
     hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
         "saved {} bytes and {} hooks to {}",
@@ -54,6 +54,25 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         backup.hooks.len(),
         args.output.display()
     ));
+    if !changing.is_empty() {
+        // hostile16 F4: a counter the robot's control loop keeps is read
+        // as it was at one moment, and said, not refused.
+        print(&format!(
+            "note: {} changed while {} read ({}): the robot's program writes {} as it runs, and the file holds the last value read",
+            if changing.len() == 1 {
+                "1 byte"
+            } else {
+                "bytes"
+            },
+            if changing.len() == 1 {
+                "it was"
+            } else {
+                "they were"
+            },
+            uploader::addresses_text(&changing),
+            if changing.len() == 1 { "it" } else { "them" },
+        ));
+    }
     Ok(ExitCode::SUCCESS)
 }
 

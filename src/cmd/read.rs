@@ -39,7 +39,18 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         hostfs::check_writable(path)?;
     }
     let (mut client, _) = ports::probed(&args.line)?;
-    let bytes = client.read_memory(args.address, args.length as usize)?;
+    // A counter the robot's program keeps is read as it was at one
+    // moment, and said (hostile16 F4), not refused as a failed read.
+    let uploader::LiveRead { bytes, changing } =
+        client.read_live(args.address, args.length as usize)?;
+    if !changing.is_empty() {
+        // On stderr: stdout is the dump, which scripts read.
+        #[allow(clippy::print_stderr, reason = "the CLI notes")]
+        eprintln!(
+            "note: the robot wrote {} while it was read, as it runs: one moment's value",
+            uploader::addresses_text(&changing)
+        );
+    }
     match &args.output {
         Some(path) => hostfs::write(path, &bytes)?,
         None => {

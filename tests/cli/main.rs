@@ -24,6 +24,7 @@ mod robot;
 mod robot_dap;
 mod robot_debug;
 mod robot_left_stub;
+mod robot_live;
 mod robot_recovery;
 mod robot_undo;
 mod room_path;

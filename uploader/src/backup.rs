@@ -351,14 +351,31 @@ pub(crate) fn table_range(profile: &RomProfile) -> Option<(u16, usize)> {
 /// # Errors
 /// A line error, [`Error::Unreadable`], [`Error::NotAHook`].
 pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Backup> {
+    Ok(backup_live(client, profile)?.0)
+}
+
+/// [`backup`], with the addresses whose bytes kept changing while they
+/// were read (a counter the robot's control loop keeps, hostile16 F4):
+/// the backup holds the last value read there, a moment of a running
+/// program, as any backup of a running machine does.
+///
+/// # Errors
+/// As [`backup`].
+pub fn backup_live<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+) -> Result<(Backup, Vec<u16>)> {
     let hooks = read_hooks(client, profile)?;
     // Restored, a stub a session left hooked would be back with no host.
     crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
     let mut areas = Vec::new();
+    let mut changing = Vec::new();
     for (address, len) in backup_ranges(profile) {
+        let read = client.read_live(address, len)?;
+        changing.extend(read.changing);
         areas.push(Area {
             address,
-            bytes: client.read_memory(address, len)?,
+            bytes: read.bytes,
         });
     }
     // The robot's own ROM, not the profile's: a restore compares with it.
@@ -378,7 +395,7 @@ pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Res
     };
     let ranges = witness_ranges(profile, &backup);
     backup.witnesses = read_witnesses(client, &ranges)?;
-    Ok(backup)
+    Ok((backup, changing))
 }
 
 /// How many bytes at a hook's target are witnessed when no entry of the
@@ -463,7 +480,7 @@ pub(crate) fn hook_windows(profile: &RomProfile, backup: &Backup) -> Vec<(u16, u
 /// Witnesses of [`hook_windows`], each range read once however often an
 /// upload keeps its undo file again before its next change.
 #[derive(Debug, Default)]
-pub(crate) struct EarlyWitnesses(Vec<Witness>);
+pub(crate) struct EarlyWitnesses(Vec<((u16, usize), Vec<Witness>)>);
 
 impl EarlyWitnesses {
     /// Hands `keep` what an upload changed so far (`backup`: the hooks and
@@ -483,28 +500,22 @@ impl EarlyWitnesses {
     ) -> Result<()> {
         let slots = image.chain_slot_bytes();
         let mut witnesses = Vec::new();
-        for (address, len) in hook_windows(profile, &backup) {
-            let known = self
-                .0
-                .iter()
-                .find(|witness| witness.address == address && usize::from(witness.len) == len);
-            let witness = match known {
-                Some(witness) => *witness,
+        for window in hook_windows(profile, &backup) {
+            let (address, len) = window;
+            let known = self.0.iter().find(|(read, _)| *read == window);
+            match known {
+                Some((_, read)) => witnesses.extend(read.iter().copied()),
                 None => {
                     let expected: Vec<Option<u8>> = (0..len)
                         .map(|i| address.wrapping_add(i as u16))
                         .map(|at| image.byte(at).filter(|_| !slots.contains(&at)))
                         .collect();
-                    let witness = Witness {
-                        address,
-                        len: len as u16,
-                        sum: crate::sums::fletcher16(&client.read_expecting(address, &expected)?),
-                    };
-                    self.0.push(witness);
-                    witness
+                    let read =
+                        witnesses_of(address, &client.read_live_expecting(address, &expected)?);
+                    witnesses.extend(read.iter().copied());
+                    self.0.push((window, read));
                 }
-            };
-            witnesses.push(witness);
+            }
         }
         backup.witnesses = witnesses;
         keep.keep(&backup);
@@ -582,14 +593,35 @@ pub(crate) fn read_witnesses<T: Transport>(
 ) -> Result<Vec<Witness>> {
     let mut witnesses = Vec::new();
     for &(address, len) in ranges {
-        let bytes = client.read_memory(address, len)?;
-        witnesses.push(Witness {
-            address,
-            len: len as u16,
-            sum: crate::sums::fletcher16(&bytes),
-        });
+        witnesses.extend(witnesses_of(address, &client.read_live(address, len)?));
     }
     Ok(witnesses)
+}
+
+/// The witnesses of what `read` found from `address`: one for each run
+/// of bytes that held still while they were read. A byte the robot kept
+/// changing (a counter in an extension's data, which its control loop
+/// bumps: hostile16 F4) is no witness of anything: a restore would find
+/// it changed again.
+pub(crate) fn witnesses_of(address: u16, read: &crate::LiveRead) -> Vec<Witness> {
+    let mut witnesses = Vec::new();
+    let mut start = 0;
+    for end in read
+        .changing
+        .iter()
+        .map(|&at| usize::from(at.wrapping_sub(address)))
+        .chain([read.bytes.len()])
+    {
+        if end > start {
+            witnesses.push(Witness {
+                address: address.wrapping_add(start as u16),
+                len: (end - start) as u16,
+                sum: crate::sums::fletcher16(&read.bytes[start..end]),
+            });
+        }
+        start = end + 1;
+    }
+    witnesses
 }
 
 /// The profile's ROM bytes of its jump table and vectors (the upload that

@@ -502,7 +502,9 @@ impl<T: Transport> ChainBus<'_, T> {
         let len = (0..len)
             .take_while(|&i| readable(self.profile, address.wrapping_add(i as u16)))
             .count();
-        match self.client.read_memory(address, len) {
+        // A chunk of code may end in the program's data, which its control
+        // loop writes as it runs (hostile16 F4): that is no failure here.
+        match self.client.read_live(address, len).map(|read| read.bytes) {
             Ok(bytes) => {
                 for (i, byte) in bytes.into_iter().enumerate() {
                     self.seen

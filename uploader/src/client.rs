@@ -618,7 +618,7 @@ impl<T: Transport> Client<T> {
     /// the same addresses ([`CHANGING`] times or more): memory the robot
     /// writes while it runs.
     pub fn read_memory(&mut self, address: u16, len: usize) -> Result<Vec<u8>> {
-        self.read_agreeing(address, len, None)
+        Ok(self.read_agreeing(address, len, None, false)?.bytes)
     }
 
     /// Reads `expected.len()` bytes from `address` as [`Client::read_memory`]
@@ -632,7 +632,34 @@ impl<T: Transport> Client<T> {
     /// # Errors
     /// As [`Client::read_memory`].
     pub fn read_expecting(&mut self, address: u16, expected: &[Option<u8>]) -> Result<Vec<u8>> {
-        self.read_agreeing(address, expected.len(), Some(expected))
+        Ok(self
+            .read_agreeing(address, expected.len(), Some(expected), false)?
+            .bytes)
+    }
+
+    /// Reads `len` bytes from `address` as [`Client::read_memory`] does,
+    /// but memory the robot writes while it runs (a counter its control
+    /// loop keeps) does not fail the read: once the same addresses have
+    /// differed between well-formed answers [`CHANGING`] times, two
+    /// answers that agree everywhere else are taken, with the later
+    /// answer's bytes at those addresses, and the addresses are named in
+    /// [`LiveRead::changing`]. For a backup of a running robot, and for
+    /// following code that shares its spans with the program's data.
+    ///
+    /// # Errors
+    /// As [`Client::read_memory`], but for [`Error::MemoryChanging`].
+    pub fn read_live(&mut self, address: u16, len: usize) -> Result<LiveRead> {
+        self.read_agreeing(address, len, None, true)
+    }
+
+    /// [`Client::read_live`], a span that holds what `expected` says
+    /// taken at once ([`Client::read_expecting`]).
+    pub(crate) fn read_live_expecting(
+        &mut self,
+        address: u16,
+        expected: &[Option<u8>],
+    ) -> Result<LiveRead> {
+        self.read_agreeing(address, expected.len(), Some(expected), true)
     }
 
     fn read_agreeing(
@@ -640,7 +667,8 @@ impl<T: Transport> Client<T> {
         address: u16,
         len: usize,
         expected: Option<&[Option<u8>]>,
-    ) -> Result<Vec<u8>> {
+        live: bool,
+    ) -> Result<LiveRead> {
         if u32::from(address) + len as u32 > 0x1_0000 {
             return Err(Error::BadImage {
                 reason: format!("reading {len} bytes at ${address:04X} runs past $FFFF"),
@@ -657,6 +685,7 @@ impl<T: Transport> Client<T> {
         // How often each address differed between two well-formed answers.
         let mut changes: std::collections::HashMap<u16, u32> = std::collections::HashMap::new();
         let mut pairs = 0u32;
+        let mut changing = std::collections::BTreeSet::new();
         self.heard_stop = false;
         while remaining > 0 {
             while let Some(&span) = todo.front() {
@@ -696,10 +725,27 @@ impl<T: Transport> Client<T> {
                                 // Two well-formed answers that differ: noise
                                 // garbles a digit here and there, memory the
                                 // robot writes differs at the same places.
-                                for (i, (was, is)) in before.iter().zip(&data).enumerate() {
-                                    if was != is {
-                                        *changes.entry(span.address() + i as u16).or_insert(0) += 1;
-                                    }
+                                let differ: Vec<u16> = before
+                                    .iter()
+                                    .zip(&data)
+                                    .enumerate()
+                                    .filter(|(_, (was, is))| was != is)
+                                    .map(|(i, _)| span.address() + i as u16)
+                                    .collect();
+                                for &at in &differ {
+                                    *changes.entry(at).or_insert(0) += 1;
+                                }
+                                let in_use = |at: &u16| {
+                                    changes.get(at).is_some_and(|&times| {
+                                        times >= CHANGING && times * 4 >= pairs
+                                    })
+                                };
+                                if live && differ.iter().all(in_use) {
+                                    // They agree but where the program writes.
+                                    changing.extend(differ);
+                                    remaining -= data.len();
+                                    out[offset..offset + data.len()].copy_from_slice(&data);
+                                    continue;
                                 }
                             }
                             todo.push_back(span);
@@ -738,8 +784,22 @@ impl<T: Transport> Client<T> {
                 }
             }
         }
-        Ok(out)
+        Ok(LiveRead {
+            bytes: out,
+            changing: changing.into_iter().collect(),
+        })
     }
+}
+
+/// What [`Client::read_live`] read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LiveRead {
+    /// The bytes, from the first address read.
+    pub bytes: Vec<u8>,
+    /// The addresses, sorted, whose bytes kept changing between answers
+    /// (memory the robot writes while it runs): their bytes are the last
+    /// answer's.
+    pub changing: Vec<u16>,
 }
 
 /// The least difference between the byte counts of two questions in

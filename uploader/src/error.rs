@@ -669,7 +669,10 @@ pub fn human_duration(duration: Duration) -> String {
 }
 
 /// `$00F0, $00F1 and 3 more`: the first addresses of a list, for messages.
-pub(crate) fn addresses_text(addresses: &[u16]) -> String {
+/// `$0422, $0423` and so on: the first few of `addresses`, and how many
+/// more.
+#[must_use]
+pub fn addresses_text(addresses: &[u16]) -> String {
     const SHOWN: usize = 8;
     let mut text = addresses
         .iter()

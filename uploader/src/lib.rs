@@ -44,10 +44,12 @@ pub mod transport;
 mod unchanged;
 mod upload;
 
-pub use backup::{Backup, Keep, MAGIC, NoKeep, Witness, backup, backup_ranges, restore};
-pub use client::{Client, ClientConfig, ClientStats, stopped_in_stub};
+pub use backup::{
+    Backup, Keep, MAGIC, NoKeep, Witness, backup, backup_live, backup_ranges, restore,
+};
+pub use client::{Client, ClientConfig, ClientStats, LiveRead, stopped_in_stub};
 pub use delta::{COARSE, FINE};
-pub use error::{Error, Result, human_duration};
+pub use error::{Error, Result, addresses_text, human_duration};
 pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};
 pub use fingerprint::{SERVICES, rom_profile_image};
 pub use image::{

@@ -874,7 +874,9 @@ fn keep_old<T: Transport>(
         if covered(&kept, area) {
             continue;
         }
-        let bytes = client.read_memory(area.address, area.bytes.len())?;
+        // What the undo puts back: a counter the old code keeps there
+        // (hostile16 F4) as it was at one moment.
+        let bytes = client.read_live(area.address, area.bytes.len())?.bytes;
         kept.areas.push(Area {
             address: area.address,
             bytes,

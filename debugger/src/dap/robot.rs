@@ -563,9 +563,12 @@ impl RobotSession {
         let bytes = if len == 0 {
             Vec::new()
         } else {
+            // A memory view of a running robot shows a counter its
+            // program keeps as it was at one moment (hostile16 F4).
             self.robot()?
-                .read_as_program(start, len)
+                .read_live_as_program(start, len)
                 .map_err(|e| failure(e).message())?
+                .bytes
         };
         let mut body = json!({
             "address": format!("0x{start:04X}"),

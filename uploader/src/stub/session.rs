@@ -26,7 +26,7 @@ use super::guard::{self, Guard};
 use super::host_step::{self, Step};
 use super::link::{StubPlan, TRAMPOLINE_LEN, TRAMPOLINES};
 use super::patch::{self, JSR, Patch};
-use crate::client::Client;
+use crate::client::{Client, LiveRead};
 use crate::image::{RomProfile, UploadImage};
 use crate::transport::{Transport, char_time};
 use isa::objfmt::HookKind;
@@ -1096,9 +1096,34 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// The line's errors, a garbled reply.
     pub fn read(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
-        if let Some(bytes) = self.while_running(|d| Ok(d.client.read_memory(address, len)?))? {
-            return Ok(bytes);
+        Ok(self.read_maybe_live(address, len, false)?.bytes)
+    }
+
+    /// [`RobotDebug::read`], with [`Client::read_live`] while the robot
+    /// runs when `live` (a counter the program keeps is read as it was at
+    /// one moment, and named); nothing changes while it is stopped.
+    fn read_maybe_live(&mut self, address: u16, len: usize, live: bool) -> StubResult<LiveRead> {
+        let running = self.while_running(|d| {
+            Ok(if live {
+                d.client.read_live(address, len)?
+            } else {
+                LiveRead {
+                    bytes: d.client.read_memory(address, len)?,
+                    changing: Vec::new(),
+                }
+            })
+        })?;
+        if let Some(read) = running {
+            return Ok(read);
         }
+        Ok(LiveRead {
+            bytes: self.read_stopped(address, len)?,
+            changing: Vec::new(),
+        })
+    }
+
+    /// [`RobotDebug::read`] through the stopped stub's frames.
+    fn read_stopped(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
         let mut out = Vec::with_capacity(len);
         while out.len() < len {
             let at = address.wrapping_add(out.len() as u16);
@@ -1760,7 +1785,26 @@ impl<T: Transport> RobotDebug<T> {
     /// # Errors
     /// As [`RobotDebug::read`].
     pub fn read_as_program(&mut self, address: u16, len: usize) -> StubResult<Vec<u8>> {
-        let mut bytes = self.read(address, len)?;
+        Ok(self.program_read(address, len, false)?.bytes)
+    }
+
+    /// [`RobotDebug::read_as_program`], but memory the program writes as
+    /// it runs (a counter its control loop keeps) is read as it was at one
+    /// moment and named in [`LiveRead::changing`], not refused: for a
+    /// display polled while the robot runs, whose point is to watch it
+    /// change.
+    ///
+    /// # Errors
+    /// As [`RobotDebug::read`], but for [`crate::Error::MemoryChanging`].
+    pub fn read_live_as_program(&mut self, address: u16, len: usize) -> StubResult<LiveRead> {
+        self.program_read(address, len, true)
+    }
+
+    fn program_read(&mut self, address: u16, len: usize, live: bool) -> StubResult<LiveRead> {
+        let LiveRead {
+            mut bytes,
+            changing,
+        } = self.read_maybe_live(address, len, live)?;
         for (i, byte) in bytes.iter_mut().enumerate() {
             let at = address.wrapping_add(i as u16);
             // Past the JSR's three bytes the code holds the program's own.
@@ -1783,7 +1827,7 @@ impl<T: Transport> RobotDebug<T> {
         for (i, at) in kept {
             bytes[i] = self.read(at, 1)?[0];
         }
-        Ok(bytes)
+        Ok(LiveRead { bytes, changing })
     }
 
     /// Writes `bytes` at `address` as the program would (each read back):
@@ -1961,7 +2005,9 @@ impl<T: Transport> RobotDebug<T> {
     /// The line's errors.
     pub fn compare_with_image(&mut self) -> StubResult<Option<(u16, u8, u8)>> {
         for area in self.image.areas().to_vec() {
-            let found = self.read(area.address, area.bytes.len())?;
+            // Only the code is read: a counter beside it changes as the
+            // robot runs.
+            let found = self.read_code(&area, &[])?;
             if let Some(i) = (0..found.len()).find(|&i| {
                 found[i] != area.bytes[i] && self.image.is_code(area.address.wrapping_add(i as u16))
             }) {

@@ -1,0 +1,177 @@
+//! Memory the robot writes while it runs, beside the code the host reads:
+//! a counter in the program's `.data` right after its code, which its
+//! `HOOK_LOOP` handler bumps on every pass of the control loop (hostile16
+//! F4). Following the chain read it with the code around it, and a backup
+//! reads all user RAM: both failed as "memory in use" on every try, so
+//! `debug --port` could not attach and `scorpion backup` could not save.
+//! An upload of another extension in front of it read the counter too, as
+//! a witness of the code the undo goes back to, and failed likewise. A
+//! plain read of the counter is still told it changes.
+
+mod common;
+
+use common::{Kept, extension_at, robot};
+use isa::objfmt::{HookKind, HookRecord};
+use romlib::protocol::Command;
+use std::time::Duration;
+use uploader::stub::{Reply, RobotDebug};
+use uploader::transport::VirtualTransport;
+use uploader::{Area, Client, NoProgress, RomProfile, UploadImage, UploadOptions, upload};
+
+/// Where the loop handler counts.
+const COUNT: u16 = 0x041E;
+
+/// `/1W` answers `W` and the count; the loop handler counts its passes,
+/// the count the first byte after the code (as ca65's `.data` after
+/// `.code` puts it):
+///
+/// ```text
+/// $0400  CMP #'W'       ; HOOK_UNKNOWN's handler
+/// $0402  BNE $0415
+/// $0404  LDA #'W'
+/// $0406  JSR PUTCH
+/// $0409  LDA $041E
+/// $040C  JSR PUTHEX
+/// $040F  JSR PUTEOL
+/// $0412  JMP CMD_DONE
+/// $0415  JMP chain      ; its slot $0416
+/// $0418  INC $041E      ; HOOK_LOOP's handler
+/// $041B  JMP chain      ; its slot $041C
+/// $041E  .byte 0
+/// ```
+fn counting() -> UploadImage {
+    let bytes = vec![
+        0xC9, b'W', 0xD0, 0x11, 0xA9, b'W', 0x20, 0x00, 0xFF, 0xAD, 0x1E, 0x04, 0x20, 0x03, 0xFF,
+        0x20, 0x09, 0xFF, 0x4C, 0x1E, 0xFF, 0x4C, 0x21, 0xFF, 0xEE, 0x1E, 0x04, 0x4C, 0x24, 0xFF,
+        0x00,
+    ];
+    let mut image = UploadImage::new(
+        vec![Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![
+            HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0400,
+                chain: Some(0x0416),
+            },
+            HookRecord {
+                kind: HookKind::Loop,
+                handler: 0x0418,
+                chain: Some(0x041C),
+            },
+        ],
+    )
+    .expect("an image");
+    image.set_code(vec![0x0400..=0x041D]);
+    image
+}
+
+/// A robot running [`counting`], uploaded as `scorpion upload` does.
+fn counting_robot() -> Client<VirtualTransport> {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(&mut client, &counting(), &options, &mut NoProgress).expect("uploaded");
+    let ask = Command::parse(b"/1W").expect("a command");
+    let first = client.ask(&ask).expect("answers");
+    let second = client.ask(&ask).expect("answers");
+    assert_ne!(first, second, "the count goes on while the robot runs");
+    client
+}
+
+#[test]
+fn a_counter_is_told_as_changing_to_a_plain_read_and_read_live() {
+    let mut client = counting_robot();
+    let error = client
+        .read_memory(0x0415, 16)
+        .expect_err("a plain read of a counter");
+    assert!(
+        matches!(&error, uploader::Error::MemoryChanging { changed, .. } if changed == &[COUNT]),
+        "{error:?}"
+    );
+    let read = client.read_live(0x0415, 16).expect("read live");
+    assert_eq!(read.changing, [COUNT]);
+    assert_eq!(read.bytes[..9], counting().areas()[0].bytes[0x15..0x1E]);
+}
+
+#[test]
+fn a_backup_of_a_robot_counting_is_saved_and_says_where() {
+    let mut client = counting_robot();
+    let (saved, changing) = uploader::backup_live(&mut client, &RomProfile::reference())
+        .expect("a backup of a running robot");
+    assert_eq!(changing, [COUNT]);
+    // Restored over a robot whose code was damaged, it is put back and
+    // verified, and the robot counts again.
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(0x0418, &[0xEA, 0xEA, 0xEA])
+        .expect("RAM");
+    uploader::restore(
+        &mut client,
+        &saved,
+        &UploadOptions::default(),
+        &mut NoProgress,
+    )
+    .expect("restored, verified");
+    let memory = client.transport().robot().robot().board().memory();
+    assert_eq!(memory[0x0418..0x041B], [0xEE, 0x1E, 0x04]);
+    client.read_live(COUNT, 1).expect("read live");
+    assert!(client.read_memory(COUNT, 1).is_err(), "it counts again");
+}
+
+#[test]
+fn a_session_attaches_beside_a_counter_after_the_code() {
+    let client = counting_robot();
+    let profile = RomProfile::reference();
+    let mut debug = RobotDebug::attach(client, &profile, counting()).expect("attaches");
+    debug
+        .set_breakpoint(0x0418, &[0x0400, 0x0418])
+        .expect("a breakpoint in the loop handler");
+    let before = debug.read(COUNT, 1).expect("read through the stub")[0];
+    debug.resume().expect("continue");
+    match debug.wait_event(Duration::from_secs(1)).expect("a stop") {
+        Reply::Stopped(registers) => assert_eq!(registers.pc, 0x0418),
+        other => panic!("no stop at the loop handler: {other:?}"),
+    }
+    assert_eq!(
+        debug.read(COUNT, 1).expect("read")[0],
+        before.wrapping_add(1)
+    );
+    debug.remove_breakpoint(0x0418).expect("removed");
+    debug.resume().expect("continue");
+    assert_eq!(debug.compare_with_image().expect("read"), None);
+    debug.detach().expect("detaches");
+}
+
+#[test]
+fn another_extension_goes_in_front_of_a_counting_one_and_comes_out() {
+    let mut client = counting_robot();
+    let options = UploadOptions::default();
+    let mut kept = Kept::default();
+    uploader::upload_keeping(
+        &mut client,
+        &extension_at(0x0700),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("uploaded in front of it");
+    let undo = kept.0.expect("an undo file");
+    // No witness covers the counter: a restore would find it changed.
+    assert!(
+        undo.witnesses
+            .iter()
+            .all(|w| !(w.address..w.address + w.len).contains(&COUNT)),
+        "{:?}",
+        undo.witnesses
+    );
+    assert!(!undo.witnesses.is_empty(), "the code the hooks go back to");
+    uploader::restore(&mut client, &undo, &options, &mut NoProgress).expect("undone");
+    let memory = client.transport().robot().robot().board().memory();
+    let hook = usize::from(romlib::symbols::HOOK_UNKNOWN) + 1;
+    assert_eq!(memory[hook..hook + 2], [0x00, 0x04], "HOOK_UNKNOWN back");
+}
