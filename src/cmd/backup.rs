@@ -46,7 +46,11 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
     // A FIFO or a device is refused before the line is used.
     hostfs::check_writable(&args.output)?;
     let (mut client, profile) = ports::probed(&args.line)?;
-    let (backup, changing) = uploader::backup_live(&mut client, &profile)?;
+    let uploader::Saved {
+        backup,
+        changing,
+        broken,
+    } = uploader::backup_live(&mut client, &profile)?;
     hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
         "saved {} bytes and {} hooks to {}",
@@ -71,6 +75,16 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             },
             uploader::addresses_text(&changing),
             if changing.len() == 1 { "it" } else { "them" },
+        ));
+    }
+    for hook in &broken {
+        // recheck16 F4: said now, not first at the restore that refuses it.
+        print(&format!(
+            "warning: {} leads {}, and that way {}: a restore of this file leaves {} at the ROM's target (upload the extension again to hook it)",
+            hook.hook.rom_symbol(),
+            hook.path,
+            hook.why,
+            hook.hook.rom_symbol()
         ));
     }
     Ok(ExitCode::SUCCESS)

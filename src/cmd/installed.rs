@@ -94,6 +94,19 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
             if let Some(slot) = hook.chain {
                 let _ = write!(out, " (chain slot ${slot:04X})");
             }
+            // recheck16 F5: an extension a restore left unhooked looked
+            // hooked in the table's own words.
+            let reached = chains
+                .iter()
+                .find(|(kind, _)| *kind == hook.kind)
+                .is_none_or(|(_, targets)| targets.contains(&hook.handler));
+            if !reached {
+                let _ = write!(
+                    out,
+                    " (not hooked: {} does not lead to it)",
+                    hook.kind.rom_symbol()
+                );
+            }
         }
         out.push('\n');
     }
@@ -116,4 +129,36 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
         let _ = writeln!(out, "{}: {}", kind.rom_symbol(), steps.join(" -> "));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::listing;
+    use isa::objfmt::HookKind;
+    use romlib::installed::{Installed, TakenHook};
+
+    /// recheck16 F5: after a restore that left an extension unhooked, the
+    /// listing named its hook as if it were taken.
+    #[test]
+    fn an_extension_no_chain_reaches_is_said_not_hooked() {
+        let everyone = [Installed {
+            id: 0x8C_8390,
+            extents: vec![0x0400..=0x044F],
+            hooks: vec![TakenHook {
+                kind: HookKind::Unknown,
+                handler: 0x0400,
+                chain: Some(0x0416),
+            }],
+            slot: 0,
+        }];
+        let unhooked = listing(&everyone, &[(HookKind::Unknown, vec![0xFF21])]);
+        assert!(
+            unhooked.contains(
+                "HOOK_UNKNOWN -> $0400 (chain slot $0416) (not hooked: HOOK_UNKNOWN does not lead to it)"
+            ),
+            "{unhooked}"
+        );
+        let hooked = listing(&everyone, &[(HookKind::Unknown, vec![0x0400, 0xFF21])]);
+        assert!(!hooked.contains("not hooked"), "{hooked}");
+    }
 }

@@ -351,20 +351,43 @@ pub(crate) fn table_range(profile: &RomProfile) -> Option<(u16, usize)> {
 /// # Errors
 /// A line error, [`Error::Unreadable`], [`Error::NotAHook`].
 pub fn backup<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Backup> {
-    Ok(backup_live(client, profile)?.0)
+    Ok(backup_live(client, profile)?.backup)
 }
 
-/// [`backup`], with the addresses whose bytes kept changing while they
-/// were read (a counter the robot's control loop keeps, hostile16 F4):
-/// the backup holds the last value read there, a moment of a running
-/// program, as any backup of a running machine does.
+/// What [`backup_live`] read, and what a person should know of it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Saved {
+    /// What the robot held.
+    pub backup: Backup,
+    /// The addresses whose bytes kept changing while they were read (a
+    /// counter the robot's control loop keeps, hostile16 F4): the backup
+    /// holds the last value read there, a moment of a running program, as
+    /// any backup of a running machine does.
+    pub changing: Vec<u16>,
+    /// Hooks whose way is already no way for a command to go (it loops,
+    /// stops the CPU, strays): a restore of the file will refuse them, as
+    /// it refuses now (recheck16 F4).
+    pub broken: Vec<BrokenHook>,
+}
+
+/// A hook whose way is no way for a command to go.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BrokenHook {
+    /// The hook.
+    pub hook: HookKind,
+    /// Where it goes.
+    pub target: u16,
+    /// What is wrong with the way.
+    pub why: &'static str,
+    /// The way, `$0800 -> $0800`.
+    pub path: String,
+}
+
+/// [`backup`], with what a person should know of it ([`Saved`]).
 ///
 /// # Errors
 /// As [`backup`].
-pub fn backup_live<T: Transport>(
-    client: &mut Client<T>,
-    profile: &RomProfile,
-) -> Result<(Backup, Vec<u16>)> {
+pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Saved> {
     let hooks = read_hooks(client, profile)?;
     // Restored, a stub a session left hooked would be back with no host.
     crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
@@ -395,7 +418,36 @@ pub fn backup_live<T: Transport>(
     };
     let ranges = witness_ranges(profile, &backup);
     backup.witnesses = read_witnesses(client, &ranges)?;
-    Ok((backup, changing))
+    let mut broken = Vec::new();
+    let into_ram: Vec<(HookKind, u16)> = backup
+        .hooks
+        .iter()
+        .copied()
+        .filter(|&(kind, target)| {
+            profile.reset_target(kind) != Some(target)
+                && profile.writable.iter().any(|range| range.contains(&target))
+        })
+        .collect();
+    if !into_ram.is_empty() {
+        let everyone = crate::table::read_installed(client, profile)?;
+        for (hook, target) in into_ram {
+            if let Some((why, path)) =
+                crate::chain::broken_way(client, profile, &everyone, (hook, target))?
+            {
+                broken.push(BrokenHook {
+                    hook,
+                    target,
+                    why,
+                    path: path.to_string(),
+                });
+            }
+        }
+    }
+    Ok(Saved {
+        backup,
+        changing,
+        broken,
+    })
 }
 
 /// How many bytes at a hook's target are witnessed when no entry of the

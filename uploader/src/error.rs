@@ -263,16 +263,16 @@ pub enum Error {
     },
 
     /// A restore whose hook would lead into code that loops, stops the
-    /// CPU, or is the other hook's handler: the file is not what `backup`
-    /// or an upload wrote (edited by hand, or damaged with its checksum
-    /// made again).
+    /// CPU, or is the other hook's handler: the robot's hook was broken
+    /// already when the file was written (`backup` warns of it), or the
+    /// file was edited by hand.
     #[error(
         "the file points {hook} at ${target:04X}, and that way {why} ({path}): the memory was restored and verified, but {hook} is left at the ROM's target"
     )]
     #[diagnostic(
         code(uploader::restore_chain_broken),
         help(
-            "the robot answers as it would with that extension not hooked; the file was not written as `backup` or an upload writes one (edited by hand?): restore another, or upload the extension again"
+            "the robot answers as it would with that extension not hooked; the robot's hook was broken already when the file was written (or the file was edited by hand): restore another, or upload the extension again"
         )
     )]
     RestoreChainBroken {

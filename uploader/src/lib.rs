@@ -45,7 +45,8 @@ mod unchanged;
 mod upload;
 
 pub use backup::{
-    Backup, Keep, MAGIC, NoKeep, Witness, backup, backup_live, backup_ranges, restore,
+    Backup, BrokenHook, Keep, MAGIC, NoKeep, Saved, Witness, backup, backup_live, backup_ranges,
+    restore,
 };
 pub use client::{Client, ClientConfig, ClientStats, LiveRead, stopped_in_stub};
 pub use delta::{COARSE, FINE};

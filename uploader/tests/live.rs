@@ -98,7 +98,11 @@ fn a_counter_is_told_as_changing_to_a_plain_read_and_read_live() {
 #[test]
 fn a_backup_of_a_robot_counting_is_saved_and_says_where() {
     let mut client = counting_robot();
-    let (saved, changing) = uploader::backup_live(&mut client, &RomProfile::reference())
+    let uploader::Saved {
+        backup: saved,
+        changing,
+        ..
+    } = uploader::backup_live(&mut client, &RomProfile::reference())
         .expect("a backup of a running robot");
     assert_eq!(changing, [COUNT]);
     // Restored over a robot whose code was damaged, it is put back and

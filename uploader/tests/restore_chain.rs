@@ -185,3 +185,38 @@ fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
     restore(&mut client, &empty, &options, &mut NoProgress).expect("a backup is not an undo");
     assert_eq!(hook(&mut client), BAD_COMMAND);
 }
+
+/// recheck16 F4: a backup of a robot whose hook was already broken (sent
+/// by hand into a loop) said only "saved", and the user learnt of it at
+/// the restore that refused it. The backup names the way, as the restore
+/// refuses it.
+#[test]
+fn a_backup_of_a_robot_whose_hook_is_broken_says_so() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0400),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    assert_eq!(saved.broken, [], "an extension's working chain");
+    {
+        let board = client.transport().robot_mut().robot_mut().board_mut();
+        board.load(0x0800, &[0x4C, 0x00, 0x08]).expect("RAM");
+        board
+            .load(HOOK_UNKNOWN + 1, &0x0800u16.to_le_bytes())
+            .expect("RAM");
+    }
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    assert_eq!(saved.broken.len(), 1, "{:?}", saved.broken);
+    let broken = &saved.broken[0];
+    assert_eq!((broken.hook, broken.target), (HookKind::Unknown, 0x0800));
+    assert!(broken.why.contains("comes back"), "{}", broken.why);
+    assert_eq!(broken.path, "$0800 -> $0800");
+    let error = restore(&mut client, &saved.backup, &options, &mut NoProgress)
+        .expect_err("the way is refused at the restore, as the backup said");
+    assert!(matches!(error, Error::RestoreChainBroken { .. }), "{error}");
+}

@@ -277,7 +277,7 @@ fn a_robot_found_stopped_with_its_code_changed_still_goes_on() {
         again
             .recovery()
             .describe()
-            .contains("differs from the image in 1 bytes from $0408")
+            .contains("differs from the image in 1 byte ($0408;")
     );
     assert_eq!(again.stopped().map(|r| r.pc), Some(AT));
     again.resume().expect("continue");

@@ -193,10 +193,14 @@ impl Recovery {
             }
             (false, _) => {}
         }
-        if let Some(first) = self.changed.first() {
+        if !self.changed.is_empty() {
+            // recheck16 F2: every place named, not the first alone.
+            let n = self.changed.len();
             parts.push(format!(
-                "its code differs from the image in {} bytes from ${first:04X} (changed while it ran or at a stop): taken as the robot's, so that it can go on; upload the image again to put them back",
-                self.changed.len()
+                "its code differs from the image in {n} {} ({}; changed while it ran or at a stop): taken as the robot's, so that it can go on; upload the image again to put {} back",
+                if n == 1 { "byte" } else { "bytes" },
+                crate::error::addresses_text(&self.changed),
+                if n == 1 { "it" } else { "them" },
             ));
         }
         if !self.removed.is_empty() {
