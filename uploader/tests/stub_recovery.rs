@@ -292,3 +292,35 @@ fn a_robot_found_stopped_with_its_code_changed_still_goes_on() {
     );
     again.detach().expect("detached");
 }
+
+/// hostile16 F3: a session killed at a stop after a `poke` into the bytes
+/// a breakpoint displaced (which the stub's trampoline runs in their
+/// place) came back with the image's bytes: the clean-up undid the poke
+/// without a word, where `quit` keeps it. Found stopped, the trampoline's
+/// copy is what is put back, and the change is said.
+#[test]
+fn a_poke_into_a_breakpoints_displaced_bytes_survives_the_clean_up() {
+    let image = handler();
+    let mut debug = attach(&image);
+    // The JSR at $0407 covers LDA #'Q' (2 bytes) and JSR PUTCH.
+    debug.set_breakpoint(0x0407, &[]).expect("set");
+    let Reply::Stopped(_) = debug.command(b"/1Q", WAIT).expect("sent") else {
+        panic!("no stop");
+    };
+    debug.write_as_program(0x0408, b"Z").expect("poked");
+    let mut again = reattach(debug.abandon(), &image);
+    assert_eq!(again.recovery().removed, [0x0407]);
+    assert_eq!(again.recovery().changed, [0x0408]);
+    assert_eq!(
+        again.read(0x0407, 3).expect("read"),
+        [0xA9, b'Z', 0x20],
+        "the program's bytes, the poke kept"
+    );
+    again.resume().expect("continue");
+    assert_eq!(
+        again.wait_event(WAIT).expect("the answer"),
+        Reply::Answer(b"Z42\r".to_vec()),
+        "the stopped command goes on with the poke"
+    );
+    again.detach().expect("detached");
+}

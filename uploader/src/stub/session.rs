@@ -628,10 +628,19 @@ impl<T: Transport> RobotDebug<T> {
                 {
                     let at = area.address.wrapping_add(i as u16);
                     let mut original = [area.bytes[i], area.bytes[i + 1], area.bytes[i + 2]];
-                    // A chain slot's bytes under the JSR are the robot's
-                    // (the uploader wrote them), not the image's: the
-                    // trampoline's copy on the robot holds them.
-                    if (0..3).any(|k| slot_bytes.contains(&at.wrapping_add(k))) {
+                    if self.stopped.is_some()
+                        && let Some(copy) = self.program_copy(at)?
+                    {
+                        // hostile16 F3: found stopped, the program runs
+                        // what the trampoline holds, a `poke` at the stop
+                        // included: that is put back (and told as a
+                        // change below), as `quit` would have.
+                        original.copy_from_slice(&copy[..3]);
+                    } else if (0..3).any(|k| slot_bytes.contains(&at.wrapping_add(k))) {
+                        // A chain slot's bytes under the JSR are the
+                        // robot's (the uploader wrote them), not the
+                        // image's: the trampoline's copy on the robot
+                        // holds them.
                         let copy = self.displaced_copy(at, &slot_bytes)?;
                         original.copy_from_slice(&copy[..3]);
                     }
@@ -752,6 +761,27 @@ impl<T: Transport> RobotDebug<T> {
     /// displaced, as the robot held them: its trampoline's copy in the
     /// stub (the displaced bytes, then `JMP` past them), found by that
     /// `JMP` and the image's bytes but for the chain slots' (`slot_bytes`).
+    /// The bytes the one trampoline of the stub for a breakpoint at
+    /// `address` runs in their place (the program's, as a `poke` at a stop
+    /// left them), when exactly one trampoline is for it and it displaces
+    /// as many bytes as a breakpoint there does; `None` else.
+    fn program_copy(&mut self, address: u16) -> StubResult<Option<Vec<u8>>> {
+        let Ok(plan) = patch::plan(address, &self.image, &[]) else {
+            return Ok(None);
+        };
+        let len = plan.displaced.len();
+        let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
+        let mut copies: Vec<Vec<u8>> = tramps
+            .chunks(TRAMPOLINE_LEN as usize)
+            .filter_map(|copy| patch::read_trampoline(copy, self.stub.entry))
+            .filter(|(at, copy)| *at == address && copy.len() == len)
+            .map(|(_, copy)| copy)
+            .collect();
+        copies.sort_unstable();
+        copies.dedup();
+        Ok((copies.len() == 1).then(|| copies.remove(0)))
+    }
+
     fn displaced_copy(&mut self, address: u16, slot_bytes: &[u16]) -> StubResult<Vec<u8>> {
         let patch = patch::plan(address, &self.image, &[])?;
         let len = patch.displaced.len();
