@@ -801,3 +801,52 @@ fn a_test_on_a_port_interrupted_during_its_upload_says_so() {
     ok(&project, &line, &["upload", "--undo"]);
     assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);
 }
+
+/// hostile14 F6b: a project of two images, tested on a port twice: each
+/// run's upload of the first image took it from behind the second to the
+/// head of the chain, and the second's put it behind again, so no second
+/// run was ever "unchanged", and `upload --undo` went back one run only
+/// (both images stayed installed). Now the first goes back where it was,
+/// the second run changes nothing, and the undo empties the robot.
+#[test]
+fn a_two_image_project_tested_twice_is_undone_to_the_robot_before() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let layout =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/checksum/checksum.toml");
+    std::fs::copy(layout, project.join("src/second.toml")).expect("the layout");
+    std::fs::write(
+        project.join("src/second.s"),
+        "        .include \"scorpion.inc\"\n        .code\n        SCORPION_UNKNOWN_HANDLER\n        cmp #'U'\n        bne other\n        lda #'U'\n        jsr PUTCH\n        jsr PUTEOL\n        jmp CMD_DONE\nother:  SCORPION_CHAIN_UNKNOWN\n",
+    )
+    .expect("the second source");
+    let manifest = std::fs::read_to_string(project.join("Scorpion.toml")).expect("the manifest");
+    let manifest = manifest.replace(
+        "[robot]",
+        "[[image]]\nname = \"second\"\nsources = [\"src/second.s\"]\ntarget = \"src/second.toml\"\n\n[robot]",
+    );
+    std::fs::write(project.join("Scorpion.toml"), manifest).expect("the manifest");
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    let before = ok(&project, &line, &["read", "$0200", "3"]);
+    let first = ok(&project, &line, &["test"]);
+    assert!(
+        first.contains("left installed on the robot: myext, second"),
+        "{first}"
+    );
+    let again = ok(&project, &line, &["test"]);
+    assert!(
+        again.contains("puts back what it held before the earlier run that put them there"),
+        "{again}"
+    );
+    let listed = ok(&project, &line, &["installed"]);
+    let undone = ok(&project, &line, &["upload", "--undo"]);
+    assert!(undone.contains("restored"), "{undone}");
+    assert_eq!(
+        ok(&project, &line, &["read", "$0200", "3"]),
+        before,
+        "{listed}"
+    );
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
+}

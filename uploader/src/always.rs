@@ -93,6 +93,18 @@ pub(crate) fn check<T: Transport>(
                     },
                     None => break,
                 }
+            } else if let Some(other) = others.iter().find(|other| other.contains(target)) {
+                // An extension that stays, in front of an earlier copy of
+                // the image: the chain goes on through it.
+                match other
+                    .hooks
+                    .iter()
+                    .find(|hook| hook.kind == kind)
+                    .and_then(|hook| hook.chain)
+                {
+                    Some(slot) => read_word(client, slot)?,
+                    None => break,
+                }
             } else {
                 break;
             };

@@ -48,6 +48,26 @@ pub(crate) struct Plan {
     /// of its chain, as they were (what an undo puts back; a hook's own
     /// operand is the undo's hooks, switched last).
     pub(crate) unlinked: Vec<Area>,
+    /// An earlier copy of the image behind another extension in a chain,
+    /// taken out of it while the upload runs: once the image is verified,
+    /// it goes back there rather than to the head of the chain (hostile14
+    /// F6b: a project of two images re-chained them at every run, and no
+    /// second run was ever "unchanged").
+    pub(crate) relink: Vec<Relink>,
+}
+
+/// Where an earlier copy of the image was in a chain, behind another
+/// extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Relink {
+    /// The hook whose chain it is.
+    pub(crate) kind: HookKind,
+    /// The chain slot of the extension in front, which pointed at the
+    /// image's handler.
+    pub(crate) slot: u16,
+    /// Where the image fell through to, what the slot holds while the
+    /// upload runs: the image's own chain slot gets it.
+    pub(crate) onward: u16,
 }
 
 /// Reads what the robot has installed (nothing, for a ROM without a table).
@@ -184,6 +204,7 @@ pub(crate) fn prepare<T: Transport>(
     let mut replaced = Vec::new();
     let mut known = hooks;
     let mut unlinked = Vec::new();
+    let mut relink = Vec::new();
     for old in &read.installed {
         match old.overlap(image.extents()) {
             None => kept.push(old.clone()),
@@ -194,7 +215,17 @@ pub(crate) fn prepare<T: Transport>(
                 // the upload points the hook past it itself.)
                 for hook in &old.hooks {
                     let context = (&read.installed[..], known);
-                    unlinked.extend(unlink(client, profile, context, *hook, &mut writes, false)?);
+                    let Some((slot, onward)) =
+                        unlink(client, profile, context, *hook, &mut writes, false)?
+                    else {
+                        continue;
+                    };
+                    relink.push(Relink {
+                        kind: hook.kind,
+                        slot: slot.address,
+                        onward,
+                    });
+                    unlinked.push(slot);
                 }
                 reused = Some(old.clone());
             }
@@ -242,6 +273,7 @@ pub(crate) fn prepare<T: Transport>(
         replaced,
         others: kept,
         unlinked,
+        relink,
     }))
 }
 
@@ -394,14 +426,9 @@ fn remove<T: Transport>(
     };
     let mut slots = Vec::new();
     for hook in &old.hooks {
-        slots.extend(unlink(
-            client,
-            profile,
-            (everyone, hooks),
-            *hook,
-            writes,
-            true,
-        )?);
+        slots.extend(
+            unlink(client, profile, (everyone, hooks), *hook, writes, true)?.map(|(slot, _)| slot),
+        );
     }
     // Clearing its flags bytes frees its entries.
     let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();
@@ -418,7 +445,7 @@ fn remove<T: Transport>(
 /// chain. `hooks`: the hooks' targets as the upload read them (until two
 /// answers agreed), so the chain is followed from there without reading
 /// them again. Returns the chain slot it re-pointed, as it was (not the
-/// hook: an undo switches hooks itself, last).
+/// hook: an undo switches hooks itself, last), and where it points now.
 fn unlink<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
@@ -426,7 +453,7 @@ fn unlink<T: Transport>(
     hook: TakenHook,
     writes: &mut Unhooking<'_, '_, T>,
     at_head: bool,
-) -> Result<Option<Area>> {
+) -> Result<Option<(Area, u16)>> {
     let head = profile.hook_address(hook.kind) + 1;
     let from_hook = hooks
         .iter()
@@ -478,7 +505,7 @@ fn unlink<T: Transport>(
                     }
                 }
             }
-            Ok(slot)
+            Ok(slot.map(|slot| (slot, after)))
         }
         _ => Ok(None),
     }

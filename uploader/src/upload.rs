@@ -177,6 +177,11 @@ pub struct UploadReport {
     /// to go (each hook and where it led): the image falls through to the
     /// ROM's target instead.
     pub dropped: Vec<(HookKind, u16)>,
+    /// Hooks whose chain had an earlier copy of the image behind another
+    /// extension: the image went back there, the chain slot of the
+    /// extension in front (given) pointing at it again, not to the head
+    /// of the chain.
+    pub relinked: Vec<(HookKind, u16)>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -519,11 +524,20 @@ pub fn upload_keeping<T: Transport>(
     let before = |kind: HookKind| target_before(&initial, kind);
 
     // Chain slots get the hooks' current targets before the body goes out,
-    // so they are verified with it.
+    // so they are verified with it; an earlier copy that goes back where it
+    // was in a chain, where it fell through to.
+    let relinks = plan
+        .as_ref()
+        .map_or_else(Vec::new, |plan| plan.relink.clone());
+    let mut relinked: Vec<table::Relink> = Vec::new();
     let mut image = image.clone();
     for record in image.hooks().to_vec() {
         if let Some(slot) = record.chain {
-            let [low, high] = before(record.kind).to_le_bytes();
+            let onward = relinks
+                .iter()
+                .find(|relink| relink.kind == record.kind)
+                .map_or_else(|| before(record.kind), |relink| relink.onward);
+            let [low, high] = onward.to_le_bytes();
             image.set_byte(slot, low);
             image.set_byte(slot + 1, high);
         }
@@ -698,7 +712,14 @@ pub fn upload_keeping<T: Transport>(
                     let end = running
                         .back_to_base(client, attempts > 0, progress)
                         .and_then(|()| {
-                            install_hooks(client, &image, options, &initial, ours, progress)
+                            install_hooks(
+                                client,
+                                &image,
+                                options,
+                                (&initial, &relinks, &mut relinked),
+                                ours,
+                                progress,
+                            )
                         });
                     match end {
                         Err(error) if recoverable(&error) && attempts < 3 => {
@@ -737,7 +758,7 @@ pub fn upload_keeping<T: Transport>(
             client,
             &image,
             options,
-            &initial,
+            (&initial, &mut relinked),
             plan.as_mut(),
             check,
             progress,
@@ -757,7 +778,7 @@ pub fn upload_keeping<T: Transport>(
             client,
             &image,
             options,
-            &initial,
+            (&initial, &mut relinked),
             plan.as_mut(),
             None,
             progress,
@@ -771,13 +792,13 @@ pub fn upload_keeping<T: Transport>(
     if let Some(kept) = kept_file {
         let kept = finished(kept, entry);
         let owns = |address: u16| session.as_ref().is_some_and(|s| s.owns(address));
-        unchanged = crate::unchanged::left_as_found(
-            client,
-            profile,
-            (&kept, &image),
-            !unlinked.is_empty(),
-            &owns,
-        );
+        // A chain slot taken past an earlier copy and pointed at it again
+        // is as it was.
+        let unlinked = unlinked
+            .iter()
+            .any(|slot| !relinked.iter().any(|relink| relink.slot == slot.address));
+        unchanged =
+            crate::unchanged::left_as_found(client, profile, (&kept, &image), unlinked, &owns);
         if unchanged {
             let code_byte = |address: u16| session.as_ref().and_then(|s| s.code_byte(address));
             let over = crate::unchanged::loader_went_over(&kept, &code_byte);
@@ -811,6 +832,10 @@ pub fn upload_keeping<T: Transport>(
         unchanged,
         replaced,
         dropped,
+        relinked: relinked
+            .iter()
+            .map(|relink| (relink.kind, relink.slot))
+            .collect(),
     })
 }
 
@@ -1192,11 +1217,14 @@ fn rom_path<T: Transport>(
     client: &mut Client<T>,
     image: &UploadImage,
     options: &UploadOptions,
-    initial: &[(HookKind, u16)],
+    (initial, relinked): (&[(HookKind, u16)], &mut Vec<table::Relink>),
     mut plan: Option<&mut table::Plan>,
     mut check: Option<&RomProfile>,
     progress: &mut dyn Progress,
 ) -> Result<(Body, Vec<InstalledHook>)> {
+    let relinks = plan
+        .as_deref()
+        .map_or_else(Vec::new, |plan| plan.relink.clone());
     for _ in 0..3 {
         let mut body = Body::new(image, Writer::Rom);
         body.plan_writes(client.transport().baud(), progress);
@@ -1211,7 +1239,14 @@ fn rom_path<T: Transport>(
             fingerprint::check_jump_table(client, profile)?;
         }
         write_flags(client, plan.as_deref_mut(), options)?;
-        let hooks = install_hooks(client, image, options, initial, None, progress)?;
+        let hooks = install_hooks(
+            client,
+            image,
+            options,
+            (initial, &relinks, relinked),
+            None,
+            progress,
+        )?;
         if still_installed(client, plan.as_deref())? {
             return Ok((body, hooks));
         }
@@ -1306,20 +1341,33 @@ fn target_before(initial: &[(HookKind, u16)], kind: HookKind) -> u16 {
 /// back to its target before the upload unless the image takes it. Then
 /// both hooks are read back whole, and whatever noise changed is put
 /// right, the hooks the image does not take included.
+///
+/// An earlier copy of the image that was behind another extension in a
+/// chain (`relinks`) goes back there instead, the chain slot in front
+/// pointed at it again, while the hook is as the upload found it (a reset
+/// since: to the head, as any image); those are added to `relinked`.
 fn install_hooks<T: Transport>(
     client: &mut Client<T>,
     image: &UploadImage,
     options: &UploadOptions,
-    initial: &[(HookKind, u16)],
+    (initial, relinks, relinked): (
+        &[(HookKind, u16)],
+        &[table::Relink],
+        &mut Vec<table::Relink>,
+    ),
     ours: Option<u16>,
     progress: &mut dyn Progress,
 ) -> Result<Vec<InstalledHook>> {
     let profile = &options.profile;
     progress.phase(Phase::Hooks, image.hooks().len());
     let mut hooks = Vec::new();
+    relinked.clear();
     for record in image.hooks() {
         let address = profile.hook_address(record.kind);
         let before = target_before(initial, record.kind);
+        let relink = relinks.iter().find(|relink| relink.kind == record.kind);
+        // What the image's chain slot was written with.
+        let slot_holds = relink.map_or(before, |relink| relink.onward);
         let reset = profile.reset_target(record.kind);
         // The loader, if the image replaces it here.
         let ours = ours.filter(|_| record.kind == HookKind::Unknown);
@@ -1334,6 +1382,31 @@ fn install_hooks<T: Transport>(
         } else {
             read_hook(client, record.kind, address, &known)?
         };
+        // Only while the extension in front is still installed: a reset
+        // since cleared the table, and an image behind code no entry
+        // names could not be uploaded again (the chain would lead back
+        // into it past what no table says).
+        if let Some(relink) = relink
+            && (current == before || Some(current) == ours)
+            && in_front_installed(client, profile, relink)?
+        {
+            // Where it was: the slot in front points at it again, the
+            // image verified.
+            write_word_verified(
+                client,
+                relink.slot,
+                record.handler.to_le_bytes(),
+                options.max_writes,
+            )?;
+            relinked.push(*relink);
+            hooks.push(InstalledHook {
+                kind: record.kind,
+                handler: record.handler,
+                previous: relink.onward,
+                chain: record.chain,
+            });
+            continue;
+        }
         let fallthrough = if current == before || Some(current) == ours {
             before
         } else if image.contains(current) {
@@ -1356,7 +1429,7 @@ fn install_hooks<T: Transport>(
                 before
             }
         };
-        if fallthrough != before
+        if fallthrough != slot_holds
             && let Some(slot) = record.chain
         {
             write_word_verified(client, slot, fallthrough.to_le_bytes(), options.max_writes)?;
@@ -1372,7 +1445,15 @@ fn install_hooks<T: Transport>(
     for kind in HookKind::ALL {
         let address = profile.hook_address(kind);
         let reset = profile.reset_target(kind);
+        let loader_leaves = kind == HookKind::Unknown && ours.is_some();
         wanted.push(match hooks.iter().find(|hook| hook.kind == kind) {
+            // Back where it was: the hook as found (the loader leaves it).
+            Some(_) if relinked.iter().any(|relink| relink.kind == kind) => Wanted {
+                address,
+                target: target_before(initial, kind),
+                also: if loader_leaves { None } else { reset },
+                write: loader_leaves,
+            },
             Some(hook) => Wanted {
                 address,
                 target: hook.handler,
@@ -1422,6 +1503,19 @@ fn install_hooks<T: Transport>(
         });
     }
     Ok(hooks)
+}
+
+/// Whether the table still names the extension whose chain slot `relink`
+/// goes back behind.
+fn in_front_installed<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    relink: &table::Relink,
+) -> Result<bool> {
+    Ok(crate::table::read_installed(client, profile)?
+        .iter()
+        .flat_map(|other| other.hooks.iter())
+        .any(|hook| hook.kind == relink.kind && hook.chain == Some(relink.slot)))
 }
 
 /// A client paced for `profile`'s receive buffer.

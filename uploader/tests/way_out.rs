@@ -95,6 +95,8 @@ fn a_hook_damaged_by_hand_is_no_way_out_for_a_new_image() {
 /// slot to the first), the first's slot damaged by hand, the first
 /// uploaded again: it is taken out of the chain by pointing the second's
 /// slot where the first fell through. That was the damaged way, hooked.
+/// Now the ROM's target is passed on, and the first goes back behind the
+/// second falling through to it.
 #[test]
 fn a_damaged_way_out_is_not_passed_on_to_the_extension_before() {
     let options = UploadOptions::default();
@@ -111,16 +113,18 @@ fn a_damaged_way_out_is_not_passed_on_to_the_extension_before() {
         );
         poke(&mut client, 0x0401, &damage.to_le_bytes());
         upload(&mut client, &first, &options, &mut Heard::default()).expect("again");
-        assert_eq!(word(&mut client, HOOK_UNKNOWN + 1), 0x0403);
-        assert_eq!(
-            word(&mut client, 0x0401),
-            0x0503,
-            "the first falls to the second"
-        );
+        // hostile14 F6b: the first goes back where it was, behind the
+        // second, and falls through to the ROM, not to the damage.
+        assert_eq!(word(&mut client, HOOK_UNKNOWN + 1), 0x0503);
         assert_eq!(
             word(&mut client, 0x0501),
+            0x0403,
+            "the second falls to the first"
+        );
+        assert_eq!(
+            word(&mut client, 0x0401),
             BAD_COMMAND,
-            "the second falls to the ROM, not to ${damage:04X}"
+            "the first falls to the ROM, not to ${damage:04X}"
         );
         answers_after_an_unknown_command(&mut client);
     }
