@@ -457,6 +457,7 @@ impl RobotMonitor {
         if let Some(registers) = d.take_unasked() {
             text.push_str("(a stop not asked for) ");
             text.push_str(&self.heard(d, &Heard::Stopped(registers))?);
+            text.push_str(&garbled_own(&registers));
         }
         Ok(text)
     }
@@ -484,7 +485,11 @@ impl RobotMonitor {
                     // Most likely the answer the last silent command owed.
                     self.owed = None;
                 }
-                Ok(Some(format!("{what}{}", self.heard(d, &heard)?)))
+                let own = match &heard {
+                    Heard::Stopped(registers) => garbled_own(registers),
+                    _ => String::new(),
+                };
+                Ok(Some(format!("{what}{}{own}", self.heard(d, &heard)?)))
             }
         }
     }
@@ -826,6 +831,25 @@ fn read_for_person<T: Transport>(
         )));
     }
     d.read_live_as_program(address, len).map_err(failure)
+}
+
+/// fresh15 F6: a stop not asked for whose A and X are a command the
+/// monitor itself sends (a `/7R` read, a `/9W` or `/7W` write, a `/1X`)
+/// is most likely that command, garbled on a noisy line into one the ROM
+/// passed down `HOOK_UNKNOWN` (a well-formed one never goes there): said,
+/// so that it is not taken for a command of the user's. Empty otherwise.
+pub(crate) fn garbled_own(registers: &Registers) -> String {
+    let own = match (registers.a, registers.x) {
+        (b'R', 7) => "/7R (a read of memory)",
+        (b'W', 9 | 7) => "/9W or /7W (a write of memory)",
+        (b'X', 1) => "/1X (a look at the robot)",
+        _ => return String::new(),
+    };
+    format!(
+        "note: A='{}' X={} is the monitor's own {own}, garbled on the line into a command the ROM passes down HOOK_UNKNOWN: no command of yours; `continue` lets it go on\n",
+        char::from(registers.a),
+        registers.x
+    )
 }
 
 /// What is said after a value read where the program writes as it runs.

@@ -420,3 +420,30 @@ fn reads_that_would_change_a_cards_registers_are_refused() {
     assert!(text(&mut m, &mut d, "mem $0480 1").contains("$0480: 42"));
     assert!(text(&mut m, &mut d, "mem $FF00 1").contains("$FF00: "));
 }
+
+/// fresh15 F6: on a noisy line one of the monitor's own `/7R` reads,
+/// garbled, went down `HOOK_UNKNOWN` and stopped at the user's breakpoint
+/// on its handler (A='R', X=7), shown as a stop like any other. It is
+/// said to be the monitor's own.
+#[test]
+fn a_stop_from_a_garbled_read_of_the_monitors_own_says_so() {
+    let (mut m, mut d) = attached();
+    text(&mut m, &mut d, "break $0403");
+    // A `/7R` whose digits noise turned into letters: malformed, so the
+    // ROM passes it to HOOK_UNKNOWN.
+    uploader::Transport::send(d.client().transport(), b"/7RZZZZ04").expect("sent");
+    let said = m
+        .notice(&mut d, std::time::Duration::from_secs(1))
+        .expect("the line")
+        .expect("the stop");
+    assert!(said.contains("stopped: breakpoint 1, $0403"), "{said}");
+    assert!(
+        said.contains("note: A='R' X=7 is the monitor's own /7R (a read of memory), garbled"),
+        "{said}"
+    );
+    // A stop by a command of the user's says nothing of the kind.
+    text(&mut m, &mut d, "continue");
+    let said = text(&mut m, &mut d, "/1Q");
+    assert!(said.contains("stopped: breakpoint 1"), "{said}");
+    assert!(!said.contains("the monitor's own"), "{said}");
+}

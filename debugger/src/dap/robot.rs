@@ -292,6 +292,10 @@ impl RobotSession {
                 if !hit.is_empty() {
                     body["hitBreakpointIds"] = json!(hit);
                 }
+                let own = crate::robot::garbled_own(registers);
+                if !own.is_empty() {
+                    outbox.output("console", &own)?;
+                }
                 outbox.event("stopped", Some(body))
             }
             Heard::Silent => {
