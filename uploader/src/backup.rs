@@ -962,6 +962,18 @@ fn refuse_later_uploads<T: Transport>(
         if crate::loader::loader_left_at(client, profile, current)?.is_some() {
             continue;
         }
+        // fresh17 F6: that upload's own image, at the head of the chain,
+        // whose handler it did not rewrite (an edit elsewhere, `--replace`
+        // of an extension that sat behind another), so the file does not
+        // hold it: its table entry, as the upload wrote it, says so.
+        if undone_extension(client, backup, profile)?.is_some_and(|undone| {
+            undone
+                .hooks
+                .iter()
+                .any(|hook| hook.kind == kind && hook.handler == current)
+        }) {
+            continue;
+        }
         let owner = crate::table::read_installed(client, profile)
             .ok()
             .and_then(|everyone| {
@@ -978,6 +990,31 @@ fn refuse_later_uploads<T: Transport>(
         });
     }
     Ok(())
+}
+
+/// The installed extension the upload an undo file undoes put in: the
+/// one whose table entry the file witnesses (an upload adds the sum of
+/// the entry it wrote), where the robot still holds that entry as
+/// written.
+fn undone_extension<T: Transport>(
+    client: &mut Client<T>,
+    backup: &Backup,
+    profile: &RomProfile,
+) -> Result<Option<romlib::installed::Installed>> {
+    let Some((table, entries)) = profile.table else {
+        return Ok(None);
+    };
+    for entry in crate::table::read_installed(client, profile)? {
+        let at = romlib::installed::entry_address(table, entries, entry.slot);
+        let Some(witness) = backup.witnesses.iter().find(|w| w.address == at) else {
+            continue;
+        };
+        let bytes = client.read_memory(at, usize::from(witness.len))?;
+        if crate::sums::fletcher16(&bytes) == witness.sum {
+            return Ok(Some(entry));
+        }
+    }
+    Ok(None)
 }
 
 /// The options a restore writes memory with: the table is written as

@@ -220,3 +220,59 @@ fn a_backup_of_a_robot_whose_hook_is_broken_says_so() {
         .expect_err("the way is refused at the restore, as the backup said");
     assert!(matches!(error, Error::RestoreChainBroken { .. }), "{error}");
 }
+
+/// fresh17 F6: the undo of an upload that replaced an extension sitting
+/// behind another (`--replace` of an edit away from the handler, the
+/// usual edit) was refused as "a later upload was chained ahead": the
+/// hook led to the new image's handler, whose bytes the upload did not
+/// rewrite, so the file did not hold them. The file witnesses the table
+/// entry the upload wrote: that names the image it undoes.
+#[test]
+fn the_undo_of_a_replacement_whose_handler_did_not_change_goes_through() {
+    let options = UploadOptions::default();
+    let replace = UploadOptions {
+        replace: true,
+        ..options.clone()
+    };
+    let undo = UploadOptions {
+        undo: true,
+        ..options.clone()
+    };
+    let mut client = uploader::client(robot(), &options.profile);
+    // 512 bytes at $0400: its chain slot's JMP first, its handler (`JMP
+    // $0400`) at $0480, far from the slot and from the edit.
+    let mut bytes = extension(512, 3).areas()[0].bytes.clone();
+    bytes[0x80..0x83].copy_from_slice(&[0x4C, 0x00, 0x04]);
+    let first = uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![isa::objfmt::HookRecord {
+            kind: HookKind::Unknown,
+            handler: 0x0480,
+            chain: Some(0x0401),
+        }],
+    )
+    .expect("an image");
+    upload(&mut client, &first, &options, &mut NoProgress).expect("the first");
+    upload(
+        &mut client,
+        &extension_at(0x0C00),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("in front");
+    let edited = common::one_byte_changed(&first, 300);
+    let mut kept = Kept::default();
+    upload_keeping(&mut client, &edited, &replace, &mut NoProgress, &mut kept).expect("replaced");
+    assert_eq!(hook(&mut client), 0x0480, "the edit at the head");
+    restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("undone");
+    assert_eq!(hook(&mut client), 0x0C03, "the chain as it was");
+    let memory = client.transport().robot().robot().board().memory();
+    assert_eq!(
+        memory[0x0400 + 300],
+        first.areas()[0].bytes[300],
+        "the first's byte back"
+    );
+}
