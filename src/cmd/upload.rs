@@ -696,6 +696,11 @@ fn upload_file(
             "the robot held this image already, installed as it is now: {} still puts back what it held before the upload that put it there",
             undo.path.display()
         );
+        // fresh17 F1: what was written then is the image's data (a
+        // counter its program keeps), put back as built.
+        if !report.written.is_empty() {
+            out.push_str("  (its data, which its program had changed, is put back as built)\n");
+        }
     }
     if !emulated && expectations.is_some() {
         out.push_str(&others_not_rehearsed(&report, profile));

@@ -137,3 +137,30 @@ fn an_editors_watch_and_memory_view_show_a_counter_as_it_goes() {
     assert_eq!(bye["success"], true, "{bye}");
     assert!(dap.ends());
 }
+
+/// fresh17 F1: uploaded again after it counted, the same image is no
+/// change to what is installed (its data put back as built, said), and
+/// the undo goes back to the robot before the first upload.
+#[test]
+fn the_same_image_again_after_it_counted_is_undone_to_the_robot_before() {
+    let (dir, sim) = counting_on_a_pty_robot();
+    let output = scorpion(
+        dir.path(),
+        &["upload", "count.elf", "--port", &sim.path, "--no-dry-run"],
+    );
+    let said = transcript(&output);
+    assert!(output.status.success(), "{said}");
+    assert!(
+        said.contains("the robot held this image already, installed as it is now")
+            && said.contains("(its data, which its program had changed, is put back as built)"),
+        "{said}"
+    );
+    let output = scorpion(dir.path(), &["upload", "--undo", "--port", &sim.path]);
+    assert!(output.status.success(), "{}", transcript(&output));
+    let output = scorpion(dir.path(), &["installed", "--port", &sim.path]);
+    assert!(
+        transcript(&output).contains("nothing installed"),
+        "{}",
+        transcript(&output)
+    );
+}

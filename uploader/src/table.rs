@@ -41,6 +41,9 @@ pub(crate) struct Plan {
     /// Whether the robot may hold much of the image already: the table
     /// lists an earlier copy of it, or an extension it replaces.
     pub(crate) held_maybe: bool,
+    /// Whether the table lists an earlier copy of this very image (the
+    /// same bytes as linked, at the same place).
+    pub(crate) reused: bool,
     /// The installed extensions `replace` took out (their chains and
     /// entries), as the table described them.
     pub(crate) replaced: Vec<Installed>,
@@ -270,6 +273,7 @@ pub(crate) fn prepare<T: Transport>(
         found: writes.found,
         hooks: writes.hooks,
         held_maybe: !replaced.is_empty() || reused.is_some(),
+        reused: reused.is_some(),
         replaced,
         others: kept,
         unlinked,

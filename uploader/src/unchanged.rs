@@ -31,22 +31,38 @@ pub(crate) type LoaderOwns<'a> = &'a dyn Fn(u16) -> bool;
 /// that goes back further keeps that too. A line that fails the reads
 /// answers "changed": the new undo file is then kept, which is always
 /// right.
+///
+/// `again`: the robot had this very image installed before. Its data
+/// (what it loads outside its code: a counter its control loop keeps)
+/// was the program's to change, and the upload put it back as built
+/// (fresh17 F1: a project with a pass counter was "changed" at every
+/// `test --port`, and its undo went back one run only): that is no
+/// change to what is installed, and an older undo file puts back what
+/// was there before the first upload of the image anyway.
 pub(crate) fn left_as_found<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     (kept, image): (&Backup, &UploadImage),
-    unlinked: bool,
+    (unlinked, again): (bool, bool),
     loader_owns: LoaderOwns<'_>,
 ) -> bool {
     if unlinked {
         return false;
     }
+    let its_data = |address: u16| {
+        again
+            && !image.is_code(address)
+            && image
+                .extents()
+                .iter()
+                .any(|extent| extent.contains(&address))
+    };
     // The robot's own bytes that were kept, in runs, with what they held.
     let mut runs: Vec<(u16, Vec<Option<u8>>)> = Vec::new();
     for area in &kept.areas {
         for (offset, &byte) in area.bytes.iter().enumerate() {
             let address = area.address.wrapping_add(offset as u16);
-            if loader_owns(address) {
+            if loader_owns(address) || its_data(address) {
                 continue;
             }
             if image.byte(address).is_some_and(|loaded| loaded != byte) {

@@ -797,8 +797,14 @@ pub fn upload_keeping<T: Transport>(
         let unlinked = unlinked
             .iter()
             .any(|slot| !relinked.iter().any(|relink| relink.slot == slot.address));
-        unchanged =
-            crate::unchanged::left_as_found(client, profile, (&kept, &image), unlinked, &owns);
+        let again = plan.as_ref().is_some_and(|plan| plan.reused);
+        unchanged = crate::unchanged::left_as_found(
+            client,
+            profile,
+            (&kept, &image),
+            (unlinked, again),
+            &owns,
+        );
         if unchanged {
             let code_byte = |address: u16| session.as_ref().and_then(|s| s.code_byte(address));
             let over = crate::unchanged::loader_went_over(&kept, &code_byte);

@@ -179,3 +179,44 @@ fn another_extension_goes_in_front_of_a_counting_one_and_comes_out() {
     let hook = usize::from(romlib::symbols::HOOK_UNKNOWN) + 1;
     assert_eq!(memory[hook..hook + 2], [0x00, 0x04], "HOOK_UNKNOWN back");
 }
+
+/// fresh17 F1: the same image uploaded again after its program counted
+/// was a change (the count put back to what the image loads), so a new
+/// undo file was kept, and after `test --port` twice the undo went back
+/// one run only. Its data is the program's to change: the upload that
+/// puts it back as built changes nothing that is installed, and the
+/// older undo file is kept.
+#[test]
+fn the_same_image_again_after_it_counted_changes_nothing_installed() {
+    let mut client = counting_robot();
+    assert_ne!(
+        client.read_live(COUNT, 1).expect("read").bytes,
+        [0],
+        "it counted"
+    );
+    let mut kept = Kept::default();
+    let report = uploader::upload_keeping(
+        &mut client,
+        &counting(),
+        &UploadOptions::default(),
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("uploaded again");
+    assert!(report.unchanged, "{report:?}");
+    assert!(kept.1, "the older undo file kept");
+    // Its code changed is a change.
+    let mut areas = counting().areas().to_vec();
+    areas[0].bytes[5] = b'w';
+    let mut edited = UploadImage::new(areas, counting().hooks().to_vec()).expect("an image");
+    edited.set_code(vec![0x0400..=0x041D]);
+    let replace = UploadOptions {
+        replace: true,
+        ..UploadOptions::default()
+    };
+    let mut kept = Kept::default();
+    let report =
+        uploader::upload_keeping(&mut client, &edited, &replace, &mut NoProgress, &mut kept)
+            .expect("uploaded");
+    assert!(!report.unchanged && !kept.1, "{report:?}");
+}
