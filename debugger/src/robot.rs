@@ -652,7 +652,17 @@ impl RobotMonitor {
                 let value = self.eval(d, &expr)?;
                 bytes.push(u8::try_from(value).map_err(|_| usage(&format!("{word} is no byte")))?);
             }
-            d.write_as_program(address, &bytes).map_err(failure)?;
+            let changing = d.write_as_program_live(address, &bytes).map_err(failure)?;
+            if !changing.is_empty() {
+                // fresh17 F8: a counter the program keeps took the write,
+                // and has moved on since.
+                return Ok(format!(
+                    "${address:04X}: {} (written; the robot's program writes {} as it runs, and has changed {} since)\n",
+                    uploader::stub::error_hex(&bytes),
+                    uploader::addresses_text(&changing),
+                    if changing.len() == 1 { "it" } else { "them" }
+                ));
+            }
             return Ok(format!(
                 "${address:04X}: {} (read back)\n",
                 uploader::stub::error_hex(&bytes)

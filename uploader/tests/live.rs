@@ -132,6 +132,21 @@ fn a_session_attaches_beside_a_counter_after_the_code() {
     let client = counting_robot();
     let profile = RomProfile::reference();
     let mut debug = RobotDebug::attach(client, &profile, counting()).expect("attaches");
+    // fresh17 F8: a write of the running counter takes, and is said to
+    // be changing since, not refused as memory that is no RAM.
+    assert_eq!(
+        debug
+            .write_as_program_live(COUNT, &[0x80])
+            .expect("written"),
+        [COUNT]
+    );
+    assert_eq!(
+        debug
+            .write_as_program_live(0x0600, &[1, 2])
+            .expect("written"),
+        [],
+        "RAM that holds still"
+    );
     debug
         .set_breakpoint(0x0418, &[0x0400, 0x0418])
         .expect("a breakpoint in the loop handler");

@@ -600,8 +600,10 @@ impl RobotSession {
         if usize::from(start) + bytes.len() > 0x1_0000 {
             return Err("writeMemory: the bytes run past $FFFF".into());
         }
+        // fresh17 F8: a counter the program keeps takes the write and
+        // moves on: written, not failed.
         self.robot()?
-            .write_as_program(start, &bytes)
+            .write_as_program_live(start, &bytes)
             .map_err(|e| failure(e).message())?;
         Ok(json!({"bytesWritten": bytes.len()}))
     }

@@ -904,20 +904,26 @@ impl<T: Transport> RobotDebug<T> {
         }
     }
 
+    /// `bytes` at `address` with `/9W` (`/7W` for an odd last byte), sent
+    /// once, not read back.
+    fn rom_write_piece_once(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        let mut text = Vec::new();
+        for (i, pair) in bytes.chunks(2).enumerate() {
+            let here = address.wrapping_add(2 * i as u16);
+            match pair {
+                [a, b] => text.extend(format!("/9W{here:04X}{a:02X}{b:02X}").bytes()),
+                [a] => text.extend(format!("/7W{here:04X}{a:02X}").bytes()),
+                _ => {}
+            }
+        }
+        Ok(self.client.send_raw(&text)?)
+    }
+
     fn rom_write_piece(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
         let mut todo = vec![(address, bytes.to_vec())];
         for _ in 0..ATTEMPTS {
             for (at, part) in &todo {
-                let mut text = Vec::new();
-                for (i, pair) in part.chunks(2).enumerate() {
-                    let here = at.wrapping_add(2 * i as u16);
-                    match pair {
-                        [a, b] => text.extend(format!("/9W{here:04X}{a:02X}{b:02X}").bytes()),
-                        [a] => text.extend(format!("/7W{here:04X}{a:02X}").bytes()),
-                        _ => {}
-                    }
-                }
-                self.client.send_raw(&text)?;
+                self.rom_write_piece_once(*at, part)?;
             }
             let expected: Vec<Option<u8>> = bytes.iter().copied().map(Some).collect();
             let found = self.client.read_expecting(address, &expected)?;
@@ -1706,6 +1712,7 @@ impl<T: Transport> RobotDebug<T> {
                 Ok(None)
             }
             Step::Host(effects) => {
+                // At a stop: nothing changes as it is read.
                 self.apply_as_program(&effects.writes, &what)?;
                 let mut registers = effects.registers;
                 registers.pc = self.program_pc(registers.pc);
@@ -1876,6 +1883,19 @@ impl<T: Transport> RobotDebug<T> {
     /// copy run otherwise (see [`Patch::with_byte`]); nothing is written
     /// then. The line's errors, [`StubError::Verify`].
     pub fn write_as_program(&mut self, address: u16, bytes: &[u8]) -> StubResult<()> {
+        self.write_as_program_live(address, bytes).map(|_| ())
+    }
+
+    /// [`RobotDebug::write_as_program`], where a byte the program writes
+    /// while it runs (a counter) is not refused for holding something
+    /// else when read back: it is written, and changing since. Returns
+    /// those addresses, sorted (fresh17 F8: a `poke` of a running counter
+    /// was said to fail, "not RAM, or the line is very noisy", though it
+    /// took).
+    ///
+    /// # Errors
+    /// As [`RobotDebug::write_as_program`].
+    pub fn write_as_program_live(&mut self, address: u16, bytes: &[u8]) -> StubResult<Vec<u16>> {
         let what = format!("a write at ${address:04X}");
         for i in 0..bytes.len() {
             let at = address.wrapping_add(i as u16);
@@ -1891,9 +1911,10 @@ impl<T: Transport> RobotDebug<T> {
         self.apply_as_program(&writes, &what)
     }
 
-    /// [`RobotDebug::write_as_program`] for writes in order (`what` names
-    /// them in a refusal).
-    fn apply_as_program(&mut self, writes: &[(u16, u8)], what: &str) -> StubResult<()> {
+    /// [`RobotDebug::write_as_program_live`] for writes in order (`what`
+    /// names them in a refusal).
+    fn apply_as_program(&mut self, writes: &[(u16, u8)], what: &str) -> StubResult<Vec<u16>> {
+        let mut changing = Vec::new();
         // All planned first: a refusal writes nothing.
         let mut patches: BTreeMap<u16, Patch> = BTreeMap::new();
         let mut plain: Vec<(u16, u8)> = Vec::new();
@@ -1937,10 +1958,59 @@ impl<T: Transport> RobotDebug<T> {
             {
                 run.push(plain[i + run.len()].1);
             }
-            self.write_verified(plain[i].0, &run)?;
+            changing.extend(self.write_plain(plain[i].0, &run)?);
             i += run.len();
         }
-        Ok(())
+        changing.sort_unstable();
+        changing.dedup();
+        Ok(changing)
+    }
+
+    /// Writes program bytes and reads them back ([`RobotDebug::write_verified`]);
+    /// while the robot runs, the read back is [`Client::read_live`]: where
+    /// bytes of the write keep changing as they are read, the program
+    /// writes there as it runs (a counter), and the bytes that hold
+    /// something else are returned as its; any other difference is
+    /// written again, then refused.
+    fn write_plain(&mut self, address: u16, bytes: &[u8]) -> StubResult<Vec<u16>> {
+        let running = self.while_running(|d| {
+            for _ in 0..ATTEMPTS {
+                d.rom_write_piece_once(address, bytes)?;
+                let read = d.client.read_live(address, bytes.len())?;
+                let differ: Vec<usize> = (0..bytes.len())
+                    .filter(|&i| read.bytes[i] != bytes[i])
+                    .collect();
+                if differ.is_empty() {
+                    return Ok(Vec::new());
+                }
+                // The program writes here as it runs: a byte that changed
+                // as it was read, and the others of the write that hold
+                // something else now (the high byte of a counter, which
+                // moves more slowly), are its.
+                if !read.changing.is_empty() {
+                    let mut changed: Vec<u16> = differ
+                        .iter()
+                        .map(|&i| address.wrapping_add(i as u16))
+                        .chain(read.changing)
+                        .collect();
+                    changed.sort_unstable();
+                    changed.dedup();
+                    return Ok(changed);
+                }
+            }
+            Err(StubError::Verify {
+                address,
+                expected: hex(bytes),
+                found: hex(&d.client.read_live(address, bytes.len())?.bytes),
+            })
+        })?;
+        match running {
+            Some(changing) => Ok(changing),
+            None => {
+                self.write_verified(address, bytes)?;
+                Ok(Vec::new())
+            }
+        }
     }
 
     /// The step's breakpoints, taken out at a stop.
