@@ -50,6 +50,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         backup,
         changing,
         broken,
+        outside,
     } = uploader::backup_live(&mut client, &profile)?;
     hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
@@ -75,6 +76,13 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             },
             uploader::addresses_text(&changing),
             if changing.len() == 1 { "it" } else { "them" },
+        ));
+    }
+    for entry in &outside {
+        // fresh17 F4: said now, not first at a restore that refuses it.
+        print(&format!(
+            "note: {} has memory outside what a backup saves (user RAM and the user zero page): the file checks it is still there at a restore, and cannot bring it back once it is gone (upload it again then)",
+            entry.describe()
         ));
     }
     for hook in &broken {

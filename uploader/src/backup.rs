@@ -368,6 +368,10 @@ pub struct Saved {
     /// stops the CPU, strays): a restore of the file will refuse them, as
     /// it refuses now (recheck16 F4).
     pub broken: Vec<BrokenHook>,
+    /// Installed extensions with memory outside what a backup saves (an
+    /// operating system in KIM-bus RAM): the file only witnesses it, and
+    /// a restore after it has gone is refused (fresh17 F4).
+    pub outside: Vec<romlib::installed::Installed>,
 }
 
 /// A hook whose way is no way for a command to go.
@@ -419,6 +423,16 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
     let ranges = witness_ranges(profile, &backup);
     backup.witnesses = read_witnesses(client, &ranges)?;
     let mut broken = Vec::new();
+    let saved = |address: u16| backup.byte_at(u32::from(address)).is_some();
+    let outside: Vec<romlib::installed::Installed> = backup_table(profile, &backup)
+        .into_iter()
+        .filter(|entry| {
+            entry
+                .extents
+                .iter()
+                .any(|extent| !saved(*extent.start()) || !saved(*extent.end()))
+        })
+        .collect();
     let into_ram: Vec<(HookKind, u16)> = backup
         .hooks
         .iter()
@@ -447,6 +461,7 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
         backup,
         changing,
         broken,
+        outside,
     })
 }
 

@@ -417,7 +417,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::witness_differs),
         help(
-            "the hook would point at code that is not there: this is another robot, or a restore or upload has changed it since; upload the image instead of undoing"
+            "the hook would point at code that is not there: this is another robot, or a restore or upload has changed it since (memory a backup does not save, the KIM bus's, is only witnessed); upload the image again instead"
         )
     )]
     WitnessDiffers {

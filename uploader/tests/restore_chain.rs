@@ -276,3 +276,35 @@ fn the_undo_of_a_replacement_whose_handler_did_not_change_goes_through() {
         "the first's byte back"
     );
 }
+
+/// fresh17 F4: a backup of a robot with an operating system in KIM-bus
+/// RAM said nothing of it; a restore after the OS had gone was refused
+/// (its code only witnessed). The backup says so as it saves.
+#[test]
+fn a_backup_names_the_extensions_it_does_not_save() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0400),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("in user RAM");
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    assert_eq!(saved.outside, [], "user RAM is saved");
+    upload(
+        &mut client,
+        &extension_at(0x1000),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("on the KIM bus");
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    let outside: Vec<_> = saved
+        .outside
+        .iter()
+        .map(|entry| entry.extents.clone())
+        .collect();
+    assert_eq!(outside, [vec![0x1000..=0x103F]]);
+}
