@@ -1333,7 +1333,7 @@ impl<T: Transport> RobotDebug<T> {
         if self.stopped.is_some() {
             return Err(StubError::Refused {
                 what: format!("sending {}", command.escape_ascii()),
-                reason: "the robot is stopped at a breakpoint: its control loop reads no command until `continue`".into(),
+                reason: "the robot is stopped (at a breakpoint, or after a step): its control loop reads no command until `continue`".into(),
             });
         }
         self.rx.clear();
