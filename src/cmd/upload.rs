@@ -362,27 +362,23 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
         );
     }
     for hook in &report.hooks {
-        match report.relinked.iter().find(|(kind, _)| *kind == hook.kind) {
-            // hostile14 F6b: left where it was in the chain.
-            Some((_, slot)) => {
-                let _ = write!(
-                    text,
-                    "\n  {} -> ... -> ${:04X} (where it was in the chain, behind the extension whose chain slot is at ${slot:04X}; falls through to ${:04X})",
-                    hook.kind.rom_symbol(),
-                    hook.handler,
-                    hook.previous
-                );
-            }
-            None => {
-                let _ = write!(
-                    text,
-                    "\n  {} -> ${:04X} (falls through to ${:04X})",
-                    hook.kind.rom_symbol(),
-                    hook.handler,
-                    hook.previous
-                );
-            }
-        }
+        // hostile14 F6b: left where it was in the chain.
+        let (way, place) = match report.relinked.iter().find(|(kind, _)| *kind == hook.kind) {
+            Some((_, slot)) => (
+                " ... ->",
+                format!(
+                    "where it was in the chain, behind the extension whose chain slot is at ${slot:04X}; "
+                ),
+            ),
+            None => ("", String::new()),
+        };
+        let _ = write!(
+            text,
+            "\n  {} ->{way} ${:04X} ({place}falls through to ${:04X})",
+            hook.kind.rom_symbol(),
+            hook.handler,
+            hook.previous
+        );
     }
     text
 }

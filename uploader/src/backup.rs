@@ -433,15 +433,7 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
                 .any(|extent| !saved(*extent.start()) || !saved(*extent.end()))
         })
         .collect();
-    let into_ram: Vec<(HookKind, u16)> = backup
-        .hooks
-        .iter()
-        .copied()
-        .filter(|&(kind, target)| {
-            profile.reset_target(kind) != Some(target)
-                && profile.writable.iter().any(|range| range.contains(&target))
-        })
-        .collect();
+    let into_ram = crate::chain::into_ram(profile, &backup.hooks);
     if !into_ram.is_empty() {
         let everyone = crate::table::read_installed(client, profile)?;
         for (hook, target) in into_ram {

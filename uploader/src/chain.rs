@@ -203,14 +203,7 @@ pub(crate) fn check_restored<T: Transport>(
     profile: &RomProfile,
     hooks: &[(HookKind, u16)],
 ) -> Result<()> {
-    let targets: Vec<(HookKind, u16)> = hooks
-        .iter()
-        .copied()
-        .filter(|&(kind, target)| {
-            profile.reset_target(kind) != Some(target)
-                && profile.writable.iter().any(|range| range.contains(&target))
-        })
-        .collect();
+    let targets = into_ram(profile, hooks);
     if targets.is_empty() {
         return Ok(());
     }
@@ -239,6 +232,19 @@ pub(crate) fn check_restored<T: Transport>(
         }
     }
     Ok(())
+}
+
+/// The hooks of `hooks` that point into RAM an upload may write (not at
+/// the ROM's own targets): those whose way a file or a robot decides.
+pub(crate) fn into_ram(profile: &RomProfile, hooks: &[(HookKind, u16)]) -> Vec<(HookKind, u16)> {
+    hooks
+        .iter()
+        .copied()
+        .filter(|&(kind, target)| {
+            profile.reset_target(kind) != Some(target)
+                && profile.writable.iter().any(|range| range.contains(&target))
+        })
+        .collect()
 }
 
 /// What a way out is, for a chain about to be made to it.

@@ -192,15 +192,7 @@ fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
 /// refuses it.
 #[test]
 fn a_backup_of_a_robot_whose_hook_is_broken_says_so() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0400),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = one_installed();
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
     assert_eq!(saved.broken, [], "an extension's working chain");
     {
@@ -282,15 +274,7 @@ fn the_undo_of_a_replacement_whose_handler_did_not_change_goes_through() {
 /// (its code only witnessed). The backup says so as it saves.
 #[test]
 fn a_backup_names_the_extensions_it_does_not_save() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0400),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("in user RAM");
+    let (options, mut client) = one_installed();
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
     assert_eq!(saved.outside, [], "user RAM is saved");
     upload(
@@ -307,4 +291,21 @@ fn a_backup_names_the_extensions_it_does_not_save() {
         .map(|entry| entry.extents.clone())
         .collect();
     assert_eq!(outside, [vec![0x1000..=0x103F]]);
+}
+
+/// A robot with the extension at $0400 uploaded, and the options used.
+fn one_installed() -> (
+    UploadOptions,
+    uploader::Client<uploader::transport::VirtualTransport>,
+) {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0400),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    (options, client)
 }
