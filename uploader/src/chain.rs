@@ -146,7 +146,7 @@ pub(crate) fn follow<T: Transport>(
         let next = match slot {
             Some(slot) => read_word(client, slot)?,
             None => {
-                let bytes = client.read_memory(at, 3)?;
+                let bytes = client.read_live(at, 3)?.bytes;
                 if bytes[0] == JMP {
                     Some(u16::from_le_bytes([bytes[1], bytes[2]]))
                 } else if let Some(stub) = crate::stub::left::at_target(client, profile, at)? {

@@ -682,8 +682,12 @@ impl<T: Transport> Client<T> {
             std::collections::HashMap::new();
         let mut failures = 0u32;
         let mut last_error = None;
-        // How often each address differed between two well-formed answers.
+        // How often each address differed between two well-formed answers,
+        // and how often two answers were compared there.
         let mut changes: std::collections::HashMap<u16, u32> = std::collections::HashMap::new();
+        // For a live read: the values each address answered, how often.
+        let mut seen: std::collections::HashMap<u16, std::collections::HashMap<u8, u32>> =
+            std::collections::HashMap::new();
         let mut pairs = 0u32;
         let mut changing = std::collections::BTreeSet::new();
         self.heard_stop = false;
@@ -703,6 +707,15 @@ impl<T: Transport> Client<T> {
                 match outcome {
                     Outcome::Answered { span, data, .. } => {
                         let offset = usize::from(span.address() - address);
+                        if live {
+                            for (i, &byte) in data.iter().enumerate() {
+                                *seen
+                                    .entry(span.address() + i as u16)
+                                    .or_default()
+                                    .entry(byte)
+                                    .or_insert(0) += 1;
+                            }
+                        }
                         let as_expected = expected.is_some_and(|expected| {
                             expected
                                 .get(offset..offset + data.len())
@@ -735,10 +748,18 @@ impl<T: Transport> Client<T> {
                                 for &at in &differ {
                                     *changes.entry(at).or_insert(0) += 1;
                                 }
+                                // hostile17 F1: memory in use answers a
+                                // new value nearly every time; a byte that
+                                // noise hit now and then answers its own
+                                // value most of the time.
                                 let in_use = |at: &u16| {
+                                    let values = seen.get(at);
+                                    let answers: u32 = values.map_or(0, |v| v.values().sum());
+                                    let most =
+                                        values.and_then(|v| v.values().max().copied()).unwrap_or(0);
                                     changes.get(at).is_some_and(|&times| {
                                         times >= CHANGING && times * 4 >= pairs
-                                    })
+                                    }) && most * 2 < answers
                                 };
                                 if live && differ.iter().all(in_use) {
                                     // They agree but where the program writes.

@@ -235,3 +235,49 @@ fn the_same_image_again_after_it_counted_changes_nothing_installed() {
             .expect("uploaded");
     assert!(!report.unchanged && !kept.1, "{report:?}");
 }
+
+/// hostile17 F1: on a noisy line, a byte of static code that noise hit a
+/// few times in one read was named as changing, and its value taken from
+/// one (garbled) answer. Memory in use differs nearly every time it is
+/// read twice; a byte noise hits now and then does not.
+#[test]
+fn noise_does_not_pass_static_memory_off_as_changing() {
+    use uploader::transport::{FaultConfig, FaultyTransport};
+    let code: Vec<u8> = (0..=255u8).map(|i| i.wrapping_mul(97)).collect();
+    for seed in 0..100 {
+        let mut robot = robot();
+        robot
+            .robot_mut()
+            .robot_mut()
+            .board_mut()
+            .load(0x0600, &code)
+            .expect("RAM");
+        let faulty = FaultyTransport::new(robot, FaultConfig::noise(seed, 0.0, 0.01, 0.0));
+        let mut client = uploader::client(faulty, &RomProfile::reference());
+        match client.read_live(0x0600, code.len()) {
+            Ok(read) => {
+                assert_eq!(read.changing, [], "seed {seed}");
+                assert_eq!(read.bytes, code, "seed {seed}");
+            }
+            // Too noisy to read is said as such, never as memory in use.
+            Err(error) => assert!(
+                matches!(error, uploader::Error::Unreadable { .. }),
+                "seed {seed}: {error}"
+            ),
+        }
+    }
+}
+
+/// hostile17 F4: a counter kept in the code section (data among code, as
+/// hand-written 6502 often has) failed the attach's compare of the code
+/// as "memory in use". Bytes the running program keeps changing are its
+/// data, not code to compare.
+#[test]
+fn a_session_attaches_to_an_image_with_a_counter_in_its_code() {
+    let client = counting_robot();
+    let mut image = counting();
+    image.set_code(vec![0x0400..=COUNT]);
+    let profile = RomProfile::reference();
+    let debug = RobotDebug::attach(client, &profile, image).expect("attaches");
+    debug.detach().expect("detaches");
+}

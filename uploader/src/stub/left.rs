@@ -54,8 +54,10 @@ pub fn at_target<T: Transport>(
     profile: &RomProfile,
     target: u16,
 ) -> Result<Option<LeftStub>> {
+    // hostile17 F2: a counter among a handler's first bytes is no stub,
+    // and no failure to read.
     find(profile, target, &mut |at, len| {
-        client.read_memory(at, len).map(Some)
+        client.read_live(at, len).map(|read| Some(read.bytes))
     })
 }
 

@@ -691,7 +691,9 @@ impl<T: Transport> RobotDebug<T> {
     /// the robot holds as the uploader filled them, may be anything): a
     /// robot that holds the image is read at half the line time, and a
     /// difference is read until two answers agree, so that it is named
-    /// with the robot's bytes.
+    /// with the robot's bytes. Bytes among the code that the running
+    /// program keeps changing (a counter kept in its code section,
+    /// hostile17 F4) are data, not code: they are given as the image's.
     fn read_code(&mut self, area: &crate::image::Area, slots: &[u16]) -> StubResult<Vec<u8>> {
         let mut found = area.bytes.clone();
         let slot = |address: u16| {
@@ -720,7 +722,12 @@ impl<T: Transport> RobotDebug<T> {
                 let expected: Vec<Option<u8>> = (i..end)
                     .map(|j| (!slot(area.address.wrapping_add(j as u16))).then_some(area.bytes[j]))
                     .collect();
-                self.client.read_expecting(at, &expected)?
+                let mut read = self.client.read_live_expecting(at, &expected)?;
+                for changing in read.changing {
+                    let k = usize::from(changing.wrapping_sub(at));
+                    read.bytes[k] = area.bytes[i + k];
+                }
+                read.bytes
             };
             found[i..end].copy_from_slice(&bytes);
             i = end;
