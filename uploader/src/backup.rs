@@ -492,11 +492,12 @@ pub(crate) fn kept_witness_ranges(
     profile: &RomProfile,
     kept: &Backup,
     image: &UploadImage,
+    window: &dyn Fn(u16) -> u16,
 ) -> Vec<(u16, usize)> {
     let mut marked = vec![false; 0x1_0000];
     for (target, extents) in hooked_extents(profile, kept) {
         let home = extents.iter().find(|extent| extent.contains(&target));
-        mark_window(&mut marked, profile, (target, WITNESS_WINDOW), home);
+        mark_window(&mut marked, profile, (target, window(target)), home);
         for extent in &extents {
             for address in extent.clone() {
                 if image.contains(address) {
@@ -513,6 +514,70 @@ pub(crate) fn kept_witness_ranges(
         }
     }
     unmarked_but_held(marked, kept)
+}
+
+/// [`kept_witness_ranges`], each hook's window as [`handler_windows`]
+/// finds it on the robot.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn kept_witness_ranges_on<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    kept: &Backup,
+    image: &UploadImage,
+) -> Result<Vec<(u16, usize)>> {
+    let windows = handler_windows(client, profile, kept)?;
+    let window = |target: u16| {
+        windows
+            .iter()
+            .find(|(at, _)| *at == target)
+            .map_or(WITNESS_WINDOW, |&(_, len)| len)
+    };
+    Ok(kept_witness_ranges(profile, kept, image, &window))
+}
+
+/// How many bytes at each hook of `kept` that goes into RAM the undo file
+/// witnesses: the handler's instructions up to its first that does not go
+/// on to the next (a `JMP`, `RTS`, `RTI`, `BRK`), at most
+/// [`WITNESS_WINDOW`]. What follows may be the extension's data, which
+/// its program writes (hostile17 F3: a counter's slow byte, witnessed,
+/// changed before the undo, which was then refused for good); so may a
+/// byte that changes as it is read, where the window stops short of it.
+/// Read from the robot as it is now.
+///
+/// # Errors
+/// The line's errors.
+fn handler_windows<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    kept: &Backup,
+) -> Result<Vec<(u16, u16)>> {
+    let mut windows = Vec::new();
+    for (target, _) in hooked_extents(profile, kept) {
+        let len = usize::from(WITNESS_WINDOW).min(0x1_0000 - usize::from(target));
+        let read = client.read_live(target, len)?;
+        let mut end = 0;
+        while end < len {
+            let op = isa::opcode(read.bytes[end]);
+            end += usize::from(op.len());
+            let goes_on = !matches!(
+                op.mnemonic,
+                isa::Mnemonic::Jmp | isa::Mnemonic::Rts | isa::Mnemonic::Rti | isa::Mnemonic::Brk
+            ) && op.kind != isa::OpcodeKind::Jam;
+            if !goes_on {
+                break;
+            }
+        }
+        let end = read
+            .changing
+            .iter()
+            .map(|&at| usize::from(at.wrapping_sub(target)))
+            .filter(|&offset| offset > 0)
+            .fold(end.min(len), usize::min);
+        windows.push((target, end.max(1) as u16));
+    }
+    Ok(windows)
 }
 
 /// How many bytes at a hook's target an undo file kept before the image's
@@ -1634,7 +1699,7 @@ mod tests {
         let image = UploadImage::try_from(&linked).expect("an image");
         assert_eq!(image.extents(), &[0x0400..=0x050F]);
         assert_eq!(
-            kept_witness_ranges(&profile, &kept, &image),
+            kept_witness_ranges(&profile, &kept, &image, &|_| WITNESS_WINDOW),
             vec![(0x0400, 0x20), (0x0440, 0xC0)]
         );
         // The whole extent, BSS included, by the rule for a full backup.

@@ -915,7 +915,7 @@ fn keep_old<T: Transport>(
     }
     keep_oldest(&mut kept.areas, first);
     overlay(&mut kept.areas, unlinked);
-    let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
+    let ranges = crate::backup::kept_witness_ranges_on(client, profile, &kept, image)?;
     kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
     Ok(Some(kept))
@@ -1102,7 +1102,7 @@ fn keep_summed<T: Transport>(
     // `sums` is hooked here): an undo checks it is still there. Nothing is
     // written yet, so a range the sums asked already tile is put together
     // from their answers; only the rest is asked.
-    let ranges = crate::backup::kept_witness_ranges(profile, &kept, image);
+    let ranges = crate::backup::kept_witness_ranges_on(client, profile, &kept, image)?;
     let joined: Vec<Option<u16>> = ranges
         .iter()
         .map(|&range| crate::sums::joined_from(known, range))

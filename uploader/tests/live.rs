@@ -281,3 +281,74 @@ fn a_session_attaches_to_an_image_with_a_counter_in_its_code() {
     let debug = RobotDebug::attach(client, &profile, image).expect("attaches");
     debug.detach().expect("detaches");
 }
+
+/// hostile17 F3: an extension whose handler jumps over a 16-bit counter
+/// its loop handler keeps: the undo file of an upload in front of it
+/// witnessed the handler's first 16 bytes, the counter's slow byte among
+/// them, and once that byte moved the undo was refused for good ("not
+/// what it was ... another upload replaced it"). The window ends at the
+/// handler's first `JMP`.
+#[test]
+fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
+    // $0600  JMP $0605      ; HOOK_UNKNOWN's handler
+    // $0603  .word 0        ; the counter
+    // $0605  JMP chain      ; its slot $0606
+    // $0608  INC $0603      ; HOOK_LOOP's handler
+    // $060B  BNE $0610
+    // $060D  INC $0604
+    // $0610  JMP chain      ; its slot $0611
+    let bytes = vec![
+        0x4C, 0x05, 0x06, 0x00, 0x00, 0x4C, 0x21, 0xFF, 0xEE, 0x03, 0x06, 0xD0, 0x03, 0xEE, 0x04,
+        0x06, 0x4C, 0x24, 0xFF,
+    ];
+    let counting = UploadImage::new(
+        vec![Area {
+            address: 0x0600,
+            bytes,
+        }],
+        vec![
+            HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0600,
+                chain: Some(0x0606),
+            },
+            HookRecord {
+                kind: HookKind::Loop,
+                handler: 0x0608,
+                chain: Some(0x0611),
+            },
+        ],
+    )
+    .expect("an image");
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(&mut client, &counting, &options, &mut NoProgress).expect("installed");
+    let mut kept = Kept::default();
+    uploader::upload_keeping(
+        &mut client,
+        &extension_at(0x0700),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("in front");
+    let high = |client: &mut Client<VirtualTransport>| {
+        client.transport().robot().robot().board().memory()[0x0604]
+    };
+    let before = high(&mut client);
+    for _ in 0..200 {
+        if high(&mut client) != before {
+            break;
+        }
+        client.probe().expect("the robot answers");
+    }
+    assert_ne!(high(&mut client), before, "the slow byte moved");
+    let undo = UploadOptions {
+        undo: true,
+        ..options
+    };
+    uploader::restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("undone");
+    let memory = client.transport().robot().robot().board().memory();
+    let hook = usize::from(romlib::symbols::HOOK_UNKNOWN) + 1;
+    assert_eq!(memory[hook..hook + 2], [0x00, 0x06], "HOOK_UNKNOWN back");
+}
