@@ -234,13 +234,22 @@ pub(crate) fn prepare<T: Transport>(
             }
             Some(_) if replace => {
                 replaced.push(old.clone());
-                unlinked.extend(remove(
-                    client,
-                    profile,
-                    (&read.installed, known),
-                    old,
-                    &mut writes,
-                )?);
+                for (kind, slot, onward) in
+                    remove(client, profile, (&read.installed, known), old, &mut writes)?
+                {
+                    // recheck17 F1: the image takes its place in the chain,
+                    // behind the extension in front of it, as a copy of
+                    // itself would.
+                    let takes = image.hooks().iter().any(|record| record.kind == kind);
+                    if takes && !relink.iter().any(|relink: &Relink| relink.kind == kind) {
+                        relink.push(Relink {
+                            kind,
+                            slot: slot.address,
+                            onward,
+                        });
+                    }
+                    unlinked.push(slot);
+                }
                 // The hooks may have moved: read from here on.
                 known = &[];
                 // Its flags are cleared now, verified.
@@ -414,7 +423,8 @@ fn differs<T: Transport>(
 /// Takes `old` out of every chain it is in (the pointer that jumps to its
 /// handler, the hook or another extension's chain slot, re-pointed at
 /// where `old` fell through, verified), then clears its entries. Returns
-/// the chain slots it re-pointed, as they were.
+/// the chain slots it re-pointed, as they were, each with its hook and
+/// where it points now.
 ///
 /// # Errors
 /// The client's, [`Error::VerifyFailed`].
@@ -424,15 +434,17 @@ fn remove<T: Transport>(
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     old: &Installed,
     writes: &mut Unhooking<'_, '_, T>,
-) -> Result<Vec<Area>> {
+) -> Result<Vec<(HookKind, Area, u16)>> {
     let Some((table, _)) = profile.table else {
         return Ok(Vec::new());
     };
     let mut slots = Vec::new();
     for hook in &old.hooks {
-        slots.extend(
-            unlink(client, profile, (everyone, hooks), *hook, writes, true)?.map(|(slot, _)| slot),
-        );
+        if let Some((slot, onward)) =
+            unlink(client, profile, (everyone, hooks), *hook, writes, true)?
+        {
+            slots.push((hook.kind, slot, onward));
+        }
     }
     // Clearing its flags bytes frees its entries.
     let now: Vec<Option<u8>> = old.flags().into_iter().map(Some).collect();

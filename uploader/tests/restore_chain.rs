@@ -213,12 +213,13 @@ fn a_backup_of_a_robot_whose_hook_is_broken_says_so() {
     assert!(matches!(error, Error::RestoreChainBroken { .. }), "{error}");
 }
 
-/// fresh17 F6: the undo of an upload that replaced an extension sitting
-/// behind another (`--replace` of an edit away from the handler, the
-/// usual edit) was refused as "a later upload was chained ahead": the
-/// hook led to the new image's handler, whose bytes the upload did not
-/// rewrite, so the file did not hold them. The file witnesses the table
-/// entry the upload wrote: that names the image it undoes.
+/// fresh17 F6: the undo of an upload that replaced an extension (an edit
+/// away from the handler, the usual one) was refused as "a later upload
+/// was chained ahead" where the hook led to the new image's handler at
+/// another place than the old one's, whose bytes the upload did not
+/// rewrite, so the file did not hold them (the old code moved a
+/// replacement behind another extension to the head). The file witnesses
+/// the table entry the upload wrote: that names the image it undoes.
 #[test]
 fn the_undo_of_a_replacement_whose_handler_did_not_change_goes_through() {
     let options = UploadOptions::default();
@@ -231,36 +232,35 @@ fn the_undo_of_a_replacement_whose_handler_did_not_change_goes_through() {
         ..options.clone()
     };
     let mut client = uploader::client(robot(), &options.profile);
-    // 512 bytes at $0400: its chain slot's JMP first, its handler (`JMP
-    // $0400`) at $0480, far from the slot and from the edit.
+    // 512 bytes at $0400: its chain slot's JMP first, two handlers (`JMP
+    // $0400`) at $0480 and $0490, far from the slot and from the edit;
+    // the first image hooks the one, the edit the other.
     let mut bytes = extension(512, 3).areas()[0].bytes.clone();
     bytes[0x80..0x83].copy_from_slice(&[0x4C, 0x00, 0x04]);
-    let first = uploader::UploadImage::new(
-        vec![uploader::Area {
-            address: 0x0400,
-            bytes,
-        }],
-        vec![isa::objfmt::HookRecord {
-            kind: HookKind::Unknown,
-            handler: 0x0480,
-            chain: Some(0x0401),
-        }],
-    )
-    .expect("an image");
+    bytes[0x90..0x93].copy_from_slice(&[0x4C, 0x00, 0x04]);
+    let hooked_at = |handler: u16, bytes: Vec<u8>| {
+        uploader::UploadImage::new(
+            vec![uploader::Area {
+                address: 0x0400,
+                bytes,
+            }],
+            vec![isa::objfmt::HookRecord {
+                kind: HookKind::Unknown,
+                handler,
+                chain: Some(0x0401),
+            }],
+        )
+        .expect("an image")
+    };
+    let first = hooked_at(0x0480, bytes.clone());
     upload(&mut client, &first, &options, &mut NoProgress).expect("the first");
-    upload(
-        &mut client,
-        &extension_at(0x0C00),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("in front");
-    let edited = common::one_byte_changed(&first, 300);
+    bytes[300] ^= 0x5A;
+    let edited = hooked_at(0x0490, bytes);
     let mut kept = Kept::default();
     upload_keeping(&mut client, &edited, &replace, &mut NoProgress, &mut kept).expect("replaced");
-    assert_eq!(hook(&mut client), 0x0480, "the edit at the head");
+    assert_eq!(hook(&mut client), 0x0490, "the edit hooked");
     restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("undone");
-    assert_eq!(hook(&mut client), 0x0C03, "the chain as it was");
+    assert_eq!(hook(&mut client), 0x0480, "the hook as it was");
     let memory = client.transport().robot().robot().board().memory();
     assert_eq!(
         memory[0x0400 + 300],
