@@ -111,6 +111,9 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
         out.push('\n');
     }
     for (kind, targets) in chains {
+        // recheck17 F4: a chain that comes back is cut where it does.
+        let again = (1..targets.len()).find(|&i| targets[..i].contains(&targets[i]));
+        let targets = &targets[..again.map_or(targets.len(), |i| i + 1)];
         let steps: Vec<String> = targets
             .iter()
             .map(|target| {
@@ -126,7 +129,13 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
                 }
             })
             .collect();
-        let _ = writeln!(out, "{}: {}", kind.rom_symbol(), steps.join(" -> "));
+        let _ = write!(out, "{}: {}", kind.rom_symbol(), steps.join(" -> "));
+        if again.is_some() {
+            out.push_str(
+                " (comes back to where it has been: a loop the robot would run for ever at its next command)",
+            );
+        }
+        out.push('\n');
     }
     out
 }
@@ -160,5 +169,16 @@ mod tests {
         );
         let hooked = listing(&everyone, &[(HookKind::Unknown, vec![0x0400, 0xFF21])]);
         assert!(!hooked.contains("not hooked"), "{hooked}");
+    }
+
+    /// recheck17 F4: a chain slot sent to its own handler by hand was
+    /// listed as `$040B -> $040B -> $040B` with no word of the loop.
+    #[test]
+    fn a_chain_that_comes_back_is_cut_and_said() {
+        let looped = listing(&[], &[(HookKind::Unknown, vec![0x040B, 0x040B, 0x040B])]);
+        assert_eq!(
+            looped,
+            "nothing installed\nHOOK_UNKNOWN: $040B -> $040B (comes back to where it has been: a loop the robot would run for ever at its next command)\n"
+        );
     }
 }

@@ -994,8 +994,19 @@ pub fn restore<T: Transport>(
             reports.push(upload(client, &image, &rom, progress)?);
         }
     }
-    crate::chain::check_restored(client, profile, &backup.hooks)?;
-    switch_hooks(client, profile, &backup.hooks, options.max_writes)?;
+    // recheck17 F3: a hook whose way is broken stays at the ROM's target;
+    // the others, whose ways are fine, are restored all the same.
+    let refused = crate::chain::check_restored(client, profile, &backup.hooks)?;
+    let fine: Vec<(HookKind, u16)> = backup
+        .hooks
+        .iter()
+        .copied()
+        .filter(|(kind, _)| !refused.iter().any(|(broken, _)| broken == kind))
+        .collect();
+    switch_hooks(client, profile, &fine, options.max_writes)?;
+    if let Some((_, error)) = refused.into_iter().next() {
+        return Err(error);
+    }
     Ok(reports)
 }
 

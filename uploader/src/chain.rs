@@ -196,16 +196,20 @@ pub(crate) fn follow<T: Transport>(
 /// the robot would run for ever), nor reach code that stops the CPU, nor
 /// be the other hook's handler in the table (hostile10 F10, F14).
 ///
+/// Returns each hook refused, with [`Error::RestoreChainBroken`] saying
+/// why: it stays at the ROM's target, the others are restored.
+///
 /// # Errors
-/// [`Error::RestoreChainBroken`]; the line's errors.
+/// The line's errors.
 pub(crate) fn check_restored<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     hooks: &[(HookKind, u16)],
-) -> Result<()> {
+) -> Result<Vec<(HookKind, Error)>> {
     let targets = into_ram(profile, hooks);
+    let mut refused = Vec::new();
     if targets.is_empty() {
-        return Ok(());
+        return Ok(refused);
     }
     let everyone = crate::table::read_installed(client, profile)?;
     for (kind, target) in targets {
@@ -222,16 +226,18 @@ pub(crate) fn check_restored<T: Transport>(
                 .any(|hook| of(hook.kind) && hook.handler == target)
         };
         if handlers(&|other| other != kind) && !handlers(&|this| this == kind) {
-            return Err(broken(
-                "is the other hook's handler in the table of installed extensions",
-                format!("${target:04X}"),
+            refused.push((
+                kind,
+                broken(
+                    "is the other hook's handler in the table of installed extensions",
+                    format!("${target:04X}"),
+                ),
             ));
-        }
-        if let Some((why, path)) = broken_way(client, profile, &everyone, (kind, target))? {
-            return Err(broken(why, path.to_string()));
+        } else if let Some((why, path)) = broken_way(client, profile, &everyone, (kind, target))? {
+            refused.push((kind, broken(why, path.to_string())));
         }
     }
-    Ok(())
+    Ok(refused)
 }
 
 /// The hooks of `hooks` that point into RAM an upload may write (not at

@@ -309,3 +309,43 @@ fn one_installed() -> (
     .expect("installed");
     (options, client)
 }
+
+/// recheck17 F3: a file whose HOOK_UNKNOWN way loops (a chain slot sent
+/// to itself by hand before the backup) and whose HOOK_LOOP is fine: the
+/// restore left both at the ROM's targets, and the loop handler of the
+/// robot's operating system stopped running without a word. The broken
+/// one stays at the ROM's target, said; the other is restored.
+#[test]
+fn a_broken_hook_in_a_file_does_not_take_the_other_down() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    // $0600  JMP chain      ; HOOK_LOOP's handler, its slot $0601
+    let os = uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0600,
+            bytes: vec![0x4C, 0x24, 0xFF],
+        }],
+        vec![isa::objfmt::HookRecord {
+            kind: HookKind::Loop,
+            handler: 0x0600,
+            chain: Some(0x0601),
+        }],
+    )
+    .expect("an image");
+    upload(&mut client, &os, &options, &mut NoProgress).expect("the loop handler");
+    let mut file = backup(&mut client, &options.profile).expect("a backup");
+    for area in &mut file.areas {
+        if (u32::from(area.address)..area.end()).contains(&0x0700) {
+            let at = usize::from(0x0700 - area.address);
+            area.bytes[at..at + 3].copy_from_slice(&[0x4C, 0x00, 0x07]);
+        }
+    }
+    file.hooks = vec![(HookKind::Unknown, 0x0700), (HookKind::Loop, 0x0600)];
+    file.witnesses.clear();
+    let error = restore(&mut client, &file, &options, &mut NoProgress).expect_err("refused");
+    assert!(matches!(error, Error::RestoreChainBroken { .. }), "{error}");
+    assert_eq!(hook(&mut client), BAD_COMMAND, "the broken one at the ROM");
+    let memory = client.transport().robot().robot().board().memory();
+    let at = usize::from(romlib::symbols::HOOK_LOOP) + 1;
+    assert_eq!(memory[at..at + 2], [0x00, 0x06], "the loop handler hooked");
+}
