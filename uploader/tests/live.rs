@@ -80,6 +80,21 @@ fn counting_robot() -> Client<VirtualTransport> {
     client
 }
 
+/// The extension at $0700 uploaded in front of what `client`'s robot
+/// runs: its undo file.
+fn in_front_kept(client: &mut Client<VirtualTransport>) -> uploader::Backup {
+    let mut kept = Kept::default();
+    uploader::upload_keeping(
+        client,
+        &extension_at(0x0700),
+        &UploadOptions::default(),
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("uploaded in front of it");
+    kept.0.expect("an undo file")
+}
+
 #[test]
 fn a_counter_is_told_as_changing_to_a_plain_read_and_read_live() {
     let mut client = counting_robot();
@@ -170,16 +185,7 @@ fn a_session_attaches_beside_a_counter_after_the_code() {
 fn another_extension_goes_in_front_of_a_counting_one_and_comes_out() {
     let mut client = counting_robot();
     let options = UploadOptions::default();
-    let mut kept = Kept::default();
-    uploader::upload_keeping(
-        &mut client,
-        &extension_at(0x0700),
-        &options,
-        &mut NoProgress,
-        &mut kept,
-    )
-    .expect("uploaded in front of it");
-    let undo = kept.0.expect("an undo file");
+    let undo = in_front_kept(&mut client);
     // No witness covers the counter: a restore would find it changed.
     assert!(
         undo.witnesses
@@ -323,15 +329,7 @@ fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
     let options = UploadOptions::default();
     let mut client = uploader::client(robot(), &options.profile);
     upload(&mut client, &counting, &options, &mut NoProgress).expect("installed");
-    let mut kept = Kept::default();
-    uploader::upload_keeping(
-        &mut client,
-        &extension_at(0x0700),
-        &options,
-        &mut NoProgress,
-        &mut kept,
-    )
-    .expect("in front");
+    let undo_file = in_front_kept(&mut client);
     let high = |client: &mut Client<VirtualTransport>| {
         client.transport().robot().robot().board().memory()[0x0604]
     };
@@ -347,7 +345,7 @@ fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
         undo: true,
         ..options
     };
-    uploader::restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("undone");
+    uploader::restore(&mut client, &undo_file, &undo, &mut NoProgress).expect("undone");
     let memory = client.transport().robot().robot().board().memory();
     let hook = usize::from(romlib::symbols::HOOK_UNKNOWN) + 1;
     assert_eq!(memory[hook..hook + 2], [0x00, 0x06], "HOOK_UNKNOWN back");
