@@ -141,6 +141,20 @@ fn an_editors_watch_and_memory_view_show_a_counter_as_it_goes() {
     );
     assert_eq!(read["success"], true, "{read}");
     assert!(read["body"].get("unreadableBytes").is_none(), "{read}");
+    // fresh17 F2: the console says which bytes change.
+    let said = (0..4)
+        .map(|_| dap.event("output")["body"]["output"].clone())
+        .find(|output| {
+            output
+                .as_str()
+                .is_some_and(|text| text.starts_with("readMemory: "))
+        });
+    assert!(
+        said.as_ref()
+            .and_then(|text| text.as_str())
+            .is_some_and(|text| text.contains("the robot wrote $04")),
+        "{said:?}"
+    );
     let bye = dap.request("disconnect", json!({}));
     assert_eq!(bye["success"], true, "{bye}");
     assert!(dap.ends());

@@ -761,7 +761,15 @@ impl<T: Transport> Client<T> {
                                         times >= CHANGING && times * 4 >= pairs
                                     }) && most * 2 < answers
                                 };
-                                if live && differ.iter().all(in_use) {
+                                // hostile17 F6: two answers of different
+                                // lengths (the span was split after a lost
+                                // answer) differ nowhere they overlap, which
+                                // is no agreement.
+                                if live
+                                    && before.len() == data.len()
+                                    && !differ.is_empty()
+                                    && differ.iter().all(in_use)
+                                {
                                     // They agree but where the program writes.
                                     changing.extend(differ);
                                     remaining -= data.len();

@@ -64,6 +64,8 @@ enum After {
     Nothing,
     Run,
     Heard(Heard, &'static str),
+    /// A line for the editor's console, after the response.
+    Console(String),
     /// `configurationDone` on a running robot: the launch's `stopOnEntry`
     /// and `commands` are seen to.
     Configured,
@@ -216,6 +218,7 @@ impl RobotSession {
             After::Nothing => {}
             After::Run => self.running = true,
             After::Heard(heard, reason) => self.heard(outbox, &heard, reason)?,
+            After::Console(text) => outbox.output("console", &text)?,
             After::Configured => self.configured(outbox)?,
             After::Exit => {
                 // `terminate` ends the debuggee; the client is told so
@@ -358,7 +361,7 @@ impl RobotSession {
                 Some(json!({ "variables": variables }))
             }
             "setVariable" => Some(self.set_variable(&args)?),
-            "readMemory" => Some(self.read_memory(&args)?),
+            "readMemory" => return self.read_memory(&args),
             "writeMemory" => Some(self.write_memory(&args)?),
             "evaluate" => return self.evaluate(&args),
             "continue" => {
@@ -551,7 +554,7 @@ impl RobotSession {
 
     /// `readMemory`: through the stub at a stop, `/7R` while running; as
     /// the program sees it (a breakpoint's `JSR` hidden).
-    fn read_memory(&mut self, args: &Arguments<'_>) -> Result<Value, String> {
+    fn read_memory(&mut self, args: &Arguments<'_>) -> Result<(Option<Value>, After), String> {
         let start = self.address(args, "readMemory")?;
         let count = args.integer("count")?.unwrap_or(0).clamp(0, MAX_READ);
         let len = usize::try_from(count)
@@ -564,25 +567,37 @@ impl RobotSession {
             Some((at, _)) => usize::from(at.wrapping_sub(start)),
             None => len,
         };
-        let bytes = if len == 0 {
-            Vec::new()
+        let read = if len == 0 {
+            uploader::LiveRead {
+                bytes: Vec::new(),
+                changing: Vec::new(),
+            }
         } else {
             // A memory view of a running robot shows a counter its
             // program keeps as it was at one moment (hostile16 F4).
             self.robot()?
                 .read_live_as_program(start, len)
                 .map_err(|e| failure(e).message())?
-                .bytes
         };
         let mut body = json!({
             "address": format!("0x{start:04X}"),
-            "data": base64::engine::general_purpose::STANDARD.encode(&bytes),
+            "data": base64::engine::general_purpose::STANDARD.encode(&read.bytes),
         });
-        let unread = usize::try_from(count).unwrap_or(0) - bytes.len();
+        let unread = usize::try_from(count).unwrap_or(0) - read.bytes.len();
         if unread > 0 {
             body["unreadableBytes"] = json!(unread);
         }
-        Ok(body)
+        // fresh17 F2: the response has no place to mark bytes that
+        // change; the console says it.
+        let after = if read.changing.is_empty() {
+            After::Nothing
+        } else {
+            After::Console(format!(
+                "readMemory: the robot wrote {} while it was read, as it runs: one moment's value\n",
+                uploader::addresses_text(&read.changing)
+            ))
+        };
+        Ok((Some(body), after))
     }
 
     /// `writeMemory`: written, then read back.
