@@ -226,29 +226,7 @@ impl uploader::Keep for UndoFile {
             });
         match older {
             Some(older) => {
-                // recheck17 F2: only what the loader went over this time.
-                // The rest of what this upload kept it left as it found
-                // it; merged in, an undo of the older file would put back
-                // another extension's chain slot or table entry as this
-                // upload found them, after that extension's own undo.
-                let over = |address: u32| {
-                    loader_went_over
-                        .iter()
-                        .any(|area| u32::from(area.address) <= address && address < area.end())
-                };
-                let mut later = uploader::Backup::default();
-                for area in &kept.areas {
-                    for (offset, &byte) in area.bytes.iter().enumerate() {
-                        let address = u32::from(area.address) + offset as u32;
-                        if over(address) {
-                            later.areas.push(uploader::Area {
-                                address: address as u16,
-                                bytes: vec![byte],
-                            });
-                        }
-                    }
-                }
-                let both = older.going_further_back(&later);
+                let both = older.going_further_back(kept);
                 match hostfs::write(&self.path, &both.encode()) {
                     Ok(()) => self.kept_older = true,
                     Err(error) => self.failed = Some(error),
@@ -408,34 +386,5 @@ mod tests {
             assert!(!marked(&path, BEFORE).exists());
             undo.finished_upload();
         }
-    }
-
-    /// recheck17 F2: an upload that changed nothing kept, with the older
-    /// file, another extension's chain slot as it found it (re-pointed
-    /// past the image and back); after that extension's own undo, the
-    /// undo of the older file put its slot back. Only what the loader went
-    /// over goes further back with the older file.
-    #[test]
-    fn an_unchanged_upload_adds_only_what_the_loader_went_over() {
-        let dir = tempfile::tempdir().expect("temporary directory");
-        let path = dir.path().join("last.undo");
-        hostfs::write(&path, &backup(1).encode()).expect("the older file");
-        let loader = Area {
-            address: 0x0E8C,
-            bytes: vec![5; 3],
-        };
-        let slot = Area {
-            address: 0x0C18,
-            bytes: vec![0x03, 0x04],
-        };
-        let mut kept = backup(1);
-        kept.areas.extend([slot, loader.clone()]);
-        let mut undo = UndoFile::new(path.clone());
-        undo.keep(&kept);
-        undo.finished_unchanged(&kept, std::slice::from_ref(&loader));
-        let mut expected = backup(1);
-        expected.areas.push(loader);
-        assert_eq!(held(&path), expected);
-        assert!(undo.kept_older);
     }
 }

@@ -234,22 +234,17 @@ pub(crate) fn prepare<T: Transport>(
             }
             Some(_) if replace => {
                 replaced.push(old.clone());
-                for (kind, slot, onward) in
-                    remove(client, profile, (&read.installed, known), old, &mut writes)?
-                {
-                    // recheck17 F1: the image takes its place in the chain,
-                    // behind the extension in front of it, as a copy of
-                    // itself would.
-                    let takes = image.hooks().iter().any(|record| record.kind == kind);
-                    if takes && !relink.iter().any(|relink: &Relink| relink.kind == kind) {
-                        relink.push(Relink {
-                            kind,
-                            slot: slot.address,
-                            onward,
-                        });
-                    }
-                    unlinked.push(slot);
-                }
+                // Not put back where it was (recheck17 F1): an undo of the
+                // upload of the extension in front would then pass its
+                // check for later uploads, and put back the table as it
+                // found it, over this image's entry (recheck18 F1).
+                unlinked.extend(remove(
+                    client,
+                    profile,
+                    (&read.installed, known),
+                    old,
+                    &mut writes,
+                )?);
                 // The hooks may have moved: read from here on.
                 known = &[];
                 // Its flags are cleared now, verified.
@@ -423,8 +418,7 @@ fn differs<T: Transport>(
 /// Takes `old` out of every chain it is in (the pointer that jumps to its
 /// handler, the hook or another extension's chain slot, re-pointed at
 /// where `old` fell through, verified), then clears its entries. Returns
-/// the chain slots it re-pointed, as they were, each with its hook and
-/// where it points now.
+/// the chain slots it re-pointed, as they were.
 ///
 /// # Errors
 /// The client's, [`Error::VerifyFailed`].
@@ -434,16 +428,14 @@ fn remove<T: Transport>(
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     old: &Installed,
     writes: &mut Unhooking<'_, '_, T>,
-) -> Result<Vec<(HookKind, Area, u16)>> {
+) -> Result<Vec<Area>> {
     let Some((table, _)) = profile.table else {
         return Ok(Vec::new());
     };
     let mut slots = Vec::new();
     for hook in &old.hooks {
-        if let Some((slot, onward)) =
-            unlink(client, profile, (everyone, hooks), *hook, writes, true)?
-        {
-            slots.push((hook.kind, slot, onward));
+        if let Some((slot, _)) = unlink(client, profile, (everyone, hooks), *hook, writes, true)? {
+            slots.push(slot);
         }
     }
     // Clearing its flags bytes frees its entries.
