@@ -375,16 +375,8 @@ impl RobotMonitor {
             "mem" | "m" | "poke" => self.mem(d, verb, &rest)?,
             "print" | "p" => {
                 let expr = self.parse(after)?;
-                match self.eval_live(d, &expr)? {
-                    (value, changing) if changing.is_empty() => {
-                        format!("{}\n", crate::expr::show(value))
-                    }
-                    (value, changing) => format!(
-                        "{} {}\n",
-                        crate::expr::show(value),
-                        changing_note(&changing)
-                    ),
-                }
+                let (value, changing) = self.eval_live(d, &expr)?;
+                format!("{}\n", shown_value(value, &changing))
             }
             "display" => {
                 if after.is_empty() {
@@ -743,12 +735,7 @@ impl RobotMonitor {
         // (a counter) is a value that changes: shown as read at one
         // moment, and said to change.
         match self.eval_live(d, expr) {
-            Ok((value, changing)) if changing.is_empty() => Ok(crate::expr::show(value)),
-            Ok((value, changing)) => Ok(format!(
-                "{} {}",
-                crate::expr::show(value),
-                changing_note(&changing)
-            )),
+            Ok((value, changing)) => Ok(shown_value(value, &changing)),
             Err(Failure::Usage(why)) => Ok(format!("({why})")),
             Err(other) => Err(other),
         }
@@ -860,6 +847,16 @@ pub(crate) fn garbled_own(registers: &Registers) -> String {
         char::from(registers.a),
         registers.x
     )
+}
+
+/// A value as `print` and `display` show it, with the note of
+/// [`changing_note`] where it was read from memory that changes.
+fn shown_value(value: i64, changing: &[u16]) -> String {
+    if changing.is_empty() {
+        crate::expr::show(value)
+    } else {
+        format!("{} {}", crate::expr::show(value), changing_note(changing))
+    }
 }
 
 /// What is said after a value read where the program writes as it runs.

@@ -435,7 +435,8 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
         .collect();
     let into_ram = crate::chain::into_ram(profile, &backup.hooks);
     if !into_ram.is_empty() {
-        let everyone = crate::table::read_installed(client, profile)?;
+        // The table as this backup read it, not read again.
+        let everyone = backup_table(profile, &backup);
         for (hook, target) in into_ram {
             if let Some((why, path)) =
                 crate::chain::broken_way(client, profile, &everyone, (hook, target))?
@@ -1036,6 +1037,8 @@ fn refuse_later_uploads<T: Transport>(
     profile: &RomProfile,
     hooks: &[(HookKind, u16)],
 ) -> Result<()> {
+    // Read once, where a hook needs it.
+    let mut undone: Option<Option<romlib::installed::Installed>> = None;
     for &(kind, target) in &backup.hooks {
         let Some(current) = hooks
             .iter()
@@ -1062,12 +1065,19 @@ fn refuse_later_uploads<T: Transport>(
         // whose handler it did not rewrite (an edit elsewhere, `--replace`
         // of an extension that sat behind another), so the file does not
         // hold it: its table entry, as the upload wrote it, says so.
-        if undone_extension(client, backup, profile)?.is_some_and(|undone| {
-            undone
-                .hooks
-                .iter()
-                .any(|hook| hook.kind == kind && hook.handler == current)
-        }) {
+        if undone.is_none() {
+            undone = Some(undone_extension(client, backup, profile)?);
+        }
+        if undone
+            .as_ref()
+            .and_then(Option::as_ref)
+            .is_some_and(|undone| {
+                undone
+                    .hooks
+                    .iter()
+                    .any(|hook| hook.kind == kind && hook.handler == current)
+            })
+        {
             continue;
         }
         let owner = crate::table::read_installed(client, profile)

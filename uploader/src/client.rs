@@ -640,10 +640,11 @@ impl<T: Transport> Client<T> {
     /// Reads `len` bytes from `address` as [`Client::read_memory`] does,
     /// but memory the robot writes while it runs (a counter its control
     /// loop keeps) does not fail the read: once the same addresses have
-    /// differed between well-formed answers [`CHANGING`] times, two
-    /// answers that agree everywhere else are taken, with the later
-    /// answer's bytes at those addresses, and the addresses are named in
-    /// [`LiveRead::changing`]. For a backup of a running robot, and for
+    /// differed between well-formed answers [`CHANGING`] times, and their
+    /// answers seldom repeat a value (noise answers the true one most of
+    /// the time), two answers of one span that agree everywhere else are
+    /// taken, with the later answer's bytes at those addresses, and the
+    /// addresses are named in [`LiveRead::changing`]. For a backup of a running robot, and for
     /// following code that shares its spans with the program's data.
     ///
     /// # Errors
@@ -682,8 +683,7 @@ impl<T: Transport> Client<T> {
             std::collections::HashMap::new();
         let mut failures = 0u32;
         let mut last_error = None;
-        // How often each address differed between two well-formed answers,
-        // and how often two answers were compared there.
+        // How often each address differed between two well-formed answers.
         let mut changes: std::collections::HashMap<u16, u32> = std::collections::HashMap::new();
         // For a live read: the values each address answered, how often.
         let mut seen: std::collections::HashMap<u16, std::collections::HashMap<u8, u32>> =
@@ -757,9 +757,10 @@ impl<T: Transport> Client<T> {
                                     let answers: u32 = values.map_or(0, |v| v.values().sum());
                                     let most =
                                         values.and_then(|v| v.values().max().copied()).unwrap_or(0);
-                                    changes.get(at).is_some_and(|&times| {
-                                        times >= CHANGING && times * 4 >= pairs
-                                    }) && most * 2 < answers
+                                    changes
+                                        .get(at)
+                                        .is_some_and(|&times| differs_often(times, pairs))
+                                        && most * 2 < answers
                                 };
                                 // hostile17 F6: two answers of different
                                 // lengths (the span was split after a lost
@@ -794,7 +795,7 @@ impl<T: Transport> Client<T> {
                 if failures > 40 * self.config.question_attempts {
                     let mut changed: Vec<u16> = changes
                         .iter()
-                        .filter(|&(_, &times)| times >= CHANGING && times * 4 >= pairs)
+                        .filter(|&(_, &times)| differs_often(times, pairs))
                         .map(|(&address, _)| address)
                         .collect();
                     if !changed.is_empty() {
@@ -829,6 +830,14 @@ pub struct LiveRead {
     /// (memory the robot writes while it runs): their bytes are the last
     /// answer's.
     pub changing: Vec<u16>,
+}
+
+/// Whether an address that differed `times` between two well-formed
+/// answers, of `pairs` pairs that differed at all, differs as memory in
+/// use does ([`CHANGING`] times, and in a quarter of the pairs), not as
+/// noise here and there does.
+fn differs_often(times: u32, pairs: u32) -> bool {
+    times >= CHANGING && times * 4 >= pairs
 }
 
 /// The least difference between the byte counts of two questions in

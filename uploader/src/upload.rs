@@ -758,7 +758,7 @@ pub fn upload_keeping<T: Transport>(
             client,
             &image,
             options,
-            (&initial, &mut relinked),
+            (&initial, &relinks, &mut relinked),
             plan.as_mut(),
             check,
             progress,
@@ -778,7 +778,7 @@ pub fn upload_keeping<T: Transport>(
             client,
             &image,
             options,
-            (&initial, &mut relinked),
+            (&initial, &relinks, &mut relinked),
             plan.as_mut(),
             None,
             progress,
@@ -1223,14 +1223,15 @@ fn rom_path<T: Transport>(
     client: &mut Client<T>,
     image: &UploadImage,
     options: &UploadOptions,
-    (initial, relinked): (&[(HookKind, u16)], &mut Vec<table::Relink>),
+    (initial, relinks, relinked): (
+        &[(HookKind, u16)],
+        &[table::Relink],
+        &mut Vec<table::Relink>,
+    ),
     mut plan: Option<&mut table::Plan>,
     mut check: Option<&RomProfile>,
     progress: &mut dyn Progress,
 ) -> Result<(Body, Vec<InstalledHook>)> {
-    let relinks = plan
-        .as_deref()
-        .map_or_else(Vec::new, |plan| plan.relink.clone());
     for _ in 0..3 {
         let mut body = Body::new(image, Writer::Rom);
         body.plan_writes(client.transport().baud(), progress);
@@ -1249,7 +1250,7 @@ fn rom_path<T: Transport>(
             client,
             image,
             options,
-            (initial, &relinks, relinked),
+            (initial, relinks, relinked),
             None,
             progress,
         )?;

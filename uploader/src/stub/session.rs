@@ -764,10 +764,19 @@ impl<T: Transport> RobotDebug<T> {
         Ok(found)
     }
 
-    /// The bytes a breakpoint an earlier session left at `address`
-    /// displaced, as the robot held them: its trampoline's copy in the
-    /// stub (the displaced bytes, then `JMP` past them), found by that
-    /// `JMP` and the image's bytes but for the chain slots' (`slot_bytes`).
+    /// The displaced bytes of each trampoline of the stub for a
+    /// breakpoint at `address` that displaces `len` bytes, as the robot
+    /// holds them (decoded: the displaced bytes, then `JMP` past them).
+    fn trampoline_copies(&mut self, address: u16, len: usize) -> StubResult<Vec<Vec<u8>>> {
+        let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
+        Ok(tramps
+            .chunks(TRAMPOLINE_LEN as usize)
+            .filter_map(|copy| patch::read_trampoline(copy, self.stub.entry))
+            .filter(|(at, copy)| *at == address && copy.len() == len)
+            .map(|(_, copy)| copy)
+            .collect())
+    }
+
     /// The bytes the one trampoline of the stub for a breakpoint at
     /// `address` runs in their place (the program's, as a `poke` at a stop
     /// left them), when exactly one trampoline is for it and it displaces
@@ -776,35 +785,27 @@ impl<T: Transport> RobotDebug<T> {
         let Ok(plan) = patch::plan(address, &self.image, &[]) else {
             return Ok(None);
         };
-        let len = plan.displaced.len();
-        let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
-        let mut copies: Vec<Vec<u8>> = tramps
-            .chunks(TRAMPOLINE_LEN as usize)
-            .filter_map(|copy| patch::read_trampoline(copy, self.stub.entry))
-            .filter(|(at, copy)| *at == address && copy.len() == len)
-            .map(|(_, copy)| copy)
-            .collect();
+        let mut copies = self.trampoline_copies(address, plan.displaced.len())?;
         copies.sort_unstable();
         copies.dedup();
         Ok((copies.len() == 1).then(|| copies.remove(0)))
     }
 
+    /// The bytes a breakpoint an earlier session left at `address`
+    /// displaced, as the robot held them: its trampoline's copy in the
+    /// stub, found by that copy and the image's bytes but for the chain
+    /// slots' (`slot_bytes`).
     fn displaced_copy(&mut self, address: u16, slot_bytes: &[u16]) -> StubResult<Vec<u8>> {
         let patch = patch::plan(address, &self.image, &[])?;
         let len = patch.displaced.len();
-        let tramps = self.read(self.stub.tramps, TRAMPOLINES * TRAMPOLINE_LEN as usize)?;
-        tramps
-            .chunks(TRAMPOLINE_LEN as usize)
-            .filter_map(|copy| patch::read_trampoline(copy, self.stub.entry))
-            .find(|(at, copy)| {
-                *at == address
-                    && copy.len() == len
-                    && (0..len).all(|k| {
-                        slot_bytes.contains(&address.wrapping_add(k as u16))
-                            || copy[k] == patch.displaced[k]
-                    })
+        self.trampoline_copies(address, len)?
+            .into_iter()
+            .find(|copy| {
+                (0..len).all(|k| {
+                    slot_bytes.contains(&address.wrapping_add(k as u16))
+                        || copy[k] == patch.displaced[k]
+                })
             })
-            .map(|(_, copy)| copy)
             .ok_or_else(|| StubError::Refused {
                 what: "attaching".into(),
                 reason: format!(
@@ -1981,6 +1982,7 @@ impl<T: Transport> RobotDebug<T> {
     /// written again, then refused.
     fn write_plain(&mut self, address: u16, bytes: &[u8]) -> StubResult<Vec<u16>> {
         let running = self.while_running(|d| {
+            let mut found = Vec::new();
             for _ in 0..ATTEMPTS {
                 d.rom_write_piece_once(address, bytes)?;
                 let read = d.client.read_live(address, bytes.len())?;
@@ -2004,11 +2006,12 @@ impl<T: Transport> RobotDebug<T> {
                     changed.dedup();
                     return Ok(changed);
                 }
+                found = read.bytes;
             }
             Err(StubError::Verify {
                 address,
                 expected: hex(bytes),
-                found: hex(&d.client.read_live(address, bytes.len())?.bytes),
+                found: hex(&found),
             })
         })?;
         match running {
