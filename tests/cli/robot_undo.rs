@@ -850,3 +850,48 @@ fn a_two_image_project_tested_twice_is_undone_to_the_robot_before() {
     let listed = ok(&project, &line, &["installed"]);
     assert!(listed.contains("nothing installed"), "{listed}");
 }
+
+/// recheck17 F2: A, then B in front of it, then A again unchanged (its
+/// undo file goes further back, to before A). After the undo of B and then
+/// of A, the robot listed nothing, but B's chain slot and its table entry
+/// were back in freed memory: the unchanged upload had added to A's older
+/// file what it found there, B's bytes. Now both undos leave the robot as
+/// it was before A, byte for byte.
+#[test]
+fn undos_out_of_order_after_an_unchanged_upload_leave_the_robot_as_before() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(d.join("a.elf"), extension_at(0x0C00, 200, None)).expect("the image");
+    std::fs::write(d.join("b.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(d, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    ok(d, &line, &["backup", "-o", "before.bak"]);
+    let a = ["a.elf", "--no-dry-run", "--undo-file", "a.undo"];
+    ok(d, &line, &[&["upload"][..], &a].concat());
+    ok(
+        d,
+        &line,
+        &["upload", "b.elf", "--no-dry-run", "--undo-file", "b.undo"],
+    );
+    let again = ok(d, &line, &[&["upload"][..], &a].concat());
+    assert!(again.contains("held this image already"), "{again}");
+    ok(d, &line, &["upload", "--undo", "--undo-file", "b.undo"]);
+    ok(d, &line, &["upload", "--undo", "--undo-file", "a.undo"]);
+    ok(d, &line, &["backup", "-o", "after.bak"]);
+    let read = |name: &str| {
+        let bytes = std::fs::read(d.join(name)).expect("the backup");
+        uploader::Backup::decode(name, &bytes).expect("it reads")
+    };
+    let (before, after) = (read("before.bak"), read("after.bak"));
+    assert_eq!(before.hooks, after.hooks);
+    for area in &before.areas {
+        for (offset, &byte) in area.bytes.iter().enumerate() {
+            let address = u32::from(area.address) + offset as u32;
+            assert_eq!(
+                after.byte_at(address),
+                Some(byte),
+                "${address:04X} is not as it was before A"
+            );
+        }
+    }
+}

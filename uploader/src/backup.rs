@@ -11,6 +11,8 @@
 //! 'H' kind:u8 target:u16                    a hook's target (0 HOOK_UNKNOWN, 1 HOOK_LOOP)
 //! 'W' address:u16 length:u16 sum:u16        a witness: the Fletcher-16 of memory a hook
 //!                                           target lies in, not held by the file itself
+//! 'T' address:u16 length:u16 sum:u16        a table entry an upload the file undoes wrote,
+//!                                           witnessed as written (an undo file's)
 //! 'R' address:u16 length:u16 bytes...       the robot's ROM there (its jump table, vectors)
 //! 'E' fnv1a32:u32                           end: FNV-1a 32 of every byte before 'E'
 //! ```
@@ -46,6 +48,13 @@ pub struct Backup {
     /// with the robot's memory before any hook moves, so that no hook is
     /// pointed at code that is not there (another robot, a restore since).
     pub witnesses: Vec<Witness>,
+    /// The table entries the uploads an undo file undoes wrote, each
+    /// witnessed as written: the extensions the undo takes out. Checked
+    /// with the [`Backup::witnesses`]; every other entry the robot lists
+    /// must hold what the file puts back (a later upload wrote it
+    /// otherwise: recheck18 F1). An older file keeps its entry's witness
+    /// among the witnesses.
+    pub written_entries: Vec<Witness>,
     /// The bytes of the robot's ROM where an image's calls land (its jump
     /// table and vectors) when the file was written: a restore onto a robot
     /// whose ROM differs there is refused.
@@ -86,7 +95,10 @@ pub trait Keep {
     /// Called in place of [`Keep::finished`] when the upload left the
     /// robot as it found it (the same image, installed as it was, the
     /// hooks where they were: read back to be sure), but for the RAM
-    /// loader, which `kept` holds what it went over of: what an earlier
+    /// loader, which `kept` holds what it went over of (`kept` holds
+    /// neither the table nor the memory of the other extensions installed,
+    /// which the upload left as found and an older file must not get as
+    /// this upload found them): what an earlier
     /// upload of it kept, with that ([`Backup::going_further_back`]),
     /// undoes this one too and goes further back, unless it holds bytes
     /// where `loader_went_over` (the loader's code written this time over
@@ -142,8 +154,10 @@ impl Backup {
             out.push(kind_code(kind));
             out.extend_from_slice(&target.to_le_bytes());
         }
-        for witness in &self.witnesses {
-            out.push(b'W');
+        let witnesses = self.witnesses.iter().map(|witness| (b'W', witness));
+        let entries = self.written_entries.iter().map(|witness| (b'T', witness));
+        for (record, witness) in witnesses.chain(entries) {
+            out.push(record);
             out.extend_from_slice(&witness.address.to_le_bytes());
             out.extend_from_slice(&witness.len.to_le_bytes());
             out.extend_from_slice(&witness.sum.to_le_bytes());
@@ -249,18 +263,23 @@ impl Backup {
                         .hooks
                         .push((kind, u16::from_le_bytes([record[1], record[2]])));
                 }
-                b'W' => {
+                kind @ (b'W' | b'T') => {
                     let record = take(&mut at, 6)?;
                     let word = |i: usize| u16::from_le_bytes([record[i], record[i + 1]]);
                     let (address, len) = (word(0), word(2));
                     if u32::from(address) + u32::from(len) > 0x1_0000 {
                         return Err(bad(start, "a witness runs past $FFFF"));
                     }
-                    backup.witnesses.push(Witness {
+                    let witness = Witness {
                         address,
                         len,
                         sum: word(4),
-                    });
+                    };
+                    if kind == b'W' {
+                        backup.witnesses.push(witness);
+                    } else {
+                        backup.written_entries.push(witness);
+                    }
                 }
                 b'R' => {
                     let head = take(&mut at, 4)?;
@@ -808,9 +827,16 @@ impl Backup {
     /// earlier upload's undo, with every byte `later` holds and this does
     /// not (the RAM loader may have gone over memory the earlier upload
     /// did not touch: as `later` found it, it is as it was before both).
-    /// The hooks, the witnesses and the ROM are this one's.
+    /// The hooks, the witnesses and the ROM are this one's; the table
+    /// entries written are both's (a project's second image is taken out
+    /// too).
     #[must_use]
     pub fn going_further_back(mut self, later: &Backup) -> Backup {
+        for entry in &later.written_entries {
+            if !self.written_entries.contains(entry) {
+                self.written_entries.push(*entry);
+            }
+        }
         let mut added: Vec<Area> = Vec::new();
         for area in &later.areas {
             for (offset, &byte) in area.bytes.iter().enumerate() {
@@ -887,7 +913,7 @@ fn check_witnesses<T: Transport>(
     resume: bool,
 ) -> Result<()> {
     let table = table_range(profile);
-    for witness in &backup.witnesses {
+    for witness in backup.witnesses.iter().chain(&backup.written_entries) {
         let bytes = client.read_memory(witness.address, usize::from(witness.len))?;
         let found = crate::sums::fletcher16(&bytes);
         // What the file itself puts there, where its restore stopped half
@@ -964,7 +990,13 @@ pub fn restore<T: Transport>(
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
     if options.undo {
-        refuse_later_uploads(client, backup, profile, &hooks)?;
+        // Read once for both looks (a restore that stopped half way has
+        // passed them already, and may have written part of the table).
+        let undone = undone_extensions(client, backup, profile)?;
+        refuse_later_uploads(client, backup, profile, (&hooks, &undone.0))?;
+        if !options.resume {
+            refuse_later_entries(backup, &undone)?;
+        }
     }
     // A debug stub a killed session left hooked: its breakpoints are not
     // the backup's to take out.
@@ -1035,10 +1067,8 @@ fn refuse_later_uploads<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
     profile: &RomProfile,
-    hooks: &[(HookKind, u16)],
+    (hooks, undone): (&[(HookKind, u16)], &[romlib::installed::Installed]),
 ) -> Result<()> {
-    // Read once, where a hook needs it.
-    let mut undone: Option<Option<romlib::installed::Installed>> = None;
     for &(kind, target) in &backup.hooks {
         let Some(current) = hooks
             .iter()
@@ -1065,19 +1095,12 @@ fn refuse_later_uploads<T: Transport>(
         // whose handler it did not rewrite (an edit elsewhere, `--replace`
         // of an extension that sat behind another), so the file does not
         // hold it: its table entry, as the upload wrote it, says so.
-        if undone.is_none() {
-            undone = Some(undone_extension(client, backup, profile)?);
-        }
-        if undone
-            .as_ref()
-            .and_then(Option::as_ref)
-            .is_some_and(|undone| {
-                undone
-                    .hooks
-                    .iter()
-                    .any(|hook| hook.kind == kind && hook.handler == current)
-            })
-        {
+        if undone.iter().any(|undone| {
+            undone
+                .hooks
+                .iter()
+                .any(|hook| hook.kind == kind && hook.handler == current)
+        }) {
             continue;
         }
         let owner = crate::table::read_installed(client, profile)
@@ -1098,29 +1121,63 @@ fn refuse_later_uploads<T: Transport>(
     Ok(())
 }
 
-/// The installed extension the upload an undo file undoes put in: the
-/// one whose table entry the file witnesses (an upload adds the sum of
-/// the entry it wrote), where the robot still holds that entry as
-/// written.
-fn undone_extension<T: Transport>(
+/// The installed extensions, split in two: those the uploads an undo file
+/// undoes put in (each one whose table entry the file witnesses as
+/// written, where the robot still holds that entry so), and the others,
+/// each with its table bytes as the robot holds them.
+type Undone = (
+    Vec<romlib::installed::Installed>,
+    Vec<(romlib::installed::Installed, [Area; 2])>,
+);
+
+fn undone_extensions<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
     profile: &RomProfile,
-) -> Result<Option<romlib::installed::Installed>> {
-    let Some((table, entries)) = profile.table else {
-        return Ok(None);
-    };
-    for entry in crate::table::read_installed(client, profile)? {
-        let at = romlib::installed::entry_address(table, entries, entry.slot);
-        let Some(witness) = backup.witnesses.iter().find(|w| w.address == at) else {
-            continue;
-        };
-        let bytes = client.read_memory(at, usize::from(witness.len))?;
-        if crate::sums::fletcher16(&bytes) == witness.sum {
-            return Ok(Some(entry));
+) -> Result<Undone> {
+    let mut undone = (Vec::new(), Vec::new());
+    for (entry, [flags, bytes]) in crate::table::installed_bytes(client, profile)? {
+        // An older file witnessed the entry among the hooks' witnesses.
+        let written = backup
+            .written_entries
+            .iter()
+            .chain(&backup.witnesses)
+            .any(|witness| {
+                witness.address == bytes.address
+                    && usize::from(witness.len) == bytes.bytes.len()
+                    && crate::sums::fletcher16(&bytes.bytes) == witness.sum
+            });
+        if written {
+            undone.0.push(entry);
+        } else {
+            undone.1.push((entry, [flags, bytes]));
         }
     }
-    Ok(None)
+    Ok(undone)
+}
+
+/// An undo puts back the table as the upload found it: every extension
+/// the robot lists now, but those the undo takes out, must hold there
+/// what the file puts back. Otherwise a later upload wrote that entry (a
+/// `--replace` of an extension the upload being undone chained in front
+/// of, whose handler stayed where it was: recheck18 F1), and the undo
+/// would list the old extension over the new one's code.
+fn refuse_later_entries(backup: &Backup, (_, others): &Undone) -> Result<()> {
+    for (entry, areas) in others {
+        let changed = areas.iter().any(|area| {
+            area.bytes.iter().enumerate().any(|(offset, &now)| {
+                let address = u32::from(area.address) + offset as u32;
+                backup.byte_at(address).is_some_and(|put| put != now)
+            })
+        });
+        if changed {
+            return Err(Error::UndoEntryChanged {
+                id: entry.id,
+                at: areas[1].address,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The options a restore writes memory with: the table is written as
@@ -1365,6 +1422,11 @@ mod tests {
                 address: 0x0800,
                 len: 0x40,
                 sum: 0x1234,
+            }],
+            written_entries: vec![Witness {
+                address: 0x0F90,
+                len: 0x10,
+                sum: 0x5678,
             }],
             rom: vec![Area {
                 address: 0xFFFA,

@@ -262,6 +262,25 @@ pub enum Error {
         owner: String,
     },
 
+    /// An undo of an upload after which another upload wrote the table
+    /// (a `--replace`, an extension added): the undo would put back the
+    /// entries as they were before, over the later one's.
+    #[error(
+        "the robot's table lists extension {id:06X} (its entry at ${at:04X}), which an upload after the one this undoes wrote: the undo would put back what the entry held before, over it; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::undo_entry_changed),
+        help(
+            "undo the later upload first (`scorpion upload --undo` where it was made, or `--undo-file FILE` with its undo file), then this one"
+        )
+    )]
+    UndoEntryChanged {
+        /// The extension the table lists now.
+        id: u32,
+        /// Where its entry is.
+        at: u16,
+    },
+
     /// A restore whose hook would lead into code that loops, stops the
     /// CPU, or is the other hook's handler: the robot's hook was broken
     /// already when the file was written (`backup` warns of it), or the

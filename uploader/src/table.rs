@@ -102,6 +102,44 @@ impl Table {
     }
 }
 
+/// Each installed extension with its table bytes as the robot holds them:
+/// its flags bytes and its entries' bytes (empty for a ROM without a
+/// table).
+///
+/// # Errors
+/// The client's, or [`romlib::Error::DamagedTable`].
+pub(crate) fn installed_bytes<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+) -> Result<Vec<(Installed, [Area; 2])>> {
+    let (Some(read), Some((address, capacity))) = (read_table(client, profile)?, profile.table)
+    else {
+        return Ok(Vec::new());
+    };
+    Ok(read
+        .installed
+        .iter()
+        .map(|entry| {
+            let slots = entry.slot..entry.slot + entry.entries();
+            let entries: Vec<u8> = slots
+                .clone()
+                .flat_map(|slot| read.entry(slot).unwrap_or_default().iter().copied())
+                .collect();
+            let areas = [
+                Area {
+                    address: installed::flags_address(address, entry.slot),
+                    bytes: read.flags[slots].to_vec(),
+                },
+                Area {
+                    address: installed::entry_address(address, capacity, entry.slot),
+                    bytes: entries,
+                },
+            ];
+            (entry.clone(), areas)
+        })
+        .collect())
+}
+
 fn read_table<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -> Result<Option<Table>> {
     read_table_with(profile, &mut |at, len| client.read_memory(at, len))
 }
@@ -234,17 +272,24 @@ pub(crate) fn prepare<T: Transport>(
             }
             Some(_) if replace => {
                 replaced.push(old.clone());
-                // Not put back where it was (recheck17 F1): an undo of the
-                // upload of the extension in front would then pass its
-                // check for later uploads, and put back the table as it
-                // found it, over this image's entry (recheck18 F1).
-                unlinked.extend(remove(
-                    client,
-                    profile,
-                    (&read.installed, known),
-                    old,
-                    &mut writes,
-                )?);
+                for (kind, slot, onward) in
+                    remove(client, profile, (&read.installed, known), old, &mut writes)?
+                {
+                    // recheck17 F1: the image takes its place in the chain,
+                    // behind the extension in front of it, as a copy of
+                    // itself would (the undo of the one in front compares
+                    // the table's entries and refuses to put this one's
+                    // back: recheck18 F1).
+                    let takes = image.hooks().iter().any(|record| record.kind == kind);
+                    if takes && !relink.iter().any(|relink: &Relink| relink.kind == kind) {
+                        relink.push(Relink {
+                            kind,
+                            slot: slot.address,
+                            onward,
+                        });
+                    }
+                    unlinked.push(slot);
+                }
                 // The hooks may have moved: read from here on.
                 known = &[];
                 // Its flags are cleared now, verified.
@@ -418,7 +463,8 @@ fn differs<T: Transport>(
 /// Takes `old` out of every chain it is in (the pointer that jumps to its
 /// handler, the hook or another extension's chain slot, re-pointed at
 /// where `old` fell through, verified), then clears its entries. Returns
-/// the chain slots it re-pointed, as they were.
+/// the chain slots it re-pointed, as they were, each with its hook and
+/// where it points now.
 ///
 /// # Errors
 /// The client's, [`Error::VerifyFailed`].
@@ -428,14 +474,16 @@ fn remove<T: Transport>(
     (everyone, hooks): (&[Installed], &[(HookKind, u16)]),
     old: &Installed,
     writes: &mut Unhooking<'_, '_, T>,
-) -> Result<Vec<Area>> {
+) -> Result<Vec<(HookKind, Area, u16)>> {
     let Some((table, _)) = profile.table else {
         return Ok(Vec::new());
     };
     let mut slots = Vec::new();
     for hook in &old.hooks {
-        if let Some((slot, _)) = unlink(client, profile, (everyone, hooks), *hook, writes, true)? {
-            slots.push(slot);
+        if let Some((slot, onward)) =
+            unlink(client, profile, (everyone, hooks), *hook, writes, true)?
+        {
+            slots.push((hook.kind, slot, onward));
         }
     }
     // Clearing its flags bytes frees its entries.

@@ -128,3 +128,38 @@ pub(crate) fn loader_went_over(kept: &Backup, code_byte: &dyn Fn(u16) -> Option<
     }
     over
 }
+
+/// What `kept` holds of the upload's own memory: without the table and
+/// without the memory of the extensions that stay installed beside the
+/// image (a chain slot taken past an earlier copy of it and pointed at it
+/// again). The upload left both as it found them; a keeper going further
+/// back ([`crate::Keep::finished_unchanged`]) must not add them to an older
+/// file as this upload found them (recheck17 F2: after the undo of an
+/// extension installed in front since, the older file put its chain slot
+/// and its table entry back into freed memory).
+pub(crate) fn own_memory(
+    kept: &Backup,
+    profile: &RomProfile,
+    others: &[romlib::installed::Installed],
+) -> Backup {
+    let table = crate::backup::table_range(profile);
+    let in_table = |address: u16| {
+        table.is_some_and(|(at, len)| {
+            usize::from(address) >= usize::from(at) && usize::from(address) < usize::from(at) + len
+        })
+    };
+    let mut own: Vec<Area> = Vec::new();
+    for area in &kept.areas {
+        for (offset, &byte) in area.bytes.iter().enumerate() {
+            let address = area.address.wrapping_add(offset as u16);
+            if in_table(address) || others.iter().any(|other| other.contains(address)) {
+                continue;
+            }
+            crate::delta::push(&mut own, address, &[byte]);
+        }
+    }
+    Backup {
+        areas: own,
+        ..kept.clone()
+    }
+}

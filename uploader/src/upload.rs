@@ -806,9 +806,11 @@ pub fn upload_keeping<T: Transport>(
             &owns,
         );
         if unchanged {
+            let others = plan.as_ref().map_or(&[][..], |plan| &plan.others[..]);
+            let own = crate::unchanged::own_memory(&kept, profile, others);
             let code_byte = |address: u16| session.as_ref().and_then(|s| s.code_byte(address));
-            let over = crate::unchanged::loader_went_over(&kept, &code_byte);
-            keep.finished_unchanged(&kept, &over);
+            let over = crate::unchanged::loader_went_over(&own, &code_byte);
+            keep.finished_unchanged(&own, &over);
         } else {
             keep.finished(&kept);
         }
@@ -1031,7 +1033,7 @@ fn overlay(areas: &mut Vec<Area>, unlinked: &[Area]) {
 /// is refused, `--port emu`'s fresh one included).
 fn finished(mut kept: Backup, entry: Option<Area>) -> Backup {
     if let Some(entry) = entry {
-        kept.witnesses.push(crate::backup::Witness {
+        kept.written_entries.push(crate::backup::Witness {
             address: entry.address,
             len: entry.bytes.len() as u16,
             sum: fletcher16(&entry.bytes),

@@ -146,3 +146,35 @@ fn a_reset_or_noise_while_a_copy_goes_back_leaves_no_way_to_unverified_code() {
         }
     }
 }
+
+/// recheck17 F1: an edit of an extension behind another, uploaded with
+/// `--replace`, went to the head of the chain, and then answered a command
+/// both handle in place of the one in front. It takes the place of the
+/// one it replaces; the one at the head, edited, stays at the head.
+#[test]
+fn a_replacement_takes_the_place_of_the_extension_it_replaces() {
+    for path in [LoaderChoice::Never, LoaderChoice::Always] {
+        let options = UploadOptions {
+            replace: true,
+            ..options(path)
+        };
+        let mut client = uploader::client(robot(), &options.profile);
+        two_installed(&mut client, &options);
+        let behind = common::one_byte_changed(&extension_at(0x0400), 40);
+        let report = upload(&mut client, &behind, &options, &mut NoProgress).expect("replaced");
+        assert_eq!(report.replaced.len(), 1, "{path:?}");
+        assert_eq!(report.relinked, [(HookKind::Unknown, 0x0701)], "{path:?}");
+        let memory = client.transport().robot().robot().board().memory();
+        assert_eq!(chain(memory), [0x0703, 0x0403], "{path:?}: its place kept");
+        assert_eq!(memory[0x0400 + 40], behind.areas()[0].bytes[40], "{path:?}");
+        let front = common::one_byte_changed(&extension_at(0x0700), 40);
+        let report = upload(&mut client, &front, &options, &mut NoProgress).expect("replaced");
+        assert_eq!(report.relinked, [], "{path:?}");
+        let memory = client.transport().robot().robot().board().memory();
+        assert_eq!(
+            chain(memory),
+            [0x0703, 0x0403],
+            "{path:?}: the head stays the head"
+        );
+    }
+}

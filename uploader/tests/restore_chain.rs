@@ -186,6 +186,75 @@ fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
     assert_eq!(hook(&mut client), BAD_COMMAND);
 }
 
+/// recheck18 F1: an extension, a second in front of it, then an edit of
+/// the first (its data; the handler where it was) with `--replace`. The
+/// undo of the second found HOOK_UNKNOWN leading where it led before the
+/// second and passed its check for later uploads; it put the table back
+/// as the second found it, listing the old image over the edit. The undo
+/// compares the table's entries with the file's: the later one is named,
+/// nothing is written, and the undos in the right order go through.
+#[test]
+fn an_undo_refuses_to_put_back_an_entry_a_later_upload_wrote() {
+    let options = UploadOptions::default();
+    let replace = UploadOptions {
+        replace: true,
+        ..options.clone()
+    };
+    let undo = UploadOptions {
+        undo: true,
+        ..options.clone()
+    };
+    let mut client = uploader::client(robot(), &options.profile);
+    let first = extension_at(0x0500);
+    let in_front = extension_at(0x0800);
+    let mut bytes = first.areas()[0].bytes.clone();
+    bytes[40] = 0x07;
+    let edited = uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0500,
+            bytes,
+        }],
+        first.hooks().to_vec(),
+    )
+    .expect("an image");
+    let mut kept = [Kept::default(), Kept::default(), Kept::default()];
+    for ((image, options), kept) in [
+        (&first, &options),
+        (&in_front, &options),
+        (&edited, &replace),
+    ]
+    .into_iter()
+    .zip(&mut kept)
+    {
+        upload_keeping(&mut client, image, options, &mut NoProgress, kept).expect("uploaded");
+    }
+    let [_, kept_in_front, kept_edit] = kept.map(|kept| kept.0.expect("kept"));
+    let held = |client: &mut uploader::Client<uploader::transport::VirtualTransport>| {
+        let memory = client.transport().robot().robot().board().memory();
+        [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
+    };
+    let before = held(&mut client);
+    let error = restore(&mut client, &kept_in_front, &undo, &mut NoProgress)
+        .expect_err("the edit wrote the table after it");
+    assert!(
+        matches!(error, Error::UndoEntryChanged { id, .. } if id == edited.id()),
+        "{error}"
+    );
+    assert!(held(&mut client) == before, "nothing written");
+    restore(&mut client, &kept_edit, &undo, &mut NoProgress).expect("the edit first");
+    let installed = uploader::read_installed(&mut client, &options.profile).expect("the table");
+    let ids: Vec<u32> = installed.iter().map(|entry| entry.id).collect();
+    assert!(
+        ids.contains(&first.id()) && ids.contains(&in_front.id()),
+        "{ids:06X?}"
+    );
+    restore(&mut client, &kept_in_front, &undo, &mut NoProgress).expect("then the one in front");
+    let installed = uploader::read_installed(&mut client, &options.profile).expect("the table");
+    let ids: Vec<u32> = installed.iter().map(|entry| entry.id).collect();
+    assert_eq!(ids, [first.id()]);
+    assert_eq!(hook(&mut client), 0x0503);
+}
+
 /// recheck16 F4: a backup of a robot whose hook was already broken (sent
 /// by hand into a loop) said only "saved", and the user learnt of it at
 /// the restore that refused it. The backup names the way, as the restore
