@@ -288,14 +288,9 @@ fn a_session_attaches_to_an_image_with_a_counter_in_its_code() {
     debug.detach().expect("detaches");
 }
 
-/// hostile17 F3: an extension whose handler jumps over a 16-bit counter
-/// its loop handler keeps: the undo file of an upload in front of it
-/// witnessed the handler's first 16 bytes, the counter's slow byte among
-/// them, and once that byte moved the undo was refused for good ("not
-/// what it was ... another upload replaced it"). The window ends at the
-/// handler's first `JMP`.
-#[test]
-fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
+/// An extension whose handler jumps over a 16-bit counter its loop
+/// handler keeps.
+fn counting_16() -> UploadImage {
     // $0600  JMP $0605      ; HOOK_UNKNOWN's handler
     // $0603  .word 0        ; the counter
     // $0605  JMP chain      ; its slot $0606
@@ -307,7 +302,7 @@ fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
         0x4C, 0x05, 0x06, 0x00, 0x00, 0x4C, 0x21, 0xFF, 0xEE, 0x03, 0x06, 0xD0, 0x03, 0xEE, 0x04,
         0x06, 0x4C, 0x24, 0xFF,
     ];
-    let counting = UploadImage::new(
+    UploadImage::new(
         vec![Area {
             address: 0x0600,
             bytes,
@@ -325,22 +320,39 @@ fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
             },
         ],
     )
-    .expect("an image");
+    .expect("an image")
+}
+
+/// Runs the robot until the slow byte of [`counting_16`]'s counter has
+/// moved from what it was.
+fn until_the_slow_byte_moved(client: &mut Client<VirtualTransport>) {
+    let high = |client: &mut Client<VirtualTransport>| {
+        client.transport().robot().robot().board().memory()[0x0604]
+    };
+    let before = high(client);
+    for _ in 0..200 {
+        if high(client) != before {
+            return;
+        }
+        client.probe().expect("the robot answers");
+    }
+    panic!("the slow byte never moved");
+}
+
+/// hostile17 F3: an extension whose handler jumps over a 16-bit counter
+/// its loop handler keeps: the undo file of an upload in front of it
+/// witnessed the handler's first 16 bytes, the counter's slow byte among
+/// them, and once that byte moved the undo was refused for good ("not
+/// what it was ... another upload replaced it"). The window ends at the
+/// handler's first `JMP`.
+#[test]
+fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
+    let counting = counting_16();
     let options = UploadOptions::default();
     let mut client = uploader::client(robot(), &options.profile);
     upload(&mut client, &counting, &options, &mut NoProgress).expect("installed");
     let undo_file = in_front_kept(&mut client);
-    let high = |client: &mut Client<VirtualTransport>| {
-        client.transport().robot().robot().board().memory()[0x0604]
-    };
-    let before = high(&mut client);
-    for _ in 0..200 {
-        if high(&mut client) != before {
-            break;
-        }
-        client.probe().expect("the robot answers");
-    }
-    assert_ne!(high(&mut client), before, "the slow byte moved");
+    until_the_slow_byte_moved(&mut client);
     let undo = UploadOptions {
         undo: true,
         ..options
@@ -349,4 +361,23 @@ fn an_undo_in_front_of_a_counter_after_a_handlers_jump_goes_through() {
     let memory = client.transport().robot().robot().board().memory();
     let hook = usize::from(romlib::symbols::HOOK_UNKNOWN) + 1;
     assert_eq!(memory[hook..hook + 2], [0x00, 0x06], "HOOK_UNKNOWN back");
+}
+
+/// recheck18 F3: a 16-bit counter in the code section. Its fast byte was
+/// taken as data (it changes as it is read), but its slow byte, which had
+/// moved and held still while it was read, failed the compare as "the
+/// robot does not hold the image". The bytes right after a changing one
+/// are its counter's.
+#[test]
+fn a_session_attaches_beside_a_sixteen_bit_counter_in_its_code() {
+    let mut image = counting_16();
+    image.set_code(vec![0x0600..=0x0612]);
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(&mut client, &image, &options, &mut NoProgress).expect("installed");
+    until_the_slow_byte_moved(&mut client);
+    let profile = RomProfile::reference();
+    let mut debug = RobotDebug::attach(client, &profile, image).expect("attaches");
+    assert_eq!(debug.compare_with_image().expect("compares"), None);
+    debug.detach().expect("detaches");
 }

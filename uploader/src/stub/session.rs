@@ -693,8 +693,12 @@ impl<T: Transport> RobotDebug<T> {
     /// difference is read until two answers agree, so that it is named
     /// with the robot's bytes. Bytes among the code that the running
     /// program keeps changing (a counter kept in its code section,
-    /// hostile17 F4) are data, not code: they are given as the image's.
+    /// hostile17 F4) are data, not code: they are given as the image's,
+    /// with the three after each (that counter's higher bytes).
     fn read_code(&mut self, area: &crate::image::Area, slots: &[u16]) -> StubResult<Vec<u8>> {
+        /// The longest counter a byte that keeps changing is taken to be
+        /// the lowest byte of (little-endian, as the 6502 counts).
+        const COUNTER_LEN: usize = 4;
         let mut found = area.bytes.clone();
         let slot = |address: u16| {
             slots
@@ -725,7 +729,15 @@ impl<T: Transport> RobotDebug<T> {
                 let mut read = self.client.read_live_expecting(at, &expected)?;
                 for changing in read.changing {
                     let k = usize::from(changing.wrapping_sub(at));
-                    read.bytes[k] = area.bytes[i + k];
+                    // recheck18 F3: the bytes after it, up to a 32-bit
+                    // counter's, are its higher bytes, which move seldom
+                    // and may hold still while they are read.
+                    // A chain slot's bytes are the robot's.
+                    for j in k..(k + COUNTER_LEN).min(end - i) {
+                        if let Some(image) = expected[j] {
+                            read.bytes[j] = image;
+                        }
+                    }
                 }
                 read.bytes
             };
