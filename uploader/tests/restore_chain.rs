@@ -127,11 +127,7 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
 
 #[test]
 fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
-    let options = UploadOptions::default();
-    let undo = UploadOptions {
-        undo: true,
-        ..options.clone()
-    };
+    let (options, _, undo) = plain_replace_undo();
     let mut client = uploader::client(robot(), &options.profile);
     let (first, second) = (extension_at(0x0500), extension_at(0x0800));
     let mut kept_first = Kept::default();
@@ -153,11 +149,6 @@ fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
     )
     .expect("the second");
     let (kept_first, kept_second) = (kept_first.0.expect("kept"), kept_second.0.expect("kept"));
-    // The hooks, and user RAM with the table.
-    let held = |client: &mut uploader::Client<uploader::transport::VirtualTransport>| {
-        let memory = client.transport().robot().robot().board().memory();
-        [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
-    };
     let before = held(&mut client);
     let error = restore(&mut client, &kept_first, &undo, &mut NoProgress)
         .expect_err("the later upload is ahead of it");
@@ -195,15 +186,7 @@ fn an_undo_of_an_upload_a_later_one_chained_ahead_of_is_refused() {
 /// nothing is written, and the undos in the right order go through.
 #[test]
 fn an_undo_refuses_to_put_back_an_entry_a_later_upload_wrote() {
-    let options = UploadOptions::default();
-    let replace = UploadOptions {
-        replace: true,
-        ..options.clone()
-    };
-    let undo = UploadOptions {
-        undo: true,
-        ..options.clone()
-    };
+    let (options, replace, undo) = plain_replace_undo();
     let mut client = uploader::client(robot(), &options.profile);
     let first = extension_at(0x0500);
     let in_front = extension_at(0x0800);
@@ -229,10 +212,6 @@ fn an_undo_refuses_to_put_back_an_entry_a_later_upload_wrote() {
         upload_keeping(&mut client, image, options, &mut NoProgress, kept).expect("uploaded");
     }
     let [_, kept_in_front, kept_edit] = kept.map(|kept| kept.0.expect("kept"));
-    let held = |client: &mut uploader::Client<uploader::transport::VirtualTransport>| {
-        let memory = client.transport().robot().robot().board().memory();
-        [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
-    };
     let before = held(&mut client);
     let error = restore(&mut client, &kept_in_front, &undo, &mut NoProgress)
         .expect_err("the edit wrote the table after it");
@@ -291,15 +270,7 @@ fn a_backup_of_a_robot_whose_hook_is_broken_says_so() {
 /// the table entry the upload wrote: that names the image it undoes.
 #[test]
 fn the_undo_of_a_replacement_whose_handler_did_not_change_goes_through() {
-    let options = UploadOptions::default();
-    let replace = UploadOptions {
-        replace: true,
-        ..options.clone()
-    };
-    let undo = UploadOptions {
-        undo: true,
-        ..options.clone()
-    };
+    let (options, replace, undo) = plain_replace_undo();
     let mut client = uploader::client(robot(), &options.profile);
     // 512 bytes at $0400: its chain slot's JMP first, two handlers (`JMP
     // $0400`) at $0480 and $0490, far from the slot and from the edit;
@@ -417,4 +388,24 @@ fn a_broken_hook_in_a_file_does_not_take_the_other_down() {
     let memory = client.transport().robot().robot().board().memory();
     let at = usize::from(romlib::symbols::HOOK_LOOP) + 1;
     assert_eq!(memory[at..at + 2], [0x00, 0x06], "the loop handler hooked");
+}
+
+/// The default upload options, with `--replace`, and an undo's.
+fn plain_replace_undo() -> (UploadOptions, UploadOptions, UploadOptions) {
+    let options = UploadOptions::default();
+    let replace = UploadOptions {
+        replace: true,
+        ..options.clone()
+    };
+    let undo = UploadOptions {
+        undo: true,
+        ..options.clone()
+    };
+    (options, replace, undo)
+}
+
+/// The hooks, and user RAM with the table.
+fn held(client: &mut uploader::Client<uploader::transport::VirtualTransport>) -> Vec<u8> {
+    let memory = client.transport().robot().robot().board().memory();
+    [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
 }
