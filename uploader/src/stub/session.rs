@@ -733,9 +733,13 @@ impl<T: Transport> RobotDebug<T> {
                     // counter's, are its higher bytes, which move seldom
                     // and may hold still while they are read.
                     // A chain slot's bytes are the robot's.
-                    for j in k..(k + COUNTER_LEN).min(end - i) {
-                        if let Some(image) = expected[j] {
-                            read.bytes[j] = image;
+                    let counter = k..(k + COUNTER_LEN).min(end - i);
+                    for (byte, image) in read.bytes[counter.clone()]
+                        .iter_mut()
+                        .zip(&expected[counter])
+                    {
+                        if let Some(image) = image {
+                            *byte = *image;
                         }
                     }
                 }
