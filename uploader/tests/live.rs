@@ -381,3 +381,41 @@ fn a_session_attaches_beside_a_sixteen_bit_counter_in_its_code() {
     assert_eq!(debug.compare_with_image().expect("compares"), None);
     debug.detach().expect("detaches");
 }
+
+/// hostile19 F3: an image that differs from the robot's only right after
+/// a counter among the code was attached without a word, its byte there
+/// taken as the counter's; a breakpoint set there and removed then put
+/// the image's byte back over the robot's instruction, and the installed
+/// extension broke. The bytes after a counter are taken as the robot
+/// holds them, and attach says it did not compare them.
+#[test]
+fn bytes_after_a_counter_among_the_code_are_the_robots() {
+    let mut image = counting_16();
+    image.set_code(vec![0x0600..=0x0612]);
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(&mut client, &image, &options, &mut NoProgress).expect("installed");
+    let mut bytes = image.areas()[0].bytes.clone();
+    bytes[5] = 0x6C;
+    let mut wrong = UploadImage::new(
+        vec![Area {
+            address: 0x0600,
+            bytes,
+        }],
+        image.hooks().to_vec(),
+    )
+    .expect("an image");
+    wrong.set_code(vec![0x0600..=0x0612]);
+    let profile = RomProfile::reference();
+    let mut debug = RobotDebug::attach(client, &profile, wrong).expect("attaches");
+    let note = debug.recovery().data_note().expect("a note");
+    assert!(note.contains("$0603"), "{note}");
+    assert_eq!(debug.image().byte(0x0605), Some(0x4C), "the robot's byte");
+    let entries = [0x0600, 0x0605, 0x0608, 0x0610];
+    debug.set_breakpoint(0x0605, &entries).expect("set");
+    debug.remove_breakpoint(0x0605).expect("removed");
+    assert_eq!(debug.compare_with_image().expect("compares"), None);
+    let mut client = debug.detach().expect("detaches");
+    let memory = client.transport().robot().robot().board().memory();
+    assert_eq!(memory[0x0605], 0x4C, "the robot's JMP as it was");
+}

@@ -161,13 +161,19 @@ impl RobotSession {
         Ok(())
     }
 
-    /// What attach found of a session that did not detach and cleaned up
-    /// (the sentence the monitor prints), if anything: for the editor's
-    /// console before the first stop.
+    /// What attach found of a session that did not detach and cleaned up,
+    /// and of data among the code (the sentences the monitor prints), if
+    /// anything: for the editor's console before the first stop.
     #[must_use]
     pub fn recovery(&self) -> Option<String> {
         let recovery = self.robot.as_ref()?.recovery();
-        recovery.found().then(|| recovery.describe())
+        let sentences: Vec<String> = recovery
+            .found()
+            .then(|| recovery.describe())
+            .into_iter()
+            .chain(recovery.data_note())
+            .collect();
+        (!sentences.is_empty()).then(|| sentences.join("\n"))
     }
 
     /// The robot runs its control loop (between requests, its line is

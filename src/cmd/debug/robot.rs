@@ -185,6 +185,9 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     if robot.recovery().found() {
         writeln!(out, "{}", robot.recovery().describe()).into_diagnostic()?;
     }
+    if let Some(note) = robot.recovery().data_note() {
+        writeln!(out, "{note}").into_diagnostic()?;
+    }
     if let Some(registers) = robot.stopped() {
         writeln!(
             out,

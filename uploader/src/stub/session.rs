@@ -162,9 +162,28 @@ pub struct Recovery {
     /// robot's, so that the session can let it go on (hostile16 F2: the
     /// robot was refused as "not the image" and stayed stopped for good).
     pub changed: Vec<u16>,
+    /// Bytes among the code that the running program changed while they
+    /// were read (a counter kept there), and the three after each where
+    /// the robot's differ from the image (that counter's higher bytes):
+    /// not compared, and taken as the robot's, so that a breakpoint or a
+    /// step there works on what the robot holds (hostile19 F3: a wrong
+    /// image's byte there was put back by a breakpoint's removal).
+    pub data_among_code: Vec<u16>,
 }
 
 impl Recovery {
+    /// What [`Recovery::data_among_code`] holds, in a sentence, if it holds
+    /// anything.
+    #[must_use]
+    pub fn data_note(&self) -> Option<String> {
+        (!self.data_among_code.is_empty()).then(|| {
+            format!(
+                "note: {} among the image's code changed while it was read, as the robot runs (a counter kept there): taken as the program's data with the bytes after it, as the robot holds them, and not compared",
+                crate::error::addresses_text(&self.data_among_code)
+            )
+        })
+    }
+
     /// Whether anything of an earlier session was found.
     #[must_use]
     pub fn found(&self) -> bool {
@@ -613,7 +632,7 @@ impl<T: Transport> RobotDebug<T> {
         let mut adopted = Vec::new();
         let slot_bytes = self.image.chain_slot_bytes();
         for area in self.image.areas().to_vec() {
-            let mut found = self.read_code(&area, &slots)?;
+            let (mut found, data) = self.read_code(&area, &slots)?;
             // Only code is compared: the program may have changed its
             // data (a `poke` of the README's session did), and a `JSR`
             // into the stub is patched only into code.
@@ -658,6 +677,14 @@ impl<T: Transport> RobotDebug<T> {
                     found[i] = area.bytes[i];
                 }
             }
+            for &at in &data {
+                let i = usize::from(at.wrapping_sub(area.address));
+                if found[i] != area.bytes[i] {
+                    adopted.push((at, found[i]));
+                    found[i] = area.bytes[i];
+                }
+            }
+            self.recovery.data_among_code.extend(data);
             let differs = |i: &usize| code[*i] && found[*i] != area.bytes[*i];
             if self.stopped.is_some() {
                 // Found stopped in the stub: it must be let go on whatever
@@ -694,12 +721,18 @@ impl<T: Transport> RobotDebug<T> {
     /// with the robot's bytes. Bytes among the code that the running
     /// program keeps changing (a counter kept in its code section,
     /// hostile17 F4) are data, not code: they are given as the image's,
-    /// with the three after each (that counter's higher bytes).
-    fn read_code(&mut self, area: &crate::image::Area, slots: &[u16]) -> StubResult<Vec<u8>> {
+    /// and named with the three after each (that counter's higher bytes,
+    /// given as the robot holds them) where those differ from the image.
+    fn read_code(
+        &mut self,
+        area: &crate::image::Area,
+        slots: &[u16],
+    ) -> StubResult<(Vec<u8>, Vec<u16>)> {
         /// The longest counter a byte that keeps changing is taken to be
         /// the lowest byte of (little-endian, as the 6502 counts).
         const COUNTER_LEN: usize = 4;
         let mut found = area.bytes.clone();
+        let mut data = Vec::new();
         let slot = |address: u16| {
             slots
                 .iter()
@@ -729,17 +762,20 @@ impl<T: Transport> RobotDebug<T> {
                 let mut read = self.client.read_live_expecting(at, &expected)?;
                 for changing in read.changing {
                     let k = usize::from(changing.wrapping_sub(at));
+                    read.bytes[k] = area.bytes[i + k];
+                    data.push(changing);
                     // recheck18 F3: the bytes after it, up to a 32-bit
                     // counter's, are its higher bytes, which move seldom
-                    // and may hold still while they are read.
-                    // A chain slot's bytes are the robot's.
-                    let counter = k..(k + COUNTER_LEN).min(end - i);
-                    for (byte, image) in read.bytes[counter.clone()]
-                        .iter_mut()
-                        .zip(&expected[counter])
+                    // and may hold still while they are read. A chain
+                    // slot's bytes are the robot's anyway.
+                    let counter = k + 1..(k + COUNTER_LEN).min(end - i);
+                    for ((image, robot), after) in expected[counter.clone()]
+                        .iter()
+                        .zip(&read.bytes[counter.clone()])
+                        .zip(counter.map(|j| at.wrapping_add(j as u16)))
                     {
-                        if let Some(image) = image {
-                            *byte = *image;
+                        if image.is_some_and(|image| image != *robot) && !data.contains(&after) {
+                            data.push(after);
                         }
                     }
                 }
@@ -748,7 +784,9 @@ impl<T: Transport> RobotDebug<T> {
             found[i..end].copy_from_slice(&bytes);
             i = end;
         }
-        Ok(found)
+        data.sort_unstable();
+        data.dedup();
+        Ok((found, data))
     }
 
     /// Breakpoints an earlier session left outside this image (a session
@@ -2137,9 +2175,10 @@ impl<T: Transport> RobotDebug<T> {
         for area in self.image.areas().to_vec() {
             // Only the code is read: a counter beside it changes as the
             // robot runs.
-            let found = self.read_code(&area, &[])?;
+            let (found, data) = self.read_code(&area, &[])?;
             if let Some(i) = (0..found.len()).find(|&i| {
-                found[i] != area.bytes[i] && self.image.is_code(area.address.wrapping_add(i as u16))
+                let at = area.address.wrapping_add(i as u16);
+                found[i] != area.bytes[i] && self.image.is_code(at) && !data.contains(&at)
             }) {
                 return Ok(Some((
                     area.address.wrapping_add(i as u16),
