@@ -49,6 +49,12 @@ pub fn flags_address(table: u16, slot: usize) -> u16 {
     table + slot as u16
 }
 
+/// Whether a flags byte marks its entry in use.
+#[must_use]
+pub fn in_use(flags: u8) -> bool {
+    flags & USED != 0
+}
+
 /// Where entry `slot`'s bytes start, in a table of `entries` entries.
 #[must_use]
 pub fn entry_address(table: u16, entries: usize, slot: usize) -> u16 {
@@ -222,7 +228,7 @@ pub fn decode<'a>(
 ) -> Result<Vec<Installed>, DamagedTable> {
     let mut installed: Vec<Installed> = Vec::new();
     for (slot, &flags) in flags.iter().enumerate() {
-        if flags & USED == 0 {
+        if !in_use(flags) {
             continue;
         }
         let address = flags_address(table, slot);

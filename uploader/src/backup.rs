@@ -275,10 +275,28 @@ impl Backup {
                         len,
                         sum: word(4),
                     };
-                    if kind == b'W' {
-                        backup.witnesses.push(witness);
+                    // hostile19 F2: each is read from the robot before
+                    // anything else is checked; one a table could not
+                    // hold, or a copy, is refused here.
+                    let entry = romlib::installed::ENTRY_LEN;
+                    let whole = usize::from(len) % entry == 0
+                        && (entry..=romlib::installed::ENTRIES * entry).contains(&usize::from(len));
+                    if kind == b'T' && !whole {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a table entry record of {len} bytes (entries are {entry} bytes each)"
+                            ),
+                        ));
+                    }
+                    let records = if kind == b'W' {
+                        &mut backup.witnesses
                     } else {
-                        backup.written_entries.push(witness);
+                        &mut backup.written_entries
+                    };
+                    // Nothing to check, or checked already.
+                    if len > 0 && !records.contains(&witness) {
+                        records.push(witness);
                     }
                 }
                 b'R' => {
@@ -985,6 +1003,7 @@ pub fn restore<T: Transport>(
         Some(whole)
     };
     check_hook_targets(backup, &memory.profile, table_range(profile))?;
+    check_records(backup, &memory.profile, profile.table)?;
     refuse_held_stub(backup, profile)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
@@ -995,7 +1014,7 @@ pub fn restore<T: Transport>(
         let undone = undone_extensions(client, backup, profile)?;
         refuse_later_uploads(client, backup, profile, (&hooks, &undone.0))?;
         if !options.resume {
-            refuse_later_entries(backup, &undone)?;
+            refuse_later_entries(backup, profile, &undone)?;
         }
     }
     // A debug stub a killed session left hooked: its breakpoints are not
@@ -1162,7 +1181,42 @@ fn undone_extensions<T: Transport>(
 /// `--replace` of an extension the upload being undone chained in front
 /// of, whose handler stayed where it was: recheck18 F1), and the undo
 /// would list the old extension over the new one's code.
-fn refuse_later_entries(backup: &Backup, (_, others): &Undone) -> Result<()> {
+fn refuse_later_entries(
+    backup: &Backup,
+    profile: &RomProfile,
+    (undone, others): &Undone,
+) -> Result<()> {
+    // hostile19 F1: the file takes out what its upload put in: the table's
+    // flags there are the file's, and an entry they list is the file's
+    // too. A file that does not hold them (edited, or records copied from
+    // another) would leave the table listing memory the undo put back.
+    if let Some((table, entries)) = profile.table {
+        let held = |address: u16, len: usize| {
+            (0..len).all(|i| backup.byte_at(u32::from(address) + i as u32).is_some())
+        };
+        for entry in undone {
+            let slots = entry.slot..entry.slot + entry.entries();
+            let freed = slots.clone().all(|slot| {
+                let flags = romlib::installed::flags_address(table, slot);
+                let listed = backup
+                    .byte_at(u32::from(flags))
+                    .map(romlib::installed::in_use);
+                let entry = romlib::installed::entry_address(table, entries, slot);
+                match listed {
+                    None => false,
+                    Some(listed) => !listed || held(entry, romlib::installed::ENTRY_LEN),
+                }
+            });
+            if !freed {
+                return Err(Error::BadImage {
+                    reason: format!(
+                        "the file takes out extension {:06X} (it holds the sum of its table entry as an upload wrote it) but does not put back the table there: the table would go on listing it over the memory the undo puts back; nothing was written",
+                        entry.id
+                    ),
+                });
+            }
+        }
+    }
     for (entry, areas) in others {
         let changed = areas.iter().any(|area| {
             area.bytes.iter().enumerate().any(|(offset, &now)| {
@@ -1259,6 +1313,53 @@ fn check_hook_targets(
         if !to_rom && !witnessed {
             check_held_entry(backup, kind, target)?;
         }
+    }
+    Ok(())
+}
+
+/// Each witness lies in memory an upload may write (the table included),
+/// and each table entry record on whole entries of the table: anything
+/// else is no file an upload or `backup` wrote, and would be read from
+/// the robot (the I/O page, where a read of the serial chip's data
+/// register eats a received byte) before the rest is checked (hostile19
+/// F2).
+fn check_records(backup: &Backup, memory: &RomProfile, table: Option<(u16, usize)>) -> Result<()> {
+    let writable = |witness: &Witness| {
+        let last = u32::from(witness.address) + u32::from(witness.len) - 1;
+        memory.writable.iter().any(|range| {
+            u32::from(*range.start()) <= u32::from(witness.address)
+                && last <= u32::from(*range.end())
+        })
+    };
+    if let Some(witness) = backup.witnesses.iter().find(|witness| !writable(witness)) {
+        return Err(Error::BadImage {
+            reason: format!(
+                "the file witnesses {} bytes at ${:04X}, outside the memory an extension may hold: no upload or backup wrote that; nothing was written",
+                witness.len, witness.address
+            ),
+        });
+    }
+    let on_entries = |witness: &Witness| {
+        table.is_some_and(|(at, entries)| {
+            let first = u32::from(romlib::installed::entry_address(at, entries, 0));
+            let end = first + (entries * romlib::installed::ENTRY_LEN) as u32;
+            let address = u32::from(witness.address);
+            address >= first
+                && (address - first) % romlib::installed::ENTRY_LEN as u32 == 0
+                && address + u32::from(witness.len) <= end
+        })
+    };
+    if let Some(entry) = backup
+        .written_entries
+        .iter()
+        .find(|entry| !on_entries(entry))
+    {
+        return Err(Error::BadImage {
+            reason: format!(
+                "the file's record of a table entry an upload wrote ({} bytes at ${:04X}) is not on the table's entries: no upload wrote that; nothing was written",
+                entry.len, entry.address
+            ),
+        });
     }
     Ok(())
 }
@@ -1425,7 +1526,7 @@ mod tests {
             }],
             written_entries: vec![Witness {
                 address: 0x0F90,
-                len: 0x10,
+                len: romlib::installed::ENTRY_LEN as u16,
                 sum: 0x5678,
             }],
             rom: vec![Area {
@@ -1478,6 +1579,33 @@ mod tests {
         );
         assert!(text.contains("HOOK_UNKNOWN"), "{text}");
         assert!(text.contains(&format!("byte {}", MAGIC.len())), "{text}");
+    }
+
+    /// hostile19 F2: a table entry record no table could hold is refused
+    /// at its place; a copy of a record is one record (3000 copies were
+    /// each read from the robot).
+    #[test]
+    fn table_entry_records_are_whole_entries_and_copies_are_one() {
+        let entry = romlib::installed::ENTRY_LEN as u8;
+        let mut body = MAGIC.to_vec();
+        let record = |kind: u8, len: u8| [kind, 0x90, 0x0F, len, 0, 0x34, 0x12];
+        for _ in 0..3 {
+            body.extend_from_slice(&record(b'T', entry));
+            body.extend_from_slice(&record(b'W', 4));
+        }
+        body.extend_from_slice(&record(b'W', 0));
+        let backup = Backup::decode("copies.bak", &with_end(body.clone())).expect("decodes");
+        assert_eq!(
+            (backup.written_entries.len(), backup.witnesses.len()),
+            (1, 1)
+        );
+        let odd = body.len();
+        body.extend_from_slice(&record(b'T', entry - 1));
+        let error = Backup::decode("odd.bak", &with_end(body)).expect_err("refused");
+        assert!(
+            matches!(&error, Error::BadBackup { offset, .. } if *offset == odd),
+            "{error:?}"
+        );
     }
 
     #[test]

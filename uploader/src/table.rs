@@ -165,7 +165,7 @@ fn read_table_with<E: From<Error>>(
     };
     let flags = read(address, capacity)?;
     let used: Vec<usize> = (0..capacity)
-        .filter(|&slot| flags[slot] & 0x80 != 0)
+        .filter(|&slot| installed::in_use(flags[slot]))
         .collect();
     let entries = match (used.first(), used.last()) {
         (Some(&first), Some(&last)) => {

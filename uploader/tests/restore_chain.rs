@@ -409,3 +409,96 @@ fn held(client: &mut uploader::Client<uploader::transport::VirtualTransport>) ->
     let memory = client.transport().robot().robot().board().memory();
     [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
 }
+
+/// hostile19 F1: an undo file that takes out an extension (it holds the
+/// sum of the entry its upload wrote) without the table's flags there
+/// went through, "verified", and left the table listing an entry of
+/// zeros. Such a file is refused before anything is written.
+#[test]
+fn an_undo_file_that_does_not_free_the_entry_it_takes_out_is_refused() {
+    let (options, _, undo) = plain_replace_undo();
+    let mut client = uploader::client(robot(), &options.profile);
+    let mut kept = Kept::default();
+    let image = extension_at(0x0700);
+    upload_keeping(&mut client, &image, &options, &mut NoProgress, &mut kept).expect("uploaded");
+    let mut file = kept.0.expect("kept");
+    let (table, entries) = options.profile.table.expect("a table");
+    file.areas = without(&file.areas, table..=table + entries as u16 - 1);
+    let before = held(&mut client);
+    let error = restore(&mut client, &file, &undo, &mut NoProgress).expect_err("refused");
+    assert!(
+        error
+            .to_string()
+            .contains("does not put back the table there"),
+        "{error}"
+    );
+    assert!(held(&mut client) == before, "nothing written");
+}
+
+/// hostile19 F2: a witness in the I/O page (a read of the serial chip's
+/// data register eats a received byte), or a table entry record off the
+/// table's entries, was read from the robot before anything else was
+/// checked. Both are refused before the line is used.
+#[test]
+fn witnesses_outside_memory_an_extension_may_hold_are_refused_unread() {
+    let (options, _, undo) = plain_replace_undo();
+    let mut client = uploader::client(robot(), &options.profile);
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0700),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("uploaded");
+    let file = kept.0.expect("kept");
+    let (table, _) = options.profile.table.expect("a table");
+    let io = uploader::Witness {
+        address: 0xC010,
+        len: 4,
+        sum: 0,
+    };
+    let off_entries = uploader::Witness {
+        address: table,
+        len: romlib::installed::ENTRY_LEN as u16,
+        sum: 0,
+    };
+    for (witnesses, entries, what) in [
+        (vec![io], vec![], "outside the memory"),
+        (vec![], vec![off_entries], "not on the table's entries"),
+    ] {
+        let mut file = file.clone();
+        file.witnesses.extend(witnesses);
+        file.written_entries.extend(entries);
+        let sent = client.stats().sent;
+        let error = restore(&mut client, &file, &undo, &mut NoProgress).expect_err("refused");
+        assert!(error.to_string().contains(what), "{error}");
+        assert_eq!(client.stats().sent, sent, "the line is not used: {error}");
+    }
+}
+
+/// `areas` without the bytes in `gone`.
+fn without(areas: &[uploader::Area], gone: std::ops::RangeInclusive<u16>) -> Vec<uploader::Area> {
+    let mut kept: Vec<uploader::Area> = Vec::new();
+    for area in areas {
+        for (offset, &byte) in area.bytes.iter().enumerate() {
+            let address = area.address.wrapping_add(offset as u16);
+            if gone.contains(&address) {
+                continue;
+            }
+            match kept.last_mut() {
+                Some(last)
+                    if u32::from(last.address) + last.bytes.len() as u32 == u32::from(address) =>
+                {
+                    last.bytes.push(byte);
+                }
+                _ => kept.push(uploader::Area {
+                    address,
+                    bytes: vec![byte],
+                }),
+            }
+        }
+    }
+    kept
+}
