@@ -20,12 +20,62 @@ pub const UPLOADING: &str = ".uploading";
 /// upload that did not finish, it is the undo file again.
 pub const BEFORE: &str = ".before";
 
+/// How many earlier uploads' undo files are kept beside the last one's
+/// (`X.undo.1` the upload before it, `X.undo.2` the one before that...):
+/// each `--undo` goes back one upload (fresh19 F1: an upload replaced the
+/// undo file of the one before it, and only the last could be undone).
+pub const EARLIER: usize = 16;
+
+/// The undo file of the `n`th upload before the one `path` undoes.
+#[must_use]
+pub fn earlier(path: &Path, n: usize) -> PathBuf {
+    marked(path, &format!(".{n}"))
+}
+
+/// Which undo file [`further_back`] made the undo file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FurtherBack {
+    /// The one an upload that did not finish found ([`BEFORE`]).
+    Unfinished,
+    /// The earlier upload's ([`earlier`]), with this many more kept.
+    Earlier(usize),
+}
+
 /// After a successful undo of the file at `path` (marked used): an undo
 /// file that goes further back ([`BEFORE`], left by an upload that did
-/// not finish) becomes the undo file. Returns whether there was one.
-pub fn further_back(path: &Path) -> bool {
+/// not finish, or else the earlier upload's) becomes the undo file.
+/// Returns which, if there was one.
+pub fn further_back(path: &Path) -> Option<FurtherBack> {
+    if path.exists() {
+        return None;
+    }
     let before = marked(path, BEFORE);
-    before.is_file() && !path.exists() && std::fs::rename(&before, path).is_ok()
+    if before.is_file() && std::fs::rename(&before, path).is_ok() {
+        return Some(FurtherBack::Unfinished);
+    }
+    if !earlier(path, 1).is_file() || std::fs::rename(earlier(path, 1), path).is_err() {
+        return None;
+    }
+    let mut n = 1;
+    while earlier(path, n + 1).is_file()
+        && std::fs::rename(earlier(path, n + 1), earlier(path, n)).is_ok()
+    {
+        n += 1;
+    }
+    Some(FurtherBack::Earlier(n - 1))
+}
+
+/// Keeps `older`, the undo file of the upload before the one whose file
+/// replaces it, as [`earlier`]`(path, 1)`, each one kept there moved one
+/// further back (the oldest beyond [`EARLIER`] dropped).
+fn keep_earlier(path: &Path, older: &[u8]) -> Result<(), hostfs::Error> {
+    let _ = std::fs::remove_file(earlier(path, EARLIER));
+    for n in (1..EARLIER).rev() {
+        if earlier(path, n).is_file() {
+            let _ = std::fs::rename(earlier(path, n), earlier(path, n + 1));
+        }
+    }
+    hostfs::write(earlier(path, 1), older)
 }
 
 /// The undo file at `path` marked with `mark` (one of [`UNDONE`],
@@ -187,7 +237,17 @@ impl uploader::Keep for UndoFile {
         let name = self.path.display().to_string();
         match earlier.and_then(|earlier| uploader::Backup::decode(&name, &earlier).ok()) {
             Some(earlier) => self.keep(&earlier.going_further_back(kept)),
-            None => self.keep(kept),
+            None => {
+                // The first image of a run: the last upload's file goes
+                // one back.
+                if !self.wrote
+                    && let Some(Some(older)) = &self.older
+                    && let Err(error) = keep_earlier(&self.path, older)
+                {
+                    self.failed = Some(error);
+                }
+                self.keep(kept);
+            }
         }
         self.wrote = true;
         self.older = None;
@@ -201,16 +261,20 @@ impl uploader::Keep for UndoFile {
     /// upload that put the image there, not to "installed".
     /// What the RAM loader went over this time, which the older file may
     /// not hold, is added to it.
-    fn finished_unchanged(&mut self, kept: &uploader::Backup, loader_went_over: &[uploader::Area]) {
+    fn finished_unchanged(
+        &mut self,
+        kept: &uploader::Backup,
+        own: &uploader::Backup,
+        loader_went_over: &[uploader::Area],
+    ) {
         let name = self.path.display().to_string();
         // hostile14 F1: where this upload's loader went over bytes the
         // older file holds (put there since that upload), the older file
         // would lose them: this upload's file is kept, as for a change.
-        let older = self
-            .older
-            .take()
-            .flatten()
-            .and_then(|older| match uploader::Backup::decode(&name, &older) {
+        let found = self.older.take().flatten();
+        let older = found
+            .as_ref()
+            .and_then(|older| match uploader::Backup::decode(&name, older) {
                 Ok(older) => Some(older),
                 Err(error) => {
                     // hostile14 F5: said, not replaced without a word.
@@ -219,14 +283,23 @@ impl uploader::Keep for UndoFile {
                 }
             })
             .filter(|older| {
-                !loader_went_over.iter().any(|area| {
+                let over = loader_went_over.iter().any(|area| {
                     (0..area.bytes.len())
                         .any(|i| older.byte_at(u32::from(area.address) + i as u32).is_some())
-                })
+                });
+                // Kept as a change's would be: one back.
+                if over
+                    && !self.wrote
+                    && let Some(found) = &found
+                    && let Err(error) = keep_earlier(&self.path, found)
+                {
+                    self.failed = Some(error);
+                }
+                !over
             });
         match older {
             Some(older) => {
-                let both = older.going_further_back(kept);
+                let both = older.going_further_back(own);
                 match hostfs::write(&self.path, &both.encode()) {
                     Ok(()) => self.kept_older = true,
                     Err(error) => self.failed = Some(error),
@@ -284,14 +357,14 @@ mod tests {
         // Killed here. The undo of this upload marks its file used.
         drop(undo);
         std::fs::rename(&path, marked(&path, UNDONE)).expect("marked used");
-        assert!(further_back(&path));
+        assert_eq!(further_back(&path), Some(FurtherBack::Unfinished));
         assert_eq!(
             held(&path),
             backup(1),
             "the older file is the undo file again"
         );
         assert!(!marked(&path, BEFORE).exists());
-        assert!(!further_back(&path), "once");
+        assert_eq!(further_back(&path), None, "there is one now");
     }
 
     /// hostile14 F6: a project's second image wrote its upload's undo file
@@ -324,6 +397,7 @@ mod tests {
             backup(1),
             "a change: the older run's file replaced"
         );
+        assert_eq!(held(&earlier(&path, 1)), backup(7), "and kept one back");
         undo.keep(&second);
         undo.finished(&second);
         undo.finished_upload();
@@ -345,7 +419,7 @@ mod tests {
         hostfs::write(&path, &damaged).expect("the older file");
         let mut undo = UndoFile::new(path.clone());
         undo.keep(&backup(2));
-        undo.finished_unchanged(&backup(2), &[]);
+        undo.finished_unchanged(&backup(2), &backup(2), &[]);
         assert_eq!(held(&path), backup(2));
         assert!(!undo.kept_older);
         assert!(undo.older_damaged.is_some());
@@ -372,7 +446,7 @@ mod tests {
                 bytes: vec![9],
             }];
             if unchanged {
-                undo.finished_unchanged(&backup(2), &over);
+                undo.finished_unchanged(&backup(2), &backup(2), &over);
             } else {
                 undo.finished(&backup(2));
             }
@@ -385,6 +459,35 @@ mod tests {
             assert_eq!(undo.kept_older, kept == backup(1));
             assert!(!marked(&path, BEFORE).exists());
             undo.finished_upload();
+        }
+    }
+
+    /// fresh19 F1: each upload that changes the robot keeps the file it
+    /// found one back, and each undo brings the one before back, to
+    /// [`EARLIER`] of them.
+    #[test]
+    fn each_upload_keeps_the_last_ones_file_one_back() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        for n in 1..=EARLIER as u8 + 3 {
+            let mut undo = UndoFile::new(path.clone());
+            undo.keep(&backup(n));
+            undo.finished(&backup(n));
+            undo.finished_upload();
+        }
+        let last = EARLIER as u8 + 3;
+        assert_eq!(held(&path), backup(last));
+        assert!(!earlier(&path, EARLIER + 1).exists(), "the oldest dropped");
+        for n in (3..=last).rev() {
+            assert_eq!(held(&path), backup(n));
+            std::fs::rename(&path, marked(&path, UNDONE)).expect("undone");
+            let back = further_back(&path);
+            if n > 3 {
+                let more = usize::from(n) - 4;
+                assert_eq!(back, Some(FurtherBack::Earlier(more)), "{n}");
+            } else {
+                assert_eq!(back, None, "no more");
+            }
         }
     }
 }

@@ -354,9 +354,9 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             "left installed on the robot: {}; `scorpion upload --undo` puts back what it held before {}",
             report.left_installed.join(", "),
             if report.kept_older_undo {
-                "the earlier run that put them there (this run changed nothing on it)"
+                "the last upload that changed it (this run changed nothing on it; each `--undo` goes back one upload)"
             } else {
-                "this run's uploads (a run that changes an image keeps a new undo file: undo before testing an edit to go back to the robot as it was)"
+                "this run's uploads (each `--undo` goes back one upload: again, to before the one before)"
             }
         );
     }

@@ -17,7 +17,9 @@ use uploader::{
 
 use crate::cmd::ports;
 use scorpion_project::runner::transcript::{self, Clock, TranscriptFailed};
-use scorpion_project::undo::{UNDOING, UNDONE, UPLOADING, UndoFile, Unfinished, marked};
+use scorpion_project::undo::{
+    FurtherBack, UNDOING, UNDONE, UPLOADING, UndoFile, Unfinished, marked,
+};
 
 /// Upload a linked image (`scorpion link` or `scorpion build` output) into
 /// the robot with its own RAM-write commands: every byte verified with
@@ -462,11 +464,21 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         }
         // An upload that did not finish is undone too.
         let _ = std::fs::remove_file(marked(&path, UPLOADING));
-        if scorpion_project::undo::further_back(&path) {
-            print(&format!(
+        match scorpion_project::undo::further_back(&path) {
+            Some(FurtherBack::Unfinished) => print(&format!(
                 "{} now holds the undo of the upload before that one (the one undone did not finish): `scorpion upload --undo` again puts back what the robot held before it\n",
                 path.display()
-            ));
+            )),
+            Some(FurtherBack::Earlier(more)) => print(&format!(
+                "{} now holds the undo of the upload before that one: `scorpion upload --undo` again puts back what the robot held before it ({})\n",
+                path.display(),
+                match more {
+                    0 => "the last undo file kept".to_owned(),
+                    1 => "1 more kept before it".to_owned(),
+                    n => format!("{n} more kept before it"),
+                }
+            )),
+            None => {}
         }
         return Ok(code);
     }
@@ -507,8 +519,9 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
         Err(error) if error.is_not_found() && used.is_file() => Err(miette::miette!(
             code = "upload::already_undone",
             help = format!(
-                "a successful undo keeps its undo file as {}; the next upload keeps a new one",
-                used.display()
+                "a successful undo keeps its undo file as {}, and the undo file of the upload before takes its place: none is left (the last {} uploads' are kept). `scorpion restore` of a backup goes further back",
+                used.display(),
+                scorpion_project::undo::EARLIER + 1
             ),
             "nothing to undo: the last upload kept in {} is already undone",
             path.display()
@@ -689,7 +702,7 @@ fn upload_file(
     if undo.kept_older {
         let _ = writeln!(
             out,
-            "the robot held this image already, installed as it is now: {} still puts back what it held before the upload that put it there",
+            "the robot held this image already, installed as it is now: {} still undoes the last upload that changed the robot",
             undo.path.display()
         );
         // fresh17 F1: what was written then is the image's data (a

@@ -663,7 +663,7 @@ fn test_on_a_port_keeps_the_projects_undo_file() {
     // to the robot as it was before the first run, and says so.
     let again = ok(&project, &line, &["test"]);
     assert!(
-        again.contains("puts back what it held before the earlier run that put them there"),
+        again.contains("puts back what it held before the last upload that changed it (this run changed nothing on it"),
         "{again}"
     );
     let uploaded = ok(&project, &line, &["upload"]);
@@ -811,21 +811,7 @@ fn a_test_on_a_port_interrupted_during_its_upload_says_so() {
 #[test]
 fn a_two_image_project_tested_twice_is_undone_to_the_robot_before() {
     let dir = tempfile::tempdir().expect("temporary directory");
-    let (project, _) = crate::new_project(dir.path());
-    let layout =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/checksum/checksum.toml");
-    std::fs::copy(layout, project.join("src/second.toml")).expect("the layout");
-    std::fs::write(
-        project.join("src/second.s"),
-        "        .include \"scorpion.inc\"\n        .code\n        SCORPION_UNKNOWN_HANDLER\n        cmp #'U'\n        bne other\n        lda #'U'\n        jsr PUTCH\n        jsr PUTEOL\n        jmp CMD_DONE\nother:  SCORPION_CHAIN_UNKNOWN\n",
-    )
-    .expect("the second source");
-    let manifest = std::fs::read_to_string(project.join("Scorpion.toml")).expect("the manifest");
-    let manifest = manifest.replace(
-        "[robot]",
-        "[[image]]\nname = \"second\"\nsources = [\"src/second.s\"]\ntarget = \"src/second.toml\"\n\n[robot]",
-    );
-    std::fs::write(project.join("Scorpion.toml"), manifest).expect("the manifest");
+    let project = two_image_project(dir.path(), 'U');
     let sim = Sim::start(dir.path(), &[]);
     let line = ["--port", sim.path.as_str()];
     let before = ok(&project, &line, &["read", "$0200", "3"]);
@@ -836,7 +822,7 @@ fn a_two_image_project_tested_twice_is_undone_to_the_robot_before() {
     );
     let again = ok(&project, &line, &["test"]);
     assert!(
-        again.contains("puts back what it held before the earlier run that put them there"),
+        again.contains("puts back what it held before the last upload that changed it (this run changed nothing on it"),
         "{again}"
     );
     let listed = ok(&project, &line, &["installed"]);
@@ -894,4 +880,96 @@ fn undos_out_of_order_after_an_unchanged_upload_leave_the_robot_as_before() {
             );
         }
     }
+}
+
+/// fresh19 F1: an upload replaced the undo file of the upload before it
+/// (a `test --port` run's, not yet used), and only the last upload could
+/// be undone. Each upload keeps the one before one back: `--undo` goes
+/// back one upload at a time, to the robot as it was before both.
+#[test]
+fn each_undo_goes_back_one_upload() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(d.join("first.elf"), extension_at(0x0C00, 200, None)).expect("the image");
+    let sim = Sim::start(d, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let before = ok(d, &line, &["read", "$0200", "3"]);
+    drop(sim);
+    let sim = two_installed(d, 300);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    assert!(ok(d, &line, &["read", "$0200", "3"]).contains("4C 03 04"));
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(
+        text.contains("now holds the undo of the upload before that one"),
+        "{text}"
+    );
+    assert!(ok(d, &line, &["read", "$0200", "3"]).contains("4C 03 0C"));
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    assert_eq!(ok(d, &line, &["read", "$0200", "3"]), before);
+    let listed = ok(d, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
+    let (success, text) = on(d, &line, &["upload", "--undo"]);
+    assert!(!success && text.contains("already undone"), "{text}");
+}
+
+/// `scorpion new myext` in `dir` with a second image at $0C00 whose
+/// handler answers `/1U` with `answer`.
+fn two_image_project(dir: &std::path::Path, answer: char) -> std::path::PathBuf {
+    let (project, _) = crate::new_project(dir);
+    let layout =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/checksum/checksum.toml");
+    std::fs::copy(layout, project.join("src/second.toml")).expect("the layout");
+    second_answers(&project, answer);
+    let manifest = std::fs::read_to_string(project.join("Scorpion.toml")).expect("the manifest");
+    let manifest = manifest.replace(
+        "[robot]",
+        "[[image]]\nname = \"second\"\nsources = [\"src/second.s\"]\ntarget = \"src/second.toml\"\n\n[robot]",
+    );
+    std::fs::write(project.join("Scorpion.toml"), manifest).expect("the manifest");
+    project
+}
+
+/// Writes the second image's source, answering `/1U` with `answer`.
+fn second_answers(project: &std::path::Path, answer: char) {
+    std::fs::write(
+        project.join("src/second.s"),
+        format!("        .include \"scorpion.inc\"\n        .code\n        SCORPION_UNKNOWN_HANDLER\n        cmp #'U'\n        bne other\n        lda #'{answer}'\n        jsr PUTCH\n        jsr PUTEOL\n        jmp CMD_DONE\nother:  SCORPION_CHAIN_UNKNOWN\n"),
+    )
+    .expect("the second source");
+}
+
+/// fresh19 F10: a project tested on a port, another extension uploaded in
+/// front, then the second image edited and tested again with `--replace`:
+/// the undo was refused at once (`witness_differs`), the other upload's
+/// file witnessing the second image's handler as it was. The witness is
+/// checked against what the robot holds once the file is written.
+#[test]
+fn the_undo_of_a_run_that_replaced_an_image_another_upload_witnessed_goes_through() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = two_image_project(dir.path(), 'U');
+    std::fs::write(
+        dir.path().join("friend.elf"),
+        extension_at(0x0800, 100, None),
+    )
+    .expect("the image");
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    let before = ok(&project, &line, &["read", "$0200", "3"]);
+    ok(&project, &line, &["test"]);
+    ok(
+        &project,
+        &line,
+        &["upload", "../friend.elf", "--no-dry-run"],
+    );
+    second_answers(&project, 'V');
+    let run = ok(&project, &line, &["test", "--replace"]);
+    assert!(ok(&project, &line, &["ask", "/1U"]).contains('V'), "{run}");
+    let undone = ok(&project, &line, &["upload", "--undo"]);
+    assert!(undone.contains("restored"), "{undone}");
+    let undone = ok(&project, &line, &["upload", "--undo"]);
+    assert!(undone.contains("restored"), "{undone}");
+    assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
 }

@@ -95,17 +95,18 @@ pub trait Keep {
     /// Called in place of [`Keep::finished`] when the upload left the
     /// robot as it found it (the same image, installed as it was, the
     /// hooks where they were: read back to be sure), but for the RAM
-    /// loader, which `kept` holds what it went over of (`kept` holds
-    /// neither the table nor the memory of the other extensions installed,
-    /// which the upload left as found and an older file must not get as
-    /// this upload found them): what an earlier
-    /// upload of it kept, with that ([`Backup::going_further_back`]),
+    /// loader, which `kept` holds what it went over of: what an earlier
+    /// upload of it kept, with `own` ([`Backup::going_further_back`]),
     /// undoes this one too and goes further back, unless it holds bytes
     /// where `loader_went_over` (the loader's code written this time over
     /// other bytes, which an older file would put back as they were before
-    /// it, losing these). By default, [`Keep::finished`].
-    fn finished_unchanged(&mut self, kept: &Backup, loader_went_over: &[Area]) {
-        let _ = loader_went_over;
+    /// it, losing these); then `kept` is this upload's undo, as a change's.
+    /// `own` is `kept` without the table and the memory of the other
+    /// extensions installed, which the upload left as found and an older
+    /// file must not take as this upload found them (recheck17 F2). By
+    /// default, [`Keep::finished`].
+    fn finished_unchanged(&mut self, kept: &Backup, own: &Backup, loader_went_over: &[Area]) {
+        let _ = (own, loader_went_over);
         self.finished(kept);
     }
 }
@@ -851,9 +852,14 @@ impl Backup {
     #[must_use]
     pub fn going_further_back(mut self, later: &Backup) -> Backup {
         for entry in &later.written_entries {
-            if !self.written_entries.contains(entry) {
-                self.written_entries.push(*entry);
-            }
+            // An entry the later upload wrote again (a `--replace` at the
+            // same slot) is as it wrote it.
+            let end = u32::from(entry.address) + u32::from(entry.len);
+            self.written_entries.retain(|earlier| {
+                u32::from(earlier.address) + u32::from(earlier.len) <= u32::from(entry.address)
+                    || u32::from(earlier.address) >= end
+            });
+            self.written_entries.push(*entry);
         }
         let mut added: Vec<Area> = Vec::new();
         for area in &later.areas {
@@ -931,9 +937,25 @@ fn check_witnesses<T: Transport>(
     resume: bool,
 ) -> Result<()> {
     let table = table_range(profile);
-    for witness in backup.witnesses.iter().chain(&backup.written_entries) {
+    // An older file witnessed its entry among the code's witnesses.
+    let code = (backup.witnesses.iter()).map(|witness| (witness, !within(table, witness.address)));
+    let entries = backup.written_entries.iter().map(|entry| (entry, false));
+    for (witness, code) in code.chain(entries) {
         let bytes = client.read_memory(witness.address, usize::from(witness.len))?;
-        let found = crate::sums::fletcher16(&bytes);
+        // The code a hook goes back to as the robot will hold it once the
+        // file is written: a file that undoes two uploads holds bytes the
+        // later one rewrote under the earlier one's witness, as they were
+        // (fresh19 F10: a project run whose second image replaced the
+        // handler an earlier upload's file witnessed could not be undone).
+        // An entry is the robot's as the upload wrote it.
+        let after: Vec<u8> = (0..u32::from(witness.len))
+            .zip(&bytes)
+            .map(|(i, &now)| {
+                let held = backup.byte_at(u32::from(witness.address) + i);
+                held.filter(|_| code).unwrap_or(now)
+            })
+            .collect();
+        let found = crate::sums::fletcher16(&after);
         // What the file itself puts there, where its restore stopped half
         // way (killed, a dead line) and wrote it already: finishing it is
         // what the file is for. Only then: a fresh robot's zeros may be

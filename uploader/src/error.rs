@@ -250,7 +250,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::undo_not_last),
         help(
-            "undo the later upload first (`scorpion upload --undo --undo-file FILE` with its undo file), or take the extension out with `scorpion upload --replace`"
+            "undo the later upload first: `scorpion upload --undo` where it was made (each undo goes back one upload, the last first), or `--undo-file FILE` with its undo file"
         )
     )]
     UndoNotLast {

@@ -810,7 +810,7 @@ pub fn upload_keeping<T: Transport>(
             let own = crate::unchanged::own_memory(&kept, profile, others);
             let code_byte = |address: u16| session.as_ref().and_then(|s| s.code_byte(address));
             let over = crate::unchanged::loader_went_over(&own, &code_byte);
-            keep.finished_unchanged(&own, &over);
+            keep.finished_unchanged(&kept, &own, &over);
         } else {
             keep.finished(&kept);
         }

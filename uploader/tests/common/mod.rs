@@ -51,7 +51,12 @@ impl uploader::Keep for Kept {
         self.0 = Some(overwritten.clone());
     }
 
-    fn finished_unchanged(&mut self, kept: &uploader::Backup, _over: &[uploader::Area]) {
+    fn finished_unchanged(
+        &mut self,
+        kept: &uploader::Backup,
+        _own: &uploader::Backup,
+        _over: &[uploader::Area],
+    ) {
         self.keep(kept);
         self.1 = true;
     }
