@@ -138,7 +138,9 @@ pub(crate) fn restore_into(
         force_rom,
         loader,
         resume,
-        undo: started.is_some(),
+        // hostile19 F7: an undo file given to `restore` is checked as an
+        // undo (only an upload's file records the entries it wrote).
+        undo: started.is_some() || !backup.written_entries.is_empty(),
         ..UploadOptions::default()
     };
     if resume {

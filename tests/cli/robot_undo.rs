@@ -973,3 +973,25 @@ fn the_undo_of_a_run_that_replaced_an_image_another_upload_witnessed_goes_throug
     let listed = ok(&project, &line, &["installed"]);
     assert!(listed.contains("nothing installed"), "{listed}");
 }
+
+/// hostile19 F7: `scorpion restore` of an upload's undo file (its help
+/// allows one) skipped the undo's checks: with a later upload in front,
+/// it went through and the table listed what was no longer there. An
+/// undo file is checked as an undo whichever command is given it.
+#[test]
+fn restore_of_an_undo_file_is_checked_as_an_undo() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(d.join("a.elf"), extension_at(0x0C00, 200, None)).expect("the image");
+    std::fs::write(d.join("b.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    let sim = Sim::start(d, &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let a = ["upload", "a.elf", "--no-dry-run", "--undo-file", "a.undo"];
+    ok(d, &line, &a);
+    ok(d, &line, &["upload", "b.elf", "--no-dry-run"]);
+    let before = ok(d, &line, &["installed"]);
+    let (success, text) = on(d, &line, &["restore", "a.undo"]);
+    assert!(!success, "{text}");
+    assert!(text.contains("undo_not_last"), "{text}");
+    assert_eq!(ok(d, &line, &["installed"]), before, "nothing written");
+}

@@ -1030,18 +1030,16 @@ pub fn restore<T: Transport>(
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
+    // A debug stub a killed session left hooked: its breakpoints are not
+    // the backup's to take out. Said first (fresh19 F11: an undo called it
+    // a later upload chained ahead).
+    crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
     if options.undo {
-        // Read once for both looks (a restore that stopped half way has
-        // passed them already, and may have written part of the table).
+        // Read once for both looks.
         let undone = undone_extensions(client, backup, profile)?;
         refuse_later_uploads(client, backup, profile, (&hooks, &undone.0))?;
-        if !options.resume {
-            refuse_later_entries(backup, profile, &undone)?;
-        }
+        refuse_later_entries(backup, (profile, options.resume), &undone)?;
     }
-    // A debug stub a killed session left hooked: its breakpoints are not
-    // the backup's to take out.
-    crate::stub::left::refuse_hooked(client, profile, &hooks, &|_| false)?;
     // The ROM the backup was taken from first: a robot with another ROM
     // is told as that (`restore --force` overrides it), not as a ROM the
     // profile's image was linked against.
@@ -1203,9 +1201,14 @@ fn undone_extensions<T: Transport>(
 /// `--replace` of an extension the upload being undone chained in front
 /// of, whose handler stayed where it was: recheck18 F1), and the undo
 /// would list the old extension over the new one's code.
+///
+/// A restore that stopped half way (`resume`) may have put back part of an
+/// entry: one whose first byte is the file's already is let through
+/// (hostile19 F8: another upload between the two halves of an undo was
+/// not looked for, and the undo listed the old extension over its code).
 fn refuse_later_entries(
     backup: &Backup,
-    profile: &RomProfile,
+    (profile, resume): (&RomProfile, bool),
     (undone, others): &Undone,
 ) -> Result<()> {
     // hostile19 F1: the file takes out what its upload put in: the table's
@@ -1246,7 +1249,11 @@ fn refuse_later_entries(
                 backup.byte_at(address).is_some_and(|put| put != now)
             })
         });
-        if changed {
+        let begun = || {
+            let first = &areas[1];
+            resume && backup.byte_at(u32::from(first.address)) == first.bytes.first().copied()
+        };
+        if changed && !begun() {
             return Err(Error::UndoEntryChanged {
                 id: entry.id,
                 at: areas[1].address,

@@ -200,6 +200,32 @@ fn a_restore_over_a_stub_left_hooked_is_refused() {
     assert!(written(&mut client) == before, "something was written");
 }
 
+/// fresh19 F11: the undo of the upload a killed session debugged was
+/// refused as "a later upload was chained ahead", with advice that could
+/// not help; the stub is named, as an upload and a restore name it.
+#[test]
+fn an_undo_over_a_stub_left_hooked_names_the_stub() {
+    let image = handler();
+    let mut client = uploaded(&[]);
+    let mut kept = common::Kept::default();
+    uploader::upload_keeping(&mut client, &image, &options(), &mut NoProgress, &mut kept)
+        .expect("uploaded");
+    let mut first = attach(client, &image);
+    first.set_breakpoint(AT, &[]).expect("set");
+    let mut client = first.abandon();
+    let before = written(&mut client);
+    let undo = UploadOptions {
+        undo: true,
+        ..options()
+    };
+    let result = uploader::restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress);
+    assert!(
+        matches!(result, Err(Error::DebugStubHooked { .. })),
+        "{result:?}"
+    );
+    assert!(written(&mut client) == before, "something was written");
+}
+
 #[test]
 fn the_stub_goes_beside_an_installed_extension_not_over_it() {
     // An extension at the very top of user RAM, where the stub went.
