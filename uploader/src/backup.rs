@@ -1078,7 +1078,9 @@ pub fn restore<T: Transport>(
             };
             reports.push(upload(client, &image, &rom, progress)?);
         }
+        table_again(client, backup, (&memory, table_range(profile)), progress)?;
     }
+    let whole_table = (!backup.areas.is_empty()).then(|| (&memory, table_range(profile)));
     // recheck17 F3: a hook whose way is broken stays at the ROM's target;
     // the others, whose ways are fine, are restored all the same.
     let refused = crate::chain::check_restored(client, profile, &backup.hooks)?;
@@ -1089,10 +1091,63 @@ pub fn restore<T: Transport>(
         .filter(|(kind, _)| !refused.iter().any(|(broken, _)| broken == kind))
         .collect();
     switch_hooks(client, profile, &fine, options.max_writes)?;
+    // And once the hooks are in: a reset as they went in cleared the table
+    // again (the code they reach is in place: a reset keeps user RAM).
+    if let Some(table) = whole_table {
+        table_again(client, backup, table, progress)?;
+    }
     if let Some((_, error)) = refused.into_iter().next() {
         return Err(error);
     }
     Ok(reports)
+}
+
+/// hostile19 F5: a reset (`/1R`) while the memory went in clears the
+/// table (and the hooks, which are still at the ROM's targets then): the
+/// table is read again before any hook moves, and what the file holds of
+/// it written again, with the ROM's commands, where a reset cleared it.
+/// Without it the hooks went to code the table no longer listed, and the
+/// undo said "verified".
+fn table_again<T: Transport>(
+    client: &mut Client<T>,
+    backup: &Backup,
+    (memory, table): (&UploadOptions, Option<(u16, usize)>),
+    progress: &mut dyn Progress,
+) -> Result<()> {
+    let Some((at, len)) = table else {
+        return Ok(());
+    };
+    let held: Vec<Option<u8>> = (0..len)
+        .map(|i| backup.byte_at(u32::from(at) + i as u32))
+        .collect();
+    if held.iter().all(Option::is_none) {
+        return Ok(());
+    }
+    if client
+        .read_expecting(at, &held)?
+        .iter()
+        .zip(&held)
+        .all(|(now, held)| held.is_none_or(|held| held == *now))
+    {
+        return Ok(());
+    }
+    let mut areas: Vec<Area> = Vec::new();
+    for (i, byte) in held.iter().enumerate() {
+        if let Some(byte) = byte {
+            crate::delta::push(&mut areas, at + i as u16, &[*byte]);
+        }
+    }
+    let rom = UploadOptions {
+        loader: LoaderChoice::Never,
+        ..memory.clone()
+    };
+    upload(
+        client,
+        &UploadImage::new(areas, Vec::new())?,
+        &rom,
+        progress,
+    )?;
+    Ok(())
 }
 
 /// An undo puts a hook back where it was before the upload it undoes: so

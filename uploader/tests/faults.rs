@@ -455,8 +455,75 @@ fn a_reset_or_noise_in_the_middle_of_a_restore_leaves_no_hook_on_unverified_code
         let transport = client.into_transport().into_inner();
         assert_safe(transport.robot(), &image, &outcome);
         let mut client = uploader::client(transport, &options.profile);
+        if result.is_ok() {
+            listed_if_hooked(&mut client, &image, &outcome);
+        }
         uploader::restore(&mut client, &saved, &options, &mut NoProgress)
             .unwrap_or_else(|error| panic!("{outcome}, then: {error}"));
         assert_done(client.into_transport(), &image, &outcome);
+    }
+}
+
+/// hostile19 F5: a reset while a restore's memory went in cleared the
+/// table it had written, and the restore hooked the extension all the
+/// same, "verified": the table listed nothing. Wherever the reset falls,
+/// a restore that says it finished leaves the hooked extension listed.
+#[test]
+fn a_reset_anywhere_in_a_restore_that_finishes_leaves_the_table_listing_what_is_hooked() {
+    let image = extension(256, 31);
+    let options = UploadOptions {
+        loader: LoaderChoice::Never,
+        ..UploadOptions::default()
+    };
+    let (installed, transport) = run(robot(), &image, &options);
+    installed.expect("installed");
+    let mut client = uploader::client(transport, &options.profile);
+    let saved = uploader::backup(&mut client, &options.profile).expect("a backup");
+    let sent = {
+        let mut client = uploader::client(robot(), &options.profile);
+        uploader::restore(&mut client, &saved, &options, &mut NoProgress).expect("restored");
+        client.stats().sent
+    };
+    let mut finished = 0;
+    for at in (0..sent).step_by(97) {
+        let mut client = uploader::client(
+            FaultyTransport::new(
+                robot(),
+                FaultConfig {
+                    reset_after: Some(at),
+                    ..FaultConfig::none(5)
+                },
+            ),
+            &options.profile,
+        );
+        let result = uploader::restore(&mut client, &saved, &options, &mut NoProgress);
+        let outcome = format!("/1R after {at} of {sent}: {result:?}");
+        let transport = client.into_transport().into_inner();
+        assert_safe(transport.robot(), &image, &outcome);
+        if result.is_ok() {
+            finished += 1;
+            let mut client = uploader::client(transport, &options.profile);
+            listed_if_hooked(&mut client, &image, &outcome);
+        }
+    }
+    assert!(finished > 0, "no restore finished");
+}
+
+/// Whether HOOK_UNKNOWN leads to `image`'s handler, and if so, that the
+/// robot's table lists it.
+fn listed_if_hooked(
+    client: &mut uploader::Client<uploader::transport::VirtualTransport>,
+    image: &uploader::UploadImage,
+    outcome: &str,
+) {
+    let memory = client.transport().robot().robot().board().memory();
+    let (_, hook) = common::target(memory, HOOK_UNKNOWN);
+    if image.hooks().iter().any(|record| record.handler == hook) {
+        let listed = uploader::read_installed(client, &uploader::RomProfile::reference())
+            .expect("the table");
+        assert!(
+            listed.iter().any(|entry| entry.id == image.id()),
+            "hooked but not listed ({outcome}): {listed:?}"
+        );
     }
 }
