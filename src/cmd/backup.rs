@@ -51,6 +51,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         changing,
         broken,
         outside,
+        damaged_table,
     } = uploader::backup_live(&mut client, &profile)?;
     hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
@@ -76,6 +77,12 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             },
             uploader::addresses_text(&changing),
             if changing.len() == 1 { "it" } else { "them" },
+        ));
+    }
+    if let Some(damaged) = &damaged_table {
+        // hostile19 F4: said now, not first at the restore that refuses it.
+        print(&format!(
+            "warning: the robot's table of installed extensions does not decode ({damaged}): a restore of this file is refused; `/1R` clears the table, then upload the extensions again"
         ));
     }
     for entry in &outside {

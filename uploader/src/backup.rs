@@ -410,6 +410,10 @@ pub struct Saved {
     /// operating system in KIM-bus RAM): the file only witnesses it, and
     /// a restore after it has gone is refused (fresh17 F4).
     pub outside: Vec<romlib::installed::Installed>,
+    /// What is wrong with the robot's table of installed extensions, where
+    /// it does not decode (changed by hand): a restore of the file refuses
+    /// it before anything moves (hostile19 F4).
+    pub damaged_table: Option<String>,
 }
 
 /// A hook whose way is no way for a command to go.
@@ -488,11 +492,13 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
             }
         }
     }
+    let damaged_table = damaged_table(profile, &backup);
     Ok(Saved {
         backup,
         changing,
         broken,
         outside,
+        damaged_table,
     })
 }
 
@@ -826,18 +832,33 @@ fn in_rom(profile: &RomProfile, target: u16) -> bool {
     })
 }
 
+/// What is wrong with the backup's copy of the table, where it does not
+/// decode.
+fn damaged_table(profile: &RomProfile, backup: &Backup) -> Option<String> {
+    decoded_table(profile, backup)?.err()
+}
+
+/// The backup's copy of the table, decoded (`None` for a ROM without a
+/// table; bytes the file does not hold are taken as zeros).
+fn decoded_table(
+    profile: &RomProfile,
+    backup: &Backup,
+) -> Option<std::result::Result<Vec<romlib::installed::Installed>, String>> {
+    let (at, entries) = profile.table?;
+    let len = entries * (1 + romlib::installed::ENTRY_LEN);
+    let held: Vec<u8> = (0..len)
+        .map(|i| backup.byte_at(u32::from(at) + i as u32).unwrap_or(0))
+        .collect();
+    Some(romlib::installed::decode_table(at, entries, &held).map_err(|damaged| damaged.to_string()))
+}
+
 /// The extensions the backup's copy of the table lists (none where it
 /// holds no table, or one that does not decode: the hooks' targets are
 /// then witnessed by their first bytes).
 fn backup_table(profile: &RomProfile, backup: &Backup) -> Vec<romlib::installed::Installed> {
-    let Some((at, entries)) = profile.table else {
-        return Vec::new();
-    };
-    let len = entries * (1 + romlib::installed::ENTRY_LEN);
-    let bytes: Vec<u8> = (0..len)
-        .map(|i| backup.byte_at(u32::from(at) + i as u32).unwrap_or(0))
-        .collect();
-    romlib::installed::decode_table(at, entries, &bytes).unwrap_or_default()
+    decoded_table(profile, backup)
+        .and_then(std::result::Result::ok)
+        .unwrap_or_default()
 }
 
 impl Backup {
@@ -1026,6 +1047,15 @@ pub fn restore<T: Transport>(
     };
     check_hook_targets(backup, &memory.profile, table_range(profile))?;
     check_records(backup, &memory.profile, profile.table)?;
+    if let Some(damaged) = damaged_table(profile, backup) {
+        // hostile19 F4: the hooks went to the ROM first, and every restore
+        // of it failed after.
+        return Err(Error::BadImage {
+            reason: format!(
+                "the file's table of installed extensions does not decode ({damaged}): it was damaged on the robot when it was saved; nothing was written"
+            ),
+        });
+    }
     refuse_held_stub(backup, profile)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.

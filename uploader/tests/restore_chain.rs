@@ -502,3 +502,29 @@ fn without(areas: &[uploader::Area], gone: std::ops::RangeInclusive<u16>) -> Vec
     }
     kept
 }
+
+/// hostile19 F4: a backup of a robot whose table was damaged by hand said
+/// only "saved"; its restore moved the hooks to the ROM and then failed,
+/// every time. The backup says so, and the restore refuses it before
+/// anything moves.
+#[test]
+fn a_backup_of_a_damaged_table_says_so_and_its_restore_moves_nothing() {
+    let (options, mut client) = one_installed();
+    let (table, _) = options.profile.table.expect("a table");
+    // The MORE bit on an entry that continues none.
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(table + 2, &[0xC0])
+        .expect("RAM");
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    let damaged = saved.damaged_table.expect("said");
+    assert!(damaged.contains("continues no entry"), "{damaged}");
+    let before = held(&mut client);
+    let error =
+        restore(&mut client, &saved.backup, &options, &mut NoProgress).expect_err("refused");
+    assert!(error.to_string().contains("does not decode"), "{error}");
+    assert!(held(&mut client) == before, "nothing moved");
+}
