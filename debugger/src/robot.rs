@@ -356,7 +356,18 @@ impl RobotMonitor {
                     ));
                 }
                 let over = matches!(verb, "next" | "n" | "nexti" | "ni");
-                let heard = d.step(&self.entries, over, WAIT).map_err(failure)?;
+                // fresh19 F6: the refusal names the command given.
+                let heard = d
+                    .step(&self.entries, over, WAIT)
+                    .map_err(|error| match error {
+                        uploader::stub::StubError::Refused { what, reason } if what == "step" => {
+                            failure(uploader::stub::StubError::Refused {
+                                what: if over { "next" } else { "step" }.into(),
+                                reason,
+                            })
+                        }
+                        other => failure(other),
+                    })?;
                 let mut text = self.heard(d, &heard)?;
                 if matches!(heard, Heard::Answer(_)) {
                     // The instruction ended the answer (`JSR PUTEOL`): the
@@ -447,7 +458,7 @@ impl RobotMonitor {
         mut text: String,
     ) -> Result<String, Failure> {
         if let Some(registers) = d.take_unasked() {
-            text.push_str("(a stop not asked for) ");
+            text.push_str("(a stop no command waited for) ");
             text.push_str(&self.heard(d, &Heard::Stopped(registers))?);
             text.push_str(&garbled_own(&registers));
         }
@@ -470,7 +481,7 @@ impl RobotMonitor {
             None => Ok(None),
             Some(heard) => {
                 let what = match heard {
-                    Heard::Stopped(_) => "(a stop not asked for) ",
+                    Heard::Stopped(_) => "(a stop no command waited for) ",
                     _ => "(unasked) ",
                 };
                 if let Heard::Answer(_) = heard {
@@ -830,7 +841,7 @@ fn read_for_person<T: Transport>(
     d.read_live_as_program(address, len).map_err(failure)
 }
 
-/// fresh15 F6: a stop not asked for whose A and X are a command the
+/// fresh15 F6: a stop no command waited for whose A and X are a command the
 /// monitor itself sends (a `/7R` read, a `/9W` or `/7W` write, a `/1X`)
 /// is most likely that command, garbled on a noisy line into one the ROM
 /// passed down `HOOK_UNKNOWN` (a well-formed one never goes there): said,

@@ -87,6 +87,11 @@ fn what_a_robot_cannot_do_is_refused_with_the_reason() {
         let why = refusal(&mut m, &mut d, line);
         assert!(why.contains(reason), "`{line}`: {why}");
     }
+    // fresh19 F6: `next` while it runs is refused as `next`.
+    for (line, said) in [("next", "next is refused"), ("step", "step is refused")] {
+        let why = format!("{:?}", m.command(&mut d, line).expect_err("refused"));
+        assert!(why.contains(said), "`{line}`: {why}");
+    }
     // At a stop, commands down the line wait for `continue`.
     text(&mut m, &mut d, "break $040C");
     assert!(text(&mut m, &mut d, "/1Q").contains("stopped: breakpoint 1, $040C"));
@@ -161,7 +166,7 @@ fn a_stop_while_idle_is_noticed() {
         .expect("the line")
         .expect("a stop");
     assert!(
-        noticed.contains("(a stop not asked for) stopped: breakpoint 1, $040C"),
+        noticed.contains("(a stop no command waited for) stopped: breakpoint 1, $040C"),
         "{noticed}"
     );
     assert!(text(&mut m, &mut d, "regs").contains("PC=$040C"));
@@ -305,7 +310,7 @@ fn a_stop_whose_frame_was_lost_is_found_before_a_command_that_needs_one() {
     );
     let shown = text(&mut m, &mut d, "regs");
     assert!(
-        shown.contains("(a stop not asked for) stopped: breakpoint 1, $040C"),
+        shown.contains("(a stop no command waited for) stopped: breakpoint 1, $040C"),
         "{shown}"
     );
     assert!(shown.contains("PC=$040C"), "{shown}");

@@ -301,7 +301,10 @@ impl uploader::Keep for UndoFile {
             Some(older) => {
                 let both = older.going_further_back(own);
                 match hostfs::write(&self.path, &both.encode()) {
-                    Ok(()) => self.kept_older = true,
+                    // fresh19 F8: a run's later image found the file its
+                    // first image wrote: no older upload's unless the
+                    // first kept one.
+                    Ok(()) => self.kept_older = !self.wrote || self.kept_older,
                     Err(error) => self.failed = Some(error),
                 }
             }
@@ -488,6 +491,22 @@ mod tests {
             } else {
                 assert_eq!(back, None, "no more");
             }
+        }
+    }
+
+    /// fresh19 F8: a run of two images that changed nothing, with no undo
+    /// file before it: the second found the first's and said the file
+    /// "still puts back what it held before the upload that put it there".
+    #[test]
+    fn a_run_with_no_older_file_does_not_say_it_kept_one() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        let mut undo = UndoFile::new(path.clone());
+        for n in [1, 2] {
+            undo.keep(&backup(n));
+            undo.finished_unchanged(&backup(n), &backup(n), &[]);
+            undo.finished_upload();
+            assert!(!undo.kept_older, "image {n}");
         }
     }
 }

@@ -30,11 +30,11 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             uploader::chain_of(&mut client, &profile, &everyone, kind)?,
         ));
     }
-    let mut text = listing(&everyone, &chains);
     // A chain that ends at no extension's handler may end at a debug stub
     // a killed session left: the user must hear of it here, before an
     // upload refuses it.
-    for (kind, targets) in &chains {
+    let mut text = String::new();
+    for (kind, targets) in &mut chains {
         let Some(&last) = targets.last() else {
             continue;
         };
@@ -71,8 +71,17 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
                 stub.previous,
                 client.transport().name(),
             );
+            // fresh19 F5: what it chains to is reached through it.
+            let onward = (*kind, stub.previous);
+            targets.extend(uploader::chain_from(
+                &mut client,
+                &profile,
+                &everyone,
+                onward,
+            )?);
         }
     }
+    let text = listing(&everyone, &chains) + text.as_str();
     std::io::stdout()
         .lock()
         .write_all(text.as_bytes())

@@ -462,7 +462,7 @@ fn a_breakpoint_in_the_control_loops_handler_stops_there_and_quit_lets_go() {
     for expected in [
         "breakpoint 1: $",
         "(rom)",
-        "(a stop not asked for) stopped: breakpoint 1, $",
+        "(a stop no command waited for) stopped: breakpoint 1, $",
         // fresh11 F7: the stop names its source line.
         " at patrol.s:",
         "breakpoint 1: $",

@@ -65,4 +65,6 @@ fn installed_names_a_stub_a_killed_monitor_left_hooked() {
         said.contains(&format!("scorpion debug --port {}", sim.path)),
         "{printed}"
     );
+    // fresh19 F5: the extension the stub chains to is reached through it.
+    assert!(!said.contains("not hooked"), "{printed}");
 }

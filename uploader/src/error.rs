@@ -245,7 +245,7 @@ pub enum Error {
     /// An undo of an upload that is no longer the last on a hook: the
     /// hook leads first to code the undo file does not put back.
     #[error(
-        "{hook} leads first to ${current:04X}{owner}, which this undo does not take out: an upload after the one it undoes was chained ahead of it, and the undo would unhook that too; nothing was written"
+        "{hook} leads first to ${current:04X}{owner}, which this undo does not take out: an upload after the one it undoes put it there (chained ahead, or on a hook the undone upload left alone), and the undo would unhook that too; nothing was written"
     )]
     #[diagnostic(
         code(uploader::undo_not_last),

@@ -63,7 +63,7 @@ pub use loader::{
 };
 pub use progress::{Event, NoProgress, Phase, Progress};
 pub use sums::fletcher16;
-pub use table::{chain_of, read_installed};
+pub use table::{chain_from, chain_of, read_installed};
 pub use transport::Transport;
 pub use upload::{
     InstalledHook, LoaderChoice, LoaderReport, UploadOptions, UploadReport, client, upload,

@@ -583,6 +583,22 @@ pub fn chain_of<T: Transport>(
     Ok(chain.into_iter().map(|(_, target)| target).collect())
 }
 
+/// `kind`'s chain from `first` on, as [`chain_of`] gives it from the
+/// hook: for what a debug stub left hooked chains to (fresh19 F5: the
+/// extensions behind it were listed as not hooked).
+///
+/// # Errors
+/// The client's.
+pub fn chain_from<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, first): (HookKind, u16),
+) -> Result<Vec<u16>> {
+    let chain = walk(client, profile, everyone, (kind, Some(first)), None)?;
+    Ok(chain.into_iter().map(|(_, target)| target).collect())
+}
+
 /// Follows `kind`'s chain from the hook: each pointer (the hook's operand,
 /// then installed chain slots) with the target it holds, read until two
 /// answers agree, up to `until` or the first target no installed
