@@ -42,6 +42,7 @@ mod table;
 mod taper;
 pub mod transport;
 mod unchanged;
+mod undo;
 mod upload;
 
 pub use backup::{
