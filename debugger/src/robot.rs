@@ -327,7 +327,9 @@ impl RobotMonitor {
                 // listed, to be deleted again (or taken out at `quit`).
                 d.remove_breakpoint(address).map_err(failure)?;
                 self.breakpoints.remove(&id);
-                format!("deleted breakpoint {id}: ${address:04X} holds the image's bytes again\n")
+                format!(
+                    "deleted breakpoint {id}: ${address:04X} holds its own bytes again (read back)\n"
+                )
             }
             "info" => {
                 let mut text = String::new();

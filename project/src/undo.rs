@@ -53,16 +53,20 @@ pub fn further_back(path: &Path) -> Option<FurtherBack> {
     if before.is_file() && std::fs::rename(&before, path).is_ok() {
         return Some(FurtherBack::Unfinished);
     }
-    if !earlier(path, 1).is_file() || std::fs::rename(earlier(path, 1), path).is_err() {
-        return None;
+    // A gap (a file taken away by hand, one that could not be written)
+    // is stepped over (hostile20 F3).
+    let mut kept = (1..=EARLIER + 1)
+        .map(|n| earlier(path, n))
+        .filter(|file| file.is_file());
+    let first = kept.next()?;
+    std::fs::rename(first, path).ok()?;
+    let mut more = 0;
+    for file in kept {
+        if std::fs::rename(&file, earlier(path, more + 1)).is_ok() {
+            more += 1;
+        }
     }
-    let mut n = 1;
-    while earlier(path, n + 1).is_file()
-        && std::fs::rename(earlier(path, n + 1), earlier(path, n)).is_ok()
-    {
-        n += 1;
-    }
-    Some(FurtherBack::Earlier(n - 1))
+    Some(FurtherBack::Earlier(more))
 }
 
 /// Keeps `older`, the undo file of the upload before the one whose file
@@ -148,6 +152,9 @@ pub struct UndoFile {
     pub path: PathBuf,
     /// Why it could not be written, if it could not.
     pub failed: Option<hostfs::Error>,
+    /// Why the undo file of the upload before could not be kept one back
+    /// ([`earlier`]), if it could not: it is lost (hostile20 F2).
+    pub history_failed: Option<hostfs::Error>,
     /// Whether it was written (said if the upload is interrupted).
     pub kept: Arc<AtomicBool>,
     /// The finished undo file the upload found there, read before its
@@ -164,6 +171,18 @@ pub struct UndoFile {
     /// images, one after the other): the file found by the next is that
     /// one's, which the next one's goes further back from, changed or not.
     wrote: bool,
+    /// The finished undo file found before this keeper's first upload:
+    /// it goes one back ([`earlier`]) once the run changes the robot.
+    found: Option<Vec<u8>>,
+    /// What this keeper's uploads kept, the first one's going further back
+    /// with each later one's: the undo of this run alone.
+    run: Option<uploader::Backup>,
+    /// Whether the file holds [`UndoFile::found`] going further back with
+    /// this run (every upload of it so far changed nothing): once one
+    /// changes the robot, the file becomes [`UndoFile::run`] (recheck20 F1:
+    /// a run whose first image was unchanged undid the upload before it
+    /// too).
+    merged: bool,
 }
 
 impl UndoFile {
@@ -173,11 +192,15 @@ impl UndoFile {
         UndoFile {
             path,
             failed: None,
+            history_failed: None,
             kept: Arc::default(),
             older: None,
             kept_older: false,
             older_damaged: None,
             wrote: false,
+            found: None,
+            run: None,
+            merged: false,
         }
     }
 
@@ -185,6 +208,17 @@ impl UndoFile {
     #[must_use]
     pub fn written(&self) -> bool {
         self.kept.load(Ordering::Relaxed)
+    }
+
+    /// This run's undo with `kept`, the last upload's, going further back
+    /// (kept for the next).
+    fn run_with(&mut self, kept: &uploader::Backup) -> uploader::Backup {
+        let run = match self.run.take() {
+            Some(run) => run.going_further_back(kept),
+            None => kept.clone(),
+        };
+        self.run = Some(run.clone());
+        run
     }
 
     /// The upload finished: the next one may replace the file.
@@ -209,6 +243,9 @@ impl uploader::Keep for UndoFile {
             {
                 self.failed = Some(error);
             }
+            if !self.wrote {
+                self.found.clone_from(&older);
+            }
             self.older = Some(older);
         }
         // Marked first: an upload killed from here on has not finished,
@@ -225,30 +262,26 @@ impl uploader::Keep for UndoFile {
         self.kept.store(true, Ordering::Relaxed);
     }
 
+    fn failed(&self) -> Option<String> {
+        self.failed.as_ref().map(ToString::to_string)
+    }
+
     fn finished(&mut self, kept: &uploader::Backup) {
         // hostile14 F6: the second image of a run wrote its own file over
         // the first's, and the undo left the first installed. An upload
         // after another through this keeper keeps both.
-        let earlier = if self.wrote {
-            self.older.clone().flatten()
-        } else {
-            None
-        };
-        let name = self.path.display().to_string();
-        match earlier.and_then(|earlier| uploader::Backup::decode(&name, &earlier).ok()) {
-            Some(earlier) => self.keep(&earlier.going_further_back(kept)),
-            None => {
-                // The first image of a run: the last upload's file goes
-                // one back.
-                if !self.wrote
-                    && let Some(Some(older)) = &self.older
-                    && let Err(error) = keep_earlier(&self.path, older)
-                {
-                    self.failed = Some(error);
-                }
-                self.keep(kept);
+        let run = self.run_with(kept);
+        if !self.wrote || self.merged {
+            // The run changes the robot: the file found before it goes
+            // one back.
+            if let Some(found) = &self.found
+                && let Err(error) = keep_earlier(&self.path, found)
+            {
+                self.history_failed = Some(error);
             }
         }
+        self.keep(&run);
+        self.merged = false;
         self.wrote = true;
         self.older = None;
         self.kept_older = false;
@@ -267,6 +300,15 @@ impl uploader::Keep for UndoFile {
         own: &uploader::Backup,
         loader_went_over: &[uploader::Area],
     ) {
+        let run = self.run_with(kept);
+        if self.wrote && !self.merged {
+            // An earlier upload of the run changed the robot: the file is
+            // the run's.
+            self.keep(&run);
+            self.older = None;
+            let _ = std::fs::remove_file(marked(&self.path, BEFORE));
+            return;
+        }
         let name = self.path.display().to_string();
         // hostile14 F1: where this upload's loader went over bytes the
         // older file holds (put there since that upload), the older file
@@ -289,11 +331,10 @@ impl uploader::Keep for UndoFile {
                 });
                 // Kept as a change's would be: one back.
                 if over
-                    && !self.wrote
-                    && let Some(found) = &found
+                    && let Some(found) = &self.found
                     && let Err(error) = keep_earlier(&self.path, found)
                 {
-                    self.failed = Some(error);
+                    self.history_failed = Some(error);
                 }
                 !over
             });
@@ -304,11 +345,17 @@ impl uploader::Keep for UndoFile {
                     // fresh19 F8: a run's later image found the file its
                     // first image wrote: no older upload's unless the
                     // first kept one.
-                    Ok(()) => self.kept_older = !self.wrote || self.kept_older,
+                    Ok(()) => {
+                        self.kept_older = !self.wrote || self.kept_older;
+                        self.merged = true;
+                    }
                     Err(error) => self.failed = Some(error),
                 }
             }
-            None => self.keep(kept),
+            None => {
+                self.merged = false;
+                self.keep(&run);
+            }
         }
         self.wrote = true;
         self.older = None;
@@ -508,5 +555,57 @@ mod tests {
             undo.finished_upload();
             assert!(!undo.kept_older, "image {n}");
         }
+    }
+
+    /// recheck20 F1: a run whose first image changed nothing (merged with
+    /// the file found, the last upload's) and whose second changed the
+    /// robot kept one file for both, and its undo undid the last upload
+    /// too. The run's file is the run's alone; the one found goes one back.
+    #[test]
+    fn a_run_that_changes_after_an_unchanged_image_keeps_the_last_uploads_file_one_back() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        hostfs::write(&path, &backup(7).encode()).expect("the last upload's file");
+        let second = Backup {
+            areas: vec![Area {
+                address: 0x0600,
+                bytes: vec![3; 2],
+            }],
+            ..Backup::default()
+        };
+        let mut undo = UndoFile::new(path.clone());
+        undo.keep(&backup(1));
+        undo.finished_unchanged(&backup(1), &backup(1), &[]);
+        undo.finished_upload();
+        assert!(undo.kept_older);
+        undo.keep(&second);
+        undo.finished(&second);
+        undo.finished_upload();
+        assert!(!undo.kept_older);
+        assert_eq!(
+            held(&path),
+            backup(1).going_further_back(&second),
+            "the run's"
+        );
+        assert_eq!(
+            held(&earlier(&path, 1)),
+            backup(7),
+            "the last upload's, one back"
+        );
+    }
+
+    /// hostile20 F3: a gap in the history (NAME.1 taken away, a directory
+    /// there) stopped the undo with "none is left" while older files lay
+    /// there: the next one is taken.
+    #[test]
+    fn a_gap_in_the_history_is_stepped_over() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("last.undo");
+        hostfs::write(earlier(&path, 2), &backup(2).encode()).expect("written");
+        hostfs::write(earlier(&path, 4), &backup(4).encode()).expect("written");
+        std::fs::create_dir(earlier(&path, 3)).expect("a directory in the way");
+        assert_eq!(further_back(&path), Some(FurtherBack::Earlier(1)));
+        assert_eq!(held(&path), backup(2));
+        assert_eq!(held(&earlier(&path, 1)), backup(4));
     }
 }

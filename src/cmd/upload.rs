@@ -679,6 +679,13 @@ fn upload_file(
             undo.path.display()
         ));
     }
+    if let Some(error) = undo.history_failed.take() {
+        // hostile20 F2: the file lost is the one before, not this one.
+        bar.say(&format!(
+            "warning: the undo file of the upload before could not be kept as {} ({error}): `scorpion upload --undo` goes back to before this upload only",
+            scorpion_project::undo::earlier(&undo.path, 1).display()
+        ));
+    }
     out.push_str(&summary(&report, &image, emulated));
     out.push('\n');
     if !emulated && undo_failed.is_none() && !report.replaced.is_empty() {

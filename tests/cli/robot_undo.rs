@@ -965,8 +965,20 @@ fn the_undo_of_a_run_that_replaced_an_image_another_upload_witnessed_goes_throug
     second_answers(&project, 'V');
     let run = ok(&project, &line, &["test", "--replace"]);
     assert!(ok(&project, &line, &["ask", "/1U"]).contains('V'), "{run}");
+    // recheck20 F1: one upload back at a time: the run, then the other
+    // extension, then the first run.
     let undone = ok(&project, &line, &["upload", "--undo"]);
     assert!(undone.contains("restored"), "{undone}");
+    assert!(ok(&project, &line, &["ask", "/1U"]).contains('U'));
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(
+        listed.contains("$0800-"),
+        "the other extension stays: {listed}"
+    );
+    let undone = ok(&project, &line, &["upload", "--undo"]);
+    assert!(undone.contains("restored"), "{undone}");
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(!listed.contains("$0800-"), "{listed}");
     let undone = ok(&project, &line, &["upload", "--undo"]);
     assert!(undone.contains("restored"), "{undone}");
     assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);

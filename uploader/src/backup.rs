@@ -109,6 +109,26 @@ pub trait Keep {
         let _ = (own, loader_went_over);
         self.finished(kept);
     }
+
+    /// Why what [`Keep::keep`] was handed could not be kept (a directory
+    /// that takes no file, a full disk), if it could not: the upload then
+    /// stops before it writes anything more ([`Error::UndoNotKept`];
+    /// hostile20 F1: the robot was changed with no record of what it
+    /// held). By default, nothing failed.
+    fn failed(&self) -> Option<String> {
+        None
+    }
+}
+
+/// Stops an upload whose keeper could not keep what it was handed.
+///
+/// # Errors
+/// [`Error::UndoNotKept`].
+pub(crate) fn kept_or_stop(keep: &dyn Keep) -> Result<()> {
+    match keep.failed() {
+        Some(why) => Err(Error::UndoNotKept { why }),
+        None => Ok(()),
+    }
 }
 
 /// Keeps nothing (reads nothing).
@@ -701,7 +721,7 @@ impl EarlyWitnesses {
         }
         backup.witnesses = witnesses;
         keep.keep(&backup);
-        Ok(())
+        kept_or_stop(keep)
     }
 }
 

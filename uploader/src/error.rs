@@ -262,6 +262,21 @@ pub enum Error {
         owner: String,
     },
 
+    /// The keeper could not keep what the upload was about to overwrite.
+    #[error(
+        "the undo file could not be written ({why}): the upload stopped before it changed the robot"
+    )]
+    #[diagnostic(
+        code(uploader::undo_not_kept),
+        help(
+            "free space where it goes, or give `--undo-file FILE` in a directory that takes files"
+        )
+    )]
+    UndoNotKept {
+        /// Why.
+        why: String,
+    },
+
     /// An undo of an upload after which another upload wrote the table
     /// (a `--replace`, an extension added): the undo would put back the
     /// entries as they were before, over the later one's.

@@ -920,6 +920,7 @@ fn keep_old<T: Transport>(
     let ranges = crate::backup::kept_witness_ranges_on(client, profile, &kept, image)?;
     kept.witnesses = crate::backup::read_witnesses(client, &ranges)?;
     keep.keep(&kept);
+    crate::backup::kept_or_stop(keep)?;
     Ok(Some(kept))
 }
 
@@ -1126,6 +1127,7 @@ fn keep_summed<T: Transport>(
         })
         .collect();
     keep.keep(&kept);
+    crate::backup::kept_or_stop(keep)?;
     Ok(Some(kept))
 }
 

@@ -528,3 +528,59 @@ fn a_backup_of_a_damaged_table_says_so_and_its_restore_moves_nothing() {
     assert!(error.to_string().contains("does not decode"), "{error}");
     assert!(held(&mut client) == before, "nothing moved");
 }
+
+/// A keeper that cannot keep anything (a full disk).
+struct CannotKeep;
+
+impl uploader::Keep for CannotKeep {
+    fn keep(&mut self, _overwritten: &uploader::Backup) {}
+
+    fn failed(&self) -> Option<String> {
+        Some("No space left on device".to_owned())
+    }
+}
+
+/// hostile20 F1: an upload whose undo file could not be written (a full
+/// disk, a directory that takes no file) warned and changed the robot all
+/// the same, exit 0, with no record of what it held. It stops before it
+/// writes anything, by either path, a `--replace` too.
+#[test]
+fn an_upload_that_cannot_keep_its_undo_writes_nothing() {
+    for loader in [
+        uploader::LoaderChoice::Never,
+        uploader::LoaderChoice::Always,
+    ] {
+        let (options, mut client) = one_installed();
+        let options = UploadOptions { loader, ..options };
+        let replace = UploadOptions {
+            replace: true,
+            ..options.clone()
+        };
+        let mut edited = extension_at(0x0400).areas()[0].bytes.clone();
+        edited[40] = 0x07;
+        let edited = uploader::UploadImage::new(
+            vec![uploader::Area {
+                address: 0x0400,
+                bytes: edited,
+            }],
+            extension_at(0x0400).hooks().to_vec(),
+        )
+        .expect("an image");
+        for (image, options) in [(extension_at(0x0800), &options), (edited, &replace)] {
+            let before = held(&mut client);
+            let error = upload_keeping(
+                &mut client,
+                &image,
+                options,
+                &mut NoProgress,
+                &mut CannotKeep,
+            )
+            .expect_err("stopped");
+            assert!(
+                matches!(error, Error::UndoNotKept { .. }),
+                "{loader:?}: {error}"
+            );
+            assert!(held(&mut client) == before, "{loader:?}: nothing written");
+        }
+    }
+}

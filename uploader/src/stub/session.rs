@@ -169,6 +169,9 @@ pub struct Recovery {
     /// step there works on what the robot holds (hostile19 F3: a wrong
     /// image's byte there was put back by a breakpoint's removal).
     pub data_among_code: Vec<u16>,
+    /// Of those, the bytes after a changing one that differ from the image
+    /// (a counter's higher bytes, or another build's code): the robot's.
+    pub differing_after: Vec<u16>,
 }
 
 impl Recovery {
@@ -176,10 +179,24 @@ impl Recovery {
     /// anything.
     #[must_use]
     pub fn data_note(&self) -> Option<String> {
-        (!self.data_among_code.is_empty()).then(|| {
+        let changing: Vec<u16> = self
+            .data_among_code
+            .iter()
+            .copied()
+            .filter(|at| !self.differing_after.contains(at))
+            .collect();
+        (!changing.is_empty()).then(|| {
+            let after = if self.differing_after.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; {} after it differ from the image (its higher bytes, or another build's code): taken as the robot holds them",
+                    crate::error::addresses_text(&self.differing_after)
+                )
+            };
             format!(
-                "note: {} among the image's code changed while it was read, as the robot runs (a counter kept there): taken as the program's data with the bytes after it, as the robot holds them, and not compared",
-                crate::error::addresses_text(&self.data_among_code)
+                "note: {} among the image's code changed while it was read, as the robot runs (a counter kept there): taken as the program's data, with the three bytes after it, and not compared{after}",
+                crate::error::addresses_text(&changing)
             )
         })
     }
@@ -682,6 +699,7 @@ impl<T: Transport> RobotDebug<T> {
                 if found[i] != area.bytes[i] {
                     adopted.push((at, found[i]));
                     found[i] = area.bytes[i];
+                    self.recovery.differing_after.push(at);
                 }
             }
             self.recovery.data_among_code.extend(data);
