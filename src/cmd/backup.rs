@@ -117,14 +117,20 @@ pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
             "interrupted: the restore did not finish; nothing that did not verify is hooked\n  `scorpion restore {file}` again puts the rest back"
         )
     })?;
-    restore_into(
+    let code = restore_into(
         transport,
         profile,
         &backup,
         &args.file,
-        (args.force, uploader::LoaderChoice::Auto),
+        (args.force, uploader::LoaderChoice::Auto, false),
         None,
-    )
+    )?;
+    // recheck20 F3: an upload's undo file restored is an undo done: the
+    // file of the upload before takes its place, as after `upload --undo`.
+    if code == ExitCode::SUCCESS && !backup.written_entries.is_empty() {
+        crate::cmd::upload::undone(&args.file)?;
+    }
+    Ok(code)
 }
 
 /// Restores `backup` (from `file`) through `transport` into a robot with
@@ -134,7 +140,7 @@ pub(crate) fn restore_into(
     profile: uploader::RomProfile,
     backup: &Backup,
     file: &Path,
-    (force_rom, loader): (bool, uploader::LoaderChoice),
+    (force_rom, loader, interrupted): (bool, uploader::LoaderChoice, bool),
     started: Option<&Path>,
 ) -> miette::Result<ExitCode> {
     // A restore of this file started before and stopped half way (the
@@ -148,6 +154,7 @@ pub(crate) fn restore_into(
         // hostile19 F7: an undo file given to `restore` is checked as an
         // undo (only an upload's file records the entries it wrote).
         undo: started.is_some() || !backup.written_entries.is_empty(),
+        interrupted,
         ..UploadOptions::default()
     };
     if resume {

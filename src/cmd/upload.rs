@@ -447,39 +447,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             profile,
             &backup,
             &path,
-            (false, loader),
+            // hostile20 F4: an upload killed after its entry went in.
+            (false, loader, marked(&path, UPLOADING).exists()),
             Some(&started),
         )
         .map_err(|report| undo_refused(report, &path))?;
-        // Marked used: a second undo says "already undone" rather than
-        // comparing the robot with an upload no longer on it. Kept (as
-        // `.undone`), not deleted: what was undone stays on disk.
-        let used = marked(&path, UNDONE);
-        if let Err(error) = std::fs::rename(&path, &used) {
-            miette::bail!(
-                "undone, but cannot mark the undo file {} used (as {}): {error}",
-                path.display(),
-                used.display()
-            );
-        }
-        // An upload that did not finish is undone too.
-        let _ = std::fs::remove_file(marked(&path, UPLOADING));
-        match scorpion_project::undo::further_back(&path) {
-            Some(FurtherBack::Unfinished) => print(&format!(
-                "{} now holds the undo of the upload before that one (the one undone did not finish): `scorpion upload --undo` again puts back what the robot held before it\n",
-                path.display()
-            )),
-            Some(FurtherBack::Earlier(more)) => print(&format!(
-                "{} now holds the undo of the upload before that one: `scorpion upload --undo` again puts back what the robot held before it ({})\n",
-                path.display(),
-                match more {
-                    0 => "the last undo file kept".to_owned(),
-                    1 => "1 more kept before it".to_owned(),
-                    n => format!("{n} more kept before it"),
-                }
-            )),
-            None => {}
-        }
+        undone(&path)?;
         return Ok(code);
     }
     // The undo file is written during the upload: a FIFO or a device there
@@ -509,6 +482,42 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// After a successful undo of the file at `path` (by `upload --undo`, or
+/// `restore` of an upload's undo file: recheck20 F3): marked used, and
+/// the file of the upload before takes its place.
+pub(crate) fn undone(path: &Path) -> miette::Result<()> {
+    // Marked used: a second undo says "already undone" rather than
+    // comparing the robot with an upload no longer on it. Kept (as
+    // `.undone`), not deleted: what was undone stays on disk.
+    let used = marked(path, UNDONE);
+    if let Err(error) = std::fs::rename(path, &used) {
+        miette::bail!(
+            "undone, but cannot mark the undo file {} used (as {}): {error}",
+            path.display(),
+            used.display()
+        );
+    }
+    // An upload that did not finish is undone too.
+    let _ = std::fs::remove_file(marked(path, UPLOADING));
+    match scorpion_project::undo::further_back(path) {
+        Some(FurtherBack::Unfinished) => print(&format!(
+            "{} now holds the undo of the upload before that one (the one undone did not finish): `scorpion upload --undo` again puts back what the robot held before it\n",
+            path.display()
+        )),
+        Some(FurtherBack::Earlier(more)) => print(&format!(
+            "{} now holds the undo of the upload before that one: `scorpion upload --undo` again puts back what the robot held before it ({})\n",
+            path.display(),
+            match more {
+                0 => "the last undo file kept".to_owned(),
+                1 => "1 more kept before it".to_owned(),
+                n => format!("{n} more kept before it"),
+            }
+        )),
+        None => {}
+    }
+    Ok(())
 }
 
 /// The undo file, read: a missing one is "nothing to undo"; a damaged

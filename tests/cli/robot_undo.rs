@@ -1007,3 +1007,25 @@ fn restore_of_an_undo_file_is_checked_as_an_undo() {
     assert!(text.contains("undo_not_last"), "{text}");
     assert_eq!(ok(d, &line, &["installed"]), before, "nothing written");
 }
+
+/// recheck20 F3: `scorpion restore` of the last upload's undo file undid
+/// it but left the file in place, and every later `upload --undo` was
+/// refused (that upload no longer on the robot). It is an undo done: the
+/// file of the upload before takes its place.
+#[test]
+fn restore_of_the_undo_file_steps_the_undo_back_too() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    let sim = two_installed(d, 300);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let text = ok(d, &line, &["restore", "scorpion-last-upload.undo"]);
+    assert!(
+        text.contains("now holds the undo of the upload before that one"),
+        "{text}"
+    );
+    assert!(ok(d, &line, &["read", "$0200", "3"]).contains("4C 03 0C"));
+    let text = ok(d, &line, &["upload", "--undo"]);
+    assert!(text.contains("restored"), "{text}");
+    let listed = ok(d, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
+}

@@ -975,12 +975,14 @@ fn check_witnesses<T: Transport>(
     client: &mut Client<T>,
     backup: &Backup,
     profile: &RomProfile,
-    resume: bool,
+    (resume, interrupted): (bool, bool),
 ) -> Result<()> {
     let table = table_range(profile);
     // An older file witnessed its entry among the code's witnesses.
     let code = (backup.witnesses.iter()).map(|witness| (witness, !within(table, witness.address)));
-    let entries = backup.written_entries.iter().map(|entry| (entry, false));
+    let entries = (backup.written_entries.iter())
+        .filter(|_| !interrupted)
+        .map(|entry| (entry, false));
     for (witness, code) in code.chain(entries) {
         let bytes = client.read_memory(witness.address, usize::from(witness.len))?;
         // The code a hook goes back to as the robot will hold it once the
@@ -1099,7 +1101,12 @@ pub fn restore<T: Transport>(
         Err(error @ Error::WrongRom { .. }) if options.force_rom => overridden.push(error),
         other => other?,
     }
-    check_witnesses(client, backup, profile, options.resume)?;
+    check_witnesses(
+        client,
+        backup,
+        profile,
+        (options.resume, options.interrupted),
+    )?;
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
             refusal: error.to_string(),

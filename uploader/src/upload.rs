@@ -88,6 +88,12 @@ pub struct UploadOptions {
     /// upload chained ahead of the one undone, which the undo would
     /// unhook too).
     pub undo: bool,
+    /// [`crate::restore`] of the undo file of an upload that did not
+    /// finish (killed, a dead line): its records of the table entries the
+    /// upload wrote are not checked as witnesses (it may have stopped
+    /// before or while it wrote them), only used to tell its extension
+    /// from others (hostile20 F4: its own undo was refused for good).
+    pub interrupted: bool,
 }
 
 impl Default for UploadOptions {
@@ -104,6 +110,7 @@ impl Default for UploadOptions {
             force_rom: false,
             resume: false,
             undo: false,
+            interrupted: false,
         }
     }
 }
@@ -554,6 +561,12 @@ pub fn upload_keeping<T: Transport>(
         plan.free_first(client, options.max_writes)?;
         entry = Some(plan.entry_area());
         image.push_area(plan.entry_area());
+        // Kept from here on, before the entry goes out: the undo of an
+        // upload killed after it tells the entry as this upload's
+        // (hostile20 F4).
+        if let Some(kept) = kept.as_mut() {
+            kept.written_entries = entry.iter().map(entry_witness).collect();
+        }
     }
     // What was kept, once kept: the upload's entry is added to it at the
     // end (see `finished`).
@@ -1033,14 +1046,17 @@ fn overlay(areas: &mut Vec<Area>, unlinked: &[Area]) {
 /// a restore has changed the table (an undo file applied to another robot
 /// is refused, `--port emu`'s fresh one included).
 fn finished(mut kept: Backup, entry: Option<Area>) -> Backup {
-    if let Some(entry) = entry {
-        kept.written_entries.push(crate::backup::Witness {
-            address: entry.address,
-            len: entry.bytes.len() as u16,
-            sum: fletcher16(&entry.bytes),
-        });
-    }
+    kept.written_entries = entry.iter().map(entry_witness).collect();
     kept
+}
+
+/// The record of the table entry an upload writes.
+fn entry_witness(entry: &Area) -> crate::backup::Witness {
+    crate::backup::Witness {
+        address: entry.address,
+        len: entry.bytes.len() as u16,
+        sum: fletcher16(&entry.bytes),
+    }
 }
 
 /// Hands `keep` what the ranges of `held` hold on the robot now (the

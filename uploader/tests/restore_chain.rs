@@ -584,3 +584,59 @@ fn an_upload_that_cannot_keep_its_undo_writes_nothing() {
         }
     }
 }
+
+/// hostile20 F4: an upload killed after its table entry went in (a
+/// `--replace`, or a new extension in front) left its undo file without
+/// the record of that entry, and its own undo was refused for good as "a
+/// later upload wrote it". The record is kept before the entry goes out,
+/// and the undo of an upload that did not finish takes it as its own:
+/// wherever the line dies, the undo puts the robot back as it was.
+#[test]
+fn the_undo_of_an_upload_cut_anywhere_puts_the_robot_back() {
+    let (options, _, undo) = plain_replace_undo();
+    let undo = UploadOptions {
+        interrupted: true,
+        ..undo
+    };
+    let in_front = extension_at(0x0800);
+    let sent = {
+        let (_, mut client) = one_installed();
+        let before = client.stats().sent;
+        upload(&mut client, &in_front, &options, &mut NoProgress).expect("uploaded");
+        client.stats().sent - before
+    };
+    let mut cut = 0;
+    for at in (0..sent).step_by(37) {
+        let (_, client) = one_installed();
+        let mut transport = client.into_transport();
+        let before = held_of(&mut transport);
+        let config = uploader::transport::FaultConfig {
+            stall_after: Some(at as usize),
+            ..uploader::transport::FaultConfig::none(3)
+        };
+        let faulty = uploader::transport::FaultyTransport::new(transport, config);
+        let mut client = uploader::client(faulty, &options.profile);
+        let mut kept = Kept::default();
+        let result = upload_keeping(&mut client, &in_front, &options, &mut NoProgress, &mut kept);
+        let mut transport = client.into_transport().into_inner();
+        let Some(file) = kept.0.filter(|_| result.is_err()) else {
+            continue;
+        };
+        cut += 1;
+        let mut client = uploader::client(transport, &options.profile);
+        restore(&mut client, &file, &undo, &mut NoProgress)
+            .unwrap_or_else(|error| panic!("cut after {at} of {sent}: {error}"));
+        transport = client.into_transport();
+        assert!(
+            held_of(&mut transport) == before,
+            "cut after {at}: not as before"
+        );
+    }
+    assert!(cut > 3, "{cut} cuts");
+}
+
+/// [`held`] of the robot behind `transport`.
+fn held_of(transport: &mut uploader::transport::VirtualTransport) -> Vec<u8> {
+    let memory = transport.robot().robot().board().memory();
+    [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
+}
