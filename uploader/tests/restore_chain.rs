@@ -611,7 +611,7 @@ fn the_undo_of_an_upload_cut_anywhere_puts_the_robot_back() {
         let mut transport = client.into_transport();
         let before = held_of(&mut transport);
         let config = uploader::transport::FaultConfig {
-            stall_after: Some(at as usize),
+            stall_after: Some(at),
             ..uploader::transport::FaultConfig::none(3)
         };
         let faulty = uploader::transport::FaultyTransport::new(transport, config);
