@@ -1147,11 +1147,37 @@ pub fn restore<T: Transport>(
         .copied()
         .filter(|(kind, _)| !refused.iter().any(|(broken, _)| broken == kind))
         .collect();
-    switch_hooks(client, profile, &fine, options.max_writes)?;
-    // And once the hooks are in: a reset as they went in cleared the table
-    // again (the code they reach is in place: a reset keeps user RAM).
-    if let Some(table) = whole_table {
-        table_again(client, backup, table, progress)?;
+    // And once the hooks are in: a reset as they went in put them back at
+    // the ROM's targets and cleared the table again (the code they reach
+    // is in place: a reset keeps user RAM). Both are read again, and
+    // written again where a reset undid them (hostile20 F5: the hooks
+    // were left at the ROM after "verified").
+    let mut rounds = 0;
+    loop {
+        switch_hooks(client, profile, &fine, options.max_writes)?;
+        if let Some(table) = whole_table {
+            table_again(client, backup, table, progress)?;
+        }
+        let now = read_hooks(client, profile)?;
+        let lost = fine.iter().find(|hook| !now.contains(hook));
+        rounds += 1;
+        match lost {
+            None => break,
+            Some(&(kind, target)) if rounds == 3 => {
+                let operand = profile.hook_address(kind) + 1;
+                let found = now
+                    .iter()
+                    .find(|(this, _)| *this == kind)
+                    .map_or(0, |h| h.1);
+                return Err(Error::VerifyFailed {
+                    address: operand,
+                    expected: target.to_le_bytes()[0],
+                    found: found.to_le_bytes()[0],
+                    attempts: rounds,
+                });
+            }
+            Some(_) => {}
+        }
     }
     if let Some((_, error)) = refused.into_iter().next() {
         return Err(error);

@@ -485,7 +485,10 @@ fn a_reset_anywhere_in_a_restore_that_finishes_leaves_the_table_listing_what_is_
         client.stats().sent
     };
     let mut finished = 0;
-    for at in (0..sent).step_by(97) {
+    // Every 97th byte, and every 7th of the end, where the hooks go in.
+    let end = sent.saturating_sub(700);
+    let points = (0..end).step_by(97).chain((end..sent).step_by(7));
+    for at in points {
         let mut client = uploader::client(
             FaultyTransport::new(
                 robot(),
@@ -504,6 +507,14 @@ fn a_reset_anywhere_in_a_restore_that_finishes_leaves_the_table_listing_what_is_
             finished += 1;
             let mut client = uploader::client(transport, &options.profile);
             listed_if_hooked(&mut client, &image, &outcome);
+            // hostile20 F5: and hooked as the file says, not left at the
+            // ROM by a reset as the hooks went in.
+            let memory = client.transport().robot().robot().board().memory();
+            let (_, hook) = common::target(memory, HOOK_UNKNOWN);
+            assert!(
+                image.hooks().iter().any(|record| record.handler == hook),
+                "finished, but HOOK_UNKNOWN -> ${hook:04X} ({outcome})"
+            );
         }
     }
     assert!(finished > 0, "no restore finished");
