@@ -847,9 +847,7 @@ fn a_two_image_project_tested_twice_is_undone_to_the_robot_before() {
 fn undos_out_of_order_after_an_unchanged_upload_leave_the_robot_as_before() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let d = dir.path();
-    std::fs::write(d.join("a.elf"), extension_at(0x0C00, 200, None)).expect("the image");
-    std::fs::write(d.join("b.elf"), extension_at(0x0400, 300, None)).expect("the image");
-    let sim = Sim::start(d, &["--baud", "19200"]);
+    let sim = a_and_b(d);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
     ok(d, &line, &["backup", "-o", "before.bak"]);
     let a = ["a.elf", "--no-dry-run", "--undo-file", "a.undo"];
@@ -994,9 +992,7 @@ fn the_undo_of_a_run_that_replaced_an_image_another_upload_witnessed_goes_throug
 fn restore_of_an_undo_file_is_checked_as_an_undo() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let d = dir.path();
-    std::fs::write(d.join("a.elf"), extension_at(0x0C00, 200, None)).expect("the image");
-    std::fs::write(d.join("b.elf"), extension_at(0x0400, 300, None)).expect("the image");
-    let sim = Sim::start(d, &["--baud", "19200"]);
+    let sim = a_and_b(d);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
     let a = ["upload", "a.elf", "--no-dry-run", "--undo-file", "a.undo"];
     ok(d, &line, &a);
@@ -1028,4 +1024,12 @@ fn restore_of_the_undo_file_steps_the_undo_back_too() {
     assert!(text.contains("restored"), "{text}");
     let listed = ok(d, &line, &["installed"]);
     assert!(listed.contains("nothing installed"), "{listed}");
+}
+
+/// A pty robot at 19200 baud, with `a.elf` (200 bytes at $0C00) and
+/// `b.elf` (300 bytes at $0400) written in `dir`, not uploaded.
+fn a_and_b(dir: &std::path::Path) -> Sim {
+    std::fs::write(dir.join("a.elf"), extension_at(0x0C00, 200, None)).expect("the image");
+    std::fs::write(dir.join("b.elf"), extension_at(0x0400, 300, None)).expect("the image");
+    Sim::start(dir, &["--baud", "19200"])
 }

@@ -486,7 +486,13 @@ fn cut_anywhere_then_undo(
             continue;
         };
         let mut client = uploader::client(transport, &options.profile);
-        restore(&mut client, &kept, options, &mut NoProgress)
+        // As `upload --undo` gives it: the file of an upload that did not
+        // finish.
+        let undo = UploadOptions {
+            interrupted: true,
+            ..options.clone()
+        };
+        restore(&mut client, &kept, &undo, &mut NoProgress)
             .unwrap_or_else(|error| panic!("cut after {at}: the undo: {error}"));
         let after = user_memory(client.transport().robot());
         assert_eq!(
@@ -752,6 +758,7 @@ fn an_undo_takes_out_the_ram_loader_a_killed_upload_left_hooked() {
     let mut client = uploader::client(transport, &options.profile);
     let undo = UploadOptions {
         undo: true,
+        interrupted: true,
         ..options
     };
     restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("the undo");
