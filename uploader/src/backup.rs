@@ -961,7 +961,7 @@ fn check_backup_rom<T: Transport>(
 
 /// Whether `address` is in `range` (an address and a length: the table's,
 /// as [`table_range`] gives it).
-fn within(range: Option<(u16, usize)>, address: u16) -> bool {
+pub(crate) fn within(range: Option<(u16, usize)>, address: u16) -> bool {
     range.is_some_and(|(at, len)| {
         usize::from(address) >= usize::from(at) && usize::from(address) < usize::from(at) + len
     })
@@ -1123,6 +1123,8 @@ pub fn restore<T: Transport>(
         .collect();
     switch_hooks(client, profile, &to_rom, options.max_writes)?;
     let mut reports = Vec::new();
+    // The table is read again where the file writes memory.
+    let table = whole.as_ref().map(|_| (&memory, table_range(profile)));
     if let Some(whole) = whole {
         let (through_loader, after) = split_for_loader(&memory, &whole, client.transport().baud())?;
         if let Some(image) = through_loader {
@@ -1135,9 +1137,10 @@ pub fn restore<T: Transport>(
             };
             reports.push(upload(client, &image, &rom, progress)?);
         }
-        table_again(client, backup, (&memory, table_range(profile)), progress)?;
     }
-    let whole_table = (!backup.areas.is_empty()).then(|| (&memory, table_range(profile)));
+    if let Some(table) = table {
+        table_again(client, backup, table, progress)?;
+    }
     // recheck17 F3: a hook whose way is broken stays at the ROM's target;
     // the others, whose ways are fine, are restored all the same.
     let refused = crate::chain::check_restored(client, profile, &backup.hooks)?;
@@ -1155,7 +1158,7 @@ pub fn restore<T: Transport>(
     let mut rounds = 0;
     loop {
         switch_hooks(client, profile, &fine, options.max_writes)?;
-        if let Some(table) = whole_table {
+        if let Some(table) = table {
             table_again(client, backup, table, progress)?;
         }
         let now = read_hooks(client, profile)?;

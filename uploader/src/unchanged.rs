@@ -143,16 +143,13 @@ pub(crate) fn own_memory(
     others: &[romlib::installed::Installed],
 ) -> Backup {
     let table = crate::backup::table_range(profile);
-    let in_table = |address: u16| {
-        table.is_some_and(|(at, len)| {
-            usize::from(address) >= usize::from(at) && usize::from(address) < usize::from(at) + len
-        })
-    };
     let mut own: Vec<Area> = Vec::new();
     for area in &kept.areas {
         for (offset, &byte) in area.bytes.iter().enumerate() {
             let address = area.address.wrapping_add(offset as u16);
-            if in_table(address) || others.iter().any(|other| other.contains(address)) {
+            if crate::backup::within(table, address)
+                || others.iter().any(|other| other.contains(address))
+            {
                 continue;
             }
             crate::delta::push(&mut own, address, &[byte]);

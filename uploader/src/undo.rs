@@ -144,10 +144,7 @@ pub(crate) fn refuse_later_entries(
                     .byte_at(u32::from(flags))
                     .map(romlib::installed::in_use);
                 let entry = romlib::installed::entry_address(table, entries, slot);
-                match listed {
-                    None => false,
-                    Some(listed) => !listed || held(entry, romlib::installed::ENTRY_LEN),
-                }
+                listed.is_some_and(|listed| !listed || held(entry, romlib::installed::ENTRY_LEN))
             });
             if !freed {
                 return Err(Error::BadImage {

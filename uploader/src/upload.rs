@@ -552,24 +552,25 @@ pub fn upload_keeping<T: Transport>(
     // The image's entry in the table goes in with the body, verified with
     // it; its flags, which make it count, once body and entry are in.
     let bytes = image.len();
-    let mut entry = None;
     if let Some(plan) = plan.as_mut() {
         if plan.frees_first() {
             check_entries_once(client, profile, &mut entries_checked)?;
             before_change(client, &image)?;
         }
         plan.free_first(client, options.max_writes)?;
-        entry = Some(plan.entry_area());
         image.push_area(plan.entry_area());
-        // Kept from here on, before the entry goes out: the undo of an
-        // upload killed after it tells the entry as this upload's
-        // (hostile20 F4).
+        // The record of the entry, with the sum of its bytes as this
+        // upload writes them, kept from here on, before the entry goes
+        // out: the undo of an upload killed after it tells the entry as
+        // this upload's (hostile20 F4). An undo finds that sum only on the
+        // robot the upload went to, and only until another upload or a
+        // restore has changed the table (an undo file applied to another
+        // robot is refused, `--port emu`'s fresh one included).
         if let Some(kept) = kept.as_mut() {
-            kept.written_entries = entry.iter().map(entry_witness).collect();
+            kept.written_entries = vec![entry_witness(&plan.entry_area())];
         }
     }
-    // What was kept, once kept: the upload's entry is added to it at the
-    // end (see `finished`).
+    // What was kept, once kept.
     let mut kept_file: Option<Backup> = None;
 
     let with_sums = wants_sums(&image, keep.wanted())
@@ -803,7 +804,6 @@ pub fn upload_keeping<T: Transport>(
 
     let mut unchanged = false;
     if let Some(kept) = kept_file {
-        let kept = finished(kept, entry);
         let owns = |address: u16| session.as_ref().is_some_and(|s| s.owns(address));
         // A chain slot taken past an earlier copy and pointed at it again
         // is as it was.
@@ -1038,16 +1038,6 @@ fn overlay(areas: &mut Vec<Area>, unlinked: &[Area]) {
             }
         }
     }
-}
-
-/// What an upload kept, once it has finished: with the sum of the
-/// image's entry in the table as the upload wrote it, which an undo finds
-/// only on the robot the upload went to, and only until another upload or
-/// a restore has changed the table (an undo file applied to another robot
-/// is refused, `--port emu`'s fresh one included).
-fn finished(mut kept: Backup, entry: Option<Area>) -> Backup {
-    kept.written_entries = entry.iter().map(entry_witness).collect();
-    kept
 }
 
 /// The record of the table entry an upload writes.
