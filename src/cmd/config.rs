@@ -77,7 +77,8 @@ pub(crate) fn flags(
     rom: Option<&PathBuf>,
 ) -> Flags {
     Flags {
-        port: port.cloned(),
+        // A bare `--port` (as `test --port` takes it): the configured one.
+        port: port.filter(|port| !port.is_empty()).cloned(),
         baud,
         cards: rig.cards.clone(),
         world: rig.world.clone(),

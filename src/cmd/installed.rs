@@ -22,6 +22,7 @@ pub(crate) struct Args {
 
 pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let (mut client, profile) = ports::probed(&args.line)?;
+    let names = project_images(&args.line);
     let everyone = uploader::read_installed(&mut client, &profile)?;
     let mut chains = Vec::new();
     for kind in HookKind::ALL {
@@ -81,7 +82,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             )?);
         }
     }
-    let text = listing(&everyone, &chains) + text.as_str();
+    let text = listing(&everyone, &chains, &names) + text.as_str();
     std::io::stdout()
         .lock()
         .write_all(text.as_bytes())
@@ -89,15 +90,84 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A project image, built as its sources are now: its name, id and memory.
+struct Known {
+    name: String,
+    id: u32,
+    extents: Vec<std::ops::RangeInclusive<u16>>,
+}
+
+/// In a project, its images built in memory (nothing written), to name
+/// what the table lists by id alone (fresh19 F12). An image that does not
+/// build names nothing, said on stderr.
+fn project_images(line: &ports::Line) -> Vec<Known> {
+    let Some(project) = line.resolve().ok().and_then(|resolved| resolved.project) else {
+        return Vec::new();
+    };
+    let mut known = Vec::new();
+    for spec in &project.file.images {
+        let built = scorpion_project::runner::build::build(&project, spec)
+            .map_err(|error| error.to_string())
+            .and_then(|built| {
+                uploader::UploadImage::try_from(&built.linked.image)
+                    .map_err(|error| error.to_string())
+            });
+        match built {
+            Ok(image) => known.push(Known {
+                name: spec.name.clone(),
+                id: image.id(),
+                extents: image.extents().to_vec(),
+            }),
+            Err(why) => {
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "note: the project's image {} does not build ({why}): what the robot lists is not matched with it",
+                    spec.name
+                );
+            }
+        }
+    }
+    known
+}
+
+/// How `image` is named beside its id: the project image it is, or the
+/// one whose memory it lies in (another build of it, or someone else's).
+fn named(image: &Installed, names: &[Known]) -> String {
+    if let Some(known) = names.iter().find(|known| known.id == image.id) {
+        return format!(" ({})", known.name);
+    }
+    let overlaps = |known: &&Known| {
+        known.extents.iter().any(|ours| {
+            image
+                .extents
+                .iter()
+                .any(|theirs| ours.start() <= theirs.end() && theirs.start() <= ours.end())
+        })
+    };
+    match names.iter().find(overlaps) {
+        Some(known) => format!(
+            " (where the project's {} goes, but not it as its sources build now)",
+            known.name
+        ),
+        None => String::new(),
+    }
+}
+
 /// The listing, for people.
-fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
+fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)], names: &[Known]) -> String {
     let mut out = String::new();
     if everyone.is_empty() {
         out.push_str("nothing installed\n");
     }
     for image in everyone {
         let extents: Vec<String> = image.extents.iter().map(extent_text).collect();
-        let _ = write!(out, "extension {:06X}: {}", image.id, extents.join(", "));
+        let _ = write!(
+            out,
+            "extension {:06X}{}: {}",
+            image.id,
+            named(image, names),
+            extents.join(", ")
+        );
         for hook in &image.hooks {
             let _ = write!(out, "; {} -> ${:04X}", hook.kind.rom_symbol(), hook.handler);
             if let Some(slot) = hook.chain {
@@ -132,8 +202,14 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)]) -> String {
                         .iter()
                         .any(|hook| hook.kind == *kind && hook.handler == *target)
                 });
+                let name = |image: &Installed| {
+                    names
+                        .iter()
+                        .find(|known| known.id == image.id)
+                        .map_or(String::new(), |known| format!(" {}", known.name))
+                };
                 match owner {
-                    Some(image) => format!("${target:04X} ({:06X})", image.id),
+                    Some(image) => format!("${target:04X} ({:06X}{})", image.id, name(image)),
                     None => format!("${target:04X}"),
                 }
             })
@@ -169,14 +245,14 @@ mod tests {
             }],
             slot: 0,
         }];
-        let unhooked = listing(&everyone, &[(HookKind::Unknown, vec![0xFF21])]);
+        let unhooked = listing(&everyone, &[(HookKind::Unknown, vec![0xFF21])], &[]);
         assert!(
             unhooked.contains(
                 "HOOK_UNKNOWN -> $0400 (chain slot $0416) (not hooked: HOOK_UNKNOWN does not lead to it)"
             ),
             "{unhooked}"
         );
-        let hooked = listing(&everyone, &[(HookKind::Unknown, vec![0x0400, 0xFF21])]);
+        let hooked = listing(&everyone, &[(HookKind::Unknown, vec![0x0400, 0xFF21])], &[]);
         assert!(!hooked.contains("not hooked"), "{hooked}");
     }
 
@@ -184,7 +260,11 @@ mod tests {
     /// listed as `$040B -> $040B -> $040B` with no word of the loop.
     #[test]
     fn a_chain_that_comes_back_is_cut_and_said() {
-        let looped = listing(&[], &[(HookKind::Unknown, vec![0x040B, 0x040B, 0x040B])]);
+        let looped = listing(
+            &[],
+            &[(HookKind::Unknown, vec![0x040B, 0x040B, 0x040B])],
+            &[],
+        );
         assert_eq!(
             looped,
             "nothing installed\nHOOK_UNKNOWN: $040B -> $040B (comes back to where it has been: a loop the robot would run for ever at its next command)\n"

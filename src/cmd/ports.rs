@@ -37,8 +37,9 @@ pub(crate) fn run(_args: &Args) -> miette::Result<ExitCode> {
 pub(crate) struct Line {
     /// The serial port the robot is on (`scorpion ports` lists them), or
     /// `emu` for the virtual Scorpion in this process [env: SCORPION_PORT;
-    /// else the per-user file's or Scorpion.toml's [robot] port].
-    #[arg(long)]
+    /// else the per-user file's or Scorpion.toml's [robot] port]. Without
+    /// a value, as `test --port`: the configured one.
+    #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
     pub(crate) port: Option<String>,
     /// The line's baud rate (the robot's) [env: SCORPION_BAUD; else the
     /// per-user file's or Scorpion.toml's [robot] baud; default 9600].

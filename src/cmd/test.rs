@@ -348,6 +348,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             "took out {old} for {image}: it overlapped the image (--replace), and no longer answers"
         );
     }
+    for (image, old) in &report.reset_freed {
+        let _ = writeln!(
+            out,
+            "warning: the robot reset while {image} went in (a /1R frees every entry): {old} is no longer installed (its code stays in RAM, unhooked); upload it again to answer its commands"
+        );
+    }
     if !report.left_installed.is_empty() {
         let _ = writeln!(
             out,

@@ -356,6 +356,13 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
             old.describe()
         );
     }
+    for old in &report.reset_freed {
+        let _ = write!(
+            text,
+            "\n  warning: the robot reset during the upload (a /1R frees every entry): {} is no longer installed (its code stays in RAM, unhooked); upload it again to answer its commands",
+            old.describe()
+        );
+    }
     if report.rewrites > 0 || report.lost_answers > 0 {
         let _ = write!(
             text,
@@ -389,10 +396,21 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
 /// on: the rehearsal's robot had this image alone, so the expectations
 /// were met without the extensions chained behind it on the robot
 /// (fresh10 F11: `/1W => nothing` passed, and the robot answered `W99`).
-fn others_not_rehearsed(report: &uploader::UploadReport, profile: &uploader::RomProfile) -> String {
+fn others_not_rehearsed(
+    report: &uploader::UploadReport,
+    profile: &uploader::RomProfile,
+    earlier: &[(String, linker::Image, UploadImage)],
+) -> String {
     let mut text = String::new();
     for hook in &report.hooks {
-        if profile.reset_target(hook.kind) != Some(hook.previous) {
+        // The project's images before this one were rehearsed with it.
+        let rehearsed = earlier.iter().any(|(_, _, image)| {
+            image
+                .hooks()
+                .iter()
+                .any(|record| record.kind == hook.kind && record.handler == hook.previous)
+        });
+        if !rehearsed && profile.reset_target(hook.kind) != Some(hook.previous) {
             let _ = writeln!(
                 text,
                 "note: on the robot {} falls through to ${:04X}, another extension the rehearsal did not have: the expectations were met without it",
@@ -402,6 +420,16 @@ fn others_not_rehearsed(report: &uploader::UploadReport, profile: &uploader::Rom
         }
     }
     text
+}
+
+/// `, with first.elf before it`: the images a rehearsal had before the
+/// one it reports on, if any.
+fn with_earlier(earlier: &[(String, linker::Image, UploadImage)]) -> String {
+    if earlier.is_empty() {
+        return String::new();
+    }
+    let names: Vec<&str> = earlier.iter().map(|(name, _, _)| name.as_str()).collect();
+    format!(", with {} before it, as on the robot", names.join(" and "))
 }
 
 /// `--fast-baud`: 0, or a rate the robot's 6551 runs at (hostile10 F15:
@@ -462,7 +490,13 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         refuse_unfinished(&args.undo_path())?;
     }
     match &args.image {
-        Some(path) => upload_file(args, &resolved, path, &mut UndoFile::new(args.undo_path())),
+        Some(path) => upload_file(
+            args,
+            &resolved,
+            path,
+            &mut UndoFile::new(args.undo_path()),
+            (&[], true),
+        ),
         None => {
             let Some(project) = &resolved.project else {
                 // None here, or a workspace: the error says which.
@@ -472,9 +506,17 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             // One keeper for all the images: the undo file puts back what
             // the robot held before the first (hostile14 F6).
             let mut undo = UndoFile::new(args.undo_path());
+            let mut paths = Vec::new();
             for spec in &project.file.images {
                 let (_, path) = scorpion_project::runner::build::build_to_target(project, spec)?;
-                let code = upload_file(args, &resolved, &path, &mut undo)?;
+                paths.push(path);
+            }
+            // fresh19 F9: each image is rehearsed with those before it,
+            // as the robot will hold them, and `--expect` is checked once
+            // the last is in (a transcript may use them all).
+            for (index, path) in paths.iter().enumerate() {
+                let last = index + 1 == paths.len();
+                let code = upload_file(args, &resolved, path, &mut undo, (&paths[..index], last))?;
                 if code != ExitCode::SUCCESS {
                     return Ok(code);
                 }
@@ -581,14 +623,23 @@ fn undo_file_writable(path: &Path, default: bool) -> miette::Result<()> {
         .wrap_err("--undo-file: the upload keeps what it overwrites there")
 }
 
-/// Uploads the linked image at `path`.
+/// Uploads the linked image at `path`, after the images at `earlier` (a
+/// project's, uploaded in this run: on the rehearsal's robot too); the
+/// expectations are checked where `check` (after a project's last image).
 fn upload_file(
     args: &Args,
     resolved: &scorpion_project::Resolved,
     path: &PathBuf,
     undo: &mut UndoFile,
+    (earlier, check): (&[PathBuf], bool),
 ) -> miette::Result<ExitCode> {
     let (linked, image) = read_image(path)?;
+    let earlier: Vec<(String, linker::Image, UploadImage)> = earlier
+        .iter()
+        .map(|path| {
+            read_image(path).map(|(linked, image)| (scorpion_project::shown(path), linked, image))
+        })
+        .collect::<miette::Result<_>>()?;
     let expectations = args.expect.as_deref().map(read_expectations).transpose()?;
     let rom = crate::cmd::config::rom(resolved)?;
     let rig = crate::cmd::config::rig(resolved);
@@ -616,18 +667,33 @@ fn upload_file(
         let (mut robot, shown) = ports::virtual_robot(baud, rom.as_ref(), &rig)?;
         // A handler that hangs in the rehearsal is named by its label.
         robot.add_labels(&linked);
+        for (_, linked, _) in &earlier {
+            robot.add_labels(linked);
+        }
         let transport = ports::Showing::new(VirtualTransport::new(robot), shown);
         let mut client = args.client(transport, profile);
+        for (name, _, image) in &earlier {
+            uploader::upload(&mut client, image, &options, &mut NoProgress).wrap_err_with(|| {
+                format!("the rehearsal on the virtual Scorpion failed (uploading {name}, before this image); nothing was sent to the robot")
+            })?;
+        }
         let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
             "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot",
         )?;
         let _ = write!(
             out,
-            "rehearsed on the virtual Scorpion: {} bytes verified in {:.2} s of robot time",
+            "rehearsed on the virtual Scorpion{}: {} bytes verified in {:.2} s of robot time",
+            with_earlier(&earlier),
             report.bytes,
             report.device_time.as_secs_f64()
         );
-        if let Some(expectations) = &expectations {
+        if let Some(expectations) = expectations.as_ref().filter(|_| !check) {
+            let _ = writeln!(
+                out,
+                "; {} is checked once the project's last image is in",
+                expectations.0
+            );
+        } else if let Some(expectations) = &expectations {
             let lines = check_expectations(
                 expectations,
                 &mut client,
@@ -652,7 +718,11 @@ fn upload_file(
 
     // The robot itself: on `emu`, a fresh virtual Scorpion with the same
     // parts; on a port, the robot, which has its own.
-    let transport = ports::open_resolved(resolved, &[])?;
+    let held: Vec<(String, linker::Image)> = earlier
+        .iter()
+        .map(|(name, linked, _)| (name.clone(), linked.clone()))
+        .collect();
+    let transport = ports::open_resolved(resolved, if emulated { &held } else { &[] })?;
     let mut client = args.client(transport, profile);
     let mut bar = Bar::new();
     // `emu` is a fresh virtual Scorpion for each command: nothing of it
@@ -728,9 +798,12 @@ fn upload_file(
         }
     }
     if !emulated && expectations.is_some() {
-        out.push_str(&others_not_rehearsed(&report, profile));
+        out.push_str(&others_not_rehearsed(&report, profile, &earlier));
     }
-    if emulated && let Some(expectations) = &expectations {
+    if emulated
+        && check
+        && let Some(expectations) = &expectations
+    {
         let lines = check_expectations(
             expectations,
             &mut client,

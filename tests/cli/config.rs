@@ -647,13 +647,23 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
         (Source::Project, "project"),
     ] {
         let (_, env) = adc.port_from(source, "/dev/no-such-scorpion-port");
-        let output = adc.run(&project, &["ask", "/1X"], &env);
-        assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(
-            stderr.contains("/dev/no-such-scorpion-port is from the ") && stderr.contains(origin),
-            "{source:?}: {stderr}"
-        );
+        // fresh19 F7: `test --port` said only "does not exist"; a bare
+        // `--port` (the configured one) was `test`'s and `debug`'s alone.
+        for args in [
+            &["ask", "/1X"][..],
+            &["test", "--port"],
+            &["installed", "--port"],
+        ] {
+            let output = adc.run(&project, args, &env);
+            assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert!(
+                stderr.contains("/dev/no-such-scorpion-port is from the ")
+                    && stderr.contains(origin)
+                    && stderr.contains("does not exist"),
+                "{source:?} {args:?}: {stderr}"
+            );
+        }
     }
     let output = adc.run(&project, &["build", "-D", "BIG=99999999999"], &[]);
     assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));

@@ -826,6 +826,20 @@ fn a_two_image_project_tested_twice_is_undone_to_the_robot_before() {
         "{again}"
     );
     let listed = ok(&project, &line, &["installed"]);
+    // fresh19 F12: in the project that built them, named.
+    assert!(
+        listed.contains(" (myext): $") && listed.contains(" (second): $"),
+        "{listed}"
+    );
+    assert!(listed.contains(" second) -> $"), "the chain too: {listed}");
+    second_answers(&project, 'Q');
+    let edited = ok(&project, &line, &["installed"]);
+    assert!(
+        edited
+            .contains(" (where the project's second goes, but not it as its sources build now): $"),
+        "{edited}"
+    );
+    second_answers(&project, 'U');
     let undone = ok(&project, &line, &["upload", "--undo"]);
     assert!(undone.contains("restored"), "{undone}");
     assert_eq!(
@@ -1032,4 +1046,50 @@ fn a_and_b(dir: &std::path::Path) -> Sim {
     std::fs::write(dir.join("a.elf"), extension_at(0x0C00, 200, None)).expect("the image");
     std::fs::write(dir.join("b.elf"), extension_at(0x0400, 300, None)).expect("the image");
     Sim::start(dir, &["--baud", "19200"])
+}
+
+/// fresh19 F9: `scorpion upload --expect` in a project of two images
+/// rehearsed each image alone, so a transcript that used both failed on
+/// the second's command (with `/1W` "no answer"). Each image is rehearsed
+/// with those before it, and the transcript checked once both are in: on
+/// `emu` and on a port alike.
+#[test]
+fn upload_expect_in_a_two_image_project_rehearses_them_together() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = two_image_project(dir.path(), 'U');
+    std::fs::write(
+        project.join("tests/both.expect"),
+        "/1V => V01\n/1U => U\n/1X => X00\n",
+    )
+    .expect("the transcript");
+    let sim = Sim::start(dir.path(), &[]);
+    for port in ["emu", sim.path.as_str()] {
+        let text = ok(
+            &project,
+            &["--port", port],
+            &["upload", "--expect", "tests/both.expect"],
+        );
+        assert!(
+            text.contains("tests/both.expect is checked once the project's last image is in"),
+            "{port}: {text}"
+        );
+        assert!(
+            text.contains("with target/scorpion/myext.elf before it, as on the robot")
+                && text.contains("3 expectations met"),
+            "{port}: {text}"
+        );
+        assert!(
+            !text.contains("the rehearsal did not have"),
+            "{port}: {text}"
+        );
+    }
+    // The transcript fails where the project's images answer otherwise.
+    second_answers(&project, 'Q');
+    let (success, text) = on(
+        &project,
+        &["--port", sim.path.as_str()],
+        &["upload", "--expect", "tests/both.expect", "--replace"],
+    );
+    assert!(!success, "{text}");
+    assert!(text.contains("nothing was sent to the robot"), "{text}");
 }

@@ -57,6 +57,9 @@ pub(crate) struct Plan {
     /// F6b: a project of two images re-chained them at every run, and no
     /// second run was ever "unchanged").
     pub(crate) relink: Vec<Relink>,
+    /// Those of `others` whose flags a reset cleared while the upload ran
+    /// (recheck20 F2): no longer installed, so nothing to chain to.
+    pub(crate) freed: Vec<Installed>,
 }
 
 /// Where an earlier copy of the image was in a chain, behind another
@@ -325,6 +328,7 @@ pub(crate) fn prepare<T: Transport>(
         reused: reused.is_some(),
         replaced,
         others: kept,
+        freed: Vec::new(),
         unlinked,
         relink,
     }))
@@ -386,12 +390,41 @@ impl Plan {
 }
 
 impl Plan {
-    /// Whether the entry's flags are still set: a reset since they were
-    /// written clears them (the first byte is enough).
-    pub(crate) fn still_there<T: Transport>(&self, client: &mut Client<T>) -> Result<bool> {
-        let at = installed::flags_address(self.table.0, self.entry.slot);
-        let wanted = &self.entry.flags()[..1];
-        Ok(differs(client, at, wanted)?.is_none())
+    /// Whether the entry's flags are still set, and the other extensions'
+    /// too: a reset since they were written clears them all (the first
+    /// byte of each is enough; one read covers them). A reset found by
+    /// the others' flags alone came before the image's were written, and
+    /// perhaps before its hooks chained to one of those others: those are
+    /// `freed` from then on, and the caller puts the hooks in again.
+    pub(crate) fn still_there<T: Transport>(&mut self, client: &mut Client<T>) -> Result<bool> {
+        let ours = self.entry.slot;
+        let watched: Vec<usize> = self
+            .others
+            .iter()
+            .filter(|other| !self.freed.contains(other))
+            .map(|other| other.slot)
+            .chain([ours])
+            .collect();
+        let first = watched.iter().copied().min().unwrap_or(ours);
+        let last = watched.iter().copied().max().unwrap_or(ours);
+        let at = installed::flags_address(self.table.0, first);
+        let read = client.read_memory(at, last - first + 1)?;
+        let set = |slot: usize| {
+            read.get(slot - first)
+                .is_some_and(|&flags| installed::in_use(flags))
+        };
+        if read.get(ours - first) != self.entry.flags().first() {
+            return Ok(false);
+        }
+        let cleared: Vec<Installed> = self
+            .others
+            .iter()
+            .filter(|other| !self.freed.contains(other) && !set(other.slot))
+            .cloned()
+            .collect();
+        let reset = !cleared.is_empty();
+        self.freed.extend(cleared);
+        Ok(!reset)
     }
 }
 

@@ -189,6 +189,10 @@ pub struct UploadReport {
     /// extension in front (given) pointing at it again, not to the head
     /// of the chain.
     pub relinked: Vec<(HookKind, u16)>,
+    /// Installed extensions a reset (`/1R`) freed while the upload ran
+    /// (their entries' flags cleared): their code is still in RAM, but no
+    /// hook leads to it, and the table no longer names it.
+    pub reset_freed: Vec<romlib::installed::Installed>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -782,7 +786,7 @@ pub fn upload_keeping<T: Transport>(
     // Through the loader, a reset is found and recovered from while the
     // body goes in; one after its last check clears the entry's flags, and
     // then the ROM's own path goes over the whole image again.
-    if session.is_some() && !still_installed(client, plan.as_ref())? {
+    if session.is_some() && !still_installed(client, plan.as_mut())? {
         unhook(client, &hooks, options)?;
         if let Some(plan) = plan.as_mut() {
             plan.forget_flags();
@@ -829,7 +833,8 @@ pub fn upload_keeping<T: Transport>(
         }
     }
     let stats = client.stats();
-    let replaced = plan.map_or_else(Vec::new, |plan| plan.replaced);
+    let (replaced, reset_freed) =
+        plan.map_or_else(Default::default, |plan| (plan.replaced, plan.freed));
     Ok(UploadReport {
         bytes,
         device_time: client.transport().now().saturating_sub(start),
@@ -857,6 +862,7 @@ pub fn upload_keeping<T: Transport>(
             .iter()
             .map(|relink| (relink.kind, relink.slot))
             .collect(),
+        reset_freed,
     })
 }
 
@@ -1264,7 +1270,7 @@ fn rom_path<T: Transport>(
             None,
             progress,
         )?;
-        if still_installed(client, plan.as_deref())? {
+        if still_installed(client, plan.as_deref_mut())? {
             return Ok((body, hooks));
         }
         unhook(client, &hooks, options)?;
@@ -1275,11 +1281,12 @@ fn rom_path<T: Transport>(
     Err(reset_error(initial))
 }
 
-/// Whether the image's entry is still flagged in the table (a ROM without
-/// a table cannot tell: yes).
+/// Whether the image's entry is still flagged in the table, and the other
+/// extensions' entries as the upload found them (a ROM without a table
+/// cannot tell: yes).
 fn still_installed<T: Transport>(
     client: &mut Client<T>,
-    plan: Option<&table::Plan>,
+    plan: Option<&mut table::Plan>,
 ) -> Result<bool> {
     match plan {
         Some(plan) => plan.still_there(client),

@@ -409,7 +409,11 @@ fn bytes_after_a_counter_among_the_code_are_the_robots() {
     let profile = RomProfile::reference();
     let mut debug = RobotDebug::attach(client, &profile, wrong).expect("attaches");
     let note = debug.recovery().data_note().expect("a note");
-    assert!(note.contains("note: $0603 among"), "{note}");
+    // The counter's high byte at $0604 may move during the read too.
+    assert!(
+        note.contains("note: $0603 among") || note.contains("note: $0603, $0604 among"),
+        "{note}"
+    );
     assert!(note.contains("$0605 after it differ"), "{note}");
     assert_eq!(debug.image().byte(0x0605), Some(0x4C), "the robot's byte");
     let entries = [0x0600, 0x0605, 0x0608, 0x0610];

@@ -178,3 +178,68 @@ fn a_replacement_takes_the_place_of_the_extension_it_replaces() {
         );
     }
 }
+
+/// recheck20 F2: a `/1R` while an edit of the extension behind another
+/// went in with `--replace`. The reset freed every entry, and the upload
+/// then chained the edit to the one in front as it had found the hook: it
+/// ended "verified" with the one in front hooked, which no entry listed.
+/// Wherever the reset falls, an upload that finishes leaves every handler
+/// its hook reaches listed in the robot's table.
+#[test]
+fn a_reset_anywhere_in_a_replacement_behind_another_leaves_nothing_hooked_unlisted() {
+    for path in [LoaderChoice::Never, LoaderChoice::Always] {
+        let options = UploadOptions {
+            replace: true,
+            ..options(path)
+        };
+        let behind = common::one_byte_changed(&extension_at(0x0400), 40);
+        let sent = {
+            let mut client = uploader::client(robot(), &options.profile);
+            two_installed(&mut client, &options);
+            let before = client.stats().sent;
+            upload(&mut client, &behind, &options, &mut NoProgress).expect("replaced");
+            client.stats().sent - before
+        };
+        let mut finished = 0;
+        for at in (0..sent).step_by(41) {
+            let mut client = uploader::client(robot(), &options.profile);
+            two_installed(&mut client, &options);
+            let transport = client.into_transport();
+            let config = FaultConfig {
+                reset_after: Some(at),
+                ..FaultConfig::none(5)
+            };
+            let mut client =
+                uploader::client(FaultyTransport::new(transport, config), &options.profile);
+            let result = upload(&mut client, &behind, &options, &mut NoProgress);
+            let outcome = format!("{path:?}, /1R after {at} of {sent}: {result:?}");
+            let transport: VirtualTransport = client.into_transport().into_inner();
+            let reached = chain(transport.robot().robot().board().memory());
+            let mut client = uploader::client(transport, &options.profile);
+            let listed = uploader::read_installed(&mut client, &options.profile)
+                .unwrap_or_else(|error| panic!("{outcome}: the table: {error}"));
+            if let Ok(report) = &result {
+                finished += 1;
+                for handler in &reached {
+                    assert!(
+                        listed
+                            .iter()
+                            .any(|entry| entry.hooks.iter().any(|hook| hook.handler == *handler)),
+                        "{outcome}: ${handler:04X} is hooked, the table lists {listed:?}"
+                    );
+                }
+                assert!(reached.contains(&0x0403), "{outcome}: {reached:04X?}");
+                // What the reset took out is said, if the table was read
+                // before it (else the upload found a robot just reset).
+                let read_before = !report.replaced.is_empty();
+                let lost = read_before && !reached.contains(&0x0703);
+                assert_eq!(
+                    report.reset_freed.len(),
+                    usize::from(lost),
+                    "{outcome}: {reached:04X?}"
+                );
+            }
+        }
+        assert!(finished > 0, "{path:?}: no upload finished");
+    }
+}

@@ -205,6 +205,19 @@ pub enum Error {
         source: romlib::Error,
     },
 
+    /// The port a file or the environment named could not be opened
+    /// (fresh19 F7: a stale one is otherwise a mystery).
+    #[error("the port {port} is from the {origin}")]
+    PortOpen {
+        /// The port.
+        port: String,
+        /// Where it came from.
+        origin: crate::resolve::Origin,
+        /// Why it did not open.
+        #[source]
+        source: Box<uploader::Error>,
+    },
+
     /// An image the robot did not take.
     #[error("cannot upload {image}")]
     UploadImage {
@@ -249,7 +262,9 @@ impl Error {
             Error::Read { source, .. }
             | Error::ScriptUnreadable { source, .. }
             | Error::RomUnreadable { source, .. } => source,
-            Error::Transcript { source, .. } | Error::UploadImage { source, .. } => &**source,
+            Error::Transcript { source, .. }
+            | Error::UploadImage { source, .. }
+            | Error::PortOpen { source, .. } => &**source,
             Error::CardPlacement { source, .. } | Error::Load { source, .. } => source,
             Error::CreateDir { .. }
             | Error::WriteTarget { .. }

@@ -129,6 +129,9 @@ pub struct Report {
     /// go (`HOOK_UNKNOWN led to $0021`), for the image that falls through
     /// to the ROM instead.
     pub dropped: Vec<(String, String)>,
+    /// Extensions a reset freed while an image went in (`extension
+    /// 8C8390 ($0400-$044F)`), for that image: no longer installed.
+    pub reset_freed: Vec<(String, String)>,
 }
 
 impl Report {

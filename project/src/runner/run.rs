@@ -34,7 +34,7 @@ use super::rig::{EMU, Rig, Scripts, is_world_file, rom, virtual_robot};
 use super::room_lines::RoomLine;
 use super::snapshot::{self, Compared};
 use super::transcript::{self, Clock, Step};
-use crate::{Environment, FILE, Flags, Found, Project, Resolved};
+use crate::{Environment, FILE, Flags, Found, Project, Resolved, Sourced};
 
 /// What to run, and how.
 #[derive(Debug, Clone, Default)]
@@ -246,8 +246,9 @@ impl Run<'_, '_, '_> {
         }
         match &self.options.port {
             Some(port) => {
-                let (setup, port) = Setup::of(project, Some(port), &self.options.environment)?;
-                let port = port.unwrap_or_default();
+                let (setup, resolved) = Setup::of(project, Some(port), &self.options.environment)?;
+                let sourced = resolved.port()?.clone();
+                let port = sourced.value.clone();
                 if self.report.failed == failed_before {
                     // The rehearsal: every transcript on the virtual robot
                     // with the project's cards and world first; the robot
@@ -256,7 +257,7 @@ impl Run<'_, '_, '_> {
                     self.virtual_checks();
                 }
                 if self.report.failed == failed_before {
-                    self.robot_transcripts(project, &setup, &built, &port)?;
+                    self.robot_transcripts(project, &setup, &built, &sourced)?;
                 } else {
                     self.record_result(
                         &format!("upload to {port}"),
@@ -597,8 +598,9 @@ impl Run<'_, '_, '_> {
         project: &Project,
         setup: &Setup,
         built: &[Built],
-        port: &str,
+        sourced: &Sourced<String>,
     ) -> Result<()> {
+        let port = sourced.value.as_str();
         // On `emu` the robot is the virtual one with the project's parts; a
         // real robot has its own cards, and is opened without them.
         let progress = self.progress;
@@ -614,7 +616,17 @@ impl Run<'_, '_, '_> {
                 Tell { scripts, progress },
             ))
         } else {
-            Box::new(SerialTransport::open(port, setup.baud)?)
+            // A port that came from a file or the environment is named
+            // with where it came from, as every other command names it.
+            let opened = SerialTransport::open(port, setup.baud);
+            Box::new(opened.map_err(|source| match &sourced.origin {
+                crate::resolve::Origin::Flag(_) => Error::Upload(source),
+                origin => Error::PortOpen {
+                    port: port.to_owned(),
+                    origin: origin.clone(),
+                    source: Box::new(source),
+                },
+            })?)
         };
         let mut client = client(transport);
         let options = uploader::UploadOptions {
@@ -659,6 +671,11 @@ impl Run<'_, '_, '_> {
                 for old in &report.replaced {
                     self.report
                         .replaced
+                        .push((image.name.clone(), old.describe()));
+                }
+                for old in &report.reset_freed {
+                    self.report
+                        .reset_freed
                         .push((image.name.clone(), old.describe()));
                 }
             }
@@ -931,30 +948,24 @@ struct Setup {
 impl Setup {
     /// The virtual robot the one resolution gives `project` (its cards,
     /// world and ROM profile; the rate from the environment, the per-user
-    /// file or the project), and the port, if `port` asks for one
-    /// (`Some("")`: the configured one).
+    /// file or the project), and that resolution, whose port is `port`
+    /// where one is given (`Some("")`: the configured one).
     fn of(
         project: &Project,
         port: Option<&str>,
         environment: &Environment,
-    ) -> Result<(Setup, Option<String>)> {
+    ) -> Result<(Setup, Resolved)> {
         let flags = Flags {
             port: port.filter(|p| !p.is_empty()).map(str::to_owned),
             ..Flags::default()
         };
         let resolved = Resolved::resolve(&flags, environment, &project.root)?;
-        let port = match port {
-            Some(_) => Some(resolved.port()?.value.clone()),
-            None => None,
+        let setup = Setup {
+            baud: resolved.baud.value,
+            rom: rom(&resolved)?,
+            rig: Rig::of(&resolved),
         };
-        Ok((
-            Setup {
-                baud: resolved.baud.value,
-                rom: rom(&resolved)?,
-                rig: Rig::of(&resolved),
-            },
-            port,
-        ))
+        Ok((setup, resolved))
     }
 }
 
