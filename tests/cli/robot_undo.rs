@@ -311,6 +311,25 @@ fn an_undo_file_whose_hook_goes_to_memory_it_neither_holds_nor_witnesses_is_refu
         assert_eq!(ok(d, &line, &["read", "$0200", "6"]), before, "{args:?}");
     }
     assert!(d.join("crafted.undo").is_file(), "not marked used");
+    // A hook into the middle of the ROM: refused as a file made by hand,
+    // not with the help of an image ("link extensions with --target").
+    for hook in &mut crafted.hooks {
+        if hook.0 == isa::objfmt::HookKind::Unknown {
+            hook.1 = 0xFF00;
+        }
+    }
+    std::fs::write(d.join("rom.undo"), crafted.encode()).expect("the crafted file");
+    for args in [
+        vec!["upload", "--undo", "--undo-file", "rom.undo"],
+        vec!["restore", "rom.undo"],
+    ] {
+        let (success, text) = on(d, &line, &args);
+        assert!(!success, "{args:?}: {text}");
+        assert!(text.contains("uploader::backup_refused"), "{text}");
+        assert!(text.contains("inside the ROM"), "{text}");
+        assert!(!text.contains("--target"), "{text}");
+        assert_eq!(ok(d, &line, &["read", "$0200", "6"]), before, "{args:?}");
+    }
     let text = ok(d, &line, &["upload", "--undo"]);
     assert!(text.contains("restored"), "{text}");
     let text = ok(d, &line, &["read", "$0200", "3"]);

@@ -1046,7 +1046,7 @@ fn check_witnesses<T: Transport>(
 ///
 /// # Errors
 /// [`Error::WrongRom`], [`Error::BackupRomDiffers`],
-/// [`Error::WitnessDiffers`], [`Error::BadImage`] for memory an upload may
+/// [`Error::WitnessDiffers`], [`Error::BackupRefused`] for memory an upload may
 /// not write, [`Error::UnwitnessedHook`] for a hook into RAM the file
 /// neither holds nor witnesses (before the line is used), and every error
 /// an upload has.
@@ -1072,7 +1072,7 @@ pub fn restore<T: Transport>(
     if let Some(damaged) = damaged_table(profile, backup) {
         // hostile19 F4: the hooks went to the ROM first, and every restore
         // of it failed after.
-        return Err(Error::BadImage {
+        return Err(Error::BackupRefused {
             reason: format!(
                 "the file's table of installed extensions does not decode ({damaged}): it was damaged on the robot when it was saved; nothing was written"
             ),
@@ -1268,7 +1268,7 @@ fn check_hook_targets(
             // A backup or an undo file only ever holds the ROM's own
             // target: anywhere else in the ROM is its data or the middle
             // of its code (hostile8's F1: a vector, a JMP's operand).
-            return Err(Error::BadImage {
+            return Err(Error::BackupRefused {
                 reason: format!(
                     "the backup points {} at ${target:04X}, inside the ROM but not where the ROM points it ({}): no extension's code is there; nothing was written",
                     kind.rom_symbol(),
@@ -1280,7 +1280,7 @@ fn check_hook_targets(
         }
         let to_ram = profile.writable.iter().any(|range| range.contains(&target));
         if !to_rom && !to_ram {
-            return Err(Error::BadImage {
+            return Err(Error::BackupRefused {
                 reason: format!(
                     "the backup points {} at ${target:04X}, which is neither the ROM nor memory an extension may hold; nothing was written",
                     kind.rom_symbol()
@@ -1294,7 +1294,7 @@ fn check_hook_targets(
         // before the robot jumps in.
         if !to_rom && within(table, target) {
             // Witnessed or held, the table is data (hostile10 F14).
-            return Err(Error::BadImage {
+            return Err(Error::BackupRefused {
                 reason: format!(
                     "the backup points {} at ${target:04X}, in the table of installed extensions: no handler starts there; nothing was written",
                     kind.rom_symbol()
@@ -1334,7 +1334,7 @@ fn check_records(backup: &Backup, memory: &RomProfile, table: Option<(u16, usize
         })
     };
     if let Some(witness) = backup.witnesses.iter().find(|witness| !writable(witness)) {
-        return Err(Error::BadImage {
+        return Err(Error::BackupRefused {
             reason: format!(
                 "the file witnesses {} bytes at ${:04X}, outside the memory an extension may hold: no upload or backup wrote that; nothing was written",
                 witness.len, witness.address
@@ -1356,7 +1356,7 @@ fn check_records(backup: &Backup, memory: &RomProfile, table: Option<(u16, usize
         .iter()
         .find(|entry| !on_entries(entry))
     {
-        return Err(Error::BadImage {
+        return Err(Error::BackupRefused {
             reason: format!(
                 "the file's record of a table entry an upload wrote ({} bytes at ${:04X}) is not on the table's entries: no upload wrote that; nothing was written",
                 entry.len, entry.address
@@ -1393,7 +1393,7 @@ fn refuse_held_stub(backup: &Backup, profile: &RomProfile) -> Result<()> {
 /// instruction other than `BRK`, every byte of it held by the file.
 fn check_held_entry(backup: &Backup, kind: HookKind, target: u16) -> Result<()> {
     let refuse = |why: String| {
-        Err(Error::BadImage {
+        Err(Error::BackupRefused {
             reason: format!(
                 "the backup points {} at ${target:04X}, {why}: no handler starts there; nothing was written",
                 kind.rom_symbol()

@@ -573,6 +573,21 @@ pub enum Error {
         target: u16,
     },
 
+    /// What a backup or undo file would write is not something a backup
+    /// or an upload wrote (a file made or changed by hand): refused before
+    /// anything is written.
+    #[error("{reason}")]
+    #[diagnostic(
+        code(uploader::backup_refused),
+        help(
+            "backups and undo files are written by `scorpion backup` and by every upload; this one was made or changed by hand, or damaged: restore another (a new `scorpion backup` is the robot as it is now)"
+        )
+    )]
+    BackupRefused {
+        /// What the file would do, and why it is refused.
+        reason: String,
+    },
+
     /// The image is not something that can be uploaded safely.
     #[error("the image cannot be uploaded: {reason}")]
     #[diagnostic(

@@ -147,7 +147,7 @@ pub(crate) fn refuse_later_entries(
                 listed.is_some_and(|listed| !listed || held(entry, romlib::installed::ENTRY_LEN))
             });
             if !freed {
-                return Err(Error::BadImage {
+                return Err(Error::BackupRefused {
                     reason: format!(
                         "the file takes out extension {:06X} (it holds the sum of its table entry as an upload wrote it) but does not put back the table there: the table would go on listing it over the memory the undo puts back; nothing was written",
                         entry.id
