@@ -68,6 +68,9 @@ pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// The help for a ROM profile that cannot be read, wherever it is met.
+pub(crate) const ROM_PROFILE_HELP: &str = "`rom` names a ROM profile (a ROM's linked image, ELF), relative to the project; `scorpion rom read -o FILE --port PORT` writes one from the robot; without `rom`, the reference ROM; `scorpion config` shows where it is looked for";
+
 /// Everything reading a project or resolving a configuration can say.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 pub enum Error {
@@ -180,12 +183,7 @@ pub enum Error {
 
     /// The project's ROM profile cannot be read.
     #[error("{file}: [robot] rom = \"{rom}\": cannot read the ROM profile")]
-    #[diagnostic(
-        code(scorpion::project::rom_unreadable),
-        help(
-            "`rom` names a ROM's linked image (ELF), relative to the project; `scorpion config` shows where it is looked for"
-        )
-    )]
+    #[diagnostic(code(scorpion::project::rom_unreadable), help("{}", ROM_PROFILE_HELP))]
     RomUnreadable {
         /// The project file.
         file: String,

@@ -221,6 +221,16 @@ impl UndoFile {
         run
     }
 
+    /// Whether the upload under way kept what it overwrote and has not
+    /// finished (the file is marked [`UPLOADING`]): only then is its undo
+    /// the way back from it. A refusal before anything was kept, after an
+    /// earlier image of the same run, leaves no such mark (fresh21 F4: the
+    /// advice then undid an upload from before the run).
+    #[must_use]
+    pub fn uploading(&self) -> bool {
+        self.written() && marked(&self.path, UPLOADING).exists()
+    }
+
     /// The upload finished: the next one may replace the file.
     pub fn finished_upload(&self) {
         let _ = std::fs::remove_file(marked(&self.path, UPLOADING));

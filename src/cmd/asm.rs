@@ -109,17 +109,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
 /// `.out` text on stdout.
 pub(crate) fn report(assembly: &assembler::Assembly) {
     for warning in &assembly.warnings {
-        #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
-        {
-            // "Warning: " as miette heads a related warning: the
-            // problem matcher reads a warning's severity there.
-            eprintln!("Warning: {:?}", miette::Report::new(warning.clone()));
-        }
+        // "Warning: " as miette heads a related warning: the problem
+        // matcher reads a warning's severity there.
+        crate::cmd::say_err(&format!(
+            "Warning: {:?}\n",
+            miette::Report::new(warning.clone())
+        ));
     }
     for message in &assembly.messages {
-        #[allow(clippy::print_stdout, reason = "`.out` text is the program's output")]
-        {
-            println!("{message}");
-        }
+        // `.out` text is the program's output.
+        crate::cmd::say_out(&format!("{message}\n"));
     }
 }

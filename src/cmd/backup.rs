@@ -208,10 +208,7 @@ impl uploader::Progress for Overrides<'_> {
     fn event(&mut self, event: &uploader::Event) {
         match event {
             uploader::Event::RomCheckOverridden { refusal } => {
-                #[allow(clippy::print_stderr, reason = "the CLI warns")]
-                {
-                    eprintln!("warning: --force overrides: {refusal}");
-                }
+                crate::cmd::say_err(&format!("warning: --force overrides: {refusal}\n"));
             }
             uploader::Event::RestoreStarted => {
                 if let Some(started) = self.started {
@@ -233,8 +230,5 @@ pub(crate) fn read_backup(path: &Path) -> miette::Result<Backup> {
 }
 
 fn print(text: &str) {
-    #[allow(clippy::print_stdout, reason = "the CLI reports the result")]
-    {
-        println!("{text}");
-    }
+    crate::cmd::say_out(&format!("{text}\n"));
 }

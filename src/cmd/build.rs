@@ -75,21 +75,16 @@ fn build_project(
         let (built, _) =
             scorpion_project::runner::build::build_to_target_with(project, spec, given)?;
         for warning in &built.warnings {
-            #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
-            {
-                // "Warning: " as miette heads a related warning: the
-                // problem matcher reads a warning's severity there.
-                eprintln!("Warning: {warning:?}");
-            }
+            // "Warning: " as miette heads a related warning: the problem
+            // matcher reads a warning's severity there.
+            crate::cmd::say_err(&format!("Warning: {warning:?}\n"));
         }
         let bytes: usize = built.linked.image.areas.iter().map(|a| a.bytes.len()).sum();
-        #[allow(clippy::print_stdout, reason = "the CLI reports what it wrote")]
-        {
-            println!(
-                "{}: {at}target/scorpion/{}.elf ({bytes} bytes, target {}), .lst, .map",
-                project.file.project.name, built.name, spec.target
-            );
-        }
+        // fresh21 F8: each line names its image (it named the project).
+        crate::cmd::say_out(&format!(
+            "{}: {at}target/scorpion/{}.elf ({bytes} bytes, target {}), .lst, .map\n",
+            built.name, built.name, spec.target
+        ));
     }
     Ok(())
 }
@@ -123,10 +118,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     }
     if let Some(last) = failures.pop() {
         for error in failures {
-            #[allow(clippy::print_stderr, reason = "the CLI reports errors")]
-            {
-                eprintln!("{:?}", miette::Report::new(error));
-            }
+            crate::cmd::say_err(&format!("{:?}\n", miette::Report::new(error)));
         }
         return Err(last.into());
     }

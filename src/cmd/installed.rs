@@ -65,7 +65,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             };
             let _ = writeln!(
                 text,
-                "{}: ${last:04X} {what} a debug stub left hooked at ${:04X}-${:04X} (chaining to ${:04X}): a debug session did not detach, and its breakpoints may still be in the code\n  to take it out: `scorpion debug --port {} --image ELF` (the image it debugged), then `quit`; or reset the robot",
+                "{}: ${last:04X} {what} a debug stub left hooked at ${:04X}-${:04X} (chaining to ${:04X}): a debug session did not detach, and its breakpoints may still be in the code\n  to take it out: `scorpion debug --port {}` in the project that built the image it debugged (elsewhere, with `--image ELF`), then `quit`; or reset the robot",
                 kind.rom_symbol(),
                 stub.address,
                 stub.end,
@@ -130,10 +130,12 @@ fn project_images(line: &ports::Line) -> Vec<Known> {
     known
 }
 
-/// How `image` is named beside its id: the project image it is, or the
-/// one whose memory it lies in (another build of it, or someone else's).
+/// How `image` is named beside its id: the project image it is (the same
+/// bytes at the same place: an image whose bytes do not depend on where it
+/// loads has one id wherever it goes, hostile21 F1), or those whose memory
+/// it lies in (another build of one of them, or someone else's).
 fn named(image: &Installed, names: &[Known]) -> String {
-    if let Some(known) = names.iter().find(|known| known.id == image.id) {
+    if let Some(known) = is(image, names) {
         return format!(" ({})", known.name);
     }
     let overlaps = |known: &&Known| {
@@ -144,13 +146,26 @@ fn named(image: &Installed, names: &[Known]) -> String {
                 .any(|theirs| ours.start() <= theirs.end() && theirs.start() <= ours.end())
         })
     };
-    match names.iter().find(overlaps) {
-        Some(known) => format!(
-            " (where the project's {} goes, but not it as its sources build now)",
-            known.name
+    let under: Vec<&str> = names
+        .iter()
+        .filter(overlaps)
+        .map(|known| known.name.as_str())
+        .collect();
+    match under.as_slice() {
+        [] => String::new(),
+        [one] => format!(" (where the project's {one} goes, but not it as its sources build now)"),
+        many => format!(
+            " (where the project's {} go, but none of them as its sources build now)",
+            many.join(", ")
         ),
-        None => String::new(),
     }
+}
+
+/// The project image `image` is: its id and its memory.
+fn is<'a>(image: &Installed, names: &'a [Known]) -> Option<&'a Known> {
+    names
+        .iter()
+        .find(|known| known.id == image.id && known.extents == image.extents)
 }
 
 /// The listing, for people.
@@ -203,10 +218,7 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)], names: &[Kno
                         .any(|hook| hook.kind == *kind && hook.handler == *target)
                 });
                 let name = |image: &Installed| {
-                    names
-                        .iter()
-                        .find(|known| known.id == image.id)
-                        .map_or(String::new(), |known| format!(" {}", known.name))
+                    is(image, names).map_or(String::new(), |known| format!(" {}", known.name))
                 };
                 match owner {
                     Some(image) => format!("${target:04X} ({:06X}{})", image.id, name(image)),
@@ -227,9 +239,47 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)], names: &[Kno
 
 #[cfg(test)]
 mod tests {
-    use super::listing;
+    use super::{Known, listing, named};
     use isa::objfmt::HookKind;
     use romlib::installed::{Installed, TakenHook};
+
+    fn known(name: &str, id: u32, extents: std::ops::RangeInclusive<u16>) -> Known {
+        Known {
+            name: name.to_owned(),
+            id,
+            extents: vec![extents],
+        }
+    }
+
+    /// hostile21 F1, F2: two images of the same bytes at two places have
+    /// one id: each is named where it is, not the first found; an older
+    /// build where two images go names both.
+    #[test]
+    fn an_extension_is_named_by_its_id_and_its_place() {
+        let names = [
+            known("i3", 0x79_4B2A, 0x0600..=0x0611),
+            known("i4", 0x79_4B2A, 0x0700..=0x0711),
+            known("za", 0x11_1111, 0x0400..=0x0411),
+            known("zb", 0x22_2222, 0x0400..=0x0411),
+        ];
+        let at = |id: u32, extents: std::ops::RangeInclusive<u16>| Installed {
+            id,
+            extents: vec![extents],
+            hooks: Vec::new(),
+            slot: 0,
+        };
+        assert_eq!(named(&at(0x79_4B2A, 0x0700..=0x0711), &names), " (i4)");
+        assert_eq!(named(&at(0x79_4B2A, 0x0600..=0x0611), &names), " (i3)");
+        assert_eq!(
+            named(&at(0x86_9D46, 0x0400..=0x0411), &names),
+            " (where the project's za, zb go, but none of them as its sources build now)"
+        );
+        assert_eq!(
+            named(&at(0x79_4B2A, 0x0608..=0x0620), &names),
+            " (where the project's i3 goes, but not it as its sources build now)"
+        );
+        assert_eq!(named(&at(0x12_3456, 0x0900..=0x0910), &names), "");
+    }
 
     /// recheck16 F5: after a restore that left an extension unhooked, the
     /// listing named its hook as if it were taken.

@@ -202,12 +202,9 @@ fn write(path: &Path, bytes: &[u8]) -> miette::Result<()> {
 
 fn report_warnings(linked: &mut Linked) {
     for warning in std::mem::take(&mut linked.warnings) {
-        #[allow(clippy::print_stderr, reason = "the CLI reports warnings")]
-        {
-            // "Warning: " as miette heads a related warning: the
-            // problem matcher reads a warning's severity there.
-            eprintln!("Warning: {:?}", miette::Report::new(warning));
-        }
+        // "Warning: " as miette heads a related warning: the problem
+        // matcher reads a warning's severity there.
+        crate::cmd::say_err(&format!("Warning: {:?}\n", miette::Report::new(warning)));
     }
 }
 
@@ -219,25 +216,22 @@ fn summary(linked: &Linked, args: &LinkArgs, output: &Path, others: &[String]) {
         .map(|area| format!("${:04X}-${:04X}", area.load, area.end().saturating_sub(1)))
         .collect();
     let bytes: usize = image.areas.iter().map(|area| area.bytes.len()).sum();
-    #[allow(clippy::print_stdout, reason = "the CLI reports what it wrote")]
-    {
-        println!(
-            "{} ({}, target {}): {} byte{} at {}, entry ${:04X}",
-            output.display(),
-            args.format(),
-            linked.layout.name,
-            bytes,
-            if bytes == 1 { "" } else { "s" },
-            if ranges.is_empty() {
-                "no address".to_owned()
-            } else {
-                ranges.join(", ")
-            },
-            image.entry
-        );
-        if !others.is_empty() {
-            println!("also wrote {}", others.join(", "));
-        }
+    crate::cmd::say_out(&format!(
+        "{} ({}, target {}): {} byte{} at {}, entry ${:04X}\n",
+        output.display(),
+        args.format(),
+        linked.layout.name,
+        bytes,
+        if bytes == 1 { "" } else { "s" },
+        if ranges.is_empty() {
+            "no address".to_owned()
+        } else {
+            ranges.join(", ")
+        },
+        image.entry
+    ));
+    if !others.is_empty() {
+        crate::cmd::say_out(&format!("also wrote {}\n", others.join(", ")));
     }
 }
 

@@ -37,6 +37,20 @@ pub(crate) fn flag_on_signals(
     Ok(flag)
 }
 
+/// Writes `text` on stdout. A stdout that is gone (piped into `head`,
+/// which has quit) is no reason to stop, least of all by a panic half way
+/// through work on a robot (fresh21 F2): what cannot be said is dropped.
+pub(crate) fn say_out(text: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+}
+
+/// [`say_out`] on stderr.
+pub(crate) fn say_err(text: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stderr().lock().write_all(text.as_bytes());
+}
+
 /// Says, on a signal (Ctrl-C, `kill`), what an interrupted upload, undo
 /// or restore left (`said`, asked then) before the process ends as the signal would
 /// have ended it.
@@ -48,10 +62,7 @@ pub(crate) fn say_when_interrupted(
         .map_err(|error| miette::miette!("cannot watch for Ctrl-C: {error}"))?;
     std::thread::spawn(move || {
         if let Some(signal) = signals.forever().next() {
-            #[allow(clippy::print_stderr, reason = "the CLI's last word")]
-            {
-                eprintln!("\n{}", said());
-            }
+            say_err(&format!("\n{}\n", said()));
             std::process::exit(128 + signal);
         }
     });

@@ -28,13 +28,10 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     };
     let root = PathBuf::from(name);
     template::create(&root, name, kind)?;
-    #[allow(clippy::print_stdout, reason = "the CLI reports what it made")]
-    {
-        println!(
-            "created {} `{name}` in {}/: cd {name} && scorpion test",
-            kind.word(),
-            root.display()
-        );
-    }
+    crate::cmd::say_out(&format!(
+        "created {} `{name}` in {}/: cd {name} && scorpion test\n",
+        kind.word(),
+        root.display()
+    ));
     Ok(ExitCode::SUCCESS)
 }

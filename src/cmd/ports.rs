@@ -92,6 +92,17 @@ pub(crate) fn open_resolved(
     let origin = &port.origin;
     let opened = SerialTransport::open(&port.value, resolved.baud.value);
     match origin {
+        // fresh21 F1: `ask --port /1X` takes `/1X` as the port; one that
+        // is no device path is said to be --port's value, with the way to
+        // give the configured port before the arguments.
+        scorpion_project::Origin::Flag(_) if opened.is_err() && !device_like(&port.value) => {
+            Ok(Box::new(opened.map_err(miette::Report::new).wrap_err_with(|| {
+                format!(
+                    "--port took `{}` as the robot's serial port; for the configured port, put a bare --port after the command's arguments, or write --port= (empty)",
+                    port.value
+                )
+            })?))
+        }
         scorpion_project::Origin::Flag(_) => Ok(Box::new(opened?)),
         _ => Ok(Box::new(
             opened
@@ -101,6 +112,16 @@ pub(crate) fn open_resolved(
     }
 }
 
+/// Whether `port` looks like a serial device's name (a path under `/dev`,
+/// a Windows `COMn`), not like a command, an address or a file that
+/// followed a bare `--port`.
+fn device_like(port: &str) -> bool {
+    port.starts_with("/dev/")
+        || port
+            .strip_prefix("COM")
+            .is_some_and(|number| !number.is_empty() && number.bytes().all(|b| b.is_ascii_digit()))
+}
+
 /// The robot `line` names, probed, for commands that only look at it
 /// (`read`, `installed`): on `emu` the project's images installed as an
 /// upload leaves them (else nothing would be there to look at), on a real
@@ -108,7 +129,32 @@ pub(crate) fn open_resolved(
 pub(crate) fn probed(
     line: &Line,
 ) -> miette::Result<(uploader::Client<Box<dyn Transport>>, RomProfile)> {
+    probed_with(line, false)
+}
+
+/// [`probed`], for `rom read`, which makes the ROM profile a project
+/// names: one that cannot be read is no reason to refuse (fresh21 F6), and
+/// the robot is read with the reference ROM's pacing, said on stderr.
+pub(crate) fn probed_for_rom(
+    line: &Line,
+) -> miette::Result<(uploader::Client<Box<dyn Transport>>, RomProfile)> {
+    probed_with(line, true)
+}
+
+fn probed_with(
+    line: &Line,
+    reference_if_unreadable: bool,
+) -> miette::Result<(uploader::Client<Box<dyn Transport>>, RomProfile)> {
     let resolved = line.resolve()?;
+    let rom = match crate::cmd::config::rom(&resolved) {
+        Err(error) if reference_if_unreadable => {
+            crate::cmd::say_err(&format!(
+                "note: {error}: the robot is read as the reference ROM's is\n"
+            ));
+            None
+        }
+        rom => rom?,
+    };
     let images = if resolved.port()?.value == EMU {
         crate::cmd::config::images(&resolved, &[])?.images
     } else {
@@ -116,10 +162,29 @@ pub(crate) fn probed(
         Vec::new()
     };
     let transport = open_resolved(&resolved, &images)?;
-    let profile = crate::cmd::config::profile(crate::cmd::config::rom(&resolved)?.as_ref())?;
+    let profile = crate::cmd::config::profile(rom.as_ref())?;
     let mut client = uploader::client(transport, &profile);
-    client.probe()?;
+    client.probe().map_err(|error| traced(error, &resolved))?;
     Ok((client, profile))
+}
+
+/// `error`, with where the port came from when it is a robot that does not
+/// answer on a port a file or the environment named (fresh21 F7: a stale
+/// setting whose device now belongs to something else only timed out).
+pub(crate) fn traced(
+    error: uploader::Error,
+    resolved: &scorpion_project::Resolved,
+) -> miette::Report {
+    let silent = matches!(error, uploader::Error::NoAnswer { .. });
+    match resolved.port.as_ref() {
+        Some(port) if silent && !matches!(port.origin, scorpion_project::Origin::Flag(_)) => {
+            miette::Report::new(error).wrap_err(format!(
+                "the port {} is from the {}",
+                port.value, port.origin
+            ))
+        }
+        _ => miette::Report::new(error),
+    }
 }
 
 /// The `--port` value that names the in-process virtual Scorpion.

@@ -45,13 +45,10 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         client.read_live(args.address, args.length as usize)?;
     if !changing.is_empty() {
         // On stderr: stdout is the dump, which scripts read.
-        #[allow(clippy::print_stderr, reason = "the CLI notes")]
-        {
-            eprintln!(
-                "note: the robot wrote {} while it was read, as it runs: one moment's value",
-                uploader::addresses_text(&changing)
-            );
-        }
+        crate::cmd::say_err(&format!(
+            "note: the robot wrote {} while it was read, as it runs: one moment's value\n",
+            uploader::addresses_text(&changing)
+        ));
     }
     match &args.output {
         Some(path) => hostfs::write(path, &bytes)?,

@@ -94,7 +94,7 @@ fn run_read(args: &ReadArgs) -> miette::Result<ExitCode> {
         ),
     };
     hostfs::check_writable(&args.output)?;
-    let (mut client, _) = ports::probed(&args.line)?;
+    let (mut client, _) = ports::probed_for_rom(&args.line)?;
     let start = platform::map::ROM_START;
     let bytes = client.read_memory(start, platform::map::ROM_SIZE)?;
     let (image, differences) = uploader::rom_profile_image(&base, start, &bytes);
@@ -118,9 +118,6 @@ fn run_read(args: &ReadArgs) -> miette::Result<ExitCode> {
             }
         );
     }
-    #[allow(clippy::print_stdout, reason = "the CLI reports the result")]
-    {
-        println!("{text}");
-    }
+    crate::cmd::say_out(&format!("{text}\n"));
     Ok(ExitCode::SUCCESS)
 }

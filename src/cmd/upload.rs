@@ -88,7 +88,9 @@ pub(crate) struct Args {
 /// What an upload interrupted left: whether `kept` says its undo file
 /// (`undo`) was written.
 fn upload_interrupted(undo: &Path, kept: &std::sync::atomic::AtomicBool) -> String {
-    if kept.load(std::sync::atomic::Ordering::Relaxed) {
+    // The mark, not only the flag: a project's later image interrupted
+    // before it kept anything has the flag of the one before (fresh21 F4).
+    if kept.load(std::sync::atomic::Ordering::Relaxed) && marked(undo, UPLOADING).exists() {
         format!(
             "interrupted: the upload did not finish; nothing that did not verify is hooked\n  `scorpion upload --undo` puts back what the robot held before it (kept in {}); then upload again",
             undo.display()
@@ -195,12 +197,8 @@ impl Bar {
     }
 
     fn say(&self, line: &str) {
-        self.bar.suspend(|| {
-            #[allow(clippy::print_stderr, reason = "the CLI reports progress")]
-            {
-                eprintln!("{line}");
-            }
-        });
+        self.bar
+            .suspend(|| crate::cmd::say_err(&format!("{line}\n")));
     }
 }
 
@@ -283,13 +281,11 @@ fn check_expectations<T: Transport>(
     let checked = expectations.check_all(client)?;
     match TranscriptFailed::of(shown, expectations, &checked.mismatches, help) {
         Some(failed) => {
-            #[allow(clippy::print_stderr, reason = "the CLI reports each failure")]
-            {
-                eprint!(
-                    "{}",
-                    transcript::describe(shown, &checked.mismatches, Clock::Robot)
-                );
-            }
+            crate::cmd::say_err(&transcript::describe(
+                shown,
+                &checked.mismatches,
+                Clock::Robot,
+            ));
             Err(failed.into())
         }
         None => Ok(checked.transcript),
@@ -399,13 +395,14 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
 fn others_not_rehearsed(
     report: &uploader::UploadReport,
     profile: &uploader::RomProfile,
-    earlier: &[(String, linker::Image, UploadImage)],
+    earlier: &[Loaded],
 ) -> String {
     let mut text = String::new();
     for hook in &report.hooks {
         // The project's images before this one were rehearsed with it.
-        let rehearsed = earlier.iter().any(|(_, _, image)| {
-            image
+        let rehearsed = earlier.iter().any(|loaded| {
+            loaded
+                .image
                 .hooks()
                 .iter()
                 .any(|record| record.kind == hook.kind && record.handler == hook.previous)
@@ -424,11 +421,11 @@ fn others_not_rehearsed(
 
 /// `, with first.elf before it`: the images a rehearsal had before the
 /// one it reports on, if any.
-fn with_earlier(earlier: &[(String, linker::Image, UploadImage)]) -> String {
+fn with_earlier(earlier: &[Loaded]) -> String {
     if earlier.is_empty() {
         return String::new();
     }
-    let names: Vec<&str> = earlier.iter().map(|(name, _, _)| name.as_str()).collect();
+    let names: Vec<&str> = earlier.iter().map(|loaded| loaded.name.as_str()).collect();
     format!(", with {} before it, as on the robot", names.join(" and "))
 }
 
@@ -490,12 +487,11 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
         refuse_unfinished(&args.undo_path())?;
     }
     match &args.image {
-        Some(path) => upload_file(
+        Some(path) => upload_all(
             args,
             &resolved,
-            path,
+            &[Loaded::read(path)?],
             &mut UndoFile::new(args.undo_path()),
-            (&[], true),
         ),
         None => {
             let Some(project) = &resolved.project else {
@@ -506,22 +502,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             // One keeper for all the images: the undo file puts back what
             // the robot held before the first (hostile14 F6).
             let mut undo = UndoFile::new(args.undo_path());
-            let mut paths = Vec::new();
+            let mut images = Vec::new();
             for spec in &project.file.images {
                 let (_, path) = scorpion_project::runner::build::build_to_target(project, spec)?;
-                paths.push(path);
+                images.push(Loaded::read(&path)?);
             }
             // fresh19 F9: each image is rehearsed with those before it,
             // as the robot will hold them, and `--expect` is checked once
             // the last is in (a transcript may use them all).
-            for (index, path) in paths.iter().enumerate() {
-                let last = index + 1 == paths.len();
-                let code = upload_file(args, &resolved, path, &mut undo, (&paths[..index], last))?;
-                if code != ExitCode::SUCCESS {
-                    return Ok(code);
-                }
-            }
-            Ok(ExitCode::SUCCESS)
+            upload_all(args, &resolved, &images, &mut undo)
         }
     }
 }
@@ -623,35 +612,48 @@ fn undo_file_writable(path: &Path, default: bool) -> miette::Result<()> {
         .wrap_err("--undo-file: the upload keeps what it overwrites there")
 }
 
-/// Uploads the linked image at `path`, after the images at `earlier` (a
-/// project's, uploaded in this run: on the rehearsal's robot too); the
-/// expectations are checked where `check` (after a project's last image).
-fn upload_file(
+/// A linked image read for an upload: its name as shown, the image as
+/// linked (its labels name a handler that hangs) and as the uploader
+/// takes it.
+struct Loaded {
+    name: String,
+    linked: linker::Image,
+    image: UploadImage,
+}
+
+impl Loaded {
+    fn read(path: &PathBuf) -> miette::Result<Loaded> {
+        let (linked, image) = read_image(path)?;
+        Ok(Loaded {
+            name: scorpion_project::shown(path),
+            linked,
+            image,
+        })
+    }
+}
+
+/// Uploads `images` one after the other (a project's, or the one named),
+/// each with one keeper. All are rehearsed first on one virtual Scorpion,
+/// and the expectations checked there once the last is in: nothing is
+/// sent to the robot unless every image and the file pass (hostile21 F4:
+/// a project's first images went to the robot before a later one's
+/// rehearsal failed, and the error said nothing was sent).
+fn upload_all(
     args: &Args,
     resolved: &scorpion_project::Resolved,
-    path: &PathBuf,
+    images: &[Loaded],
     undo: &mut UndoFile,
-    (earlier, check): (&[PathBuf], bool),
 ) -> miette::Result<ExitCode> {
-    let (linked, image) = read_image(path)?;
-    let earlier: Vec<(String, linker::Image, UploadImage)> = earlier
-        .iter()
-        .map(|path| {
-            read_image(path).map(|(linked, image)| (scorpion_project::shown(path), linked, image))
-        })
-        .collect::<miette::Result<_>>()?;
     let expectations = args.expect.as_deref().map(read_expectations).transpose()?;
     let rom = crate::cmd::config::rom(resolved)?;
-    let rig = crate::cmd::config::rig(resolved);
     let options = UploadOptions {
         profile: crate::cmd::config::profile(rom.as_ref())?,
         ..args.options()
     };
-    let profile = &options.profile;
-    profile.check(&image)?;
-    let baud = resolved.baud.value;
+    for loaded in images {
+        options.profile.check(&loaded.image)?;
+    }
     let emulated = resolved.is_emulated();
-    let mut out = String::new();
     // fresh10 F11: the pair uploaded with a zero exit and nothing checked.
     if args.no_dry_run && expectations.is_some() && !emulated {
         return Err(miette::miette!(
@@ -659,68 +661,134 @@ fn upload_file(
             "--expect is checked on the rehearsal, which --no-dry-run skips (expectations are never sent to a real robot)"
         ));
     }
-
-    // The rehearsal: the same upload into a virtual Scorpion, then the
+    // The rehearsal: the same uploads into a virtual Scorpion, then the
     // expectations, before the robot is touched. (Into `emu` without
     // expectations it would be the upload itself over again.)
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
-        let (mut robot, shown) = ports::virtual_robot(baud, rom.as_ref(), &rig)?;
-        // A handler that hangs in the rehearsal is named by its label.
-        robot.add_labels(&linked);
-        for (_, linked, _) in &earlier {
-            robot.add_labels(linked);
-        }
-        let transport = ports::Showing::new(VirtualTransport::new(robot), shown);
-        let mut client = args.client(transport, profile);
-        for (name, _, image) in &earlier {
-            uploader::upload(&mut client, image, &options, &mut NoProgress).wrap_err_with(|| {
-                format!("the rehearsal on the virtual Scorpion failed (uploading {name}, before this image); nothing was sent to the robot")
-            })?;
-        }
-        let report = uploader::upload(&mut client, &image, &options, &mut NoProgress).wrap_err(
-            "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot",
+        rehearse(args, resolved, images, &options, expectations.as_ref())?;
+    }
+    for (index, loaded) in images.iter().enumerate() {
+        let last = index + 1 == images.len();
+        let expect = expectations.as_ref().filter(|_| last);
+        let code = upload_file(
+            args,
+            resolved,
+            (&images[..index], loaded),
+            undo,
+            (&options, expect, expectations.is_some()),
         )?;
+        if code != ExitCode::SUCCESS {
+            return Ok(code);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Uploads `images` into one fresh virtual Scorpion with the resolved
+/// cards and surroundings, one after the other as the robot will hold
+/// them, a line for each; then checks `expectations` there.
+fn rehearse(
+    args: &Args,
+    resolved: &scorpion_project::Resolved,
+    images: &[Loaded],
+    options: &UploadOptions,
+    expectations: Option<&(String, Expectations)>,
+) -> miette::Result<()> {
+    let rom = crate::cmd::config::rom(resolved)?;
+    let rig = crate::cmd::config::rig(resolved);
+    let (mut robot, shown) = ports::virtual_robot(resolved.baud.value, rom.as_ref(), &rig)?;
+    // A handler that hangs in the rehearsal is named by its label.
+    for loaded in images {
+        robot.add_labels(&loaded.linked);
+    }
+    let transport = ports::Showing::new(VirtualTransport::new(robot), shown);
+    let mut client = args.client(transport, &options.profile);
+    let mut out = String::new();
+    for (index, loaded) in images.iter().enumerate() {
+        let report = uploader::upload(&mut client, &loaded.image, options, &mut NoProgress)
+            .wrap_err_with(|| match index {
+                0 if images.len() == 1 => {
+                    "the rehearsal on the virtual Scorpion failed; nothing was sent to the robot"
+                        .to_owned()
+                }
+                _ => format!(
+                    "the rehearsal on the virtual Scorpion failed (uploading {}{}); nothing was sent to the robot",
+                    loaded.name,
+                    with_earlier(&images[..index])
+                ),
+            })?;
         let _ = write!(
             out,
             "rehearsed on the virtual Scorpion{}: {} bytes verified in {:.2} s of robot time",
-            with_earlier(&earlier),
+            with_earlier(&images[..index]),
             report.bytes,
             report.device_time.as_secs_f64()
         );
-        if let Some(expectations) = expectations.as_ref().filter(|_| !check) {
-            let _ = writeln!(
-                out,
-                "; {} is checked once the project's last image is in",
-                expectations.0
-            );
-        } else if let Some(expectations) = &expectations {
-            let lines = check_expectations(
-                expectations,
-                &mut client,
-                "the image does not behave on the virtual Scorpion as the expectations say; nothing was sent to the robot",
-            )?;
-            let _ = writeln!(
-                out,
-                ", {} expectation{} met",
-                lines.len(),
-                if lines.len() == 1 { "" } else { "s" },
-            );
-            // On `emu` the transcript follows the upload itself.
-            if !emulated {
-                out.push_str(&transcript(&lines));
+        match expectations {
+            Some(expectations) if index + 1 < images.len() => {
+                let _ = writeln!(
+                    out,
+                    "; {} is checked once the project's last image is in",
+                    expectations.0
+                );
             }
-        } else {
-            out.push('\n');
+            _ => out.push('\n'),
         }
-        print(&out);
-        out.clear();
     }
+    if let Some(expectations) = expectations {
+        let others = resolved
+            .project
+            .as_ref()
+            .is_some_and(|project| project.file.images.len() > 1);
+        let alone = if images.len() == 1 && others {
+            // fresh21 F5: a project's transcript may need its other images.
+            " (the rehearsal had this image alone: in a project, `scorpion upload --expect FILE` with no image named rehearses all its images together)"
+        } else {
+            ""
+        };
+        let lines = check_expectations(
+            expectations,
+            &mut client,
+            &format!(
+                "the image does not behave on the virtual Scorpion as the expectations say{alone}; nothing was sent to the robot"
+            ),
+        )?;
+        out.pop();
+        let _ = writeln!(
+            out,
+            ", {} expectation{} met",
+            lines.len(),
+            if lines.len() == 1 { "" } else { "s" },
+        );
+        // On `emu` the transcript follows the upload itself.
+        if !resolved.is_emulated() {
+            out.push_str(&transcript(&lines));
+        }
+    }
+    print(&out);
+    Ok(())
+}
+
+/// Uploads `loaded` to the robot `resolved` names, after `earlier` (on
+/// `emu`, a fresh virtual Scorpion, which holds them already); `expect`,
+/// on `emu`, is checked after it (`--expect` was given: `expected`).
+fn upload_file(
+    args: &Args,
+    resolved: &scorpion_project::Resolved,
+    (earlier, loaded): (&[Loaded], &Loaded),
+    undo: &mut UndoFile,
+    (options, expect, expected): (&UploadOptions, Option<&(String, Expectations)>, bool),
+) -> miette::Result<ExitCode> {
+    let image = &loaded.image;
+    let profile = &options.profile;
+    let emulated = resolved.is_emulated();
+    let mut out = String::new();
 
     // The robot itself: on `emu`, a fresh virtual Scorpion with the same
     // parts; on a port, the robot, which has its own.
     let held: Vec<(String, linker::Image)> = earlier
         .iter()
-        .map(|(name, linked, _)| (name.clone(), linked.clone()))
+        .map(|loaded| (loaded.name.clone(), loaded.linked.clone()))
         .collect();
     let transport = ports::open_resolved(resolved, if emulated { &held } else { &[] })?;
     let mut client = args.client(transport, profile);
@@ -728,24 +796,24 @@ fn upload_file(
     // `emu` is a fresh virtual Scorpion for each command: nothing of it
     // outlives this one for an undo to put back.
     let result = if emulated {
-        uploader::upload(&mut client, &image, &options, &mut bar)
+        uploader::upload(&mut client, image, options, &mut bar)
     } else {
         let (path, kept) = (undo.path.clone(), std::sync::Arc::clone(&undo.kept));
         crate::cmd::say_when_interrupted(move || upload_interrupted(&path, &kept))?;
-        uploader::upload_keeping(&mut client, &image, &options, &mut bar, undo)
+        uploader::upload_keeping(&mut client, image, options, &mut bar, undo)
     };
     bar.bar.finish_and_clear();
     let report = match result {
         Ok(report) => report,
         // fresh11 F6: a line that failed half way left the undo file
         // marked, and nothing said so.
-        Err(error) if !emulated && undo.written() => {
+        Err(error) if !emulated && undo.uploading() => {
             return Err(miette::Report::new(error).wrap_err(format!(
                 "the upload did not finish; nothing that did not verify is hooked; what the robot held before it is kept in {} (marked {UPLOADING}): `scorpion upload --undo` puts it back",
                 undo.path.display()
             )));
         }
-        Err(error) => return Err(error.into()),
+        Err(error) => return Err(ports::traced(error, resolved)),
     };
     if !emulated {
         // Finished: the next upload may replace the undo file.
@@ -765,7 +833,7 @@ fn upload_file(
             scorpion_project::undo::earlier(&undo.path, 1).display()
         ));
     }
-    out.push_str(&summary(&report, &image, emulated));
+    out.push_str(&summary(&report, image, emulated));
     out.push('\n');
     if !emulated && undo_failed.is_none() && !report.replaced.is_empty() {
         let _ = writeln!(
@@ -797,13 +865,10 @@ fn upload_file(
             out.push_str("  (its data, which its program had changed, is put back as built)\n");
         }
     }
-    if !emulated && expectations.is_some() {
-        out.push_str(&others_not_rehearsed(&report, profile, &earlier));
+    if !emulated && expected {
+        out.push_str(&others_not_rehearsed(&report, profile, earlier));
     }
-    if emulated
-        && check
-        && let Some(expectations) = &expectations
-    {
+    if emulated && let Some(expectations) = expect {
         let lines = check_expectations(
             expectations,
             &mut client,
@@ -820,8 +885,5 @@ fn upload_file(
 }
 
 fn print(text: &str) {
-    #[allow(clippy::print_stdout, reason = "the CLI reports the result")]
-    {
-        print!("{text}");
-    }
+    crate::cmd::say_out(text);
 }

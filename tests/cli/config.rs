@@ -653,6 +653,7 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
             &["ask", "/1X"][..],
             &["test", "--port"],
             &["installed", "--port"],
+            &["ask", "--port=", "/1X"],
         ] {
             let output = adc.run(&project, args, &env);
             assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
@@ -665,6 +666,16 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
             );
         }
     }
+    // fresh21 F1: a bare `--port` before the arguments takes the first as
+    // the port; the error says so, and how to write it.
+    let output = adc.run(&project, &["ask", "--port", "/1X", "/1V"], &[]);
+    assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--port took `/1X` as the robot's serial port")
+            && stderr.contains("--port= (empty)"),
+        "{stderr}"
+    );
     let output = adc.run(&project, &["build", "-D", "BIG=99999999999"], &[]);
     assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));
     let stderr = String::from_utf8_lossy(&output.stderr);

@@ -624,3 +624,46 @@ fn a_step_over_a_store_to_the_cards_register_runs_on_the_robot() {
         "the card answered: {printed}"
     );
 }
+
+/// fresh21 F2: `scorpion debug --port ... | head -2`: once `head` quit,
+/// the session's next line failed to print, and the process ended there
+/// with the stub still hooked (every upload then refused). Whatever ends
+/// the session, its output gone included, the robot is given back.
+#[test]
+fn a_session_whose_output_is_gone_gives_the_robot_back() {
+    use std::process::{Command, Stdio};
+    let (dir, sim) = readme_handler_on_a_pty_robot();
+    let hooked = scorpion(dir.path(), &["read", "--port", &sim.path, "$0200", "3"]);
+    let before = String::from_utf8_lossy(&hooked.stdout).into_owned();
+    for closed in ["stdout", "stderr"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(["debug", "--port", &sim.path, "--image", "ext.elf"])
+            .current_dir(dir.path())
+            .env("NO_COLOR", "1")
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("scorpion runs");
+        // The reader of one of them quits at once, as `head -0` would.
+        let (out, err) = (child.stdout.take(), child.stderr.take());
+        let kept = if closed == "stdout" {
+            drop(out);
+            err.map(|err| std::thread::spawn(move || std::io::read_to_string(err)))
+        } else {
+            drop(err);
+            out.map(|out| std::thread::spawn(move || std::io::read_to_string(out)))
+        };
+        let status = child.wait().expect("it ends");
+        let said = kept
+            .map(|reader| reader.join().expect("read").unwrap_or_default())
+            .unwrap_or_default();
+        assert!(!said.contains("panicked"), "{closed}: {said}");
+        let after = scorpion(dir.path(), &["read", "--port", &sim.path, "$0200", "3"]);
+        assert_eq!(
+            String::from_utf8_lossy(&after.stdout),
+            before,
+            "{closed} closed ({status}): the stub is left hooked\n{said}"
+        );
+    }
+}

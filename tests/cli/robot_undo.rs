@@ -1082,6 +1082,35 @@ fn upload_expect_in_a_two_image_project_rehearses_them_together() {
     )
     .expect("the transcript");
     let sim = Sim::start(dir.path(), &[]);
+    // hostile21 F4: a transcript that fails (here on the last image's
+    // command) sends nothing, the first image included.
+    std::fs::write(project.join("tests/bad.expect"), "/1V => V01\n/1U => UX\n")
+        .expect("the transcript");
+    let line = ["--port", sim.path.as_str()];
+    let before = ok(&project, &line, &["read", "$0200", "3"]);
+    let (success, text) = on(&project, &line, &["upload", "--expect", "tests/bad.expect"]);
+    assert!(!success, "{text}");
+    assert!(text.contains("nothing was sent to the robot"), "{text}");
+    assert!(!text.contains("uploaded and verified"), "{text}");
+    assert_eq!(ok(&project, &line, &["read", "$0200", "3"]), before);
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
+    // fresh21 F5: one image named is rehearsed alone, and the help says so.
+    let (success, text) = on(
+        &project,
+        &line,
+        &[
+            "upload",
+            "target/scorpion/myext.elf",
+            "--expect",
+            "tests/both.expect",
+        ],
+    );
+    assert!(!success, "{text}");
+    assert!(
+        text.contains("the rehearsal had this image alone"),
+        "{text}"
+    );
     for port in ["emu", sim.path.as_str()] {
         let text = ok(
             &project,
@@ -1111,4 +1140,95 @@ fn upload_expect_in_a_two_image_project_rehearses_them_together() {
     );
     assert!(!success, "{text}");
     assert!(text.contains("nothing was sent to the robot"), "{text}");
+}
+
+/// fresh21 F4: a project's upload whose second image is refused (it
+/// overlaps an older build of itself, no `--replace`) after the first
+/// changed nothing said "the upload did not finish ... `scorpion upload
+/// --undo` puts it back", and that undo took out an upload from before
+/// the run. Nothing of the refused image was kept or written: the refusal
+/// says only what is in the way, by `upload` and by `test --port` alike.
+#[test]
+fn a_later_image_refused_before_it_kept_anything_gives_no_undo_advice() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = two_image_project(dir.path(), 'U');
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    ok(&project, &line, &["test"]);
+    second_answers(&project, 'Q');
+    let before = ok(&project, &line, &["installed"]);
+    for args in [&["upload"][..], &["test"]] {
+        let (success, text) = on(&project, &line, args);
+        assert!(!success, "{args:?}: {text}");
+        assert!(text.contains("overlaps"), "{args:?}: {text}");
+        assert!(!text.contains("did not finish"), "{args:?}: {text}");
+        assert!(!text.contains("puts it back"), "{args:?}: {text}");
+        assert_eq!(ok(&project, &line, &["installed"]), before, "{args:?}");
+    }
+}
+
+/// fresh21 F6: a project whose `[robot] rom` names a profile not made yet
+/// (a fresh clone: the README's `rom read -o` then `rom = ...`) refused
+/// `rom read -o` itself, the command that makes it, with a code and no
+/// help. It reads the robot (a note says the profile is missing), and
+/// every command that then meets a missing profile says how to make one.
+#[test]
+fn rom_read_makes_the_profile_a_project_names_before_it_exists() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let toml = project.join("Scorpion.toml");
+    let manifest = std::fs::read_to_string(&toml).expect("the manifest");
+    std::fs::write(
+        &toml,
+        manifest.replace("[robot]\n", "[robot]\nrom = \"robot-rom.elf\"\n"),
+    )
+    .expect("the manifest");
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    let (success, text) = on(&project, &line, &["installed"]);
+    assert!(!success, "{text}");
+    assert!(
+        text.contains("scorpion::project::rom_unreadable") && text.contains("rom read -o FILE"),
+        "{text}"
+    );
+    let text = ok(&project, &line, &["rom", "read", "-o", "robot-rom.elf"]);
+    assert!(
+        text.contains("robot-rom.elf") && text.contains("note:"),
+        "{text}"
+    );
+    assert!(project.join("robot-rom.elf").is_file());
+    let text = ok(&project, &line, &["installed"]);
+    assert!(text.contains("nothing installed"), "{text}");
+}
+
+/// fresh21 F7: a port the environment (or a file) names, whose device
+/// answers nothing (a stale setting: the number now another terminal's),
+/// timed out with the cable's help alone; a port that does not exist
+/// named where it came from. A silent one does too.
+#[test]
+fn a_configured_port_that_answers_nothing_names_where_it_came_from() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let (project, _) = crate::new_project(dir.path());
+    let sim = Sim::start(dir.path(), &[]);
+    let pid = nix::unistd::Pid::from_raw(i32::try_from(sim.child.id()).expect("a pid"));
+    nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGSTOP).expect("stopped");
+    for args in [&["installed"][..], &["upload", "--no-dry-run"]] {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_scorpion"))
+            .args(args)
+            .current_dir(&project)
+            .env("SCORPION_PORT", &sim.path)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("scorpion runs");
+        let text = transcript(&output);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {text}");
+        assert!(
+            text.contains(&format!(
+                "the port {} is from the environment SCORPION_PORT",
+                sim.path
+            )) && text.contains("no answer"),
+            "{args:?}: {text}"
+        );
+    }
+    let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGCONT);
 }

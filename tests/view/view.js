@@ -75,9 +75,13 @@ async function main() {
       { timeout: PATIENCE },
     );
     const named = (await front.textContent()).trim();
-    // Only the front bumper closed: the others named and open.
-    const others = await page.$$eval("#bumpers li:not(.on)", (items) => items.map((i) => i.textContent));
-    if (others.length !== 7 || !others.every((t) => t.endsWith("open"))) throw new Error(`the other bumpers: ${others}`);
+    // Every bumper named with its state; the back ones open. (The robot
+    // drives on against the post while this is read: on a loaded machine
+    // a front corner closes too, so those two may be either.)
+    const all = await page.$$eval("#bumpers li", (items) => items.map((i) => i.textContent.trim()));
+    const back = ["0 back open", "1 back-right open", "7 back-left open"];
+    if (all.length !== 8 || !all.every((t) => /^[0-7] [a-z-]+ (open|closed)$/.test(t)) || !back.every((t) => all.includes(t)))
+      throw new Error(`the bumpers: ${all}`);
     const title = await page.textContent('#robot .bumper[data-bit="4"] title');
     console.log(`view: bumper named "${named}", drawn as "${title}"`);
     for (const [list, name] of [["Trackers", "left"], ["Trackers", "right"], ["Lamps", "tracker lamps"], ["Eyes", "left"], ["Eyes", "right"]]) {

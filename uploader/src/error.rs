@@ -196,7 +196,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::stopped_in_debug_stub),
         help(
-            "`scorpion debug --port {port} --image ELF` (the image it runs) finds it stopped, takes the breakpoints and the stub out and lets it go on; or reset the robot"
+            "`scorpion debug --port {port}` in the project that built the image it runs (elsewhere, with `--image ELF`) finds it stopped, takes the breakpoints and the stub out and lets it go on; or reset the robot"
         )
     )]
     StoppedInDebugStub {
@@ -349,7 +349,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::debug_stub_hooked),
         help(
-            "`scorpion debug --port {port} --image ELF` (the image it debugged) takes the stub and its breakpoints out: run it, `quit`, and try again; or reset the robot"
+            "`scorpion debug --port {port}` in the project that built the image it debugged (elsewhere, with `--image ELF`) takes the stub and its breakpoints out: run it, `quit`, and try again; or reset the robot"
         )
     )]
     DebugStubHooked {

@@ -487,7 +487,9 @@ fn a_reset_anywhere_in_a_restore_that_finishes_leaves_the_table_listing_what_is_
     let mut finished = 0;
     // Every 97th byte, and every 7th of the end, where the hooks go in.
     let end = sent.saturating_sub(700);
-    let points = (0..end).step_by(97).chain((end..sent).step_by(7));
+    let points = (0..end)
+        .step_by(common::fault_step(97))
+        .chain((end..sent).step_by(common::fault_step(7)));
     for at in points {
         let mut client = uploader::client(
             FaultyTransport::new(

@@ -201,7 +201,7 @@ fn a_reset_anywhere_in_a_replacement_behind_another_leaves_nothing_hooked_unlist
             client.stats().sent - before
         };
         let mut finished = 0;
-        for at in (0..sent).step_by(41) {
+        for at in (0..sent).step_by(common::fault_step(41)) {
             let mut client = uploader::client(robot(), &options.profile);
             two_installed(&mut client, &options);
             let transport = client.into_transport();

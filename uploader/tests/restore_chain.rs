@@ -606,7 +606,7 @@ fn the_undo_of_an_upload_cut_anywhere_puts_the_robot_back() {
         client.stats().sent - before
     };
     let mut cut = 0;
-    for at in (0..sent).step_by(37) {
+    for at in (0..sent).step_by(common::fault_step(37)) {
         let (_, client) = one_installed();
         let mut transport = client.into_transport();
         let before = held_of(&mut transport);

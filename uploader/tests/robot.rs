@@ -421,7 +421,12 @@ fn a_full_replace_cut_anywhere_leaves_an_undo_that_puts_the_old_extension_back()
         let before = user_memory(transport.robot());
         (transport, before)
     };
-    cut_anywhere_then_undo(&installed, &new, &options, (10..2000).step_by(15));
+    cut_anywhere_then_undo(
+        &installed,
+        &new,
+        &options,
+        (10..2000).step_by(common::fault_step(15)),
+    );
 }
 
 /// The same image again (its hook disarmed first, the RAM loader found
@@ -446,7 +451,12 @@ fn replaced_cut_anywhere_then_undo(old: &uploader::UploadImage, new: &uploader::
         let before = user_memory(transport.robot());
         (transport, before)
     };
-    cut_anywhere_then_undo(&installed, new, &options, (20..1400).step_by(40));
+    cut_anywhere_then_undo(
+        &installed,
+        new,
+        &options,
+        (20..1400).step_by(common::fault_step(40)),
+    );
 }
 
 /// Uploads `image` with `options` to the robot `robot` makes (with its

@@ -301,6 +301,11 @@ impl Error {
 // to a variant that is the lower error whole.
 impl Diagnostic for Error {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        // fresh21 F6: one code and help for a ROM profile that cannot be
+        // read, whichever command meets it (the file's own said nothing).
+        if let Error::RomUnreadable { .. } = self {
+            return Some(Box::new("scorpion::project::rom_unreadable"));
+        }
         self.lower().and_then(Diagnostic::code)
     }
 
@@ -309,6 +314,9 @@ impl Diagnostic for Error {
     }
 
     fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        if let Error::RomUnreadable { .. } = self {
+            return Some(Box::new(crate::error::ROM_PROFILE_HELP));
+        }
         self.lower().and_then(Diagnostic::help)
     }
 

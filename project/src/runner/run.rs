@@ -619,8 +619,12 @@ impl Run<'_, '_, '_> {
             // A port that came from a file or the environment is named
             // with where it came from, as every other command names it.
             let opened = SerialTransport::open(port, setup.baud);
+            // A bare `--port` before a filter takes the filter as the
+            // port (fresh21 F1): one that is no device is named as the
+            // flag's.
+            let device = port.starts_with("/dev/") || port.starts_with("COM");
             Box::new(opened.map_err(|source| match &sourced.origin {
-                crate::resolve::Origin::Flag(_) => Error::Upload(source),
+                crate::resolve::Origin::Flag(_) if device => Error::Upload(source),
                 origin => Error::PortOpen {
                     port: port.to_owned(),
                     origin: origin.clone(),
@@ -687,7 +691,7 @@ impl Run<'_, '_, '_> {
                 // A failed upload is a failed test, said like the others;
                 // the transcripts would only test what the robot had.
                 let mut why = indent(&rendered(error));
-                if let Some(undo) = undo.as_ref().filter(|undo| undo.written()) {
+                if let Some(undo) = undo.as_ref().filter(|undo| undo.uploading()) {
                     why.push_str(&format!(
                         "    (what the robot held before it is kept in {} (marked {}): `scorpion upload --undo` puts it back)\n",
                         undo.path.display(),

@@ -154,13 +154,8 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         images: linked,
         root,
     } = attach(args, port, None, &mut |said| {
-        #[allow(
-            clippy::print_stderr,
-            reason = "progress of a long attach, before the session starts"
-        )]
-        {
-            eprintln!("{said}");
-        }
+        // Progress of a long attach, before the session starts.
+        crate::cmd::say_err(&format!("{said}\n"));
     })?;
     let mut completion = Completion::default();
     completion.names.extend(symbols.names().map(str::to_owned));
@@ -172,30 +167,11 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
         None,
     );
     let mut out = std::io::stdout().lock();
-    let stub = robot.stub().clone();
-    writeln!(
-        out,
-        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands",
-        robot.client().transport().name(),
-        stub.address,
-        u32::from(stub.address) + stub.bytes.len() as u32 - 1,
-        stub.previous
-    )
-    .into_diagnostic()?;
-    if robot.recovery().found() {
-        writeln!(out, "{}", robot.recovery().describe()).into_diagnostic()?;
-    }
-    if let Some(note) = robot.recovery().data_note() {
-        writeln!(out, "{note}").into_diagnostic()?;
-    }
-    if let Some(registers) = robot.stopped() {
-        writeln!(
-            out,
-            "stopped at {}: {}",
-            monitor.place(registers.pc),
-            debugger::robot::show_registers(&registers)
-        )
-        .into_diagnostic()?;
+    // fresh21 F2: an output that fails here (stdout piped into `head`) must
+    // not end the process with the stub hooked: the robot is given back.
+    if let Err(error) = introduce(&mut robot, &monitor, &mut out) {
+        let _ = robot.detach();
+        return Err(error);
     }
     // A Ctrl-C, a closed terminal or a `kill` must not end the process
     // with the robot stopped in the stub or a JSR left in its code: each
@@ -269,6 +245,41 @@ pub(crate) fn run(args: &Args, port: &str) -> miette::Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// The session's first lines: where the stub is, what attach found, and
+/// the stop the robot is in, if any.
+fn introduce<T: uploader::transport::Transport>(
+    robot: &mut RobotDebug<T>,
+    monitor: &RobotMonitor,
+    out: &mut impl Write,
+) -> miette::Result<()> {
+    let stub = robot.stub().clone();
+    writeln!(
+        out,
+        "the robot on {}: the stub at ${:04X}-${:04X}, hooked ahead of ${:04X}; `help` lists the commands",
+        robot.client().transport().name(),
+        stub.address,
+        u32::from(stub.address) + stub.bytes.len() as u32 - 1,
+        stub.previous
+    )
+    .into_diagnostic()?;
+    if robot.recovery().found() {
+        writeln!(out, "{}", robot.recovery().describe()).into_diagnostic()?;
+    }
+    if let Some(note) = robot.recovery().data_note() {
+        writeln!(out, "{note}").into_diagnostic()?;
+    }
+    if let Some(registers) = robot.stopped() {
+        writeln!(
+            out,
+            "stopped at {}: {}",
+            monitor.place(registers.pc),
+            debugger::robot::show_registers(&registers)
+        )
+        .into_diagnostic()?;
+    }
+    Ok(())
 }
 
 /// Reads and answers the monitor's lines until `quit`, the end of input

@@ -112,7 +112,7 @@ pub enum StubError {
     #[diagnostic(
         code(uploader::stub::not_the_image),
         help(
-            "upload the image first (`scorpion upload ELF --port PORT --replace`), or give `debug` the image the robot runs; nothing was written"
+            "upload the image first (`scorpion upload --replace` in its project, or `scorpion upload ELF --port PORT --replace`), or give `debug` the image the robot runs; nothing was written"
         )
     )]
     NotTheImage {

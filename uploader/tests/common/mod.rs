@@ -62,6 +62,17 @@ impl uploader::Keep for Kept {
     }
 }
 
+/// The step between the places a sweep test puts its fault: `usual`, or
+/// `SCORPION_FAULT_STEP` where set (`1`: every byte, for a long run by
+/// hand; CI keeps the usual steps).
+pub(crate) fn fault_step(usual: usize) -> usize {
+    std::env::var("SCORPION_FAULT_STEP")
+        .ok()
+        .and_then(|step| step.parse().ok())
+        .filter(|&step| step > 0)
+        .unwrap_or(usual)
+}
+
 /// The 8N1 control value for 9600 baud (emulator::board::acia).
 pub const CTRL_9600: u8 = 0x1E;
 
