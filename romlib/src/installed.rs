@@ -302,6 +302,25 @@ pub fn decode<'a>(
             });
         }
     }
+    // No loader lists two extensions in one place (an overlap is refused,
+    // or the old one taken out first): two entries that claim the same
+    // memory were written by hand (hostile21 F14: one extension listed
+    // twice, restored, and a hook then ran through memory no entry held).
+    for (index, one) in installed.iter().enumerate() {
+        if let Some(other) = installed[index + 1..]
+            .iter()
+            .find(|other| other.overlap(&one.extents).is_some())
+        {
+            return Err(DamagedTable {
+                address: flags_address(table, other.slot),
+                reason: format!(
+                    "it claims memory the entry at slot {} claims too ({})",
+                    one.slot,
+                    one.describe()
+                ),
+            });
+        }
+    }
     Ok(installed)
 }
 
@@ -460,6 +479,16 @@ mod tests {
         image.hooks[1].handler = 0x2000;
         let error = decode_table(TABLE, ENTRIES, &table_with(&image)).unwrap_err();
         assert!(error.reason.contains("HOOK_LOOP"), "{error}");
+        // hostile21 F14: one extension listed twice (a copy at slot 4).
+        let image = sample();
+        let mut table = table_with(&image);
+        let again = Installed { slot: 4, ..image };
+        let copy = table_with(&again);
+        table[4..6].copy_from_slice(&copy[4..6]);
+        let start = ENTRIES + 4 * ENTRY_LEN;
+        table[start..start + 2 * ENTRY_LEN].copy_from_slice(&copy[start..start + 2 * ENTRY_LEN]);
+        let error = decode_table(TABLE, ENTRIES, &table).unwrap_err();
+        assert!(error.reason.contains("slot 1 claims too"), "{error}");
     }
 
     #[test]

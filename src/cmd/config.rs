@@ -22,7 +22,13 @@ use crate::cmd::rig::Rig;
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
     /// The serial port, as a command would be given it.
-    #[arg(long)]
+    #[arg(
+        long,
+        value_name = "PORT",
+        num_args = 0..=1,
+        default_missing_value = crate::cmd::ports::CONFIGURED,
+        value_parser = crate::cmd::ports::port_value
+    )]
     port: Option<String>,
     /// The baud rate, as a command would be given it.
     #[arg(long)]
@@ -78,7 +84,7 @@ pub(crate) fn flags(
 ) -> Flags {
     Flags {
         // A bare `--port` (as `test --port` takes it): the configured one.
-        port: port.filter(|port| !port.is_empty()).cloned(),
+        port: crate::cmd::ports::given_port(port).cloned(),
         baud,
         cards: rig.cards.clone(),
         world: rig.world.clone(),

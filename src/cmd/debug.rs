@@ -59,7 +59,13 @@ pub(crate) struct Args {
     /// Debug the real robot on PORT instead (alone: the [robot] port of
     /// the environment, the per-user file or the project), through a stub
     /// uploaded beside the image: docs/DEBUGGING.md, "Debug on the robot".
-    #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
+    #[arg(
+        long,
+        value_name = "PORT",
+        num_args = 0..=1,
+        default_missing_value = crate::cmd::ports::CONFIGURED,
+        value_parser = crate::cmd::ports::port_value
+    )]
     pub(crate) port: Option<String>,
 }
 

@@ -39,7 +39,13 @@ pub(crate) struct Line {
     /// `emu` for the virtual Scorpion in this process [env: SCORPION_PORT;
     /// else the per-user file's or Scorpion.toml's [robot] port]. Without
     /// a value, as `test --port`: the configured one.
-    #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
+    #[arg(
+        long,
+        value_name = "PORT",
+        num_args = 0..=1,
+        default_missing_value = CONFIGURED,
+        value_parser = port_value
+    )]
     pub(crate) port: Option<String>,
     /// The line's baud rate (the robot's) [env: SCORPION_BAUD; else the
     /// per-user file's or Scorpion.toml's [robot] baud; default 9600].
@@ -98,7 +104,7 @@ pub(crate) fn open_resolved(
         scorpion_project::Origin::Flag(_) if opened.is_err() && !device_like(&port.value) => {
             Ok(Box::new(opened.map_err(miette::Report::new).wrap_err_with(|| {
                 format!(
-                    "--port took `{}` as the robot's serial port; for the configured port, put a bare --port after the command's arguments, or write --port= (empty)",
+                    "--port took `{}` as the robot's serial port; for the configured port, put a bare --port after the command's arguments (or before `--`)",
                     port.value
                 )
             })?))
@@ -185,6 +191,25 @@ pub(crate) fn traced(
         }
         _ => miette::Report::new(error),
     }
+}
+
+/// What a bare `--port` stands for: the port the environment, the per-user
+/// file or the project names.
+pub(crate) const CONFIGURED: &str = "(configured)";
+
+/// A `--port` value: an empty one is refused (hostile21 F13: a script's
+/// `--port "$ROBOT"` with `ROBOT` unset talked to the configured robot).
+pub(crate) fn port_value(value: &str) -> Result<String, String> {
+    if value.is_empty() {
+        Err("an empty port: give one, or write --port alone (after the command's arguments) for the configured one".to_owned())
+    } else {
+        Ok(value.to_owned())
+    }
+}
+
+/// `--port`'s value as the resolution takes it: `None` for a bare one.
+pub(crate) fn given_port(port: Option<&String>) -> Option<&String> {
+    port.filter(|port| port.as_str() != CONFIGURED)
 }
 
 /// The `--port` value that names the in-process virtual Scorpion.

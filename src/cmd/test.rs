@@ -56,7 +56,13 @@ pub(crate) struct Args {
     /// to the robot on PORT and run them there (no snapshots). Without a
     /// value: SCORPION_PORT, else the per-user file's, else the project's
     /// [robot] port.
-    #[arg(long, value_name = "PORT", num_args = 0..=1, default_missing_value = "")]
+    #[arg(
+        long,
+        value_name = "PORT",
+        num_args = 0..=1,
+        default_missing_value = crate::cmd::ports::CONFIGURED,
+        value_parser = crate::cmd::ports::port_value
+    )]
     port: Option<String>,
     /// With --port: replace what the robot has installed where the images
     /// go (an earlier build of them, most often), as `scorpion upload
@@ -270,7 +276,12 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     let options = runner::Options {
         filter: filter.clone(),
         mode: args.mode(),
-        port: args.port.clone(),
+        // The runner takes an empty port for the configured one.
+        port: args.port.as_ref().map(|port| {
+            crate::cmd::ports::given_port(Some(port))
+                .cloned()
+                .unwrap_or_default()
+        }),
         replace: args.replace,
         environment: Environment::from_process()?,
         path: args.path.clone(),

@@ -181,6 +181,9 @@ impl Args {
 /// bytes/s and ETA.
 struct Bar {
     bar: ProgressBar,
+    /// The warnings said: one the upload meets again (a hook found changed
+    /// on each of its tries) is said once (recheck21).
+    said: Vec<String>,
 }
 
 impl Bar {
@@ -193,7 +196,10 @@ impl Bar {
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> "),
         );
-        Bar { bar }
+        Bar {
+            bar,
+            said: Vec::new(),
+        }
     }
 
     fn say(&self, line: &str) {
@@ -250,7 +256,10 @@ impl Progress for Bar {
             ),
             _ => return,
         };
-        self.say(&line);
+        if !self.said.contains(&line) {
+            self.say(&line);
+            self.said.push(line);
+        }
     }
 }
 

@@ -653,7 +653,7 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
             &["ask", "/1X"][..],
             &["test", "--port"],
             &["installed", "--port"],
-            &["ask", "--port=", "/1X"],
+            &["ask", "--port", "--", "/1X"],
         ] {
             let output = adc.run(&project, args, &env);
             assert_eq!(output.status.code(), Some(1), "{}", transcript(&output));
@@ -673,9 +673,15 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(
         stderr.contains("--port took `/1X` as the robot's serial port")
-            && stderr.contains("--port= (empty)"),
+            && stderr.contains("(or before `--`)"),
         "{stderr}"
     );
+    // hostile21 F13: an empty value (a script's unset variable) is refused,
+    // not taken for the configured port.
+    let output = adc.run(&project, &["ask", "--port", "", "/1X"], &[]);
+    assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("an empty port"), "{stderr}");
     let output = adc.run(&project, &["build", "-D", "BIG=99999999999"], &[]);
     assert_eq!(output.status.code(), Some(2), "{}", transcript(&output));
     let stderr = String::from_utf8_lossy(&output.stderr);

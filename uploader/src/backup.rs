@@ -240,6 +240,15 @@ impl Backup {
                     if end > 0x1_0000 {
                         return Err(bad(start, "a memory record runs past $FFFF"));
                     }
+                    // hostile21 F9: said to overlap what it lay inside.
+                    if len == 0 {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a memory record of 0 bytes (at ${address:04X}): no backup writes one"
+                            ),
+                        ));
+                    }
                     if let Some(&(_, _, first)) = areas_at
                         .iter()
                         .find(|&&(from, to, _)| u32::from(address) < to && from < end)
@@ -872,6 +881,37 @@ fn decoded_table(
     Some(romlib::installed::decode_table(at, entries, &held).map_err(|damaged| damaged.to_string()))
 }
 
+/// hostile21 F6: a file whose table lists an extension on a hook, and
+/// which gives that hook no target, was restored "verified" with the hook
+/// left at the ROM and the extension unhooked. Refused before anything is
+/// written (only where the file holds the entry's flags: an undo file holds
+/// what its upload changed).
+fn check_hooks_given(profile: &RomProfile, backup: &Backup) -> Result<()> {
+    let Some((table, _)) = profile.table else {
+        return Ok(());
+    };
+    for entry in backup_table(profile, backup) {
+        let flags = romlib::installed::flags_address(table, entry.slot);
+        if backup.byte_at(u32::from(flags)).is_none() {
+            continue;
+        }
+        for hook in &entry.hooks {
+            if !backup.hooks.iter().any(|(kind, _)| *kind == hook.kind) {
+                return Err(Error::BackupRefused {
+                    reason: format!(
+                        "the file's table lists {} on {} (its handler at ${:04X}), but the file gives {} no target: it would be left at the ROM's and the extension unhooked; nothing was written",
+                        entry.describe(),
+                        hook.kind.rom_symbol(),
+                        hook.handler,
+                        hook.kind.rom_symbol()
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The extensions the backup's copy of the table lists (none where it
 /// holds no table, or one that does not decode: the hooks' targets are
 /// then witnessed by their first bytes).
@@ -1069,6 +1109,7 @@ pub fn restore<T: Transport>(
     };
     check_hook_targets(backup, &memory.profile, table_range(profile))?;
     check_records(backup, &memory.profile, profile.table)?;
+    check_hooks_given(profile, backup)?;
     if let Some(damaged) = damaged_table(profile, backup) {
         // hostile19 F4: the hooks went to the ROM first, and every restore
         // of it failed after.
@@ -1328,16 +1369,31 @@ fn check_hook_targets(
 fn check_records(backup: &Backup, memory: &RomProfile, table: Option<(u16, usize)>) -> Result<()> {
     let writable = |witness: &Witness| {
         let last = u32::from(witness.address) + u32::from(witness.len) - 1;
-        memory.writable.iter().any(|range| {
-            u32::from(*range.start()) <= u32::from(witness.address)
-                && last <= u32::from(*range.end())
-        })
+        u16::try_from(last).is_ok_and(|last| memory.writable_span(witness.address, last))
     };
     if let Some(witness) = backup.witnesses.iter().find(|witness| !writable(witness)) {
         return Err(Error::BackupRefused {
             reason: format!(
                 "the file witnesses {} bytes at ${:04X}, outside the memory an extension may hold: no upload or backup wrote that; nothing was written",
                 witness.len, witness.address
+            ),
+        });
+    }
+    // hostile21 F8: ROM records are read from the robot to compare; one
+    // outside the ROM would read the I/O page (a read of the serial chip's
+    // data register eats a received byte) and blame the ROM.
+    let start = memory
+        .rom
+        .as_ref()
+        .map_or(platform::map::ROM_START, |rom| rom.address);
+    let in_the_rom =
+        |area: &Area| area.address >= start && !area.bytes.is_empty() && area.end() <= 0x1_0000;
+    if let Some(area) = backup.rom.iter().find(|area| !in_the_rom(area)) {
+        return Err(Error::BackupRefused {
+            reason: format!(
+                "the file's record of the robot's ROM ({} bytes at ${:04X}) is not in the ROM: no backup wrote that; nothing was written",
+                area.bytes.len(),
+                area.address
             ),
         });
     }
@@ -1622,6 +1678,12 @@ mod tests {
             "{error:?}"
         );
         assert!(error.to_string().contains("$0402"), "{error}");
+        // hostile21 F9: an empty record inside another is said to be empty.
+        let mut body = MAGIC.to_vec();
+        body.extend_from_slice(&[b'A', 0x00, 0x04, 4, 0, 1, 2, 3, 4]);
+        body.extend_from_slice(&[b'A', 0x02, 0x04, 0, 0]);
+        let error = Backup::decode("empty.bak", &with_end(body)).expect_err("refused");
+        assert!(error.to_string().contains("0 bytes (at $0402)"), "{error}");
     }
 
     #[test]

@@ -530,7 +530,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::robot_reset),
         help(
-            "the robot reset or another program wrote to it; the body is in RAM but not hooked; upload again"
+            "the robot reset or another program wrote to it; nothing of the image is hooked; upload again (a reset frees every installed extension: `scorpion installed` lists what is left)"
         )
     )]
     RobotReset {

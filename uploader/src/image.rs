@@ -538,6 +538,26 @@ impl RomProfile {
         })
     }
 
+    /// Whether every byte of `first..=last` is writable, in one range or
+    /// several that meet (hostile21 F5: an undo file's record of the
+    /// table's last entry and of KIM-bus RAM after it, `$0FF1-$1011`, lies
+    /// in two ranges, and its undo was refused).
+    #[must_use]
+    pub fn writable_span(&self, first: u16, last: u16) -> bool {
+        let mut at = u32::from(first);
+        while at <= u32::from(last) {
+            let Some(range) = self
+                .writable
+                .iter()
+                .find(|range| u32::from(*range.start()) <= at && at <= u32::from(*range.end()))
+            else {
+                return false;
+            };
+            at = u32::from(*range.end()) + 1;
+        }
+        true
+    }
+
     /// Checks that every byte of `image` is writable.
     ///
     /// # Errors
@@ -545,11 +565,7 @@ impl RomProfile {
     pub fn check(&self, image: &UploadImage) -> Result<()> {
         for area in image.areas() {
             let last = (area.end() - 1) as u16;
-            let inside = self
-                .writable
-                .iter()
-                .any(|range| range.contains(&area.address) && range.contains(&last));
-            if !inside {
+            if !self.writable_span(area.address, last) {
                 let ranges: Vec<String> = self
                     .writable
                     .iter()

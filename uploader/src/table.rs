@@ -382,6 +382,11 @@ impl Plan {
         Ok(())
     }
 
+    /// Whether the table listed no extension in use when it was read.
+    pub(crate) fn lists_nothing(&self) -> bool {
+        self.others.is_empty() && self.replaced.is_empty() && !self.reused
+    }
+
     /// The flags are known to be cleared (a reset): the next write sets
     /// them again.
     pub(crate) fn forget_flags(&mut self) {

@@ -367,15 +367,17 @@ pub fn upload_keeping<T: Transport>(
     let mut entries_checked = rom_checked;
     // A refusal comes before anything changes: `prepare` may unhook an
     // extension it replaces, and `choose_loader` decides only after.
-    if options.loader == LoaderChoice::Always {
-        crate::always::check(
+    if options.loader == LoaderChoice::Always
+        && let Err(error) = crate::always::check(
             client,
             profile,
             image,
             &hooks_now,
             options.replace,
             leftover.as_ref(),
-        )?;
+        )
+    {
+        return Err(reset_or(client, profile, &hooks_now, error));
     }
     if options.replace && !entries_checked {
         fingerprint::check_reset_entries(client, profile)?;
@@ -410,6 +412,32 @@ pub fn upload_keeping<T: Transport>(
         (options.max_writes, &hooks_now),
         &mut before_unhook,
     )?;
+    // hostile21 F10: a reset between the read of the hooks and that of the
+    // table: the table is empty, the hooks as read lead into code it no
+    // longer lists (the image then chained to it, and the upload ended
+    // "verified" with it hooked). Where the table lists nothing and a hook
+    // is not at the ROM's target, the hooks are read again (nothing has
+    // been written yet); what a reset moved is taken as it is now.
+    if plan.as_ref().is_some_and(table::Plan::lists_nothing)
+        && hooks_now
+            .iter()
+            .any(|&(kind, target)| profile.reset_target(kind) != Some(target))
+    {
+        let again = read_hooks(client, profile)?;
+        for (&(kind, before), &(_, after)) in hooks_now.iter().zip(&again) {
+            if before != after {
+                progress.event(&Event::HookChanged {
+                    kind,
+                    before,
+                    after,
+                });
+            }
+        }
+        if let Some(plan) = plan.as_mut() {
+            plan.hooks.clone_from(&again);
+        }
+        hooks_now = again;
+    }
     // What an undo puts back: the hooks and the table as found (the table
     // as `prepare` read it, flags and the entries in use: no more reads).
     let mut kept = keep.wanted().then(|| {
@@ -442,6 +470,7 @@ pub fn upload_keeping<T: Transport>(
     let others = plan.as_ref().map_or(&[][..], |plan| plan.others.as_slice());
     let mut initial = Vec::new();
     let mut dropped = Vec::new();
+    let initial_read = hooks_now.clone();
     for (kind, mut target) in hooks_now {
         let address = profile.hook_address(kind);
         let loader = leftover
@@ -513,10 +542,11 @@ pub fn upload_keeping<T: Transport>(
                 chain::Way::Fine => {}
                 // Chaining the image to it would make a loop.
                 chain::Way::ComesBack(path) => {
-                    return Err(Error::ChainComesBack {
+                    let error = Error::ChainComesBack {
                         hook: kind.rom_symbol(),
                         path: path.to_string(),
-                    });
+                    };
+                    return Err(reset_or(client, profile, &initial_read, error));
                 }
                 // hostile15 F2: a hook damaged by hand (into the ROM's zero
                 // page, the middle of the ROM, code that stops the CPU) is
@@ -1310,6 +1340,29 @@ fn unhook<T: Transport>(
         switch_hook(client, address, to, options.max_writes)?;
     }
     Ok(())
+}
+
+/// `error`, a refusal found from the hooks as first read, unless a reset
+/// since moved them (recheck21 F1: `/1R` as an upload began left chain
+/// slots in RAM leading "back into the image", and the refusal blamed a
+/// loop): then the reset, said as one. Nothing was written either way.
+fn reset_or<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    read: &[(HookKind, u16)],
+    error: Error,
+) -> Error {
+    let Ok(now) = read_hooks(client, profile) else {
+        return error;
+    };
+    read.iter()
+        .zip(&now)
+        .find(|((_, before), (_, after))| before != after)
+        .map_or(error, |(&(kind, before), &(_, after))| Error::RobotReset {
+            hook: kind.rom_symbol(),
+            before,
+            after,
+        })
 }
 
 /// The robot reset while the image went in, more often than retried.

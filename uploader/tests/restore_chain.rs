@@ -640,3 +640,97 @@ fn held_of(transport: &mut uploader::transport::VirtualTransport) -> Vec<u8> {
     let memory = transport.robot().robot().board().memory();
     [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat()
 }
+
+/// hostile21 F5: the eighth extension, on the KIM bus's RAM at $1000,
+/// takes the table's last entry ($0FF1-$0FFF): its undo file holds one
+/// record from there on, across two writable ranges that meet, and its
+/// undo was refused ("outside the memory an upload may write"). It goes
+/// through.
+#[test]
+fn the_undo_of_an_extension_after_the_tables_last_entry_goes_through() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    for base in (0..7).map(|n| 0x0400 + n * 0x80) {
+        upload(&mut client, &extension_at(base), &options, &mut NoProgress).expect("installed");
+    }
+    let before = backup(&mut client, &options.profile).expect("a backup");
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x1000),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("the eighth");
+    // As a project's run keeps it (its images' undos merged): the table's
+    // entry and the memory after it in one record.
+    let kept = kept.0.expect("kept");
+    let mut run = kept.clone();
+    run.areas.clear();
+    let file = run.going_further_back(&kept);
+    assert!(
+        file.areas
+            .iter()
+            .any(|area| area.address <= 0x0FFF && area.end() > 0x1000),
+        "{:?}",
+        file.areas
+            .iter()
+            .map(|area| (area.address, area.bytes.len()))
+            .collect::<Vec<_>>()
+    );
+    // The table's last entry and the memory after it: one span, in two
+    // writable ranges.
+    let held = |address: u32| file.byte_at(address).is_some();
+    assert!(held(0x0FFF) && held(0x1000), "{:?}", file.areas);
+    let undo = UploadOptions {
+        undo: true,
+        ..UploadOptions::default()
+    };
+    restore(&mut client, &file, &undo, &mut NoProgress).expect("undone");
+    let after = backup(&mut client, &options.profile).expect("a backup");
+    assert_eq!(before.hooks, after.hooks);
+    assert_eq!(before.areas, after.areas);
+}
+
+/// hostile21 F6, F8: a backup whose hook records were taken out was
+/// restored "verified" with the hooks left at the ROM and every extension
+/// unhooked; one with a record of "the ROM" at the serial chip's register
+/// had it read (eating a received byte) and blamed on the ROM. Both are
+/// refused before a byte is sent.
+#[test]
+fn a_backup_without_its_hooks_or_with_rom_records_off_the_rom_sends_nothing() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0400),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    let mut no_hooks = saved.clone();
+    no_hooks.hooks.clear();
+    let mut off_rom = saved.clone();
+    off_rom.rom.push(uploader::Area {
+        address: 0xC010,
+        bytes: vec![0],
+    });
+    for (name, file, why) in [
+        ("no hooks", no_hooks, "gives HOOK_UNKNOWN no target"),
+        ("off the ROM", off_rom, "is not in the ROM"),
+    ] {
+        let sent = client.stats().sent;
+        let result = restore(&mut client, &file, &options, &mut NoProgress);
+        match result {
+            Err(Error::BackupRefused { reason }) => {
+                assert!(reason.contains(why), "{name}: {reason}")
+            }
+            other => panic!("{name}: {other:?}"),
+        }
+        assert_eq!(client.stats().sent, sent, "{name}: something was sent");
+        assert_eq!(hook(&mut client), 0x0403, "{name}");
+    }
+    restore(&mut client, &saved, &options, &mut NoProgress).expect("the backup itself");
+}

@@ -641,6 +641,9 @@ impl Run<'_, '_, '_> {
         // upload`'s do, in the project's undo file (fresh10 F22: none was
         // kept); `emu` is a fresh virtual Scorpion with nothing to undo.
         let mut undo = (port != EMU).then(|| UndoFile::new(undo::in_project(&project.root)));
+        // The ids of the images this run left on the robot, for what a
+        // reset during a later one freed.
+        let mut uploaded_here: Vec<(u32, String)> = Vec::new();
         for image in built {
             let name = format!("upload {}", image.name);
             self.start(&name);
@@ -649,15 +652,12 @@ impl Run<'_, '_, '_> {
                 return Ok(());
             }
             let upload = UploadImage::try_from(&image.linked.image)?;
+            let mut seen = HooksSeen::default();
             let uploaded = match undo.as_mut() {
-                Some(undo) => uploader::upload_keeping(
-                    &mut client,
-                    &upload,
-                    &options,
-                    &mut uploader::NoProgress,
-                    undo,
-                ),
-                None => uploader::upload(&mut client, &upload, &options, &mut uploader::NoProgress),
+                Some(undo) => {
+                    uploader::upload_keeping(&mut client, &upload, &options, &mut seen, undo)
+                }
+                None => uploader::upload(&mut client, &upload, &options, &mut seen),
             };
             // fresh14 F5: the hint only where something installed is in
             // the way, not after every failure (a robot that is not there).
@@ -677,10 +677,25 @@ impl Run<'_, '_, '_> {
                         .replaced
                         .push((image.name.clone(), old.describe()));
                 }
+                // hostile21 F12: what a reset freed is named as the
+                // project's image it is, and no longer said to be left
+                // installed.
                 for old in &report.reset_freed {
-                    self.report
-                        .reset_freed
-                        .push((image.name.clone(), old.describe()));
+                    let ours = uploaded_here.iter().find(|(id, _)| *id == old.id);
+                    let named = match ours {
+                        Some((_, name)) => format!("{name} ({})", old.describe()),
+                        None => old.describe(),
+                    };
+                    if let Some((_, name)) = ours {
+                        self.report.left_installed.retain(|left| left != name);
+                    }
+                    self.report.reset_freed.push((image.name.clone(), named));
+                }
+                for &(hook, before, after) in &seen.changed {
+                    self.report.reset_freed.push((
+                        image.name.clone(),
+                        format!("what {hook} led to (${before:04X}; it leads to ${after:04X} now)"),
+                    ));
                 }
             }
             let uploaded = uploaded.map_err(|source| Error::UploadImage {
@@ -725,6 +740,7 @@ impl Run<'_, '_, '_> {
                 let kept_older = undo.as_ref().is_some_and(|undo| undo.kept_older);
                 self.report.kept_older_undo = kept_older && (first || self.report.kept_older_undo);
                 self.report.left_installed.push(image.name.clone());
+                uploaded_here.push((upload.id(), image.name.clone()));
             }
         }
         let clock = if port == EMU {
@@ -970,6 +986,31 @@ impl Setup {
             rig: Rig::of(&resolved),
         };
         Ok((setup, resolved))
+    }
+}
+
+/// The hooks an upload found changed under it (a reset), from its
+/// progress: said with what the reset freed.
+#[derive(Default)]
+struct HooksSeen {
+    /// Each hook (its name), where it led, and where it leads now.
+    changed: Vec<(&'static str, u16, u16)>,
+}
+
+impl uploader::Progress for HooksSeen {
+    fn event(&mut self, event: &uploader::Event) {
+        if let uploader::Event::HookChanged {
+            kind,
+            before,
+            after,
+        } = event
+            && !self
+                .changed
+                .iter()
+                .any(|(k, b, _)| *k == kind.rom_symbol() && b == before)
+        {
+            self.changed.push((kind.rom_symbol(), *before, *after));
+        }
     }
 }
 

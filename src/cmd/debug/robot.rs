@@ -36,7 +36,9 @@ pub(crate) fn attach(
     say: &mut dyn FnMut(&str),
 ) -> miette::Result<debugger::dap::Attached> {
     // `--port` alone: the one the environment or the project names.
-    let port = (!port.is_empty()).then(|| port.to_owned());
+    // (An editor's launch configuration gives an empty one.)
+    let configured = port.is_empty() || port == crate::cmd::ports::CONFIGURED;
+    let port = (!configured).then(|| port.to_owned());
     let flags = crate::cmd::config::flags(port.as_ref(), args.baud, &args.rig, args.rom.as_ref());
     let resolved = match here {
         Some(here) => crate::cmd::config::resolve_in(&flags, here)?,
