@@ -235,7 +235,7 @@ impl Progress for Bar {
                 before,
                 after,
             } => format!(
-                "warning: {} changed from ${before:04X} to ${after:04X} during the upload (a reset?)",
+                "warning: {} changed from ${before:04X} to ${after:04X} during the upload (a reset? A /1R frees every installed extension: what it led to is no longer installed; `scorpion installed` lists what is)",
                 kind.rom_symbol()
             ),
             Event::HookDisarmed { kind, from, to } => format!(
