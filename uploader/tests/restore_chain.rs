@@ -700,15 +700,7 @@ fn the_undo_of_an_extension_after_the_tables_last_entry_goes_through() {
 /// refused before a byte is sent.
 #[test]
 fn a_backup_without_its_hooks_or_with_rom_records_off_the_rom_sends_nothing() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0400),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = one_installed();
     let saved = backup(&mut client, &options.profile).expect("a backup");
     let mut no_hooks = saved.clone();
     no_hooks.hooks.clear();
