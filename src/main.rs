@@ -78,7 +78,19 @@ fn main() -> ExitCode {
     // `$scorpion`) reads the message on the line above its place, which a
     // message wrapped at 80 columns split from it.
     let _ = miette::set_hook(Box::new(|_| Box::new(report::Reports::new())));
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|error| {
+        let _ = error.print();
+        // recheck22 F2: `read --port $0200 6` took `$0200` for the port,
+        // and clap then missed an argument: said, with the way to write it.
+        if error.kind() == clap::error::ErrorKind::MissingRequiredArgument
+            && let Some(taken) = cmd::ports::swallowed(std::env::args().skip(1))
+        {
+            cmd::say_err(&format!(
+                "note: --port took `{taken}` as its value; for the configured port, put a bare --port after the command's arguments (or before `--`)\n"
+            ));
+        }
+        std::process::exit(error.exit_code());
+    });
     let result = match cli.command {
         Command::Asm(args) => cmd::asm::run(&args),
         Command::Disasm(args) => cmd::disasm::run(&args),

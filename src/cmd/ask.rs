@@ -191,7 +191,8 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
     for command in &args.commands {
         let answer = robot
             .exchange(command, timeout)
-            .wrap_err_with(|| format!("`{command}`"))?;
+            .wrap_err_with(|| format!("`{command}`"))
+            .map_err(|report| ports::traced_report(report, &resolved))?;
         let silent = answer.is_none() && matches!(command, Command::Extension(_));
         if silent && !args.allow_silence {
             out.flush().into_diagnostic()?;

@@ -124,7 +124,8 @@ pub(crate) fn run_restore(args: &RestoreArgs) -> miette::Result<ExitCode> {
         &args.file,
         (args.force, uploader::LoaderChoice::Auto, false),
         None,
-    )?;
+    )
+    .map_err(|report| ports::traced_report(report, &resolved))?;
     // recheck20 F3: an upload's undo file restored is an undo done: the
     // file of the upload before takes its place, as after `upload --undo`.
     if code == ExitCode::SUCCESS && !backup.written_entries.is_empty() {

@@ -118,6 +118,15 @@ pub(crate) fn open_resolved(
     }
 }
 
+/// The value a bare `--port` seems to have taken from the arguments that
+/// follow it (one that is no device's name), if any.
+pub(crate) fn swallowed(args: impl Iterator<Item = String>) -> Option<String> {
+    let args: Vec<String> = args.collect();
+    args.windows(2)
+        .find(|pair| pair[0] == "--port" && !pair[1].starts_with('-') && !device_like(&pair[1]))
+        .map(|pair| pair[1].clone())
+}
+
 /// Whether `port` looks like a serial device's name (a path under `/dev`,
 /// a Windows `COMn`), not like a command, an address or a file that
 /// followed a bare `--port`.
@@ -181,15 +190,31 @@ pub(crate) fn traced(
     error: uploader::Error,
     resolved: &scorpion_project::Resolved,
 ) -> miette::Report {
-    let silent = matches!(error, uploader::Error::NoAnswer { .. });
+    traced_report(miette::Report::new(error), resolved)
+}
+
+/// [`traced`] for an error already said as a report (an undo refused, a
+/// command's answer), whose cause is a robot that does not answer.
+pub(crate) fn traced_report(
+    report: miette::Report,
+    resolved: &scorpion_project::Resolved,
+) -> miette::Report {
+    let silent = report.chain().any(|cause| {
+        let line = cause.downcast_ref::<uploader::Error>().or_else(|| {
+            match cause.downcast_ref::<uploader::stub::StubError>() {
+                Some(uploader::stub::StubError::Line(error)) => Some(error),
+                _ => None,
+            }
+        });
+        matches!(line, Some(uploader::Error::NoAnswer { .. }))
+    });
     match resolved.port.as_ref() {
-        Some(port) if silent && !matches!(port.origin, scorpion_project::Origin::Flag(_)) => {
-            miette::Report::new(error).wrap_err(format!(
+        Some(port) if silent && !matches!(port.origin, scorpion_project::Origin::Flag(_)) => report
+            .wrap_err(format!(
                 "the port {} is from the {}",
                 port.value, port.origin
-            ))
-        }
-        _ => miette::Report::new(error),
+            )),
+        _ => report,
     }
 }
 

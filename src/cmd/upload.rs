@@ -485,7 +485,7 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             (false, loader, marked(&path, UPLOADING).exists()),
             Some(&started),
         )
-        .map_err(|report| undo_refused(report, &path))?;
+        .map_err(|report| ports::traced_report(undo_refused(report, &path), &resolved))?;
         undone(&path)?;
         return Ok(code);
     }

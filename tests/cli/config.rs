@@ -676,6 +676,16 @@ fn a_port_that_does_not_open_names_its_source_and_a_big_define_its_range() {
             && stderr.contains("(or before `--`)"),
         "{stderr}"
     );
+    // recheck22 F2: where clap then misses an argument, and in `test`.
+    for (args, code) in [
+        (&["read", "--port", "$0200", "6"][..], 2),
+        (&["test", "--port", "adc"], 1),
+    ] {
+        let output = adc.run(&project, args, &[]);
+        assert_eq!(output.status.code(), Some(code), "{}", transcript(&output));
+        let said = transcript(&output);
+        assert!(said.contains("--port took `"), "{args:?}: {said}");
+    }
     // hostile21 F13: an empty value (a script's unset variable) is refused,
     // not taken for the configured port.
     let output = adc.run(&project, &["ask", "--port", "", "/1X"], &[]);

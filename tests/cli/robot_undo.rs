@@ -1212,7 +1212,13 @@ fn a_configured_port_that_answers_nothing_names_where_it_came_from() {
     let sim = Sim::start(dir.path(), &[]);
     let pid = nix::unistd::Pid::from_raw(i32::try_from(sim.child.id()).expect("a pid"));
     nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGSTOP).expect("stopped");
-    for args in [&["installed"][..], &["upload", "--no-dry-run"]] {
+    // recheck22 F1: `ask` and `debug --port` too.
+    for args in [
+        &["installed"][..],
+        &["upload", "--no-dry-run"],
+        &["ask", "/1X"],
+        &["debug", "--port"],
+    ] {
         let output = std::process::Command::new(env!("CARGO_BIN_EXE_scorpion"))
             .args(args)
             .current_dir(&project)

@@ -218,6 +218,19 @@ pub enum Error {
         source: Box<uploader::Error>,
     },
 
+    /// A `--port` value that is no device's name did not open: a bare
+    /// `--port` took the word after it (`test --port robo`, a filter).
+    #[error(
+        "--port took `{port}` as the robot's serial port; for the configured port, put a bare --port after the command's arguments (or before `--`)"
+    )]
+    PortTaken {
+        /// The value.
+        port: String,
+        /// Why it did not open.
+        #[source]
+        source: Box<uploader::Error>,
+    },
+
     /// An image the robot did not take.
     #[error("cannot upload {image}")]
     UploadImage {
@@ -264,7 +277,8 @@ impl Error {
             | Error::RomUnreadable { source, .. } => source,
             Error::Transcript { source, .. }
             | Error::UploadImage { source, .. }
-            | Error::PortOpen { source, .. } => &**source,
+            | Error::PortOpen { source, .. }
+            | Error::PortTaken { source, .. } => &**source,
             Error::CardPlacement { source, .. } | Error::Load { source, .. } => source,
             Error::CreateDir { .. }
             | Error::WriteTarget { .. }

@@ -625,6 +625,10 @@ impl Run<'_, '_, '_> {
             let device = port.starts_with("/dev/") || port.starts_with("COM");
             Box::new(opened.map_err(|source| match &sourced.origin {
                 crate::resolve::Origin::Flag(_) if device => Error::Upload(source),
+                crate::resolve::Origin::Flag(_) => Error::PortTaken {
+                    port: port.to_owned(),
+                    source: Box::new(source),
+                },
                 origin => Error::PortOpen {
                     port: port.to_owned(),
                     origin: origin.clone(),

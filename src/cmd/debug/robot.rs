@@ -112,7 +112,8 @@ pub(crate) fn attach(
             seconds(first)
         ));
     }
-    let robot = RobotDebug::attach(client, &profile, code)?;
+    let robot = RobotDebug::attach(client, &profile, code)
+        .map_err(|error| ports::traced_report(miette::Report::new(error), &resolved))?;
     // The monitor and an editor alike (fresh15 F3: the adapter said
     // nothing of it).
     let stub = robot.stub();
