@@ -184,6 +184,8 @@ struct Bar {
     /// The warnings said: one the upload meets again (a hook found changed
     /// on each of its tries) is said once (recheck21).
     said: Vec<String>,
+    /// Whether a hook was found changed under the upload (a reset).
+    hooks_changed: bool,
 }
 
 impl Bar {
@@ -199,6 +201,7 @@ impl Bar {
         Bar {
             bar,
             said: Vec::new(),
+            hooks_changed: false,
         }
     }
 
@@ -234,10 +237,13 @@ impl Progress for Bar {
                 kind,
                 before,
                 after,
-            } => format!(
-                "warning: {} changed from ${before:04X} to ${after:04X} during the upload (a reset? A /1R frees every installed extension: what it led to is no longer installed; `scorpion installed` lists what is)",
-                kind.rom_symbol()
-            ),
+            } => {
+                self.hooks_changed = true;
+                format!(
+                    "warning: {} changed from ${before:04X} to ${after:04X} during the upload (a reset? A /1R frees every installed extension: what it led to is no longer installed; `scorpion installed` lists what is)",
+                    kind.rom_symbol()
+                )
+            }
             Event::HookDisarmed { kind, from, to } => format!(
                 "{} pointed into the upload (${from:04X}); pointed it at ${to:04X} while the upload runs (it is hooked to the image again at the end)",
                 kind.rom_symbol()
@@ -676,21 +682,70 @@ fn upload_all(
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
         rehearse(args, resolved, images, &options, expectations.as_ref())?;
     }
+    if !emulated && images.len() > 1 && !options.replace {
+        refuse_overlaps(args, resolved, images, &options)?;
+    }
     for (index, loaded) in images.iter().enumerate() {
         let last = index + 1 == images.len();
         let expect = expectations.as_ref().filter(|_| last);
-        let code = upload_file(
+        let reset = upload_file(
             args,
             resolved,
             (&images[..index], loaded),
             undo,
             (&options, expect, expectations.is_some()),
         )?;
-        if code != ExitCode::SUCCESS {
-            return Ok(code);
+        // hostile22 F5: a reset frees every entry, this command's earlier
+        // images' too, whatever the upload under way could tell of it.
+        if reset && index > 0 {
+            let names: Vec<&str> = images[..index]
+                .iter()
+                .map(|earlier| earlier.name.as_str())
+                .collect();
+            print(&format!(
+                "warning: the robot reset while {} went in (a /1R frees every installed extension): {} uploaded before it by this command {} no longer installed; `scorpion upload` again puts {} back\n",
+                loaded.name,
+                names.join(", "),
+                if names.len() == 1 { "is" } else { "are" },
+                if names.len() == 1 { "it" } else { "them" },
+            ));
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses a project's images before any is sent where one overlaps an
+/// extension the robot's table lists (other than an earlier copy of
+/// itself): its upload would be refused after the ones before it went in
+/// (hostile22 F7). The rehearsal cannot know: its robot holds nothing.
+fn refuse_overlaps(
+    args: &Args,
+    resolved: &scorpion_project::Resolved,
+    images: &[Loaded],
+    options: &UploadOptions,
+) -> miette::Result<()> {
+    let transport = ports::open_resolved(resolved, &[])?;
+    let mut client = args.client(transport, &options.profile);
+    client
+        .probe()
+        .map_err(|error| ports::traced(error, resolved))?;
+    let installed = uploader::read_installed(&mut client, &options.profile)
+        .map_err(|error| ports::traced(error, resolved))?;
+    for loaded in images {
+        let extents = loaded.image.extents();
+        for old in &installed {
+            if old.id == loaded.image.id() && old.extents == extents {
+                continue;
+            }
+            if let Some(overlap) = old.overlap(extents) {
+                return Err(miette::Report::new(overlap).wrap_err(format!(
+                    "{} cannot go in beside what the robot holds: nothing was sent to the robot (the project's images go in all or none)",
+                    loaded.name
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Uploads `images` into one fresh virtual Scorpion with the resolved
@@ -781,13 +836,15 @@ fn rehearse(
 /// Uploads `loaded` to the robot `resolved` names, after `earlier` (on
 /// `emu`, a fresh virtual Scorpion, which holds them already); `expect`,
 /// on `emu`, is checked after it (`--expect` was given: `expected`).
+/// Whether the robot reset while it went in (its hooks found changed, or
+/// other extensions' entries freed).
 fn upload_file(
     args: &Args,
     resolved: &scorpion_project::Resolved,
     (earlier, loaded): (&[Loaded], &Loaded),
     undo: &mut UndoFile,
     (options, expect, expected): (&UploadOptions, Option<&(String, Expectations)>, bool),
-) -> miette::Result<ExitCode> {
+) -> miette::Result<bool> {
     let image = &loaded.image;
     let profile = &options.profile;
     let emulated = resolved.is_emulated();
@@ -890,7 +947,7 @@ fn upload_file(
         );
     }
     print(&out);
-    Ok(ExitCode::SUCCESS)
+    Ok(bar.hooks_changed || !report.reset_freed.is_empty())
 }
 
 fn print(text: &str) {

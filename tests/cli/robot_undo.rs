@@ -1238,3 +1238,34 @@ fn a_configured_port_that_answers_nothing_names_where_it_came_from() {
     }
     let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGCONT);
 }
+
+/// hostile22 F7, recheck22 F5: a project's later image that overlaps an
+/// extension on the robot (a friend's, where it goes) was refused after
+/// the images before it went in, and nothing said they had. It is found
+/// from the robot's table before any image is sent.
+#[test]
+fn a_project_image_in_the_way_of_an_installed_extension_sends_nothing() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = two_image_project(dir.path(), 'U');
+    std::fs::write(
+        dir.path().join("friend.elf"),
+        extension_at(0x0C00, 100, None),
+    )
+    .expect("the image");
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    ok(
+        &project,
+        &line,
+        &["upload", "../friend.elf", "--no-dry-run"],
+    );
+    let before = ok(&project, &line, &["installed"]);
+    let (success, text) = on(&project, &line, &["upload"]);
+    assert!(!success, "{text}");
+    assert!(
+        text.contains("nothing was sent to the robot") && text.contains("overlaps"),
+        "{text}"
+    );
+    assert!(!text.contains("uploaded and verified"), "{text}");
+    assert_eq!(ok(&project, &line, &["installed"]), before);
+}

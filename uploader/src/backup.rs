@@ -1104,7 +1104,14 @@ pub fn restore<T: Transport>(
         None
     } else {
         let whole = UploadImage::new(backup.areas.clone(), Vec::new())?;
-        memory.profile.check(&whole)?;
+        // hostile22 F2: said as a file's, not an image's ("link with
+        // --target").
+        memory.profile.check(&whole).map_err(|error| match error {
+            Error::BadImage { reason } => Error::BackupRefused {
+                reason: format!("the file's memory records: {reason}; nothing was written"),
+            },
+            error => error,
+        })?;
         Some(whole)
     };
     check_hook_targets(backup, &memory.profile, table_range(profile))?;

@@ -709,9 +709,21 @@ fn a_backup_without_its_hooks_or_with_rom_records_off_the_rom_sends_nothing() {
         address: 0xC010,
         bytes: vec![0],
     });
+    // hostile22 F2: memory outside what an upload may write, said as the
+    // file's (it was an image's "link with --target").
+    let mut io = saved.clone();
+    io.areas.push(uploader::Area {
+        address: 0xC000,
+        bytes: vec![0; 4],
+    });
     for (name, file, why) in [
         ("no hooks", no_hooks, "gives HOOK_UNKNOWN no target"),
         ("off the ROM", off_rom, "is not in the ROM"),
+        (
+            "the I/O page",
+            io,
+            "the file's memory records: $C000-$C003 is outside",
+        ),
     ] {
         let sent = client.stats().sent;
         let result = restore(&mut client, &file, &options, &mut NoProgress);

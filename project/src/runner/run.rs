@@ -701,6 +701,17 @@ impl Run<'_, '_, '_> {
                         format!("what {hook} led to (${before:04X}; it leads to ${after:04X} now)"),
                     ));
                 }
+                // hostile22 F6: a reset frees every entry: this run's
+                // earlier images too, whether or not the upload could
+                // name them (one early in it found the table empty).
+                if !seen.changed.is_empty() || !report.reset_freed.is_empty() {
+                    for (_, name) in uploaded_here.drain(..) {
+                        if self.report.left_installed.contains(&name) {
+                            self.report.left_installed.retain(|left| *left != name);
+                            self.report.reset_freed.push((image.name.clone(), name));
+                        }
+                    }
+                }
             }
             let uploaded = uploaded.map_err(|source| Error::UploadImage {
                 image: image.name.clone(),
