@@ -909,7 +909,70 @@ fn check_hooks_given(profile: &RomProfile, backup: &Backup) -> Result<()> {
             }
         }
     }
+    check_hook_owners(profile, backup, table)
+}
+
+/// hostile22 F9, F10: where the file holds the table's flags whole, a hook
+/// into RAM must go to the handler, for that hook, of an extension the
+/// table lists, if it lists any on that hook: a hook to the other hook's
+/// handler (the memory was written, then the restore refused) or to code
+/// no entry names (the RAM loader's place, which the next upload writes
+/// over) is refused before a byte is written.
+fn check_hook_owners(profile: &RomProfile, backup: &Backup, table: u16) -> Result<()> {
+    let entries = profile.table.map_or(0, |(_, entries)| entries);
+    let whole = (0..entries).all(|slot| {
+        backup
+            .byte_at(u32::from(romlib::installed::flags_address(table, slot)))
+            .is_some()
+    });
+    if !whole {
+        return Ok(());
+    }
+    let listed = backup_table(profile, backup);
+    for &(kind, target) in &backup.hooks {
+        if profile.reset_target(kind) == Some(target) || in_rom(profile, target) {
+            continue;
+        }
+        let on_this = || {
+            listed
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .filter(|hook| hook.kind == kind)
+        };
+        if on_this().count() == 0 || on_this().any(|hook| hook.handler == target) {
+            continue;
+        }
+        let other = listed.iter().find(|entry| {
+            entry
+                .hooks
+                .iter()
+                .any(|hook| hook.kind != kind && hook.handler == target)
+        });
+        let what = match other {
+            Some(entry) => format!(
+                "the {} handler of {}",
+                other_kind(kind).rom_symbol(),
+                entry.describe()
+            ),
+            None => "code no extension its table lists".to_owned(),
+        };
+        return Err(Error::BackupRefused {
+            reason: format!(
+                "the file points {} at ${target:04X}, {what}, while its table lists extensions on {}: they would not be reached; nothing was written",
+                kind.rom_symbol(),
+                kind.rom_symbol()
+            ),
+        });
+    }
     Ok(())
+}
+
+/// The hook that is not `kind`.
+fn other_kind(kind: HookKind) -> HookKind {
+    match kind {
+        HookKind::Unknown => HookKind::Loop,
+        HookKind::Loop => HookKind::Unknown,
+    }
 }
 
 /// The extensions the backup's copy of the table lists (none where it

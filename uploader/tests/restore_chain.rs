@@ -108,6 +108,9 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
         if let Some(slot) = slot {
             put(0x0401, &slot.to_le_bytes());
         }
+        // The table lists nothing: a hook past what it lists is refused
+        // before the way is followed (hostile22 F9), which this is about.
+        put(0x0F80, &[0]);
         file.hooks = vec![
             (HookKind::Unknown, at),
             (HookKind::Loop, romlib::symbols::ROM_LOOP),
@@ -258,7 +261,12 @@ fn a_backup_of_a_robot_whose_hook_is_broken_says_so() {
     assert_eq!(broken.path, "$0800 -> $0800");
     let error = restore(&mut client, &saved.backup, &options, &mut NoProgress)
         .expect_err("the way is refused at the restore, as the backup said");
-    assert!(matches!(error, Error::RestoreChainBroken { .. }), "{error}");
+    // The table lists the extension the hook no longer reaches: refused
+    // before a byte is written (hostile22 F9).
+    assert!(
+        matches!(error, Error::BackupRefused { ref reason } if reason.contains("$0800")),
+        "{error}"
+    );
 }
 
 /// fresh17 F6: the undo of an upload that replaced an extension (an edit
@@ -737,4 +745,98 @@ fn a_backup_without_its_hooks_or_with_rom_records_off_the_rom_sends_nothing() {
         assert_eq!(hook(&mut client), 0x0403, "{name}");
     }
     restore(&mut client, &saved, &options, &mut NoProgress).expect("the backup itself");
+}
+
+/// hostile22 F9: a file (made by hand) whose hook goes to a copy of a
+/// handler in the RAM loader's place, which no entry of its table lists,
+/// while the table lists the extension the hook went to: restored, exit
+/// 0, the listed extension unhooked. Refused before a byte is sent.
+#[test]
+fn a_backup_hooking_code_its_table_does_not_list_sends_nothing() {
+    let (options, mut client) = one_installed();
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    let mut crafted = saved.clone();
+    let copy = extension_at(0x0E8C);
+    let bytes = &copy.areas()[0].bytes;
+    for area in &mut crafted.areas {
+        for (offset, &byte) in bytes.iter().enumerate() {
+            let at = 0x0E8C + offset as u32;
+            if let Some(index) = at.checked_sub(u32::from(area.address))
+                && (index as usize) < area.bytes.len()
+            {
+                area.bytes[index as usize] = byte;
+            }
+        }
+    }
+    assert_eq!(crafted.byte_at(0x0E8F), Some(0x4C), "the copy is held");
+    for hook in &mut crafted.hooks {
+        if hook.0 == HookKind::Unknown {
+            hook.1 = 0x0E8F;
+        }
+    }
+    let sent = client.stats().sent;
+    match restore(&mut client, &crafted, &options, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            assert!(
+                reason.contains("code no extension its table lists"),
+                "{reason}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(client.stats().sent, sent, "something was sent");
+    assert_eq!(hook(&mut client), 0x0403);
+}
+
+/// hostile22 F10 (hostile21 F7): a file that points HOOK_LOOP at the
+/// extension's HOOK_UNKNOWN handler was refused once its memory was
+/// written, the hooks then left at the ROM. Its own table says whose
+/// handler that is: refused before a byte is sent.
+#[test]
+fn a_backup_pointing_a_hook_at_the_other_hooks_handler_sends_nothing() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    // $0400 JMP slot / $0403 handler: JMP $0400; $0406 JMP slot / $0409
+    // handler: JMP $0406.
+    let mut bytes = vec![
+        0x4C, 0x00, 0x00, 0x4C, 0x00, 0x04, 0x4C, 0x00, 0x00, 0x4C, 0x06, 0x04,
+    ];
+    bytes.resize(32, 0xEA);
+    let image = uploader::UploadImage::new(
+        vec![uploader::Area {
+            address: 0x0400,
+            bytes,
+        }],
+        vec![
+            isa::objfmt::HookRecord {
+                kind: HookKind::Unknown,
+                handler: 0x0403,
+                chain: Some(0x0401),
+            },
+            isa::objfmt::HookRecord {
+                kind: HookKind::Loop,
+                handler: 0x0409,
+                chain: Some(0x0407),
+            },
+        ],
+    )
+    .expect("an image");
+    upload(&mut client, &image, &options, &mut NoProgress).expect("installed");
+    let mut crafted = backup(&mut client, &options.profile).expect("a backup");
+    for hook in &mut crafted.hooks {
+        if hook.0 == HookKind::Loop {
+            hook.1 = 0x0403;
+        }
+    }
+    let sent = client.stats().sent;
+    match restore(&mut client, &crafted, &options, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            assert!(
+                reason.contains("the HOOK_UNKNOWN handler of extension"),
+                "{reason}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(client.stats().sent, sent, "something was sent");
 }
