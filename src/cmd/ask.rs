@@ -199,7 +199,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             // The ROM's profile says where its hook goes: needed only here.
             let rom = crate::cmd::config::rom(&resolved)?;
             let profile = crate::cmd::config::profile(rom.as_ref())?;
-            return Err(no_answer(&mut robot, &profile, command, args.timeout));
+            let silent = no_answer(&mut robot, &profile, command, args.timeout);
+            // recheck23 F2: a robot that answers nothing, on a port a file
+            // or the environment named, is said with where it came from.
+            return Err(match ports::origin_of(&resolved) {
+                Some(origin) if silent.to_string().contains("the robot answers nothing") => {
+                    silent.wrap_err(origin)
+                }
+                _ => silent,
+            });
         }
         if args.decode {
             write!(out, "{}", decode(command, answer.as_ref())).into_diagnostic()?;

@@ -208,14 +208,20 @@ pub(crate) fn traced_report(
         });
         matches!(line, Some(uploader::Error::NoAnswer { .. }))
     });
-    match resolved.port.as_ref() {
-        Some(port) if silent && !matches!(port.origin, scorpion_project::Origin::Flag(_)) => report
-            .wrap_err(format!(
-                "the port {} is from the {}",
-                port.value, port.origin
-            )),
+    match origin_of(resolved) {
+        Some(origin) if silent => report.wrap_err(origin),
         _ => report,
     }
+}
+
+/// `the port /dev/pts/8 is from the environment SCORPION_PORT`, where the
+/// port came from a file or the environment (not from `--port PORT`).
+pub(crate) fn origin_of(resolved: &scorpion_project::Resolved) -> Option<String> {
+    resolved
+        .port
+        .as_ref()
+        .filter(|port| !matches!(port.origin, scorpion_project::Origin::Flag(_)))
+        .map(|port| format!("the port {} is from the {}", port.value, port.origin))
 }
 
 /// What a bare `--port` stands for: the port the environment, the per-user

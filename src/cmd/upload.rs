@@ -688,7 +688,7 @@ fn upload_all(
     for (index, loaded) in images.iter().enumerate() {
         let last = index + 1 == images.len();
         let expect = expectations.as_ref().filter(|_| last);
-        let reset = upload_file(
+        let (reset, listed) = upload_file(
             args,
             resolved,
             (&images[..index], loaded),
@@ -696,8 +696,14 @@ fn upload_all(
             (&options, expect, expectations.is_some()),
         )?;
         // hostile22 F5: a reset frees every entry, this command's earlier
-        // images' too, whatever the upload under way could tell of it.
-        if reset && index > 0 {
+        // images' too, whatever the upload under way could tell of it;
+        // recheck23 F1: one just before its first read leaves the hooks at
+        // the ROM, and only the table it read tells (they are not in it).
+        let before = &images[..index];
+        let gone = before
+            .iter()
+            .any(|earlier| !listed.contains(&earlier.image.id()));
+        if (reset || gone) && index > 0 {
             let names: Vec<&str> = images[..index]
                 .iter()
                 .map(|earlier| earlier.name.as_str())
@@ -837,14 +843,15 @@ fn rehearse(
 /// `emu`, a fresh virtual Scorpion, which holds them already); `expect`,
 /// on `emu`, is checked after it (`--expect` was given: `expected`).
 /// Whether the robot reset while it went in (its hooks found changed, or
-/// other extensions' entries freed).
+/// other extensions' entries freed), and the ids the robot's table listed
+/// when the upload read it (none on `emu`, whose robot is fresh).
 fn upload_file(
     args: &Args,
     resolved: &scorpion_project::Resolved,
     (earlier, loaded): (&[Loaded], &Loaded),
     undo: &mut UndoFile,
     (options, expect, expected): (&UploadOptions, Option<&(String, Expectations)>, bool),
-) -> miette::Result<bool> {
+) -> miette::Result<(bool, Vec<u32>)> {
     let image = &loaded.image;
     let profile = &options.profile;
     let emulated = resolved.is_emulated();
@@ -947,7 +954,15 @@ fn upload_file(
         );
     }
     print(&out);
-    Ok(bar.hooks_changed || !report.reset_freed.is_empty())
+    let reset = bar.hooks_changed || !report.reset_freed.is_empty();
+    // `emu` is a fresh virtual Scorpion with the earlier images loaded:
+    // its table is theirs.
+    let listed = if emulated {
+        earlier.iter().map(|loaded| loaded.image.id()).collect()
+    } else {
+        report.listed
+    };
+    Ok((reset, listed))
 }
 
 fn print(text: &str) {

@@ -1217,7 +1217,9 @@ fn a_configured_port_that_answers_nothing_names_where_it_came_from() {
         &["installed"][..],
         &["upload", "--no-dry-run"],
         &["ask", "/1X"],
+        &["ask", "/1H"],
         &["debug", "--port"],
+        &["test", "--port"],
     ] {
         let output = std::process::Command::new(env!("CARGO_BIN_EXE_scorpion"))
             .args(args)

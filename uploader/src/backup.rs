@@ -909,7 +909,7 @@ fn check_hooks_given(profile: &RomProfile, backup: &Backup) -> Result<()> {
             }
         }
     }
-    check_hook_owners(profile, backup, table)
+    Ok(())
 }
 
 /// hostile22 F9, F10: where the file holds the table's flags whole, a hook
@@ -1190,6 +1190,10 @@ pub fn restore<T: Transport>(
         });
     }
     refuse_held_stub(backup, profile)?;
+    // After the stub's own refusal: a stub is code no entry lists too.
+    if let Some((table, _)) = profile.table {
+        check_hook_owners(profile, backup, table)?;
+    }
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;

@@ -193,6 +193,11 @@ pub struct UploadReport {
     /// (their entries' flags cleared): their code is still in RAM, but no
     /// hook leads to it, and the table no longer names it.
     pub reset_freed: Vec<romlib::installed::Installed>,
+    /// The ids of the extensions the robot's table listed when the upload
+    /// read it (an earlier copy of the image included): an uploader of
+    /// several images tells from it that a reset freed the ones it sent
+    /// before (recheck23 F1).
+    pub listed: Vec<u32>,
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -863,6 +868,18 @@ pub fn upload_keeping<T: Transport>(
         }
     }
     let stats = client.stats();
+    let listed = plan.as_ref().map_or_else(Vec::new, |plan| {
+        let mut listed: Vec<u32> = plan
+            .others
+            .iter()
+            .chain(&plan.replaced)
+            .map(|entry| entry.id)
+            .collect();
+        if plan.reused {
+            listed.push(image.id());
+        }
+        listed
+    });
     let (replaced, reset_freed) =
         plan.map_or_else(Default::default, |plan| (plan.replaced, plan.freed));
     Ok(UploadReport {
@@ -893,6 +910,7 @@ pub fn upload_keeping<T: Transport>(
             .map(|relink| (relink.kind, relink.slot))
             .collect(),
         reset_freed,
+        listed,
     })
 }
 

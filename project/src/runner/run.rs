@@ -669,6 +669,16 @@ impl Run<'_, '_, '_> {
                 uploaded,
                 Err(uploader::Error::Robot(_) | uploader::Error::HookInUse { .. })
             );
+            // recheck23 F2: a silent robot on a port a file or the
+            // environment named: where it came from.
+            let silent_from = match (&uploaded, &sourced.origin) {
+                (Err(uploader::Error::NoAnswer { .. }), origin)
+                    if !matches!(origin, crate::resolve::Origin::Flag(_)) =>
+                {
+                    Some(format!("    (the port {port} is from the {origin})\n"))
+                }
+                _ => None,
+            };
             if let Ok(report) = &uploaded {
                 for &(kind, from) in &report.dropped {
                     self.report.dropped.push((
@@ -728,6 +738,7 @@ impl Run<'_, '_, '_> {
                         undo::UPLOADING
                     ));
                 }
+                why.push_str(silent_from.as_deref().unwrap_or_default());
                 if !self.options.replace && in_the_way {
                     why.push_str(
                         "    (`scorpion test --port --replace` replaces what the robot has there)\n",
