@@ -184,8 +184,6 @@ struct Bar {
     /// The warnings said: one the upload meets again (a hook found changed
     /// on each of its tries) is said once (recheck21).
     said: Vec<String>,
-    /// Whether a hook was found changed under the upload (a reset).
-    hooks_changed: bool,
 }
 
 impl Bar {
@@ -201,7 +199,6 @@ impl Bar {
         Bar {
             bar,
             said: Vec::new(),
-            hooks_changed: false,
         }
     }
 
@@ -238,7 +235,6 @@ impl Progress for Bar {
                 before,
                 after,
             } => {
-                self.hooks_changed = true;
                 format!(
                     "warning: {} changed from ${before:04X} to ${after:04X} during the upload (a reset? A /1R frees every installed extension: what it led to is no longer installed; `scorpion installed` lists what is)",
                     kind.rom_symbol()
@@ -688,26 +684,48 @@ fn upload_all(
     for (index, loaded) in images.iter().enumerate() {
         let last = index + 1 == images.len();
         let expect = expectations.as_ref().filter(|_| last);
-        let (reset, listed) = upload_file(
+        let (freed, listed) = upload_file(
             args,
             resolved,
             (&images[..index], loaded),
             undo,
             (&options, expect, expectations.is_some()),
-        )?;
+        )
+        .map_err(|report| {
+            // recheck23 F4: refused as a reset: the earlier ones went too.
+            let reset = report.chain().any(|cause| {
+                matches!(
+                    cause.downcast_ref::<uploader::Error>(),
+                    Some(uploader::Error::RobotReset { .. })
+                )
+            });
+            match images[..index].iter().map(|earlier| earlier.name.as_str()).collect::<Vec<_>>() {
+                names if reset && !names.is_empty() => report.wrap_err(format!(
+                    "the robot reset while {} went in: {} uploaded before it by this command no longer installed (a /1R frees every installed extension)",
+                    loaded.name,
+                    if names.len() == 1 {
+                        format!("{} is", names[0])
+                    } else {
+                        format!("{} are", names.join(", "))
+                    }
+                )),
+                _ => report,
+            }
+        })?;
         // hostile22 F5: a reset frees every entry, this command's earlier
-        // images' too, whatever the upload under way could tell of it;
-        // recheck23 F1: one just before its first read leaves the hooks at
-        // the ROM, and only the table it read tells (they are not in it).
-        let before = &images[..index];
-        let gone = before
+        // images' too: those the table no longer listed when this upload
+        // read it (recheck23 F1: a reset just before its first read left
+        // the hooks at the ROM, and only the table tells), and those a
+        // reset after that freed (the upload names them).
+        let names: Vec<&str> = images[..index]
             .iter()
-            .any(|earlier| !listed.contains(&earlier.image.id()));
-        if (reset || gone) && index > 0 {
-            let names: Vec<&str> = images[..index]
-                .iter()
-                .map(|earlier| earlier.name.as_str())
-                .collect();
+            .filter(|earlier| {
+                let id = earlier.image.id();
+                !listed.contains(&id) || freed.contains(&id)
+            })
+            .map(|earlier| earlier.name.as_str())
+            .collect();
+        if !names.is_empty() {
             print(&format!(
                 "warning: the robot reset while {} went in (a /1R frees every installed extension): {} uploaded before it by this command {} no longer installed; `scorpion upload` again puts {} back\n",
                 loaded.name,
@@ -722,8 +740,10 @@ fn upload_all(
 
 /// Refuses a project's images before any is sent where one overlaps an
 /// extension the robot's table lists (other than an earlier copy of
-/// itself): its upload would be refused after the ones before it went in
-/// (hostile22 F7). The rehearsal cannot know: its robot holds nothing.
+/// itself) or an image before it, or where the table has too few free
+/// entries for them all: its upload would be refused after the ones
+/// before it went in (hostile22 F7, recheck23 F3, F5). The rehearsal
+/// cannot know the robot's, and `--no-dry-run` skips it.
 fn refuse_overlaps(
     args: &Args,
     resolved: &scorpion_project::Resolved,
@@ -735,21 +755,45 @@ fn refuse_overlaps(
     client
         .probe()
         .map_err(|error| ports::traced(error, resolved))?;
-    let installed = uploader::read_installed(&mut client, &options.profile)
+    let mut holding = uploader::read_installed(&mut client, &options.profile)
         .map_err(|error| ports::traced(error, resolved))?;
+    let free = options.profile.table.map(|(_, entries)| {
+        entries.saturating_sub(
+            holding
+                .iter()
+                .map(romlib::installed::Installed::entries)
+                .sum(),
+        )
+    });
+    let mut needed = 0;
     for loaded in images {
         let extents = loaded.image.extents();
-        for old in &installed {
-            if old.id == loaded.image.id() && old.extents == extents {
-                continue;
-            }
-            if let Some(overlap) = old.overlap(extents) {
-                return Err(miette::Report::new(overlap).wrap_err(format!(
-                    "{} cannot go in beside what the robot holds: nothing was sent to the robot (the project's images go in all or none)",
-                    loaded.name
-                )));
-            }
+        let held = holding
+            .iter()
+            .any(|old| old.id == loaded.image.id() && old.extents == extents);
+        if held {
+            continue;
         }
+        if let Some(overlap) = holding.iter().find_map(|old| old.overlap(extents)) {
+            return Err(miette::Report::new(overlap).wrap_err(format!(
+                "{} cannot go in beside what the robot holds, or an image before it: nothing was sent to the robot (the project's images go in all or none)",
+                loaded.name
+            )));
+        }
+        let entry = romlib::installed::Installed::new(
+            loaded.image.id(),
+            extents.to_vec(),
+            loaded.image.hooks(),
+        );
+        needed += entry.entries();
+        holding.push(entry);
+    }
+    if let Some(free) = free.filter(|&free| needed > free) {
+        return Err(miette::miette!(
+            code = "upload::table_full",
+            help = "`scorpion installed` lists what the robot holds; take some out (`scorpion upload --undo`, or `--replace`), or reset the robot (/1R frees every entry)",
+            "the project's images need {needed} entries in the robot's table of installed extensions, which has {free} free: nothing was sent to the robot (the project's images go in all or none)"
+        ));
     }
     Ok(())
 }
@@ -842,16 +886,16 @@ fn rehearse(
 /// Uploads `loaded` to the robot `resolved` names, after `earlier` (on
 /// `emu`, a fresh virtual Scorpion, which holds them already); `expect`,
 /// on `emu`, is checked after it (`--expect` was given: `expected`).
-/// Whether the robot reset while it went in (its hooks found changed, or
-/// other extensions' entries freed), and the ids the robot's table listed
-/// when the upload read it (none on `emu`, whose robot is fresh).
+/// The ids of the extensions a reset freed while it went in, and the ids
+/// the robot's table listed when the upload read it (on `emu`, whose
+/// robot is fresh, the earlier images').
 fn upload_file(
     args: &Args,
     resolved: &scorpion_project::Resolved,
     (earlier, loaded): (&[Loaded], &Loaded),
     undo: &mut UndoFile,
     (options, expect, expected): (&UploadOptions, Option<&(String, Expectations)>, bool),
-) -> miette::Result<(bool, Vec<u32>)> {
+) -> miette::Result<(Vec<u32>, Vec<u32>)> {
     let image = &loaded.image;
     let profile = &options.profile;
     let emulated = resolved.is_emulated();
@@ -954,7 +998,7 @@ fn upload_file(
         );
     }
     print(&out);
-    let reset = bar.hooks_changed || !report.reset_freed.is_empty();
+    let freed = report.reset_freed.iter().map(|entry| entry.id).collect();
     // `emu` is a fresh virtual Scorpion with the earlier images loaded:
     // its table is theirs.
     let listed = if emulated {
@@ -962,7 +1006,7 @@ fn upload_file(
     } else {
         report.listed
     };
-    Ok((reset, listed))
+    Ok((freed, listed))
 }
 
 fn print(text: &str) {

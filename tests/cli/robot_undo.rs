@@ -1271,3 +1271,49 @@ fn a_project_image_in_the_way_of_an_installed_extension_sends_nothing() {
     assert!(!text.contains("uploaded and verified"), "{text}");
     assert_eq!(ok(&project, &line, &["installed"]), before);
 }
+
+/// recheck23 F3, F5: the check before a project's images are sent missed
+/// two ways a later one is refused after the first went in: the table
+/// too full for them all, and images that overlap each other (with
+/// `--no-dry-run`, which skips the rehearsal that finds it).
+#[test]
+fn a_project_that_cannot_go_in_whole_sends_nothing() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let project = two_image_project(dir.path(), 'U');
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    // Seven of the eight entries taken.
+    for n in 0..7u16 {
+        let base = 0x1000 + n * 0x100;
+        let name = format!("friend{n}.elf");
+        std::fs::write(dir.path().join(&name), extension_at(base, 40, None)).expect("the image");
+        ok(
+            &project,
+            &line,
+            &["upload", &format!("../{name}"), "--no-dry-run"],
+        );
+    }
+    let before = ok(&project, &line, &["installed"]);
+    let (success, text) = on(&project, &line, &["upload", "--no-dry-run"]);
+    assert!(!success, "{text}");
+    assert!(
+        text.contains("need 2 entries") && text.contains("which has 1 free"),
+        "{text}"
+    );
+    assert!(!text.contains("uploaded and verified"), "{text}");
+    assert_eq!(ok(&project, &line, &["installed"]), before);
+    // The second image moved onto the first.
+    let layout = project.join("src/second.toml");
+    let text = std::fs::read_to_string(&layout).expect("the layout");
+    std::fs::write(&layout, text.replace("\"$0C00\"", "\"$0400\"")).expect("the layout");
+    let sim = Sim::start(dir.path(), &[]);
+    let line = ["--port", sim.path.as_str()];
+    let (success, text) = on(&project, &line, &["upload", "--no-dry-run"]);
+    assert!(!success, "{text}");
+    assert!(
+        text.contains("or an image before it: nothing was sent to the robot"),
+        "{text}"
+    );
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
+}
