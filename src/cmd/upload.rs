@@ -717,11 +717,13 @@ fn upload_all(
         // read it (recheck23 F1: a reset just before its first read left
         // the hooks at the ROM, and only the table tells), and those a
         // reset after that freed (the upload names them).
+        // (A ROM without a table lists nothing: nothing to tell from.)
+        let tells = options.profile.table.is_some();
         let names: Vec<&str> = images[..index]
             .iter()
             .filter(|earlier| {
                 let id = earlier.image.id();
-                !listed.contains(&id) || freed.contains(&id)
+                (tells && !listed.contains(&id)) || freed.contains(&id)
             })
             .map(|earlier| earlier.name.as_str())
             .collect();
