@@ -681,6 +681,8 @@ fn upload_all(
     if !emulated && images.len() > 1 && !options.replace {
         refuse_overlaps(args, resolved, images, &options)?;
     }
+    // The earlier images said to be freed, so each is said once.
+    let mut said_gone: Vec<&str> = Vec::new();
     for (index, loaded) in images.iter().enumerate() {
         let last = index + 1 == images.len();
         let expect = expectations.as_ref().filter(|_| last);
@@ -699,17 +701,20 @@ fn upload_all(
                     Some(uploader::Error::RobotReset { .. })
                 )
             });
-            match images[..index].iter().map(|earlier| earlier.name.as_str()).collect::<Vec<_>>() {
-                names if reset && !names.is_empty() => report.wrap_err(format!(
-                    "the robot reset while {} went in: {} uploaded before it by this command no longer installed (a /1R frees every installed extension)",
+            let names: Vec<&str> = images[..index]
+                .iter()
+                .map(|earlier| earlier.name.as_str())
+                .collect();
+            if reset && !names.is_empty() {
+                // recheck24 F2: "X uploaded before it ... is no longer".
+                report.wrap_err(format!(
+                    "the robot reset while {} went in: {} uploaded before it by this command {} no longer installed (a /1R frees every installed extension)",
                     loaded.name,
-                    if names.len() == 1 {
-                        format!("{} is", names[0])
-                    } else {
-                        format!("{} are", names.join(", "))
-                    }
-                )),
-                _ => report,
+                    names.join(", "),
+                    if names.len() == 1 { "is" } else { "are" }
+                ))
+            } else {
+                report
             }
         })?;
         // hostile22 F5: a reset frees every entry, this command's earlier
@@ -719,6 +724,7 @@ fn upload_all(
         // reset after that freed (the upload names them).
         // (A ROM without a table lists nothing: nothing to tell from.)
         let tells = options.profile.table.is_some();
+        // recheck24 F1: each said once (one reset, not one per image after).
         let names: Vec<&str> = images[..index]
             .iter()
             .filter(|earlier| {
@@ -726,7 +732,9 @@ fn upload_all(
                 (tells && !listed.contains(&id)) || freed.contains(&id)
             })
             .map(|earlier| earlier.name.as_str())
+            .filter(|name| !said_gone.contains(name))
             .collect();
+        said_gone.extend(names.iter().copied());
         if !names.is_empty() {
             print(&format!(
                 "warning: the robot reset while {} went in (a /1R frees every installed extension): {} uploaded before it by this command {} no longer installed; `scorpion upload` again puts {} back\n",
