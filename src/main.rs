@@ -86,7 +86,8 @@ fn main() -> ExitCode {
             && let Some(taken) = cmd::ports::swallowed(std::env::args().skip(1))
         {
             cmd::say_err(&format!(
-                "note: --port took `{taken}` as its value; for the configured port, put a bare --port after the command's arguments (or before `--`)\n"
+                "note: --port took `{taken}` as its value; {}\n",
+                scorpion_project::BARE_PORT
             ));
         }
         std::process::exit(error.exit_code());

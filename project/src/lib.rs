@@ -33,7 +33,7 @@ pub use file::{
     ImageSpec, Meta, ProjectFile, RobotSpec, TestsSpec, UserRobot, UserSettings, WorkspaceFile,
 };
 pub use project::{Found, Project, Workspace, shown};
-pub use resolve::{Environment, Flags, Origin, Resolved, Sourced};
+pub use resolve::{BARE_PORT, Environment, Flags, Origin, Resolved, Sourced, device_like};
 
 /// The project file's name.
 pub const FILE: &str = "Scorpion.toml";

@@ -64,6 +64,22 @@ impl fmt::Display for Origin {
     }
 }
 
+/// How to give the configured port where a bare `--port` took the word
+/// after it for its value.
+pub const BARE_PORT: &str =
+    "for the configured port, put a bare --port after the command's arguments (or before `--`)";
+
+/// Whether `port` looks like a serial device's name (a path under `/dev`,
+/// a Windows `COMn`), not like a command, an address, a filter or a file
+/// that followed a bare `--port`.
+#[must_use]
+pub fn device_like(port: &str) -> bool {
+    port.starts_with("/dev/")
+        || port
+            .strip_prefix("COM")
+            .is_some_and(|number| !number.is_empty() && number.bytes().all(|b| b.is_ascii_digit()))
+}
+
 /// A setting and where it came from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Sourced<T> {

@@ -143,7 +143,7 @@ fn no_answer(
     robot: &mut Robot,
     profile: &uploader::RomProfile,
     command: &Command,
-    timeout: u64,
+    (timeout, origin): (u64, Option<String>),
 ) -> miette::Report {
     let rom = profile.reset_target(isa::objfmt::HookKind::Unknown);
     match robot.unknown_hook_target(profile) {
@@ -155,10 +155,16 @@ fn no_answer(
             help = "`scorpion installed` lists what the robot has; --allow-silence accepts an extension's instruction, which answers nothing; --timeout MS waits longer",
             "`{command}`: no answer within {timeout} ms: no installed extension answered it"
         ),
-        None => miette::miette!(
-            help = "is the robot on, its cable in, and its DIP switches at the --baud rate?",
-            "`{command}`: no answer within {timeout} ms, and no answer to a read of HOOK_UNKNOWN either: the robot answers nothing"
-        ),
+        None => {
+            let silent = miette::miette!(
+                help = "is the robot on, its cable in, and its DIP switches at the --baud rate?",
+                "`{command}`: no answer within {timeout} ms, and no answer to a read of HOOK_UNKNOWN either: the robot answers nothing"
+            );
+            match origin {
+                Some(origin) => silent.wrap_err(origin),
+                None => silent,
+            }
+        }
     }
 }
 
@@ -199,15 +205,15 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             // The ROM's profile says where its hook goes: needed only here.
             let rom = crate::cmd::config::rom(&resolved)?;
             let profile = crate::cmd::config::profile(rom.as_ref())?;
-            let silent = no_answer(&mut robot, &profile, command, args.timeout);
             // recheck23 F2: a robot that answers nothing, on a port a file
             // or the environment named, is said with where it came from.
-            return Err(match ports::origin_of(&resolved) {
-                Some(origin) if silent.to_string().contains("the robot answers nothing") => {
-                    silent.wrap_err(origin)
-                }
-                _ => silent,
-            });
+            let origin = ports::origin_of(&resolved);
+            return Err(no_answer(
+                &mut robot,
+                &profile,
+                command,
+                (args.timeout, origin),
+            ));
         }
         if args.decode {
             write!(out, "{}", decode(command, answer.as_ref())).into_diagnostic()?;

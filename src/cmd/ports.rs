@@ -101,19 +101,24 @@ pub(crate) fn open_resolved(
         // fresh21 F1: `ask --port /1X` takes `/1X` as the port; one that
         // is no device path is said to be --port's value, with the way to
         // give the configured port before the arguments.
-        scorpion_project::Origin::Flag(_) if opened.is_err() && !device_like(&port.value) => {
-            Ok(Box::new(opened.map_err(miette::Report::new).wrap_err_with(|| {
-                format!(
-                    "--port took `{}` as the robot's serial port; for the configured port, put a bare --port after the command's arguments (or before `--`)",
-                    port.value
-                )
-            })?))
+        scorpion_project::Origin::Flag(_)
+            if opened.is_err() && !scorpion_project::device_like(&port.value) =>
+        {
+            Ok(Box::new(
+                opened.map_err(miette::Report::new).wrap_err_with(|| {
+                    format!(
+                        "--port took `{}` as the robot's serial port; {}",
+                        port.value,
+                        scorpion_project::BARE_PORT
+                    )
+                })?,
+            ))
         }
         scorpion_project::Origin::Flag(_) => Ok(Box::new(opened?)),
         _ => Ok(Box::new(
             opened
                 .map_err(miette::Report::new)
-                .wrap_err_with(|| format!("the port {} is from the {origin}", port.value))?,
+                .wrap_err_with(|| origin_of(resolved).unwrap_or_default())?,
         )),
     }
 }
@@ -123,18 +128,12 @@ pub(crate) fn open_resolved(
 pub(crate) fn swallowed(args: impl Iterator<Item = String>) -> Option<String> {
     let args: Vec<String> = args.collect();
     args.windows(2)
-        .find(|pair| pair[0] == "--port" && !pair[1].starts_with('-') && !device_like(&pair[1]))
+        .find(|pair| {
+            pair[0] == "--port"
+                && !pair[1].starts_with('-')
+                && !scorpion_project::device_like(&pair[1])
+        })
         .map(|pair| pair[1].clone())
-}
-
-/// Whether `port` looks like a serial device's name (a path under `/dev`,
-/// a Windows `COMn`), not like a command, an address or a file that
-/// followed a bare `--port`.
-fn device_like(port: &str) -> bool {
-    port.starts_with("/dev/")
-        || port
-            .strip_prefix("COM")
-            .is_some_and(|number| !number.is_empty() && number.bytes().all(|b| b.is_ascii_digit()))
 }
 
 /// The robot `line` names, probed, for commands that only look at it

@@ -686,7 +686,7 @@ fn upload_all(
     for (index, loaded) in images.iter().enumerate() {
         let last = index + 1 == images.len();
         let expect = expectations.as_ref().filter(|_| last);
-        let (freed, listed) = upload_file(
+        let gone = upload_file(
             args,
             resolved,
             (&images[..index], loaded),
@@ -718,19 +718,11 @@ fn upload_all(
             }
         })?;
         // hostile22 F5: a reset frees every entry, this command's earlier
-        // images' too: those the table no longer listed when this upload
-        // read it (recheck23 F1: a reset just before its first read left
-        // the hooks at the ROM, and only the table tells), and those a
-        // reset after that freed (the upload names them).
-        // (A ROM without a table lists nothing: nothing to tell from.)
-        let tells = options.profile.table.is_some();
-        // recheck24 F1: each said once (one reset, not one per image after).
+        // images' too ([`uploader::UploadReport::gone`]); recheck24 F1:
+        // each said once (one reset, not one per image after).
         let names: Vec<&str> = images[..index]
             .iter()
-            .filter(|earlier| {
-                let id = earlier.image.id();
-                (tells && !listed.contains(&id)) || freed.contains(&id)
-            })
+            .filter(|earlier| gone.contains(&earlier.image.id()))
             .map(|earlier| earlier.name.as_str())
             .filter(|name| !said_gone.contains(name))
             .collect();
@@ -896,16 +888,15 @@ fn rehearse(
 /// Uploads `loaded` to the robot `resolved` names, after `earlier` (on
 /// `emu`, a fresh virtual Scorpion, which holds them already); `expect`,
 /// on `emu`, is checked after it (`--expect` was given: `expected`).
-/// The ids of the extensions a reset freed while it went in, and the ids
-/// the robot's table listed when the upload read it (on `emu`, whose
-/// robot is fresh, the earlier images').
+/// The ids of the earlier images no longer installed once it went in
+/// ([`uploader::UploadReport::gone`]).
 fn upload_file(
     args: &Args,
     resolved: &scorpion_project::Resolved,
     (earlier, loaded): (&[Loaded], &Loaded),
     undo: &mut UndoFile,
     (options, expect, expected): (&UploadOptions, Option<&(String, Expectations)>, bool),
-) -> miette::Result<(Vec<u32>, Vec<u32>)> {
+) -> miette::Result<Vec<u32>> {
     let image = &loaded.image;
     let profile = &options.profile;
     let emulated = resolved.is_emulated();
@@ -1008,15 +999,8 @@ fn upload_file(
         );
     }
     print(&out);
-    let freed = report.reset_freed.iter().map(|entry| entry.id).collect();
-    // `emu` is a fresh virtual Scorpion with the earlier images loaded:
-    // its table is theirs.
-    let listed = if emulated {
-        earlier.iter().map(|loaded| loaded.image.id()).collect()
-    } else {
-        report.listed
-    };
-    Ok((freed, listed))
+    let earlier: Vec<u32> = earlier.iter().map(|loaded| loaded.image.id()).collect();
+    Ok(report.gone(&earlier))
 }
 
 fn print(text: &str) {

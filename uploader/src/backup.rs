@@ -918,8 +918,10 @@ fn check_hooks_given(profile: &RomProfile, backup: &Backup) -> Result<()> {
 /// handler (the memory was written, then the restore refused) or to code
 /// no entry names (the RAM loader's place, which the next upload writes
 /// over) is refused before a byte is written.
-fn check_hook_owners(profile: &RomProfile, backup: &Backup, table: u16) -> Result<()> {
-    let entries = profile.table.map_or(0, |(_, entries)| entries);
+fn check_hook_owners(profile: &RomProfile, backup: &Backup) -> Result<()> {
+    let Some((table, entries)) = profile.table else {
+        return Ok(());
+    };
     let whole = (0..entries).all(|slot| {
         backup
             .byte_at(u32::from(romlib::installed::flags_address(table, slot)))
@@ -942,18 +944,15 @@ fn check_hook_owners(profile: &RomProfile, backup: &Backup, table: u16) -> Resul
         if on_this().count() == 0 || on_this().any(|hook| hook.handler == target) {
             continue;
         }
-        let other = listed.iter().find(|entry| {
-            entry
-                .hooks
-                .iter()
-                .any(|hook| hook.kind != kind && hook.handler == target)
+        let other = listed.iter().find_map(|entry| {
+            (entry.hooks.iter())
+                .find(|hook| hook.kind != kind && hook.handler == target)
+                .map(|hook| (entry, hook.kind))
         });
         let what = match other {
-            Some(entry) => format!(
-                "the {} handler of {}",
-                other_kind(kind).rom_symbol(),
-                entry.describe()
-            ),
+            Some((entry, its)) => {
+                format!("the {} handler of {}", its.rom_symbol(), entry.describe())
+            }
             None => "code no extension its table lists".to_owned(),
         };
         return Err(Error::BackupRefused {
@@ -965,14 +964,6 @@ fn check_hook_owners(profile: &RomProfile, backup: &Backup, table: u16) -> Resul
         });
     }
     Ok(())
-}
-
-/// The hook that is not `kind`.
-fn other_kind(kind: HookKind) -> HookKind {
-    match kind {
-        HookKind::Unknown => HookKind::Loop,
-        HookKind::Loop => HookKind::Unknown,
-    }
 }
 
 /// The extensions the backup's copy of the table lists (none where it
@@ -1191,9 +1182,7 @@ pub fn restore<T: Transport>(
     }
     refuse_held_stub(backup, profile)?;
     // After the stub's own refusal: a stub is code no entry lists too.
-    if let Some((table, _)) = profile.table {
-        check_hook_owners(profile, backup, table)?;
-    }
+    check_hook_owners(profile, backup)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;

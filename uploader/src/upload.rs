@@ -194,10 +194,29 @@ pub struct UploadReport {
     /// hook leads to it, and the table no longer names it.
     pub reset_freed: Vec<romlib::installed::Installed>,
     /// The ids of the extensions the robot's table listed when the upload
-    /// read it (an earlier copy of the image included): an uploader of
-    /// several images tells from it that a reset freed the ones it sent
-    /// before (recheck23 F1).
-    pub listed: Vec<u32>,
+    /// read it (an earlier copy of the image included; `None`: the ROM
+    /// keeps no table): see [`UploadReport::gone`].
+    pub listed: Option<Vec<u32>>,
+}
+
+impl UploadReport {
+    /// Of `earlier`, the ids of extensions an uploader put in before this
+    /// upload, those no longer installed: not in the table when this
+    /// upload read it (a reset before: recheck23 F1), or freed by a reset
+    /// while it ran.
+    #[must_use]
+    pub fn gone(&self, earlier: &[u32]) -> Vec<u32> {
+        earlier
+            .iter()
+            .copied()
+            .filter(|id| {
+                self.listed
+                    .as_ref()
+                    .is_some_and(|listed| !listed.contains(id))
+                    || self.reset_freed.iter().any(|entry| entry.id == *id)
+            })
+            .collect()
+    }
 }
 
 /// Reads the hooks (the first question of an upload), and returns them
@@ -868,7 +887,7 @@ pub fn upload_keeping<T: Transport>(
         }
     }
     let stats = client.stats();
-    let listed = plan.as_ref().map_or_else(Vec::new, |plan| {
+    let listed = plan.as_ref().map(|plan| {
         let mut listed: Vec<u32> = plan
             .others
             .iter()

@@ -220,9 +220,7 @@ pub enum Error {
 
     /// A `--port` value that is no device's name did not open: a bare
     /// `--port` took the word after it (`test --port robo`, a filter).
-    #[error(
-        "--port took `{port}` as the robot's serial port; for the configured port, put a bare --port after the command's arguments (or before `--`)"
-    )]
+    #[error("--port took `{port}` as the robot's serial port; {hint}", hint = crate::BARE_PORT)]
     PortTaken {
         /// The value.
         port: String,

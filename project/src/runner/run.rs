@@ -622,7 +622,7 @@ impl Run<'_, '_, '_> {
             // A bare `--port` before a filter takes the filter as the
             // port (fresh21 F1): one that is no device is named as the
             // flag's.
-            let device = port.starts_with("/dev/") || port.starts_with("COM");
+            let device = crate::device_like(port);
             Box::new(opened.map_err(|source| match &sourced.origin {
                 crate::resolve::Origin::Flag(_) if device => Error::Upload(source),
                 crate::resolve::Origin::Flag(_) => Error::PortTaken {
@@ -712,14 +712,17 @@ impl Run<'_, '_, '_> {
                     ));
                 }
                 // hostile22 F6: a reset frees every entry: this run's
-                // earlier images too, whether or not the upload could
-                // name them (one early in it found the table empty).
-                if !seen.changed.is_empty() || !report.reset_freed.is_empty() {
-                    for (_, name) in uploaded_here.drain(..) {
-                        if self.report.left_installed.contains(&name) {
-                            self.report.left_installed.retain(|left| *left != name);
-                            self.report.reset_freed.push((image.name.clone(), name));
-                        }
+                // earlier images too, whether or not the upload could name
+                // them (one early in it found the table empty), as
+                // `scorpion upload` tells them.
+                let ids: Vec<u32> = uploaded_here.iter().map(|(id, _)| *id).collect();
+                let gone = report.gone(&ids);
+                for (_, name) in uploaded_here.iter().filter(|(id, _)| gone.contains(id)) {
+                    if self.report.left_installed.contains(name) {
+                        self.report.left_installed.retain(|left| left != name);
+                        self.report
+                            .reset_freed
+                            .push((image.name.clone(), name.clone()));
                     }
                 }
             }
