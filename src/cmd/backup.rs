@@ -52,6 +52,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         broken,
         outside,
         damaged_table,
+        disagreements,
     } = uploader::backup_live(&mut client, &profile)?;
     hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
@@ -91,6 +92,18 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             "note: {} has memory outside what a backup saves (user RAM and the user zero page): the file checks it is still there at a restore, and cannot bring it back once it is gone (upload it again then)",
             entry.describe()
         ));
+    }
+    for found in &disagreements {
+        // Said now, not first at the restore (hostile22 F4, hSkip).
+        let then = match found {
+            uploader::Disagreement::ThroughFreed { .. } => {
+                "a restore of this file is refused (`/1R` clears the table and the hooks; then upload the extensions again)"
+            }
+            uploader::Disagreement::NotHooked { .. } => {
+                "a restore of this file puts it back so, listed and never run (upload it again to hook it)"
+            }
+        };
+        print(&format!("warning: {}: {then}", found.describe()));
     }
     for hook in &broken {
         // recheck16 F4: said now, not first at the restore that refuses it.
@@ -210,6 +223,12 @@ impl uploader::Progress for Overrides<'_> {
         match event {
             uploader::Event::RomCheckOverridden { refusal } => {
                 crate::cmd::say_err(&format!("warning: --force overrides: {refusal}\n"));
+            }
+            uploader::Event::RestoredNotHooked { found } => {
+                crate::cmd::say_err(&format!(
+                    "warning: in the file, {}: restored as the file holds it, listed and never run (upload it again to hook it)\n",
+                    found.describe()
+                ));
             }
             uploader::Event::RestoreStarted => {
                 if let Some(started) = self.started {

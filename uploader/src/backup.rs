@@ -443,6 +443,10 @@ pub struct Saved {
     /// it does not decode (changed by hand): a restore of the file refuses
     /// it before anything moves (hostile19 F4).
     pub damaged_table: Option<String>,
+    /// Where the robot's hooks and its table disagree: a restore of the
+    /// file refuses a way through a freed entry and puts back an extension
+    /// its hooks do not lead to as it is (listed, never run).
+    pub disagreements: Vec<crate::held_way::Disagreement>,
 }
 
 /// A hook whose way is no way for a command to go.
@@ -522,12 +526,14 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
         }
     }
     let damaged_table = damaged_table(profile, &backup);
+    let disagreements = crate::held_way::disagreements(profile, &backup);
     Ok(Saved {
         backup,
         changing,
         broken,
         outside,
         damaged_table,
+        disagreements,
     })
 }
 
@@ -969,7 +975,10 @@ fn check_hook_owners(profile: &RomProfile, backup: &Backup) -> Result<()> {
 /// The extensions the backup's copy of the table lists (none where it
 /// holds no table, or one that does not decode: the hooks' targets are
 /// then witnessed by their first bytes).
-fn backup_table(profile: &RomProfile, backup: &Backup) -> Vec<romlib::installed::Installed> {
+pub(crate) fn backup_table(
+    profile: &RomProfile,
+    backup: &Backup,
+) -> Vec<romlib::installed::Installed> {
     decoded_table(profile, backup)
         .and_then(std::result::Result::ok)
         .unwrap_or_default()
@@ -1183,6 +1192,18 @@ pub fn restore<T: Transport>(
     refuse_held_stub(backup, profile)?;
     // After the stub's own refusal: a stub is code no entry lists too.
     check_hook_owners(profile, backup)?;
+    let disagreements = crate::held_way::disagreements(profile, backup);
+    if let Some(through) = disagreements
+        .iter()
+        .find(|found| matches!(found, crate::held_way::Disagreement::ThroughFreed { .. }))
+    {
+        return Err(Error::BackupRefused {
+            reason: format!(
+                "in the file, {}: restored, commands would run through memory the next upload may be put in; nothing was written",
+                through.describe()
+            ),
+        });
+    }
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
@@ -1221,6 +1242,9 @@ pub fn restore<T: Transport>(
         memory.loader = LoaderChoice::Never;
     }
     progress.event(&crate::progress::Event::RestoreStarted);
+    for found in disagreements {
+        progress.event(&crate::progress::Event::RestoredNotHooked { found });
+    }
     let to_rom: Vec<(HookKind, u16)> = HookKind::ALL
         .into_iter()
         .filter_map(|kind| profile.reset_target(kind).map(|to| (kind, to)))

@@ -30,6 +30,7 @@ mod delta;
 mod error;
 mod expect;
 mod fingerprint;
+mod held_way;
 mod hooks;
 mod image;
 mod loader;
@@ -54,6 +55,7 @@ pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, addresses_text, human_duration};
 pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};
 pub use fingerprint::{SERVICES, rom_profile_image};
+pub use held_way::Disagreement;
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
     UploadImage,

@@ -106,6 +106,13 @@ pub enum Event {
     /// A restore's checks passed: it writes from here on. One stopped
     /// after this may be run again with [`crate::UploadOptions::resume`].
     RestoreStarted,
+    /// What a restore puts back as the file holds it: an extension its
+    /// table lists on a hook its hooks do not lead to (listed, and never
+    /// run, as it was when the file was written).
+    RestoredNotHooked {
+        /// The disagreement.
+        found: crate::held_way::Disagreement,
+    },
 }
 
 /// Receives progress; every method has a no-op default.

@@ -840,3 +840,143 @@ fn a_backup_pointing_a_hook_at_the_other_hooks_handler_sends_nothing() {
     }
     assert_eq!(client.stats().sent, sent, "something was sent");
 }
+
+/// Two extensions on HOOK_UNKNOWN, $0800 in front of $0500, and a backup
+/// of them: HOOK_UNKNOWN -> $0803 -> $0503 -> the ROM.
+fn two_in_a_chain() -> (
+    UploadOptions,
+    uploader::Client<uploader::transport::VirtualTransport>,
+    uploader::Backup,
+) {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    for at in [0x0500, 0x0800] {
+        upload(&mut client, &extension_at(at), &options, &mut NoProgress).expect("installed");
+    }
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    (options, client, saved)
+}
+
+/// Sets the byte at `at` in the file (the file holds it).
+fn set(file: &mut uploader::Backup, at: u16, byte: u8) {
+    let area = file
+        .areas
+        .iter_mut()
+        .find(|area| at >= area.address && usize::from(at - area.address) < area.bytes.len())
+        .expect("held");
+    area.bytes[usize::from(at - area.address)] = byte;
+}
+
+/// Records what a restore says as it goes.
+#[derive(Default)]
+struct Said(Vec<uploader::Event>);
+
+impl uploader::Progress for Said {
+    fn event(&mut self, event: &uploader::Event) {
+        self.0.push(event.clone());
+    }
+}
+
+fn not_hooked(said: &Said) -> Vec<String> {
+    said.0
+        .iter()
+        .filter_map(|event| match event {
+            uploader::Event::RestoredNotHooked { found } => Some(found.describe()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// hostile22 F4: a file whose table frees the extension at $0500 while
+/// the one at $0800 still chains to it was restored, exit 0, with
+/// HOOK_UNKNOWN running through memory the table calls free (the next
+/// upload may go there). Refused before a byte is sent; `backup` of a
+/// robot in that state says so.
+#[test]
+fn a_backup_whose_hooks_run_through_a_freed_entry_sends_nothing() {
+    let (options, mut client, mut crafted) = two_in_a_chain();
+    let table = romlib::installed::TABLE;
+    assert_eq!(
+        crafted.byte_at(u32::from(table)).map(|f| f & 0x80),
+        Some(0x80)
+    );
+    set(&mut crafted, table, 0);
+    let sent = client.stats().sent;
+    match restore(&mut client, &crafted, &options, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            assert!(
+                reason.contains("HOOK_UNKNOWN runs through extension")
+                    && reason.contains("($0500-$053F)")
+                    && reason.contains("$0803 -> $0503")
+                    && reason.contains("an entry the table has freed")
+                    && reason.contains("nothing was written"),
+                "{reason}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(client.stats().sent, sent, "something was sent");
+    // The robot put in that state by hand: its backup tells it.
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(table, &[0])
+        .expect("RAM");
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    let told: Vec<String> = saved.disagreements.iter().map(|d| d.describe()).collect();
+    assert_eq!(
+        told,
+        ["HOOK_UNKNOWN runs through extension 000000 ($0500-$053F) ($0803 -> $0503), an entry the table has freed".replace("000000", &format!("{:06X}", extension_at(0x0500).id()))],
+    );
+}
+
+/// recheck22 F6, hSkip: a file whose HOOK_UNKNOWN is at the ROM's target
+/// while its table lists both extensions on it, or whose front extension
+/// chains past the other to the ROM, was restored "verified" without a
+/// word of the extensions it leaves listed and never run. It is restored
+/// as it holds them (a robot is left so by an extension that takes the
+/// hook whole, and a backup of it must come back), and said.
+#[test]
+fn a_backup_whose_hooks_skip_a_listed_extension_says_so() {
+    let (options, mut client, saved) = two_in_a_chain();
+    let mut at_rom = saved.clone();
+    for hook in &mut at_rom.hooks {
+        if hook.0 == HookKind::Unknown {
+            hook.1 = BAD_COMMAND;
+        }
+    }
+    let mut said = Said::default();
+    restore(&mut client, &at_rom, &options, &mut said).expect("restored as it is");
+    assert_eq!(hook(&mut client), BAD_COMMAND);
+    let told = not_hooked(&said);
+    assert_eq!(told.len(), 2, "{told:?}");
+    assert!(
+        told.iter()
+            .all(|line| line.contains("but HOOK_UNKNOWN does not lead to it")),
+        "{told:?}"
+    );
+    // The front one chains past the other, to the ROM.
+    let mut skip = saved.clone();
+    let [low, high] = BAD_COMMAND.to_le_bytes();
+    set(&mut skip, 0x0801, low);
+    set(&mut skip, 0x0802, high);
+    let mut said = Said::default();
+    restore(&mut client, &skip, &options, &mut said).expect("restored as it is");
+    assert_eq!(hook(&mut client), 0x0803);
+    let told = not_hooked(&said);
+    assert_eq!(told.len(), 1, "{told:?}");
+    assert!(
+        told[0].contains("($0500-$053F) on HOOK_UNKNOWN")
+            && told[0].ends_with(&format!("($0803 -> ${BAD_COMMAND:04X})")),
+        "{told:?}"
+    );
+    // A backup of the robot now says it too, and a whole one says nothing.
+    let now = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    assert_eq!(now.disagreements.len(), 1, "{:?}", now.disagreements);
+    let mut said = Said::default();
+    restore(&mut client, &saved, &options, &mut said).expect("restored");
+    assert!(not_hooked(&said).is_empty(), "{:?}", said.0);
+    assert_eq!(hook(&mut client), 0x0803);
+}
