@@ -757,46 +757,12 @@ fn refuse_overlaps(
     client
         .probe()
         .map_err(|error| ports::traced(error, resolved))?;
-    let mut holding = uploader::read_installed(&mut client, &options.profile)
+    let named: Vec<(&str, &UploadImage)> = images
+        .iter()
+        .map(|loaded| (loaded.name.as_str(), &loaded.image))
+        .collect();
+    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &named)
         .map_err(|error| ports::traced(error, resolved))?;
-    let free = options.profile.table.map(|(_, entries)| {
-        entries.saturating_sub(
-            holding
-                .iter()
-                .map(romlib::installed::Installed::entries)
-                .sum(),
-        )
-    });
-    let mut needed = 0;
-    for loaded in images {
-        let extents = loaded.image.extents();
-        let held = holding
-            .iter()
-            .any(|old| old.id == loaded.image.id() && old.extents == extents);
-        if held {
-            continue;
-        }
-        if let Some(overlap) = holding.iter().find_map(|old| old.overlap(extents)) {
-            return Err(miette::Report::new(overlap).wrap_err(format!(
-                "{} cannot go in beside what the robot holds, or an image before it: nothing was sent to the robot (the project's images go in all or none)",
-                loaded.name
-            )));
-        }
-        let entry = romlib::installed::Installed::new(
-            loaded.image.id(),
-            extents.to_vec(),
-            loaded.image.hooks(),
-        );
-        needed += entry.entries();
-        holding.push(entry);
-    }
-    if let Some(free) = free.filter(|&free| needed > free) {
-        return Err(miette::miette!(
-            code = "upload::table_full",
-            help = "`scorpion installed` lists what the robot holds; take some out (`scorpion upload --undo`, or `--replace`), or reset the robot (/1R frees every entry)",
-            "the project's images need {needed} entries in the robot's table of installed extensions, which has {free} free: nothing was sent to the robot (the project's images go in all or none)"
-        ));
-    }
     Ok(())
 }
 

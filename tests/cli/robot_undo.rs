@@ -1304,6 +1304,19 @@ fn a_project_that_cannot_go_in_whole_sends_nothing() {
     );
     assert!(!text.contains("uploaded and verified"), "{text}");
     assert_eq!(ok(&project, &line, &["installed"]), before);
+    // recheck24: `test --port` took what fitted, then refused the next
+    // with a `--replace` hint that could not help. All or none too.
+    let (success, tested) = on(&project, &line, &["test"]);
+    assert!(!success, "{tested}");
+    assert!(
+        tested.contains("need 2 entries") && tested.contains("which has 1 free"),
+        "{tested}"
+    );
+    assert!(
+        !tested.contains("left installed") && !tested.contains("--replace replaces"),
+        "{tested}"
+    );
+    assert_eq!(ok(&project, &line, &["installed"]), before);
     // The second image moved onto the first.
     let layout = project.join("src/second.toml");
     let text = std::fs::read_to_string(&layout).expect("the layout");
@@ -1315,6 +1328,14 @@ fn a_project_that_cannot_go_in_whole_sends_nothing() {
     assert!(
         text.contains("or an image before it: nothing was sent to the robot"),
         "{text}"
+    );
+    let listed = ok(&project, &line, &["installed"]);
+    assert!(listed.contains("nothing installed"), "{listed}");
+    let (success, tested) = on(&project, &line, &["test"]);
+    assert!(!success, "{tested}");
+    assert!(
+        tested.contains("cannot load second") && tested.contains("nothing was sent to the robot"),
+        "{tested}"
     );
     let listed = ok(&project, &line, &["installed"]);
     assert!(listed.contains("nothing installed"), "{listed}");

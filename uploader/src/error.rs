@@ -69,6 +69,39 @@ pub enum Error {
         reason: String,
     },
 
+    /// One of a project's images cannot go in beside what the robot
+    /// holds or an image before it: refused before any is sent.
+    #[error(
+        "{image} cannot go in beside what the robot holds, or an image before it: nothing was sent to the robot (the project's images go in all or none)"
+    )]
+    #[diagnostic(code(uploader::image_in_the_way))]
+    ImageInTheWay {
+        /// The image's name.
+        image: String,
+        /// The overlap.
+        #[source]
+        #[diagnostic_source]
+        source: romlib::Error,
+    },
+
+    /// A project's images need more entries of the robot's table than it
+    /// has free: refused before any is sent.
+    #[error(
+        "the project's images need {needed} entries in the robot's table of installed extensions, which has {free} free: nothing was sent to the robot (the project's images go in all or none)"
+    )]
+    #[diagnostic(
+        code(uploader::table_full),
+        help(
+            "`scorpion installed` lists what the robot holds; take some out (`scorpion upload --undo`, or `--replace`), or reset the robot (/1R frees every entry)"
+        )
+    )]
+    ProjectTableFull {
+        /// Entries the images need.
+        needed: usize,
+        /// Entries free.
+        free: usize,
+    },
+
     /// The serial port is held by another program.
     #[error("serial port {port} is busy")]
     #[diagnostic(

@@ -35,6 +35,7 @@ mod hooks;
 mod image;
 mod loader;
 mod progress;
+mod room;
 mod session;
 pub mod stub;
 mod summed;
@@ -65,6 +66,7 @@ pub use loader::{
     rom_only_estimate,
 };
 pub use progress::{Event, NoProgress, Phase, Progress};
+pub use room::refuse_what_cannot_go_in;
 pub use sums::fletcher16;
 pub use table::{chain_from, chain_of, read_installed};
 pub use transport::Transport;

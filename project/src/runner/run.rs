@@ -648,12 +648,39 @@ impl Run<'_, '_, '_> {
         // The ids of the images this run left on the robot, for what a
         // reset during a later one freed.
         let mut uploaded_here: Vec<(u32, String)> = Vec::new();
-        for image in built {
+        for (index, image) in built.iter().enumerate() {
             let name = format!("upload {}", image.name);
             self.start(&name);
             if let Some(why) = undo.as_ref().and_then(|undo| undo_refused(&undo.path)) {
                 self.record_result(&name, Err(why));
                 return Ok(());
+            }
+            // recheck24: all or none, as `scorpion upload` (a full table
+            // took the first images, then refused the next).
+            if index == 0 && port != EMU && built.len() > 1 && !self.options.replace {
+                let images = built
+                    .iter()
+                    .map(|built| {
+                        Ok((
+                            built.name.as_str(),
+                            UploadImage::try_from(&built.linked.image)?,
+                        ))
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                let named: Vec<(&str, &UploadImage)> =
+                    images.iter().map(|(name, image)| (*name, image)).collect();
+                if let Err(source) =
+                    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &named)
+                {
+                    let silent = silent_note(&source, sourced);
+                    let mut why = indent(&rendered(Error::UploadImage {
+                        image: image.name.clone(),
+                        source: Box::new(source),
+                    }));
+                    why.push_str(&silent);
+                    self.record_result(&name, Err(why));
+                    return Ok(());
+                }
             }
             let upload = UploadImage::try_from(&image.linked.image)?;
             let mut seen = HooksSeen::default();
@@ -671,14 +698,6 @@ impl Run<'_, '_, '_> {
             );
             // recheck23 F2: a silent robot on a port a file or the
             // environment named: where it came from.
-            let silent_from = match (&uploaded, &sourced.origin) {
-                (Err(uploader::Error::NoAnswer { .. }), origin)
-                    if !matches!(origin, crate::resolve::Origin::Flag(_)) =>
-                {
-                    Some(format!("    (the port {port} is from the {origin})\n"))
-                }
-                _ => None,
-            };
             if let Ok(report) = &uploaded {
                 for &(kind, from) in &report.dropped {
                     self.report.dropped.push((
@@ -726,6 +745,11 @@ impl Run<'_, '_, '_> {
                     }
                 }
             }
+            let silent = uploaded
+                .as_ref()
+                .err()
+                .map(|error| silent_note(error, sourced))
+                .unwrap_or_default();
             let uploaded = uploaded.map_err(|source| Error::UploadImage {
                 image: image.name.clone(),
                 source: Box::new(source),
@@ -741,7 +765,7 @@ impl Run<'_, '_, '_> {
                         undo::UPLOADING
                     ));
                 }
-                why.push_str(silent_from.as_deref().unwrap_or_default());
+                why.push_str(&silent);
                 if !self.options.replace && in_the_way {
                     why.push_str(
                         "    (`scorpion test --port --replace` replaces what the robot has there)\n",
@@ -797,6 +821,19 @@ impl Run<'_, '_, '_> {
         }
         *self.report.port_time.get_or_insert_default() += started.elapsed();
         Ok(())
+    }
+}
+
+/// recheck23 F2: a silent robot on a port a file or the environment
+/// named: where it came from (a line of a test's failure).
+fn silent_note(error: &uploader::Error, sourced: &Sourced<String>) -> String {
+    match (error, &sourced.origin) {
+        (uploader::Error::NoAnswer { .. }, origin)
+            if !matches!(origin, crate::resolve::Origin::Flag(_)) =>
+        {
+            format!("    (the port {} is from the {origin})\n", sourced.value)
+        }
+        _ => String::new(),
     }
 }
 
