@@ -89,12 +89,24 @@ pub struct Installed {
 /// extent that ends before it starts, or a hook's handler or chain slot
 /// outside the entry's own memory.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("the table of installed extensions at ${address:04X} is damaged: {reason}")]
+#[error(
+    "the table of installed extensions is damaged at the entry whose flags are at ${address:04X}: {reason}"
+)]
 pub struct DamagedTable {
     /// The entry's address.
     pub address: u16,
     /// What is wrong.
     pub reason: String,
+}
+
+/// `1 entry`, `3 entries`, as messages count a table's entries.
+#[must_use]
+pub fn entries_text(count: usize) -> String {
+    if count == 1 {
+        "1 entry".to_owned()
+    } else {
+        format!("{count} entries")
+    }
 }
 
 /// `$0400-$0452`, as messages write an extent.
@@ -255,6 +267,12 @@ pub fn decode<'a>(
             };
             owner.extents.push(first..=last);
             continue;
+        }
+        // hostile25 F2: zeroed by hand, flags kept: no loader writes an
+        // entry of nothing (a chain then ran through memory it seemed to
+        // list at $0000).
+        if bytes[..ENTRY_LEN].iter().all(|&byte| byte == 0) {
+            return Err(damaged("it is marked in use and holds nothing (all zeros)"));
         }
         let mut hooks = Vec::new();
         for (flag, kind, at) in [
@@ -459,6 +477,11 @@ mod tests {
             vec![],
             "stale bytes of a free entry"
         );
+        // hostile25 F2: an entry in use zeroed by hand.
+        let mut table = vec![0u8; TABLE_LEN];
+        table[3] = 0x81;
+        let error = decode_table(TABLE, ENTRIES, &table).unwrap_err();
+        assert!(error.reason.contains("holds nothing"), "{error}");
         let mut table = table_with(&sample());
         table[ENTRIES + 2 * ENTRY_LEN] ^= 1;
         let error = decode_table(TABLE, ENTRIES, &table).unwrap_err();

@@ -588,7 +588,10 @@ impl VirtualScorpion {
                 installed::free_slot(&present, new.entries(), capacity).ok_or_else(|| {
                     Error::TableFull {
                         capacity,
-                        reason: format!("the image needs {} entries", new.entries()),
+                        reason: format!(
+                            "the image needs {}",
+                            installed::entries_text(new.entries())
+                        ),
                     }
                 })?;
             entry = Some((

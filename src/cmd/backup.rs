@@ -53,6 +53,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         outside,
         damaged_table,
         disagreements,
+        refused,
     } = uploader::backup_live(&mut client, &profile)?;
     hostfs::write(&args.output, &backup.encode())?;
     print(&format!(
@@ -80,6 +81,16 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             if changing.len() == 1 { "it" } else { "them" },
         ));
     }
+    if let Some(refused) = &refused {
+        // fresh25 F2: said as the restore will refuse it, in place of
+        // the looks below that would say otherwise.
+        let reason = refused.trim_end_matches("; nothing was written");
+        print(&format!(
+            "warning: a restore of this file will be refused: {reason} (the robot was changed by hand; `/1R` clears the table and the hooks, then upload the extensions again)"
+        ));
+    }
+    let damaged_table = damaged_table.filter(|_| refused.is_none());
+    let broken: Vec<_> = broken.into_iter().filter(|_| refused.is_none()).collect();
     if let Some(damaged) = &damaged_table {
         // hostile19 F4: said now, not first at the restore that refuses it.
         print(&format!(
@@ -94,16 +105,14 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         ));
     }
     for found in &disagreements {
-        // Said now, not first at the restore (hostile22 F4, hSkip).
-        let then = match found {
-            uploader::Disagreement::ThroughFreed { .. } => {
-                "a restore of this file is refused (`/1R` clears the table and the hooks; then upload the extensions again)"
-            }
-            uploader::Disagreement::NotHooked { .. } => {
-                "a restore of this file puts it back so, listed and never run (upload it again to hook it)"
-            }
-        };
-        print(&format!("warning: {}: {then}", found.describe()));
+        // Said now, not first at the restore (hostile22 F4, hSkip); one
+        // the restore refuses is said above.
+        if let uploader::Disagreement::NotHooked { .. } = found {
+            print(&format!(
+                "warning: {}: a restore of this file puts it back so, listed and never run (upload it again to hook it)",
+                found.describe()
+            ));
+        }
     }
     for hook in &broken {
         // recheck16 F4: said now, not first at the restore that refuses it.
@@ -226,7 +235,7 @@ impl uploader::Progress for Overrides<'_> {
             }
             uploader::Event::RestoredNotHooked { found } => {
                 crate::cmd::say_err(&format!(
-                    "warning: in the file, {}: restored as the file holds it, listed and never run (upload it again to hook it)\n",
+                    "warning: restored, {}: it is listed and never runs, as the file had it (upload it again to hook it)\n",
                     found.describe()
                 ));
             }

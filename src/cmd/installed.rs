@@ -82,7 +82,18 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             )?);
         }
     }
-    let text = listing(&everyone, &chains, &names) + text.as_str();
+    let mut text = listing(&everyone, &chains, &names) + text.as_str();
+    // fresh25 F7: how much room is left, for a project refused as the
+    // table is full.
+    if let Some((_, capacity)) = profile.table.filter(|_| !everyone.is_empty()) {
+        let used: usize = everyone.iter().map(Installed::entries).sum();
+        let _ = writeln!(
+            text,
+            "{} of the table's {capacity} entries in use, {} free",
+            used,
+            capacity.saturating_sub(used)
+        );
+    }
     std::io::stdout()
         .lock()
         .write_all(text.as_bytes())

@@ -570,9 +570,12 @@ fn read_undo(path: &Path) -> miette::Result<uploader::Backup> {
         Err(error) if error.is_not_found() && used.is_file() => Err(miette::miette!(
             code = "upload::already_undone",
             help = format!(
-                "a successful undo keeps its undo file as {}, and the undo file of the upload before takes its place: none is left (the last {} uploads' are kept). `scorpion restore` of a backup goes further back",
+                "a successful undo keeps its undo file as {}, and the undo file of the upload before takes its place: none is left (an upload keeps its own and the {} before it, {}.1 to {}.{}). `scorpion restore` of a backup goes further back",
                 used.display(),
-                scorpion_project::undo::EARLIER + 1
+                scorpion_project::undo::EARLIER,
+                path.display(),
+                path.display(),
+                scorpion_project::undo::EARLIER
             ),
             "nothing to undo: the last upload kept in {} is already undone",
             path.display()
@@ -678,7 +681,7 @@ fn upload_all(
     if !args.no_dry_run && (!emulated || expectations.is_some()) {
         rehearse(args, resolved, images, &options, expectations.as_ref())?;
     }
-    if !emulated && images.len() > 1 && !options.replace {
+    if !emulated && images.len() > 1 {
         refuse_overlaps(args, resolved, images, &options)?;
     }
     // The earlier images said to be freed, so each is said once.
@@ -761,7 +764,7 @@ fn refuse_overlaps(
         .iter()
         .map(|loaded| (loaded.name.as_str(), &loaded.image))
         .collect();
-    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &named)
+    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &named, options.replace)
         .map_err(|error| ports::traced(error, resolved))?;
     Ok(())
 }

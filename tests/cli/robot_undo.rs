@@ -45,6 +45,17 @@ fn on(dir: &std::path::Path, line: &[&str], args: &[&str]) -> (bool, String) {
     (output.status.success(), transcript(&output))
 }
 
+/// Uploads a friend's extension (100 bytes at `at`, `friend.elf` beside
+/// `project`) to the robot on `line`, from the project.
+fn upload_friend(project: &std::path::Path, line: &[&str], at: u16) {
+    let friend = project
+        .parent()
+        .expect("beside the project")
+        .join("friend.elf");
+    std::fs::write(friend, extension_at(at, 100, None)).expect("the image");
+    ok(project, line, &["upload", "../friend.elf", "--no-dry-run"]);
+}
+
 /// `on` that must succeed.
 fn ok(dir: &std::path::Path, line: &[&str], args: &[&str]) -> String {
     let (success, text) = on(dir, line, args);
@@ -979,20 +990,11 @@ fn second_answers(project: &std::path::Path, answer: char) {
 fn the_undo_of_a_run_that_replaced_an_image_another_upload_witnessed_goes_through() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let project = two_image_project(dir.path(), 'U');
-    std::fs::write(
-        dir.path().join("friend.elf"),
-        extension_at(0x0800, 100, None),
-    )
-    .expect("the image");
     let sim = Sim::start(dir.path(), &[]);
     let line = ["--port", sim.path.as_str()];
     let before = ok(&project, &line, &["read", "$0200", "3"]);
     ok(&project, &line, &["test"]);
-    ok(
-        &project,
-        &line,
-        &["upload", "../friend.elf", "--no-dry-run"],
-    );
+    upload_friend(&project, &line, 0x0800);
     second_answers(&project, 'V');
     let run = ok(&project, &line, &["test", "--replace"]);
     assert!(ok(&project, &line, &["ask", "/1U"]).contains('V'), "{run}");
@@ -1251,18 +1253,9 @@ fn a_configured_port_that_answers_nothing_names_where_it_came_from() {
 fn a_project_image_in_the_way_of_an_installed_extension_sends_nothing() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let project = two_image_project(dir.path(), 'U');
-    std::fs::write(
-        dir.path().join("friend.elf"),
-        extension_at(0x0C00, 100, None),
-    )
-    .expect("the image");
     let sim = Sim::start(dir.path(), &[]);
     let line = ["--port", sim.path.as_str()];
-    ok(
-        &project,
-        &line,
-        &["upload", "../friend.elf", "--no-dry-run"],
-    );
+    upload_friend(&project, &line, 0x0C00);
     let before = ok(&project, &line, &["installed"]);
     let (success, text) = on(&project, &line, &["upload"]);
     assert!(!success, "{text}");
@@ -1271,6 +1264,20 @@ fn a_project_image_in_the_way_of_an_installed_extension_sends_nothing() {
         "{text}"
     );
     assert!(!text.contains("uploaded and verified"), "{text}");
+    // fresh25 F5: the help fits a project (no `--target`), and `test
+    // --port` names the image in the way and gives it too.
+    assert!(
+        text.contains("`--replace` takes out") && !text.contains("--target"),
+        "{text}"
+    );
+    assert_eq!(ok(&project, &line, &["installed"]), before);
+    let (success, tested) = on(&project, &line, &["test"]);
+    assert!(!success, "{tested}");
+    assert!(
+        tested.contains("test upload second ... FAILED")
+            && tested.contains("`--replace` takes out"),
+        "{tested}"
+    );
     assert_eq!(ok(&project, &line, &["installed"]), before);
 }
 
@@ -1317,6 +1324,20 @@ fn a_project_that_cannot_go_in_whole_sends_nothing() {
         "{tested}"
     );
     assert_eq!(ok(&project, &line, &["installed"]), before);
+    // fresh25 F1: `--replace` frees nothing here: refused alike, where it
+    // took the first image, then refused the second.
+    for command in [
+        &["upload", "--replace", "--no-dry-run"][..],
+        &["test", "--replace"],
+    ] {
+        let (success, text) = on(&project, &line, command);
+        assert!(!success, "{text}");
+        assert!(
+            text.contains("need 2 entries") && text.contains("which has 1 free"),
+            "{text}"
+        );
+        assert_eq!(ok(&project, &line, &["installed"]), before);
+    }
     // The second image moved onto the first.
     let layout = project.join("src/second.toml");
     let text = std::fs::read_to_string(&layout).expect("the layout");

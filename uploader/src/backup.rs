@@ -447,6 +447,9 @@ pub struct Saved {
     /// file refuses a way through a freed entry and puts back an extension
     /// its hooks do not lead to as it is (listed, never run).
     pub disagreements: Vec<crate::held_way::Disagreement>,
+    /// Why a restore of the file will be refused before it writes
+    /// anything, if it will: the robot's own state, changed by hand.
+    pub refused: Option<String>,
 }
 
 /// A hook whose way is no way for a command to go.
@@ -527,6 +530,11 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
     }
     let damaged_table = damaged_table(profile, &backup);
     let disagreements = crate::held_way::disagreements(profile, &backup);
+    // fresh25 F2: what a restore of the file will refuse, said now as the
+    // restore will say it (not what the robot-side check would do after).
+    let refused = check_file(profile, &memory_profile(profile), &backup)
+        .err()
+        .map(|error| error.to_string());
     Ok(Saved {
         backup,
         changing,
@@ -534,6 +542,7 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
         outside,
         damaged_table,
         disagreements,
+        refused,
     })
 }
 
@@ -1163,47 +1172,7 @@ pub fn restore<T: Transport>(
     // Everything the file asks is checked before the robot is touched: a
     // file refused half way must not have moved a hook first.
     let memory = memory_options(options);
-    let whole = if backup.areas.is_empty() {
-        None
-    } else {
-        let whole = UploadImage::new(backup.areas.clone(), Vec::new())?;
-        // hostile22 F2: said as a file's, not an image's ("link with
-        // --target").
-        memory.profile.check(&whole).map_err(|error| match error {
-            Error::BadImage { reason } => Error::BackupRefused {
-                reason: format!("the file's memory records: {reason}; nothing was written"),
-            },
-            error => error,
-        })?;
-        Some(whole)
-    };
-    check_hook_targets(backup, &memory.profile, table_range(profile))?;
-    check_records(backup, &memory.profile, profile.table)?;
-    check_hooks_given(profile, backup)?;
-    if let Some(damaged) = damaged_table(profile, backup) {
-        // hostile19 F4: the hooks went to the ROM first, and every restore
-        // of it failed after.
-        return Err(Error::BackupRefused {
-            reason: format!(
-                "the file's table of installed extensions does not decode ({damaged}): it was damaged on the robot when it was saved; nothing was written"
-            ),
-        });
-    }
-    refuse_held_stub(backup, profile)?;
-    // After the stub's own refusal: a stub is code no entry lists too.
-    check_hook_owners(profile, backup)?;
-    let disagreements = crate::held_way::disagreements(profile, backup);
-    if let Some(through) = disagreements
-        .iter()
-        .find(|found| matches!(found, crate::held_way::Disagreement::ThroughFreed { .. }))
-    {
-        return Err(Error::BackupRefused {
-            reason: format!(
-                "in the file, {}: restored, commands would run through memory the next upload may be put in; nothing was written",
-                through.describe()
-            ),
-        });
-    }
+    let whole = check_file(profile, &memory.profile, backup)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
@@ -1232,6 +1201,7 @@ pub fn restore<T: Transport>(
         profile,
         (options.resume, options.interrupted),
     )?;
+    refuse_ways_over_robot(client, profile, backup)?;
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
             refusal: error.to_string(),
@@ -1242,9 +1212,6 @@ pub fn restore<T: Transport>(
         memory.loader = LoaderChoice::Never;
     }
     progress.event(&crate::progress::Event::RestoreStarted);
-    for found in disagreements {
-        progress.event(&crate::progress::Event::RestoredNotHooked { found });
-    }
     let to_rom: Vec<(HookKind, u16)> = HookKind::ALL
         .into_iter()
         .filter_map(|kind| profile.reset_target(kind).map(|to| (kind, to)))
@@ -1313,6 +1280,12 @@ pub fn restore<T: Transport>(
     if let Some((_, error)) = refused.into_iter().next() {
         return Err(error);
     }
+    // What the robot now lists and its hooks do not lead to, as
+    // `installed` shows it (fresh25 F3: an undo file does not hold the
+    // chain slots to tell it before).
+    for found in crate::held_way::unreached(client, profile)? {
+        progress.event(&crate::progress::Event::RestoredNotHooked { found });
+    }
     Ok(reports)
 }
 
@@ -1364,17 +1337,111 @@ fn table_again<T: Transport>(
     Ok(())
 }
 
+/// What a restore checks of a file before the line is used: its memory
+/// records, hooks, witnesses and table, each as something `backup` or an
+/// upload could have written, and its hooks followed through its own
+/// memory ([`crate::held_way`]). Returns the memory as one image (none
+/// where the file holds none). `memory` is the profile the memory is
+/// written with ([`memory_options`]).
+fn check_file(
+    profile: &RomProfile,
+    memory: &RomProfile,
+    backup: &Backup,
+) -> Result<Option<UploadImage>> {
+    let whole = if backup.areas.is_empty() {
+        None
+    } else {
+        let whole = UploadImage::new(backup.areas.clone(), Vec::new())?;
+        // hostile22 F2: said as a file's, not an image's ("link with
+        // --target").
+        memory.check(&whole).map_err(|error| match error {
+            Error::BadImage { reason } => Error::BackupRefused {
+                reason: format!("the file's memory records: {reason}; nothing was written"),
+            },
+            error => error,
+        })?;
+        Some(whole)
+    };
+    check_hook_targets(backup, memory, table_range(profile))?;
+    check_records(backup, memory, profile.table)?;
+    check_hooks_given(profile, backup)?;
+    if let Some(damaged) = damaged_table(profile, backup) {
+        // hostile19 F4: the hooks went to the ROM first, and every restore
+        // of it failed after.
+        return Err(Error::BackupRefused {
+            reason: format!(
+                "the file's table of installed extensions does not decode ({damaged}): it was damaged on the robot when it was saved; nothing was written"
+            ),
+        });
+    }
+    refuse_held_stub(backup, profile)?;
+    // After the stub's own refusal: a stub is code no entry lists too.
+    check_hook_owners(profile, backup)?;
+    refuse_ways(profile, backup, "in the file")?;
+    Ok(whole)
+}
+
+/// Refuses the ways through `seen` (a file, or a file over what the robot
+/// holds) that a restore must not hook ([`crate::held_way`]); `place`
+/// says whose memory it was.
+fn refuse_ways(profile: &RomProfile, seen: &Backup, place: &str) -> Result<()> {
+    let refused = crate::held_way::disagreements(profile, seen)
+        .into_iter()
+        .find_map(|found| found.refusal().map(|why| (found, why)));
+    match refused {
+        Some((found, why)) => Err(Error::BackupRefused {
+            reason: format!(
+                "{place}, {}: restored, {why}; nothing was written",
+                found.describe()
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// hostile25 F1: a file that holds some of the table's bytes and not all
+/// (made by hand: an undo file holds its upload's entries and all the
+/// flags it read) leaves the robot's for the rest. Its ways are followed
+/// over the table as the restore will leave it: the robot's bytes read
+/// under the file's.
+fn refuse_ways_over_robot<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    backup: &Backup,
+) -> Result<()> {
+    let Some((at, len)) = table_range(profile) else {
+        return Ok(());
+    };
+    let held = (0..len)
+        .filter(|i| backup.byte_at(u32::from(at) + *i as u32).is_some())
+        .count();
+    if held == 0 || held == len {
+        return Ok(());
+    }
+    let mut seen = backup.clone();
+    seen.areas.push(Area {
+        address: at,
+        bytes: client.read_memory(at, len)?,
+    });
+    refuse_ways(profile, &seen, "on the robot as the file would leave it")
+}
+
 /// The options a restore writes memory with: the table is written as
 /// memory, flags and all, while no hook points into RAM (no table
 /// bookkeeping of the upload's own).
 fn memory_options(options: &UploadOptions) -> UploadOptions {
-    let mut memory = options.clone();
-    memory.profile.table = None;
-    if let Some((address, len)) = table_range(&options.profile) {
-        memory
-            .profile
-            .writable
-            .push(address..=address + (len as u16 - 1));
+    UploadOptions {
+        profile: memory_profile(&options.profile),
+        ..options.clone()
+    }
+}
+
+/// [`memory_options`]'s profile.
+fn memory_profile(profile: &RomProfile) -> RomProfile {
+    let mut memory = profile.clone();
+    memory.table = None;
+    if let Some((address, len)) = table_range(profile) {
+        memory.writable.push(address..=address + (len as u16 - 1));
     }
     memory
 }

@@ -73,6 +73,47 @@ pub(crate) fn comes_back<T: Transport>(
     )
 }
 
+/// hostile25 F4: before a replacement frees anything, the way of `kind`
+/// from `target` into `image`'s memory, where it gets there other than as
+/// the replacement re-points it (from the hook itself, or from the chain
+/// slot of an extension `everyone` lists): through code no entry lists,
+/// which the replacement cannot re-point. It freed the old entry, then
+/// refused as a loop, and the undo of a robot left so was refused too.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn unlisted_way_into<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+    image: &crate::image::UploadImage,
+) -> Result<Option<Path>> {
+    let End::Inside(path) = follow(
+        client,
+        profile,
+        everyone,
+        (kind, target),
+        &|at, _| image.contains(at),
+        false,
+    )?
+    else {
+        return Ok(None);
+    };
+    let listed = |at: u16| {
+        everyone
+            .iter()
+            .flat_map(|other| other.hooks.iter())
+            .any(|hook| hook.kind == kind && hook.handler == at)
+    };
+    let before = path.0.len().checked_sub(2).map(|i| path.0[i]);
+    Ok(match before {
+        None => None,
+        Some(at) if listed(at) => None,
+        Some(_) => Some(path),
+    })
+}
+
 /// How a chain followed from a hook's target ends.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) enum End {

@@ -74,25 +74,31 @@ pub enum Error {
     #[error(
         "{image} cannot go in beside what the robot holds, or an image before it: nothing was sent to the robot (the project's images go in all or none)"
     )]
-    #[diagnostic(code(uploader::image_in_the_way))]
+    #[diagnostic(
+        code(uploader::image_in_the_way),
+        help(
+            "`--replace` takes out what the image overlaps on the robot; or move the image (its layout in the project), take out what is in the way (`scorpion upload --undo` of its upload), or reset the robot (/1R frees every entry)"
+        )
+    )]
     ImageInTheWay {
         /// The image's name.
         image: String,
-        /// The overlap.
+        /// The overlap (its help, for an image outside a project, is not
+        /// this one's: fresh25 F5).
         #[source]
-        #[diagnostic_source]
         source: romlib::Error,
     },
 
     /// A project's images need more entries of the robot's table than it
     /// has free: refused before any is sent.
     #[error(
-        "the project's images need {needed} entries in the robot's table of installed extensions, which has {free} free: nothing was sent to the robot (the project's images go in all or none)"
+        "the project's images need {} in the robot's table of installed extensions, which has {free} free: nothing was sent to the robot (the project's images go in all or none)",
+        romlib::installed::entries_text(.needed.to_owned())
     )]
     #[diagnostic(
         code(uploader::table_full),
         help(
-            "`scorpion installed` lists what the robot holds; take some out (`scorpion upload --undo`, or `--replace`), or reset the robot (/1R frees every entry)"
+            "`scorpion installed` lists what the robot holds; take some out (`scorpion upload --undo` goes back one upload), or reset the robot (/1R frees every entry)"
         )
     )]
     ProjectTableFull {
@@ -283,7 +289,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::undo_not_last),
         help(
-            "undo the later upload first: `scorpion upload --undo` where it was made (each undo goes back one upload, the last first), or `--undo-file FILE` with its undo file"
+            "undo the later upload first: `scorpion upload --undo` where it was made (each undo goes back one upload, the last first), or `--undo-file FILE` with its undo file; where a `scorpion restore` put it back after its upload was undone (no undo file is left for it), restore a backup from before it instead"
         )
     )]
     UndoNotLast {
@@ -418,8 +424,9 @@ pub enum Error {
 
     /// The line went quiet in the middle of the work.
     #[error(
-        "the line to {port} stalled: nothing received for {} with {outstanding} answers due",
-        human_duration(*.waited)
+        "the line to {port} stalled: nothing received for {} with {} due",
+        human_duration(*.waited),
+        if *.outstanding == 1 { "an answer".to_owned() } else { format!("{} answers", .outstanding) }
     )]
     #[diagnostic(
         code(uploader::stalled),
@@ -613,7 +620,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::backup_refused),
         help(
-            "backups and undo files are written by `scorpion backup` and by every upload; this one was made or changed by hand, or damaged: restore another (a new `scorpion backup` is the robot as it is now)"
+            "backups and undo files are written by `scorpion backup` and by every upload; this one was made or changed by hand, or damaged, or is a backup of a robot changed by hand (`scorpion backup` warned of it as it saved): restore another, or reset the robot (/1R) and upload the extensions again"
         )
     )]
     BackupRefused {

@@ -10,9 +10,11 @@
 //!   it is listed and never runs, as `installed` then shows. Said, not
 //!   refused: a robot is left so by an extension that takes a hook whole,
 //!   or a way dropped by hand, and a restore puts back what was there.
+//!   `backup` tells it from the file; a restore from the robot once it is
+//!   done ([`unreached`]: an undo file does not hold the chain slots).
 //!
 //! Only bytes the file holds are followed; where it holds no more (an undo
-//! file, memory a backup only witnesses), nothing is told.
+//! file, memory a backup only witnesses), nothing is told from the file.
 
 use isa::objfmt::HookKind;
 use romlib::installed::{ENTRY_LEN, Installed, entry_address, in_use};
@@ -34,14 +36,34 @@ pub enum Disagreement {
         /// The way the hook goes, `$0800 -> $F0A2`.
         path: String,
     },
-    /// The hook's way runs, past a listed extension, into the memory of
-    /// `freed`, an entry the table no longer lists.
+    /// The hook's way runs into the memory of `freed`, an entry the table
+    /// no longer lists.
     ThroughFreed {
         /// The hook.
         hook: HookKind,
         /// What the freed entry's bytes still say.
         freed: Installed,
         /// The way there.
+        path: String,
+    },
+    /// The hook's way runs into code no entry lists while extensions the
+    /// table lists on it are still to come (hostile25 F2: an entry
+    /// zeroed; an upload only ever chains to such code last).
+    Unlisted {
+        /// The hook.
+        hook: HookKind,
+        /// The extensions listed on the hook the way has not reached.
+        behind: Vec<Installed>,
+        /// The way there.
+        path: String,
+    },
+    /// The hook's way comes back, through listed extensions' chain slots,
+    /// to where it has been (hostile25 F5: told only once the memory was
+    /// written).
+    Loops {
+        /// The hook.
+        hook: HookKind,
+        /// The way, the address it comes back to last.
         path: String,
     },
 }
@@ -66,21 +88,33 @@ impl Disagreement {
                 hook.rom_symbol(),
                 freed.describe()
             ),
+            Disagreement::Unlisted { hook, behind, path } => {
+                let behind: Vec<String> = behind.iter().map(Installed::describe).collect();
+                format!(
+                    "{} runs through code no entry of the table lists ({path}), before {} the table lists on it",
+                    hook.rom_symbol(),
+                    behind.join(", ")
+                )
+            }
+            Disagreement::Loops { hook, path } => format!(
+                "{} comes back to where it has been ({path}), a loop the robot would run for ever at its next unknown command",
+                hook.rom_symbol()
+            ),
         }
     }
-}
 
-/// How a way followed through the file ended.
-enum End {
-    /// At the ROM (its target or elsewhere in it).
-    Rom,
-    /// At an extension that takes the hook whole (no chain slot).
-    Whole,
-    /// At code no entry lists, past a listed extension when `past`.
-    Unlisted { past: bool },
-    /// Where the file holds no more, or back where it has been (the
-    /// robot-side check after the memory tells loops).
-    Unknown,
+    /// Why a restore refuses it, where it does (all but
+    /// [`Disagreement::NotHooked`], which is put back as it is).
+    #[must_use]
+    pub fn refusal(&self) -> Option<&'static str> {
+        match self {
+            Disagreement::NotHooked { .. } => None,
+            Disagreement::ThroughFreed { .. } | Disagreement::Unlisted { .. } => {
+                Some("commands would run through memory the next upload may be put in")
+            }
+            Disagreement::Loops { .. } => Some("no unknown command would ever end"),
+        }
+    }
 }
 
 /// The disagreements between `backup`'s hooks and its table (none where
@@ -105,68 +139,129 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
     };
     let mut found = Vec::new();
     for &(kind, target) in &backup.hooks {
+        let on_hook: Vec<&Installed> = listed
+            .iter()
+            .filter(|entry| entry.hooks.iter().any(|hook| hook.kind == kind))
+            .collect();
         let mut path: Vec<u16> = Vec::new();
         let mut at = target;
-        let end = loop {
+        // Whether the way was followed to its end (the ROM, an extension
+        // that takes the hook whole, or code after every listed one).
+        let ended = loop {
             if profile.reset_target(kind) == Some(at) || in_rom(profile, at) {
                 path.push(at);
-                break End::Rom;
+                break true;
             }
-            if path.contains(&at) || path.len() > listed.len() {
-                break End::Unknown;
-            }
+            let came_back = path.contains(&at);
             path.push(at);
+            if came_back {
+                found.push(Disagreement::Loops {
+                    hook: kind,
+                    path: path_text(&path),
+                });
+                break false;
+            }
             let handler = listed
                 .iter()
                 .flat_map(|entry| entry.hooks.iter())
                 .find(|hook| hook.kind == kind && hook.handler == at);
-            match handler {
-                Some(hook) => match hook.chain {
-                    None => break End::Whole,
-                    Some(slot) => match word(slot) {
-                        Some(next) => at = next,
-                        None => break End::Unknown,
-                    },
-                },
-                None => {
-                    break End::Unlisted {
-                        past: path.len() > 1,
-                    };
+            if let Some(hook) = handler {
+                match hook.chain.map(word) {
+                    None => break true,
+                    Some(Some(next)) => at = next,
+                    Some(None) => break false,
                 }
+                continue;
             }
+            // Inside a listed extension but not at its handler is the
+            // robot-side check's (a way that strays).
+            if listed.iter().any(|entry| entry.contains(at)) {
+                break false;
+            }
+            if let Some(entry) = freed.iter().find(|entry| entry.contains(at)) {
+                found.push(Disagreement::ThroughFreed {
+                    hook: kind,
+                    freed: entry.clone(),
+                    path: path_text(&path),
+                });
+                break false;
+            }
+            let behind: Vec<Installed> = on_hook
+                .iter()
+                .filter(|entry| !reached(entry, kind, &path))
+                .map(|entry| (*entry).clone())
+                .collect();
+            if !behind.is_empty() {
+                found.push(Disagreement::Unlisted {
+                    hook: kind,
+                    behind,
+                    path: path_text(&path),
+                });
+                break false;
+            }
+            // An owner's code after every listed extension: an upload
+            // chains to whatever a hook led to.
+            break true;
         };
-        let shown = path_text(&path);
-        // Inside a listed extension but not at its handler is the
-        // robot-side check's (a way that strays).
-        let unowned = !listed.iter().any(|entry| entry.contains(at));
-        if let End::Unlisted { past: true } = end
-            && unowned
-            && let Some(entry) = freed.iter().find(|entry| entry.contains(at))
-        {
-            found.push(Disagreement::ThroughFreed {
-                hook: kind,
-                freed: entry.clone(),
-                path: shown,
-            });
-            continue;
-        }
-        if matches!(end, End::Rom | End::Unlisted { .. }) {
-            for entry in &listed {
-                let skipped = entry
-                    .hooks
-                    .iter()
-                    .any(|hook| hook.kind == kind && !path.contains(&hook.handler));
-                if skipped {
-                    found.push(Disagreement::NotHooked {
-                        hook: kind,
-                        extension: entry.clone(),
-                        path: shown.clone(),
-                    });
-                }
-            }
+        if ended {
+            found.extend(not_hooked(&listed, kind, &path));
         }
     }
     found
+}
+
+/// Whether `path` goes through `entry`'s `kind` handler.
+fn reached(entry: &Installed, kind: HookKind, path: &[u16]) -> bool {
+    entry
+        .hooks
+        .iter()
+        .any(|hook| hook.kind == kind && path.contains(&hook.handler))
+}
+
+/// What the robot's table lists on a hook whose chain, as the robot holds
+/// it now, does not lead to it: as `installed` marks it "not hooked".
+///
+/// # Errors
+/// The line's.
+pub(crate) fn unreached<T: crate::transport::Transport>(
+    client: &mut crate::client::Client<T>,
+    profile: &RomProfile,
+) -> crate::Result<Vec<Disagreement>> {
+    let everyone = crate::table::read_installed(client, profile)?;
+    let mut found = Vec::new();
+    if everyone.is_empty() {
+        return Ok(found);
+    }
+    for kind in HookKind::ALL {
+        let listed_on = everyone
+            .iter()
+            .any(|entry| entry.hooks.iter().any(|hook| hook.kind == kind));
+        if !listed_on {
+            continue;
+        }
+        let path = crate::table::chain_of(client, profile, &everyone, kind)?;
+        found.extend(not_hooked(&everyone, kind, &path));
+    }
+    Ok(found)
+}
+
+/// Each of `listed` with a `kind` handler that `path` (a hook's way) does
+/// not go through.
+fn not_hooked(listed: &[Installed], kind: HookKind, path: &[u16]) -> Vec<Disagreement> {
+    listed
+        .iter()
+        .filter(|entry| {
+            entry
+                .hooks
+                .iter()
+                .any(|hook| hook.kind == kind && !path.contains(&hook.handler))
+        })
+        .map(|entry| Disagreement::NotHooked {
+            hook: kind,
+            extension: entry.clone(),
+            path: path_text(path),
+        })
+        .collect()
 }
 
 /// `$0800 -> $F0A2`.

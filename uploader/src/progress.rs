@@ -106,9 +106,9 @@ pub enum Event {
     /// A restore's checks passed: it writes from here on. One stopped
     /// after this may be run again with [`crate::UploadOptions::resume`].
     RestoreStarted,
-    /// What a restore puts back as the file holds it: an extension its
-    /// table lists on a hook its hooks do not lead to (listed, and never
-    /// run, as it was when the file was written).
+    /// Once a restore is done: an extension the robot's table lists on a
+    /// hook whose chain does not lead to it (listed, and never run, as
+    /// the file had it; `installed` marks it "not hooked").
     RestoredNotHooked {
         /// The disagreement.
         found: crate::held_way::Disagreement,

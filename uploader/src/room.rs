@@ -13,7 +13,10 @@ use crate::{Error, Result};
 /// Refuses `images` (each with its name, in the order they go in) where
 /// one overlaps an extension the robot's table lists (other than an
 /// earlier copy of itself) or an image before it, or where the table has
-/// too few free entries for them all. Reads the table only.
+/// too few free entries for them all. With `replace`, what an image
+/// overlaps is taken out for it, and its entries count as free (fresh25
+/// F1: the count was skipped, and a full table took the first image, then
+/// refused the next). Reads the table only.
 ///
 /// # Errors
 /// [`Error::ImageInTheWay`], [`Error::ProjectTableFull`], and the line's.
@@ -21,21 +24,28 @@ pub fn refuse_what_cannot_go_in<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     images: &[(&str, &UploadImage)],
+    replace: bool,
 ) -> Result<()> {
-    let mut holding = crate::table::read_installed(client, profile)?;
-    let free = profile
-        .table
-        .map(|(_, entries)| entries.saturating_sub(holding.iter().map(Installed::entries).sum()));
+    let mut listed = crate::table::read_installed(client, profile)?;
+    let entries = |held: &[Installed]| held.iter().map(Installed::entries).sum::<usize>();
+    let in_use = entries(&listed);
+    // The images checked so far: the ones after must not overlap them,
+    // `replace` or not (a layout of the project's own).
+    let mut ours: Vec<Installed> = Vec::new();
     let mut needed = 0;
     for &(name, image) in images {
         let extents = image.extents();
-        if holding
+        if listed
             .iter()
             .any(|old| old.id == image.id() && old.extents == extents)
         {
             continue;
         }
-        if let Some(overlap) = holding.iter().find_map(|old| old.overlap(extents)) {
+        let in_the_way = |held: &[Installed]| held.iter().find_map(|old| old.overlap(extents));
+        if replace && in_the_way(&ours).is_none() {
+            listed.retain(|old| old.overlap(extents).is_none());
+        }
+        if let Some(overlap) = in_the_way(&ours).or_else(|| in_the_way(&listed)) {
             return Err(Error::ImageInTheWay {
                 image: name.to_owned(),
                 source: overlap,
@@ -43,11 +53,19 @@ pub fn refuse_what_cannot_go_in<T: Transport>(
         }
         let entry = Installed::new(image.id(), extents.to_vec(), image.hooks());
         needed += entry.entries();
-        // Held once checked: the images after it must not overlap it.
-        holding.push(entry);
+        ours.push(entry);
     }
-    match free {
-        Some(free) if needed > free => Err(Error::ProjectTableFull { needed, free }),
-        _ => Ok(()),
+    // What `replace` takes out was in use before: counted free.
+    let taken_out = in_use - entries(&listed);
+    match profile.table {
+        Some((_, capacity)) => {
+            // What `replace` takes out was in use before: counted free.
+            let free = (capacity + taken_out).saturating_sub(in_use);
+            if needed > free {
+                return Err(Error::ProjectTableFull { needed, free });
+            }
+            Ok(())
+        }
+        None => Ok(()),
     }
 }

@@ -245,6 +245,22 @@ pub(crate) fn prepare<T: Transport>(
         before,
         hooks: hooks.to_vec(),
     };
+    let in_the_way = read.installed.iter().any(|old| {
+        old.overlap(image.extents()).is_some() && !(old.id == id && old.extents == image.extents())
+    });
+    if replace && in_the_way {
+        for &(kind, target) in hooks {
+            let way = (kind, target);
+            if let Some(path) =
+                crate::chain::unlisted_way_into(client, profile, &read.installed, way, image)?
+            {
+                return Err(Error::ChainComesBack {
+                    hook: kind.rom_symbol(),
+                    path: path.to_string(),
+                });
+            }
+        }
+    }
     let mut replaced = Vec::new();
     let mut known = hooks;
     let mut unlinked = Vec::new();
@@ -308,8 +324,8 @@ pub(crate) fn prepare<T: Transport>(
             Error::Robot(romlib::Error::TableFull {
                 capacity: table.1,
                 reason: format!(
-                    "the image needs {} entries, one per place its memory is in",
-                    entry.entries()
+                    "the image needs {}, one per place its memory is in",
+                    installed::entries_text(entry.entries())
                 ),
             })
         })?,

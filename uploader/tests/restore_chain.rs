@@ -111,6 +111,9 @@ fn a_file_whose_hook_loops_or_stops_the_cpu_is_not_hooked() {
         // The table lists nothing: a hook past what it lists is refused
         // before the way is followed (hostile22 F9), which this is about.
         put(0x0F80, &[0]);
+        // Nor the entry's bytes: the way into a freed entry's memory is
+        // refused before too (hostile25 F6).
+        put(0x0F88, &[0; romlib::installed::ENTRY_LEN]);
         file.hooks = vec![
             (HookKind::Unknown, at),
             (HookKind::Loop, romlib::symbols::ROM_LOOP),
@@ -979,4 +982,208 @@ fn a_backup_whose_hooks_skip_a_listed_extension_says_so() {
     restore(&mut client, &saved, &options, &mut said).expect("restored");
     assert!(not_hooked(&said).is_empty(), "{:?}", said.0);
     assert_eq!(hook(&mut client), 0x0803);
+}
+
+/// fresh25 F3: an undo that puts back a hook past an extension the table
+/// still lists (B in front of A, the hook sent to A by hand, then B
+/// hooked again by an upload, then that upload undone) said nothing; a
+/// restore of a backup of the same state said it. The undo file does not
+/// hold the chain slots: told from the robot once the undo is done.
+#[test]
+fn an_undo_that_leaves_a_listed_extension_unhooked_says_so() {
+    let (options, _, undo) = plain_replace_undo();
+    let mut client = uploader::client(robot(), &options.profile);
+    for at in [0x0500, 0x0800] {
+        upload(&mut client, &extension_at(at), &options, &mut NoProgress).expect("installed");
+    }
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(HOOK_UNKNOWN + 1, &0x0503u16.to_le_bytes())
+        .expect("RAM");
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0800),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("hooked again");
+    assert_eq!(hook(&mut client), 0x0803);
+    let mut said = Said::default();
+    restore(&mut client, &kept.0.expect("kept"), &undo, &mut said).expect("undone");
+    assert_eq!(hook(&mut client), 0x0503);
+    let told = not_hooked(&said);
+    assert_eq!(told.len(), 1, "{told:?}");
+    assert!(
+        told[0].contains("($0800-$083F) on HOOK_UNKNOWN")
+            && told[0].ends_with(&format!("($0503 -> ${BAD_COMMAND:04X})")),
+        "{told:?}"
+    );
+}
+
+/// fresh25 F2: `backup` of a robot whose HOOK_UNKNOWN an owner pointed
+/// at zeros said a restore would leave the hook at the ROM's target; the
+/// restore refused the file as made by hand. `backup` now says the
+/// restore's own refusal, and the restore gives it.
+#[test]
+fn a_backup_says_the_refusal_its_restore_will_give() {
+    let (options, mut client) = one_installed();
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(HOOK_UNKNOWN + 1, &0x0700u16.to_le_bytes())
+        .expect("RAM");
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    let said = saved.refused.clone().expect("a restore of it is refused");
+    assert!(said.contains("$0700, which holds $00"), "{said}");
+    match restore(&mut client, &saved.backup, &options, &mut NoProgress) {
+        Err(error @ Error::BackupRefused { .. }) => assert_eq!(error.to_string(), said),
+        other => panic!("{other:?}"),
+    }
+    // A robot as an upload leaves it: nothing to say.
+    let (options, mut client) = one_installed();
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    assert_eq!(saved.refused, None);
+}
+
+/// Three extensions on HOOK_UNKNOWN: $0A00 in front of $0800 in front of
+/// $0500, the robot and a backup of it.
+fn three_in_a_chain() -> (
+    UploadOptions,
+    uploader::Client<uploader::transport::VirtualTransport>,
+    uploader::Backup,
+) {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    for at in [0x0500, 0x0800, 0x0A00] {
+        upload(&mut client, &extension_at(at), &options, &mut NoProgress).expect("installed");
+    }
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    (options, client, saved)
+}
+
+/// Refused, and the robot's memory as it was.
+fn refused_untouched(
+    client: &mut uploader::Client<uploader::transport::VirtualTransport>,
+    file: &uploader::Backup,
+    options: &UploadOptions,
+    wanted: &[&str],
+) {
+    let before = held(client);
+    match restore(client, file, options, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            for part in wanted {
+                assert!(reason.contains(part), "{part:?}: {reason}");
+            }
+            assert!(reason.ends_with("nothing was written"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(client) == before, "the robot's memory changed");
+}
+
+/// hostile25 F1, F2, F5, F6: files whose ways the restore found wrong only
+/// after writing, or not at all (exit 0): the table frees every entry the
+/// hook runs through; the middle extension's entry points elsewhere, so
+/// the way runs through unlisted code before the last one; a chain slot
+/// sent back to the front (a loop); the front one's flags left out of the
+/// file, which then leaves the robot's (cleared by a reset). Each is
+/// refused before a byte is written.
+#[test]
+fn a_backup_whose_ways_run_wrong_is_refused_before_writing() {
+    let table = romlib::installed::TABLE;
+    let entries = romlib::installed::ENTRIES as u16;
+    let entry_len = romlib::installed::ENTRY_LEN as u16;
+    // F6: nothing listed, the hook into the freed entries' code.
+    let (options, mut client, saved) = three_in_a_chain();
+    let mut freed = saved.clone();
+    for slot in 0..3 {
+        set(&mut freed, table + slot, 0);
+    }
+    refused_untouched(
+        &mut client,
+        &freed,
+        &options,
+        &["runs through extension", "($0A00-$0A3F) ($0A03)", "freed"],
+    );
+    // F2: the middle one's entry says $0C00 (handler and chain slot moved
+    // with it): its code at $0800 is no entry's, and $0500 is behind it.
+    let mut elsewhere = saved.clone();
+    let middle = table + entries + entry_len;
+    for (offset, byte) in [(4, 0x0C), (6, 0x0C), (8, 0x0C), (10, 0x0C)] {
+        set(&mut elsewhere, middle + offset, byte);
+    }
+    refused_untouched(
+        &mut client,
+        &elsewhere,
+        &options,
+        &[
+            "code no entry of the table lists ($0A03 -> $0803)",
+            "before extension",
+            "($0500-$053F)",
+        ],
+    );
+    // F5: the last one's chain slot sent back to the front.
+    let mut loops = saved.clone();
+    set(&mut loops, 0x0501, 0x03);
+    set(&mut loops, 0x0502, 0x0A);
+    refused_untouched(
+        &mut client,
+        &loops,
+        &options,
+        &["comes back to where it has been ($0A03 -> $0803 -> $0503 -> $0A03)"],
+    );
+    // F1: the front one's flags not in the file; the robot reset.
+    let mut part = saved.clone();
+    part.areas = without(&part.areas, table + 2..=table + 2);
+    let reset = romlib::protocol::Command::parse(b"/1R").expect("a command");
+    let _ = client.listen(&reset).expect("the line works");
+    refused_untouched(
+        &mut client,
+        &part,
+        &options,
+        &[
+            "on the robot as the file would leave it",
+            "($0A00-$0A3F) ($0A03), an entry the table has freed",
+        ],
+    );
+    // The file whole goes through.
+    restore(&mut client, &saved, &options, &mut NoProgress).expect("restored");
+    assert_eq!(hook(&mut client), 0x0A03);
+}
+
+/// hostile25 F4: on a robot whose HOOK_UNKNOWN runs through code no entry
+/// lists (the front extension's flags cleared by hand), `--replace` of
+/// the one behind it freed that one's entry, then refused as a loop
+/// ("nothing was written"), and the undo of it was refused. The way into
+/// the image through the unlisted code is refused before anything moves.
+#[test]
+fn a_replacement_reached_through_unlisted_code_moves_nothing() {
+    let (options, mut client, _) = three_in_a_chain();
+    let table = romlib::installed::TABLE;
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(table + 2, &[0])
+        .expect("RAM");
+    let before = held(&mut client);
+    let options = UploadOptions {
+        replace: true,
+        ..options
+    };
+    let edit = common::one_byte_changed(&extension_at(0x0800), 40);
+    let mut kept = Kept::default();
+    match upload_keeping(&mut client, &edit, &options, &mut NoProgress, &mut kept) {
+        Err(Error::ChainComesBack { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "the robot changed");
 }

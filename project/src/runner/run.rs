@@ -648,39 +648,49 @@ impl Run<'_, '_, '_> {
         // The ids of the images this run left on the robot, for what a
         // reset during a later one freed.
         let mut uploaded_here: Vec<(u32, String)> = Vec::new();
-        for (index, image) in built.iter().enumerate() {
+        // recheck24: all or none, as `scorpion upload` (a full table took
+        // the first images, then refused the next). Said as the upload of
+        // the image in the way (fresh25 F5).
+        if port != EMU && built.len() > 1 {
+            let images = built
+                .iter()
+                .map(|built| {
+                    Ok((
+                        built.name.as_str(),
+                        UploadImage::try_from(&built.linked.image)?,
+                    ))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let named: Vec<(&str, &UploadImage)> =
+                images.iter().map(|(name, image)| (*name, image)).collect();
+            if let Err(source) = uploader::refuse_what_cannot_go_in(
+                &mut client,
+                &options.profile,
+                &named,
+                options.replace,
+            ) {
+                let image = match &source {
+                    uploader::Error::ImageInTheWay { image, .. } => image.clone(),
+                    _ => built[0].name.clone(),
+                };
+                let name = format!("upload {image}");
+                self.start(&name);
+                let silent = silent_note(&source, sourced);
+                let mut why = indent(&rendered(Error::UploadImage {
+                    image,
+                    source: Box::new(source),
+                }));
+                why.push_str(&silent);
+                self.record_result(&name, Err(why));
+                return Ok(());
+            }
+        }
+        for image in built {
             let name = format!("upload {}", image.name);
             self.start(&name);
             if let Some(why) = undo.as_ref().and_then(|undo| undo_refused(&undo.path)) {
                 self.record_result(&name, Err(why));
                 return Ok(());
-            }
-            // recheck24: all or none, as `scorpion upload` (a full table
-            // took the first images, then refused the next).
-            if index == 0 && port != EMU && built.len() > 1 && !self.options.replace {
-                let images = built
-                    .iter()
-                    .map(|built| {
-                        Ok((
-                            built.name.as_str(),
-                            UploadImage::try_from(&built.linked.image)?,
-                        ))
-                    })
-                    .collect::<Result<Vec<_>>>()?;
-                let named: Vec<(&str, &UploadImage)> =
-                    images.iter().map(|(name, image)| (*name, image)).collect();
-                if let Err(source) =
-                    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &named)
-                {
-                    let silent = silent_note(&source, sourced);
-                    let mut why = indent(&rendered(Error::UploadImage {
-                        image: image.name.clone(),
-                        source: Box::new(source),
-                    }));
-                    why.push_str(&silent);
-                    self.record_result(&name, Err(why));
-                    return Ok(());
-                }
             }
             let upload = UploadImage::try_from(&image.linked.image)?;
             let mut seen = HooksSeen::default();
@@ -724,12 +734,6 @@ impl Run<'_, '_, '_> {
                     }
                     self.report.reset_freed.push((image.name.clone(), named));
                 }
-                for &(hook, before, after) in &seen.changed {
-                    self.report.reset_freed.push((
-                        image.name.clone(),
-                        format!("what {hook} led to (${before:04X}; it leads to ${after:04X} now)"),
-                    ));
-                }
                 // hostile22 F6: a reset frees every entry: this run's
                 // earlier images too, whether or not the upload could name
                 // them (one early in it found the table empty), as
@@ -742,6 +746,18 @@ impl Run<'_, '_, '_> {
                         self.report
                             .reset_freed
                             .push((image.name.clone(), name.clone()));
+                    }
+                }
+                // Where a hook moved and nothing freed was named, what it
+                // led to (hostile25 F8: said beside the image it was).
+                if report.reset_freed.is_empty() && gone.is_empty() {
+                    for &(hook, before, after) in &seen.changed {
+                        self.report.reset_freed.push((
+                            image.name.clone(),
+                            format!(
+                                "what {hook} led to (${before:04X}; it leads to ${after:04X} now)"
+                            ),
+                        ));
                     }
                 }
             }
