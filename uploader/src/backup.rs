@@ -1251,16 +1251,21 @@ pub fn restore<T: Transport>(
     // written again where a reset undid them (hostile20 F5: the hooks
     // were left at the ROM after "verified").
     let mut rounds = 0;
-    loop {
+    let unreached = loop {
         switch_hooks(client, profile, &fine, options.max_writes)?;
         if let Some(table) = table {
             table_again(client, backup, table, progress)?;
         }
+        // What the robot lists and its hooks do not lead to, as
+        // `installed` shows it (fresh25 F3: an undo file does not hold
+        // the chain slots to tell it before). Read before the hooks are
+        // read back: a reset while it is read is found by that.
+        let unreached = crate::held_way::unreached(client, profile)?;
         let now = read_hooks(client, profile)?;
         let lost = fine.iter().find(|hook| !now.contains(hook));
         rounds += 1;
         match lost {
-            None => break,
+            None => break unreached,
             Some(&(kind, target)) if rounds == 3 => {
                 let operand = profile.hook_address(kind) + 1;
                 let found = now
@@ -1276,14 +1281,11 @@ pub fn restore<T: Transport>(
             }
             Some(_) => {}
         }
-    }
+    };
     if let Some((_, error)) = refused.into_iter().next() {
         return Err(error);
     }
-    // What the robot now lists and its hooks do not lead to, as
-    // `installed` shows it (fresh25 F3: an undo file does not hold the
-    // chain slots to tell it before).
-    for found in crate::held_way::unreached(client, profile)? {
+    for found in unreached {
         progress.event(&crate::progress::Event::RestoredNotHooked { found });
     }
     Ok(reports)
