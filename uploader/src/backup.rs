@@ -532,7 +532,7 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
     let disagreements = crate::held_way::disagreements(profile, &backup);
     // fresh25 F2: what a restore of the file will refuse, said now as the
     // restore will say it (not what the robot-side check would do after).
-    let refused = check_file(profile, &memory_profile(profile), &backup)
+    let refused = check_file(profile, &memory_profile(profile), &backup, false)
         .err()
         .map(|error| error.to_string());
     Ok(Saved {
@@ -890,6 +890,20 @@ fn decoded_table(
 ) -> Option<std::result::Result<Vec<romlib::installed::Installed>, String>> {
     let (at, entries) = profile.table?;
     let len = entries * (1 + romlib::installed::ENTRY_LEN);
+    // recheck25 R5: an entry in use that the file does not hold whole is
+    // not the file's to judge (read as zeros, it was called damaged on
+    // the robot): the robot's copy is looked at where the file holds
+    // part of the table ([`refuse_ways_over_robot`]).
+    let cut = (0..entries).any(|slot| {
+        let flags = backup.byte_at(u32::from(romlib::installed::flags_address(at, slot)));
+        let entry = romlib::installed::entry_address(at, entries, slot);
+        flags.is_some_and(romlib::installed::in_use)
+            && (0..romlib::installed::ENTRY_LEN)
+                .any(|i| backup.byte_at(u32::from(entry) + i as u32).is_none())
+    });
+    if cut {
+        return None;
+    }
     let held: Vec<u8> = (0..len)
         .map(|i| backup.byte_at(u32::from(at) + i as u32).unwrap_or(0))
         .collect();
@@ -1172,7 +1186,7 @@ pub fn restore<T: Transport>(
     // Everything the file asks is checked before the robot is touched: a
     // file refused half way must not have moved a hook first.
     let memory = memory_options(options);
-    let whole = check_file(profile, &memory.profile, backup)?;
+    let whole = check_file(profile, &memory.profile, backup, options.undo)?;
     // A restore or upload that died at the loader's fast rate may have
     // left the robot there: `connect` finds it and asks it back.
     let (hooks, _) = crate::upload::connect(client, options)?;
@@ -1201,7 +1215,7 @@ pub fn restore<T: Transport>(
         profile,
         (options.resume, options.interrupted),
     )?;
-    refuse_ways_over_robot(client, profile, backup)?;
+    refuse_ways_over_robot(client, profile, backup, options.undo)?;
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
             refusal: error.to_string(),
@@ -1344,11 +1358,17 @@ fn table_again<T: Transport>(
 /// upload could have written, and its hooks followed through its own
 /// memory ([`crate::held_way`]). Returns the memory as one image (none
 /// where the file holds none). `memory` is the profile the memory is
-/// written with ([`memory_options`]).
+/// written with ([`memory_options`]). An upload's undo file (`undo`)
+/// puts back the robot as its upload found it: a way through code no
+/// entry lists that the upload chained in front of (an owner's, hooked
+/// by hand, or a freed entry's) is not refused there (recheck25 R6: the
+/// upload went through, and its undo was refused as made by hand); the
+/// witnesses still check that code is what it was.
 fn check_file(
     profile: &RomProfile,
     memory: &RomProfile,
     backup: &Backup,
+    undo: bool,
 ) -> Result<Option<UploadImage>> {
     let whole = if backup.areas.is_empty() {
         None
@@ -1378,17 +1398,20 @@ fn check_file(
     }
     refuse_held_stub(backup, profile)?;
     // After the stub's own refusal: a stub is code no entry lists too.
-    check_hook_owners(profile, backup)?;
-    refuse_ways(profile, backup, "in the file")?;
+    if !undo {
+        check_hook_owners(profile, backup)?;
+    }
+    refuse_ways(profile, backup, "in the file", undo)?;
     Ok(whole)
 }
 
 /// Refuses the ways through `seen` (a file, or a file over what the robot
 /// holds) that a restore must not hook ([`crate::held_way`]); `place`
-/// says whose memory it was.
-fn refuse_ways(profile: &RomProfile, seen: &Backup, place: &str) -> Result<()> {
+/// says whose memory it was; `undo`, as [`check_file`] takes it.
+fn refuse_ways(profile: &RomProfile, seen: &Backup, place: &str, undo: bool) -> Result<()> {
     let refused = crate::held_way::disagreements(profile, seen)
         .into_iter()
+        .filter(|found| !(undo && found.made_by_hand_before()))
         .find_map(|found| found.refusal().map(|why| (found, why)));
     match refused {
         Some((found, why)) => Err(Error::BackupRefused {
@@ -1410,6 +1433,7 @@ fn refuse_ways_over_robot<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     backup: &Backup,
+    undo: bool,
 ) -> Result<()> {
     let Some((at, len)) = table_range(profile) else {
         return Ok(());
@@ -1425,7 +1449,12 @@ fn refuse_ways_over_robot<T: Transport>(
         address: at,
         bytes: client.read_memory(at, len)?,
     });
-    refuse_ways(profile, &seen, "on the robot as the file would leave it")
+    refuse_ways(
+        profile,
+        &seen,
+        "on the robot as the file would leave it",
+        undo,
+    )
 }
 
 /// The options a restore writes memory with: the table is written as

@@ -243,6 +243,25 @@ pub enum Error {
         port: String,
     },
 
+    /// A hook's way that reaches memory a replacement takes through code
+    /// no entry of the table lists: the replacement could not re-point
+    /// it (hostile25 F4, recheck25 R1).
+    #[error(
+        "{hook} leads {path}: into memory the image takes, through code no entry of the robot's table lists, which a replacement cannot re-point; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::unlisted_way_in),
+        help(
+            "the robot's hooks or table were changed by hand (`scorpion installed` shows the chain): reset the robot (/1R frees every entry) or restore a backup from before, then upload again"
+        )
+    )]
+    UnlistedWayIn {
+        /// The hook.
+        hook: &'static str,
+        /// The way, `$0600 -> $0500`.
+        path: String,
+    },
+
     /// A hook's chain that comes back into the image: the image would
     /// chain to code that jumps back into it, a loop the robot would run
     /// for ever at its next unknown command.

@@ -97,10 +97,22 @@ impl Disagreement {
                 )
             }
             Disagreement::Loops { hook, path } => format!(
-                "{} comes back to where it has been ({path}), a loop the robot would run for ever at its next unknown command",
-                hook.rom_symbol()
+                "{} comes back to where it has been ({path}), a loop the robot would run for ever {}",
+                hook.rom_symbol(),
+                when_run(*hook)
             ),
         }
+    }
+
+    /// Whether it is a way through memory the table does not list, which
+    /// an upload may have found so (changed by hand before it) and
+    /// chained in front of: its undo puts it back as found.
+    #[must_use]
+    pub(crate) fn made_by_hand_before(&self) -> bool {
+        matches!(
+            self,
+            Disagreement::ThroughFreed { .. } | Disagreement::Unlisted { .. }
+        )
     }
 
     /// Why a restore refuses it, where it does (all but
@@ -112,6 +124,10 @@ impl Disagreement {
             Disagreement::ThroughFreed { .. } | Disagreement::Unlisted { .. } => {
                 Some("commands would run through memory the next upload may be put in")
             }
+            Disagreement::Loops {
+                hook: HookKind::Loop,
+                ..
+            } => Some("the robot would stop answering at once"),
             Disagreement::Loops { .. } => Some("no unknown command would ever end"),
         }
     }
@@ -210,6 +226,15 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
     found
 }
 
+/// When the robot runs `kind`'s way (recheck25 R7: a loop on HOOK_LOOP
+/// stops it at once, not at an unknown command).
+fn when_run(kind: HookKind) -> &'static str {
+    match kind {
+        HookKind::Unknown => "at its next unknown command",
+        HookKind::Loop => "as soon as its control loop runs it",
+    }
+}
+
 /// Whether `path` goes through `entry`'s `kind` handler.
 fn reached(entry: &Installed, kind: HookKind, path: &[u16]) -> bool {
     entry
@@ -240,7 +265,20 @@ pub(crate) fn unreached<T: crate::transport::Transport>(
             continue;
         }
         let path = crate::table::chain_of(client, profile, &everyone, kind)?;
-        found.extend(not_hooked(&everyone, kind, &path));
+        // A chain that ends at code no entry lists may go on through it
+        // (recheck25 R2: said "never runs" of one that answered).
+        let ends = path
+            .last()
+            .is_none_or(|&at| profile.reset_target(kind) == Some(at) || in_rom(profile, at));
+        let whole = path.last().is_some_and(|&at| {
+            everyone
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .any(|hook| hook.kind == kind && hook.handler == at && hook.chain.is_none())
+        });
+        if ends || whole {
+            found.extend(not_hooked(&everyone, kind, &path));
+        }
     }
     Ok(found)
 }

@@ -254,7 +254,7 @@ pub(crate) fn prepare<T: Transport>(
             if let Some(path) =
                 crate::chain::unlisted_way_into(client, profile, &read.installed, way, image)?
             {
-                return Err(Error::ChainComesBack {
+                return Err(Error::UnlistedWayIn {
                     hook: kind.rom_symbol(),
                     path: path.to_string(),
                 });

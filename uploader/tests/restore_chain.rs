@@ -1182,8 +1182,86 @@ fn a_replacement_reached_through_unlisted_code_moves_nothing() {
     let edit = common::one_byte_changed(&extension_at(0x0800), 40);
     let mut kept = Kept::default();
     match upload_keeping(&mut client, &edit, &options, &mut NoProgress, &mut kept) {
-        Err(Error::ChainComesBack { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
+        Err(Error::UnlistedWayIn { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
         other => panic!("{other:?}"),
     }
     assert!(held(&mut client) == before, "the robot changed");
+}
+
+/// recheck25 R1: the same robot and a project whose last image replaces
+/// the extension behind the unlisted code: the first images went in,
+/// then the last was refused. The check of the project's images before
+/// any is sent refuses it; without the unlisted code it passes.
+#[test]
+fn a_project_replacing_behind_unlisted_code_is_refused_before_any_image() {
+    let (options, mut client, _) = three_in_a_chain();
+    let first = extension_at(0x0C00);
+    let last = common::one_byte_changed(&extension_at(0x0800), 40);
+    let images = [("m0", &first), ("m2", &last)];
+    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &images, true)
+        .expect("a replacement the chain re-points");
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(romlib::installed::TABLE + 2, &[0])
+        .expect("RAM");
+    match uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &images, true) {
+        Err(Error::UnlistedWayIn { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// recheck25 R5: a file without one entry's bytes (its flags kept) was
+/// refused as a table "damaged on the robot when it was saved", read as
+/// zeros. The robot's copy of the entry is what the restore leaves: it is
+/// looked at there, and the restore goes through.
+#[test]
+fn a_backup_without_an_entrys_bytes_is_judged_over_the_robots_copy() {
+    let (options, mut client, saved) = two_in_a_chain();
+    let (table, entries) = options.profile.table.expect("a table");
+    let entry = romlib::installed::entry_address(table, entries, 1);
+    let mut cut = saved.clone();
+    cut.areas = without(
+        &cut.areas,
+        entry..=entry + romlib::installed::ENTRY_LEN as u16 - 1,
+    );
+    let reset = romlib::protocol::Command::parse(b"/1R").expect("a command");
+    let _ = client.listen(&reset).expect("the line works");
+    restore(&mut client, &cut, &options, &mut NoProgress).expect("restored");
+    assert_eq!(hook(&mut client), 0x0803);
+    let listed = uploader::read_installed(&mut client, &options.profile).expect("the table");
+    assert_eq!(listed.len(), 2, "{listed:?}");
+}
+
+/// recheck25 R6: an upload in front of code no entry lists (the front
+/// extension's flags cleared by hand) went through, and its undo was
+/// refused as a file made by hand. The undo puts back what its upload
+/// found.
+#[test]
+fn the_undo_of_an_upload_in_front_of_unlisted_code_goes_through() {
+    let (options, mut client, _) = three_in_a_chain();
+    let (_, _, undo) = plain_replace_undo();
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(romlib::installed::TABLE + 2, &[0])
+        .expect("RAM");
+    let before = held(&mut client);
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0C00),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("in front");
+    assert_eq!(hook(&mut client), 0x0C03);
+    restore(&mut client, &kept.0.expect("kept"), &undo, &mut NoProgress).expect("undone");
+    assert_eq!(hook(&mut client), 0x0A03);
+    assert!(held(&mut client) == before, "the robot as it was");
 }
