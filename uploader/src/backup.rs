@@ -557,6 +557,13 @@ const WITNESS_WINDOW: u16 = 16;
 /// what the backup holds itself (a restore writes and verifies that).
 pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16, usize)> {
     let mut marked = vec![false; 0x1_0000];
+    // Every step of a way into memory the backup does not hold: a
+    // restore checks the code there is what it was (hostile26 F2).
+    for (_, at) in crate::held_way::steps(profile, backup) {
+        if profile.writable.iter().any(|range| range.contains(&at)) {
+            mark_window(&mut marked, profile, (at, WITNESS_WINDOW), None);
+        }
+    }
     for (target, extents) in hooked_extents(profile, backup) {
         if extents.is_empty() {
             mark_window(&mut marked, profile, (target, WITNESS_WINDOW), None);
@@ -1385,6 +1392,9 @@ fn check_file(
         Some(whole)
     };
     check_hook_targets(backup, memory, table_range(profile))?;
+    if !undo {
+        check_steps(profile, backup)?;
+    }
     check_records(backup, memory, profile.table)?;
     check_hooks_given(profile, backup)?;
     if let Some(damaged) = damaged_table(profile, backup) {
@@ -1540,6 +1550,29 @@ fn check_hook_targets(
         }
         if !to_rom && !witnessed {
             check_held_entry(backup, kind, target)?;
+        }
+    }
+    Ok(())
+}
+
+/// hostile26 F1: each step of a backup's ways into RAM (past the first,
+/// which [`check_hook_targets`] checks) lies in memory the file holds or
+/// witnesses, as `backup` writes it: else the code a restore hooks there
+/// is not checked. (An undo file witnesses the code its hooks go back to;
+/// what lies behind that, its upload did not change.)
+fn check_steps(profile: &RomProfile, backup: &Backup) -> Result<()> {
+    for (kind, at) in crate::held_way::steps(profile, backup) {
+        let writable = profile.writable.iter().any(|range| range.contains(&at));
+        let held = backup.byte_at(u32::from(at)).is_some();
+        let witnessed = backup.witnesses.iter().any(|witness| {
+            u32::from(witness.address) <= u32::from(at)
+                && u32::from(at) < u32::from(witness.address) + u32::from(witness.len)
+        });
+        if writable && !held && !witnessed {
+            return Err(Error::UnwitnessedHook {
+                hook: kind.rom_symbol(),
+                target: at,
+            });
         }
     }
     Ok(())

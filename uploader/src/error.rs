@@ -531,7 +531,7 @@ pub enum Error {
     /// restores nor witnesses: nothing tells what code is there, and the
     /// robot would jump into whatever it holds. Nothing was written.
     #[error(
-        "the file points {hook} at ${target:04X}, which is not in the ROM's code, not restored by this file (it holds no byte there) and not witnessed by it (no checksum of the file covers it): the robot would jump into whatever that memory holds; nothing was written"
+        "the file's {hook} goes to ${target:04X} (the hook, or a chain slot or JMP on its way), which is not in the ROM's code, not restored by this file (it holds no byte there) and not witnessed by it (no checksum of the file covers it): the robot would jump into whatever that memory holds; nothing was written"
     )]
     #[diagnostic(
         code(uploader::unwitnessed_hook),

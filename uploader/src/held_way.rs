@@ -226,6 +226,53 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
     found
 }
 
+/// Each address every hook's way goes through, as far as `backup` holds
+/// it (listed extensions' chain slots, and `JMP`s in code it holds), the
+/// ROM left out: the code a restore of it hooks, every byte of which it
+/// must hold or witness (hostile26 F1, F2: a way on into memory outside
+/// the file, into code no entry lists, was checked at its first step
+/// only).
+#[must_use]
+pub(crate) fn steps(profile: &RomProfile, backup: &Backup) -> Vec<(HookKind, u16)> {
+    let listed = crate::backup::backup_table(profile, backup);
+    let word = |at: u16| {
+        let low = backup.byte_at(u32::from(at))?;
+        let high = backup.byte_at(u32::from(at) + 1)?;
+        Some(u16::from_le_bytes([low, high]))
+    };
+    let mut steps = Vec::new();
+    for &(kind, target) in &backup.hooks {
+        let mut path: Vec<u16> = Vec::new();
+        let mut at = target;
+        while profile.reset_target(kind) != Some(at)
+            && !in_rom(profile, at)
+            && !path.contains(&at)
+            && path.len() < 16
+        {
+            path.push(at);
+            steps.push((kind, at));
+            let slot = listed
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .find(|hook| hook.kind == kind && hook.handler == at)
+                .map(|hook| hook.chain);
+            let next = match slot {
+                Some(Some(slot)) => word(slot),
+                Some(None) => None,
+                None if backup.byte_at(u32::from(at)) == Some(crate::hooks::JMP) => {
+                    word(at.wrapping_add(1))
+                }
+                None => None,
+            };
+            match next {
+                Some(next) => at = next,
+                None => break,
+            }
+        }
+    }
+    steps
+}
+
 /// When the robot runs `kind`'s way (recheck25 R7: a loop on HOOK_LOOP
 /// stops it at once, not at an unknown command).
 fn when_run(kind: HookKind) -> &'static str {

@@ -1265,3 +1265,62 @@ fn the_undo_of_an_upload_in_front_of_unlisted_code_goes_through() {
     assert_eq!(hook(&mut client), 0x0A03);
     assert!(held(&mut client) == before, "the robot as it was");
 }
+
+/// hostile26 F1: a backup whose way goes on, past the first step, into
+/// memory the file neither holds nor witnesses (the extension behind's
+/// code cut out of it) was restored, exit 0, the table listing code that
+/// was not there. Each step is checked as the first is.
+#[test]
+fn a_backup_whose_way_goes_on_into_memory_it_does_not_hold_is_refused() {
+    let (options, mut client, saved) = two_in_a_chain();
+    let mut cut = saved.clone();
+    cut.areas = without(&cut.areas, 0x0500..=0x053F);
+    let before = held(&mut client);
+    match restore(&mut client, &cut, &options, &mut NoProgress) {
+        Err(Error::UnwitnessedHook { target, .. }) => assert_eq!(target, 0x0503),
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+}
+
+/// hostile26 F2: an extension whose chain slot an owner sent on into code
+/// on the KIM bus no entry lists: `backup` kept no witness of it, and a
+/// restore after that code changed said "verified". The backup witnesses
+/// it, and the restore refuses the change.
+#[test]
+fn a_backup_witnesses_the_code_its_ways_reach_outside_what_it_saves() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0500),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    let owners = [
+        0x4C,
+        BAD_COMMAND.to_le_bytes()[0],
+        BAD_COMMAND.to_le_bytes()[1],
+    ];
+    let board = client.transport().robot_mut().robot_mut().board_mut();
+    board.load(0x1000, &owners).expect("KIM-bus RAM");
+    board.load(0x0501, &[0x00, 0x10]).expect("RAM");
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    assert!(
+        saved
+            .witnesses
+            .iter()
+            .any(|witness| witness.address <= 0x1000 && 0x1000 < witness.address + witness.len),
+        "{:?}",
+        saved.witnesses
+    );
+    let board = client.transport().robot_mut().robot_mut().board_mut();
+    board
+        .load(0x1000, &[0x02, 0x02, 0x02])
+        .expect("KIM-bus RAM");
+    match restore(&mut client, &saved, &options, &mut NoProgress) {
+        Err(Error::WitnessDiffers { .. }) => {}
+        other => panic!("{other:?}"),
+    }
+}
