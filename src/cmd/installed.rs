@@ -82,7 +82,22 @@ pub(crate) fn run(args: &Args) -> miette::Result<ExitCode> {
             )?);
         }
     }
-    let mut text = listing(&everyone, &chains, &names) + text.as_str();
+    // recheck26 N4: a chain that ends in code no entry lists may go on
+    // through it to an extension the table's chain slots do not reach.
+    let open_ends: Vec<HookKind> = chains
+        .iter()
+        .filter(|(kind, targets)| {
+            targets.last().is_some_and(|&last| {
+                profile.reset_target(*kind) != Some(last)
+                    && !everyone
+                        .iter()
+                        .flat_map(|image| image.hooks.iter())
+                        .any(|hook| hook.kind == *kind && hook.handler == last)
+            })
+        })
+        .map(|(kind, _)| *kind)
+        .collect();
+    let mut text = listing(&everyone, (&chains, &open_ends), &names) + text.as_str();
     // fresh25 F7: how much room is left, for a project refused as the
     // table is full.
     if let Some((_, capacity)) = profile.table.filter(|_| !everyone.is_empty()) {
@@ -180,7 +195,11 @@ fn is<'a>(image: &Installed, names: &'a [Known]) -> Option<&'a Known> {
 }
 
 /// The listing, for people.
-fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)], names: &[Known]) -> String {
+fn listing(
+    everyone: &[Installed],
+    (chains, open_ends): (&[(HookKind, Vec<u16>)], &[HookKind]),
+    names: &[Known],
+) -> String {
     let mut out = String::new();
     if everyone.is_empty() {
         out.push_str("nothing installed\n");
@@ -205,7 +224,13 @@ fn listing(everyone: &[Installed], chains: &[(HookKind, Vec<u16>)], names: &[Kno
                 .iter()
                 .find(|(kind, _)| *kind == hook.kind)
                 .is_none_or(|(_, targets)| targets.contains(&hook.handler));
-            if !reached {
+            if !reached && open_ends.contains(&hook.kind) {
+                let _ = write!(
+                    out,
+                    " (not on {}'s chain as the table follows it: that goes on through code no entry lists, which may lead here)",
+                    hook.kind.rom_symbol()
+                );
+            } else if !reached {
                 let _ = write!(
                     out,
                     " (not hooked: {} does not lead to it)",
@@ -306,15 +331,30 @@ mod tests {
             }],
             slot: 0,
         }];
-        let unhooked = listing(&everyone, &[(HookKind::Unknown, vec![0xFF21])], &[]);
+        let unhooked = listing(&everyone, (&[(HookKind::Unknown, vec![0xFF21])], &[]), &[]);
         assert!(
             unhooked.contains(
                 "HOOK_UNKNOWN -> $0400 (chain slot $0416) (not hooked: HOOK_UNKNOWN does not lead to it)"
             ),
             "{unhooked}"
         );
-        let hooked = listing(&everyone, &[(HookKind::Unknown, vec![0x0400, 0xFF21])], &[]);
+        let hooked = listing(
+            &everyone,
+            (&[(HookKind::Unknown, vec![0x0400, 0xFF21])], &[]),
+            &[],
+        );
         assert!(!hooked.contains("not hooked"), "{hooked}");
+        // recheck26 N4: a chain that ends in code no entry lists may lead
+        // on to it.
+        let open = listing(
+            &everyone,
+            (&[(HookKind::Unknown, vec![0x0600])], &[HookKind::Unknown]),
+            &[],
+        );
+        assert!(
+            open.contains("(not on HOOK_UNKNOWN's chain as the table follows it: that goes on through code no entry lists, which may lead here)"),
+            "{open}"
+        );
     }
 
     /// recheck17 F4: a chain slot sent to its own handler by hand was
@@ -323,7 +363,7 @@ mod tests {
     fn a_chain_that_comes_back_is_cut_and_said() {
         let looped = listing(
             &[],
-            &[(HookKind::Unknown, vec![0x040B, 0x040B, 0x040B])],
+            (&[(HookKind::Unknown, vec![0x040B, 0x040B, 0x040B])], &[]),
             &[],
         );
         assert_eq!(

@@ -1361,3 +1361,34 @@ fn a_project_that_cannot_go_in_whole_sends_nothing() {
     let listed = ok(&project, &line, &["installed"]);
     assert!(listed.contains("nothing installed"), "{listed}");
 }
+
+/// fresh25 F2, F7: `backup` of a robot whose HOOK_UNKNOWN an owner
+/// pointed at zeros said a restore would leave the hook at the ROM; the
+/// restore refused the file as made by hand. `backup` says the refusal
+/// the restore gives; `installed` counts the table's free entries.
+#[test]
+fn backup_says_the_refusal_its_restore_will_give() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let d = dir.path();
+    std::fs::write(d.join("ext.elf"), extension_at(0x0400, 40, None)).expect("the image");
+    let sim = Sim::start(d, &[]);
+    let line = ["--port", sim.path.as_str()];
+    ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
+    let listed = ok(d, &line, &["installed"]);
+    assert!(
+        listed.contains("1 of the table's 8 entries in use, 7 free"),
+        "{listed}"
+    );
+    ok(d, &line, &["ask", "--allow-silence", "/9W02010007"]);
+    let saved = ok(d, &line, &["backup", "-o", "odd.bak"]);
+    let said = "the backup points HOOK_UNKNOWN at $0700, which holds $00";
+    assert!(
+        saved.contains(&format!(
+            "warning: a restore of this file will be refused: {said}"
+        )),
+        "{saved}"
+    );
+    assert!(!saved.contains("leaves HOOK_UNKNOWN at the ROM"), "{saved}");
+    let (success, text) = on(d, &line, &["restore", "odd.bak"]);
+    assert!(!success && text.contains(said), "{text}");
+}

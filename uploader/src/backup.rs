@@ -443,9 +443,9 @@ pub struct Saved {
     /// it does not decode (changed by hand): a restore of the file refuses
     /// it before anything moves (hostile19 F4).
     pub damaged_table: Option<String>,
-    /// Where the robot's hooks and its table disagree: a restore of the
-    /// file refuses a way through a freed entry and puts back an extension
-    /// its hooks do not lead to as it is (listed, never run).
+    /// Where the robot's hooks and its table disagree, as the file holds
+    /// them: a restore puts back an extension its hooks do not lead to as
+    /// it is (listed, never run), and refuses the others (`refused`).
     pub disagreements: Vec<crate::held_way::Disagreement>,
     /// Why a restore of the file will be refused before it writes
     /// anything, if it will: the robot's own state, changed by hand.
@@ -559,7 +559,8 @@ pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16,
     let mut marked = vec![false; 0x1_0000];
     // Every step of a way into memory the backup does not hold: a
     // restore checks the code there is what it was (hostile26 F2).
-    for (_, at) in crate::held_way::steps(profile, backup) {
+    for (_, way) in crate::held_way::steps(profile, backup) {
+        let at = way[way.len() - 1];
         if profile.writable.iter().any(|range| range.contains(&at)) {
             mark_window(&mut marked, profile, (at, WITNESS_WINDOW), None);
         }
@@ -993,7 +994,7 @@ fn check_hook_owners(profile: &RomProfile, backup: &Backup) -> Result<()> {
         };
         return Err(Error::BackupRefused {
             reason: format!(
-                "the file points {} at ${target:04X}, {what}, while its table lists extensions on {}: they would not be reached; nothing was written",
+                "the file points {} at ${target:04X}, {what}, while its table lists extensions on {}: they would be reached through that code, if at all (the table's chain slots do not lead to them); nothing was written",
                 kind.rom_symbol(),
                 kind.rom_symbol()
             ),
@@ -1392,7 +1393,9 @@ fn check_file(
         Some(whole)
     };
     check_hook_targets(backup, memory, table_range(profile))?;
-    if !undo {
+    // An undo file (given to `restore` too) witnesses the code its hooks
+    // go back to; what lies behind that, its upload did not change.
+    if !undo && backup.written_entries.is_empty() {
         check_steps(profile, backup)?;
     }
     check_records(backup, memory, profile.table)?;
@@ -1561,17 +1564,20 @@ fn check_hook_targets(
 /// is not checked. (An undo file witnesses the code its hooks go back to;
 /// what lies behind that, its upload did not change.)
 fn check_steps(profile: &RomProfile, backup: &Backup) -> Result<()> {
-    for (kind, at) in crate::held_way::steps(profile, backup) {
+    for (kind, way) in crate::held_way::steps(profile, backup) {
+        let at = way[way.len() - 1];
         let writable = profile.writable.iter().any(|range| range.contains(&at));
         let held = backup.byte_at(u32::from(at)).is_some();
         let witnessed = backup.witnesses.iter().any(|witness| {
             u32::from(witness.address) <= u32::from(at)
                 && u32::from(at) < u32::from(witness.address) + u32::from(witness.len)
         });
-        if writable && !held && !witnessed {
-            return Err(Error::UnwitnessedHook {
+        // The first step is `check_hook_targets`'s.
+        if way.len() > 1 && writable && !held && !witnessed {
+            return Err(Error::UnwitnessedStep {
                 hook: kind.rom_symbol(),
                 target: at,
+                path: crate::held_way::path_text(&way),
             });
         }
     }

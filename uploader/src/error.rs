@@ -247,7 +247,7 @@ pub enum Error {
     /// no entry of the table lists: the replacement could not re-point
     /// it (hostile25 F4, recheck25 R1).
     #[error(
-        "{hook} leads {path}: into memory the image takes, through code no entry of the robot's table lists, which a replacement cannot re-point; nothing was written"
+        "{hook} leads {path}: into memory the image takes, through code no entry of the robot's table lists, which no upload can re-point; nothing was written"
     )]
     #[diagnostic(
         code(uploader::unlisted_way_in),
@@ -266,12 +266,12 @@ pub enum Error {
     /// chain to code that jumps back into it, a loop the robot would run
     /// for ever at its next unknown command.
     #[error(
-        "{hook} leads {path}, back into the image: chained to it, the image would run in a loop at the robot's next unknown command; nothing was written"
+        "{hook} leads {path}, back into the image: chained to it, the image would run in a loop the next time the robot follows {hook}; nothing was written"
     )]
     #[diagnostic(
         code(uploader::chain_comes_back),
         help(
-            "the code at the start of that way jumps into an earlier copy of this image (an owner's JMP, a stub's chain): point {hook} back at the ROM (`scorpion restore` of a backup taken before, or reset the robot) and upload again"
+            "the code on that way jumps into the memory the image takes (an earlier copy of it, an owner's JMP, a stub's chain, code whose table entry was freed): point {hook} back at the ROM (`scorpion restore` of a backup taken before, or reset the robot) and upload again"
         )
     )]
     ChainComesBack {
@@ -527,11 +527,32 @@ pub enum Error {
         found: u16,
     },
 
+    /// A backup's hook leads on, by a chain slot or a `JMP` the file
+    /// holds, into RAM the file neither restores nor witnesses (hostile26
+    /// F1). Nothing was written.
+    #[error(
+        "the file's {hook} leads {path}, on into ${target:04X}, which the file neither restores (it holds no byte there) nor witnesses (no checksum of it covers it): the code there is not checked, and the robot would run whatever that memory holds; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::unwitnessed_hook),
+        help(
+            "a file `scorpion backup` writes holds user RAM and witnesses the code each hook's way reaches outside it: this file was made or changed by something else; restore another backup, or upload the extensions instead"
+        )
+    )]
+    UnwitnessedStep {
+        /// The hook.
+        hook: &'static str,
+        /// Where the way goes that nothing checks.
+        target: u16,
+        /// The way there, `$0803 -> $0503`.
+        path: String,
+    },
+
     /// A backup or undo file points a hook into RAM that it neither
     /// restores nor witnesses: nothing tells what code is there, and the
     /// robot would jump into whatever it holds. Nothing was written.
     #[error(
-        "the file's {hook} goes to ${target:04X} (the hook, or a chain slot or JMP on its way), which is not in the ROM's code, not restored by this file (it holds no byte there) and not witnessed by it (no checksum of the file covers it): the robot would jump into whatever that memory holds; nothing was written"
+        "the file points {hook} at ${target:04X}, which is not in the ROM's code, not restored by this file (it holds no byte there) and not witnessed by it (no checksum of the file covers it): the robot would jump into whatever that memory holds; nothing was written"
     )]
     #[diagnostic(
         code(uploader::unwitnessed_hook),

@@ -148,11 +148,7 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
     };
     let listed = crate::backup::backup_table(profile, backup);
     let freed = freed_entries(backup, (table, entries), &flags);
-    let word = |at: u16| {
-        let low = backup.byte_at(u32::from(at))?;
-        let high = backup.byte_at(u32::from(at) + 1)?;
-        Some(u16::from_le_bytes([low, high]))
-    };
+    let word = |at: u16| word_at(backup, at);
     let mut found = Vec::new();
     for &(kind, target) in &backup.hooks {
         let on_hook: Vec<&Installed> = listed
@@ -226,20 +222,16 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
     found
 }
 
-/// Each address every hook's way goes through, as far as `backup` holds
-/// it (listed extensions' chain slots, and `JMP`s in code it holds), the
+/// Each address every hook's way goes through (with the way to it), as
+/// far as `backup` holds it (listed extensions' chain slots, and `JMP`s in code it holds), the
 /// ROM left out: the code a restore of it hooks, every byte of which it
 /// must hold or witness (hostile26 F1, F2: a way on into memory outside
 /// the file, into code no entry lists, was checked at its first step
 /// only).
 #[must_use]
-pub(crate) fn steps(profile: &RomProfile, backup: &Backup) -> Vec<(HookKind, u16)> {
+pub(crate) fn steps(profile: &RomProfile, backup: &Backup) -> Vec<(HookKind, Vec<u16>)> {
     let listed = crate::backup::backup_table(profile, backup);
-    let word = |at: u16| {
-        let low = backup.byte_at(u32::from(at))?;
-        let high = backup.byte_at(u32::from(at) + 1)?;
-        Some(u16::from_le_bytes([low, high]))
-    };
+    let word = |at: u16| word_at(backup, at);
     let mut steps = Vec::new();
     for &(kind, target) in &backup.hooks {
         let mut path: Vec<u16> = Vec::new();
@@ -250,7 +242,7 @@ pub(crate) fn steps(profile: &RomProfile, backup: &Backup) -> Vec<(HookKind, u16
             && path.len() < 16
         {
             path.push(at);
-            steps.push((kind, at));
+            steps.push((kind, path.clone()));
             let slot = listed
                 .iter()
                 .flat_map(|entry| entry.hooks.iter())
@@ -349,8 +341,15 @@ fn not_hooked(listed: &[Installed], kind: HookKind, path: &[u16]) -> Vec<Disagre
         .collect()
 }
 
+/// The little-endian word `backup` holds at `at`, if it holds both bytes.
+fn word_at(backup: &Backup, at: u16) -> Option<u16> {
+    let low = backup.byte_at(u32::from(at))?;
+    let high = backup.byte_at(u32::from(at) + 1)?;
+    Some(u16::from_le_bytes([low, high]))
+}
+
 /// `$0800 -> $F0A2`.
-fn path_text(path: &[u16]) -> String {
+pub(crate) fn path_text(path: &[u16]) -> String {
     path.iter()
         .map(|at| format!("${at:04X}"))
         .collect::<Vec<_>>()

@@ -28,7 +28,7 @@ pub fn refuse_what_cannot_go_in<T: Transport>(
 ) -> Result<()> {
     let mut listed = crate::table::read_installed(client, profile)?;
     let everyone = listed.clone();
-    // The hooks, read once, where a replacement needs them.
+    // The hooks, read once.
     let mut hooks: Option<Vec<(isa::objfmt::HookKind, u16)>> = None;
     let entries = |held: &[Installed]| held.iter().map(Installed::entries).sum::<usize>();
     let in_use = entries(&listed);
@@ -45,27 +45,26 @@ pub fn refuse_what_cannot_go_in<T: Transport>(
             continue;
         }
         let in_the_way = |held: &[Installed]| held.iter().find_map(|old| old.overlap(extents));
-        if replace && in_the_way(&ours).is_none() {
-            // recheck25 R1: a way into it through code no entry lists is
-            // refused by its own upload once the images before it went
-            // in: refused here, before any is sent.
-            if in_the_way(&listed).is_some() {
-                let hooks = match &hooks {
-                    Some(hooks) => hooks,
-                    None => hooks.insert(crate::hooks::read_hooks(client, profile)?),
-                };
-                for &(kind, target) in hooks.iter() {
-                    let way = (kind, target);
-                    if let Some(path) =
-                        crate::chain::unlisted_way_into(client, profile, &everyone, way, image)?
-                    {
-                        return Err(Error::UnlistedWayIn {
-                            hook: kind.rom_symbol(),
-                            path: path.to_string(),
-                        });
-                    }
-                }
+        // recheck25 R1, recheck26 N3: a way into it through code no entry
+        // lists is refused by its own upload once the images before it
+        // went in (a replacement, or memory the table calls free): refused
+        // here, before any is sent.
+        let hooks = match &hooks {
+            Some(hooks) => hooks,
+            None => hooks.insert(crate::hooks::read_hooks(client, profile)?),
+        };
+        for &(kind, target) in hooks.iter() {
+            let way = (kind, target);
+            if let Some(path) =
+                crate::chain::unlisted_way_into(client, profile, &everyone, way, image)?
+            {
+                return Err(Error::UnlistedWayIn {
+                    hook: kind.rom_symbol(),
+                    path: path.to_string(),
+                });
             }
+        }
+        if replace && in_the_way(&ours).is_none() {
             listed.retain(|old| old.overlap(extents).is_none());
         }
         if let Some(overlap) = in_the_way(&ours).or_else(|| in_the_way(&listed)) {

@@ -523,13 +523,7 @@ fn a_backup_of_a_damaged_table_says_so_and_its_restore_moves_nothing() {
     let (options, mut client) = one_installed();
     let (table, _) = options.profile.table.expect("a table");
     // The MORE bit on an entry that continues none.
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(table + 2, &[0xC0])
-        .expect("RAM");
+    by_hand(&mut client, table + 2, &[0xC0]);
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
     let damaged = saved.damaged_table.expect("said");
     assert!(damaged.contains("continues no entry"), "{damaged}");
@@ -844,20 +838,39 @@ fn a_backup_pointing_a_hook_at_the_other_hooks_handler_sends_nothing() {
     assert_eq!(client.stats().sent, sent, "something was sent");
 }
 
-/// Two extensions on HOOK_UNKNOWN, $0800 in front of $0500, and a backup
-/// of them: HOOK_UNKNOWN -> $0803 -> $0503 -> the ROM.
-fn two_in_a_chain() -> (
+/// Extensions on HOOK_UNKNOWN at `bases`, each uploaded in front of the
+/// ones before (`[0x0500, 0x0800]`: HOOK_UNKNOWN -> $0803 -> $0503 -> the
+/// ROM), the robot, and a backup of it.
+fn in_a_chain(
+    bases: &[u16],
+) -> (
     UploadOptions,
     uploader::Client<uploader::transport::VirtualTransport>,
     uploader::Backup,
 ) {
     let options = UploadOptions::default();
     let mut client = uploader::client(robot(), &options.profile);
-    for at in [0x0500, 0x0800] {
+    for &at in bases {
         upload(&mut client, &extension_at(at), &options, &mut NoProgress).expect("installed");
     }
     let saved = backup(&mut client, &options.profile).expect("a backup");
     (options, client, saved)
+}
+
+/// Puts `bytes` into the robot's memory at `at` as an owner would, by
+/// hand.
+fn by_hand(
+    client: &mut uploader::Client<uploader::transport::VirtualTransport>,
+    at: u16,
+    bytes: &[u8],
+) {
+    client
+        .transport()
+        .robot_mut()
+        .robot_mut()
+        .board_mut()
+        .load(at, bytes)
+        .expect("RAM");
 }
 
 /// Sets the byte at `at` in the file (the file holds it).
@@ -897,7 +910,7 @@ fn not_hooked(said: &Said) -> Vec<String> {
 /// robot in that state says so.
 #[test]
 fn a_backup_whose_hooks_run_through_a_freed_entry_sends_nothing() {
-    let (options, mut client, mut crafted) = two_in_a_chain();
+    let (options, mut client, mut crafted) = in_a_chain(&[0x0500, 0x0800]);
     let table = romlib::installed::TABLE;
     assert_eq!(
         crafted.byte_at(u32::from(table)).map(|f| f & 0x80),
@@ -920,13 +933,7 @@ fn a_backup_whose_hooks_run_through_a_freed_entry_sends_nothing() {
     }
     assert_eq!(client.stats().sent, sent, "something was sent");
     // The robot put in that state by hand: its backup tells it.
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(table, &[0])
-        .expect("RAM");
+    by_hand(&mut client, table, &[0]);
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
     let told: Vec<String> = saved.disagreements.iter().map(|d| d.describe()).collect();
     assert_eq!(
@@ -943,7 +950,7 @@ fn a_backup_whose_hooks_run_through_a_freed_entry_sends_nothing() {
 /// hook whole, and a backup of it must come back), and said.
 #[test]
 fn a_backup_whose_hooks_skip_a_listed_extension_says_so() {
-    let (options, mut client, saved) = two_in_a_chain();
+    let (options, mut client, saved) = in_a_chain(&[0x0500, 0x0800]);
     let mut at_rom = saved.clone();
     for hook in &mut at_rom.hooks {
         if hook.0 == HookKind::Unknown {
@@ -996,13 +1003,7 @@ fn an_undo_that_leaves_a_listed_extension_unhooked_says_so() {
     for at in [0x0500, 0x0800] {
         upload(&mut client, &extension_at(at), &options, &mut NoProgress).expect("installed");
     }
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(HOOK_UNKNOWN + 1, &0x0503u16.to_le_bytes())
-        .expect("RAM");
+    by_hand(&mut client, HOOK_UNKNOWN + 1, &0x0503u16.to_le_bytes());
     let mut kept = Kept::default();
     upload_keeping(
         &mut client,
@@ -1032,13 +1033,7 @@ fn an_undo_that_leaves_a_listed_extension_unhooked_says_so() {
 #[test]
 fn a_backup_says_the_refusal_its_restore_will_give() {
     let (options, mut client) = one_installed();
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(HOOK_UNKNOWN + 1, &0x0700u16.to_le_bytes())
-        .expect("RAM");
+    by_hand(&mut client, HOOK_UNKNOWN + 1, &0x0700u16.to_le_bytes());
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
     let said = saved.refused.clone().expect("a restore of it is refused");
     assert!(said.contains("$0700, which holds $00"), "{said}");
@@ -1050,22 +1045,6 @@ fn a_backup_says_the_refusal_its_restore_will_give() {
     let (options, mut client) = one_installed();
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
     assert_eq!(saved.refused, None);
-}
-
-/// Three extensions on HOOK_UNKNOWN: $0A00 in front of $0800 in front of
-/// $0500, the robot and a backup of it.
-fn three_in_a_chain() -> (
-    UploadOptions,
-    uploader::Client<uploader::transport::VirtualTransport>,
-    uploader::Backup,
-) {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    for at in [0x0500, 0x0800, 0x0A00] {
-        upload(&mut client, &extension_at(at), &options, &mut NoProgress).expect("installed");
-    }
-    let saved = backup(&mut client, &options.profile).expect("a backup");
-    (options, client, saved)
 }
 
 /// Refused, and the robot's memory as it was.
@@ -1101,7 +1080,7 @@ fn a_backup_whose_ways_run_wrong_is_refused_before_writing() {
     let entries = romlib::installed::ENTRIES as u16;
     let entry_len = romlib::installed::ENTRY_LEN as u16;
     // F6: nothing listed, the hook into the freed entries' code.
-    let (options, mut client, saved) = three_in_a_chain();
+    let (options, mut client, saved) = in_a_chain(&[0x0500, 0x0800, 0x0A00]);
     let mut freed = saved.clone();
     for slot in 0..3 {
         set(&mut freed, table + slot, 0);
@@ -1165,15 +1144,9 @@ fn a_backup_whose_ways_run_wrong_is_refused_before_writing() {
 /// the image through the unlisted code is refused before anything moves.
 #[test]
 fn a_replacement_reached_through_unlisted_code_moves_nothing() {
-    let (options, mut client, _) = three_in_a_chain();
+    let (options, mut client, _) = in_a_chain(&[0x0500, 0x0800, 0x0A00]);
     let table = romlib::installed::TABLE;
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(table + 2, &[0])
-        .expect("RAM");
+    by_hand(&mut client, table + 2, &[0]);
     let before = held(&mut client);
     let options = UploadOptions {
         replace: true,
@@ -1194,20 +1167,24 @@ fn a_replacement_reached_through_unlisted_code_moves_nothing() {
 /// any is sent refuses it; without the unlisted code it passes.
 #[test]
 fn a_project_replacing_behind_unlisted_code_is_refused_before_any_image() {
-    let (options, mut client, _) = three_in_a_chain();
+    let (options, mut client, _) = in_a_chain(&[0x0500, 0x0800, 0x0A00]);
     let first = extension_at(0x0C00);
     let last = common::one_byte_changed(&extension_at(0x0800), 40);
     let images = [("m0", &first), ("m2", &last)];
     uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &images, true)
         .expect("a replacement the chain re-points");
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(romlib::installed::TABLE + 2, &[0])
-        .expect("RAM");
+    by_hand(&mut client, romlib::installed::TABLE + 2, &[0]);
     match uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &images, true) {
+        Err(Error::UnlistedWayIn { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
+        other => panic!("{other:?}"),
+    }
+    // recheck26 N3: without `--replace`, the one behind freed too: the
+    // last image goes where the table says is free, and the way runs
+    // into it all the same.
+    by_hand(&mut client, romlib::installed::TABLE + 1, &[0]);
+    let last = extension_at(0x0800);
+    let images = [("m0", &first), ("m2", &last)];
+    match uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &images, false) {
         Err(Error::UnlistedWayIn { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
         other => panic!("{other:?}"),
     }
@@ -1219,7 +1196,7 @@ fn a_project_replacing_behind_unlisted_code_is_refused_before_any_image() {
 /// looked at there, and the restore goes through.
 #[test]
 fn a_backup_without_an_entrys_bytes_is_judged_over_the_robots_copy() {
-    let (options, mut client, saved) = two_in_a_chain();
+    let (options, mut client, saved) = in_a_chain(&[0x0500, 0x0800]);
     let (table, entries) = options.profile.table.expect("a table");
     let entry = romlib::installed::entry_address(table, entries, 1);
     let mut cut = saved.clone();
@@ -1241,15 +1218,9 @@ fn a_backup_without_an_entrys_bytes_is_judged_over_the_robots_copy() {
 /// found.
 #[test]
 fn the_undo_of_an_upload_in_front_of_unlisted_code_goes_through() {
-    let (options, mut client, _) = three_in_a_chain();
+    let (options, mut client, _) = in_a_chain(&[0x0500, 0x0800, 0x0A00]);
     let (_, _, undo) = plain_replace_undo();
-    client
-        .transport()
-        .robot_mut()
-        .robot_mut()
-        .board_mut()
-        .load(romlib::installed::TABLE + 2, &[0])
-        .expect("RAM");
+    by_hand(&mut client, romlib::installed::TABLE + 2, &[0]);
     let before = held(&mut client);
     let mut kept = Kept::default();
     upload_keeping(
@@ -1272,12 +1243,14 @@ fn the_undo_of_an_upload_in_front_of_unlisted_code_goes_through() {
 /// was not there. Each step is checked as the first is.
 #[test]
 fn a_backup_whose_way_goes_on_into_memory_it_does_not_hold_is_refused() {
-    let (options, mut client, saved) = two_in_a_chain();
+    let (options, mut client, saved) = in_a_chain(&[0x0500, 0x0800]);
     let mut cut = saved.clone();
     cut.areas = without(&cut.areas, 0x0500..=0x053F);
     let before = held(&mut client);
     match restore(&mut client, &cut, &options, &mut NoProgress) {
-        Err(Error::UnwitnessedHook { target, .. }) => assert_eq!(target, 0x0503),
+        Err(Error::UnwitnessedStep { target, path, .. }) => {
+            assert_eq!((target, path.as_str()), (0x0503, "$0803 -> $0503"));
+        }
         other => panic!("{other:?}"),
     }
     assert!(held(&mut client) == before, "nothing written");

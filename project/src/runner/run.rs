@@ -671,7 +671,13 @@ impl Run<'_, '_, '_> {
             ) {
                 let image = match &source {
                     uploader::Error::ImageInTheWay { image, .. } => image.clone(),
-                    _ => built[0].name.clone(),
+                    // recheck26 N6: the project's images together (a
+                    // table too full for them all).
+                    _ => built
+                        .iter()
+                        .map(|built| built.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
                 };
                 let name = format!("upload {image}");
                 self.start(&name);
