@@ -54,6 +54,23 @@ pub fn refuse_what_cannot_go_in<T: Transport>(
             None => hooks.insert(crate::hooks::read_hooks(client, profile)?),
         };
         for &(kind, target) in hooks.iter() {
+            // recheck27: a hook into this image's place, at code no entry
+            // lists, is one the images before it chain to as they go in:
+            // it comes back into this one (alone, the upload re-points
+            // the hook itself).
+            let listed_handler = everyone
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .any(|hook| hook.kind == kind && hook.handler == target);
+            let chained_before = ours
+                .iter()
+                .any(|earlier| earlier.hooks.iter().any(|hook| hook.kind == kind));
+            if image.contains(target) && !listed_handler && chained_before {
+                return Err(Error::UnlistedWayIn {
+                    hook: kind.rom_symbol(),
+                    path: format!("${target:04X}"),
+                });
+            }
             let way = (kind, target);
             if let Some(path) =
                 crate::chain::unlisted_way_into(client, profile, &everyone, way, image)?

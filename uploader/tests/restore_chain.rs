@@ -1188,6 +1188,20 @@ fn a_project_replacing_behind_unlisted_code_is_refused_before_any_image() {
         Err(Error::UnlistedWayIn { path, .. }) => assert_eq!(path, "$0A03 -> $0A00 -> $0803"),
         other => panic!("{other:?}"),
     }
+    // recheck27: the last image where the hook itself goes (code no entry
+    // lists): the first chains to it as it goes in. Alone, it is fine.
+    let last = extension_at(0x0A00);
+    match uploader::refuse_what_cannot_go_in(
+        &mut client,
+        &options.profile,
+        &[("m0", &first), ("m2", &last)],
+        false,
+    ) {
+        Err(Error::UnlistedWayIn { path, .. }) => assert_eq!(path, "$0A03"),
+        other => panic!("{other:?}"),
+    }
+    uploader::refuse_what_cannot_go_in(&mut client, &options.profile, &[("m2", &last)], false)
+        .expect("alone, the upload points the hook past it");
 }
 
 /// recheck25 R5: a file without one entry's bytes (its flags kept) was
