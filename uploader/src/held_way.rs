@@ -1,20 +1,25 @@
-//! Where a backup's hooks lead through the file's own memory, told
-//! against the file's own table before a restore writes anything (and
-//! said by `backup` of a robot in such a state). Two disagreements are
-//! possible where the file holds the table's flags whole:
-//! - the way runs, past a listed extension's chain slot, into the memory
-//!   of an entry the table frees (hostile22 F4): restored, commands would
-//!   run through code the next upload may be put over. Refused.
-//! - an extension the table lists on a hook is not on that hook's way (the
-//!   hook at the ROM's target, or a chain that skips it, hSkip): restored,
-//!   it is listed and never runs, as `installed` then shows. Said, not
-//!   refused: a robot is left so by an extension that takes a hook whole,
-//!   or a way dropped by hand, and a restore puts back what was there.
+//! Where a backup's hooks lead through the file's own memory (over the
+//! robot's table where the file holds part of it), told against the
+//! file's table before a restore writes anything, and said by `backup` of
+//! a robot in such a state ([`Disagreement`]):
+//! - refused: a way into the memory of an entry the table has freed
+//!   (hostile22 F4), through code no entry lists before an extension the
+//!   table lists on that hook (hostile25 F2), or back to where it has been
+//!   (hostile25 F5). Restored, commands would run through memory the next
+//!   upload may take, or never end. An upload's undo puts back the first
+//!   two where its upload found them so.
+//! - said, not refused: an extension the table lists on a hook whose way
+//!   does not reach it (the hook at the ROM's target, a chain that skips
+//!   it, hSkip): restored, it is listed and never runs, as `installed`
+//!   shows. A robot is left so by an extension that takes a hook whole, or
+//!   a way dropped by hand, and a restore puts back what was there.
 //!   `backup` tells it from the file; a restore from the robot once it is
 //!   done ([`unreached`]: an undo file does not hold the chain slots).
 //!
-//! Only bytes the file holds are followed; where it holds no more (an undo
-//! file, memory a backup only witnesses), nothing is told from the file.
+//! [`steps`] lists each address a way goes through, which a backup must
+//! hold or witness. Only bytes the file holds are followed; where it holds
+//! no more (an undo file, memory a backup only witnesses), nothing is told
+//! from the file.
 
 use isa::objfmt::HookKind;
 use romlib::installed::{ENTRY_LEN, Installed, entry_address, in_use};
