@@ -51,7 +51,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         changing,
         broken,
         outside,
-        damaged_table,
+        damaged_table: _,
         disagreements,
         refused,
     } = uploader::backup_live(&mut client, &profile)?;
@@ -89,14 +89,9 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             "warning: a restore of this file will be refused: {reason} (the robot was changed by hand; `/1R` clears the table and the hooks, then upload the extensions again)"
         ));
     }
-    let damaged_table = damaged_table.filter(|_| refused.is_none());
+    // A table that does not decode (hostile19 F4) is one of the restore's
+    // refusals, said above.
     let broken: Vec<_> = broken.into_iter().filter(|_| refused.is_none()).collect();
-    if let Some(damaged) = &damaged_table {
-        // hostile19 F4: said now, not first at the restore that refuses it.
-        print(&format!(
-            "warning: the robot's table of installed extensions does not decode ({damaged}): a restore of this file is refused; `/1R` clears the table, then upload the extensions again"
-        ));
-    }
     for entry in &outside {
         // fresh17 F4: said now, not first at a restore that refuses it.
         print(&format!(
