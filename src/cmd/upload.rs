@@ -247,10 +247,23 @@ impl Progress for Bar {
             Event::WayOutDropped {
                 kind,
                 from,
+                slot: None,
                 why,
                 path,
             } => format!(
                 "warning: {} led to ${from:04X}, which {why} ({path}): the image falls through to the ROM's target instead",
+                kind.rom_symbol()
+            ),
+            // recheck27 P2: said as the hook's own way, "HOOK_UNKNOWN led
+            // to $0000" where it led into the upload.
+            Event::WayOutDropped {
+                kind,
+                from,
+                slot: Some(slot),
+                why,
+                path,
+            } => format!(
+                "warning: {} led into the upload, and the chain slot there (${slot:04X}) to ${from:04X}, which {why} ({path}): the image falls through to the ROM's target instead",
                 kind.rom_symbol()
             ),
             Event::LoaderRestored { baud, .. } => format!(

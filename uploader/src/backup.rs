@@ -498,7 +498,8 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
         rom,
         ..Backup::default()
     };
-    let ranges = witness_ranges(profile, &backup);
+    let seen = crate::held_way::over_robot(client, profile, &backup)?;
+    let ranges = witness_ranges_over(profile, &backup, &seen);
     backup.witnesses = read_witnesses(client, &ranges)?;
     let mut broken = Vec::new();
     let saved = |address: u16| backup.byte_at(u32::from(address)).is_some();
@@ -555,11 +556,19 @@ const WITNESS_WINDOW: u16 = 16;
 /// the backup's own table) that holds its target, or the first
 /// [`WITNESS_WINDOW`] bytes at the target where no entry holds it; less
 /// what the backup holds itself (a restore writes and verifies that).
+#[cfg(test)]
 pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16, usize)> {
+    witness_ranges_over(profile, backup, backup)
+}
+
+/// [`witness_ranges`], the ways followed through `seen` (the backup over
+/// the robot's bytes, [`crate::held_way::over_robot`]): the code a way
+/// reaches outside the backup, and where its `JMP` goes on (N1).
+fn witness_ranges_over(profile: &RomProfile, backup: &Backup, seen: &Backup) -> Vec<(u16, usize)> {
     let mut marked = vec![false; 0x1_0000];
     // Every step of a way into memory the backup does not hold: a
     // restore checks the code there is what it was (hostile26 F2).
-    for (_, way) in crate::held_way::steps(profile, backup) {
+    for (_, way) in crate::held_way::steps(profile, seen) {
         let at = way[way.len() - 1];
         if profile.writable.iter().any(|range| range.contains(&at)) {
             mark_window(&mut marked, profile, (at, WITNESS_WINDOW), None);
@@ -1223,7 +1232,22 @@ pub fn restore<T: Transport>(
         profile,
         (options.resume, options.interrupted),
     )?;
-    refuse_ways_over_robot(client, profile, backup, options.undo)?;
+    // The ways as the restore would leave them, followed past what the
+    // file holds over the robot's bytes (the witnesses checked above).
+    let seen = crate::held_way::over_robot(client, profile, backup)?;
+    if seen != *backup {
+        refuse_ways(
+            profile,
+            &seen,
+            "on the robot as the file would leave it",
+            options.undo,
+        )?;
+    }
+    if options.undo || !backup.written_entries.is_empty() {
+        check_steps_on_robot(client, profile, backup, &seen)?;
+    } else {
+        check_steps_over(profile, backup, &seen)?;
+    }
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
             refusal: error.to_string(),
@@ -1437,39 +1461,6 @@ fn refuse_ways(profile: &RomProfile, seen: &Backup, place: &str, undo: bool) -> 
     }
 }
 
-/// hostile25 F1: a file that holds some of the table's bytes and not all
-/// (made by hand: an undo file holds its upload's entries and all the
-/// flags it read) leaves the robot's for the rest. Its ways are followed
-/// over the table as the restore will leave it: the robot's bytes read
-/// under the file's.
-fn refuse_ways_over_robot<T: Transport>(
-    client: &mut Client<T>,
-    profile: &RomProfile,
-    backup: &Backup,
-    undo: bool,
-) -> Result<()> {
-    let Some((at, len)) = table_range(profile) else {
-        return Ok(());
-    };
-    let held = (0..len)
-        .filter(|i| backup.byte_at(u32::from(at) + *i as u32).is_some())
-        .count();
-    if held == 0 || held == len {
-        return Ok(());
-    }
-    let mut seen = backup.clone();
-    seen.areas.push(Area {
-        address: at,
-        bytes: client.read_memory(at, len)?,
-    });
-    refuse_ways(
-        profile,
-        &seen,
-        "on the robot as the file would leave it",
-        undo,
-    )
-}
-
 /// The options a restore writes memory with: the table is written as
 /// memory, flags and all, while no hook points into RAM (no table
 /// bookkeeping of the upload's own).
@@ -1562,26 +1553,97 @@ fn check_hook_targets(
 /// which [`check_hook_targets`] checks) lies in memory the file holds or
 /// witnesses, as `backup` writes it: else the code a restore hooks there
 /// is not checked. (An undo file witnesses the code its hooks go back to;
-/// what lies behind that, its upload did not change.)
+/// what lies behind that, [`check_steps_on_robot`] checks.)
 fn check_steps(profile: &RomProfile, backup: &Backup) -> Result<()> {
-    for (kind, way) in crate::held_way::steps(profile, backup) {
-        let at = way[way.len() - 1];
-        let writable = profile.writable.iter().any(|range| range.contains(&at));
-        let held = backup.byte_at(u32::from(at)).is_some();
-        let witnessed = backup.witnesses.iter().any(|witness| {
-            u32::from(witness.address) <= u32::from(at)
-                && u32::from(at) < u32::from(witness.address) + u32::from(witness.len)
-        });
-        // The first step is `check_hook_targets`'s.
-        if way.len() > 1 && writable && !held && !witnessed {
-            return Err(Error::UnwitnessedStep {
-                hook: kind.rom_symbol(),
-                target: at,
-                path: crate::held_way::path_text(&way),
-            });
-        }
+    check_steps_over(profile, backup, backup)
+}
+
+/// [`check_steps`], the ways followed through `seen` (the file over the
+/// robot's bytes): a step on from code the file only witnesses (N1).
+fn check_steps_over(profile: &RomProfile, backup: &Backup, seen: &Backup) -> Result<()> {
+    match unchecked_steps(profile, backup, seen).into_iter().next() {
+        Some((kind, way)) => Err(Error::UnwitnessedStep {
+            hook: kind.rom_symbol(),
+            target: way[way.len() - 1],
+            path: crate::held_way::path_text(&way),
+        }),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// hostile26 F1b: an undo file's ways past the first step into memory it
+/// neither holds nor witnesses lie in an extension the robot's table lists
+/// now, or on a way the robot's hooks run now: code its upload did not
+/// change, which the robot runs already. A file changed by hand (or a
+/// robot reset since, its table cleared, its hooks at the ROM) hooked
+/// code nothing checked, exit 0.
+///
+/// # Errors
+/// [`Error::UndoStepUnlisted`]; the line's errors.
+fn check_steps_on_robot<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    backup: &Backup,
+    seen: &Backup,
+) -> Result<()> {
+    let listed = crate::table::read_installed(client, profile)?;
+    let unchecked: Vec<(HookKind, Vec<u16>)> = unchecked_steps(profile, backup, seen)
+        .into_iter()
+        .filter(|(_, way)| {
+            !listed
+                .iter()
+                .any(|entry| entry.contains(way[way.len() - 1]))
+        })
+        .collect();
+    if unchecked.is_empty() {
+        return Ok(());
+    }
+    // Code no entry lists that the robot's ways run through now (recheck25
+    // R6: an upload chained in front of it, its undo puts that way back).
+    let now = Backup {
+        hooks: read_hooks(client, profile)?,
+        ..Backup::default()
+    };
+    let now = crate::held_way::over_robot(client, profile, &now)?;
+    let run_now: Vec<u16> = crate::held_way::steps(profile, &now)
+        .into_iter()
+        .map(|(_, way)| way[way.len() - 1])
+        .collect();
+    match unchecked
+        .into_iter()
+        .find(|(_, way)| !run_now.contains(&way[way.len() - 1]))
+    {
+        Some((kind, way)) => Err(Error::UndoStepUnlisted {
+            hook: kind.rom_symbol(),
+            target: way[way.len() - 1],
+            path: crate::held_way::path_text(&way),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The steps of the file's ways into RAM (followed through `seen`), past
+/// the first, that land in memory it neither holds nor witnesses: each
+/// with the way there.
+fn unchecked_steps(
+    profile: &RomProfile,
+    backup: &Backup,
+    seen: &Backup,
+) -> Vec<(HookKind, Vec<u16>)> {
+    crate::held_way::steps(profile, seen)
+        .into_iter()
+        .filter(|(_, way)| {
+            let at = way[way.len() - 1];
+            let writable = profile.writable.iter().any(|range| range.contains(&at));
+            let held = backup.byte_at(u32::from(at)).is_some();
+            let witnessed = backup.witnesses.iter().any(|witness| {
+                u32::from(witness.address) <= u32::from(at)
+                    && u32::from(at) < u32::from(witness.address) + u32::from(witness.len)
+            });
+            // The first step is `check_hook_targets`'s.
+            way.len() > 1 && writable && !held && !witnessed
+        })
+        .collect()
 }
 
 /// Each witness lies in memory an upload may write (the table included),

@@ -7,6 +7,7 @@
 //! chain slot and a debug stub's chain; other code ends the look (where it
 //! goes cannot be known without running it).
 
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 use emulator::{Bus, Cpu};
@@ -152,6 +153,59 @@ pub(crate) fn follow<T: Transport>(
     inside: &dyn Fn(u16, &[u16]) -> bool,
     strict: bool,
 ) -> Result<End> {
+    let mut touched = BTreeSet::new();
+    follow_noting(
+        client,
+        profile,
+        everyone,
+        (kind, target),
+        (inside, strict),
+        &mut touched,
+    )
+}
+
+/// hostile26 F4: the memory the way of `kind` from `target` touches in
+/// code no entry of `everyone` lists (nor a debug stub's): each byte its
+/// `JMP`s and the code run on the host read or wrote, as the robot would
+/// run it once. What that code is beyond those bytes (a branch not taken
+/// this time, a counter it keeps further on) no look can tell: a caller
+/// keeps a margin around them.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn unlisted_touched<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+) -> Result<BTreeSet<u16>> {
+    let mut touched = BTreeSet::new();
+    follow_noting(
+        client,
+        profile,
+        everyone,
+        (kind, target),
+        (&|_, _| false, false),
+        &mut touched,
+    )?;
+    touched.retain(|&at| !everyone.iter().any(|other| other.contains(at)));
+    Ok(touched)
+}
+
+/// Where a walk ends: `inside(at, way)`, `way` the addresses gone
+/// through before `at`.
+type Inside<'a> = &'a dyn Fn(u16, &[u16]) -> bool;
+
+/// [`follow`], adding to `touched` every byte of code no entry lists
+/// (nor a debug stub's) that the way reads or writes.
+fn follow_noting<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+    (inside, strict): (Inside<'_>, bool),
+    touched: &mut BTreeSet<u16>,
+) -> Result<End> {
     let mut path: Vec<u16> = Vec::new();
     let mut at = target;
     for _ in 0..MOST_STEPS {
@@ -189,6 +243,7 @@ pub(crate) fn follow<T: Transport>(
             None => {
                 let bytes = client.read_live(at, 3)?.bytes;
                 if bytes[0] == JMP {
+                    touched.extend([at, at.wrapping_add(1), at.wrapping_add(2)]);
                     Some(u16::from_le_bytes([bytes[1], bytes[2]]))
                 } else if let Some(stub) = crate::stub::left::at_target(client, profile, at)? {
                     // A debug stub (hooked or left in RAM by a session)
@@ -204,7 +259,7 @@ pub(crate) fn follow<T: Transport>(
                                 .flat_map(|other| other.hooks.iter())
                                 .any(|hook| hook.kind == kind && hook.handler == pc)
                     };
-                    match run_to_landing(client, profile, at, &landing, strict)? {
+                    match run_to_landing(client, profile, at, &landing, strict, touched)? {
                         Landing::At(pc) | Landing::Left(pc) => Some(pc),
                         Landing::Stops(pc) => {
                             path.push(pc);
@@ -436,6 +491,7 @@ fn run_to_landing<T: Transport>(
     start: u16,
     landing: &dyn Fn(u16) -> bool,
     strict: bool,
+    touched: &mut BTreeSet<u16>,
 ) -> Result<Landing> {
     let mut bus = ChainBus {
         client,
@@ -444,6 +500,7 @@ fn run_to_landing<T: Transport>(
         failed: None,
         outside: false,
         wrote: false,
+        touched,
     };
     let mut cpu = Cpu::new();
     cpu.set_idle_skip(false);
@@ -479,6 +536,10 @@ fn run_to_landing<T: Transport>(
                 bus.byte(cpu.pc.wrapping_add(1)),
                 bus.byte(cpu.pc.wrapping_add(2)),
             ]);
+            // Where it calls is code the way runs too.
+            if readable(profile, target) {
+                bus.touched.insert(target);
+            }
             if target == start || visited.contains(&target) {
                 return Ok(Landing::Loops(target));
             }
@@ -540,10 +601,15 @@ struct ChainBus<'a, T: Transport> {
     outside: bool,
     /// A write since the last look: the state of memory changed.
     wrote: bool,
+    /// Every readable address the run read or wrote.
+    touched: &'a mut BTreeSet<u16>,
 }
 
 impl<T: Transport> ChainBus<'_, T> {
     fn byte(&mut self, address: u16) -> u8 {
+        if readable(self.profile, address) {
+            self.touched.insert(address);
+        }
         if let Some(&byte) = self.seen.get(&address) {
             return byte;
         }
@@ -581,6 +647,9 @@ impl<T: Transport> Bus for ChainBus<'_, T> {
     }
 
     fn write(&mut self, address: u16, value: u8, _cycle: u64) {
+        if readable(self.profile, address) {
+            self.touched.insert(address);
+        }
         self.seen.insert(address, value);
         self.wrote = true;
     }

@@ -364,7 +364,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::restore_chain_broken),
         help(
-            "the robot answers as it would with that extension not hooked; the robot's hook was broken already when the file was written (or the file was edited by hand): restore another, or upload the extension again"
+            "the robot answers as it would with the extensions on that way not hooked; the robot's hook was broken already when the file was written (or the file was edited by hand): restore another, or upload those extensions again"
         )
     )]
     RestoreChainBroken {
@@ -540,6 +540,27 @@ pub enum Error {
         )
     )]
     UnwitnessedStep {
+        /// The hook.
+        hook: &'static str,
+        /// Where the way goes that nothing checks.
+        target: u16,
+        /// The way there, `$0803 -> $0503`.
+        path: String,
+    },
+
+    /// An undo file's hook leads on, past the code it witnesses, into RAM
+    /// it neither puts back nor witnesses and that no entry of the robot's
+    /// table lists now (hostile26 F1b). Nothing was written.
+    #[error(
+        "the undo file's {hook} leads {path}, on into ${target:04X}, which the file neither puts back nor witnesses, no entry of the robot's table lists now, and no hook of the robot leads through now: the code there is not checked, and the robot would run whatever that memory holds; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::undo_step_unlisted),
+        help(
+            "an undo file holds what its upload overwrote and witnesses the code its hooks go back to; what lies further on must be an extension the robot still lists, or code its hooks run now. A reset (`/1R`) clears the table, and a file changed by hand may point anywhere: upload the extensions again, or restore a backup taken with `scorpion backup`"
+        )
+    )]
+    UndoStepUnlisted {
         /// The hook.
         hook: &'static str,
         /// Where the way goes that nothing checks.

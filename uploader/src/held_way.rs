@@ -5,8 +5,9 @@
 //! - refused: a way into the memory of an entry the table has freed
 //!   (hostile22 F4), through code no entry lists before an extension the
 //!   table lists on that hook (hostile25 F2), or back to where it has been
-//!   (hostile25 F5). Restored, commands would run through memory the next
-//!   upload may take, or never end. An upload's undo puts back the first
+//!   (hostile25 F5), or into a listed extension but not to its handler
+//!   (hostile25 F5b). Restored, commands would run through memory the
+//!   next upload may take, the middle of code, or never end. An upload's undo puts back the first
 //!   two where its upload found them so.
 //! - said, not refused: an extension the table lists on a hook whose way
 //!   does not reach it (the hook at the ROM's target, a chain that skips
@@ -62,6 +63,18 @@ pub enum Disagreement {
         /// The way there.
         path: String,
     },
+    /// The hook's way runs into the memory of `extension`, which the
+    /// table lists, but not to its handler on that hook: the middle of its
+    /// code, where no chain goes (hostile25 F5b: told only once the memory
+    /// was written).
+    Strays {
+        /// The hook.
+        hook: HookKind,
+        /// The extension whose memory it runs into.
+        extension: Installed,
+        /// The way there.
+        path: String,
+    },
     /// The hook's way comes back, through listed extensions' chain slots,
     /// to where it has been (hostile25 F5: told only once the memory was
     /// written).
@@ -101,6 +114,15 @@ impl Disagreement {
                     behind.join(", ")
                 )
             }
+            Disagreement::Strays {
+                hook,
+                extension,
+                path,
+            } => format!(
+                "{} runs into {} ({path}) but not to its handler on that hook",
+                hook.rom_symbol(),
+                extension.describe()
+            ),
             Disagreement::Loops { hook, path } => format!(
                 "{} comes back to where it has been ({path}), a loop the robot would run for ever {}",
                 hook.rom_symbol(),
@@ -128,6 +150,9 @@ impl Disagreement {
             Disagreement::NotHooked { .. } => None,
             Disagreement::ThroughFreed { .. } | Disagreement::Unlisted { .. } => {
                 Some("commands would run through memory the next upload may be put in")
+            }
+            Disagreement::Strays { .. } => {
+                Some("commands would run the middle of its code, where no chain goes")
             }
             Disagreement::Loops {
                 hook: HookKind::Loop,
@@ -190,9 +215,12 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
                 }
                 continue;
             }
-            // Inside a listed extension but not at its handler is the
-            // robot-side check's (a way that strays).
-            if listed.iter().any(|entry| entry.contains(at)) {
+            if let Some(entry) = listed.iter().find(|entry| entry.contains(at)) {
+                found.push(Disagreement::Strays {
+                    hook: kind,
+                    extension: entry.clone(),
+                    path: path_text(&path),
+                });
                 break false;
             }
             if let Some(entry) = freed.iter().find(|entry| entry.contains(at)) {
@@ -392,3 +420,78 @@ fn freed_entries(backup: &Backup, (table, entries): (u16, usize), flags: &[u8]) 
     }
     freed
 }
+
+/// `backup` as a restore of it would leave the robot, as far as its ways
+/// go: the robot's table under the file's where the file does not hold it
+/// whole, and the robot's bytes where a way goes on through memory the
+/// file does not hold (a listed extension's chain slot, the `JMP` at a
+/// step), the file's own bytes first. Read once the file's witnesses are
+/// checked, so the robot's bytes at a witnessed step are the file's.
+/// Then [`steps`] and [`disagreements`] follow a way past what the file
+/// holds (N1: the code a backup only witnesses went on, by its `JMP`, into
+/// memory nothing checked; hostile26 F1b, an undo file's chain slots).
+///
+/// # Errors
+/// The line's.
+pub(crate) fn over_robot<T: crate::transport::Transport>(
+    client: &mut crate::client::Client<T>,
+    profile: &RomProfile,
+    backup: &Backup,
+) -> crate::Result<Backup> {
+    let mut seen = backup.clone();
+    if let Some((at, len)) = crate::backup::table_range(profile) {
+        let whole = (0..len).all(|i| backup.byte_at(u32::from(at) + i as u32).is_some());
+        if !whole {
+            seen.areas.push(crate::image::Area {
+                address: at,
+                bytes: client.read_memory(at, len)?,
+            });
+        }
+    }
+    let readable = |at: u16| profile.writable.iter().any(|range| range.contains(&at));
+    for _ in 0..MOST_READS {
+        let listed = crate::backup::backup_table(profile, &seen);
+        let mut wanted = std::collections::BTreeSet::new();
+        for (kind, way) in steps(profile, &seen) {
+            let at = way[way.len() - 1];
+            let slot = listed
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .find(|hook| hook.kind == kind && hook.handler == at)
+                .map(|hook| hook.chain);
+            let bytes: Vec<u16> = match slot {
+                Some(Some(slot)) => vec![slot, slot.wrapping_add(1)],
+                Some(None) => Vec::new(),
+                None => (0..3).map(|i| at.wrapping_add(i)).collect(),
+            };
+            wanted.extend(
+                bytes
+                    .into_iter()
+                    .filter(|&at| readable(at) && seen.byte_at(u32::from(at)).is_none()),
+            );
+        }
+        if wanted.is_empty() {
+            break;
+        }
+        let mut runs: Vec<(u16, usize)> = Vec::new();
+        for at in wanted {
+            match runs.last_mut() {
+                Some((start, len)) if u32::from(*start) + *len as u32 == u32::from(at) => {
+                    *len += 1;
+                }
+                _ => runs.push((at, 1)),
+            }
+        }
+        for (at, len) in runs {
+            seen.areas.push(crate::image::Area {
+                address: at,
+                bytes: client.read_memory(at, len)?,
+            });
+        }
+    }
+    Ok(seen)
+}
+
+/// Rounds of reads [`over_robot`] makes, each a step further down the
+/// ways: as many as [`steps`] follows.
+const MOST_READS: usize = 16;

@@ -226,6 +226,10 @@ pub(crate) fn switch_hook<T: Transport>(
     )
 }
 
+/// Tries at a read a quiet line failed before it is given up (fresh15
+/// F5: a line quiet for 1.5 s anywhere in an attach).
+pub(crate) const QUIET_LOOKS: u32 = 3;
+
 /// Points the hook at `address` to `target` as [`switch_hook`] does, but
 /// reads every RAM hook of the ROM back whole, the others as they were
 /// before (read first): a `/9W` to `HOOK_UNKNOWN`'s operand whose address
@@ -247,7 +251,9 @@ pub(crate) fn switch_hook_among<T: Transport>(
         also: None,
         write: true,
     }];
-    for (kind, now) in read_hooks(client, profile)? {
+    // A read only: tried again where the line went quiet a while.
+    let now = crate::session::tried_quiet(QUIET_LOOKS, || read_hooks(client, profile))?;
+    for (kind, now) in now {
         let other = profile.hook_address(kind);
         if other != address {
             wanted.push(Wanted {

@@ -64,6 +64,10 @@ pub enum Event {
         kind: HookKind,
         /// Where the way out led.
         from: u16,
+        /// Where it was read, where that was not the hook itself: the
+        /// chain slot of what the hook led to inside the upload (an
+        /// earlier copy of the image, or code by hand there: recheck27 P2).
+        slot: Option<u16>,
         /// Why it is no way.
         why: &'static str,
         /// The way followed.

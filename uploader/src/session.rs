@@ -761,6 +761,24 @@ impl Session {
 
 /// `attempt` up to `times` times, until it succeeds: its last result. For
 /// looks a noisy line can fail one at a time.
+/// [`tried`], again only where nothing at all came back ([`Error::NoAnswer`]:
+/// a line quiet a while, fresh15 F5), not where answers came damaged (a
+/// noisy line, whose next try meets the same noise and whose caller gives
+/// up fast).
+///
+/// # Errors
+/// The last attempt's.
+pub(crate) fn tried_quiet<R>(times: u32, mut attempt: impl FnMut() -> Result<R>) -> Result<R> {
+    let mut result = attempt();
+    for _ in 1..times {
+        if !matches!(result, Err(Error::NoAnswer { .. })) {
+            break;
+        }
+        result = attempt();
+    }
+    result
+}
+
 pub(crate) fn tried<R>(times: u32, mut attempt: impl FnMut() -> Result<R>) -> Result<R> {
     let mut result = attempt();
     for _ in 1..times {

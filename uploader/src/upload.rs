@@ -537,7 +537,7 @@ pub fn upload_keeping<T: Transport>(
                     chain::Way::Fine => Some(to),
                     chain::Way::ComesBack(_) => None,
                     chain::Way::Broken(why, path) => {
-                        drop_way(progress, &mut dropped, (kind, to), why, &path);
+                        drop_way(progress, &mut dropped, (kind, to, slot), why, &path);
                         None
                     }
                 },
@@ -578,7 +578,7 @@ pub fn upload_keeping<T: Transport>(
                 // A hook the image does not take is left as it is.
                 chain::Way::Broken(why, path) => {
                     if let Some(to) = profile.reset_target(kind).filter(|_| takes) {
-                        drop_way(progress, &mut dropped, (kind, target), why, &path);
+                        drop_way(progress, &mut dropped, (kind, target, None), why, &path);
                         target = to;
                     }
                 }
@@ -938,13 +938,14 @@ pub fn upload_keeping<T: Transport>(
 fn drop_way(
     progress: &mut dyn Progress,
     dropped: &mut Vec<(HookKind, u16)>,
-    (kind, from): (HookKind, u16),
+    (kind, from, slot): (HookKind, u16, Option<u16>),
     why: &'static str,
     path: &chain::Path,
 ) {
     progress.event(&Event::WayOutDropped {
         kind,
         from,
+        slot,
         why,
         path: path.to_string(),
     });

@@ -1118,6 +1118,21 @@ fn a_backup_whose_ways_run_wrong_is_refused_before_writing() {
         &options,
         &["comes back to where it has been ($0A03 -> $0803 -> $0503 -> $0A03)"],
     );
+    // F5b: the middle one's chain slot sent into the middle of the last
+    // one's code (its `BNE`), not its handler: told only after writing.
+    let mut strays = saved.clone();
+    set(&mut strays, 0x0801, 0x05);
+    set(&mut strays, 0x0802, 0x05);
+    refused_untouched(
+        &mut client,
+        &strays,
+        &options,
+        &[
+            "runs into extension",
+            "($0500-$053F) ($0A03 -> $0803 -> $0505) but not to its handler",
+            "the middle of its code",
+        ],
+    );
     // F1: the front one's flags not in the file; the robot reset.
     let mut part = saved.clone();
     part.areas = without(&part.areas, table + 2..=table + 2);
@@ -1306,6 +1321,107 @@ fn a_backup_witnesses_the_code_its_ways_reach_outside_what_it_saves() {
     board
         .load(0x1000, &[0x02, 0x02, 0x02])
         .expect("KIM-bus RAM");
+    match restore(&mut client, &saved, &options, &mut NoProgress) {
+        Err(Error::WitnessDiffers { .. }) => {}
+        other => panic!("{other:?}"),
+    }
+}
+
+/// hostile26 F1b: an undo file made by hand (b's code and the whole table
+/// put in it, HOOK_UNKNOWN at b, its witnesses dropped) whose way goes on
+/// from b's chain slot into a, which it neither holds nor witnesses, on a
+/// robot reset since (its table lists nothing) and a's code changed: the
+/// undo went through, exit 0, the table listing code nothing checked. A
+/// later step must lie in an extension the robot still lists.
+#[test]
+fn an_undo_whose_way_goes_on_into_code_nothing_checks_is_refused() {
+    let (options, mut client, _) = in_a_chain(&[0x0500]);
+    let (_, _, undo) = plain_replace_undo();
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0800),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("in front");
+    let mut file = kept.0.expect("kept");
+    let (table, entries) = options.profile.table.expect("a table");
+    let end = romlib::installed::entry_address(table, entries, entries - 1)
+        + romlib::installed::ENTRY_LEN as u16;
+    let memory = client.transport().robot().robot().board().memory();
+    let area = |at: u16, end: u16| uploader::Area {
+        address: at,
+        bytes: memory[usize::from(at)..usize::from(end)].to_vec(),
+    };
+    file.areas = vec![area(0x0800, 0x0840), area(table, end)];
+    file.witnesses.clear();
+    file.written_entries.clear();
+    for hook in &mut file.hooks {
+        if hook.0 == HookKind::Unknown {
+            hook.1 = 0x0803;
+        }
+    }
+    let reset = romlib::protocol::Command::parse(b"/1R").expect("a command");
+    let _ = client.listen(&reset).expect("the line works");
+    by_hand(&mut client, 0x0504, b"Z");
+    let before = held(&mut client);
+    match restore(&mut client, &file, &undo, &mut NoProgress) {
+        Err(Error::UndoStepUnlisted { target, path, .. }) => {
+            assert_eq!((target, path.as_str()), (0x0503, "$0803 -> $0503"));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+}
+
+/// N1: the owner's code on the KIM bus that a chain slot leads to goes on,
+/// by its `JMP`, to more of it: `backup` witnessed the first 16 bytes
+/// only, and a restore after the code further on changed said "verified".
+/// Each step is witnessed, and a file without the later witness is
+/// refused.
+#[test]
+fn a_backup_witnesses_every_step_of_code_outside_what_it_saves() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0500),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    by_hand(&mut client, 0x1000, &[0x4C, 0x00, 0x20]);
+    by_hand(&mut client, 0x2000, &[0x4C, lo, hi]);
+    by_hand(&mut client, 0x0501, &[0x00, 0x10]);
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    let witnessed = |at: u16| {
+        saved
+            .witnesses
+            .iter()
+            .any(|witness| witness.address <= at && at < witness.address + witness.len)
+    };
+    assert!(
+        witnessed(0x1000) && witnessed(0x2000),
+        "{:?}",
+        saved.witnesses
+    );
+    // The file without the later witness: nothing checks $2000.
+    let mut cut = saved.clone();
+    cut.witnesses
+        .retain(|witness| !(witness.address <= 0x2000 && 0x2000 < witness.address + witness.len));
+    let before = held(&mut client);
+    match restore(&mut client, &cut, &options, &mut NoProgress) {
+        Err(Error::UnwitnessedStep { target, path, .. }) => {
+            assert_eq!((target, path.as_str()), (0x2000, "$0503 -> $1000 -> $2000"));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+    // The code further on changed: the restore is refused.
+    by_hand(&mut client, 0x2000, &[0x02, 0x02, 0x02]);
     match restore(&mut client, &saved, &options, &mut NoProgress) {
         Err(Error::WitnessDiffers { .. }) => {}
         other => panic!("{other:?}"),

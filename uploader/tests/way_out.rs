@@ -15,16 +15,18 @@ use uploader::transport::VirtualTransport;
 use uploader::{Client, UploadOptions, upload};
 use uploader::{Event, Phase, Progress};
 
-/// The ways out dropped, as the progress heard them.
+/// The ways out dropped, as the progress heard them, and where each was
+/// read where that was not the hook itself.
 #[derive(Default)]
-struct Heard(Vec<u16>);
+struct Heard(Vec<u16>, Vec<Option<u16>>);
 
 impl Progress for Heard {
     fn phase(&mut self, _phase: Phase, _total: usize) {}
     fn advanced(&mut self, _done: usize) {}
     fn event(&mut self, event: &Event) {
-        if let Event::WayOutDropped { from, .. } = event {
+        if let Event::WayOutDropped { from, slot, .. } = event {
             self.0.push(*from);
+            self.1.push(*slot);
         }
     }
 }
@@ -152,4 +154,22 @@ fn a_way_out_into_the_middle_of_another_extension_is_dropped() {
     assert_eq!(heard.0, [0x0505]);
     assert_eq!(word(&mut client, 0x0401), BAD_COMMAND);
     answers_after_an_unknown_command(&mut client);
+}
+
+/// recheck27 P2: HOOK_UNKNOWN pointed by hand at code in the place the
+/// upload takes, whose chain slot (as the image has it) holds zeros: the
+/// warning said "HOOK_UNKNOWN led to $0000". It says where $0000 was read.
+#[test]
+fn a_way_out_read_from_the_uploads_own_place_says_where_it_was_read() {
+    let options = UploadOptions::default();
+    let image = extension_at(0x0400);
+    let mut client = uploader::client(robot(), &options.profile);
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    poke(&mut client, 0x0403, &[0x4C, lo, hi]);
+    poke(&mut client, HOOK_UNKNOWN + 1, &0x0403u16.to_le_bytes());
+    let mut heard = Heard::default();
+    upload(&mut client, &image, &options, &mut heard).expect("uploaded");
+    assert_eq!((heard.0, heard.1), (vec![0x0000], vec![Some(0x0401)]));
+    assert_eq!(word(&mut client, 0x0401), BAD_COMMAND);
+    assert_eq!(word(&mut client, HOOK_UNKNOWN + 1), 0x0403);
 }

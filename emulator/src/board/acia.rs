@@ -327,9 +327,11 @@ impl Acia {
     }
 
     fn catch_up(&mut self, cycle: u64) {
-        if cycle <= self.now {
-            return;
-        }
+        // Not only forward: a receiver whose rate changed can find a
+        // character whose stop bit it sampled before `now` (its next event
+        // in the past), which is taken now; else the board waited on that
+        // event for ever (a noisy line's `/1F` hung the virtual robot).
+        let cycle = cycle.max(self.now);
         // Receive and transmit events in time order, so that an overrun
         // depends only on when characters arrive against when they are read.
         loop {
@@ -496,6 +498,21 @@ mod tests {
         assert!(!acia.irq(), "reading the status clears IRQ");
         assert_eq!(acia.read(reg::DATA, at + 2), b'/');
         assert_eq!(acia.peek(reg::STATUS) & status::RDRF, 0);
+    }
+
+    /// A character half in when the rate goes from 9600 to 19200: at the
+    /// new rate its stop bit was sampled before now. Its event was in the
+    /// past, a sync there did nothing, and the board waited on it for
+    /// ever (the noisy-line runs of `uploader`'s stub_faults hung).
+    #[test]
+    fn a_character_due_before_now_after_a_rate_change_is_taken() {
+        let mut acia = scorpion_acia();
+        acia.host_send(b'/', 100);
+        acia.sync(800);
+        acia.write(reg::CONTROL, control::FORMAT_8N1 | 0x0F, 800);
+        let at = acia.next_event().expect("the character is due");
+        acia.sync(at);
+        assert_ne!(acia.next_event(), Some(at), "the event at {at} stays due");
     }
 
     #[test]

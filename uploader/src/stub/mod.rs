@@ -11,7 +11,8 @@
 //! - [`guard`]: what a person at a stop may change;
 //! - [`patch`]: what a breakpoint displaces, and where a step goes;
 //! - [`session`]: [`RobotDebug`], the debugger attached;
-//! - `summed`: the stub's code written through the RAM loader's frames.
+//! - `summed`: the stub's code written through the RAM loader's frames;
+//! - [`unlisted`]: code a hook leads to that no entry lists, kept clear of.
 
 pub mod error;
 pub mod frame;
@@ -22,6 +23,7 @@ pub mod link;
 pub mod patch;
 pub mod session;
 mod summed;
+pub mod unlisted;
 
 pub use error::{StubError, StubResult, hex as error_hex};
 pub use link::StubPlan;

@@ -312,7 +312,7 @@ impl<T: Transport> RobotDebug<T> {
         } else {
             debug.client.probe()?;
         }
-        let (taken, installed) = debug.taken(profile)?;
+        let (taken, installed) = debug.taken(profile, !stopped)?;
         let placed = StubPlan::place_beside(profile, &debug.image, hook, &taken)?;
         debug.stub = placed.clone();
         if stopped {
@@ -517,12 +517,15 @@ impl<T: Transport> RobotDebug<T> {
     }
 
     /// What the stub must not go over besides the image: the extensions
-    /// the robot's table names (read from the robot) and the RAM loader's
+    /// the robot's table names (read from the robot), the RAM loader's
     /// memory (an upload of the image puts it there, and may find it
-    /// again).
+    /// again) and, on a robot that runs (`live`: its memory read with the
+    /// ROM's commands), code a hook leads to that no entry lists, with a
+    /// margin ([`super::unlisted`]).
     fn taken(
         &mut self,
         profile: &RomProfile,
+        live: bool,
     ) -> StubResult<(Vec<RangeInclusive<u16>>, Vec<Installed>)> {
         let installed = crate::table::installed_with(profile, &mut |at, len| self.read(at, len))?;
         let mut taken: Vec<RangeInclusive<u16>> = installed
@@ -534,6 +537,14 @@ impl<T: Transport> RobotDebug<T> {
             let code = &loader.code;
             taken.push(code.address..=code.address.wrapping_add(code.bytes.len() as u16 - 1));
             taken.push(u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()));
+        }
+        if live {
+            taken.extend(super::unlisted::clear_of(
+                &mut self.client,
+                profile,
+                &installed,
+                &self.image,
+            )?);
         }
         Ok((taken, installed))
     }

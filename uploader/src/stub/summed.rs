@@ -49,8 +49,13 @@ pub(super) fn write_summed<T: Transport>(
     let Some(loader) = Loader::place(profile, image, (base, FAST_BAUD))? else {
         return Ok(false);
     };
-    let hooks = read_hooks(client, profile)?;
-    if crate::beside::refusal(client, profile, &hooks, installed, &loader)?.is_some() {
+    // Reads only: tried again where the line went quiet a while.
+    let hooks =
+        crate::session::tried_quiet(crate::hooks::QUIET_LOOKS, || read_hooks(client, profile))?;
+    let refused = crate::session::tried_quiet(crate::hooks::QUIET_LOOKS, || {
+        crate::beside::refusal(client, profile, &hooks, installed, &loader)
+    })?;
+    if refused.is_some() {
         return Ok(false);
     }
     let Some(&(_, original)) = hooks.iter().find(|(kind, _)| *kind == HookKind::Unknown) else {
