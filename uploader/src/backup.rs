@@ -1235,6 +1235,16 @@ pub fn restore<T: Transport>(
     // The ways as the restore would leave them, followed past what the
     // file holds over the robot's bytes (the witnesses checked above).
     let seen = crate::held_way::over_robot(client, profile, backup)?;
+    // hostile28 F4: a file holding part of the table (an undo file with an
+    // entry cut out) over what a reset left of the robot's: the table it
+    // would leave does not decode. Told before the flags go in.
+    if let Some(damaged) = damaged_table(profile, &seen) {
+        return Err(Error::BackupRefused {
+            reason: format!(
+                "the table of installed extensions, the file's over the robot's, would not decode ({damaged}): the file does not hold the entries its flags mark in use; nothing was written"
+            ),
+        });
+    }
     if seen != *backup {
         refuse_ways(
             profile,

@@ -1427,3 +1427,40 @@ fn a_backup_witnesses_every_step_of_code_outside_what_it_saves() {
         other => panic!("{other:?}"),
     }
 }
+
+/// hostile28 F4: b's undo file with a's entry cut out, on a robot reset
+/// since (its flags cleared) whose stale copy of that entry was zeroed:
+/// the undo wrote a's flag, then refused the table as damaged, and every
+/// command after that failed. Refused before the flags go in.
+#[test]
+fn an_undo_whose_table_would_not_decode_over_the_robots_writes_nothing() {
+    let (options, mut client, _) = in_a_chain(&[0x0500]);
+    let (_, _, undo) = plain_replace_undo();
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0800),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("in front");
+    let mut file = kept.0.expect("kept");
+    let (table, entries) = options.profile.table.expect("a table");
+    let entry = romlib::installed::entry_address(table, entries, 0);
+    let len = romlib::installed::ENTRY_LEN as u16;
+    file.areas = without(&file.areas, entry..=entry + len - 1);
+    let reset = romlib::protocol::Command::parse(b"/1R").expect("a command");
+    let _ = client.listen(&reset).expect("the line works");
+    by_hand(&mut client, entry, &vec![0; usize::from(len)]);
+    let before = held(&mut client);
+    match restore(&mut client, &file, &undo, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            assert!(reason.contains("would not decode"), "{reason}");
+            assert!(reason.ends_with("nothing was written"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+    uploader::read_installed(&mut client, &options.profile).expect("the table decodes");
+}

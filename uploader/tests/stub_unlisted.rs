@@ -1,23 +1,19 @@
-//! hostile26 F4: a robot whose `HOOK_LOOP` runs code no entry of the
-//! table lists (an owner's, by hand), just where the stub would go on a
-//! robot without it. The stub was written there with the ROM's commands
-//! while the loop ran it, and the robot jammed. Attaching keeps the stub
-//! clear of that code (a margin around what its way touches) and the
-//! robot goes on running it.
+//! hostile26 F4, hostile28 F1, F2: a robot whose `HOOK_LOOP` runs code no
+//! entry of the table lists (an owner's, by hand), just where the stub
+//! would go. The stub was written over it with the ROM's commands while
+//! the loop ran it, and the robot jammed; a margin around what one run on
+//! the host touched missed the branches it did not take. Attaching is
+//! refused before anything is written, and the robot runs on.
 
 mod common;
 
 use common::stub::{handler, robot};
 use isa::objfmt::HookKind;
-use romlib::symbols::HOOK_LOOP;
-use std::time::Duration;
 use uploader::RomProfile;
-use uploader::stub::{Reply, RobotDebug, StubPlan, unlisted::MARGIN};
-
-const WAIT: Duration = Duration::from_secs(1);
+use uploader::stub::{RobotDebug, StubError, StubPlan};
 
 #[test]
-fn the_stub_goes_clear_of_unlisted_code_a_hook_runs() {
+fn attaching_to_a_robot_whose_hook_runs_unlisted_code_is_refused_untouched() {
     let profile = RomProfile::reference();
     let image = handler();
     // Where the stub goes on a robot with nothing else.
@@ -38,43 +34,33 @@ fn the_stub_goes_clear_of_unlisted_code_a_hook_runs() {
         .robot_mut()
         .install_hook(HookKind::Loop, code, Some(code + 4))
         .expect("HOOK_LOOP is a JMP");
-    let client = uploader::client(transport, &profile);
-    let mut debug = RobotDebug::attach(client, &profile, image).expect("attaches");
-
-    let stub = debug.stub().clone();
-    let (start, end) = (
-        u32::from(stub.address),
-        u32::from(stub.address) + stub.bytes.len() as u32,
-    );
-    let (low, high) = (
-        u32::from(code - MARGIN),
-        u32::from(counter) + u32::from(MARGIN),
-    );
+    let ram = |transport: &uploader::transport::VirtualTransport| {
+        let memory = transport.robot().robot().board().memory();
+        // The hooks, user RAM and the table (the ROM's own RAM changes
+        // with every command).
+        let mut ram = [&memory[0x0200..0x0206], &memory[0x0400..0x1000]].concat();
+        ram[6 + usize::from(counter) - 0x0400] = 0;
+        ram
+    };
+    let before = ram(&transport);
+    let count = |transport: &uploader::transport::VirtualTransport| {
+        transport.robot().robot().board().memory()[usize::from(counter)]
+    };
+    let first = count(&transport);
+    let client = uploader::client(&mut transport, &profile);
+    let Err(error) = RobotDebug::attach(client, &profile, image) else {
+        panic!("attached over code HOOK_LOOP runs");
+    };
+    let said = error.to_string();
     assert!(
-        end <= low || start > high,
-        "the stub at ${start:04X}-${end:04X} meets the unlisted code's ${low:04X}-${high:04X}"
+        matches!(error, StubError::Refused { .. })
+            && said.contains(&format!("HOOK_LOOP (${code:04X}) runs code at ${code:04X}")),
+        "{said}"
     );
-    // The robot runs on: the loop still counts, the image's command answers.
-    let before = debug.read_live_as_program(counter, 1).expect("read").bytes[0];
-    assert_eq!(
-        debug.command(b"/1Q", WAIT).expect("the line"),
-        Reply::Answer(b"Q42\r".to_vec())
-    );
-    let after = debug.read_live_as_program(counter, 1).expect("read").bytes[0];
-    assert_ne!(before, after, "HOOK_LOOP's code still runs");
-    let client = debug.detach().expect("detached");
-    let robot = client.into_transport().into_robot();
-    let memory = robot.robot().board().memory();
-    assert_eq!(
-        [
-            memory[usize::from(HOOK_LOOP) + 1],
-            memory[usize::from(HOOK_LOOP) + 2]
-        ],
-        code.to_le_bytes(),
-        "HOOK_LOOP untouched"
-    );
-    assert_eq!(
-        &memory[usize::from(code)..usize::from(code) + 3],
-        &[0xEE, lo, hi]
-    );
+    assert!(ram(&transport) == before, "user RAM changed");
+    // The robot runs on: its loop still counts.
+    let mut client = uploader::client(&mut transport, &profile);
+    client.probe().expect("the robot answers");
+    drop(client);
+    assert_ne!(count(&transport), first, "HOOK_LOOP's code still runs");
 }

@@ -12,7 +12,7 @@
 //! - [`patch`]: what a breakpoint displaces, and where a step goes;
 //! - [`session`]: [`RobotDebug`], the debugger attached;
 //! - `summed`: the stub's code written through the RAM loader's frames;
-//! - [`unlisted`]: code a hook leads to that no entry lists, kept clear of.
+//! - [`unlisted`]: code a hook leads to that no entry lists, refused.
 
 pub mod error;
 pub mod frame;

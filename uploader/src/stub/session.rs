@@ -517,11 +517,11 @@ impl<T: Transport> RobotDebug<T> {
     }
 
     /// What the stub must not go over besides the image: the extensions
-    /// the robot's table names (read from the robot), the RAM loader's
+    /// the robot's table names (read from the robot) and the RAM loader's
     /// memory (an upload of the image puts it there, and may find it
-    /// again) and, on a robot that runs (`live`: its memory read with the
-    /// ROM's commands), code a hook leads to that no entry lists, with a
-    /// margin ([`super::unlisted`]).
+    /// again). On a robot that runs (`live`: its memory read with the
+    /// ROM's commands), code a hook leads to that no entry lists is
+    /// refused ([`super::unlisted`]).
     fn taken(
         &mut self,
         profile: &RomProfile,
@@ -539,12 +539,7 @@ impl<T: Transport> RobotDebug<T> {
             taken.push(u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()));
         }
         if live {
-            taken.extend(super::unlisted::clear_of(
-                &mut self.client,
-                profile,
-                &installed,
-                &self.image,
-            )?);
+            super::unlisted::refuse(&mut self.client, profile, &installed, &self.image)?;
         }
         Ok((taken, installed))
     }
