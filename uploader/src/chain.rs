@@ -164,12 +164,10 @@ pub(crate) fn follow<T: Transport>(
     )
 }
 
-/// hostile26 F4: the memory the way of `kind` from `target` touches in
-/// code no entry of `everyone` lists (nor a debug stub's): each byte its
-/// `JMP`s and the code run on the host read or wrote, as the robot would
-/// run it once. What that code is beyond those bytes (a branch not taken
-/// this time, a counter it keeps further on) no look can tell: a caller
-/// keeps a margin around them.
+/// hostile26 F4: the code the way of `kind` from `target` runs that no
+/// entry of `everyone` lists (nor a debug stub's): the bytes of its `JMP`s
+/// and of each instruction run on the host, as the robot would run it
+/// once (a branch not taken this time is not seen).
 ///
 /// # Errors
 /// The line's errors.
@@ -196,8 +194,8 @@ pub(crate) fn unlisted_touched<T: Transport>(
 /// through before `at`.
 type Inside<'a> = &'a dyn Fn(u16, &[u16]) -> bool;
 
-/// [`follow`], adding to `touched` every byte of code no entry lists
-/// (nor a debug stub's) that the way reads or writes.
+/// [`follow`], adding to `touched` every byte of code the way runs (the
+/// caller leaves out what entries list).
 fn follow_noting<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
@@ -557,6 +555,14 @@ fn run_to_landing<T: Transport>(
             }
         }
         visited.insert(cpu.pc);
+        // The code the way runs (not the data it reads and writes, which
+        // may be anyone's): each instruction's bytes.
+        for i in 0..u16::from(info.len()) {
+            let at = cpu.pc.wrapping_add(i);
+            if readable(profile, at) {
+                bus.touched.insert(at);
+            }
+        }
         cpu.step(&mut bus);
         if let Some(error) = bus.failed.take() {
             return Err(error);
@@ -601,15 +607,12 @@ struct ChainBus<'a, T: Transport> {
     outside: bool,
     /// A write since the last look: the state of memory changed.
     wrote: bool,
-    /// Every readable address the run read or wrote.
+    /// Every readable address of the code the run ran.
     touched: &'a mut BTreeSet<u16>,
 }
 
 impl<T: Transport> ChainBus<'_, T> {
     fn byte(&mut self, address: u16) -> u8 {
-        if readable(self.profile, address) {
-            self.touched.insert(address);
-        }
         if let Some(&byte) = self.seen.get(&address) {
             return byte;
         }
@@ -647,9 +650,6 @@ impl<T: Transport> Bus for ChainBus<'_, T> {
     }
 
     fn write(&mut self, address: u16, value: u8, _cycle: u64) {
-        if readable(self.profile, address) {
-            self.touched.insert(address);
-        }
         self.seen.insert(address, value);
         self.wrote = true;
     }

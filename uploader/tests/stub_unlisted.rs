@@ -16,12 +16,23 @@ use uploader::stub::{RobotDebug, StubError, StubPlan};
 fn attaching_to_a_robot_whose_hook_runs_unlisted_code_is_refused_untouched() {
     let profile = RomProfile::reference();
     let image = handler();
-    // Where the stub goes on a robot with nothing else.
-    let alone = StubPlan::place(&profile, &image, profile.hook_unknown).expect("links");
+    // Where the stub goes on a robot with nothing else: beside the image
+    // and the RAM loader an upload of it uses.
+    let loader = uploader::loader_plan(&profile, &image, (9600, uploader::FAST_BAUD))
+        .expect("links")
+        .expect("room for the loader");
+    let taken = [
+        loader.code.address..=loader.code.address + loader.code.bytes.len() as u16 - 1,
+        u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()),
+    ];
+    let alone =
+        StubPlan::place_beside(&profile, &image, profile.hook_unknown, &taken).expect("links");
     // `INC counter; JMP chain` in the middle of that place, on HOOK_LOOP,
     // listed by no entry.
     let code = alone.address + 0x40;
-    let counter = code + 0x10;
+    // Its counter outside that place: a read of the place that finds its
+    // bytes changing refuses too, as memory in use.
+    let counter = alone.address - 0x10;
     let [lo, hi] = counter.to_le_bytes();
     let mut transport = robot(&image);
     transport

@@ -312,7 +312,7 @@ impl<T: Transport> RobotDebug<T> {
         } else {
             debug.client.probe()?;
         }
-        let (taken, installed) = debug.taken(profile, !stopped)?;
+        let (taken, installed) = debug.taken(profile)?;
         let placed = StubPlan::place_beside(profile, &debug.image, hook, &taken)?;
         debug.stub = placed.clone();
         if stopped {
@@ -420,6 +420,13 @@ impl<T: Transport> RobotDebug<T> {
                 ),
             });
         }
+        if debug.stopped.is_none() {
+            // Nothing is written before: code a hook runs that no entry
+            // lists is refused (hostile26 F4, hostile28 F1, F2); this
+            // image's stub, where it goes, is not such code.
+            let stub = |at: u16| present && placed.contains(at);
+            super::unlisted::refuse(&mut debug.client, profile, &installed, &debug.image, &stub)?;
+        }
         // The image's code compared first: a robot that does not hold it is
         // told so with the bytes that differ, not as "not installed"
         // (fresh14 F9).
@@ -519,13 +526,10 @@ impl<T: Transport> RobotDebug<T> {
     /// What the stub must not go over besides the image: the extensions
     /// the robot's table names (read from the robot) and the RAM loader's
     /// memory (an upload of the image puts it there, and may find it
-    /// again). On a robot that runs (`live`: its memory read with the
-    /// ROM's commands), code a hook leads to that no entry lists is
-    /// refused ([`super::unlisted`]).
+    /// again).
     fn taken(
         &mut self,
         profile: &RomProfile,
-        live: bool,
     ) -> StubResult<(Vec<RangeInclusive<u16>>, Vec<Installed>)> {
         let installed = crate::table::installed_with(profile, &mut |at, len| self.read(at, len))?;
         let mut taken: Vec<RangeInclusive<u16>> = installed
@@ -538,9 +542,7 @@ impl<T: Transport> RobotDebug<T> {
             taken.push(code.address..=code.address.wrapping_add(code.bytes.len() as u16 - 1));
             taken.push(u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()));
         }
-        if live {
-            super::unlisted::refuse(&mut self.client, profile, &installed, &self.image)?;
-        }
+
         Ok((taken, installed))
     }
 

@@ -18,7 +18,10 @@ use crate::image::{RomProfile, UploadImage};
 use crate::transport::Transport;
 
 /// Refuses attaching where a hook's way runs code in RAM that neither
-/// `installed` nor `image` holds, naming the hook and the first address.
+/// `installed` nor `image` holds, nor `stub` (where this image's stub
+/// goes: a hook into the middle of a stub a session left there is that
+/// stub, which attaching recognises, hostile10 F11), naming the hook and
+/// the first address.
 ///
 /// # Errors
 /// [`StubError::Refused`]; the line's errors.
@@ -27,6 +30,7 @@ pub(super) fn refuse<T: Transport>(
     profile: &RomProfile,
     installed: &[Installed],
     image: &UploadImage,
+    stub: &dyn Fn(u16) -> bool,
 ) -> StubResult<()> {
     // Only reads: tried again where the line went quiet (fresh15 F5's
     // quiet line, which every other look of an attach survives).
@@ -37,7 +41,7 @@ pub(super) fn refuse<T: Transport>(
             }
             let mut touched: BTreeSet<u16> =
                 crate::chain::unlisted_touched(client, profile, installed, (kind, target))?;
-            touched.retain(|&at| !image.contains(at));
+            touched.retain(|&at| !image.contains(at) && !stub(at));
             if let Some(&first) = touched.first() {
                 return Ok(Some((kind, target, first)));
             }
