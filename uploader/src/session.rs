@@ -761,6 +761,10 @@ impl Session {
 
 /// `attempt` up to `times` times, until it succeeds: its last result. For
 /// looks a noisy line can fail one at a time.
+pub(crate) fn tried<R>(times: u32, attempt: impl FnMut() -> Result<R>) -> Result<R> {
+    tried_while(times, |_| true, attempt)
+}
+
 /// [`tried`], again only where nothing at all came back ([`Error::NoAnswer`]:
 /// a line quiet a while, fresh15 F5), not where answers came damaged (a
 /// noisy line, whose next try meets the same noise and whose caller gives
@@ -768,24 +772,27 @@ impl Session {
 ///
 /// # Errors
 /// The last attempt's.
-pub(crate) fn tried_quiet<R>(times: u32, mut attempt: impl FnMut() -> Result<R>) -> Result<R> {
-    let mut result = attempt();
-    for _ in 1..times {
-        if !matches!(result, Err(Error::NoAnswer { .. })) {
-            break;
-        }
-        result = attempt();
-    }
-    result
+pub(crate) fn tried_quiet<R>(times: u32, attempt: impl FnMut() -> Result<R>) -> Result<R> {
+    tried_while(
+        times,
+        |error| matches!(error, Error::NoAnswer { .. }),
+        attempt,
+    )
 }
 
-pub(crate) fn tried<R>(times: u32, mut attempt: impl FnMut() -> Result<R>) -> Result<R> {
+/// `attempt` up to `times` times, again while it fails with an error
+/// `again` takes: its last result.
+fn tried_while<R>(
+    times: u32,
+    again: impl Fn(&Error) -> bool,
+    mut attempt: impl FnMut() -> Result<R>,
+) -> Result<R> {
     let mut result = attempt();
     for _ in 1..times {
-        if result.is_ok() {
-            break;
+        match &result {
+            Err(error) if again(error) => result = attempt(),
+            _ => break,
         }
-        result = attempt();
     }
     result
 }

@@ -542,7 +542,6 @@ impl<T: Transport> RobotDebug<T> {
             taken.push(code.address..=code.address.wrapping_add(code.bytes.len() as u16 - 1));
             taken.push(u16::from(*loader.zero_page.start())..=u16::from(*loader.zero_page.end()));
         }
-
         Ok((taken, installed))
     }
 
