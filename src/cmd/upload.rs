@@ -334,8 +334,15 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
         .device_time
         .max(Duration::from_millis(1))
         .as_secs_f64();
+    let written: usize = report.written.iter().map(|range| range.1).sum();
+    // fresh28 F4: "uploaded" where the robot held every byte already.
+    let (what, held) = if written == 0 && report.bytes > 0 {
+        ("verified", " (nothing written: the robot held them all)")
+    } else {
+        ("uploaded and verified", "")
+    };
     let mut text = format!(
-        "uploaded and verified {} bytes in {seconds:.2} s{} ({:.0} bytes/s)",
+        "{what} {} bytes{held} in {seconds:.2} s{} ({:.0} bytes/s)",
         report.bytes,
         if emulated { " of robot time" } else { "" },
         report.bytes as f64 / seconds
@@ -351,8 +358,7 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
         // asked for (`--loader never`): said, so no one looks for it.
         text.push_str(", with the ROM's own commands (/9W, /7R)");
     }
-    let written: usize = report.written.iter().map(|range| range.1).sum();
-    if written < report.bytes {
+    if 0 < written && written < report.bytes {
         let _ = write!(
             text,
             "\n  {written} bytes written in {} range{}: the robot held the rest (checksums computed on it)",

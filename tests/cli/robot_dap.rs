@@ -164,9 +164,10 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
     // fresh15 F3: what stays in RAM after it, as the monitor says it.
     let said = dap.event("output");
     assert!(
-        said["body"]["output"].as_str().is_some_and(|text| text
-            .starts_with("the debug stub is at $")
-            && text.contains("stay in user RAM after the session, unhooked; no undo puts back")),
+        said["body"]["output"]
+            .as_str()
+            .is_some_and(|text| text.starts_with("the debug stub is at $")
+                && text.contains("stay in memory after the session, unhooked; no undo puts back")),
         "{said}"
     );
     // On the robot there is no going back and no data breakpoint.

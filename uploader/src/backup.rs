@@ -499,8 +499,17 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
         ..Backup::default()
     };
     let seen = crate::held_way::over_robot(client, profile, &backup)?;
-    let ranges = witness_ranges_over(profile, &backup, &seen);
+    // hostile28 F3: every byte of code the ways run outside what the file
+    // holds, each arm of a branch too, not only the steps' first bytes.
+    let everyone = backup_table(profile, &seen);
+    let laid = crate::way_checked::laid(&backup);
+    let code = crate::way_checked::code_of(client, profile, (&backup.hooks, &everyone), &laid)?;
+    let ranges = witness_ranges_over(profile, &backup, &seen, &code);
     backup.witnesses = read_witnesses(client, &ranges)?;
+    // Code that changed while it was read is witnessed by nothing: its
+    // restore refuses it, said now as it will say it.
+    let unwitnessed = crate::way_checked::first_unchecked(profile, &backup, &code, &|_| false)
+        .map(|(way, at)| crate::way_checked::unchecked_error(way, at, false).to_string());
     let mut broken = Vec::new();
     let saved = |address: u16| backup.byte_at(u32::from(address)).is_some();
     let outside: Vec<romlib::installed::Installed> = backup_table(profile, &backup)
@@ -535,7 +544,8 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
     // restore will say it (not what the robot-side check would do after).
     let refused = check_file(profile, &memory_profile(profile), &backup, false)
         .err()
-        .map(|error| error.to_string());
+        .map(|error| error.to_string())
+        .or(unwitnessed);
     Ok(Saved {
         backup,
         changing,
@@ -558,14 +568,25 @@ const WITNESS_WINDOW: u16 = 16;
 /// what the backup holds itself (a restore writes and verifies that).
 #[cfg(test)]
 pub(crate) fn witness_ranges(profile: &RomProfile, backup: &Backup) -> Vec<(u16, usize)> {
-    witness_ranges_over(profile, backup, backup)
+    witness_ranges_over(profile, backup, backup, &[])
 }
 
 /// [`witness_ranges`], the ways followed through `seen` (the backup over
 /// the robot's bytes, [`crate::held_way::over_robot`]): the code a way
-/// reaches outside the backup, and where its `JMP` goes on (N1).
-fn witness_ranges_over(profile: &RomProfile, backup: &Backup, seen: &Backup) -> Vec<(u16, usize)> {
+/// reaches outside the backup, and where its `JMP` goes on (N1); and every
+/// byte of `code` (hostile28 F3).
+fn witness_ranges_over(
+    profile: &RomProfile,
+    backup: &Backup,
+    seen: &Backup,
+    code: &[crate::way_checked::WayCode],
+) -> Vec<(u16, usize)> {
     let mut marked = vec![false; 0x1_0000];
+    for at in code.iter().flat_map(|way| way.code.iter()) {
+        if profile.writable.iter().any(|range| range.contains(at)) {
+            marked[usize::from(*at)] = true;
+        }
+    }
     // Every step of a way into memory the backup does not hold: a
     // restore checks the code there is what it was (hostile26 F2).
     for (_, way) in crate::held_way::steps(profile, seen) {
@@ -1059,6 +1080,15 @@ impl Backup {
         self
     }
 
+    /// Whether a witness of the file covers `address`.
+    #[must_use]
+    pub fn witnessed(&self, address: u16) -> bool {
+        self.witnesses.iter().any(|witness| {
+            u32::from(witness.address) <= u32::from(address)
+                && u32::from(address) < u32::from(witness.address) + u32::from(witness.len)
+        })
+    }
+
     /// The byte the backup holds at `address`, if it holds one.
     #[must_use]
     pub fn byte_at(&self, address: u32) -> Option<u8> {
@@ -1253,10 +1283,15 @@ pub fn restore<T: Transport>(
             options.undo,
         )?;
     }
-    if options.undo || !backup.written_entries.is_empty() {
+    let undo = options.undo || !backup.written_entries.is_empty();
+    if undo {
         check_steps_on_robot(client, profile, backup, &seen)?;
     } else {
         check_steps_over(profile, backup, &seen)?;
+    }
+    crate::way_checked::check_restore(client, profile, (backup, &seen), undo)?;
+    if undo && !options.resume && !options.interrupted {
+        crate::relisted::check(client, profile, (backup, &seen))?;
     }
     for error in &overridden {
         progress.event(&crate::progress::Event::RomCheckOverridden {
@@ -1646,10 +1681,7 @@ fn unchecked_steps(
             let at = way[way.len() - 1];
             let writable = profile.writable.iter().any(|range| range.contains(&at));
             let held = backup.byte_at(u32::from(at)).is_some();
-            let witnessed = backup.witnesses.iter().any(|witness| {
-                u32::from(witness.address) <= u32::from(at)
-                    && u32::from(at) < u32::from(witness.address) + u32::from(witness.len)
-            });
+            let witnessed = backup.witnessed(at);
             // The first step is `check_hook_targets`'s.
             way.len() > 1 && writable && !held && !witnessed
         })

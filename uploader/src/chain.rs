@@ -7,7 +7,7 @@
 //! chain slot and a debug stub's chain; other code ends the look (where it
 //! goes cannot be known without running it).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
 use emulator::{Bus, Cpu};
@@ -20,6 +20,8 @@ use crate::hooks::{JMP, read_word};
 use crate::image::RomProfile;
 use crate::transport::Transport;
 use crate::{Error, Result};
+
+mod reach;
 
 /// Jumps followed at most: a longer run is a loop of the robot's own
 /// (it already hangs there), not one through what is written now.
@@ -153,14 +155,13 @@ pub(crate) fn follow<T: Transport>(
     inside: &dyn Fn(u16, &[u16]) -> bool,
     strict: bool,
 ) -> Result<End> {
-    let mut touched = BTreeSet::new();
     follow_noting(
         client,
         profile,
         everyone,
         (kind, target),
         (inside, strict),
-        &mut touched,
+        &mut Noted::default(),
     )
 }
 
@@ -177,17 +178,124 @@ pub(crate) fn unlisted_touched<T: Transport>(
     everyone: &[Installed],
     (kind, target): (HookKind, u16),
 ) -> Result<BTreeSet<u16>> {
-    let mut touched = BTreeSet::new();
+    let mut noted = Noted::default();
     follow_noting(
         client,
         profile,
         everyone,
         (kind, target),
         (&|_, _| false, false),
-        &mut touched,
+        &mut noted,
     )?;
+    let mut touched = noted.code;
     touched.retain(|&at| !everyone.iter().any(|other| other.contains(at)));
     Ok(touched)
+}
+
+/// What a walk ([`follow_noting`]) reads over the robot's memory and what
+/// it notes on the way.
+#[derive(Debug, Default)]
+pub(crate) struct Noted {
+    /// Bytes taken instead of the robot's (a file's, as a restore would
+    /// write them).
+    pub(crate) laid: BTreeMap<u16, u8>,
+    /// Every readable address of the code the way runs: the bytes of its
+    /// `JMP`s and of each instruction run on the host.
+    pub(crate) code: BTreeSet<u16>,
+    /// The addresses the way went through, as far as it was followed.
+    pub(crate) way: Vec<u16>,
+}
+
+/// `len` bytes from `at`: the `laid` ones, the robot's elsewhere.
+fn laid_read<T: Transport>(
+    client: &mut Client<T>,
+    laid: &BTreeMap<u16, u8>,
+    at: u16,
+    len: usize,
+) -> Result<Vec<u8>> {
+    let held: Option<Vec<u8>> = (0..len)
+        .map(|i| laid.get(&at.wrapping_add(i as u16)).copied())
+        .collect();
+    if let Some(held) = held {
+        return Ok(held);
+    }
+    let mut bytes = client.read_live(at, len)?.bytes;
+    for (i, byte) in bytes.iter_mut().enumerate() {
+        if let Some(&over) = laid.get(&at.wrapping_add(i as u16)) {
+            *byte = over;
+        }
+    }
+    Ok(bytes)
+}
+
+/// A chain slot's word: the `laid` bytes, the robot's elsewhere.
+fn laid_word<T: Transport>(
+    client: &mut Client<T>,
+    laid: &BTreeMap<u16, u8>,
+    at: u16,
+) -> Result<Option<u16>> {
+    let over = (laid.get(&at), laid.get(&at.wrapping_add(1)));
+    if let (Some(&lo), Some(&hi)) = over {
+        return Ok(Some(u16::from_le_bytes([lo, hi])));
+    }
+    let Some(word) = read_word(client, at)? else {
+        return Ok(None);
+    };
+    let [lo, hi] = word.to_le_bytes();
+    Ok(Some(u16::from_le_bytes([
+        over.0.copied().unwrap_or(lo),
+        over.1.copied().unwrap_or(hi),
+    ])))
+}
+
+/// The way of `kind` from `target` over the robot's memory with `laid`
+/// bytes over it (a file's, as a restore would leave them), looking for a
+/// broken way (`strict`: calls into RAM followed), and every byte of the
+/// code it runs outside what `everyone` lists: each `JMP`, each
+/// instruction run on the host, and every instruction reachable from a
+/// step on a branch or call not taken in that run (hostile28 F3: code
+/// before a step's `JMP` hid where it went).
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn way_code<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    everyone: &[Installed],
+    (kind, target): (HookKind, u16),
+    laid: BTreeMap<u16, u8>,
+) -> Result<Noted> {
+    let mut noted = Noted {
+        laid,
+        ..Noted::default()
+    };
+    follow_noting(
+        client,
+        profile,
+        everyone,
+        (kind, target),
+        (&|_, _| false, true),
+        &mut noted,
+    )?;
+    let listed = |at: u16| everyone.iter().any(|other| other.contains(at));
+    let starts: Vec<u16> = noted
+        .way
+        .iter()
+        .copied()
+        .filter(|&at| readable(profile, at) && !listed(at))
+        .collect();
+    let mut bus = ChainBus {
+        client,
+        profile,
+        seen: noted.laid.clone(),
+        failed: None,
+        outside: false,
+        wrote: false,
+        touched: &mut noted.code,
+    };
+    reach::reach(&mut bus, &starts, &listed)?;
+    noted.code.retain(|&at| !listed(at));
+    Ok(noted)
 }
 
 /// Where a walk ends: `inside(at, way)`, `way` the addresses gone
@@ -202,14 +310,19 @@ fn follow_noting<T: Transport>(
     everyone: &[Installed],
     (kind, target): (HookKind, u16),
     (inside, strict): (Inside<'_>, bool),
-    touched: &mut BTreeSet<u16>,
+    noted: &mut Noted,
 ) -> Result<End> {
-    let mut path: Vec<u16> = Vec::new();
+    let Noted {
+        laid,
+        code: touched,
+        way: path,
+    } = noted;
+    path.clear();
     let mut at = target;
     for _ in 0..MOST_STEPS {
-        if inside(at, &path) {
+        if inside(at, path) {
             path.push(at);
-            return Ok(End::Inside(Path(path)));
+            return Ok(End::Inside(Path(path.clone())));
         }
         path.push(at);
         let readable = profile
@@ -221,7 +334,7 @@ fn follow_noting<T: Transport>(
         }
         if !readable {
             return Ok(if strict && !rom_entry(profile, at) {
-                End::Strays(Path(path))
+                End::Strays(Path(path.clone()))
             } else {
                 End::Elsewhere
             });
@@ -233,13 +346,13 @@ fn follow_noting<T: Transport>(
         // hostile15 F7: into an installed extension but not at its
         // handler: the middle of its code, where no chain goes.
         if strict && handler.is_none() && everyone.iter().any(|other| other.contains(at)) {
-            return Ok(End::Strays(Path(path)));
+            return Ok(End::Strays(Path(path.clone())));
         }
         let slot = handler.and_then(|hook| hook.chain);
         let next = match slot {
-            Some(slot) => read_word(client, slot)?,
+            Some(slot) => laid_word(client, laid, slot)?,
             None => {
-                let bytes = client.read_live(at, 3)?.bytes;
+                let bytes = laid_read(client, laid, at, 3)?;
                 if bytes[0] == JMP {
                     touched.extend([at, at.wrapping_add(1), at.wrapping_add(2)]);
                     Some(u16::from_le_bytes([bytes[1], bytes[2]]))
@@ -251,25 +364,35 @@ fn follow_noting<T: Transport>(
                     // Other code: run on the host over the robot's memory
                     // as an unknown command would run it, to where it goes.
                     let landing = |pc: u16| {
-                        inside(pc, &path)
+                        inside(pc, path)
                             || everyone
                                 .iter()
                                 .flat_map(|other| other.hooks.iter())
                                 .any(|hook| hook.kind == kind && hook.handler == pc)
                     };
-                    match run_to_landing(client, profile, at, &landing, strict, touched)? {
+                    let bus = ChainBus {
+                        client,
+                        profile,
+                        seen: laid.clone(),
+                        failed: None,
+                        outside: false,
+                        wrote: false,
+                        touched,
+                    };
+                    let landed = run_to_landing(bus, at, &landing, strict)?;
+                    match landed {
                         Landing::At(pc) | Landing::Left(pc) => Some(pc),
                         Landing::Stops(pc) => {
                             path.push(pc);
-                            return Ok(End::Stops(Path(path)));
+                            return Ok(End::Stops(Path(path.clone())));
                         }
                         Landing::Loops(pc) => {
                             path.push(pc);
-                            return Ok(End::Loops(Path(path)));
+                            return Ok(End::Loops(Path(path.clone())));
                         }
                         Landing::Returns(pc) => {
                             path.push(pc);
-                            return Ok(End::Returns(Path(path)));
+                            return Ok(End::Returns(Path(path.clone())));
                         }
                         Landing::Elsewhere => None,
                     }
@@ -484,22 +607,12 @@ const CHUNK: usize = 16;
 /// is a loop; `strict` (looking for a broken way), a call into RAM is
 /// followed, and one into memory no code may be in strays.
 fn run_to_landing<T: Transport>(
-    client: &mut Client<T>,
-    profile: &RomProfile,
+    mut bus: ChainBus<'_, T>,
     start: u16,
     landing: &dyn Fn(u16) -> bool,
     strict: bool,
-    touched: &mut BTreeSet<u16>,
 ) -> Result<Landing> {
-    let mut bus = ChainBus {
-        client,
-        profile,
-        seen: std::collections::BTreeMap::new(),
-        failed: None,
-        outside: false,
-        wrote: false,
-        touched,
-    };
+    let profile = bus.profile;
     let mut cpu = Cpu::new();
     cpu.set_idle_skip(false);
     (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, ENTRY_S, start);
@@ -598,10 +711,11 @@ fn readable(profile: &RomProfile, at: u16) -> bool {
 
 /// The robot's memory for [`run_to_landing`]: read through the line a
 /// chunk at a time, each byte once; writes kept on the host.
-struct ChainBus<'a, T: Transport> {
+pub(crate) struct ChainBus<'a, T: Transport> {
     client: &'a mut Client<T>,
     profile: &'a RomProfile,
-    seen: std::collections::BTreeMap<u16, u8>,
+    /// Bytes read (or laid: a file's), and those the run wrote.
+    seen: BTreeMap<u16, u8>,
     failed: Option<crate::Error>,
     /// An access outside what may be read: the run ends there.
     outside: bool,
@@ -612,7 +726,9 @@ struct ChainBus<'a, T: Transport> {
 }
 
 impl<T: Transport> ChainBus<'_, T> {
-    fn byte(&mut self, address: u16) -> u8 {
+    /// The byte at `address`, read from the robot once; 0 where it may
+    /// not be read or the line failed (see `outside`, `failed`).
+    pub(crate) fn byte(&mut self, address: u16) -> u8 {
         if let Some(&byte) = self.seen.get(&address) {
             return byte;
         }

@@ -531,12 +531,12 @@ pub enum Error {
     /// holds, into RAM the file neither restores nor witnesses (hostile26
     /// F1). Nothing was written.
     #[error(
-        "the file's {hook} leads {path}, on into ${target:04X}, which the file neither restores (it holds no byte there) nor witnesses (no checksum of it covers it): the code there is not checked, and the robot would run whatever that memory holds; nothing was written"
+        "the file's {hook} leads {path} and runs the code at ${target:04X}, which the file neither restores (it holds no byte there) nor witnesses (no checksum of it covers it): the code there is not checked, and the robot would run whatever that memory holds; nothing was written"
     )]
     #[diagnostic(
         code(uploader::unwitnessed_hook),
         help(
-            "a file `scorpion backup` writes holds user RAM and witnesses the code each hook's way reaches outside it: this file was made or changed by something else; restore another backup, or upload the extensions instead"
+            "a file `scorpion backup` writes holds user RAM and witnesses every byte of code each hook's way runs outside it: this file was made by an older `scorpion backup`, or changed by something else, or that code changed while `backup` read it; take a new backup, restore another, or upload the extensions instead"
         )
     )]
     UnwitnessedStep {
@@ -552,7 +552,7 @@ pub enum Error {
     /// it neither puts back nor witnesses and that no entry of the robot's
     /// table lists now (hostile26 F1b). Nothing was written.
     #[error(
-        "the undo file's {hook} leads {path}, on into ${target:04X}, which the file neither puts back nor witnesses, no entry of the robot's table lists now, and no hook of the robot leads through now: the code there is not checked, and the robot would run whatever that memory holds; nothing was written"
+        "the undo file's {hook} leads {path} and runs the code at ${target:04X}, which the file neither puts back nor witnesses, no entry of the robot's table lists now, and no hook of the robot leads through now: the code there is not checked, and the robot would run whatever that memory holds; nothing was written"
     )]
     #[diagnostic(
         code(uploader::undo_step_unlisted),
@@ -567,6 +567,46 @@ pub enum Error {
         target: u16,
         /// The way there, `$0803 -> $0503`.
         path: String,
+    },
+
+    /// An undo file puts in code no entry of its table lists, on a hook's
+    /// way, where no hook of the robot runs code now (hostile28 F5: a
+    /// record added by hand, a hook pointed at it). Nothing was written.
+    #[error(
+        "the undo file's {hook} leads {path} and runs the code it puts in at ${target:04X}, which no entry of the table lists and no hook of the robot runs now: an upload's undo puts back such code only where the upload found a hook running it, and overwrote none of it; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::undo_adds_code),
+        help(
+            "this undo file was changed by hand, or the robot's hooks were moved since the upload: upload the extension you want as an image (it is then listed and checked), or restore a backup taken with `scorpion backup`"
+        )
+    )]
+    UndoAddsCode {
+        /// The hook.
+        hook: &'static str,
+        /// The first byte of that code the way runs.
+        target: u16,
+        /// The way there, `$0803 -> $0503`.
+        path: String,
+    },
+
+    /// An undo would list again an extension the robot no longer lists,
+    /// from what memory still holds, where the file checks part of it
+    /// only (hostile28 F6, F7: a reset since). Nothing was written.
+    #[error(
+        "the undo would list {extension} again, which the robot no longer lists (nor any extension the undo takes out: a reset since the upload clears the table), and the file neither puts back nor witnesses {what}: what memory holds there may have changed since; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::undo_relists_unchecked),
+        help(
+            "a reset (`/1R`) clears the table and leaves memory for anyone to change: upload that extension again (its image is checked as it goes in), or restore a backup taken with `scorpion backup`"
+        )
+    )]
+    UndoRelistsUnchecked {
+        /// The extension, as `installed` names it.
+        extension: String,
+        /// What of it nothing checks, with the first such address.
+        what: String,
     },
 
     /// A backup or undo file points a hook into RAM that it neither

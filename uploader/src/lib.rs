@@ -35,6 +35,7 @@ mod hooks;
 mod image;
 mod loader;
 mod progress;
+mod relisted;
 mod room;
 mod session;
 pub mod stub;
@@ -46,6 +47,7 @@ pub mod transport;
 mod unchanged;
 mod undo;
 mod upload;
+mod way_checked;
 
 pub use backup::{
     Backup, BrokenHook, Keep, MAGIC, NoKeep, Saved, Witness, backup, backup_live, backup_ranges,

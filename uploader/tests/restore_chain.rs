@@ -1464,3 +1464,239 @@ fn an_undo_whose_table_would_not_decode_over_the_robots_writes_nothing() {
     assert!(held(&mut client) == before, "nothing written");
     uploader::read_installed(&mut client, &options.profile).expect("the table decodes");
 }
+
+/// The robot of hostile28 F3: the extension at $0500 on HOOK_UNKNOWN, its
+/// chain slot by hand into code on the KIM bus that does something before
+/// each `JMP`: $1000 `NOP` x14, `JMP $2000` (its high byte at $1010, past
+/// a 16-byte window); $2000 `LDA $0F00`, `BNE $2008`, `JMP $3000`;
+/// $2008 `JMP $3100`; $3000 and $3100 `INC $0F01`, `JMP BAD_COMMAND`. The
+/// host run takes one arm of the branch ($0F00 holds 0: $3000).
+fn kim_code_before_each_jmp() -> (
+    UploadOptions,
+    uploader::Client<uploader::transport::VirtualTransport>,
+    uploader::Backup,
+) {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0500),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    let mut first = vec![0xEA; 14];
+    first.extend([0x4C, 0x00, 0x20]);
+    by_hand(&mut client, 0x1000, &first);
+    by_hand(
+        &mut client,
+        0x2000,
+        &[
+            0xAD, 0x00, 0x0F, 0xD0, 0x03, 0x4C, 0x00, 0x30, 0x4C, 0x00, 0x31,
+        ],
+    );
+    by_hand(&mut client, 0x3000, &[0xEE, 0x01, 0x0F, 0x4C, lo, hi]);
+    by_hand(&mut client, 0x3100, &[0xEE, 0x01, 0x0F, 0x4C, lo, hi]);
+    by_hand(&mut client, 0x0501, &[0x00, 0x10]);
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    (options, client, saved)
+}
+
+/// hostile28 F3 (a), (b): `backup` witnessed 16 bytes at each step, and
+/// followed a step only when it began with a `JMP`: the `JMP`'s high byte
+/// past the window, and every step after it, changed with the restore
+/// saying "verified". Now every byte of code the way runs is witnessed,
+/// both arms of a branch too, and a change anywhere in it is refused
+/// before anything is written.
+#[test]
+fn a_backup_witnesses_every_byte_of_code_its_ways_run() {
+    let (options, mut client, saved) = kim_code_before_each_jmp();
+    let code = (0x1000..=0x1010)
+        .chain(0x2000..=0x200A)
+        .chain(0x3000..=0x3005)
+        .chain(0x3100..=0x3105);
+    let unwitnessed: Vec<u16> = code.filter(|&at| !saved.witnessed(at)).collect();
+    assert!(
+        unwitnessed.is_empty(),
+        "{unwitnessed:04X?} of {:?}",
+        saved.witnesses
+    );
+    for (at, byte) in [
+        (0x1010, 0x21),
+        (0x2006, 0x01),
+        (0x3002, 0x05),
+        (0x3101, 0x14),
+    ] {
+        let before = client.transport().robot().robot().board().memory()[usize::from(at)];
+        by_hand(&mut client, at, &[byte]);
+        let held_before = held(&mut client);
+        match restore(&mut client, &saved, &options, &mut NoProgress) {
+            Err(Error::WitnessDiffers { address, len, .. }) => {
+                assert!(
+                    address <= at && at < address + len,
+                    "${at:04X}: ${address:04X}+{len}"
+                );
+            }
+            other => panic!("${at:04X} changed: {other:?}"),
+        }
+        assert!(
+            held(&mut client) == held_before,
+            "nothing written (${at:04X})"
+        );
+        by_hand(&mut client, at, &[before]);
+    }
+    restore(&mut client, &saved, &options, &mut NoProgress).expect("unchanged, restored");
+}
+
+/// hostile28 F3 (c): a file whose witness of a step was cut to the step's
+/// opcode byte (or dropped) checks nothing of the rest of the code the
+/// way runs: refused, the byte named, nothing written.
+#[test]
+fn a_file_that_witnesses_part_of_the_code_a_way_runs_is_refused() {
+    let (options, mut client, saved) = kim_code_before_each_jmp();
+    let covering = |file: &uploader::Backup, at: u16| {
+        file.witnesses
+            .iter()
+            .position(|w| w.address <= at && at < w.address + w.len)
+            .expect("witnessed")
+    };
+    // The witness of $3100 (the arm not run) dropped.
+    let mut dropped = saved.clone();
+    let i = covering(&dropped, 0x3100);
+    let cut = dropped.witnesses.remove(i);
+    // Only what lies outside $3100-$3105 is witnessed again.
+    for (start, end) in [(cut.address, 0x30FF), (0x3106, cut.address + cut.len - 1)] {
+        if start <= end {
+            let bytes = &client.transport().robot().robot().board().memory()
+                [usize::from(start)..=usize::from(end)];
+            dropped.witnesses.push(uploader::Witness {
+                address: start,
+                len: end - start + 1,
+                sum: uploader::fletcher16(bytes),
+            });
+        }
+    }
+    let before = held(&mut client);
+    match restore(&mut client, &dropped, &options, &mut NoProgress) {
+        Err(error @ Error::UnwitnessedStep { target: 0x3100, .. }) => {
+            let text = error.to_string();
+            assert!(text.contains("runs the code at $3100"), "{text}");
+            assert!(text.ends_with("nothing was written"), "{text}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+    // The witness of $1000 cut before the `JMP`'s high byte.
+    let mut short = saved.clone();
+    let i = covering(&short, 0x1000);
+    let memory = client.transport().robot().robot().board().memory().to_vec();
+    let first = short.witnesses[i];
+    assert_eq!(first.address, 0x1000, "{:?}", short.witnesses);
+    short.witnesses[i] = uploader::Witness {
+        address: 0x1000,
+        len: 16,
+        sum: uploader::fletcher16(&memory[0x1000..0x1010]),
+    };
+    if first.len > 17 {
+        short.witnesses.push(uploader::Witness {
+            address: 0x1011,
+            len: first.len - 17,
+            sum: uploader::fletcher16(&memory[0x1011..usize::from(first.address + first.len)]),
+        });
+    }
+    match restore(&mut client, &short, &options, &mut NoProgress) {
+        Err(Error::UnwitnessedStep {
+            target: 0x1010,
+            path,
+            ..
+        }) => {
+            assert!(path.starts_with("$0503 -> $1000"), "{path}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+}
+
+/// a at $0500 installed, then b at $0800 in front of it with its undo
+/// kept: the robot, and b's undo file.
+fn b_in_front_of_a_kept() -> (
+    UploadOptions,
+    uploader::Client<uploader::transport::VirtualTransport>,
+    uploader::Backup,
+) {
+    let (options, mut client, _) = in_a_chain(&[0x0500]);
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0800),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("in front");
+    (options, client, kept.0.expect("kept"))
+}
+
+/// hostile28 F5: b's undo file with a record of code added by hand at
+/// $0900 (`JMP` a's handler) and HOOK_UNKNOWN pointed at it: restored,
+/// exit 0, the hook running memory the table calls free. An upload's
+/// undo puts back code no entry lists only where the robot runs it.
+#[test]
+fn an_undo_that_puts_in_code_no_entry_lists_and_nothing_runs_is_refused() {
+    let (_, mut client, mut file) = b_in_front_of_a_kept();
+    let (_, _, undo) = plain_replace_undo();
+    file.areas.push(uploader::Area {
+        address: 0x0900,
+        bytes: vec![0x4C, 0x03, 0x05],
+    });
+    for (kind, target) in &mut file.hooks {
+        if *kind == HookKind::Unknown {
+            *target = 0x0900;
+        }
+    }
+    let before = held(&mut client);
+    match restore(&mut client, &file, &undo, &mut NoProgress) {
+        Err(error @ Error::UndoAddsCode { target: 0x0900, .. }) => {
+            assert!(
+                error.to_string().ends_with("nothing was written"),
+                "{error}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+    assert_eq!(hook(&mut client), 0x0803, "b still hooked");
+}
+
+/// hostile28 F6, F7: after `/1R` (the table's flags cleared, memory
+/// kept), b's undo marked a in use again from what memory held: a's
+/// code past the 16 bytes the file witnesses changed by hand, or its
+/// entry's id, and the undo said "verified". Refused, nothing written;
+/// with the robot as the upload left it, the undo goes through.
+#[test]
+fn an_undo_after_a_reset_lists_nothing_it_does_not_check() {
+    let (_, mut client, file) = b_in_front_of_a_kept();
+    let (options, _, undo) = plain_replace_undo();
+    let (table, entries) = options.profile.table.expect("a table");
+    let reset = romlib::protocol::Command::parse(b"/1R").expect("a command");
+    let _ = client.listen(&reset).expect("the line works");
+    // a's tail, past what the file witnesses, now runs $0900.
+    by_hand(&mut client, 0x0530, &[0x4C, 0x00, 0x09]);
+    let a_entry = romlib::installed::entry_address(table, entries, 0);
+    by_hand(&mut client, a_entry + 1, &[0x56, 0x34, 0x12]);
+    let before = held(&mut client);
+    match restore(&mut client, &file, &undo, &mut NoProgress) {
+        Err(error @ Error::UndoRelistsUnchecked { .. }) => {
+            let text = error.to_string();
+            assert!(text.contains("no longer lists"), "{text}");
+            assert!(text.ends_with("nothing was written"), "{text}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+    // Not reset: the same undo goes through.
+    let (_, mut client, file) = b_in_front_of_a_kept();
+    restore(&mut client, &file, &undo, &mut NoProgress).expect("undone");
+    assert_eq!(hook(&mut client), 0x0503, "a hooked again");
+}

@@ -1,0 +1,176 @@
+//! Every byte of code a file's hooks run, as a restore would leave them,
+//! is one the file holds or witnesses (hostile28 F3, fresh28 F2). A way
+//! that went through code on the KIM bus was followed only through chain
+//! slots and a `JMP` at each step: code before the `JMP` (`INC counter;
+//! JMP next`, what every loop handler looks like), or a `JMP` whose
+//! operand lay past the witnessed bytes, hid the next step, which could
+//! change and be restored with "verified", exit 0. The ways are followed
+//! as [`crate::chain::way_code`] does (run on the host, and every arm of
+//! its branches): `backup` witnesses all of it, a restore refuses what it
+//! does not check.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use isa::objfmt::HookKind;
+use romlib::installed::Installed;
+
+use crate::backup::Backup;
+use crate::client::Client;
+use crate::image::RomProfile;
+use crate::transport::Transport;
+use crate::{Error, Result};
+
+/// The code one hook's way runs outside the extensions listed.
+#[derive(Debug, Clone)]
+pub(crate) struct WayCode {
+    /// The hook.
+    pub(crate) hook: HookKind,
+    /// The steps the way went through.
+    pub(crate) way: Vec<u16>,
+    /// Every byte of code it runs that no listed extension holds.
+    pub(crate) code: BTreeSet<u16>,
+}
+
+/// The bytes `backup` holds, as a restore would write them (the first
+/// area that holds a byte, as [`Backup::byte_at`] reads it).
+#[must_use]
+pub(crate) fn laid(backup: &Backup) -> BTreeMap<u16, u8> {
+    let mut laid = BTreeMap::new();
+    for area in &backup.areas {
+        for (i, &byte) in area.bytes.iter().enumerate() {
+            laid.entry(area.address.wrapping_add(i as u16))
+                .or_insert(byte);
+        }
+    }
+    laid
+}
+
+/// The code each of `hooks` that goes into RAM runs, over the robot's
+/// memory with `laid` over it, `everyone` the table it would list.
+///
+/// # Errors
+/// The line's errors.
+pub(crate) fn code_of<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    (hooks, everyone): (&[(HookKind, u16)], &[Installed]),
+    laid: &BTreeMap<u16, u8>,
+) -> Result<Vec<WayCode>> {
+    let mut ways = Vec::new();
+    for (hook, target) in crate::chain::into_ram(profile, hooks) {
+        let noted =
+            crate::chain::way_code(client, profile, everyone, (hook, target), laid.clone())?;
+        ways.push(WayCode {
+            hook,
+            way: noted.way,
+            code: noted.code,
+        });
+    }
+    Ok(ways)
+}
+
+/// The first byte of `ways` in memory an extension may hold that
+/// `backup` neither holds nor witnesses and `fine` does not excuse: the
+/// hook, the way, the byte.
+#[must_use]
+pub(crate) fn first_unchecked<'a>(
+    profile: &RomProfile,
+    backup: &Backup,
+    ways: &'a [WayCode],
+    fine: &dyn Fn(u16) -> bool,
+) -> Option<(&'a WayCode, u16)> {
+    ways.iter().find_map(|way| {
+        way.code
+            .iter()
+            .copied()
+            .find(|&at| {
+                let writable = profile.writable.iter().any(|range| range.contains(&at));
+                writable
+                    && backup.byte_at(u32::from(at)).is_none()
+                    && !backup.witnessed(at)
+                    && !fine(at)
+            })
+            .map(|at| (way, at))
+    })
+}
+
+/// Before a restore writes anything: every byte of code `backup`'s hooks
+/// run, over the robot as `seen` (the file over the robot's table and
+/// ways, its witnesses checked) says, is held or witnessed by the file.
+/// An undo file's may also be code of an extension the robot lists now,
+/// or code the robot's own hooks run now (recheck25 R6: an upload chained
+/// in front of an owner's code; its undo puts that way back); and code no
+/// entry lists that it puts in must be such code too.
+///
+/// # Errors
+/// [`Error::UnwitnessedStep`] for a backup, [`Error::UndoStepUnlisted`]
+/// and [`Error::UndoAddsCode`] for an undo file; the line's errors.
+pub(crate) fn check_restore<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    (backup, seen): (&Backup, &Backup),
+    undo: bool,
+) -> Result<()> {
+    let everyone = crate::backup::backup_table(profile, seen);
+    let ways = code_of(client, profile, (&backup.hooks, &everyone), &laid(backup))?;
+    if !undo {
+        return match first_unchecked(profile, backup, &ways, &|_| false) {
+            Some((way, at)) => Err(unchecked_error(way, at, false)),
+            None => Ok(()),
+        };
+    }
+    let put_in = |at: u16| backup.byte_at(u32::from(at)).is_some();
+    let nothing_to_ask = first_unchecked(profile, backup, &ways, &|_| false).is_none()
+        && !ways.iter().any(|way| way.code.iter().any(|&at| put_in(at)));
+    if nothing_to_ask {
+        return Ok(());
+    }
+    let listed = crate::table::read_installed(client, profile)?;
+    let hooks = crate::hooks::read_hooks(client, profile)?;
+    let now = code_of(client, profile, (&hooks, &listed), &BTreeMap::new())?;
+    let run_now = |at: u16| {
+        listed.iter().any(|entry| entry.contains(at))
+            || now.iter().any(|way| way.code.contains(&at))
+    };
+    if let Some((way, at)) = first_unchecked(profile, backup, &ways, &run_now) {
+        return Err(unchecked_error(way, at, true));
+    }
+    // hostile28 F5: code no entry lists that the file puts in itself. An
+    // upload chains in front of such code where it finds a hook running
+    // it, and overwrites none of it; its undo finds it run still.
+    let added = ways.iter().find_map(|way| {
+        way.code
+            .iter()
+            .copied()
+            .find(|&at| put_in(at) && !run_now(at))
+            .map(|at| (way, at))
+    });
+    match added {
+        Some((way, at)) => Err(Error::UndoAddsCode {
+            hook: way.hook.rom_symbol(),
+            target: at,
+            path: crate::held_way::path_text(&way.way),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The refusal of a restore whose `way` runs the code at `at`, which
+/// nothing checks.
+pub(crate) fn unchecked_error(way: &WayCode, at: u16, undo: bool) -> Error {
+    let hook = way.hook.rom_symbol();
+    let path = crate::held_way::path_text(&way.way);
+    if undo {
+        Error::UndoStepUnlisted {
+            hook,
+            target: at,
+            path,
+        }
+    } else {
+        Error::UnwitnessedStep {
+            hook,
+            target: at,
+            path,
+        }
+    }
+}
