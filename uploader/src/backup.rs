@@ -588,16 +588,25 @@ fn witness_ranges_over(
         }
     }
     // Every step of a way into memory the backup does not hold: a
-    // restore checks the code there is what it was (hostile26 F2).
+    // restore checks the code there is what it was (hostile26 F2). Where
+    // the code the way runs is known byte by byte, that is all: a window
+    // past it takes in data the code writes (a counter in line), which a
+    // restore would find changed.
+    let run = |at: u16| code.iter().any(|way| way.code.contains(&at));
+    let listed = backup_table(profile, seen);
+    let in_listed = |at: u16| listed.iter().any(|entry| entry.contains(at));
     for (_, way) in crate::held_way::steps(profile, seen) {
         let at = way[way.len() - 1];
-        if profile.writable.iter().any(|range| range.contains(&at)) {
+        let writable = profile.writable.iter().any(|range| range.contains(&at));
+        if writable && (in_listed(at) || !run(at)) {
             mark_window(&mut marked, profile, (at, WITNESS_WINDOW), None);
         }
     }
     for (target, extents) in hooked_extents(profile, backup) {
         if extents.is_empty() {
-            mark_window(&mut marked, profile, (target, WITNESS_WINDOW), None);
+            if !run(target) {
+                mark_window(&mut marked, profile, (target, WITNESS_WINDOW), None);
+            }
         } else {
             for extent in extents {
                 marked[usize::from(*extent.start())..=usize::from(*extent.end())].fill(true);

@@ -204,6 +204,9 @@ pub(crate) struct Noted {
     pub(crate) code: BTreeSet<u16>,
     /// The addresses the way went through, as far as it was followed.
     pub(crate) way: Vec<u16>,
+    /// What the code run on the host wrote: its data (a counter after a
+    /// branch always taken, an operand it changes), not code to check.
+    pub(crate) data: BTreeSet<u16>,
 }
 
 /// `len` bytes from `at`: the `laid` ones, the robot's elsewhere.
@@ -292,9 +295,11 @@ pub(crate) fn way_code<T: Transport>(
         outside: false,
         wrote: false,
         touched: &mut noted.code,
+        written: &mut noted.data,
     };
     reach::reach(&mut bus, &starts, &listed)?;
-    noted.code.retain(|&at| !listed(at));
+    let data = &noted.data;
+    noted.code.retain(|&at| !listed(at) && !data.contains(&at));
     Ok(noted)
 }
 
@@ -316,6 +321,7 @@ fn follow_noting<T: Transport>(
         laid,
         code: touched,
         way: path,
+        data: written,
     } = noted;
     path.clear();
     let mut at = target;
@@ -378,6 +384,7 @@ fn follow_noting<T: Transport>(
                         outside: false,
                         wrote: false,
                         touched,
+                        written,
                     };
                     let landed = run_to_landing(bus, at, &landing, strict)?;
                     match landed {
@@ -723,6 +730,8 @@ pub(crate) struct ChainBus<'a, T: Transport> {
     wrote: bool,
     /// Every readable address of the code the run ran.
     touched: &'a mut BTreeSet<u16>,
+    /// Every address the run wrote.
+    written: &'a mut BTreeSet<u16>,
 }
 
 impl<T: Transport> ChainBus<'_, T> {
@@ -768,6 +777,7 @@ impl<T: Transport> Bus for ChainBus<'_, T> {
     fn write(&mut self, address: u16, value: u8, _cycle: u64) {
         self.seen.insert(address, value);
         self.wrote = true;
+        self.written.insert(address);
     }
 
     fn dummy_read(&mut self, _address: u16, _cycle: u64) {}

@@ -1700,3 +1700,35 @@ fn an_undo_after_a_reset_lists_nothing_it_does_not_check() {
     restore(&mut client, &file, &undo, &mut NoProgress).expect("undone");
     assert_eq!(hook(&mut client), 0x0503, "a hooked again");
 }
+
+/// A counter the way's own code keeps in line, after a branch always
+/// taken ($1000 `INC $1007`, `LDA #1`, `BNE $1008`; $1007 the counter;
+/// $1008 `JMP BAD_COMMAND`): reached as code on the branch's other arm,
+/// it is data the code writes, which changes as it runs. Not witnessed,
+/// not refused: the backup restores with the counter moved on.
+#[test]
+fn data_the_ways_code_writes_is_not_taken_for_code() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0500),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    by_hand(
+        &mut client,
+        0x1000,
+        &[0xEE, 0x07, 0x10, 0xA9, 0x01, 0xD0, 0x01, 0x00, 0x4C, lo, hi],
+    );
+    by_hand(&mut client, 0x0501, &[0x00, 0x10]);
+    let saved = backup(&mut client, &options.profile).expect("a backup");
+    assert!(!saved.witnessed(0x1007), "{:?}", saved.witnesses);
+    for at in (0x1000..=0x1006).chain(0x1008..=0x100A) {
+        assert!(saved.witnessed(at), "${at:04X}: {:?}", saved.witnesses);
+    }
+    by_hand(&mut client, 0x1007, &[0x2A]);
+    restore(&mut client, &saved, &options, &mut NoProgress).expect("restored");
+}
