@@ -173,7 +173,7 @@ pub enum Error {
     #[diagnostic(
         code(scorpion::config::no_port),
         help(
-            "give it (`--port /dev/ttyUSB0`, or `--port emu` for the virtual Scorpion), set SCORPION_PORT, or add `port` to [robot] in {user} (yours) or Scorpion.toml (the project's)"
+            "give it (`--port /dev/ttyUSB0`, or `--port emu` for the virtual Scorpion; in an editor's launch configuration, its `port`), set SCORPION_PORT, or add `port` to [robot] in {user} (yours) or Scorpion.toml (the project's)"
         )
     )]
     NoPort {

@@ -99,14 +99,44 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
             entry.describe()
         ));
     }
+    // fresh29 F2: code no entry lists that a hook's way runs outside what
+    // the file saves (an owner's, on the KIM bus) is only witnessed: said
+    // now, not first at a restore that refuses it.
+    let owners: Vec<String> = backup
+        .witnesses
+        .iter()
+        .filter(|witness| !outside.iter().any(|entry| entry.contains(witness.address)))
+        .map(|witness| {
+            let last = u32::from(witness.address) + u32::from(witness.len) - 1;
+            if witness.len == 1 {
+                format!("${:04X}", witness.address)
+            } else {
+                format!("${:04X}-${last:04X}", witness.address)
+            }
+        })
+        .collect();
+    if !owners.is_empty() && refused.is_none() {
+        print(&format!(
+            "note: the hooks' ways run code no entry lists outside what a backup saves ({}): the file checks at a restore that it is still there byte for byte and cannot bring it back, so a change there (by hand too) refuses the restore",
+            owners.join(", ")
+        ));
+    }
     for found in &disagreements {
         // Said now, not first at the restore (hostile22 F4, hSkip); one
         // the restore refuses is said above.
-        if let uploader::Disagreement::NotHooked { .. } = found {
-            print(&format!(
+        match found {
+            uploader::Disagreement::NotHooked { .. } => print(&format!(
                 "warning: {}: a restore of this file puts it back so, listed and never run (upload it again to hook it)",
                 found.describe()
-            ));
+            )),
+            // fresh28 F1: an owner's handler in front of the extensions.
+            uploader::Disagreement::Unlisted { first: true, .. } if refused.is_none() => {
+                print(&format!(
+                    "note: {}: a handler of your own in front of them, which a restore of this file puts back so (an upload over that code is refused while a hook runs it)",
+                    found.describe()
+                ));
+            }
+            _ => {}
         }
     }
     for hook in &broken {

@@ -214,7 +214,8 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         // fresh14 F8: what stays in RAM, said as the session starts.
         "stay in memory after the session, unhooked; no undo puts back what was there",
         // fresh28 F3: and the loader's zero page.
-        "and its state in user zero page $F8-$FF, stay in memory",
+        "its state in user zero page $F8-$FF), stay in memory",
+        "(and user zero page $F6-$F7)",
     ] {
         assert!(printed.contains(expected), "{expected}:\n{printed}");
     }

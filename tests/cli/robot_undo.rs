@@ -138,7 +138,7 @@ fn an_undo_file_from_one_robot_is_refused_on_another() {
     // there, the range named as the table's entry.
     assert!(
         text.contains(
-            "the upload the undo file scorpion-last-upload.undo undoes is no longer on the robot"
+            "the robot is not as the upload the undo file scorpion-last-upload.undo undoes left it"
         ),
         "{text}"
     );

@@ -207,6 +207,10 @@ pub(crate) struct Noted {
     /// What the code run on the host wrote: its data (a counter after a
     /// branch always taken, an operand it changes), not code to check.
     pub(crate) data: BTreeSet<u16>,
+    /// Whether the way ends where a command's way may: the ROM, or code
+    /// past every listed extension (not a loop, code that stops the CPU,
+    /// a return nothing called, or memory no code may be in).
+    pub(crate) fine: bool,
 }
 
 /// `len` bytes from `at`: the `laid` ones, the robot's elsewhere.
@@ -272,14 +276,15 @@ pub(crate) fn way_code<T: Transport>(
         laid,
         ..Noted::default()
     };
-    follow_noting(
+    let end = follow_noting(
         client,
         profile,
         everyone,
         (kind, target),
-        (&|_, _| false, true),
+        (&|at, way| way.contains(&at), true),
         &mut noted,
     )?;
+    noted.fine = end == End::Elsewhere;
     let listed = |at: u16| everyone.iter().any(|other| other.contains(at));
     let starts: Vec<u16> = noted
         .way
@@ -322,6 +327,7 @@ fn follow_noting<T: Transport>(
         code: touched,
         way: path,
         data: written,
+        ..
     } = noted;
     path.clear();
     let mut at = target;

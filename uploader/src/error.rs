@@ -271,7 +271,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::chain_comes_back),
         help(
-            "the code on that way jumps into the memory the image takes (an earlier copy of it, an owner's JMP, a stub's chain, code whose table entry was freed): point {hook} back at the ROM (`scorpion restore` of a backup taken before, or reset the robot) and upload again"
+            "the code on that way jumps into the memory the image takes (an earlier copy of it, an owner's JMP, a stub's chain, code whose table entry was freed): point {hook} back at the ROM (`scorpion restore` of a backup taken before, or reset the robot) and upload again; an image installed already, behind a handler of your own that jumps to it, needs no upload (`scorpion installed` lists it)"
         )
     )]
     ChainComesBack {
@@ -510,7 +510,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::witness_differs),
         help(
-            "the hook would point at code that is not there: this is another robot, or a restore or upload has changed it since (memory a backup does not save, the KIM bus's, is only witnessed); upload the image again instead"
+            "the hook would point at code that is not there: this is another robot, or a restore, an upload or a change by hand has changed it since (memory a backup does not save, the KIM bus's, is only witnessed); put that code back as it was, take a new backup, or upload the image again instead (`--force` overrides only a ROM that differs)"
         )
     )]
     WitnessDiffers {
@@ -599,7 +599,7 @@ pub enum Error {
     #[diagnostic(
         code(uploader::undo_relists_unchecked),
         help(
-            "a reset (`/1R`) clears the table and leaves memory for anyone to change: upload that extension again (its image is checked as it goes in), or restore a backup taken with `scorpion backup`"
+            "a reset (`/1R`) clears the table and leaves memory for anyone to change, so no undo file kept before it can be used: upload the extensions you want again (each image is checked as it goes in), or restore a backup taken with `scorpion backup`"
         )
     )]
     UndoRelistsUnchecked {

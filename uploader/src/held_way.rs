@@ -62,6 +62,11 @@ pub enum Disagreement {
         behind: Vec<Installed>,
         /// The way there.
         path: String,
+        /// Whether that code is the hook's own target, in front of every
+        /// listed extension: an owner's handler (fresh28 F1), which a
+        /// restore puts back where its way goes on into them (told over
+        /// the robot, [`crate::way_checked::owner_in_front`]).
+        first: bool,
     },
     /// The hook's way runs into the memory of `extension`, which the
     /// table lists, but not to its handler on that hook: the middle of its
@@ -106,11 +111,17 @@ impl Disagreement {
                 hook.rom_symbol(),
                 freed.describe()
             ),
-            Disagreement::Unlisted { hook, behind, path } => {
+            Disagreement::Unlisted {
+                hook,
+                behind,
+                path,
+                first,
+            } => {
                 let behind: Vec<String> = behind.iter().map(Installed::describe).collect();
                 format!(
-                    "{} runs through code no entry of the table lists ({path}), before {} the table lists on it",
+                    "{} runs {}through code no entry of the table lists ({path}), before {} the table lists on it",
                     hook.rom_symbol(),
+                    if *first { "first " } else { "" },
                     behind.join(", ")
                 )
             }
@@ -148,6 +159,7 @@ impl Disagreement {
     pub fn refusal(&self) -> Option<&'static str> {
         match self {
             Disagreement::NotHooked { .. } => None,
+            Disagreement::Unlisted { first: true, .. } => None,
             Disagreement::ThroughFreed { .. } | Disagreement::Unlisted { .. } => {
                 Some("commands would run through memory the next upload may be put in")
             }
@@ -240,6 +252,7 @@ pub(crate) fn disagreements(profile: &RomProfile, backup: &Backup) -> Vec<Disagr
                 found.push(Disagreement::Unlisted {
                     hook: kind,
                     behind,
+                    first: path.len() == 1,
                     path: path_text(&path),
                 });
                 break false;

@@ -58,8 +58,8 @@ pub(crate) fn check<T: Transport>(
                 .find(|&at| !checked(at))
         };
         let what = match (unchecked_entry, unchecked_code()) {
-            (Some(at), _) => format!("its table entry (${at:04X})"),
-            (None, Some(at)) => format!("its memory (${at:04X})"),
+            (Some(at), _) => format!("its table entry (from ${at:04X})"),
+            (None, Some(at)) => format!("all of its memory (from ${at:04X})"),
             (None, None) => continue,
         };
         return Err(Error::UndoRelistsUnchecked {

@@ -29,6 +29,8 @@ pub(crate) struct WayCode {
     pub(crate) way: Vec<u16>,
     /// Every byte of code it runs that no listed extension holds.
     pub(crate) code: BTreeSet<u16>,
+    /// Whether it ends where a command's way may ([`crate::chain::Noted`]).
+    pub(crate) fine: bool,
 }
 
 /// The bytes `backup` holds, as a restore would write them (the first
@@ -64,6 +66,7 @@ pub(crate) fn code_of<T: Transport>(
             hook,
             way: noted.way,
             code: noted.code,
+            fine: noted.fine,
         });
     }
     Ok(ways)
@@ -114,6 +117,9 @@ pub(crate) fn check_restore<T: Transport>(
     let everyone = crate::backup::backup_table(profile, seen);
     let ways = code_of(client, profile, (&backup.hooks, &everyone), &laid(backup))?;
     if !undo {
+        if let Some(error) = owner_in_front(&everyone, &ways) {
+            return Err(error);
+        }
         return match first_unchecked(profile, backup, &ways, &|_| false) {
             Some((way, at)) => Err(unchecked_error(way, at, false)),
             None => Ok(()),
@@ -155,6 +161,48 @@ pub(crate) fn check_restore<T: Transport>(
     }
 }
 
+/// fresh28 F1: a hook at code no entry lists, while the table lists
+/// extensions on that hook, is an owner's handler in front of them (a
+/// backup of a robot an owner set up so could not be restored) only where
+/// its way goes on into a listed extension's handler on that hook and
+/// ends where a command's way may. Anything else is refused as before
+/// (hostile22 F10: a copy of an extension in the RAM loader's place whose
+/// way led nowhere).
+#[must_use]
+pub(crate) fn owner_in_front(everyone: &[Installed], ways: &[WayCode]) -> Option<Error> {
+    ways.iter().find_map(|way| {
+        let on_hook = |at: u16| {
+            everyone
+                .iter()
+                .flat_map(|entry| entry.hooks.iter())
+                .any(|hook| hook.kind == way.hook && hook.handler == at)
+        };
+        let any_on_hook = everyone
+            .iter()
+            .flat_map(|entry| entry.hooks.iter())
+            .any(|hook| hook.kind == way.hook);
+        let target = *way.way.first()?;
+        if !any_on_hook || on_hook(target) || everyone.iter().any(|e| e.contains(target)) {
+            return None;
+        }
+        if way.fine && way.way.iter().any(|&at| on_hook(at)) {
+            return None;
+        }
+        let hook = way.hook.rom_symbol();
+        Some(Error::BackupRefused {
+            reason: format!(
+                "the file points {hook} at ${target:04X}, code no extension its table lists, while its table lists extensions on {hook}, and that code's way ({}) {}; nothing was written",
+                crate::held_way::path_text(&way.way),
+                if way.fine {
+                    "does not go on into them"
+                } else {
+                    "does not end where a command's way may (a loop, code that stops the CPU, or memory no code may be in)"
+                }
+            ),
+        })
+    })
+}
+
 /// The refusal of a restore whose `way` runs the code at `at`, which
 /// nothing checks.
 pub(crate) fn unchecked_error(way: &WayCode, at: u16, undo: bool) -> Error {
@@ -172,5 +220,77 @@ pub(crate) fn unchecked_error(way: &WayCode, at: u16, undo: bool) -> Error {
             target: at,
             path,
         }
+    }
+}
+
+/// The hooks an undo leaves as they are: each whose way, over the file's
+/// bytes laid on the robot's, is the way it takes now, step for step and
+/// byte for byte of code, the file writing none of it; and the code of
+/// the others and of the extensions the undo lists.
+#[derive(Debug)]
+pub(crate) struct Unchanged {
+    /// The code only hooks the undo leaves run.
+    left: BTreeSet<u16>,
+    /// The code hooks the undo changes run, and the memory of every
+    /// extension it lists.
+    changed: BTreeSet<u16>,
+}
+
+impl Unchanged {
+    /// Follows `backup`'s ways as the undo would leave them and the
+    /// robot's as they are.
+    ///
+    /// # Errors
+    /// The line's errors.
+    pub(crate) fn read<T: Transport>(
+        client: &mut Client<T>,
+        profile: &RomProfile,
+        backup: &Backup,
+    ) -> Result<Unchanged> {
+        let seen = crate::held_way::over_robot(client, profile, backup)?;
+        let after_listed = crate::backup::backup_table(profile, &seen);
+        let after = code_of(
+            client,
+            profile,
+            (&backup.hooks, &after_listed),
+            &laid(backup),
+        )?;
+        let listed = crate::table::read_installed(client, profile)?;
+        let hooks = crate::hooks::read_hooks(client, profile)?;
+        let now = code_of(client, profile, (&hooks, &listed), &BTreeMap::new())?;
+        let mut left = BTreeSet::new();
+        let mut changed: BTreeSet<u16> = after_listed
+            .iter()
+            .flat_map(|entry| entry.extents.iter().flat_map(Clone::clone))
+            .collect();
+        for way in &after {
+            let same = now.iter().any(|then| {
+                then.hook == way.hook && then.way == way.way && then.code == way.code && then.fine
+            }) && way
+                .code
+                .iter()
+                .all(|&at| backup.byte_at(u32::from(at)).is_none());
+            if same {
+                left.extend(way.code.iter().copied());
+            } else {
+                changed.extend(way.code.iter().copied());
+            }
+        }
+        Ok(Unchanged { left, changed })
+    }
+
+    /// Whether `witness` covers code only hooks the undo leaves run: its
+    /// change, by hand since, is not the undo's to refuse.
+    #[must_use]
+    pub(crate) fn only_on_unchanged(&self, witness: &crate::backup::Witness) -> bool {
+        let bytes = (0..witness.len).map(|i| witness.address.wrapping_add(i));
+        let mut any = false;
+        for at in bytes {
+            if self.changed.contains(&at) {
+                return false;
+            }
+            any |= self.left.contains(&at);
+        }
+        any
     }
 }

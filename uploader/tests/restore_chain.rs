@@ -749,7 +749,7 @@ fn a_backup_without_its_hooks_or_with_rom_records_off_the_rom_sends_nothing() {
 /// while the table lists the extension the hook went to: restored, exit
 /// 0, the listed extension unhooked. Refused before a byte is sent.
 #[test]
-fn a_backup_hooking_code_its_table_does_not_list_sends_nothing() {
+fn a_backup_hooking_code_its_table_does_not_list_writes_nothing() {
     let (options, mut client) = one_installed();
     let saved = backup(&mut client, &options.profile).expect("a backup");
     let mut crafted = saved.clone();
@@ -771,17 +771,21 @@ fn a_backup_hooking_code_its_table_does_not_list_sends_nothing() {
             hook.1 = 0x0E8F;
         }
     }
-    let sent = client.stats().sent;
+    // Its way ($0E8F -> $0E8C -> $0000) leads nowhere: no owner's handler
+    // in front of the extension (fresh28 F1), told once the way is
+    // followed, before anything is written.
+    let before = held(&mut client);
     match restore(&mut client, &crafted, &options, &mut NoProgress) {
         Err(Error::BackupRefused { reason }) => {
             assert!(
                 reason.contains("code no extension its table lists"),
                 "{reason}"
             );
+            assert!(reason.ends_with("nothing was written"), "{reason}");
         }
         other => panic!("{other:?}"),
     }
-    assert_eq!(client.stats().sent, sent, "something was sent");
+    assert!(held(&mut client) == before, "nothing written");
     assert_eq!(hook(&mut client), 0x0403);
 }
 
@@ -1731,4 +1735,82 @@ fn data_the_ways_code_writes_is_not_taken_for_code() {
     }
     by_hand(&mut client, 0x1007, &[0x2A]);
     restore(&mut client, &saved, &options, &mut NoProgress).expect("restored");
+}
+
+/// fresh28 F1: an owner's handler in front of an uploaded extension
+/// (HOOK_UNKNOWN by hand at $0900: `NOP`, `JMP` the extension's handler).
+/// Its backup was refused ("code no extension its table lists") on the
+/// robot it was taken from. It is restored as it was; one whose code goes
+/// elsewhere is still refused, nothing written.
+#[test]
+fn an_owners_handler_in_front_of_an_extension_is_restored_as_it_was() {
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0500),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    by_hand(&mut client, 0x0900, &[0xEA, 0x4C, 0x03, 0x05]);
+    by_hand(&mut client, HOOK_UNKNOWN + 1, &[0x00, 0x09]);
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    assert_eq!(saved.refused, None, "{:?}", saved.refused);
+    let file = saved.backup;
+    by_hand(&mut client, HOOK_UNKNOWN + 1, &[0x03, 0x05]);
+    by_hand(&mut client, 0x0900, &[0; 4]);
+    restore(&mut client, &file, &options, &mut NoProgress).expect("restored");
+    assert_eq!(
+        hook(&mut client),
+        0x0900,
+        "the owner's handler in front again"
+    );
+    // The owner's code changed in the file to go past the extension.
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    let mut past = file.clone();
+    set(&mut past, 0x0902, lo);
+    set(&mut past, 0x0903, hi);
+    let before = held(&mut client);
+    match restore(&mut client, &past, &options, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            assert!(reason.contains("does not go on into them"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+}
+
+/// fresh29 F1: an owner's HOOK_LOOP handler at $0600 (`INC $0700`, `JMP`
+/// the ROM's loop), then an upload on HOOK_UNKNOWN with its undo kept;
+/// the owner changes his handler by hand (`INC $0702`). The undo was
+/// refused ("the upload ... is no longer on the robot"), though it leaves
+/// HOOK_LOOP as it is. It goes through, the owner's change kept; a change
+/// to the code the undo hooks anew is still refused.
+#[test]
+fn an_undo_leaves_an_owners_change_on_a_hook_it_does_not_move() {
+    let options = UploadOptions::default();
+    let (_, _, undo) = plain_replace_undo();
+    let mut client = uploader::client(robot(), &options.profile);
+    let [lo, hi] = romlib::symbols::ROM_LOOP.to_le_bytes();
+    by_hand(&mut client, 0x0600, &[0xEE, 0x00, 0x07, 0x4C, lo, hi]);
+    by_hand(&mut client, romlib::symbols::HOOK_LOOP + 1, &[0x00, 0x06]);
+    let mut kept = Kept::default();
+    upload_keeping(
+        &mut client,
+        &extension_at(0x0800),
+        &options,
+        &mut NoProgress,
+        &mut kept,
+    )
+    .expect("installed");
+    let file = kept.0.expect("kept");
+    assert!(file.witnessed(0x0600), "{:?}", file.witnesses);
+    by_hand(&mut client, 0x0601, &[0x02]);
+    restore(&mut client, &file, &undo, &mut NoProgress).expect("undone");
+    let memory = client.transport().robot().robot().board().memory();
+    assert_eq!(memory[0x0601], 0x02, "the owner's change kept");
+    let at = usize::from(romlib::symbols::HOOK_LOOP) + 1;
+    assert_eq!(memory[at..at + 2], [0x00, 0x06], "HOOK_LOOP as it was");
+    assert_eq!(hook(&mut client), BAD_COMMAND, "the upload undone");
 }

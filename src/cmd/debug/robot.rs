@@ -120,7 +120,9 @@ pub(crate) fn attach(
             .flatten()
             .map(|loader| {
                 format!(
-                    " and its state in user zero page ${:02X}-${:02X}",
+                    " (${:04X}-${:04X}, its state in user zero page ${:02X}-${:02X})",
+                    loader.code.address,
+                    u32::from(loader.code.address) + loader.code.bytes.len() as u32 - 1,
                     loader.zero_page.start(),
                     loader.zero_page.end()
                 )
@@ -132,9 +134,11 @@ pub(crate) fn attach(
     // nothing of it).
     let stub = robot.stub();
     say(&format!(
-        "the debug stub is at ${:04X}-${:04X}: it, and the RAM loader that wrote it{loader_zero_page}, stay in memory after the session, unhooked; no undo puts back what was there (`scorpion backup` before a session keeps it)",
+        "the debug stub is at ${:04X}-${:04X} (and user zero page ${:02X}-${:02X}): it, and the RAM loader that wrote it{loader_zero_page}, stay in memory after the session, unhooked; no undo puts back what was there (`scorpion backup` before a session keeps it)",
         stub.address,
         u32::from(stub.address) + stub.bytes.len() as u32 - 1,
+        stub.zero_page,
+        stub.zero_page.wrapping_add(1),
     ));
     let linked: Vec<linker::Image> = images.into_iter().map(|(_, image)| image).collect();
     // A JSR where no instruction starts would cut one in two: the line
