@@ -844,7 +844,9 @@ fn mark_window(
     marked[usize::from(target)..=usize::from(end)].fill(true);
 }
 
-/// The marked addresses as ranges, less what `backup` holds itself.
+/// The marked addresses as runs, less what `backup` holds itself: each
+/// read once, its witnesses of odd length ([`witnesses_of`]; or the
+/// sums' ranges that tile it, `sums::tiled_odd`).
 fn unmarked_but_held(mut marked: Vec<bool>, backup: &Backup) -> Vec<(u16, usize)> {
     for area in &backup.areas {
         let start = usize::from(area.address);
@@ -889,11 +891,13 @@ pub(crate) fn witnesses_of(address: u16, read: &crate::LiveRead) -> Vec<Witness>
         .map(|&at| usize::from(at.wrapping_sub(address)))
         .chain([read.bytes.len()])
     {
-        if end > start {
+        // Of odd length, as the ranges read are (hostile29 F2).
+        for (at, len) in crate::sums::odd_pieces(end.saturating_sub(start), 0xFFFF) {
+            let from = start + at;
             witnesses.push(Witness {
-                address: address.wrapping_add(start as u16),
-                len: (end - start) as u16,
-                sum: crate::sums::fletcher16(&read.bytes[start..end]),
+                address: address.wrapping_add(from as u16),
+                len: len as u16,
+                sum: crate::sums::fletcher16(&read.bytes[from..from + len]),
             });
         }
         start = end + 1;

@@ -602,6 +602,10 @@ const MOST_INSTRUCTIONS: usize = 4096;
 /// pushes.
 const ENTRY_S: u8 = 0xF0;
 
+/// Bytes a handler's calls may push before the run takes them for a call
+/// that never returns: half the 6502's stack.
+const DEEPEST: u8 = 0x80;
+
 /// Bytes read from the robot at once for the host's run.
 const CHUNK: usize = 16;
 
@@ -630,7 +634,6 @@ fn run_to_landing<T: Transport>(
     cpu.set_idle_skip(false);
     (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, ENTRY_S, start);
     let mut states = std::collections::HashSet::new();
-    let mut visited = std::collections::BTreeSet::new();
     for _ in 0..MOST_INSTRUCTIONS {
         let opcode = bus.byte(cpu.pc);
         if let Some(error) = bus.failed.take() {
@@ -654,8 +657,6 @@ fn run_to_landing<T: Transport>(
             }
         }
         if info.mnemonic == Mnemonic::Jsr {
-            // hostile16 F1: a call back into code this run has been
-            // through (`JSR` to itself) calls itself for ever.
             let target = u16::from_le_bytes([
                 bus.byte(cpu.pc.wrapping_add(1)),
                 bus.byte(cpu.pc.wrapping_add(2)),
@@ -664,7 +665,12 @@ fn run_to_landing<T: Transport>(
             if readable(profile, target) {
                 bus.touched.insert(target);
             }
-            if target == start || visited.contains(&target) {
+            // hostile16 F1: a call that calls itself for ever (`JSR` to
+            // itself) pushes without end; a subroutine called twice, or
+            // a recursion that ends, returns (hostile29 F3: taken for a
+            // loop, the hook was left at the ROM). More than
+            // [`DEEPEST`] bytes pushed: the robot's stack would wrap.
+            if ENTRY_S.saturating_sub(cpu.s) > DEEPEST {
                 return Ok(Landing::Loops(target));
             }
             // A call into the ROM (a service) returns where the ROM
@@ -680,7 +686,6 @@ fn run_to_landing<T: Transport>(
                 return Ok(Landing::Left(target));
             }
         }
-        visited.insert(cpu.pc);
         // The code the way runs (not the data it reads and writes, which
         // may be anyone's): each instruction's bytes.
         for i in 0..u16::from(info.len()) {

@@ -41,45 +41,95 @@ pub fn fletcher16(bytes: &[u8]) -> u16 {
 /// A range of robot memory: first address and length (up to `$10000`).
 pub(crate) type Range = (u16, usize);
 
-/// The sum of two ranges, one after the other, from their sums (`second`
-/// over `second_len` bytes): the first sums add, and every byte of the
-/// second range adds the first range's first sum to the running sum once
-/// more.
+/// `len` bytes as the fewest pieces of odd length about `about` bytes
+/// long (a piece may be one or two longer), as even in length as odd
+/// counts allow: `(offset, len)`. For sums asked where the count of
+/// questions costs line time (a delta upload's passes): 2048 bytes are 8
+/// pieces of 255 and 257, as 8 of 256 were. Odd, as [`odd_pieces`] says.
 #[must_use]
-pub(crate) fn fletcher16_joined(first: u16, second: u16, second_len: usize) -> u16 {
-    let [first_a, second_a] = first.to_be_bytes();
-    let [first_b, second_b] = second.to_be_bytes();
-    // Mod 256: only the length's low byte counts.
-    let times = (second_len & 0xFF) as u8;
-    u16::from_be_bytes([
-        first_a.wrapping_add(first_b),
-        second_a
-            .wrapping_add(first_a.wrapping_mul(times))
-            .wrapping_add(second_b),
-    ])
+pub(crate) fn odd_partition(len: usize, about: usize) -> Vec<(usize, usize)> {
+    if len == 0 {
+        return Vec::new();
+    }
+    let mut count = len.div_ceil(about.max(1));
+    // Odd pieces add up to `len` only in a count of its parity.
+    if count % 2 != len % 2 {
+        count += 1;
+    }
+    let base = len / count;
+    let base = if base % 2 == 0 { base - 1 } else { base };
+    // Even, and less than two a piece: the first pieces take two more.
+    let longer = (len - base * count) / 2;
+    let mut pieces = Vec::with_capacity(count);
+    let mut at = 0;
+    for i in 0..count {
+        let piece = if i < longer { base + 2 } else { base };
+        pieces.push((at, piece));
+        at += piece;
+    }
+    pieces
 }
 
-/// The robot's sum of `range`, put together from `known` sums of ranges
-/// that tile it exactly (each taken from the robot at the same moment as
-/// far as the range goes: before anything was written); `None` where they
-/// do not.
+/// hostile29 F2: `len` bytes as pieces of at most `most` bytes (odd),
+/// each of odd length (an even rest is one byte shorter, its last byte a
+/// piece of its own): `(offset, len)`. Both sums are mod 256, so over an
+/// even count some runs of one byte sum as zeros do (256 bytes of `$EA`,
+/// a page of `NOP`s; 32 of `$10`), and an upload took such a page on a
+/// robot holding zeros for held. Over an odd count the first sum of a run
+/// of one byte is that byte times an odd number: no two runs sum alike.
 #[must_use]
-pub(crate) fn joined_from(known: &[(Range, u16)], (address, len): Range) -> Option<u16> {
-    let end = usize::from(address) + len;
-    let mut at = usize::from(address);
-    let mut sum = fletcher16(&[]);
-    while at < end {
-        // The longest known range starting here that stays inside.
-        let &((_, part_len), part) = known
-            .iter()
-            .filter(|((start, part_len), _)| {
-                usize::from(*start) == at && *part_len > 0 && at + part_len <= end
-            })
-            .max_by_key(|((_, part_len), _)| *part_len)?;
-        sum = fletcher16_joined(sum, part, part_len);
-        at += part_len;
+pub(crate) fn odd_pieces(len: usize, most: usize) -> Vec<(usize, usize)> {
+    let most = most.max(1);
+    let most = if most % 2 == 0 { most - 1 } else { most };
+    let mut pieces = Vec::new();
+    let mut at = 0;
+    while at < len {
+        let take = match (len - at).min(most) {
+            even if even % 2 == 0 => even - 1,
+            odd => odd,
+        };
+        pieces.push((at, take));
+        at += take;
     }
-    Some(sum)
+    pieces
+}
+
+/// `range` as odd-length ranges (hostile29 F2): the `known` ones of odd
+/// length that tile it where they do, with their sums; the rest as odd
+/// pieces to ask ([`odd_pieces`]), `None`.
+#[must_use]
+pub(crate) fn tiled_odd(
+    known: &[(Range, u16)],
+    (address, len): Range,
+) -> Vec<(Range, Option<u16>)> {
+    let end = usize::from(address) + len;
+    let odd_known = |at: usize| {
+        known
+            .iter()
+            .filter(|((start, part), _)| {
+                usize::from(*start) == at && part % 2 == 1 && at + part <= end
+            })
+            .max_by_key(|((_, part), _)| *part)
+            .copied()
+    };
+    let mut out = Vec::new();
+    let mut at = usize::from(address);
+    while at < end {
+        if let Some((range, sum)) = odd_known(at) {
+            out.push((range, Some(sum)));
+            at += range.1;
+            continue;
+        }
+        // Up to where a known range starts, or the end.
+        let gap_end = (at + 1..end)
+            .find(|&next| odd_known(next).is_some())
+            .unwrap_or(end);
+        for (offset, piece) in odd_pieces(gap_end - at, gap_end - at) {
+            out.push((((at + offset) as u16, piece), None));
+        }
+        at = gap_end;
+    }
+    out
 }
 
 /// The question for one range.
@@ -165,37 +215,89 @@ mod tests {
     }
 
     #[test]
-    fn sums_of_parts_join_into_the_sum_of_the_whole() {
-        let bytes: Vec<u8> = (0..700u32).map(|i| (i * 37 % 251) as u8).collect();
-        for cut in [0usize, 1, 31, 256, 300, 699, 700] {
-            let (a, b) = bytes.split_at(cut);
-            assert_eq!(
-                fletcher16_joined(fletcher16(a), fletcher16(b), b.len()),
-                fletcher16(&bytes),
-                "cut at {cut}"
+    fn known_odd_ranges_tile_what_they_can_and_the_rest_is_asked_in_odd_pieces() {
+        let known: Vec<(Range, u16)> = vec![
+            ((0x0400, 255), 1),
+            ((0x04FF, 257), 2),
+            ((0x0600, 32), 3), // even: no witness
+        ];
+        assert_eq!(
+            tiled_odd(&known, (0x0400, 512)),
+            vec![((0x0400, 255), Some(1)), ((0x04FF, 257), Some(2))]
+        );
+        assert_eq!(
+            tiled_odd(&known, (0x03FC, 300)),
+            vec![
+                ((0x03FC, 3), None),
+                ((0x03FF, 1), None),
+                ((0x0400, 255), Some(1)),
+                ((0x04FF, 41), None),
+            ]
+        );
+        assert_eq!(
+            tiled_odd(&known, (0x0600, 32)),
+            vec![((0x0600, 31), None), ((0x061F, 1), None)]
+        );
+    }
+
+    /// hostile29 F2: a run of one byte over an odd count sums as no run
+    /// of another byte does (over 256, every even byte sums as zeros).
+    #[test]
+    fn odd_pieces_tell_every_run_of_one_byte_apart() {
+        assert_eq!(
+            fletcher16(&[0xEA; 256]),
+            fletcher16(&[0; 256]),
+            "the blind spot"
+        );
+        for most in [255usize, 31, 127] {
+            let mut sums = std::collections::HashMap::new();
+            for byte in 0..=255u8 {
+                let pieces: Vec<u16> = odd_pieces(256, most)
+                    .into_iter()
+                    .map(|(_, len)| fletcher16(&vec![byte; len]))
+                    .collect();
+                if let Some(other) = sums.insert(pieces, byte) {
+                    panic!("${byte:02X} sums as ${other:02X} in pieces of {most}");
+                }
+            }
+        }
+        for len in 0..600 {
+            let pieces = odd_pieces(len, 255);
+            assert_eq!(pieces.iter().map(|p| p.1).sum::<usize>(), len, "{len}");
+            assert!(
+                pieces.iter().all(|p| p.1 % 2 == 1 && p.1 <= 255),
+                "{len}: {pieces:?}"
+            );
+            assert!(
+                pieces.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0),
+                "{len}"
             );
         }
-        let known: Vec<(Range, u16)> =
-            [(0x400u16, 256usize), (0x500, 256), (0x600, 32), (0x620, 32)]
-                .iter()
-                .map(|&(address, len)| {
-                    let start = usize::from(address - 0x400);
-                    ((address, len), fletcher16(&bytes[start..start + len]))
-                })
-                .collect();
-        assert_eq!(
-            joined_from(&known, (0x400, 576)),
-            Some(fletcher16(&bytes[..576]))
-        );
-        assert_eq!(
-            joined_from(&known, (0x500, 288)),
-            Some(fletcher16(&bytes[256..544]))
-        );
-        // A gap, a range that runs past what is known, one that starts
-        // inside a known range: asked of the robot instead.
-        assert_eq!(joined_from(&known, (0x400, 600)), None);
-        assert_eq!(joined_from(&known, (0x410, 16)), None);
-        assert_eq!(joined_from(&known, (0x400, 0)), Some(fletcher16(&[])));
+        assert_eq!(odd_pieces(256, 256), vec![(0, 255), (255, 1)]);
+        for len in 1..3000 {
+            for about in [31usize, 37, 256] {
+                let pieces = odd_partition(len, about);
+                assert_eq!(
+                    pieces.iter().map(|p| p.1).sum::<usize>(),
+                    len,
+                    "{len}/{about}"
+                );
+                assert!(
+                    pieces.iter().all(|p| p.1 % 2 == 1 && p.1 <= about + 2),
+                    "{len}/{about}: {pieces:?}"
+                );
+                assert!(
+                    pieces.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0),
+                    "{len}/{about}"
+                );
+                assert!(
+                    pieces.len() <= len.div_ceil(about) + 1,
+                    "{len}/{about}: {pieces:?}"
+                );
+            }
+        }
+        assert_eq!(odd_partition(2048, 256).len(), 8);
+        assert_eq!(odd_partition(255, 37).len(), 7);
     }
 
     #[test]

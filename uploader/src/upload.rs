@@ -1141,14 +1141,14 @@ fn keep_summed<T: Transport>(
     let Some(mut kept) = kept else {
         return Ok(None);
     };
-    // The sum of zeros is also that of a run of one even byte (Fletcher-16
-    // sums modulo 256: 256 bytes of $EA, a NOP sled, sum to nothing). A
-    // second sum, of all but the first byte, tells them apart: over an odd
-    // count no run of one byte but zero sums to nothing.
+    // A range that sums as zeros is taken for zeros unread. Its count is
+    // odd (`sums::odd_pieces`), so no run of one byte but zero sums to
+    // nothing; other bytes may, one time in 65536: a second sum, of all but
+    // the first byte, tells them apart.
     let twice: Vec<crate::sums::Range> = held
         .iter()
         .filter(|(area, sum)| {
-            *sum == fletcher16(&[]) && area.bytes.len() % 2 == 0 && !covered(&kept, area)
+            *sum == fletcher16(&[]) && area.bytes.len() > 1 && !covered(&kept, area)
         })
         .map(|(area, _)| (area.address + 1, area.bytes.len() - 1))
         .collect();
@@ -1185,22 +1185,22 @@ fn keep_summed<T: Transport>(
     // `sums` is hooked here): an undo checks it is still there. Nothing is
     // written yet, so a range the sums asked already tile is put together
     // from their answers; only the rest is asked.
-    let ranges = crate::backup::kept_witness_ranges_on(client, profile, &kept, image)?;
-    let joined: Vec<Option<u16>> = ranges
-        .iter()
-        .map(|&range| crate::sums::joined_from(known, range))
-        .collect();
+    // Each witness of odd length (hostile29 F2): the ranges the sums asked
+    // where they tile it, odd pieces of the rest asked.
+    let ranges: Vec<(crate::sums::Range, Option<u16>)> =
+        crate::backup::kept_witness_ranges_on(client, profile, &kept, image)?
+            .into_iter()
+            .flat_map(|range| crate::sums::tiled_odd(known, range))
+            .collect();
     let unknown: Vec<crate::sums::Range> = ranges
         .iter()
-        .zip(&joined)
         .filter(|(_, sum)| sum.is_none())
         .map(|(range, _)| *range)
         .collect();
     let mut asked = crate::sums::robot_sums(client, &unknown)?.into_iter();
     kept.witnesses = ranges
-        .iter()
-        .zip(joined)
-        .map(|(&(address, len), sum)| crate::backup::Witness {
+        .into_iter()
+        .map(|((address, len), sum)| crate::backup::Witness {
             address,
             len: len as u16,
             sum: sum.or_else(|| asked.next()).unwrap_or(0),

@@ -1814,3 +1814,59 @@ fn an_undo_leaves_an_owners_change_on_a_hook_it_does_not_move() {
     assert_eq!(memory[at..at + 2], [0x00, 0x06], "HOOK_LOOP as it was");
     assert_eq!(hook(&mut client), BAD_COMMAND, "the upload undone");
 }
+
+/// hostile29 F3: a loop handler that calls one subroutine twice ($0900
+/// `JSR $0A00`, `JSR $0A00`, `JMP` the ROM's loop; $0A00 `INC $0F20`,
+/// `RTS`), or recurses five deep and returns, was taken for "a loop the
+/// robot would run for ever": a backup warned, and its restore left
+/// HOOK_LOOP at the ROM. Both are restored as they were; a file whose
+/// subroutine calls itself for ever leaves HOOK_LOOP at the ROM.
+#[test]
+fn a_subroutine_called_twice_or_a_recursion_that_ends_is_no_loop() {
+    let [lo, hi] = romlib::symbols::ROM_LOOP.to_le_bytes();
+    let twice = [0x20, 0x00, 0x0A, 0x20, 0x00, 0x0A, 0x4C, lo, hi];
+    let sub = [0xEE, 0x20, 0x0F, 0x60];
+    // $0900: LDA #5; STA $0F21; JSR $0A00; JMP the ROM's loop. $0A00:
+    // DEC $0F21; BEQ +3; JSR $0A00; RTS.
+    let five = [0xA9, 0x05, 0x8D, 0x21, 0x0F, 0x20, 0x00, 0x0A, 0x4C, lo, hi];
+    let recursion = [0xCE, 0x21, 0x0F, 0xF0, 0x03, 0x20, 0x00, 0x0A, 0x60];
+    let loop_at = usize::from(romlib::symbols::HOOK_LOOP) + 1;
+    for (name, handler, sub) in [
+        ("twice", &twice[..], &sub[..]),
+        ("recursion", &five[..], &recursion[..]),
+    ] {
+        let options = UploadOptions::default();
+        let mut client = uploader::client(robot(), &options.profile);
+        by_hand(&mut client, 0x0900, handler);
+        by_hand(&mut client, 0x0A00, sub);
+        by_hand(&mut client, romlib::symbols::HOOK_LOOP + 1, &[0x00, 0x09]);
+        let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+        assert!(saved.broken.is_empty(), "{name}: {:?}", saved.broken);
+        restore(&mut client, &saved.backup, &options, &mut NoProgress)
+            .unwrap_or_else(|error| panic!("{name}: {error}"));
+        let memory = client.transport().robot().robot().board().memory();
+        assert_eq!(
+            memory[loop_at..loop_at + 2],
+            [0x00, 0x09],
+            "{name}: HOOK_LOOP as it was"
+        );
+        if name == "twice" {
+            // The subroutine made to call itself for ever, in the file.
+            let mut file = saved.backup.clone();
+            for (i, byte) in [0x20u8, 0x00, 0x0A].into_iter().enumerate() {
+                set(&mut file, 0x0A00 + i as u16, byte);
+            }
+            match restore(&mut client, &file, &options, &mut NoProgress) {
+                Err(Error::RestoreChainBroken { .. }) => {}
+                other => panic!("for ever: {other:?}"),
+            }
+            let memory = client.transport().robot().robot().board().memory();
+            let rom = romlib::symbols::ROM_LOOP.to_le_bytes();
+            assert_eq!(
+                memory[loop_at..loop_at + 2],
+                rom,
+                "HOOK_LOOP left at the ROM"
+            );
+        }
+    }
+}

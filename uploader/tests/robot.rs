@@ -175,7 +175,8 @@ fn one_byte_change_of(len: usize, offset: usize) {
         "{:?}",
         report.written
     );
-    assert_eq!(len, FINE, "{:?}", report.written);
+    // A fine range: about FINE bytes, odd (hostile29 F2).
+    assert!(len <= FINE + 2 && len % 2 == 1, "{:?}", report.written);
     // The table entry (its id changed) is the only other range.
     assert_eq!(report.written.len(), 2, "{:?}", report.written);
     assert_done(client.into_transport(), &new, "the one-byte change");
