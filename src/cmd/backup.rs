@@ -83,10 +83,11 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
     }
     if let Some(refused) = &refused {
         // fresh25 F2: said as the restore will refuse it, in place of
-        // the looks below that would say otherwise.
+        // the looks below that would say otherwise; not blamed on a hand
+        // change (hostile29 F4: code that changed while it was read).
         let reason = refused.trim_end_matches("; nothing was written");
         print(&format!(
-            "warning: a restore of this file will be refused: {reason} (the robot was changed by hand; `/1R` clears the table and the hooks, then upload the extensions again)"
+            "warning: a restore of this file will be refused, writing nothing: {reason}"
         ));
     }
     // A table that does not decode (hostile19 F4) is one of the restore's

@@ -337,7 +337,10 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
     let written: usize = report.written.iter().map(|range| range.1).sum();
     // fresh28 F4: "uploaded" where the robot held every byte already.
     let (what, held) = if written == 0 && report.bytes > 0 {
-        ("verified", " (nothing written: the robot held them all)")
+        (
+            "verified",
+            " (none of them written: the robot held them all)",
+        )
     } else {
         ("uploaded and verified", "")
     };

@@ -282,7 +282,7 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
     for expected in [
         "it is the built-in reference ROM, byte for byte",
         "uploaded and verified 700 bytes",
-        "verified 700 bytes (nothing written: the robot held them all)",
+        "verified 700 bytes (none of them written: the robot held them all)",
         "restored scorpion-last-upload.undo",
         "restored robot.bak",
     ] {

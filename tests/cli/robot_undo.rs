@@ -210,7 +210,7 @@ fn a_second_identical_upload_beside_another_extension_writes_nothing() {
     let d = dir.path();
     let text = ok(d, &line, &["upload", "ext.elf", "--no-dry-run"]);
     assert!(
-        text.contains("(nothing written: the robot held them all)"),
+        text.contains("(none of them written: the robot held them all)"),
         "{text}"
     );
     assert!(!text.contains("uploaded and verified"), "{text}");
@@ -1388,7 +1388,7 @@ fn backup_says_the_refusal_its_restore_will_give() {
     let said = "the backup points HOOK_UNKNOWN at $0700, which holds $00";
     assert!(
         saved.contains(&format!(
-            "warning: a restore of this file will be refused: {said}"
+            "warning: a restore of this file will be refused, writing nothing: {said}"
         )),
         "{saved}"
     );

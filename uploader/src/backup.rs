@@ -509,6 +509,7 @@ pub fn backup_live<T: Transport>(client: &mut Client<T>, profile: &RomProfile) -
     // Code that changed while it was read is witnessed by nothing: its
     // restore refuses it, said now as it will say it.
     let unwitnessed = crate::way_checked::owner_in_front(&everyone, &code)
+        .or_else(|| crate::way_checked::computed_outside(profile, &backup, &code))
         .map(|error| error.to_string())
         .or_else(|| {
             crate::way_checked::first_unchecked(profile, &backup, &code, &|_| false)

@@ -207,6 +207,10 @@ pub(crate) struct Noted {
     /// What the code run on the host wrote: its data (a counter after a
     /// branch always taken, an operand it changes), not code to check.
     pub(crate) data: BTreeSet<u16>,
+    /// The first jump the way makes to where its data says (a `JMP`
+    /// through a pointer, an `RTS` or `RTI` to an address it pushed): the
+    /// code it may reach from there cannot all be known (hostile29 F1).
+    pub(crate) computed: Option<u16>,
     /// Whether the way ends where a command's way may: the ROM, or code
     /// past every listed extension (not a loop, code that stops the CPU,
     /// a return nothing called, or memory no code may be in).
@@ -301,6 +305,7 @@ pub(crate) fn way_code<T: Transport>(
         wrote: false,
         touched: &mut noted.code,
         written: &mut noted.data,
+        computed: &mut noted.computed,
     };
     reach::reach(&mut bus, &starts, &listed)?;
     let data = &noted.data;
@@ -327,6 +332,7 @@ fn follow_noting<T: Transport>(
         code: touched,
         way: path,
         data: written,
+        computed,
         ..
     } = noted;
     path.clear();
@@ -391,6 +397,7 @@ fn follow_noting<T: Transport>(
                         wrote: false,
                         touched,
                         written,
+                        computed,
                     };
                     let landed = run_to_landing(bus, at, &landing, strict)?;
                     match landed {
@@ -634,6 +641,8 @@ fn run_to_landing<T: Transport>(
     cpu.set_idle_skip(false);
     (cpu.a, cpu.x, cpu.y, cpu.s, cpu.pc) = (0, 1, 0, ENTRY_S, start);
     let mut states = std::collections::HashSet::new();
+    // Calls made and not yet returned from.
+    let mut calls = 0u32;
     for _ in 0..MOST_INSTRUCTIONS {
         let opcode = bus.byte(cpu.pc);
         if let Some(error) = bus.failed.take() {
@@ -655,6 +664,15 @@ fn run_to_landing<T: Transport>(
             if u16::from(cpu.s) + pulled > u16::from(ENTRY_S) {
                 return Ok(Landing::Returns(cpu.pc));
             }
+            // A return no call of this run made: to an address the code
+            // pushed (a jump table).
+            if calls == 0 || info.mnemonic == Mnemonic::Rti {
+                bus.computed.get_or_insert(cpu.pc);
+            }
+            calls = calls.saturating_sub(1);
+        }
+        if info.mnemonic == Mnemonic::Jmp && info.mode == isa::AddressingMode::Indirect {
+            bus.computed.get_or_insert(cpu.pc);
         }
         if info.mnemonic == Mnemonic::Jsr {
             let target = u16::from_le_bytes([
@@ -685,6 +703,7 @@ fn run_to_landing<T: Transport>(
             if !readable(profile, target) {
                 return Ok(Landing::Left(target));
             }
+            calls += 1;
         }
         // The code the way runs (not the data it reads and writes, which
         // may be anyone's): each instruction's bytes.
@@ -743,6 +762,9 @@ pub(crate) struct ChainBus<'a, T: Transport> {
     touched: &'a mut BTreeSet<u16>,
     /// Every address the run wrote.
     written: &'a mut BTreeSet<u16>,
+    /// Where the run first jumped where its data said (see
+    /// [`Noted::computed`]).
+    computed: &'a mut Option<u16>,
 }
 
 impl<T: Transport> ChainBus<'_, T> {

@@ -590,6 +590,29 @@ pub enum Error {
         path: String,
     },
 
+    /// A backup's hook leads through code that jumps where its data says,
+    /// part of it outside what the file restores (hostile29 F1). Nothing
+    /// was written.
+    #[error(
+        "the file's {hook} leads {path}, and at ${at:04X} jumps where its data says (through a pointer, or an RTS to an address it pushed), while part of that way's code lies outside what the file restores (${outside:04X}, only witnessed): the code it may jump to cannot all be known, so a restore cannot check it; nothing was written"
+    )]
+    #[diagnostic(
+        code(uploader::computed_way_outside),
+        help(
+            "`scorpion backup` witnesses the code a way was seen to run; a jump table's other targets on the KIM bus may have changed unseen. Keep such code in user RAM, where a backup holds it all, or upload it as an extension (its image is checked as it goes in)"
+        )
+    )]
+    ComputedWayOutside {
+        /// The hook.
+        hook: &'static str,
+        /// The way, `$0716 -> $1000`.
+        path: String,
+        /// The computed jump.
+        at: u16,
+        /// The first byte of the way's code outside what the file holds.
+        outside: u16,
+    },
+
     /// An undo would list again an extension the robot no longer lists,
     /// from what memory still holds, where the file checks part of it
     /// only (hostile28 F6, F7: a reset since). Nothing was written.

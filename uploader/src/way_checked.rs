@@ -31,6 +31,8 @@ pub(crate) struct WayCode {
     pub(crate) code: BTreeSet<u16>,
     /// Whether it ends where a command's way may ([`crate::chain::Noted`]).
     pub(crate) fine: bool,
+    /// Where it jumps where its data says, if it does.
+    pub(crate) computed: Option<u16>,
 }
 
 /// The bytes `backup` holds, as a restore would write them (the first
@@ -67,6 +69,7 @@ pub(crate) fn code_of<T: Transport>(
             way: noted.way,
             code: noted.code,
             fine: noted.fine,
+            computed: noted.computed,
         });
     }
     Ok(ways)
@@ -118,6 +121,9 @@ pub(crate) fn check_restore<T: Transport>(
     let ways = code_of(client, profile, (&backup.hooks, &everyone), &laid(backup))?;
     if !undo {
         if let Some(error) = owner_in_front(&everyone, &ways) {
+            return Err(error);
+        }
+        if let Some(error) = computed_outside(profile, backup, &ways) {
             return Err(error);
         }
         return match first_unchecked(profile, backup, &ways, &|_| false) {
@@ -199,6 +205,34 @@ pub(crate) fn owner_in_front(everyone: &[Installed], ways: &[WayCode]) -> Option
                     "does not end where a command's way may (a loop, code that stops the CPU, or memory no code may be in)"
                 }
             ),
+        })
+    })
+}
+
+/// hostile29 F1: a way that jumps where its data says (a jump table, a
+/// pointer set on a rare path, `PHA`/`PHA`/`RTS`) may run code no run on
+/// the host saw, so nothing tells which bytes a backup must witness. Where
+/// all of the way's code lies in memory the file restores, its targets
+/// most likely do too; where part lies outside it (the KIM bus, only
+/// witnessed), a restore is refused: a handler `backup` never saw could
+/// have changed.
+#[must_use]
+pub(crate) fn computed_outside(
+    profile: &RomProfile,
+    backup: &Backup,
+    ways: &[WayCode],
+) -> Option<Error> {
+    ways.iter().find_map(|way| {
+        let at = way.computed?;
+        let outside = way.code.iter().copied().find(|&byte| {
+            profile.writable.iter().any(|range| range.contains(&byte))
+                && backup.byte_at(u32::from(byte)).is_none()
+        })?;
+        Some(Error::ComputedWayOutside {
+            hook: way.hook.rom_symbol(),
+            path: crate::held_way::path_text(&way.way),
+            at,
+            outside,
         })
     })
 }

@@ -1870,3 +1870,52 @@ fn a_subroutine_called_twice_or_a_recursion_that_ends_is_no_loop() {
         }
     }
 }
+
+/// hostile29 F1: code on the KIM bus that a chain slot leads to and that
+/// jumps through a pointer it sets (`LDA #0`, `STA $0F10`, `LDA #>target`,
+/// `STA $0F11`, `JMP ($0F10)`): `backup` witnessed the one target it saw,
+/// and a jump table's other handlers changed unseen, restored with exit
+/// 0. Refused before anything is written, and said by `backup`; the same
+/// code in user RAM, which the file restores whole, goes through.
+#[test]
+fn a_way_that_jumps_where_its_data_says_outside_the_file_is_refused() {
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    for (code_at, refused) in [(0x1000u16, true), (0x0900, false)] {
+        let target = code_at + 0x20;
+        let [t_lo, t_hi] = target.to_le_bytes();
+        let options = UploadOptions::default();
+        let mut client = uploader::client(robot(), &options.profile);
+        upload(
+            &mut client,
+            &extension_at(0x0500),
+            &options,
+            &mut NoProgress,
+        )
+        .expect("installed");
+        by_hand(
+            &mut client,
+            code_at,
+            &[
+                0xA9, t_lo, 0x8D, 0x10, 0x0F, 0xA9, t_hi, 0x8D, 0x11, 0x0F, 0x6C, 0x10, 0x0F,
+            ],
+        );
+        by_hand(&mut client, target, &[0x4C, lo, hi]);
+        let [c_lo, c_hi] = code_at.to_le_bytes();
+        by_hand(&mut client, 0x0501, &[c_lo, c_hi]);
+        let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+        let before = held(&mut client);
+        let result = restore(&mut client, &saved.backup, &options, &mut NoProgress);
+        if refused {
+            let said = saved.refused.unwrap_or_default();
+            assert!(said.contains("jumps where its data says"), "{said}");
+            match result {
+                Err(Error::ComputedWayOutside { at, .. }) => assert_eq!(at, code_at + 10),
+                other => panic!("{other:?}"),
+            }
+            assert!(held(&mut client) == before, "nothing written");
+        } else {
+            assert_eq!(saved.refused, None);
+            result.expect("restored");
+        }
+    }
+}

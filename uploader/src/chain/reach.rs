@@ -50,6 +50,11 @@ pub(super) fn reach<T: Transport>(
                 bus.touched.insert(at);
             }
         }
+        let indirect = instruction.opcode.mnemonic == Mnemonic::Jmp
+            && instruction.opcode.mode == AddressingMode::Indirect;
+        if indirect {
+            bus.computed.get_or_insert(pc);
+        }
         todo.extend(successors(&instruction));
     }
     Ok(())
