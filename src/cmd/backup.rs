@@ -118,7 +118,7 @@ pub(crate) fn run_backup(args: &BackupArgs) -> miette::Result<ExitCode> {
         .collect();
     if !owners.is_empty() && refused.is_none() {
         print(&format!(
-            "note: the hooks' ways run code no entry lists outside what a backup saves ({}): the file checks at a restore that it is still there byte for byte and cannot bring it back, so a change there (by hand too) refuses the restore",
+            "note: the hooks' ways run code no entry lists outside what a backup saves ({}): the file checks at a restore, by its checksums, that it is still there, and cannot bring it back, so a change there (by hand too) refuses the restore",
             owners.join(", ")
         ));
     }

@@ -969,8 +969,12 @@ fn upload_file(
             undo.path.display()
         );
         // fresh17 F1: what was written then is the image's data (a
-        // counter its program keeps), put back as built.
-        if !report.written.is_empty() {
+        // counter its program keeps), put back as built. Only where the
+        // robot's bytes were compared (fresh30 F1, hostile29 F8: `--full`
+        // or no loader writes every byte, changed or not).
+        let compared = report.loader.is_some() && report.without_loader.is_none();
+        let written: usize = report.written.iter().map(|range| range.1).sum();
+        if compared && 0 < written && written < report.bytes {
             out.push_str("  (its data, which its program had changed, is put back as built)\n");
         }
     }

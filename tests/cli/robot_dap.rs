@@ -167,7 +167,7 @@ fn a_dap_session_on_the_pty_robot_and_the_code_compared_after() {
         said["body"]["output"]
             .as_str()
             .is_some_and(|text| text.starts_with("the debug stub is at $")
-                && text.contains("stay in memory after the session, unhooked; no undo puts back")),
+                && text.contains("in memory after the session, unhooked; no undo puts back")),
         "{said}"
     );
     // On the robot there is no going back and no data breakpoint.

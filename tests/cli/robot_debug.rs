@@ -212,7 +212,7 @@ fn the_readme_section_runs_as_written_against_the_pty_robot() {
         "deleted breakpoint 1",
         "detached",
         // fresh14 F8: what stays in RAM, said as the session starts.
-        "stay in memory after the session, unhooked; no undo puts back what was there",
+        "in memory after the session, unhooked; no undo puts back what was there",
         // fresh28 F3: and the loader's zero page.
         "its state in user zero page $F8-$FF), stay in memory",
         "(and user zero page $F6-$F7)",

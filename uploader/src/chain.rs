@@ -289,6 +289,12 @@ pub(crate) fn way_code<T: Transport>(
         &mut noted,
     )?;
     noted.fine = end == End::Elsewhere;
+    // hostile30 F5: code the run ran that the run wrote (a `JMP` whose
+    // operand it bumps) goes where its data says. (Bytes only reached
+    // below, on an arm not run, may be data: a counter in line.)
+    if let Some(&own) = noted.code.iter().find(|at| noted.data.contains(at)) {
+        noted.computed.get_or_insert(own);
+    }
     let listed = |at: u16| everyone.iter().any(|other| other.contains(at));
     let starts: Vec<u16> = noted
         .way

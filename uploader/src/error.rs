@@ -303,12 +303,12 @@ pub enum Error {
     /// An undo of an upload that is no longer the last on a hook: the
     /// hook leads first to code the undo file does not put back.
     #[error(
-        "{hook} leads first to ${current:04X}{owner}, which this undo does not take out: an upload after the one it undoes put it there (chained ahead, or on a hook the undone upload left alone), and the undo would unhook that too; nothing was written"
+        "{hook} leads first to ${current:04X}{owner}, which this undo does not take out: an upload after the one it undoes, or a change by hand, put it there (chained ahead, or on a hook the undone upload left alone), and the undo would unhook that too; nothing was written"
     )]
     #[diagnostic(
         code(uploader::undo_not_last),
         help(
-            "undo the later upload first: `scorpion upload --undo` where it was made (each undo goes back one upload, the last first), or `--undo-file FILE` with its undo file; where a `scorpion restore` put it back after its upload was undone (no undo file is left for it), restore a backup from before it instead"
+            "undo the later upload first: `scorpion upload --undo` where it was made (each undo goes back one upload, the last first), or `--undo-file FILE` with its undo file; where a `scorpion restore` put it back after its upload was undone (no undo file is left for it), restore a backup from before it instead; where you pointed the hook there by hand, point it back where it was (`scorpion installed` shows the hooks; PROTOCOL.md's `/9W`), undo, then point it at your code again"
         )
     )]
     UndoNotLast {

@@ -1919,3 +1919,33 @@ fn a_way_that_jumps_where_its_data_says_outside_the_file_is_refused() {
         }
     }
 }
+
+/// hostile30 F5: code on the KIM bus that bumps the operand of its own
+/// `JMP` ($1000 `INC $1004`, `JMP $2000`: the jump goes elsewhere every
+/// pass) was taken for a fixed jump; its restore went through unchecked.
+/// It jumps where its data says: refused, and `backup` says so.
+#[test]
+fn code_that_changes_its_own_jump_is_a_jump_where_its_data_says() {
+    let [lo, hi] = BAD_COMMAND.to_le_bytes();
+    let options = UploadOptions::default();
+    let mut client = uploader::client(robot(), &options.profile);
+    upload(
+        &mut client,
+        &extension_at(0x0500),
+        &options,
+        &mut NoProgress,
+    )
+    .expect("installed");
+    by_hand(&mut client, 0x1000, &[0xEE, 0x04, 0x10, 0x4C, 0x00, 0x20]);
+    by_hand(&mut client, 0x2000, &[0x4C, lo, hi]);
+    by_hand(&mut client, 0x0501, &[0x00, 0x10]);
+    let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
+    let said = saved.refused.clone().unwrap_or_default();
+    assert!(said.contains("jumps where its data says"), "{said}");
+    let before = held(&mut client);
+    match restore(&mut client, &saved.backup, &options, &mut NoProgress) {
+        Err(Error::ComputedWayOutside { .. }) => {}
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
+}

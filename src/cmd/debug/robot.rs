@@ -112,29 +112,27 @@ pub(crate) fn attach(
             seconds(first)
         ));
     }
-    // fresh28 F3: the RAM loader that writes the stub keeps its state in
-    // user zero page the image does not load: said with the stub's place.
-    let loader_zero_page =
-        uploader::loader_plan(&profile, &code, (resolved.baud.value, uploader::FAST_BAUD))
-            .ok()
-            .flatten()
-            .map(|loader| {
-                format!(
-                    " (${:04X}-${:04X}, its state in user zero page ${:02X}-${:02X})",
-                    loader.code.address,
-                    u32::from(loader.code.address) + loader.code.bytes.len() as u32 - 1,
-                    loader.zero_page.start(),
-                    loader.zero_page.end()
-                )
-            })
-            .unwrap_or_default();
     let robot = RobotDebug::attach(client, &profile, code)
         .map_err(|error| ports::traced_report(miette::Report::new(error), &resolved))?;
     // The monitor and an editor alike (fresh15 F3: the adapter said
     // nothing of it).
     let stub = robot.stub();
+    // fresh28 F3, fresh30 F4: the RAM loader that wrote the stub, where
+    // it did, stays with its state in user zero page.
+    let loader_zero_page = robot
+        .loader()
+        .map(|loader| {
+            format!(
+                ", and the RAM loader that wrote it (${:04X}-${:04X}, its state in user zero page ${:02X}-${:02X})",
+                loader.code.start(),
+                loader.code.end(),
+                loader.zero_page.start(),
+                loader.zero_page.end()
+            )
+        })
+        .map_or_else(|| " stays".to_owned(), |loader| format!("{loader}, stay"));
     say(&format!(
-        "the debug stub is at ${:04X}-${:04X} (and user zero page ${:02X}-${:02X}): it, and the RAM loader that wrote it{loader_zero_page}, stay in memory after the session, unhooked; no undo puts back what was there (`scorpion backup` before a session keeps it)",
+        "the debug stub is at ${:04X}-${:04X} (and user zero page ${:02X}-${:02X}): it{loader_zero_page} in memory after the session, unhooked; no undo puts back what was there (`scorpion backup` before a session keeps it)",
         stub.address,
         u32::from(stub.address) + stub.bytes.len() as u32 - 1,
         stub.zero_page,

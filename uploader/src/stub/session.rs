@@ -122,6 +122,8 @@ pub struct RobotDebug<T> {
     guard: Guard,
     /// The ROM the image was linked against (its hooks, for detach).
     profile: RomProfile,
+    /// Where the RAM loader that wrote the stub went, if it did.
+    loader: Option<super::summed::LoaderMemory>,
 }
 
 /// The pieces of `bytes` (at `address`) that `held` (read there) does not
@@ -297,6 +299,7 @@ impl<T: Transport> RobotDebug<T> {
             partial: Vec::new(),
             pending: None,
             recovery: Recovery::default(),
+            loader: None,
             starts: None,
             temporary: Vec::new(),
             alone: None,
@@ -451,13 +454,18 @@ impl<T: Transport> RobotDebug<T> {
                 &[]
             };
             let todo = differing(stub.address, &stub.bytes, held);
-            let summed = !todo.is_empty()
-                && super::summed::write_summed(
+            let loader = if todo.is_empty() {
+                None
+            } else {
+                super::summed::write_summed(
                     &mut debug.client,
                     profile,
                     (&debug.image, &installed),
                     &todo,
-                )?;
+                )?
+            };
+            let summed = loader.is_some();
+            debug.loader = loader;
             if !summed {
                 debug.rom_write_over(stub.address, &stub.bytes, held)?;
             }
@@ -920,6 +928,13 @@ impl<T: Transport> RobotDebug<T> {
     #[must_use]
     pub fn stub(&self) -> &StubPlan {
         &self.stub
+    }
+
+    /// Where the RAM loader that wrote the stub went (and stays), if the
+    /// stub went in through it.
+    #[must_use]
+    pub fn loader(&self) -> Option<&super::summed::LoaderMemory> {
+        self.loader.as_ref()
     }
 
     /// The registers, when stopped.

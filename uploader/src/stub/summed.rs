@@ -37,17 +37,31 @@ const REMOVE_ATTEMPTS: u32 = 3;
 /// (`HOOK_UNKNOWN` back where it was); [`StubError::LoaderLeft`] when it
 /// could not be (seed 64 of the noisy-line runs: a frame the noise made
 /// longer held the loader until the line gave up).
+/// Where the RAM loader that wrote a stub went: it stays there, unhooked
+/// (fresh28 F3, fresh30 F4: the start-up note says it only where it went).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoaderMemory {
+    /// Its code.
+    pub code: std::ops::RangeInclusive<u16>,
+    /// Its state in user zero page.
+    pub zero_page: std::ops::RangeInclusive<u8>,
+}
+
 pub(super) fn write_summed<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     (image, installed): (&UploadImage, &[Installed]),
     areas: &[Area],
-) -> StubResult<bool> {
+) -> StubResult<Option<LoaderMemory>> {
     let base = client.transport().baud();
     // Placed and linked as an upload's, so a loader one left is found: the
     // line stays at its rate all the same (`None` for the fast one).
     let Some(loader) = Loader::place(profile, image, (base, FAST_BAUD))? else {
-        return Ok(false);
+        return Ok(None);
+    };
+    let memory = LoaderMemory {
+        code: loader.image.extents().first().cloned().unwrap_or(0..=0),
+        zero_page: loader.zero_page..=loader.zero_page + (crate::loader::ZERO_PAGE_LEN - 1),
     };
     // Reads only: tried again where the line went quiet a while.
     let hooks =
@@ -56,10 +70,10 @@ pub(super) fn write_summed<T: Transport>(
         crate::beside::refusal(client, profile, &hooks, installed, &loader)
     })?;
     if refused.is_some() {
-        return Ok(false);
+        return Ok(None);
     }
     let Some(&(_, original)) = hooks.iter().find(|(kind, _)| *kind == HookKind::Unknown) else {
-        return Ok(false);
+        return Ok(None);
     };
     let limits = UploadOptions::default().limits();
     let mut session = Session::new(loader, profile, original, (base, None), limits, true, None);
@@ -71,7 +85,7 @@ pub(super) fn write_summed<T: Transport>(
     let taken_out =
         crate::session::tried(REMOVE_ATTEMPTS, || session.remove(client, &mut progress));
     match (written, taken_out) {
-        (Ok(_), Ok(())) => Ok(true),
+        (Ok(_), Ok(())) => Ok(Some(memory)),
         (Err(error), Ok(())) => Err(error.into()),
         (Ok(_), Err(error)) | (Err(error), Err(_)) => Err(StubError::LoaderLeft {
             source: error,
