@@ -972,10 +972,18 @@ fn upload_file(
         // counter its program keeps), put back as built. Only where the
         // robot's bytes were compared (fresh30 F1, hostile29 F8: `--full`
         // or no loader writes every byte, changed or not).
-        let compared = report.loader.is_some() && report.without_loader.is_none();
+        let compared = options.delta && report.loader.is_some() && report.without_loader.is_none();
         let written: usize = report.written.iter().map(|range| range.1).sum();
-        if compared && 0 < written && written < report.bytes {
+        let data = image.code().is_some_and(|code| {
+            image.areas().iter().any(|area| {
+                (u32::from(area.address)..area.end())
+                    .any(|at| !code.iter().any(|range| range.contains(&(at as u16))))
+            })
+        });
+        if compared && 0 < written {
             out.push_str("  (its data, which its program had changed, is put back as built)\n");
+        } else if !compared && data {
+            out.push_str("  (every byte written again, its data as built)\n");
         }
     }
     if !emulated && expected {
