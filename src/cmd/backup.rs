@@ -226,7 +226,7 @@ pub(crate) fn restore_into(
     // the ROM's commands: written whatever the robot held (fresh10 F3:
     // an unchanged robot read as "188 written").
     let after_loader: usize = match reports.as_slice() {
-        [_, after] => after.written.iter().map(|range| range.1).sum(),
+        [_, after] => after.written_bytes(),
         _ => 0,
     };
     let written = match after_loader {

@@ -334,7 +334,7 @@ fn summary(report: &UploadReport, image: &UploadImage, emulated: bool) -> String
         .device_time
         .max(Duration::from_millis(1))
         .as_secs_f64();
-    let written: usize = report.written.iter().map(|range| range.1).sum();
+    let written = report.written_bytes();
     // fresh28 F4: "uploaded" where the robot held every byte already.
     let (what, held) = if written == 0 && report.bytes > 0 {
         (
@@ -973,7 +973,7 @@ fn upload_file(
         // robot's bytes were compared (fresh30 F1, hostile29 F8: `--full`
         // or no loader writes every byte, changed or not).
         let compared = options.delta && report.loader.is_some() && report.without_loader.is_none();
-        let written: usize = report.written.iter().map(|range| range.1).sum();
+        let written = report.written_bytes();
         let data = image.code().is_some_and(|code| {
             image.areas().iter().any(|area| {
                 (u32::from(area.address)..area.end())

@@ -161,7 +161,7 @@ fn main() {
         "one byte changed (delta)",
         delta.device_time.as_secs_f64(),
         format!("{delta_ratio:.3}x 1 s"),
-        format!("{} B", delta.written.iter().map(|r| r.1).sum::<usize>()),
+        format!("{} B", delta.written_bytes()),
         delta.chars_sent + delta.chars_received,
         wall.as_millis()
     );

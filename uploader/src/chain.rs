@@ -302,17 +302,11 @@ pub(crate) fn way_code<T: Transport>(
         .copied()
         .filter(|&at| readable(profile, at) && !listed(at))
         .collect();
-    let mut bus = ChainBus {
-        client,
-        profile,
-        seen: noted.laid.clone(),
-        failed: None,
-        outside: false,
-        wrote: false,
-        touched: &mut noted.code,
-        written: &mut noted.data,
-        computed: &mut noted.computed,
-    };
+    let mut bus = ChainBus::over(
+        (client, profile),
+        &noted.laid,
+        (&mut noted.code, &mut noted.data, &mut noted.computed),
+    );
     reach::reach(&mut bus, &starts, &listed)?;
     let data = &noted.data;
     noted.code.retain(|&at| !listed(at) && !data.contains(&at));
@@ -394,17 +388,7 @@ fn follow_noting<T: Transport>(
                                 .flat_map(|other| other.hooks.iter())
                                 .any(|hook| hook.kind == kind && hook.handler == pc)
                     };
-                    let bus = ChainBus {
-                        client,
-                        profile,
-                        seen: laid.clone(),
-                        failed: None,
-                        outside: false,
-                        wrote: false,
-                        touched,
-                        written,
-                        computed,
-                    };
+                    let bus = ChainBus::over((client, profile), laid, (touched, written, computed));
                     let landed = run_to_landing(bus, at, &landing, strict)?;
                     match landed {
                         Landing::At(pc) | Landing::Left(pc) => Some(pc),
@@ -752,9 +736,17 @@ fn readable(profile: &RomProfile, at: u16) -> bool {
             .is_some_and(|zp| at <= 0xFF && zp.contains(&(at as u8)))
 }
 
+/// Where a [`ChainBus`] notes: a [`Noted`]'s `code`, `data` and
+/// `computed`.
+type NotedParts<'a> = (
+    &'a mut BTreeSet<u16>,
+    &'a mut BTreeSet<u16>,
+    &'a mut Option<u16>,
+);
+
 /// The robot's memory for [`run_to_landing`]: read through the line a
 /// chunk at a time, each byte once; writes kept on the host.
-pub(crate) struct ChainBus<'a, T: Transport> {
+struct ChainBus<'a, T: Transport> {
     client: &'a mut Client<T>,
     profile: &'a RomProfile,
     /// Bytes read (or laid: a file's), and those the run wrote.
@@ -773,10 +765,31 @@ pub(crate) struct ChainBus<'a, T: Transport> {
     computed: &'a mut Option<u16>,
 }
 
-impl<T: Transport> ChainBus<'_, T> {
+impl<'a, T: Transport> ChainBus<'a, T> {
+    /// A bus over the robot's memory with `laid` bytes over it (a file's),
+    /// noting the code run, what it wrote and a jump where its data says
+    /// (a [`Noted`]'s parts).
+    fn over(
+        (client, profile): (&'a mut Client<T>, &'a RomProfile),
+        laid: &BTreeMap<u16, u8>,
+        (touched, written, computed): NotedParts<'a>,
+    ) -> Self {
+        ChainBus {
+            client,
+            profile,
+            seen: laid.clone(),
+            failed: None,
+            outside: false,
+            wrote: false,
+            touched,
+            written,
+            computed,
+        }
+    }
+
     /// The byte at `address`, read from the robot once; 0 where it may
     /// not be read or the line failed (see `outside`, `failed`).
-    pub(crate) fn byte(&mut self, address: u16) -> u8 {
+    fn byte(&mut self, address: u16) -> u8 {
         if let Some(&byte) = self.seen.get(&address) {
             return byte;
         }

@@ -124,15 +124,7 @@ pub fn loader_plan(
     image: &UploadImage,
     rates: (u32, u32),
 ) -> Result<Option<LoaderPlan>> {
-    Ok(
-        Loader::place(profile, image, rates)?.map(|loader| LoaderPlan {
-            code: loader.image.areas()[0].clone(),
-            rate_handler: loader.rate,
-            frames_handler: loader.frames,
-            sums_handler: loader.sums,
-            zero_page: loader.zero_page..=loader.zero_page + (ZERO_PAGE_LEN - 1),
-        }),
-    )
+    Ok(Loader::place(profile, image, rates)?.map(|loader| loader.plan()))
 }
 
 /// Whether `target` (a hook's) is the RAM loader where an upload leaves
@@ -183,6 +175,17 @@ pub fn loader_left_at<T: Transport>(
 }
 
 impl Loader {
+    /// Where it goes and what it is, as tools see it.
+    pub(crate) fn plan(&self) -> LoaderPlan {
+        LoaderPlan {
+            code: self.image.areas()[0].clone(),
+            rate_handler: self.rate,
+            frames_handler: self.frames,
+            sums_handler: self.sums,
+            zero_page: self.zero_page..=self.zero_page + (ZERO_PAGE_LEN - 1),
+        }
+    }
+
     /// Links the loader for `profile` and a line at `rates`, in RAM and
     /// zero page the image leaves free: `None` when there is no room or
     /// the ROM lacks the services.

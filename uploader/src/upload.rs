@@ -200,6 +200,12 @@ pub struct UploadReport {
 }
 
 impl UploadReport {
+    /// How many bytes [`UploadReport::written`] holds.
+    #[must_use]
+    pub fn written_bytes(&self) -> usize {
+        self.written.iter().map(|range| range.1).sum()
+    }
+
     /// Of `earlier`, the ids of extensions an uploader put in before this
     /// upload, those no longer installed: not in the table when this
     /// upload read it (a reset before: recheck23 F1), or freed by a reset

@@ -75,6 +75,20 @@ pub(crate) fn code_of<T: Transport>(
     Ok(ways)
 }
 
+/// What the robot lists now, and the code its hooks run now.
+///
+/// # Errors
+/// The line's errors.
+fn ways_now<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+) -> Result<(Vec<Installed>, Vec<WayCode>)> {
+    let listed = crate::table::read_installed(client, profile)?;
+    let hooks = crate::hooks::read_hooks(client, profile)?;
+    let now = code_of(client, profile, (&hooks, &listed), &BTreeMap::new())?;
+    Ok((listed, now))
+}
+
 /// The first byte of `ways` in memory an extension may hold that
 /// `backup` neither holds nor witnesses and `fine` does not excuse: the
 /// hook, the way, the byte.
@@ -137,9 +151,7 @@ pub(crate) fn check_restore<T: Transport>(
     if nothing_to_ask {
         return Ok(());
     }
-    let listed = crate::table::read_installed(client, profile)?;
-    let hooks = crate::hooks::read_hooks(client, profile)?;
-    let now = code_of(client, profile, (&hooks, &listed), &BTreeMap::new())?;
+    let (listed, now) = ways_now(client, profile)?;
     let run_now = |at: u16| {
         listed.iter().any(|entry| entry.contains(at))
             || now.iter().any(|way| way.code.contains(&at))
@@ -289,9 +301,7 @@ impl Unchanged {
             (&backup.hooks, &after_listed),
             &laid(backup),
         )?;
-        let listed = crate::table::read_installed(client, profile)?;
-        let hooks = crate::hooks::read_hooks(client, profile)?;
-        let now = code_of(client, profile, (&hooks, &listed), &BTreeMap::new())?;
+        let (_, now) = ways_now(client, profile)?;
         let mut left = BTreeSet::new();
         let mut changed: BTreeSet<u16> = after_listed
             .iter()

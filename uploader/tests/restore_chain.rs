@@ -349,15 +349,19 @@ fn one_installed() -> (
     UploadOptions,
     uploader::Client<uploader::transport::VirtualTransport>,
 ) {
+    installed_at(0x0400)
+}
+
+/// The robot with one extension at `base` installed, and the options.
+fn installed_at(
+    base: u16,
+) -> (
+    UploadOptions,
+    uploader::Client<uploader::transport::VirtualTransport>,
+) {
     let options = UploadOptions::default();
     let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0400),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    upload(&mut client, &extension_at(base), &options, &mut NoProgress).expect("installed");
     (options, client)
 }
 
@@ -1295,15 +1299,7 @@ fn a_backup_whose_way_goes_on_into_memory_it_does_not_hold_is_refused() {
 /// it, and the restore refuses the change.
 #[test]
 fn a_backup_witnesses_the_code_its_ways_reach_outside_what_it_saves() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0500),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = installed_at(0x0500);
     let owners = [
         0x4C,
         BAD_COMMAND.to_le_bytes()[0],
@@ -1387,15 +1383,7 @@ fn an_undo_whose_way_goes_on_into_code_nothing_checks_is_refused() {
 /// refused.
 #[test]
 fn a_backup_witnesses_every_step_of_code_outside_what_it_saves() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0500),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = installed_at(0x0500);
     let [lo, hi] = BAD_COMMAND.to_le_bytes();
     by_hand(&mut client, 0x1000, &[0x4C, 0x00, 0x20]);
     by_hand(&mut client, 0x2000, &[0x4C, lo, hi]);
@@ -1480,15 +1468,7 @@ fn kim_code_before_each_jmp() -> (
     uploader::Client<uploader::transport::VirtualTransport>,
     uploader::Backup,
 ) {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0500),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = installed_at(0x0500);
     let [lo, hi] = BAD_COMMAND.to_le_bytes();
     let mut first = vec![0xEA; 14];
     first.extend([0x4C, 0x00, 0x20]);
@@ -1712,15 +1692,7 @@ fn an_undo_after_a_reset_lists_nothing_it_does_not_check() {
 /// not refused: the backup restores with the counter moved on.
 #[test]
 fn data_the_ways_code_writes_is_not_taken_for_code() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0500),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = installed_at(0x0500);
     let [lo, hi] = BAD_COMMAND.to_le_bytes();
     by_hand(
         &mut client,
@@ -1744,15 +1716,7 @@ fn data_the_ways_code_writes_is_not_taken_for_code() {
 /// elsewhere is still refused, nothing written.
 #[test]
 fn an_owners_handler_in_front_of_an_extension_is_restored_as_it_was() {
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0500),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = installed_at(0x0500);
     by_hand(&mut client, 0x0900, &[0xEA, 0x4C, 0x03, 0x05]);
     by_hand(&mut client, HOOK_UNKNOWN + 1, &[0x00, 0x09]);
     let saved = uploader::backup_live(&mut client, &options.profile).expect("a backup");
@@ -1883,15 +1847,7 @@ fn a_way_that_jumps_where_its_data_says_outside_the_file_is_refused() {
     for (code_at, refused) in [(0x1000u16, true), (0x0900, false)] {
         let target = code_at + 0x20;
         let [t_lo, t_hi] = target.to_le_bytes();
-        let options = UploadOptions::default();
-        let mut client = uploader::client(robot(), &options.profile);
-        upload(
-            &mut client,
-            &extension_at(0x0500),
-            &options,
-            &mut NoProgress,
-        )
-        .expect("installed");
+        let (options, mut client) = installed_at(0x0500);
         by_hand(
             &mut client,
             code_at,
@@ -1927,15 +1883,7 @@ fn a_way_that_jumps_where_its_data_says_outside_the_file_is_refused() {
 #[test]
 fn code_that_changes_its_own_jump_is_a_jump_where_its_data_says() {
     let [lo, hi] = BAD_COMMAND.to_le_bytes();
-    let options = UploadOptions::default();
-    let mut client = uploader::client(robot(), &options.profile);
-    upload(
-        &mut client,
-        &extension_at(0x0500),
-        &options,
-        &mut NoProgress,
-    )
-    .expect("installed");
+    let (options, mut client) = installed_at(0x0500);
     by_hand(&mut client, 0x1000, &[0xEE, 0x04, 0x10, 0x4C, 0x00, 0x20]);
     by_hand(&mut client, 0x2000, &[0x4C, lo, hi]);
     by_hand(&mut client, 0x0501, &[0x00, 0x10]);

@@ -158,7 +158,7 @@ fn one_byte_change_of(len: usize, offset: usize) {
     };
     let mut client = uploader::client(robot(), &options.profile);
     let first = upload(&mut client, &image, &options, &mut NoProgress).expect("the first upload");
-    assert_eq!(first.written.iter().map(|r| r.1).sum::<usize>(), len + 15);
+    assert_eq!(first.written_bytes(), len + 15);
 
     let new = one_byte_changed(&image, offset);
     let report = upload(&mut client, &new, &options, &mut NoProgress).expect("the change");

@@ -124,8 +124,8 @@ pub(crate) fn attach(
         .map(|loader| {
             format!(
                 ", and the RAM loader that wrote it (${:04X}-${:04X}, its state in user zero page ${:02X}-${:02X})",
-                loader.code.start(),
-                loader.code.end(),
+                loader.code.address,
+                loader.code.end() - 1,
                 loader.zero_page.start(),
                 loader.zero_page.end()
             )

@@ -23,7 +23,6 @@ pub mod link;
 pub mod patch;
 pub mod session;
 mod summed;
-pub use summed::LoaderMemory;
 pub mod unlisted;
 
 pub use error::{StubError, StubResult, hex as error_hex};

@@ -123,7 +123,7 @@ pub struct RobotDebug<T> {
     /// The ROM the image was linked against (its hooks, for detach).
     profile: RomProfile,
     /// Where the RAM loader that wrote the stub went, if it did.
-    loader: Option<super::summed::LoaderMemory>,
+    loader: Option<crate::LoaderPlan>,
 }
 
 /// The pieces of `bytes` (at `address`) that `held` (read there) does not
@@ -933,7 +933,7 @@ impl<T: Transport> RobotDebug<T> {
     /// Where the RAM loader that wrote the stub went (and stays), if the
     /// stub went in through it.
     #[must_use]
-    pub fn loader(&self) -> Option<&super::summed::LoaderMemory> {
+    pub fn loader(&self) -> Option<&crate::LoaderPlan> {
         self.loader.as_ref()
     }
 

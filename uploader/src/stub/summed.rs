@@ -16,7 +16,7 @@ use super::error::{StubError, StubResult};
 use crate::client::Client;
 use crate::hooks::read_hooks;
 use crate::image::{Area, RomProfile, UploadImage};
-use crate::loader::{FAST_BAUD, Loader};
+use crate::loader::{FAST_BAUD, Loader, LoaderPlan};
 use crate::progress::NoProgress;
 use crate::session::Session;
 use crate::transport::Transport;
@@ -26,8 +26,9 @@ use crate::upload::UploadOptions;
 const REMOVE_ATTEMPTS: u32 = 3;
 
 /// Writes `areas` through the RAM loader placed for `image` (as an upload
-/// of it places it), verified by the robot's sums; `false`, with nothing
-/// written, when the image leaves the loader no room, the ROM lacks its
+/// of it places it), verified by the robot's sums: where that loader went
+/// (it stays there, unhooked: fresh28 F3, fresh30 F4); `None`, with
+/// nothing written, when the image leaves the loader no room, the ROM lacks its
 /// services, or it may not go in beside the extensions `installed` (on
 /// one of them, or a hook leads to code no entry names, as an upload
 /// refuses it): the caller writes with the ROM's commands then.
@@ -37,32 +38,19 @@ const REMOVE_ATTEMPTS: u32 = 3;
 /// (`HOOK_UNKNOWN` back where it was); [`StubError::LoaderLeft`] when it
 /// could not be (seed 64 of the noisy-line runs: a frame the noise made
 /// longer held the loader until the line gave up).
-/// Where the RAM loader that wrote a stub went: it stays there, unhooked
-/// (fresh28 F3, fresh30 F4: the start-up note says it only where it went).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct LoaderMemory {
-    /// Its code.
-    pub code: std::ops::RangeInclusive<u16>,
-    /// Its state in user zero page.
-    pub zero_page: std::ops::RangeInclusive<u8>,
-}
-
 pub(super) fn write_summed<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     (image, installed): (&UploadImage, &[Installed]),
     areas: &[Area],
-) -> StubResult<Option<LoaderMemory>> {
+) -> StubResult<Option<LoaderPlan>> {
     let base = client.transport().baud();
     // Placed and linked as an upload's, so a loader one left is found: the
     // line stays at its rate all the same (`None` for the fast one).
     let Some(loader) = Loader::place(profile, image, (base, FAST_BAUD))? else {
         return Ok(None);
     };
-    let memory = LoaderMemory {
-        code: loader.image.extents().first().cloned().unwrap_or(0..=0),
-        zero_page: loader.zero_page..=loader.zero_page + (crate::loader::ZERO_PAGE_LEN - 1),
-    };
+    let plan = loader.plan();
     // Reads only: tried again where the line went quiet a while.
     let hooks =
         crate::session::tried_quiet(crate::hooks::QUIET_LOOKS, || read_hooks(client, profile))?;
@@ -85,7 +73,7 @@ pub(super) fn write_summed<T: Transport>(
     let taken_out =
         crate::session::tried(REMOVE_ATTEMPTS, || session.remove(client, &mut progress));
     match (written, taken_out) {
-        (Ok(_), Ok(())) => Ok(Some(memory)),
+        (Ok(_), Ok(())) => Ok(Some(plan)),
         (Err(error), Ok(())) => Err(error.into()),
         (Ok(_), Err(error)) | (Err(error), Err(_)) => Err(StubError::LoaderLeft {
             source: error,
