@@ -626,7 +626,7 @@ fn undo_refused(report: miette::Report, path: &Path) -> miette::Report {
         }) => miette::miette!(
             code = "uploader::witness_differs",
             help = "another upload replaced it, it was undone already (by a restore or an undo with another undo file), or that memory was changed by hand since (put it back as it was, and undo again); nothing was changed: otherwise upload the image you want instead of undoing",
-            "the robot is not as the upload the undo file {} undoes left it: ${address:04X}-${:04X}, {what}, is not what it was when the undo file was written (its Fletcher-16 was ${expected:04X}, the robot's is ${found:04X})",
+            "the robot is not as the upload the undo file {} undoes left it: ${address:04X}-${:04X}, {what}, is not what it was when the undo file was written (its checksum was {expected}, the robot's is {found})",
             path.display(),
             u32::from(*address) + u32::from(*len) - 1
         ),

@@ -32,15 +32,21 @@
 ; next command's first byte as its last, and the ROM then ignores the rest
 ; of that command (it has no slash): the uploader asks again.
 ;
-; sums    (last): /9Kaaaannnn answers Kaaaass tt: the address, then a
-;         Fletcher-16 of nnnn bytes from aaaa (two sums mod 256, both
-;         starting at zero: ss = the sum of the bytes, tt = the sum of
-;         the running sums), so the uploader can tell which ranges of an
-;         image a robot holds already without reading every byte, and
-;         that the robot's ROM is the one an image was linked against.
-;         Any one byte changed changes ss. Anything else falls into
-;         `frames`. It goes in through `frames`, verified, and only then
-;         is hooked: every part falls only into parts verified before it.
+; sums    (last): /9Kaaaannnn answers Kaaaassssssss: the address, then
+;         two sums of nnnn bytes from aaaa, both mod 65536 and starting
+;         at zero: the first (four digits) the sum of the bytes, the
+;         second (four digits) the sum of the running first sums, so
+;         that the uploader can tell which ranges of an image a robot
+;         holds already without reading every byte, and that the robot's
+;         ROM is the one an image was linked against. Over up to 257
+;         bytes the first sum is exact, and any change of one or two
+;         bytes changes one of them: two bytes that change by +d and -d,
+;         k apart, change the second by d times k, less than 65536
+;         (hostile30 F1: with both sums mod 256, bit 7 of two bytes two
+;         apart, or a $40 moved four bytes, passed unseen). Anything
+;         else falls into `frames`. It goes in through `frames`,
+;         verified, and only then is hooked: every part falls only into
+;         parts verified before it.
 ;
 ; Assembled twice (build.rs): with RING = 1 the data bytes are taken
 ; straight from the ROM's receive ring (RXBUF, RXHEAD, RXTAIL: a 256-byte
@@ -70,6 +76,10 @@ KEY     = LZP                   ; the frame's key
 SUM0    = LZP + 1               ; the Fletcher sums of the header
 SUM1    = LZP + 2
 HEAD    = LZP + 3               ; the header, last byte first: c1 c0 count lo hi
+SUMS    = LZP                   ; sums: the answer's four bytes, last first
+FIRSTHI = LZP + 3               ; the first sum, high byte
+FIRSTLO = LZP + 2               ;   low byte (in X while the bytes are added)
+SECOND  = LZP                   ; the second sum, low byte, then high
 COUNT   = HEAD + 2
 DEST    = HEAD + 3              ; lo, hi: the frame's first address
 ARGS    = HEAD + 1              ; sums: its fields, last first: count lo, hi, DEST
@@ -129,9 +139,9 @@ data:   jsr CHKCH               ; the bytes are usually in the ring already
         beq drop
 
 ; /9Kaaaannnn: the address is answered first, so the answer starts
-; while the sums are added (24 cycles a byte). A part page first: Y
-; starts at 256 - the low byte of the count, DEST that much lower, so
-; one loop over whole pages does all.
+; while the sums are added (35 cycles a byte, 41 where the first sum's
+; low byte carries, one more where (DEST),y crosses a page). A part page first: Y starts at 256 - the low byte of
+; the count, DEST that much lower, so one loop over whole pages does all.
 __scorpion_hook_unknown:
 sums:   cmp #'K'
         bne frames
@@ -150,8 +160,6 @@ args:   jsr GETHEX              ; X kept
         jsr PUTHEX
         lda DEST
         jsr PUTHEX
-        ldx #0                  ; X = the first sum
-        stx SUM1
         ldy LENLO
         beq pages               ; whole pages only: Y = 0
         inc LENHI               ; the part page counts as one
@@ -166,23 +174,35 @@ args:   jsr GETHEX              ; X kept
         sta DEST
         bcs pages
         dec DEST + 1
-pages:  lda LENHI
+pages:  ldx #0                  ; X = the first sum's low byte
+        stx FIRSTHI
+        stx SECOND
+        stx SECOND + 1
+        lda LENHI
         beq answer
+        clc                     ; clear at the top of each byte
 add:    txa
-        clc
         adc (DEST),y
         tax
+        bcc second
+        inc FIRSTHI
         clc
-        adc SUM1
-        sta SUM1
+second: adc SECOND              ; A = the first sum's low byte
+        sta SECOND
+        lda FIRSTHI
+        adc SECOND + 1
+        sta SECOND + 1
+        clc
         iny
         bne add
         inc DEST + 1
         dec LENHI
         bne add
-answer: txa
-        jsr PUTHEX
-        lda SUM1
-        jsr PUTHEX
+answer: stx FIRSTLO
+        ldx #3
+digits: lda SUMS,x              ; first sum high, low; second sum high, low
+        jsr PUTHEX              ; X kept
+        dex
+        bpl digits
         jsr PUTEOL
 sdrop:  jmp CMD_DONE

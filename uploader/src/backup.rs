@@ -6,19 +6,26 @@
 //! # The file format
 //!
 //! ```text
-//! SCORPION-BACKUP 1\n                       magic line (ASCII)
+//! SCORPION-BACKUP 2\n                       magic line (ASCII)
 //! 'A' address:u16 length:u16 bytes...       memory (repeated)
 //! 'H' kind:u8 target:u16                    a hook's target (0 HOOK_UNKNOWN, 1 HOOK_LOOP)
-//! 'W' address:u16 length:u16 sum:u16        a witness: the Fletcher-16 of memory a hook
-//!                                           target lies in, not held by the file itself
-//! 'T' address:u16 length:u16 sum:u16        a table entry an upload the file undoes wrote,
+//! 'W' address:u16 length:u16 sum:u32        a witness: the robot's sum (`robot_sum`) of
+//!                                           memory a hook's way runs, not held by the file
+//! 'T' address:u16 length:u16 sum:u32        a table entry an upload the file undoes wrote,
 //!                                           witnessed as written (an undo file's)
+//! 'w', 't' address:u16 length:u16 sum:u16   the same, kept from a version 1 file: the
+//!                                           narrow Fletcher-16 (`fletcher16`)
 //! 'R' address:u16 length:u16 bytes...       the robot's ROM there (its jump table, vectors)
 //! 'E' fnv1a32:u32                           end: FNV-1a 32 of every byte before 'E'
 //! ```
 //!
 //! Numbers are little-endian. A file that does not end in a matching `E`
 //! record is refused whole: nothing of a damaged backup is written.
+//!
+//! Version 1 (`SCORPION-BACKUP 1`, before hostile30) held its `W` and `T`
+//! sums as the narrow Fletcher-16 (both sums mod 256), which some changes
+//! of two bytes pass. Such a file is still read (its witnesses as narrow
+//! ones, checked as they were); every file written is version 2.
 
 use isa::objfmt::HookKind;
 
@@ -33,7 +40,10 @@ use crate::upload::{LoaderChoice, UploadOptions, UploadReport, upload};
 use crate::{Error, Result};
 
 /// The first line of a backup file.
-pub const MAGIC: &[u8] = b"SCORPION-BACKUP 1\n";
+pub const MAGIC: &[u8] = b"SCORPION-BACKUP 2\n";
+
+/// The first line of a version 1 file (narrow witnesses), still read.
+pub const MAGIC_1: &[u8] = b"SCORPION-BACKUP 1\n";
 
 /// What a robot held: memory and hook targets.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -61,16 +71,59 @@ pub struct Backup {
     pub rom: Vec<Area>,
 }
 
-/// The Fletcher-16 ([`crate::fletcher16`]) of `len` bytes from `address`,
-/// as the robot held them.
+/// The checksum of `len` bytes from `address`, as the robot held them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Witness {
     /// The first address.
     pub address: u16,
     /// How many bytes.
     pub len: u16,
-    /// Their Fletcher-16.
-    pub sum: u16,
+    /// Their checksum.
+    pub sum: Checksum,
+}
+
+/// What a [`Witness`] holds of the bytes it covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Checksum {
+    /// The robot's sum ([`crate::robot_sum`]): over at most
+    /// [`crate::sums::EXACT`] bytes, as every witness written is, no
+    /// change of one or two bytes passes it.
+    Wide(u32),
+    /// A version 1 file's Fletcher-16 ([`crate::fletcher16`], both sums
+    /// mod 256), which some changes of two bytes pass (hostile30 F4).
+    Narrow(u16),
+}
+
+impl Checksum {
+    /// The checksum a witness of `bytes` holds now.
+    #[must_use]
+    pub fn of(bytes: &[u8]) -> Checksum {
+        Checksum::Wide(crate::robot_sum(bytes))
+    }
+
+    /// `bytes`' checksum of the same kind as this one.
+    #[must_use]
+    pub fn of_like(self, bytes: &[u8]) -> Checksum {
+        match self {
+            Checksum::Wide(_) => Checksum::of(bytes),
+            Checksum::Narrow(_) => Checksum::Narrow(crate::fletcher16(bytes)),
+        }
+    }
+
+    /// Whether `bytes` sum to this.
+    #[must_use]
+    pub fn matches(self, bytes: &[u8]) -> bool {
+        self.of_like(bytes) == self
+    }
+}
+
+impl std::fmt::Display for Checksum {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Checksum::Wide(sum) => write!(f, "${sum:08X}"),
+            Checksum::Narrow(sum) => write!(f, "${sum:04X} (a version 1 file's Fletcher-16)"),
+        }
+    }
 }
 
 /// Where an upload keeps what it is about to overwrite.
@@ -178,10 +231,18 @@ impl Backup {
         let witnesses = self.witnesses.iter().map(|witness| (b'W', witness));
         let entries = self.written_entries.iter().map(|witness| (b'T', witness));
         for (record, witness) in witnesses.chain(entries) {
-            out.push(record);
+            let narrow = matches!(witness.sum, Checksum::Narrow(_));
+            out.push(if narrow {
+                record.to_ascii_lowercase()
+            } else {
+                record
+            });
             out.extend_from_slice(&witness.address.to_le_bytes());
             out.extend_from_slice(&witness.len.to_le_bytes());
-            out.extend_from_slice(&witness.sum.to_le_bytes());
+            match witness.sum {
+                Checksum::Wide(sum) => out.extend_from_slice(&sum.to_le_bytes()),
+                Checksum::Narrow(sum) => out.extend_from_slice(&sum.to_le_bytes()),
+            }
         }
         for area in &self.rom {
             out.push(b'R');
@@ -205,8 +266,12 @@ impl Backup {
             offset: at,
             reason: reason.to_owned(),
         };
-        if !bytes.starts_with(MAGIC) {
-            return Err(bad(0, "it does not start with `SCORPION-BACKUP 1`"));
+        let version_1 = bytes.starts_with(MAGIC_1);
+        if !bytes.starts_with(MAGIC) && !version_1 {
+            return Err(bad(
+                0,
+                "it does not start with `SCORPION-BACKUP 2` (or an older `SCORPION-BACKUP 1`)",
+            ));
         }
         let mut at = MAGIC.len();
         let mut backup = Backup::default();
@@ -293,18 +358,34 @@ impl Backup {
                         .hooks
                         .push((kind, u16::from_le_bytes([record[1], record[2]])));
                 }
-                kind @ (b'W' | b'T') => {
-                    let record = take(&mut at, 6)?;
+                kind @ (b'W' | b'T' | b'w' | b't') => {
+                    // A version 1 file's `W` and `T` are narrow, as its
+                    // copies' `w` and `t` are in version 2.
+                    let narrow = version_1 || kind.is_ascii_lowercase();
+                    if version_1 && kind.is_ascii_lowercase() {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "an unknown record `{}` (version 1 files have none)",
+                                char::from(kind)
+                            ),
+                        ));
+                    }
+                    let kind = kind.to_ascii_uppercase();
+                    let record = take(&mut at, if narrow { 6 } else { 8 })?;
                     let word = |i: usize| u16::from_le_bytes([record[i], record[i + 1]]);
                     let (address, len) = (word(0), word(2));
                     if u32::from(address) + u32::from(len) > 0x1_0000 {
                         return Err(bad(start, "a witness runs past $FFFF"));
                     }
-                    let witness = Witness {
-                        address,
-                        len,
-                        sum: word(4),
+                    let sum = if narrow {
+                        Checksum::Narrow(word(4))
+                    } else {
+                        Checksum::Wide(u32::from_le_bytes([
+                            record[4], record[5], record[6], record[7],
+                        ]))
                     };
+                    let witness = Witness { address, len, sum };
                     // hostile19 F2: each is read from the robot before
                     // anything else is checked; one a table could not
                     // hold, or a copy, is refused here.
@@ -362,7 +443,9 @@ impl Backup {
                 other => {
                     return Err(bad(
                         start,
-                        &format!("an unknown record: expected A, H, W, R or E, found ${other:02X}"),
+                        &format!(
+                            "an unknown record: expected A, H, W, T, w, t, R or E, found ${other:02X}"
+                        ),
                     ));
                 }
             }
@@ -846,8 +929,8 @@ fn mark_window(
 }
 
 /// The marked addresses as runs, less what `backup` holds itself: each
-/// read once, its witnesses of odd length ([`witnesses_of`]; or the
-/// sums' ranges that tile it, `sums::tiled_odd`).
+/// read once, its witnesses of at most `sums::EXACT` bytes
+/// ([`witnesses_of`]; or the sums' ranges that tile it, `sums::tiled`).
 fn unmarked_but_held(mut marked: Vec<bool>, backup: &Backup) -> Vec<(u16, usize)> {
     for area in &backup.areas {
         let start = usize::from(area.address);
@@ -892,13 +975,14 @@ pub(crate) fn witnesses_of(address: u16, read: &crate::LiveRead) -> Vec<Witness>
         .map(|&at| usize::from(at.wrapping_sub(address)))
         .chain([read.bytes.len()])
     {
-        // Of odd length, as the ranges read are (hostile29 F2).
-        for (at, len) in crate::sums::odd_pieces(end.saturating_sub(start), 0xFFFF) {
+        // Short enough for their sums to see any change of one or two
+        // bytes (hostile30 F4).
+        for (at, len) in crate::sums::pieces(end.saturating_sub(start), crate::sums::EXACT) {
             let from = start + at;
             witnesses.push(Witness {
                 address: address.wrapping_add(from as u16),
                 len: len as u16,
-                sum: crate::sums::fletcher16(&read.bytes[from..from + len]),
+                sum: Checksum::of(&read.bytes[from..from + len]),
             });
         }
         start = end + 1;
@@ -1192,7 +1276,7 @@ fn check_witnesses<T: Transport>(
                 held.filter(|_| code).unwrap_or(now)
             })
             .collect();
-        let found = crate::sums::fletcher16(&after);
+        let found = witness.sum.of_like(&after);
         // What the file itself puts there, where its restore stopped half
         // way (killed, a dead line) and wrote it already: finishing it is
         // what the file is for. Only then: a fresh robot's zeros may be
@@ -1939,15 +2023,23 @@ mod tests {
                 },
             ],
             hooks: vec![(HookKind::Unknown, 0xFF21), (HookKind::Loop, 0x0456)],
-            witnesses: vec![Witness {
-                address: 0x0800,
-                len: 0x40,
-                sum: 0x1234,
-            }],
+            witnesses: vec![
+                Witness {
+                    address: 0x0800,
+                    len: 0x40,
+                    sum: Checksum::Wide(0x1234_5678),
+                },
+                // Kept from a version 1 file.
+                Witness {
+                    address: 0x0900,
+                    len: 0x40,
+                    sum: Checksum::Narrow(0x1234),
+                },
+            ],
             written_entries: vec![Witness {
                 address: 0x0F90,
                 len: romlib::installed::ENTRY_LEN as u16,
-                sum: 0x5678,
+                sum: Checksum::Wide(0x5678_9ABC),
             }],
             rom: vec![Area {
                 address: 0xFFFA,
@@ -1975,6 +2067,40 @@ mod tests {
             );
         }
         assert!(Backup::decode("b", &bytes[..bytes.len() - 1]).is_err());
+    }
+
+    /// hostile30: a version 1 file (narrow sums in its `W` and `T`) is
+    /// still read, its witnesses narrow; written again, they are kept as
+    /// `w` and `t` records and read back the same. A `w` in a version 1
+    /// file is refused at its place.
+    #[test]
+    fn a_version_1_file_is_read_with_its_narrow_sums() {
+        let entry = romlib::installed::ENTRY_LEN as u8;
+        let mut body = MAGIC_1.to_vec();
+        body.extend_from_slice(&[b'H', 0, 0x00, 0x08]);
+        body.extend_from_slice(&[b'W', 0x00, 0x08, 0x10, 0, 0x34, 0x12]);
+        body.extend_from_slice(&[b'T', 0x90, 0x0F, entry, 0, 0x78, 0x56]);
+        let backup = Backup::decode("old.bak", &with_end(body.clone())).expect("decodes");
+        assert_eq!(backup.witnesses[0].sum, Checksum::Narrow(0x1234));
+        assert_eq!(backup.written_entries[0].sum, Checksum::Narrow(0x5678));
+        let again = backup.encode();
+        assert!(again.starts_with(MAGIC));
+        assert!(again.windows(2).any(|w| w == [b'w', 0x00]), "kept narrow");
+        assert_eq!(
+            Backup::decode("again.bak", &again).expect("decodes"),
+            backup
+        );
+        let narrow = |bytes: &[u8]| Checksum::Narrow(crate::fletcher16(bytes));
+        assert!(narrow(&[1, 2, 3]).matches(&[1, 2, 3]));
+        assert!(!narrow(&[1, 2, 3]).matches(&[1, 2, 4]));
+        // Version 1 had no narrow copies to tell apart.
+        let at = body.len();
+        body.extend_from_slice(&[b'w', 0x00, 0x08, 0x10, 0, 0x34, 0x12]);
+        let error = Backup::decode("mixed.bak", &with_end(body)).expect_err("refused");
+        assert!(
+            matches!(&error, Error::BadBackup { offset, .. } if *offset == at),
+            "{error:?}"
+        );
     }
 
     /// A backup file with `backup`'s records and a good end record.
@@ -2008,7 +2134,7 @@ mod tests {
     fn table_entry_records_are_whole_entries_and_copies_are_one() {
         let entry = romlib::installed::ENTRY_LEN as u8;
         let mut body = MAGIC.to_vec();
-        let record = |kind: u8, len: u8| [kind, 0x90, 0x0F, len, 0, 0x34, 0x12];
+        let record = |kind: u8, len: u8| [kind, 0x90, 0x0F, len, 0, 0x34, 0x12, 0, 0];
         for _ in 0..3 {
             body.extend_from_slice(&record(b'T', entry));
             body.extend_from_slice(&record(b'W', 4));
@@ -2123,7 +2249,7 @@ mod tests {
             witnesses: vec![Witness {
                 address: 0x0701,
                 len: 0x10,
-                sum: 0,
+                sum: Checksum::Wide(0),
             }],
             ..Backup::default()
         };
@@ -2152,7 +2278,7 @@ mod tests {
             witnesses: vec![Witness {
                 address: 0x06F8,
                 len: 0x09,
-                sum: 0,
+                sum: Checksum::Wide(0),
             }],
             ..bare.clone()
         };
@@ -2218,7 +2344,7 @@ mod tests {
                     witnesses: vec![Witness {
                         address: table_at + 8,
                         len: 15,
-                        sum: 0,
+                        sum: Checksum::Wide(0),
                     }],
                     ..file(table_at + 8, Vec::new())
                 },

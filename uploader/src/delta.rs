@@ -9,28 +9,27 @@
 //!
 //! A frame costs one character a byte on the way out and its `/7R`
 //! verification two on the way back; a sum question and its answer cost
-//! 21 characters whatever the range. So a fine pass over a coarse range
+//! 25 characters whatever the range. So a fine pass over a coarse range
 //! (8 questions) pays when it spares most of the range's bytes.
 
 use crate::Result;
 use crate::client::Client;
 use crate::image::{Area, UploadImage};
-use crate::sums::{Range, fletcher16, odd_partition, robot_sums};
+use crate::sums::{Range, partition, robot_sum, robot_sums};
 use crate::transport::Transport;
 
-/// Bytes of a range of the coarse pass, about ([`odd_partition`]).
+/// Bytes of a range of the coarse pass, about ([`partition`]).
 pub const COARSE: usize = 256;
 
 /// Bytes of a range of the fine pass, about: a coarse range is 7 of them.
 pub const FINE: usize = 37;
 
-/// `image`'s ranges of about `size` bytes, each within an area and of
-/// odd length ([`odd_partition`]; hostile29 F2: over an even count a page
-/// of one even byte summed as zeros do), with their bytes.
+/// `image`'s ranges of about `size` bytes, each within an area
+/// ([`partition`]), with their bytes.
 fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
     let mut out = Vec::new();
     for area in areas {
-        for (at, len) in odd_partition(area.bytes.len(), size) {
+        for (at, len) in partition(area.bytes.len(), size) {
             out.push(((area.address + at as u16, len), &area.bytes[at..at + len]));
         }
     }
@@ -38,10 +37,10 @@ fn split(areas: &[Area], size: usize) -> Vec<(Range, &[u8])> {
 }
 
 /// A range's index and the robot's sum of it.
-type Differs = (usize, u16);
+type Differs = (usize, u32);
 
 /// Ranges with the robot's sums of them.
-pub(crate) type Known = Vec<(Range, u16)>;
+pub(crate) type Known = Vec<(Range, u32)>;
 
 /// The ranges of `ranges` whose robot sum differs from the host's, the
 /// robot's sums of `first` (asked first, in the same batch), and every
@@ -50,7 +49,7 @@ fn differ<T: Transport>(
     client: &mut Client<T>,
     first: &[Range],
     ranges: &[(Range, &[u8])],
-) -> Result<(Vec<Differs>, Vec<u16>, Known)> {
+) -> Result<(Vec<Differs>, Vec<u32>, Known)> {
     let mut asked: Vec<Range> = first.to_vec();
     asked.extend(ranges.iter().map(|(range, _)| *range));
     let mut found = robot_sums(client, &asked)?;
@@ -60,14 +59,14 @@ fn differ<T: Transport>(
         .iter()
         .zip(rest)
         .enumerate()
-        .filter(|(_, ((_, bytes), found))| fletcher16(bytes) != *found)
+        .filter(|(_, ((_, bytes), found))| robot_sum(bytes) != *found)
         .map(|(i, (_, found))| (i, found))
         .collect();
     Ok((wrong, found, known))
 }
 
 /// A range of the image and the robot's sum of what it holds there.
-pub(crate) type Held = (Area, u16);
+pub(crate) type Held = (Area, u32);
 
 /// What the sums of an upload found, before anything was written.
 pub(crate) struct Summed {
@@ -75,7 +74,7 @@ pub(crate) struct Summed {
     /// what it holds there.
     pub held: Vec<Held>,
     /// The robot's sums of the ranges asked first.
-    pub first: Vec<u16>,
+    pub first: Vec<u32>,
     /// Every range asked, with the robot's sum of it: what a later sum
     /// of the same memory, still unwritten, can be put together from.
     pub known: Known,
@@ -109,7 +108,7 @@ pub(crate) fn differing_and<T: Transport>(
 ) -> Result<Summed> {
     let coarse = split(image.areas(), COARSE);
     let (wrong, sums, mut known) = differ(client, first, &coarse)?;
-    let held = |range: &(Range, &[u8]), sum: u16| {
+    let held = |range: &(Range, &[u8]), sum: u32| {
         (
             Area {
                 address: range.0.0,
@@ -237,17 +236,9 @@ mod tests {
             },
         ];
         let ranges: Vec<Range> = split(&areas, 31).into_iter().map(|(r, _)| r).collect();
-        // Of odd length (hostile29 F2).
         assert_eq!(
             ranges,
-            vec![
-                (0x0400, 19),
-                (0x0413, 17),
-                (0x0424, 17),
-                (0x0435, 17),
-                (0x1000, 5),
-                (0x1005, 5)
-            ]
+            vec![(0x0400, 24), (0x0418, 23), (0x042F, 23), (0x1000, 10),]
         );
         let mut out = Vec::new();
         push(&mut out, 0x0400, &[1, 2]);

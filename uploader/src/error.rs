@@ -27,9 +27,9 @@ pub enum Error {
         /// Bytes of the jump table and vectors that differ: address,
         /// expected, found.
         differences: Vec<(u16, u8, u8)>,
-        /// The whole ROM's checksum, expected and found, when the jump
-        /// table agreed and the sums did not.
-        whole_sum: Option<(u16, u16)>,
+        /// The first range of the ROM whose checksum differs, expected
+        /// and found, when the jump table agreed and the sums did not.
+        whole_sum: Option<crate::fingerprint::RomSum>,
     },
 
     /// A range written through the loader kept summing otherwise on the
@@ -504,7 +504,7 @@ pub enum Error {
     /// Memory a restored hook would point into no longer holds what it
     /// held when the backup was written. Nothing was changed.
     #[error(
-        "${address:04X}-${end:04X}, {what}, is not what it was when the backup was written: its Fletcher-16 was ${expected:04X}, the robot's is ${found:04X}; nothing was changed",
+        "${address:04X}-${end:04X}, {what}, is not what it was when the backup was written: its checksum was {expected}, the robot's is {found}; nothing was changed",
         end = u32::from(*address) + u32::from(*len) - 1
     )]
     #[diagnostic(
@@ -522,9 +522,9 @@ pub enum Error {
         /// How many bytes.
         len: u16,
         /// The sum in the backup.
-        expected: u16,
+        expected: crate::backup::Checksum,
         /// The robot's.
-        found: u16,
+        found: crate::backup::Checksum,
     },
 
     /// A backup's hook leads on, by a chain slot or a `JMP` the file

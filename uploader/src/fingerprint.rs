@@ -16,7 +16,11 @@ use romlib::protocol::{Answer, Command, ReadSpan};
 
 use crate::client::{Client, spans};
 use crate::image::RomProfile;
-use crate::sums::fletcher16;
+use crate::sums::robot_sum;
+
+/// A range of the ROM whose sums on the robot differ from the profile's:
+/// the range, the profile's sum, the robot's.
+pub type RomSum = ((u16, usize), u32, u32);
 use crate::transport::Transport;
 use crate::{Error, Result};
 
@@ -179,59 +183,71 @@ fn read_once<T: Transport>(client: &mut Client<T>, span: ReadSpan) -> Result<Opt
 /// The jump table's and the vectors' ranges with the profile's sums of
 /// them, for a robot whose loader was found in RAM (see `upload`); empty
 /// for a profile without the ROM's bytes.
-pub(crate) fn table_sums(profile: &RomProfile) -> Vec<((u16, usize), u16)> {
+pub(crate) fn table_sums(profile: &RomProfile) -> Vec<((u16, usize), u32)> {
     profile
         .jump_table
         .iter()
-        .filter_map(|range| {
-            // Of odd length (hostile29 F2: over an even count some runs of
-            // one byte sum as zeros do): one more byte of the ROM, after
-            // the range or before it.
-            let (start, end) = (*range.start(), *range.end());
-            let odd = if (end - start) % 2 == 0 {
-                start..=end
-            } else if end < u16::MAX && expected(profile, &(start..=end + 1)).is_some() {
-                start..=end + 1
-            } else {
-                start.saturating_sub(1)..=end
-            };
-            let bytes = expected(profile, &odd)?;
-            Some(((*odd.start(), bytes.len()), fletcher16(&bytes)))
+        .flat_map(|range| {
+            let start = *range.start();
+            let bytes = expected(profile, range).unwrap_or_default();
+            crate::sums::pieces(bytes.len(), crate::sums::EXACT)
+                .into_iter()
+                .map(move |(at, len)| {
+                    let piece = &bytes[at..at + len];
+                    ((start.wrapping_add(at as u16), len), robot_sum(piece))
+                })
+                .collect::<Vec<_>>()
         })
         .collect()
 }
 
 /// The range of the profile's ROM the loader's `sums` checks, and its
-/// sum; `None` for a profile without the ROM's bytes.
-pub(crate) fn whole_rom(profile: &RomProfile) -> Option<((u16, usize), u16)> {
-    let rom = profile.rom.as_ref()?;
+/// sum; none for a profile without the ROM's bytes. One range: a question
+/// costs an answer of 14 characters, and the jump table and vectors,
+/// where an image's calls land, are compared byte for byte besides. Over
+/// more than [`crate::sums::EXACT`] bytes, two bytes changed by `+d` and
+/// `-d` pass when `d` times their distance is a multiple of 65536 (`$80`
+/// 512 bytes apart); another ROM differs in more than that.
+pub(crate) fn whole_rom(profile: &RomProfile) -> Vec<((u16, usize), u32)> {
+    let Some(rom) = profile.rom.as_ref() else {
+        return Vec::new();
+    };
     // A count of $10000 cannot be asked (a ROM from $0000 would lose its
     // last byte here; the jump table and vectors are read whole).
-    // Odd (hostile29 F2: over an even count some runs of one byte sum as
-    // zeros do); the last byte is the vectors', read whole.
     let len = rom.bytes.len().min(0xFFFF);
-    let len = if len % 2 == 0 {
-        len.saturating_sub(1)
-    } else {
-        len
-    };
-    Some(((rom.address, len), fletcher16(&rom.bytes[..len])))
+    vec![((rom.address, len), robot_sum(&rom.bytes[..len]))]
 }
 
-/// Compares the robot's sum of its whole ROM (from the loader's `sums`)
-/// with the profile's.
+/// Compares the robot's sums of its whole ROM (from the loader's `sums`,
+/// in the order of [`whole_rom`]) with the profile's. A range whose sum
+/// differs is asked again (noise may have turned a digit of its answer
+/// into another digit) until an answer is the profile's, or the same
+/// other sum comes twice.
 ///
 /// # Errors
-/// [`Error::WrongRom`] with both sums.
-pub(crate) fn check_whole(profile: &RomProfile, expected: u16, found: u16) -> Result<()> {
-    if found == expected {
-        return Ok(());
+/// [`Error::WrongRom`] with the first range that differs and both sums;
+/// a line error.
+pub(crate) fn check_whole<T: Transport>(
+    client: &mut Client<T>,
+    profile: &RomProfile,
+    expected: &[((u16, usize), u32)],
+    found: &[u32],
+) -> Result<()> {
+    for (i, &(range, sum)) in expected.iter().enumerate() {
+        let mut seen = vec![found.get(i).copied().unwrap_or(!sum)];
+        while seen.last() != Some(&sum) {
+            let last = seen[seen.len() - 1];
+            if seen[..seen.len() - 1].contains(&last) || seen.len() > 4 {
+                return Err(Error::WrongRom {
+                    profile: profile.name.clone(),
+                    differences: Vec::new(),
+                    whole_sum: Some((range, sum, last)),
+                });
+            }
+            seen.extend(crate::sums::robot_sums(client, &[range])?);
+        }
     }
-    Err(Error::WrongRom {
-        profile: profile.name.clone(),
-        differences: Vec::new(),
-        whole_sum: Some((expected, found)),
-    })
+    Ok(())
 }
 
 /// A ROM profile for a robot's ROM read whole: `base`'s image (its
@@ -260,10 +276,11 @@ pub fn rom_profile_image(base: &linker::Image, start: u16, bytes: &[u8]) -> (lin
 }
 
 /// What differs, for the error message.
-pub(crate) fn describe(differences: &[(u16, u8, u8)], whole_sum: Option<(u16, u16)>) -> String {
-    if let Some((expected, found)) = whole_sum {
+pub(crate) fn describe(differences: &[(u16, u8, u8)], whole_sum: Option<RomSum>) -> String {
+    if let Some(((address, len), expected, found)) = whole_sum {
         return format!(
-            "its jump table and vectors agree, but a checksum of the whole ROM computed on the robot is ${found:04X}, expected ${expected:04X}"
+            "its jump table and vectors agree, but a checksum of ${address:04X}-${:04X} computed on the robot is ${found:08X}, expected ${expected:08X}",
+            usize::from(address) + len - 1
         );
     }
     let shown: Vec<String> = differences

@@ -50,14 +50,14 @@ mod upload;
 mod way_checked;
 
 pub use backup::{
-    Backup, BrokenHook, Keep, MAGIC, NoKeep, Saved, Witness, backup, backup_live, backup_ranges,
-    restore,
+    Backup, BrokenHook, Checksum, Keep, MAGIC, MAGIC_1, NoKeep, Saved, Witness, backup,
+    backup_live, backup_ranges, restore,
 };
 pub use client::{Client, ClientConfig, ClientStats, LiveRead, stopped_in_stub};
 pub use delta::{COARSE, FINE};
 pub use error::{Error, Result, addresses_text, human_duration};
 pub use expect::{Checked, Expectation, Expectations, Mismatch, NOTHING, Required, answer_text};
-pub use fingerprint::{SERVICES, rom_profile_image};
+pub use fingerprint::{RomSum, SERVICES, rom_profile_image};
 pub use held_way::Disagreement;
 pub use image::{
     Area, CONSERVATIVE_RX_BUFFER, REFERENCE_RX_BUFFER, ReceiveRing, RomProfile, Services,
@@ -69,7 +69,7 @@ pub use loader::{
 };
 pub use progress::{Event, NoProgress, Phase, Progress};
 pub use room::refuse_what_cannot_go_in;
-pub use sums::fletcher16;
+pub use sums::{EXACT, fletcher16, robot_sum};
 pub use table::{chain_from, chain_of, read_installed};
 pub use transport::Transport;
 pub use upload::{

@@ -1,11 +1,19 @@
 //! Checksums computed on the robot by the RAM loader's `sums` part
-//! (`/9Kaaaannnn`, answered `Kaaaassss`): what tells an upload which
+//! (`/9Kaaaannnn`, answered `Kaaaassssssss`): what tells an upload which
 //! ranges a robot holds already, and a robot's ROM from another, without
 //! reading every byte over the line.
 //!
-//! The sum is Fletcher-16 with both sums mod 256 and starting at zero:
-//! the first is the sum of the bytes, so any one byte changed changes it;
-//! the second, the sum of the running first sums, catches swaps.
+//! The sum ([`robot_sum`]) is Fletcher's with both sums mod 65536 and
+//! starting at zero: the first is the sum of the bytes, the second the sum
+//! of the running first sums. Over up to [`EXACT`] bytes the first is the
+//! bytes' true sum, so any one byte changed changes it, and two bytes that
+//! change by `+d` and `-d`, `k` apart, change the second by `d * k`, which
+//! is less than 65536: no change of one or two bytes goes unseen. Both
+//! sums were mod 256 once, and two bytes whose distance times their change
+//! was a multiple of 256 (bit 7 of two bytes two apart, `$40` moved four
+//! bytes) passed as held (hostile30 F1-F4). Three or more bytes can still
+//! change together unseen (`+1, -2, +1` in a row, as with every sum of
+//! this kind): `--full` reads back every byte.
 
 use std::time::Duration;
 
@@ -15,19 +23,48 @@ use crate::client::Client;
 use crate::transport::Transport;
 use crate::{Error, Result};
 
-/// The loader's time per byte summed (24 cycles at 1 MHz), plus the
-/// command's parsing.
-const CYCLES_PER_BYTE: u64 = 24;
+/// The loader's time per byte summed at most (42 cycles at 1 MHz, 35
+/// where the first sum's low byte does not carry), plus the command's
+/// parsing.
+const CYCLES_PER_BYTE: u64 = 42;
 
-/// Characters of an answer: `K`, four address digits, four sum digits,
+/// Characters of an answer: `K`, four address digits, eight sum digits,
 /// the carriage return.
-pub(crate) const ANSWER_LEN: usize = 10;
+pub(crate) const ANSWER_LEN: usize = 14;
+
+/// The longest range over which the first sum is exact (255 x 257 <
+/// 65536), and so over which [`robot_sum`] sees every change of one or
+/// two bytes, and only zeros sum to zero. Every range whose sum decides
+/// anything is at most this long.
+pub const EXACT: usize = 257;
 
 /// The most a range is asked again after its answer was lost.
 const ATTEMPTS: u32 = 6;
 
-/// The Fletcher-16 of `bytes` as `sums` computes it: the first sum in
-/// the high byte.
+/// The checksum of `bytes` as the loader's `sums` computes it: the
+/// first sum (of the bytes, mod 65536) in the high half, the second (of
+/// the running first sums, mod 65536) in the low half.
+#[must_use]
+pub fn robot_sum(bytes: &[u8]) -> u32 {
+    let (mut first, mut second) = (0u16, 0u16);
+    for &byte in bytes {
+        first = first.wrapping_add(u16::from(byte));
+        second = second.wrapping_add(first);
+    }
+    u32::from(first) << 16 | u32::from(second)
+}
+
+/// Whether a range of `len` bytes that the robot summed to `sum` holds
+/// nothing but zeros, known without a read: over at most [`EXACT`]
+/// bytes only zeros sum to nothing.
+#[must_use]
+pub(crate) fn sums_as_zeros(sum: u32, len: usize) -> bool {
+    sum == 0 && len <= EXACT
+}
+
+/// The Fletcher-16 of `bytes` as the loader computed it before
+/// hostile30 (both sums mod 256, the first in the high byte): what the
+/// witnesses of a version 1 backup file hold.
 #[must_use]
 pub fn fletcher16(bytes: &[u8]) -> u16 {
     let (mut first, mut second) = (0u8, 0u8);
@@ -41,73 +78,50 @@ pub fn fletcher16(bytes: &[u8]) -> u16 {
 /// A range of robot memory: first address and length (up to `$10000`).
 pub(crate) type Range = (u16, usize);
 
-/// `len` bytes as the fewest pieces of odd length about `about` bytes
-/// long (a piece may be one or two longer), as even in length as odd
-/// counts allow: `(offset, len)`. For sums asked where the count of
-/// questions costs line time (a delta upload's passes): 2048 bytes are 8
-/// pieces of 255 and 257, as 8 of 256 were. Odd, as [`odd_pieces`] says.
+/// `len` bytes as the fewest pieces of at most `about` bytes (and at
+/// most [`EXACT`]), as even in length as they can be: `(offset, len)`.
+/// For sums asked where the count of questions costs line time (a delta
+/// upload's passes): 2048 bytes are 8 pieces of 256.
 #[must_use]
-pub(crate) fn odd_partition(len: usize, about: usize) -> Vec<(usize, usize)> {
+pub(crate) fn partition(len: usize, about: usize) -> Vec<(usize, usize)> {
     if len == 0 {
         return Vec::new();
     }
-    let mut count = len.div_ceil(about.max(1));
-    // Odd pieces add up to `len` only in a count of its parity.
-    if count % 2 != len % 2 {
-        count += 1;
-    }
-    let base = len / count;
-    let base = if base % 2 == 0 { base - 1 } else { base };
-    // Even, and less than two a piece: the first pieces take two more.
-    let longer = (len - base * count) / 2;
+    let about = about.clamp(1, EXACT);
+    let count = len.div_ceil(about);
+    let (base, longer) = (len / count, len % count);
     let mut pieces = Vec::with_capacity(count);
     let mut at = 0;
     for i in 0..count {
-        let piece = if i < longer { base + 2 } else { base };
+        let piece = base + usize::from(i < longer);
         pieces.push((at, piece));
         at += piece;
     }
     pieces
 }
 
-/// hostile29 F2: `len` bytes as pieces of at most `most` bytes (odd),
-/// each of odd length (an even rest is one byte shorter, its last byte a
-/// piece of its own): `(offset, len)`. Both sums are mod 256, so over an
-/// even count some runs of one byte sum as zeros do (256 bytes of `$EA`,
-/// a page of `NOP`s; 32 of `$10`), and an upload took such a page on a
-/// robot holding zeros for held. Over an odd count the first sum of a run
-/// of one byte is that byte times an odd number: no two runs sum alike.
+/// `len` bytes as pieces of at most `most` bytes (and at most
+/// [`EXACT`]), the last one shorter: `(offset, len)`.
 #[must_use]
-pub(crate) fn odd_pieces(len: usize, most: usize) -> Vec<(usize, usize)> {
-    let most = most.max(1);
-    let most = if most % 2 == 0 { most - 1 } else { most };
-    let mut pieces = Vec::new();
-    let mut at = 0;
-    while at < len {
-        let take = match (len - at).min(most) {
-            even if even % 2 == 0 => even - 1,
-            odd => odd,
-        };
-        pieces.push((at, take));
-        at += take;
-    }
-    pieces
+pub(crate) fn pieces(len: usize, most: usize) -> Vec<(usize, usize)> {
+    let most = most.clamp(1, EXACT);
+    (0..len)
+        .step_by(most)
+        .map(|at| (at, most.min(len - at)))
+        .collect()
 }
 
-/// `range` as odd-length ranges (hostile29 F2): the `known` ones of odd
-/// length that tile it where they do, with their sums; the rest as odd
-/// pieces to ask ([`odd_pieces`]), `None`.
+/// `range` as ranges of at most [`EXACT`] bytes: the `known` ones (with
+/// their sums) that tile it where they do, the rest as pieces to ask
+/// ([`pieces`]), `None`.
 #[must_use]
-pub(crate) fn tiled_odd(
-    known: &[(Range, u16)],
-    (address, len): Range,
-) -> Vec<(Range, Option<u16>)> {
+pub(crate) fn tiled(known: &[(Range, u32)], (address, len): Range) -> Vec<(Range, Option<u32>)> {
     let end = usize::from(address) + len;
-    let odd_known = |at: usize| {
+    let known_at = |at: usize| {
         known
             .iter()
             .filter(|((start, part), _)| {
-                usize::from(*start) == at && part % 2 == 1 && at + part <= end
+                usize::from(*start) == at && (1..=EXACT).contains(part) && at + part <= end
             })
             .max_by_key(|((_, part), _)| *part)
             .copied()
@@ -115,16 +129,16 @@ pub(crate) fn tiled_odd(
     let mut out = Vec::new();
     let mut at = usize::from(address);
     while at < end {
-        if let Some((range, sum)) = odd_known(at) {
+        if let Some((range, sum)) = known_at(at) {
             out.push((range, Some(sum)));
             at += range.1;
             continue;
         }
         // Up to where a known range starts, or the end.
         let gap_end = (at + 1..end)
-            .find(|&next| odd_known(next).is_some())
+            .find(|&next| known_at(next).is_some())
             .unwrap_or(end);
-        for (offset, piece) in odd_pieces(gap_end - at, gap_end - at) {
+        for (offset, piece) in pieces(gap_end - at, EXACT) {
             out.push((((at + offset) as u16, piece), None));
         }
         at = gap_end;
@@ -139,14 +153,14 @@ pub(crate) fn question((address, len): Range) -> Vec<u8> {
 }
 
 /// An answer's address and sum, if it is one.
-pub(crate) fn parse(frame: &[u8]) -> Option<(u16, u16)> {
+pub(crate) fn parse(frame: &[u8]) -> Option<(u16, u32)> {
     let text = frame.strip_suffix(&[EOL])?.strip_prefix(b"K")?;
-    if text.len() != 8 || !text.iter().all(u8::is_ascii_hexdigit) {
+    if text.len() != 12 || !text.iter().all(u8::is_ascii_hexdigit) {
         return None;
     }
     let text = std::str::from_utf8(text).ok()?;
     let address = u16::from_str_radix(&text[..4], 16).ok()?;
-    let sum = u16::from_str_radix(&text[4..], 16).ok()?;
+    let sum = u32::from_str_radix(&text[4..], 16).ok()?;
     Some((address, sum))
 }
 
@@ -166,8 +180,8 @@ pub(crate) fn work(longest: usize) -> Duration {
 pub(crate) fn robot_sums<T: Transport>(
     client: &mut Client<T>,
     ranges: &[Range],
-) -> Result<Vec<u16>> {
-    let mut found: Vec<Option<u16>> = vec![None; ranges.len()];
+) -> Result<Vec<u32>> {
+    let mut found: Vec<Option<u32>> = vec![None; ranges.len()];
     for attempt in 0..ATTEMPTS {
         let missing: Vec<usize> = (0..ranges.len()).filter(|&i| found[i].is_none()).collect();
         if missing.is_empty() {
@@ -198,114 +212,141 @@ pub(crate) fn robot_sums<T: Transport>(
 mod tests {
     use super::*;
 
+    /// hostile30 F1-F4: no change of one or two bytes in a range of up to
+    /// `EXACT` bytes sums as the bytes did, whatever the bytes and the
+    /// distance. Both sums mod 256 missed bit 7 of two bytes two apart,
+    /// `$40` moved four bytes, +1/-1 256 apart, and a page of `NOP`s
+    /// summed as zeros.
     #[test]
-    fn one_byte_changed_changes_the_sum() {
-        let bytes: Vec<u8> = (0..=255u8).cycle().take(2048).collect();
-        let sum = fletcher16(&bytes);
-        for at in [0usize, 1, 255, 1024, 2047] {
-            for delta in [1u8, 0x80, 0xFF] {
-                let mut changed = bytes.clone();
-                changed[at] = changed[at].wrapping_add(delta);
-                assert_ne!(fletcher16(&changed), sum, "byte {at} + {delta}");
+    fn no_change_of_one_or_two_bytes_sums_alike() {
+        let mut rng = 0x2545_f491_u32;
+        let mut next = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            rng
+        };
+        for len in [2usize, 3, 5, 37, 256, EXACT] {
+            let bytes: Vec<u8> = (0..len).map(|_| next() as u8).collect();
+            let sum = robot_sum(&bytes);
+            for at in 0..len {
+                for new in 0..=255u8 {
+                    if new == bytes[at] {
+                        continue;
+                    }
+                    let mut changed = bytes.clone();
+                    changed[at] = new;
+                    assert_ne!(robot_sum(&changed), sum, "{len}: byte {at} to {new:02X}");
+                }
             }
-        }
-        let mut swapped = bytes.clone();
-        swapped.swap(3, 4);
-        assert_ne!(fletcher16(&swapped), sum, "a swap");
-    }
-
-    #[test]
-    fn known_odd_ranges_tile_what_they_can_and_the_rest_is_asked_in_odd_pieces() {
-        let known: Vec<(Range, u16)> = vec![
-            ((0x0400, 255), 1),
-            ((0x04FF, 257), 2),
-            ((0x0600, 32), 3), // even: no witness
-        ];
-        assert_eq!(
-            tiled_odd(&known, (0x0400, 512)),
-            vec![((0x0400, 255), Some(1)), ((0x04FF, 257), Some(2))]
-        );
-        assert_eq!(
-            tiled_odd(&known, (0x03FC, 300)),
-            vec![
-                ((0x03FC, 3), None),
-                ((0x03FF, 1), None),
-                ((0x0400, 255), Some(1)),
-                ((0x04FF, 41), None),
-            ]
-        );
-        assert_eq!(
-            tiled_odd(&known, (0x0600, 32)),
-            vec![((0x0600, 31), None), ((0x061F, 1), None)]
-        );
-    }
-
-    /// hostile29 F2: a run of one byte over an odd count sums as no run
-    /// of another byte does (over 256, every even byte sums as zeros).
-    #[test]
-    fn odd_pieces_tell_every_run_of_one_byte_apart() {
-        assert_eq!(
-            fletcher16(&[0xEA; 256]),
-            fletcher16(&[0; 256]),
-            "the blind spot"
-        );
-        for most in [255usize, 31, 127] {
-            let mut sums = std::collections::HashMap::new();
-            for byte in 0..=255u8 {
-                let pieces: Vec<u16> = odd_pieces(256, most)
-                    .into_iter()
-                    .map(|(_, len)| fletcher16(&vec![byte; len]))
-                    .collect();
-                if let Some(other) = sums.insert(pieces, byte) {
-                    panic!("${byte:02X} sums as ${other:02X} in pieces of {most}");
+            // Every pair of places, every pair of changes would take
+            // long: every distance with the changes that cancel in the
+            // first sum (the only ones that can cancel in both), and a
+            // sample of the rest.
+            for first in 0..len {
+                for second in first + 1..len {
+                    for d in 1..=255u8 {
+                        let mut changed = bytes.clone();
+                        changed[first] = changed[first].wrapping_add(d);
+                        changed[second] = changed[second].wrapping_sub(d);
+                        assert_ne!(
+                            robot_sum(&changed),
+                            sum,
+                            "{len}: +{d} at {first}, -{d} at {second}"
+                        );
+                    }
+                    let mut changed = bytes.clone();
+                    changed[first] ^= next() as u8 | 1;
+                    changed[second] ^= next() as u8 | 1;
+                    assert_ne!(robot_sum(&changed), sum, "{len}: {first} and {second}");
                 }
             }
         }
-        for len in 0..600 {
-            let pieces = odd_pieces(len, 255);
-            assert_eq!(pieces.iter().map(|p| p.1).sum::<usize>(), len, "{len}");
-            assert!(
-                pieces.iter().all(|p| p.1 % 2 == 1 && p.1 <= 255),
-                "{len}: {pieces:?}"
-            );
-            assert!(
-                pieces.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0),
-                "{len}"
-            );
-        }
-        assert_eq!(odd_pieces(256, 256), vec![(0, 255), (255, 1)]);
-        for len in 1..3000 {
-            for about in [31usize, 37, 256] {
-                let pieces = odd_partition(len, about);
-                assert_eq!(
-                    pieces.iter().map(|p| p.1).sum::<usize>(),
-                    len,
-                    "{len}/{about}"
-                );
-                assert!(
-                    pieces.iter().all(|p| p.1 % 2 == 1 && p.1 <= about + 2),
-                    "{len}/{about}: {pieces:?}"
-                );
-                assert!(
-                    pieces.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0),
-                    "{len}/{about}"
-                );
-                assert!(
-                    pieces.len() <= len.div_ceil(about) + 1,
-                    "{len}/{about}: {pieces:?}"
-                );
+        // The narrow sums' blind spots, as hostile30 met them.
+        assert_eq!(fletcher16(&[0x80, 0, 0x80]), fletcher16(&[0, 0, 0]));
+        assert_ne!(robot_sum(&[0x80, 0, 0x80]), robot_sum(&[0, 0, 0]));
+        assert_eq!(fletcher16(&[0xEA; 256]), fletcher16(&[0; 256]));
+        assert_ne!(robot_sum(&[0xEA; 256]), robot_sum(&[0; 256]));
+        // What three bytes can do, and why `--full` exists.
+        assert_eq!(robot_sum(&[2, 1, 2]), robot_sum(&[1, 3, 1]));
+    }
+
+    #[test]
+    fn only_zeros_sum_as_zeros_and_only_where_the_first_sum_is_exact() {
+        for byte in 1..=255u8 {
+            for len in [1usize, 2, 255, 256, EXACT] {
+                assert_ne!(robot_sum(&vec![byte; len]), 0, "{len} x {byte:02X}");
             }
         }
-        assert_eq!(odd_partition(2048, 256).len(), 8);
-        assert_eq!(odd_partition(255, 37).len(), 7);
+        assert!(sums_as_zeros(robot_sum(&[0; EXACT]), EXACT));
+        assert!(!sums_as_zeros(0, EXACT + 1), "no longer exact");
+        assert_eq!(robot_sum(&vec![0x80; 512]) >> 16, 0, "the first sum wraps");
+    }
+
+    #[test]
+    fn the_sum_is_what_the_loader_answers() {
+        // Worked by hand: first = 1 + 2 + 3 = 6; second = 1 + 3 + 6 = 10.
+        assert_eq!(robot_sum(&[1, 2, 3]), 0x0006_000A);
+        assert_eq!(robot_sum(&[0xFF; 2]), 0x01FE_02FD);
+        assert_eq!(robot_sum(&[]), 0);
+    }
+
+    #[test]
+    fn known_ranges_tile_what_they_can_and_the_rest_is_asked_in_pieces() {
+        let known: Vec<(Range, u32)> = vec![
+            ((0x0400, 256), 1),
+            ((0x0500, 256), 2),
+            ((0x0600, 300), 3), // longer than a sum sees whole: no witness
+        ];
+        assert_eq!(
+            tiled(&known, (0x0400, 512)),
+            vec![((0x0400, 256), Some(1)), ((0x0500, 256), Some(2))]
+        );
+        assert_eq!(
+            tiled(&known, (0x03FC, 300)),
+            vec![
+                ((0x03FC, 4), None),
+                ((0x0400, 256), Some(1)),
+                ((0x0500, 40), None),
+            ]
+        );
+        assert_eq!(
+            tiled(&known, (0x0600, 300)),
+            vec![((0x0600, EXACT), None), ((0x0701, 43), None)]
+        );
+    }
+
+    #[test]
+    fn pieces_and_partitions_cover_their_bytes_within_what_a_sum_sees() {
+        for len in 0..3000 {
+            for most in [1usize, 31, 37, 256, EXACT, 0xFFFF] {
+                let pieces = pieces(len, most);
+                assert_eq!(pieces.iter().map(|p| p.1).sum::<usize>(), len, "{len}");
+                assert!(pieces.iter().all(|p| p.1 <= most.min(EXACT) && p.1 > 0));
+                assert!(pieces.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0));
+            }
+            for about in [31usize, 37, 256, 1000] {
+                let pieces = partition(len, about);
+                assert_eq!(pieces.iter().map(|p| p.1).sum::<usize>(), len);
+                assert!(pieces.iter().all(|p| p.1 <= about.min(EXACT) && p.1 > 0));
+                assert!(pieces.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0));
+                assert_eq!(pieces.len(), len.div_ceil(about.min(EXACT)));
+            }
+        }
+        assert_eq!(
+            partition(2048, 256),
+            (0..8).map(|i| (i * 256, 256)).collect::<Vec<_>>()
+        );
+        assert_eq!(partition(256, 37).len(), 7);
     }
 
     #[test]
     fn answers_parse_and_garbage_does_not() {
-        assert_eq!(parse(b"K0400A1B2\r"), Some((0x0400, 0xA1B2)));
-        assert_eq!(parse(b"K0400A1B\r"), None);
-        assert_eq!(parse(b"R0400A1B2\r"), None);
-        assert_eq!(parse(b"K0400A1BZ\r"), None);
+        assert_eq!(parse(b"K04000102A1B2\r"), Some((0x0400, 0x0102_A1B2)));
+        assert_eq!(parse(b"K0400A1B2\r"), None, "the narrow sums' answer");
+        assert_eq!(parse(b"K04000102A1B\r"), None);
+        assert_eq!(parse(b"R04000102A1B2\r"), None);
+        assert_eq!(parse(b"K04000102A1BZ\r"), None);
         assert_eq!(question((0xF000, 0x1000)), b"/9KF0001000");
     }
 }

@@ -30,7 +30,7 @@ use crate::image::{Area, RomProfile, UploadImage};
 use crate::loader::{FAST_BAUD, Loader, loader_estimate, rom_only_estimate};
 use crate::progress::{Event, Phase, Progress};
 use crate::session::{Session, recoverable};
-use crate::sums::fletcher16;
+use crate::sums::robot_sum;
 use crate::table;
 use crate::transport::{Transport, char_time};
 use crate::{Error, Result};
@@ -714,8 +714,11 @@ pub fn upload_keeping<T: Transport>(
                 // verified: this robot has stayed powered since an upload
                 // put it there, which summed its ROM (the jump table is
                 // read each time).
-                let rom = fingerprint::whole_rom(profile)
-                    .filter(|_| running.wrote_loader() && !options.force_rom);
+                let rom = if running.wrote_loader() && !options.force_rom {
+                    fingerprint::whole_rom(profile)
+                } else {
+                    Vec::new()
+                };
                 let mut first: Vec<(u16, usize)> = rom.iter().map(|(range, _)| *range).collect();
                 let table = running
                     .take_rom_check()
@@ -752,10 +755,9 @@ pub fn upload_keeping<T: Transport>(
                     first: found,
                     known,
                 } = summed;
-                let mut found = found.into_iter();
-                if let Some((_, expected)) = rom {
-                    fingerprint::check_whole(profile, expected, found.next().unwrap_or(0))?;
-                }
+                let (whole, rest) = found.split_at(rom.len().min(found.len()));
+                fingerprint::check_whole(client, profile, &rom, whole)?;
+                let mut found = rest.iter().copied();
                 if let Some((sums, profile)) = table {
                     let differ = sums.iter().any(|(_, sum)| found.next() != Some(*sum));
                     if differ {
@@ -1125,58 +1127,37 @@ fn entry_witness(entry: &Area) -> crate::backup::Witness {
     crate::backup::Witness {
         address: entry.address,
         len: entry.bytes.len() as u16,
-        sum: fletcher16(&entry.bytes),
+        sum: crate::backup::Checksum::of(&entry.bytes),
     }
 }
 
 /// Hands `keep` what the ranges of `held` hold on the robot now (the
 /// ranges about to be written, each with the robot's sum of it), with the
 /// hooks and table read at the start. A range whose sum is that of zeros
-/// (RAM nothing was loaded into, on the virtual robot) is taken for zeros
-/// without a read, with the same trust a delta upload puts in a sum; any
-/// other is read once at the loader's rate and checked against its sum
-/// (read again, up to four times, if noise changed an answer).
+/// (RAM nothing was loaded into, on the virtual robot) is zeros, known
+/// without a read: over at most `sums::EXACT` bytes nothing else sums to
+/// nothing. Any other is read once at the loader's rate and checked
+/// against its sum (read again, up to four times, if noise changed an
+/// answer).
 fn keep_summed<T: Transport>(
     client: &mut Client<T>,
     profile: &RomProfile,
     kept: Option<Backup>,
-    (held, known): (&[delta::Held], &[(crate::sums::Range, u16)]),
+    (held, known): (&[delta::Held], &[(crate::sums::Range, u32)]),
     (image, unlinked): (&UploadImage, &[Area]),
     keep: &mut dyn Keep,
 ) -> Result<Option<Backup>> {
     let Some(mut kept) = kept else {
         return Ok(None);
     };
-    // A range that sums as zeros is taken for zeros unread. Its count is
-    // odd (`sums::odd_pieces`), so no run of one byte but zero sums to
-    // nothing; other bytes may, one time in 65536: a second sum, of all but
-    // the first byte, tells them apart.
-    let twice: Vec<crate::sums::Range> = held
-        .iter()
-        .filter(|(area, sum)| {
-            *sum == fletcher16(&[]) && area.bytes.len() > 1 && !covered(&kept, area)
-        })
-        .map(|(area, _)| (area.address + 1, area.bytes.len() - 1))
-        .collect();
-    // None asked (no question goes out) where none sums as zeros.
-    let second: std::collections::HashMap<u16, u16> = twice
-        .iter()
-        .map(|&(address, _)| address - 1)
-        .zip(crate::sums::robot_sums(client, &twice)?)
-        .collect();
     let first = kept.areas.len();
     for (area, sum) in held {
         let len = area.bytes.len();
         if covered(&kept, area) {
             continue;
         }
-        let zeros = vec![0; len];
-        let nothing = fletcher16(&zeros) == *sum
-            && second
-                .get(&area.address)
-                .is_none_or(|&sum| sum == fletcher16(&zeros[1..]));
-        let bytes = if nothing {
-            zeros
+        let bytes = if crate::sums::sums_as_zeros(*sum, len) {
+            vec![0; len]
         } else {
             read_summed(client, area.address, len, *sum)?
         };
@@ -1191,12 +1172,12 @@ fn keep_summed<T: Transport>(
     // `sums` is hooked here): an undo checks it is still there. Nothing is
     // written yet, so a range the sums asked already tile is put together
     // from their answers; only the rest is asked.
-    // Each witness of odd length (hostile29 F2): the ranges the sums asked
-    // where they tile it, odd pieces of the rest asked.
-    let ranges: Vec<(crate::sums::Range, Option<u16>)> =
+    // Each witness of at most `sums::EXACT` bytes (hostile30 F4): the
+    // ranges the sums asked where they tile it, pieces of the rest asked.
+    let ranges: Vec<(crate::sums::Range, Option<u32>)> =
         crate::backup::kept_witness_ranges_on(client, profile, &kept, image)?
             .into_iter()
-            .flat_map(|range| crate::sums::tiled_odd(known, range))
+            .flat_map(|range| crate::sums::tiled(known, range))
             .collect();
     let unknown: Vec<crate::sums::Range> = ranges
         .iter()
@@ -1209,7 +1190,7 @@ fn keep_summed<T: Transport>(
         .map(|((address, len), sum)| crate::backup::Witness {
             address,
             len: len as u16,
-            sum: sum.or_else(|| asked.next()).unwrap_or(0),
+            sum: crate::backup::Checksum::Wide(sum.or_else(|| asked.next()).unwrap_or(0)),
         })
         .collect();
     keep.keep(&kept);
@@ -1224,7 +1205,7 @@ fn read_summed<T: Transport>(
     client: &mut Client<T>,
     address: u16,
     len: usize,
-    sum: u16,
+    sum: u32,
 ) -> Result<Vec<u8>> {
     for _ in 0..4 {
         let mut bytes = Vec::with_capacity(len);
@@ -1240,7 +1221,7 @@ fn read_summed<T: Transport>(
                 Err(error) => return Err(error),
             }
         }
-        if bytes.len() == len && fletcher16(&bytes) == sum {
+        if bytes.len() == len && robot_sum(&bytes) == sum {
             return Ok(bytes);
         }
     }

@@ -128,11 +128,14 @@ fn the_reset_button_in_the_middle_ends_verified_or_fails_safely() {
 fn a_short_stall_recovers() {
     let image = extension(1024, 14);
     for path in PATHS {
+        // In the middle of the image's frames (through the loader, after
+        // the ROM's sums: a stall there loses answers, asked again, and
+        // needs no round of sums after the writes).
         let config = FaultConfig {
             stall_after: Some(if path == LoaderChoice::Never {
                 3000
             } else {
-                900
+                1100
             }),
             stall_for: Some(Duration::from_millis(1500)),
             ..FaultConfig::none(9)

@@ -1,8 +1,9 @@
 //! hostile29 F2: the robot's sums are Fletcher-16 mod 256, under which a
 //! page of one even byte (256 `NOP`s, `$EA`) sums as a page of zeros. An
 //! upload of such pages onto a robot holding zeros took them for held and
-//! said "verified" with 768 bytes wrong. Every range summed is of odd
-//! length now; each case here writes every byte it must.
+//! said "verified" with 768 bytes wrong. Both sums are 16 bits now, over
+//! ranges of at most `uploader::EXACT` bytes, under which only zeros sum
+//! as zeros; each case here writes every byte it must.
 
 mod common;
 

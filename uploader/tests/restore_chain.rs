@@ -472,12 +472,12 @@ fn witnesses_outside_memory_an_extension_may_hold_are_refused_unread() {
     let io = uploader::Witness {
         address: 0xC010,
         len: 4,
-        sum: 0,
+        sum: uploader::Checksum::Wide(0),
     };
     let off_entries = uploader::Witness {
         address: table,
         len: romlib::installed::ENTRY_LEN as u16,
-        sum: 0,
+        sum: uploader::Checksum::Wide(0),
     };
     for (witnesses, entries, what) in [
         (vec![io], vec![], "outside the memory"),
@@ -1533,6 +1533,44 @@ fn a_backup_witnesses_every_byte_of_code_its_ways_run() {
     restore(&mut client, &saved, &options, &mut NoProgress).expect("unchanged, restored");
 }
 
+/// hostile30 F4: witnesses were Fletcher-16 mod 256, blind to bit 7 of
+/// two bytes two apart: two `NOP`s of the owner's KIM-bus code turned
+/// into `ROR A` passed, and the restore said "verified". Each witness is
+/// the robot's wide sum over at most `EXACT` bytes now: refused, nothing
+/// written.
+#[test]
+fn a_witness_sees_two_bytes_changed_that_summed_alike_mod_256() {
+    let (options, mut client, saved) = kim_code_before_each_jmp();
+    assert!(
+        saved
+            .witnesses
+            .iter()
+            .all(|witness| usize::from(witness.len) <= uploader::EXACT
+                && matches!(witness.sum, uploader::Checksum::Wide(_))),
+        "{:?}",
+        saved.witnesses
+    );
+    let memory = client.transport().robot().robot().board().memory().to_vec();
+    let changed = [0x6A, 0xEA, 0x6A];
+    assert_eq!(
+        uploader::fletcher16(&changed),
+        uploader::fletcher16(&memory[0x1002..0x1005]),
+        "the narrow sums' blind spot"
+    );
+    by_hand(&mut client, 0x1002, &changed);
+    let held_before = held(&mut client);
+    match restore(&mut client, &saved, &options, &mut NoProgress) {
+        Err(Error::WitnessDiffers { address, len, .. }) => {
+            assert!(
+                address <= 0x1002 && 0x1004 < address + len,
+                "${address:04X}+{len}"
+            );
+        }
+        other => panic!("two bytes changed: {other:?}"),
+    }
+    assert!(held(&mut client) == held_before, "nothing written");
+}
+
 /// hostile28 F3 (c): a file whose witness of a step was cut to the step's
 /// opcode byte (or dropped) checks nothing of the rest of the code the
 /// way runs: refused, the byte named, nothing written.
@@ -1557,7 +1595,7 @@ fn a_file_that_witnesses_part_of_the_code_a_way_runs_is_refused() {
             dropped.witnesses.push(uploader::Witness {
                 address: start,
                 len: end - start + 1,
-                sum: uploader::fletcher16(bytes),
+                sum: uploader::Checksum::of(bytes),
             });
         }
     }
@@ -1580,13 +1618,13 @@ fn a_file_that_witnesses_part_of_the_code_a_way_runs_is_refused() {
     short.witnesses[i] = uploader::Witness {
         address: 0x1000,
         len: 16,
-        sum: uploader::fletcher16(&memory[0x1000..0x1010]),
+        sum: uploader::Checksum::of(&memory[0x1000..0x1010]),
     };
     if first.len > 17 {
         short.witnesses.push(uploader::Witness {
             address: 0x1011,
             len: first.len - 17,
-            sum: uploader::fletcher16(&memory[0x1011..usize::from(first.address + first.len)]),
+            sum: uploader::Checksum::of(&memory[0x1011..usize::from(first.address + first.len)]),
         });
     }
     match restore(&mut client, &short, &options, &mut NoProgress) {

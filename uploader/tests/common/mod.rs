@@ -11,6 +11,12 @@
 mod image;
 pub(crate) mod stub;
 
+/// hostile30's 1022-byte extension at $0400 (`image::extension`): long
+/// enough for the loader's sums, and for ranges of every kind.
+pub(crate) fn extension_big() -> uploader::UploadImage {
+    image::extension(1022, 7)
+}
+
 /// An extension of 64 bytes at `base`: its handler at `base + 3` jumps
 /// to its chain slot's `JMP` at `base` (it falls through).
 pub(crate) fn extension_at(base: u16) -> uploader::UploadImage {
