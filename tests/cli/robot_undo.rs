@@ -760,9 +760,9 @@ fn a_no_change_upload_whose_loader_went_over_data_keeps_an_undo_that_puts_it_bac
         .nth(1)
         .and_then(|rest| rest.get(..4))
         .map(str::to_owned);
-    // Where the loader ran: the top of user RAM ($0E7A on the reference
+    // Where the loader ran: the top of user RAM ($0E7F on the reference
     // ROM), whatever `installed` says of it.
-    let at = loader.unwrap_or_else(|| "0E7A".to_owned());
+    let at = loader.unwrap_or_else(|| "0E7F".to_owned());
     ok(
         d,
         &line,

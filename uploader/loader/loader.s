@@ -32,16 +32,20 @@
 ; next command's first byte as its last, and the ROM then ignores the rest
 ; of that command (it has no slash): the uploader asks again.
 ;
-; sums    (last): /9Kaaaannnn answers Kaaaassssssss: the address, then
-;         two sums of nnnn bytes from aaaa, both mod 65536 and starting
-;         at zero: the first (four digits) the sum of the bytes, the
-;         second (four digits) the sum of the running first sums, so
-;         that the uploader can tell which ranges of an image a robot
-;         holds already without reading every byte, and that the robot's
-;         ROM is the one an image was linked against. Over up to 257
-;         bytes the first sum is exact, and any change of one or two
-;         bytes changes one of them: two bytes that change by +d and -d,
-;         k apart, change the second by d times k, less than 65536
+; sums    (last): /9Kaaaassnn answers Kaaaa, then for each of nn pieces
+;         of ss bytes (00: 256), one after the other from aaaa, eight
+;         digits: two sums of the piece, both mod 65536 and starting at
+;         zero, the first (four digits) the sum of the bytes, the second
+;         (four digits) the sum of the running first sums. So the
+;         uploader can tell which ranges of an image a robot holds
+;         already without reading every byte, and that the robot's ROM
+;         is the one an image was linked against; many pieces in one
+;         question, since each answer is a wait for the robot (PUTCH
+;         waits for the 6551 at each character); nn = 00 answers no
+;         sums. Over a piece of up to 256 bytes the first sum is exact,
+;         and any change of one or two bytes changes one of them: two
+;         bytes that change by +d and -d, k apart, change the second by
+;         d times k, less than 65536
 ;         (hostile30 F1: with both sums mod 256, bit 7 of two bytes two
 ;         apart, or a $40 moved four bytes, passed unseen). Anything
 ;         else falls into `frames`. It goes in through `frames`,
@@ -82,9 +86,9 @@ FIRSTLO = LZP + 2               ;   low byte (in X while the bytes are added)
 SECOND  = LZP                   ; the second sum, low byte, then high
 COUNT   = HEAD + 2
 DEST    = HEAD + 3              ; lo, hi: the frame's first address
-ARGS    = HEAD + 1              ; sums: its fields, last first: count lo, hi, DEST
-LENLO   = HEAD + 1
-LENHI   = HEAD + 2
+ARGS    = HEAD + 1              ; sums: its fields, last first: nn, ss, DEST
+PIECES  = HEAD + 1              ; sums: pieces still to sum
+SIZE    = HEAD + 2              ; sums: bytes a piece (0: 256)
 
         .export __scorpion_hook_unknown, rate, frames, sums
         .segment "CODE"
@@ -138,17 +142,18 @@ data:   jsr CHKCH               ; the bytes are usually in the ring already
 .endif
         beq drop
 
-; /9Kaaaannnn: the address is answered first, so the answer starts
-; while the sums are added (35 cycles a byte, 41 where the first sum's
-; low byte carries, one more where (DEST),y crosses a page). A part page first: Y starts at 256 - the low byte of
-; the count, DEST that much lower, so one loop over whole pages does all.
+; /9Kaaaassnn: the address is answered first. Each piece's bytes are
+; added at 35 cycles a byte (41 where the first sum's low byte carries,
+; one more where (DEST),y crosses a page), from Y = 256 - ss, DEST that
+; much lower, so the loop ends as Y wraps; DEST + 256 is then the next
+; piece's first byte.
 __scorpion_hook_unknown:
 sums:   cmp #'K'
         bne frames
         cpx #9
         bne frames
         ldy #1
-        ldx #3                  ; address high, low, count high, low
+        ldx #3                  ; address high, low, ss, nn
 args:   jsr GETHEX              ; X kept
         bcs sdrop
         sta ARGS,x
@@ -160,26 +165,23 @@ args:   jsr GETHEX              ; X kept
         jsr PUTHEX
         lda DEST
         jsr PUTHEX
-        ldy LENLO
-        beq pages               ; whole pages only: Y = 0
-        inc LENHI               ; the part page counts as one
-        tya
-        eor #$FF
-        tay
-        iny                     ; Y = 256 - the low byte
+        lda PIECES              ; none: a count noise made up, say (00
+        beq eol                 ; would otherwise be 256)
+piece:  lda #0
+        sec
+        sbc SIZE
+        tay                     ; Y = 256 - ss (0 for 256)
         sty KEY
         lda DEST
         sec
         sbc KEY
         sta DEST
-        bcs pages
+        bcs zero
         dec DEST + 1
-pages:  ldx #0                  ; X = the first sum's low byte
+zero:   ldx #0                  ; X = the first sum's low byte
         stx FIRSTHI
         stx SECOND
         stx SECOND + 1
-        lda LENHI
-        beq answer
         clc                     ; clear at the top of each byte
 add:    txa
         adc (DEST),y
@@ -195,14 +197,14 @@ second: adc SECOND              ; A = the first sum's low byte
         clc
         iny
         bne add
-        inc DEST + 1
-        dec LENHI
-        bne add
-answer: stx FIRSTLO
+        inc DEST + 1            ; the next piece's first byte
+        stx FIRSTLO
         ldx #3
 digits: lda SUMS,x              ; first sum high, low; second sum high, low
         jsr PUTHEX              ; X kept
         dex
         bpl digits
-        jsr PUTEOL
+        dec PIECES
+        bne piece
+eol:    jsr PUTEOL
 sdrop:  jmp CMD_DONE

@@ -201,21 +201,21 @@ pub(crate) fn table_sums(profile: &RomProfile) -> Vec<((u16, usize), u32)> {
         .collect()
 }
 
-/// The range of the profile's ROM the loader's `sums` checks, and its
-/// sum; none for a profile without the ROM's bytes. One range: a question
-/// costs an answer of 14 characters, and the jump table and vectors,
-/// where an image's calls land, are compared byte for byte besides. Over
-/// more than [`crate::sums::EXACT`] bytes, two bytes changed by `+d` and
-/// `-d` pass when `d` times their distance is a multiple of 65536 (`$80`
-/// 512 bytes apart); another ROM differs in more than that.
+/// The ranges of the profile's ROM the loader's `sums` checks, each of
+/// at most [`crate::sums::EXACT`] bytes (over which the sums see every
+/// change of one or two bytes; they go in one question), with their
+/// sums; none for a profile without the ROM's bytes.
 pub(crate) fn whole_rom(profile: &RomProfile) -> Vec<((u16, usize), u32)> {
     let Some(rom) = profile.rom.as_ref() else {
         return Vec::new();
     };
-    // A count of $10000 cannot be asked (a ROM from $0000 would lose its
-    // last byte here; the jump table and vectors are read whole).
-    let len = rom.bytes.len().min(0xFFFF);
-    vec![((rom.address, len), robot_sum(&rom.bytes[..len]))]
+    crate::sums::pieces(rom.bytes.len().min(0x1_0000), crate::sums::EXACT)
+        .into_iter()
+        .map(|(at, piece)| {
+            let range = (rom.address.wrapping_add(at as u16), piece);
+            (range, robot_sum(&rom.bytes[at..at + piece]))
+        })
+        .collect()
 }
 
 /// Compares the robot's sums of its whole ROM (from the loader's `sums`,

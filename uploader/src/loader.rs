@@ -305,6 +305,13 @@ impl Loader {
         self.part(self.frames, self.sums)
     }
 
+    /// `frames` and `sums`: what a loader found in RAM is verified by, at
+    /// the fast rate, before `sums` is hooked.
+    pub(crate) fn frames_and_sums_part(&self) -> Result<UploadImage> {
+        let end = self.image.areas()[0].end();
+        self.part(self.frames, end)
+    }
+
     /// `sums` alone: what goes in through `frames`.
     pub(crate) fn sums_part(&self) -> Result<UploadImage> {
         let end = self.image.areas()[0].end();

@@ -325,7 +325,7 @@ impl Session {
     fn hook_loader<T: Transport>(
         &mut self,
         client: &mut Client<T>,
-        start: Start,
+        mut start: Start,
         before_write: &mut BeforeWrite<'_, T>,
     ) -> Result<()> {
         match self.fast {
@@ -346,6 +346,23 @@ impl Session {
                     self.fast = None;
                 }
                 self.keep_zero_page(client, before_write)?;
+                // A loader found in RAM: `frames` and `sums` read in one go
+                // and, both as linked, `sums` hooked at once (it falls only
+                // into parts now verified), sparing a hook and a wait.
+                if start == Start::Resident && self.with_sums && self.keep_under {
+                    let both = self.loader.frames_and_sums_part()?;
+                    if self.resident_as_linked(client, &both, start, before_write)? {
+                        self.target = client.transport().baud();
+                        return switch_hook(
+                            client,
+                            self.hook,
+                            self.loader.sums,
+                            self.limits.max_writes,
+                        );
+                    }
+                    // Changed since (kept above): written again, verified.
+                    start = Start::Verify;
+                }
                 let part = self.loader.frames_part()?;
                 self.verify_rom_part(client, &part, start, before_write)?;
             }

@@ -157,7 +157,11 @@ pub(crate) fn write_summed<T: Transport>(
         let asked_at = client.transport().now();
         let frames = client.batch(&entries, ANSWER_LEN, work(longest))?;
         let mut found: Vec<Option<u32>> = vec![None; units.len()];
-        for (address, sum) in frames.iter().filter_map(|frame| parse(frame)) {
+        let answers = frames.iter().filter_map(|frame| parse(frame));
+        for (address, sum) in answers.filter_map(|(address, sums)| match sums[..] {
+            [sum] => Some((address, sum)),
+            _ => None,
+        }) {
             if let Some(&i) = asked.iter().find(|&&i| units[i].area.address == address) {
                 found[i] = Some(sum);
             }

@@ -1,7 +1,10 @@
 //! Checksums computed on the robot by the RAM loader's `sums` part
-//! (`/9Kaaaannnn`, answered `Kaaaassssssss`): what tells an upload which
-//! ranges a robot holds already, and a robot's ROM from another, without
-//! reading every byte over the line.
+//! (`/9Kaaaassnn`: `nn` pieces of `ss` bytes from `aaaa`, answered `Kaaaa`
+//! and eight digits a piece): what tells an upload which ranges a robot
+//! holds already, and a robot's ROM from another, without reading every
+//! byte over the line. Ranges of one length that follow each other go in
+//! one question ([`robot_sums`]): the robot waits for the line at each
+//! character it answers, and the address and the question are paid once.
 //!
 //! The sum ([`robot_sum`]) is Fletcher's with both sums mod 65536 and
 //! starting at zero: the first is the sum of the bytes, the second the sum
@@ -28,15 +31,18 @@ use crate::{Error, Result};
 /// parsing.
 const CYCLES_PER_BYTE: u64 = 42;
 
-/// Characters of an answer: `K`, four address digits, eight sum digits,
-/// the carriage return.
+/// Characters of an answer of one piece: `K`, four address digits, eight
+/// sum digits, the carriage return.
 pub(crate) const ANSWER_LEN: usize = 14;
 
-/// The longest range over which the first sum is exact (255 x 257 <
-/// 65536), and so over which [`robot_sum`] sees every change of one or
-/// two bytes, and only zeros sum to zero. Every range whose sum decides
-/// anything is at most this long.
-pub const EXACT: usize = 257;
+/// The longest piece the loader sums (a question's `ss`), over which the
+/// first sum is exact (255 x 256 < 65536), and so over which [`robot_sum`]
+/// sees every change of one or two bytes, and only zeros sum to zero.
+/// Every range whose sum decides anything is at most this long.
+pub const EXACT: usize = 256;
+
+/// The most pieces one question asks (an answer of 262 characters).
+const MOST_PIECES: usize = 32;
 
 /// The most a range is asked again after its answer was lost.
 const ATTEMPTS: u32 = 6;
@@ -146,22 +152,76 @@ pub(crate) fn tiled(known: &[(Range, u32)], (address, len): Range) -> Vec<(Range
     out
 }
 
-/// The question for one range.
-pub(crate) fn question((address, len): Range) -> Vec<u8> {
-    // A length of $10000 cannot be asked; nothing asks for it.
-    format!("/9K{address:04X}{:04X}", len.min(0xFFFF)).into_bytes()
+/// The question for `count` pieces of `size` bytes (1 to [`EXACT`]) from
+/// `address`.
+fn question_of(address: u16, size: usize, count: usize) -> Vec<u8> {
+    format!("/9K{address:04X}{:02X}{count:02X}", size & 0xFF).into_bytes()
 }
 
-/// An answer's address and sum, if it is one.
-pub(crate) fn parse(frame: &[u8]) -> Option<(u16, u32)> {
+/// The question for one range of at most [`EXACT`] bytes.
+pub(crate) fn question((address, len): Range) -> Vec<u8> {
+    question_of(address, len.clamp(1, EXACT), 1)
+}
+
+/// An answer's address and sums (one a piece), if it is one.
+pub(crate) fn parse(frame: &[u8]) -> Option<(u16, Vec<u32>)> {
     let text = frame.strip_suffix(&[EOL])?.strip_prefix(b"K")?;
-    if text.len() != 12 || !text.iter().all(u8::is_ascii_hexdigit) {
+    if text.len() < 12 || (text.len() - 4) % 8 != 0 || !text.iter().all(u8::is_ascii_hexdigit) {
         return None;
     }
     let text = std::str::from_utf8(text).ok()?;
     let address = u16::from_str_radix(&text[..4], 16).ok()?;
-    let sum = u32::from_str_radix(&text[4..], 16).ok()?;
-    Some((address, sum))
+    let sums = (4..text.len())
+        .step_by(8)
+        .map(|at| u32::from_str_radix(&text[at..at + 8], 16).ok())
+        .collect::<Option<Vec<u32>>>()?;
+    Some((address, sums))
+}
+
+/// The sum of two ranges one after the other, from the sum of each and
+/// the length of the second: the second sum of the first range's bytes
+/// gains the first range's first sum once for each byte after them.
+#[must_use]
+pub(crate) fn joined(first: u32, second: u32, second_len: usize) -> u32 {
+    let (a1, a2) = ((first >> 16) as u16, first as u16);
+    let (b1, b2) = ((second >> 16) as u16, second as u16);
+    let one = a1.wrapping_add(b1);
+    let two = a2
+        .wrapping_add(b2)
+        .wrapping_add(a1.wrapping_mul(second_len as u16));
+    u32::from(one) << 16 | u32::from(two)
+}
+
+/// One question: `count` pieces of `size` bytes from `address`, and the
+/// pieces' indexes among those asked.
+struct Asked {
+    address: u16,
+    size: usize,
+    pieces: Vec<usize>,
+}
+
+/// `pieces` (each at most [`EXACT`] bytes) as questions: pieces of one
+/// length that follow each other, up to `most` ([`MOST_PIECES`] at most),
+/// in one.
+fn questions(pieces: &[Range], todo: &[usize], most: usize) -> Vec<Asked> {
+    let most = most.clamp(1, MOST_PIECES);
+    let mut out: Vec<Asked> = Vec::new();
+    for &i in todo {
+        let (address, size) = pieces[i];
+        if let Some(last) = out.last_mut() {
+            let next = usize::from(last.address) + last.size * last.pieces.len();
+            if last.size == size && next == usize::from(address) && last.pieces.len() < most {
+                last.pieces.push(i);
+                continue;
+            }
+        }
+        out.push(Asked {
+            address,
+            size,
+            pieces: vec![i],
+        });
+    }
+    out
 }
 
 /// The robot's time to answer one question over at most `longest` bytes,
@@ -170,9 +230,9 @@ pub(crate) fn work(longest: usize) -> Duration {
     Duration::from_micros(longest as u64 * CYCLES_PER_BYTE + 2_000)
 }
 
-/// The robot's checksums of `ranges` (distinct first addresses), asked
-/// of the loader's `sums`, which must be hooked. Lost answers are asked
-/// again.
+/// The robot's checksums of `ranges`, asked of the loader's `sums`,
+/// which must be hooked: a range longer than [`EXACT`] in pieces, its sum
+/// put together from theirs ([`joined`]). Lost answers are asked again.
 ///
 /// # Errors
 /// [`Error::Unreadable`] when a range's answer keeps being lost; a line
@@ -181,31 +241,64 @@ pub(crate) fn robot_sums<T: Transport>(
     client: &mut Client<T>,
     ranges: &[Range],
 ) -> Result<Vec<u32>> {
-    let mut found: Vec<Option<u32>> = vec![None; ranges.len()];
+    // Each range as pieces; `owner[i]` is the range piece `i` is of.
+    let mut pieces: Vec<Range> = Vec::new();
+    let mut owner: Vec<usize> = Vec::new();
+    for (r, &(address, len)) in ranges.iter().enumerate() {
+        for (at, piece) in self::pieces(len, EXACT) {
+            pieces.push((address.wrapping_add(at as u16), piece));
+            owner.push(r);
+        }
+    }
+    let mut found: Vec<Option<u32>> = vec![None; pieces.len()];
     for attempt in 0..ATTEMPTS {
-        let missing: Vec<usize> = (0..ranges.len()).filter(|&i| found[i].is_none()).collect();
+        let missing: Vec<usize> = (0..pieces.len()).filter(|&i| found[i].is_none()).collect();
         if missing.is_empty() {
             break;
         }
-        let longest = missing.iter().map(|&i| ranges[i].1).max().unwrap_or(0);
-        let questions: Vec<Vec<u8>> = missing.iter().map(|&i| question(ranges[i])).collect();
-        let frames = client.batch(&questions, ANSWER_LEN, work(longest))?;
-        for (address, sum) in frames.iter().filter_map(|frame| parse(frame)) {
-            if let Some(&i) = missing.iter().find(|&&i| ranges[i].0 == address) {
-                found[i] = Some(sum);
+        // A long answer is more likely to lose a character to noise:
+        // what is asked again goes in questions a quarter as long each
+        // time, down to one piece a question.
+        let asked = questions(&pieces, &missing, MOST_PIECES >> (2 * attempt));
+        let longest = asked
+            .iter()
+            .map(|q| q.size * q.pieces.len())
+            .max()
+            .unwrap_or(0);
+        let most = asked.iter().map(|q| q.pieces.len()).max().unwrap_or(1);
+        let texts: Vec<Vec<u8>> = asked
+            .iter()
+            .map(|q| question_of(q.address, q.size, q.pieces.len()))
+            .collect();
+        let answer_len = ANSWER_LEN + 8 * (most - 1);
+        let frames = client.batch(&texts, answer_len, work(longest))?;
+        for (address, sums) in frames.iter().filter_map(|frame| parse(frame)) {
+            let question = asked
+                .iter()
+                .find(|q| q.address == address && q.pieces.len() == sums.len());
+            if let Some(question) = question {
+                for (&i, &sum) in question.pieces.iter().zip(&sums) {
+                    found[i] = Some(sum);
+                }
             }
         }
         if attempt + 1 == ATTEMPTS {
-            if let Some(&i) = missing.iter().find(|&&i| found[i].is_none()) {
+            if let Some(i) = (0..pieces.len()).find(|&i| found[i].is_none()) {
                 return Err(Error::Unreadable {
-                    address: ranges[i].0,
+                    address: pieces[i].0,
                     attempts: ATTEMPTS,
                     last: None,
                 });
             }
         }
     }
-    Ok(found.into_iter().map(|sum| sum.unwrap_or(0)).collect())
+    let mut sums: Vec<Option<u32>> = vec![None; ranges.len()];
+    for (i, sum) in found.into_iter().enumerate() {
+        let sum = sum.unwrap_or(0);
+        let r = owner[i];
+        sums[r] = Some(sums[r].map_or(sum, |before| joined(before, sum, pieces[i].1)));
+    }
+    Ok(sums.into_iter().map(|sum| sum.unwrap_or(0)).collect())
 }
 
 #[cfg(test)]
@@ -296,7 +389,7 @@ mod tests {
         let known: Vec<(Range, u32)> = vec![
             ((0x0400, 256), 1),
             ((0x0500, 256), 2),
-            ((0x0600, 300), 3), // longer than a sum sees whole: no witness
+            ((0x0600, 300), 3), // longer than a piece: no witness
         ];
         assert_eq!(
             tiled(&known, (0x0400, 512)),
@@ -312,7 +405,7 @@ mod tests {
         );
         assert_eq!(
             tiled(&known, (0x0600, 300)),
-            vec![((0x0600, EXACT), None), ((0x0701, 43), None)]
+            vec![((0x0600, EXACT), None), ((0x0700, 44), None)]
         );
     }
 
@@ -342,11 +435,64 @@ mod tests {
 
     #[test]
     fn answers_parse_and_garbage_does_not() {
-        assert_eq!(parse(b"K04000102A1B2\r"), Some((0x0400, 0x0102_A1B2)));
+        assert_eq!(parse(b"K04000102A1B2\r"), Some((0x0400, vec![0x0102_A1B2])));
+        assert_eq!(
+            parse(b"K04000102A1B2FFFF0000\r"),
+            Some((0x0400, vec![0x0102_A1B2, 0xFFFF_0000]))
+        );
         assert_eq!(parse(b"K0400A1B2\r"), None, "the narrow sums' answer");
         assert_eq!(parse(b"K04000102A1B\r"), None);
+        assert_eq!(parse(b"K04000102A1B2FFFF\r"), None, "half a piece");
         assert_eq!(parse(b"R04000102A1B2\r"), None);
         assert_eq!(parse(b"K04000102A1BZ\r"), None);
-        assert_eq!(question((0xF000, 0x1000)), b"/9KF0001000");
+        assert_eq!(question((0xF000, 256)), b"/9KF0000001");
+        assert_eq!(question((0x0400, 37)), b"/9K04002501");
+    }
+
+    #[test]
+    fn pieces_that_follow_each_other_go_in_one_question_and_join() {
+        let pieces: Vec<Range> = vec![
+            (0x0400, 256),
+            (0x0500, 256),
+            (0x0600, 256),
+            (0x0700, 37),
+            (0x0725, 37),
+            (0x0800, 37), // not after the one before
+            (0x0825, 36),
+        ];
+        let all: Vec<usize> = (0..pieces.len()).collect();
+        let asked = questions(&pieces, &all, MOST_PIECES);
+        let shape: Vec<(u16, usize, Vec<usize>)> = asked
+            .iter()
+            .map(|q| (q.address, q.size, q.pieces.clone()))
+            .collect();
+        assert_eq!(
+            shape,
+            vec![
+                (0x0400, 256, vec![0, 1, 2]),
+                (0x0700, 37, vec![3, 4]),
+                (0x0800, 37, vec![5]),
+                (0x0825, 36, vec![6]),
+            ]
+        );
+        assert_eq!(question_of(0x0400, 256, 3), b"/9K04000003");
+        // Missing ones only, still grouped where they follow each other.
+        let asked = questions(&pieces, &[0, 2], MOST_PIECES);
+        assert_eq!(asked.len(), 2);
+        // Asked again, in shorter questions.
+        assert_eq!(questions(&pieces, &all, 2)[0].pieces, vec![0, 1]);
+        assert_eq!(questions(&pieces, &all, 0).len(), pieces.len());
+        let bytes: Vec<u8> = (0..1000u32).map(|i| (i * 7 + i / 3) as u8).collect();
+        for cut in [0usize, 1, 256, 500, 999, 1000] {
+            assert_eq!(
+                joined(
+                    robot_sum(&bytes[..cut]),
+                    robot_sum(&bytes[cut..]),
+                    1000 - cut
+                ),
+                robot_sum(&bytes),
+                "cut at {cut}"
+            );
+        }
     }
 }
