@@ -385,6 +385,17 @@ impl Backup {
                             record[4], record[5], record[6], record[7],
                         ]))
                     };
+                    // Every witness written is at most `EXACT` bytes,
+                    // over which its sums see any change of one or two.
+                    if !narrow && usize::from(len) > crate::sums::EXACT {
+                        return Err(bad(
+                            start,
+                            &format!(
+                                "a witness of {len} bytes (at ${address:04X}): a version 2 file's are at most {}",
+                                crate::sums::EXACT
+                            ),
+                        ));
+                    }
                     let witness = Witness { address, len, sum };
                     // hostile19 F2: each is read from the robot before
                     // anything else is checked; one a table could not
@@ -2141,6 +2152,11 @@ mod tests {
         }
         body.extend_from_slice(&record(b'W', 0));
         let backup = Backup::decode("copies.bak", &with_end(body.clone())).expect("decodes");
+        // Longer than its sums see whole: no file writes one.
+        let mut long = MAGIC.to_vec();
+        long.extend_from_slice(&[b'W', 0x00, 0x08, 0x01, 0x01, 0, 0, 0, 0]);
+        let error = Backup::decode("long.bak", &with_end(long)).expect_err("refused");
+        assert!(error.to_string().contains("257 bytes"), "{error}");
         assert_eq!(
             (backup.written_entries.len(), backup.witnesses.len()),
             (1, 1)

@@ -230,6 +230,55 @@ pub(crate) fn work(longest: usize) -> Duration {
     Duration::from_micros(longest as u64 * CYCLES_PER_BYTE + 2_000)
 }
 
+/// `asked` in batches in which no two questions start at one address:
+/// answers are matched by their address (ranges of two lengths there go
+/// in separate batches).
+fn batches(asked: Vec<Asked>) -> Vec<Vec<Asked>> {
+    let mut out: Vec<Vec<Asked>> = Vec::new();
+    for question in asked {
+        match out
+            .iter_mut()
+            .find(|batch| batch.iter().all(|q| q.address != question.address))
+        {
+            Some(batch) => batch.push(question),
+            None => out.push(vec![question]),
+        }
+    }
+    out
+}
+
+/// Asks `asked` (distinct first addresses) in one batch; each answer's
+/// sums go to its question's pieces in `found`.
+fn ask_batch<T: Transport>(
+    client: &mut Client<T>,
+    asked: &[Asked],
+    found: &mut [Option<u32>],
+) -> Result<()> {
+    let longest = asked
+        .iter()
+        .map(|q| q.size * q.pieces.len())
+        .max()
+        .unwrap_or(0);
+    let most = asked.iter().map(|q| q.pieces.len()).max().unwrap_or(1);
+    let texts: Vec<Vec<u8>> = asked
+        .iter()
+        .map(|q| question_of(q.address, q.size, q.pieces.len()))
+        .collect();
+    let answer_len = ANSWER_LEN + 8 * (most - 1);
+    let frames = client.batch(&texts, answer_len, work(longest))?;
+    for (address, sums) in frames.iter().filter_map(|frame| parse(frame)) {
+        let question = asked
+            .iter()
+            .find(|q| q.address == address && q.pieces.len() == sums.len());
+        if let Some(question) = question {
+            for (&i, &sum) in question.pieces.iter().zip(&sums) {
+                found[i] = Some(sum);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The robot's checksums of `ranges`, asked of the loader's `sums`,
 /// which must be hooked: a range longer than [`EXACT`] in pieces, its sum
 /// put together from theirs ([`joined`]). Lost answers are asked again.
@@ -260,27 +309,8 @@ pub(crate) fn robot_sums<T: Transport>(
         // what is asked again goes in questions a quarter as long each
         // time, down to one piece a question.
         let asked = questions(&pieces, &missing, MOST_PIECES >> (2 * attempt));
-        let longest = asked
-            .iter()
-            .map(|q| q.size * q.pieces.len())
-            .max()
-            .unwrap_or(0);
-        let most = asked.iter().map(|q| q.pieces.len()).max().unwrap_or(1);
-        let texts: Vec<Vec<u8>> = asked
-            .iter()
-            .map(|q| question_of(q.address, q.size, q.pieces.len()))
-            .collect();
-        let answer_len = ANSWER_LEN + 8 * (most - 1);
-        let frames = client.batch(&texts, answer_len, work(longest))?;
-        for (address, sums) in frames.iter().filter_map(|frame| parse(frame)) {
-            let question = asked
-                .iter()
-                .find(|q| q.address == address && q.pieces.len() == sums.len());
-            if let Some(question) = question {
-                for (&i, &sum) in question.pieces.iter().zip(&sums) {
-                    found[i] = Some(sum);
-                }
-            }
+        for batch in batches(asked) {
+            ask_batch(client, &batch, &mut found)?;
         }
         if attempt + 1 == ATTEMPTS {
             if let Some(i) = (0..pieces.len()).find(|&i| found[i].is_none()) {
@@ -482,6 +512,17 @@ mod tests {
         // Asked again, in shorter questions.
         assert_eq!(questions(&pieces, &all, 2)[0].pieces, vec![0, 1]);
         assert_eq!(questions(&pieces, &all, 0).len(), pieces.len());
+        // Two ranges from one address: never in one batch.
+        let twice: Vec<Range> = vec![(0x0400, 37), (0x0400, 36), (0x0500, 10)];
+        let split = batches(questions(&twice, &[0, 1, 2], MOST_PIECES));
+        let shape: Vec<Vec<(u16, usize)>> = split
+            .iter()
+            .map(|batch| batch.iter().map(|q| (q.address, q.size)).collect())
+            .collect();
+        assert_eq!(
+            shape,
+            vec![vec![(0x0400, 37), (0x0500, 10)], vec![(0x0400, 36)]]
+        );
         let bytes: Vec<u8> = (0..1000u32).map(|i| (i * 7 + i / 3) as u8).collect();
         for cut in [0usize, 1, 256, 500, 999, 1000] {
             assert_eq!(
