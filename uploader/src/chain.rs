@@ -215,6 +215,9 @@ pub(crate) struct Noted {
     /// past every listed extension (not a loop, code that stops the CPU,
     /// a return nothing called, or memory no code may be in).
     pub(crate) fine: bool,
+    /// The lowest address of a listed extension's code the way runs, if
+    /// it runs any: where it goes into one (for messages).
+    pub(crate) entered: Option<u16>,
 }
 
 /// `len` bytes from `at`: the `laid` ones, the robot's elsewhere.
@@ -308,6 +311,7 @@ pub(crate) fn way_code<T: Transport>(
         (&mut noted.code, &mut noted.data, &mut noted.computed),
     );
     reach::reach(&mut bus, &starts, &listed)?;
+    noted.entered = noted.code.iter().copied().find(|&at| listed(at));
     let data = &noted.data;
     noted.code.retain(|&at| !listed(at) && !data.contains(&at));
     Ok(noted)

@@ -33,6 +33,8 @@ pub(crate) struct WayCode {
     pub(crate) fine: bool,
     /// Where it jumps where its data says, if it does.
     pub(crate) computed: Option<u16>,
+    /// Where it goes into a listed extension's code, if it does.
+    pub(crate) entered: Option<u16>,
 }
 
 /// The bytes `backup` holds, as a restore would write them (the first
@@ -70,6 +72,7 @@ pub(crate) fn code_of<T: Transport>(
             code: noted.code,
             fine: noted.fine,
             computed: noted.computed,
+            entered: noted.entered,
         });
     }
     Ok(ways)
@@ -207,15 +210,25 @@ pub(crate) fn owner_in_front(everyone: &[Installed], ways: &[WayCode]) -> Option
             return None;
         }
         let hook = way.hook.rom_symbol();
+        // hostile30 F8: a way that runs an extension's code from its
+        // middle says so, not that it never reaches the extension.
+        let inside = way.entered.and_then(|at| {
+            let entry = everyone.iter().find(|entry| entry.contains(at))?;
+            let handler = entry.hooks.iter().find(|h| h.kind == way.hook)?.handler;
+            Some(format!(
+                "goes into extension {:06X} at ${at:04X}, not at its {hook} handler ${handler:04X}",
+                entry.id
+            ))
+        });
+        let how = match inside {
+            Some(inside) if way.fine => inside,
+            _ if way.fine => "does not go on into them".to_owned(),
+            _ => "does not end where a command's way may (a loop, code that stops the CPU, or memory no code may be in)".to_owned(),
+        };
         Some(Error::BackupRefused {
             reason: format!(
-                "the file points {hook} at ${target:04X}, code no extension its table lists, while its table lists extensions on {hook}, and that code's way ({}) {}; nothing was written",
+                "the file points {hook} at ${target:04X}, code no extension its table lists, while its table lists extensions on {hook}, and that code's way ({}) {how}; nothing was written",
                 crate::held_way::path_text(&way.way),
-                if way.fine {
-                    "does not go on into them"
-                } else {
-                    "does not end where a command's way may (a loop, code that stops the CPU, or memory no code may be in)"
-                }
             ),
         })
     })

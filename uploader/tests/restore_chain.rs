@@ -1781,6 +1781,22 @@ fn an_owners_handler_in_front_of_an_extension_is_restored_as_it_was() {
         other => panic!("{other:?}"),
     }
     assert!(held(&mut client) == before, "nothing written");
+    // hostile30 F8: into the extension elsewhere than its handler (its
+    // chain slot's `JMP` at $0500, which goes on to the ROM): refused, the
+    // way into it named.
+    let mut middle = file.clone();
+    set(&mut middle, 0x0902, 0x00);
+    set(&mut middle, 0x0903, 0x05);
+    match restore(&mut client, &middle, &options, &mut NoProgress) {
+        Err(Error::BackupRefused { reason }) => {
+            assert!(
+                reason.contains("at $0500, not at its HOOK_UNKNOWN handler $0503"),
+                "{reason}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(held(&mut client) == before, "nothing written");
 }
 
 /// fresh29 F1: an owner's HOOK_LOOP handler at $0600 (`INC $0700`, `JMP`
