@@ -445,3 +445,35 @@ fn a_step_out_of_a_subroutine_called_at_a_breakpoint_stops_after_the_call() {
     debug.remove_breakpoint(0x0407).expect("removed");
     assert_eq!(debug.compare_with_image().expect("read"), None);
 }
+
+/// fresh30 F5: steps from the handler into the ROM (`/1Z` is not the
+/// handler's: `BNE` to the chain slot, `JMP BAD_COMMAND`, ...) run on the
+/// host until one must run on the robot with its next instruction in the
+/// ROM. That refusal said "it goes outside the uploaded code", which the
+/// steps before it had done too; it now says what tells it apart.
+#[test]
+fn a_step_the_robot_must_run_in_the_rom_says_why_the_ones_before_went() {
+    let image = handler();
+    let mut debug = attach(&image);
+    debug.set_breakpoint(0x0403, &[]).expect("set");
+    assert!(matches!(
+        debug.command(b"/1Z", WAIT).expect("sent"),
+        Reply::Stopped(_)
+    ));
+    let mut went = Vec::new();
+    let reason = loop {
+        match debug.step(&[], false, WAIT) {
+            Ok(Reply::Stopped(at)) => went.push(at.pc),
+            Err(StubError::Refused { reason, .. }) => break reason,
+            other => panic!("after {went:04X?}: {other:?}"),
+        }
+        assert!(went.len() < 50, "no refusal: {went:04X?}");
+    };
+    assert!(
+        went.iter().any(|&pc| pc >= 0xF000),
+        "steps into the ROM first: {went:04X?}"
+    );
+    assert!(reason.contains("must run on the robot"), "{reason}");
+    assert!(reason.contains("continue"), "{reason}");
+    debug.resume().expect("continue");
+}

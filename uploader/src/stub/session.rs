@@ -1728,7 +1728,7 @@ impl<T: Transport> RobotDebug<T> {
                 return Err(StubError::Refused {
                     what: format!("a step from ${pc:04X}"),
                     reason: format!(
-                        "it goes to ${to:04X}, outside the uploaded code (the ROM cannot be patched): set a breakpoint where it comes back and continue"
+                        "the instruction there must run on the robot (it pushes, or touches I/O or the stub's bytes), and the next one, ${to:04X}, lies outside the uploaded code, where no breakpoint can stop it (the ROM cannot be patched; steps the host can run itself go through there): continue, with a breakpoint in the uploaded code where the robot comes back to it, if it does"
                     ),
                 });
             }
