@@ -634,3 +634,42 @@ fn expectations_on_a_port_say_what_the_rehearsal_lacked() {
         "{text}"
     );
 }
+
+/// hostile31 F3: a version 1 file (an earlier scorpion's) checks the code
+/// it only witnesses with both sums mod 256, which some changes of two
+/// bytes pass; `restore` and `upload --undo` say so whenever they use one.
+#[test]
+fn a_version_1_file_is_read_with_a_warning_about_its_checks() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    // HOOK_UNKNOWN at the ROM's target; a witness of $1000-$100F.
+    let mut body = b"SCORPION-BACKUP 1\n".to_vec();
+    body.extend_from_slice(&[b'H', 0, 0x21, 0xFF]);
+    body.extend_from_slice(&[b'W', 0x00, 0x10, 0x10, 0x00, 0x00, 0x00]);
+    // The end record: FNV-1a 32 of every byte before it.
+    let sum = body.iter().fold(0x811C_9DC5_u32, |hash, &byte| {
+        (hash ^ u32::from(byte)).wrapping_mul(0x0100_0193)
+    });
+    body.push(b'E');
+    body.extend_from_slice(&sum.to_le_bytes());
+    std::fs::write(dir.path().join("old.bak"), &body).expect("the file");
+    std::fs::write(dir.path().join("old.undo"), &body).expect("the file");
+    for args in [
+        vec!["restore", "old.bak", "--port", "emu"],
+        vec![
+            "upload",
+            "--undo",
+            "--undo-file",
+            "old.undo",
+            "--port",
+            "emu",
+        ],
+    ] {
+        let output = scorpion(dir.path(), &args);
+        let text = transcript(&output);
+        assert!(
+            text.contains("old.") && text.contains("was written by an earlier scorpion"),
+            "{args:?}: {text}"
+        );
+        assert!(text.contains("take a new backup"), "{args:?}: {text}");
+    }
+}

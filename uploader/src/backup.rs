@@ -213,6 +213,16 @@ fn kind_code(kind: HookKind) -> u8 {
 }
 
 impl Backup {
+    /// Whether any of the file's checks is a version 1 file's narrow
+    /// Fletcher-16 ([`Checksum::Narrow`]), which some changes of two
+    /// bytes pass.
+    #[must_use]
+    pub fn narrow_checks(&self) -> bool {
+        (self.witnesses.iter())
+            .chain(&self.written_entries)
+            .any(|witness| matches!(witness.sum, Checksum::Narrow(_)))
+    }
+
     /// The file's bytes.
     #[must_use]
     pub fn encode(&self) -> Vec<u8> {
@@ -2092,6 +2102,11 @@ mod tests {
         body.extend_from_slice(&[b'W', 0x00, 0x08, 0x10, 0, 0x34, 0x12]);
         body.extend_from_slice(&[b'T', 0x90, 0x0F, entry, 0, 0x78, 0x56]);
         let backup = Backup::decode("old.bak", &with_end(body.clone())).expect("decodes");
+        assert!(backup.narrow_checks());
+        let mut wide = sample();
+        wide.witnesses
+            .retain(|w| matches!(w.sum, Checksum::Wide(_)));
+        assert!(!wide.narrow_checks());
         assert_eq!(backup.witnesses[0].sum, Checksum::Narrow(0x1234));
         assert_eq!(backup.written_entries[0].sum, Checksum::Narrow(0x5678));
         let again = backup.encode();
