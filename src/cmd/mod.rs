@@ -21,6 +21,7 @@ pub(crate) mod rom;
 pub(crate) mod sim;
 pub(crate) mod test;
 pub(crate) mod upload;
+pub(crate) mod uploaded;
 pub(crate) mod view;
 
 /// A flag that any of `signals` sets, instead of ending the process: the

@@ -682,14 +682,20 @@ fn upload_all(
 ) -> miette::Result<ExitCode> {
     let expectations = args.expect.as_deref().map(read_expectations).transpose()?;
     let rom = crate::cmd::config::rom(resolved)?;
+    let emulated = resolved.is_emulated();
     let options = UploadOptions {
         profile: crate::cmd::config::profile(rom.as_ref())?,
+        // hostile31 F1: the earlier versions this project uploaded.
+        previous: if emulated {
+            Vec::new()
+        } else {
+            crate::cmd::uploaded::read(&undo.path)
+        },
         ..args.options()
     };
     for loaded in images {
         options.profile.check(&loaded.image)?;
     }
-    let emulated = resolved.is_emulated();
     // fresh10 F11: the pair uploaded with a zero exit and nothing checked.
     if args.no_dry_run && expectations.is_some() && !emulated {
         return Err(miette::miette!(
@@ -927,6 +933,7 @@ fn upload_file(
     if !emulated {
         // Finished: the next upload may replace the undo file.
         undo.finished_upload();
+        crate::cmd::uploaded::record(&undo.path, image);
     }
     let undo_failed = undo.failed.take();
     if let Some(error) = &undo_failed {

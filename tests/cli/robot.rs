@@ -71,11 +71,17 @@ fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
 /// [`extension_elf`] at `base` instead of $0400.
 pub(crate) fn extension_at(base: u16, len: usize, changed: Option<usize>) -> Vec<u8> {
     let mut bytes: Vec<u8> = (0..len).map(|i| (i * 37 + 11) as u8).collect();
-    let [low, high] = base.to_le_bytes();
-    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, low, high]);
     if let Some(at) = changed {
         bytes[at] ^= 0x5A;
     }
+    extension_of(base, bytes)
+}
+
+/// `bytes` at `base` as [`extension_at`] lays them out: its first six
+/// bytes become the chain slot's `JMP` and the handler's.
+pub(crate) fn extension_of(base: u16, mut bytes: Vec<u8>) -> Vec<u8> {
+    let [low, high] = base.to_le_bytes();
+    bytes[..6].copy_from_slice(&[0x4C, 0x00, 0x00, 0x4C, low, high]);
     let image = Image {
         entry: u32::from(base) + 3,
         flags: 0,
@@ -672,4 +678,41 @@ fn a_version_1_file_is_read_with_a_warning_about_its_checks() {
         );
         assert!(text.contains("take a new backup"), "{args:?}: {text}");
     }
+}
+
+/// hostile31 F1: an edit that only moves bytes about (two instructions
+/// whose bytes add up alike swapped) balances the robot's sums, and the
+/// `--replace` upload of it left the old bytes, "verified". `upload`
+/// keeps each image it put in beside its undo file, and the next upload
+/// writes where the earlier version differs, whatever the sums say.
+#[test]
+fn an_edit_that_balances_the_sums_is_written_by_the_next_upload() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let mut bytes: Vec<u8> = (0..600).map(|i| (i * 37 + 11) as u8).collect();
+    bytes[300..304].copy_from_slice(&[0xA9, 0x10, 0x69, 0x50]);
+    std::fs::write(
+        dir.path().join("v1.elf"),
+        extension_of(0x0400, bytes.clone()),
+    )
+    .expect("v1");
+    bytes[300..304].copy_from_slice(&[0x69, 0x50, 0xA9, 0x10]);
+    std::fs::write(dir.path().join("v2.elf"), extension_of(0x0400, bytes)).expect("v2");
+    let sim = Sim::start(dir.path(), &["--baud", "19200"]);
+    let line = ["--port", sim.path.as_str(), "--baud", "19200"];
+    let run = |args: &[&str]| {
+        let mut all = args.to_vec();
+        all.extend(line);
+        let output = scorpion(dir.path(), &all);
+        let text = transcript(&output);
+        assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
+        text
+    };
+    run(&["upload", "v1.elf", "--no-dry-run"]);
+    assert!(
+        dir.path().join("scorpion-last-upload.undo.images").is_dir(),
+        "the image kept beside the undo file"
+    );
+    run(&["upload", "v2.elf", "--no-dry-run", "--replace"]);
+    let text = run(&["ask", "/7R052C04"]);
+    assert!(text.contains("R6950A910"), "v2's bytes at $052C: {text}");
 }

@@ -219,6 +219,64 @@ pub(crate) fn push(out: &mut Vec<Area>, address: u16, bytes: &[u8]) {
     });
 }
 
+/// hostile31 F1: `held` (the ranges to write) and every range the sums
+/// took for held in which `previous` (the earlier version the robot's
+/// table listed in the image's place, as it was uploaded) differs from
+/// the image: an edit that only moves bytes about (instructions swapped,
+/// constants rotated, a table shifted) can balance the robot's sums. The
+/// smallest range asked (`known`) that holds each such byte is written,
+/// with the robot's sum of it. Only adds ranges: a wrong `previous` costs
+/// writes, never a byte left unwritten.
+pub(crate) fn with_known_changes(
+    mut held: Vec<Held>,
+    known: &Known,
+    image: &UploadImage,
+    previous: &[Area],
+) -> Vec<Held> {
+    if previous.is_empty() {
+        return held;
+    }
+    let within = |at: u32, start: u16, len: usize| {
+        u32::from(start) <= at && at < u32::from(start) + len as u32
+    };
+    for area in image.areas() {
+        for (i, &byte) in area.bytes.iter().enumerate() {
+            let at = u32::from(area.address) + i as u32;
+            let before = previous.iter().find_map(|earlier| {
+                let offset = at.checked_sub(u32::from(earlier.address))?;
+                earlier.bytes.get(offset as usize).copied()
+            });
+            if before.is_none_or(|before| before == byte)
+                || held
+                    .iter()
+                    .any(|(range, _)| within(at, range.address, range.bytes.len()))
+            {
+                continue;
+            }
+            let range = known
+                .iter()
+                .filter(|((start, len), _)| within(at, *start, *len))
+                .filter(|((start, len), _)| {
+                    u32::from(*start) >= u32::from(area.address)
+                        && u32::from(*start) + *len as u32 <= area.end()
+                })
+                .min_by_key(|((_, len), _)| *len);
+            if let Some(&((start, len), sum)) = range {
+                let from = usize::from(start - area.address);
+                held.push((
+                    Area {
+                        address: start,
+                        bytes: area.bytes[from..from + len].to_vec(),
+                    },
+                    sum,
+                ));
+            }
+        }
+    }
+    held.sort_by_key(|(range, _)| range.address);
+    held
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,7 +18,9 @@
 //! change together unseen where they balance both sums: `+1, -2, +1` in a
 //! row, and edits that only move bytes about (hostile31 F1: two
 //! instructions whose bytes add up alike swapped, constants rotated, a
-//! table shifted by an entry). `--full` reads back every byte. A third
+//! table shifted by an entry). Where the caller knows the earlier version
+//! (`UploadOptions::previous`), the ranges where it differs are written
+//! anyway; `--full` writes every byte. A third
 //! sum (of the running second sums) would see those; measured on the
 //! bench it costs the one-byte change about 0.12 s of robot time (19
 //! cycles a byte more, four digits a piece), which the one-second goal

@@ -94,6 +94,13 @@ pub struct UploadOptions {
     /// before or while it wrote them), only used to tell its extension
     /// from others (hostile20 F4: its own undo was refused for good).
     pub interrupted: bool,
+    /// Images uploaded before, as linked (a caller's record of them):
+    /// where the robot's table lists one of them in the image's place
+    /// (an earlier version `--replace` takes out), every range in which
+    /// it differs from the image is written, whatever the robot's sums
+    /// say (hostile31 F1: an edit that only moves bytes about balances
+    /// the sums). It can only add writes.
+    pub previous: Vec<UploadImage>,
 }
 
 impl Default for UploadOptions {
@@ -111,6 +118,7 @@ impl Default for UploadOptions {
             resume: false,
             undo: false,
             interrupted: false,
+            previous: Vec::new(),
         }
     }
 }
@@ -637,6 +645,17 @@ pub fn upload_keeping<T: Transport>(
     // What was kept, once kept.
     let mut kept_file: Option<Backup> = None;
 
+    // The bytes of the earlier version the table lists where the image
+    // goes, as uploaded (hostile31 F1).
+    let previous: Vec<Area> = options
+        .previous
+        .iter()
+        .filter(|earlier| {
+            plan.as_ref()
+                .is_some_and(|plan| plan.replaced.iter().any(|gone| gone.id == earlier.id()))
+        })
+        .flat_map(|earlier| earlier.areas().to_vec())
+        .collect();
     let with_sums = wants_sums(&image, keep.wanted())
         || (options.delta && plan.as_ref().is_some_and(|plan| plan.held_maybe));
     let (loader, without_loader) = choose_loader(
@@ -755,6 +774,7 @@ pub fn upload_keeping<T: Transport>(
                     first: found,
                     known,
                 } = summed;
+                let todo = delta::with_known_changes(todo, &known, &image, &previous);
                 let (whole, rest) = found.split_at(rom.len().min(found.len()));
                 fingerprint::check_whole(client, profile, &rom, whole)?;
                 let mut found = rest.iter().copied();

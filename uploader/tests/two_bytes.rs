@@ -218,3 +218,42 @@ fn a_restore_puts_back_two_bytes_the_narrow_sums_took_for_held() {
         );
     }
 }
+
+/// hostile31 F1: an edit that only moves bytes about (two instructions
+/// whose bytes add up alike swapped) balances both of the robot's sums:
+/// the `--replace` upload of it took the old bytes for held. Given the
+/// earlier version as it was uploaded (`UploadOptions::previous`, which
+/// `scorpion upload` keeps beside its undo file), the ranges where the
+/// two differ are written whatever the sums say.
+#[test]
+fn an_edit_that_balances_the_sums_is_written_where_the_earlier_version_is_known() {
+    let v1 = common::extension_big();
+    let mut areas = v1.areas().to_vec();
+    areas[0].bytes[300..304].copy_from_slice(&[0xA9, 0x10, 0x69, 0x50]);
+    let v1 = UploadImage::new(areas.clone(), v1.hooks().to_vec()).expect("v1");
+    areas[0].bytes[300..304].copy_from_slice(&[0x69, 0x50, 0xA9, 0x10]);
+    let v2 = UploadImage::new(areas, v1.hooks().to_vec()).expect("v2");
+    assert_eq!(
+        uploader::robot_sum(&v1.areas()[0].bytes),
+        uploader::robot_sum(&v2.areas()[0].bytes),
+        "the sums balance"
+    );
+    let at = 0x0400 + 300;
+    for (previous, written) in [(vec![], false), (vec![v1.clone()], true)] {
+        let options = UploadOptions::default();
+        let mut client = uploader::client(robot(), &options.profile);
+        upload(&mut client, &v1, &options, &mut NoProgress).expect("v1 installed");
+        let replace = UploadOptions {
+            replace: true,
+            previous,
+            ..UploadOptions::default()
+        };
+        upload(&mut client, &v2, &replace, &mut NoProgress).expect("v2 uploaded");
+        let wanted = &v2.areas()[0].bytes[300..304];
+        assert_eq!(
+            held(&mut client, at..at + 4) == wanted,
+            written,
+            "the earlier version given: {written}"
+        );
+    }
+}
