@@ -239,9 +239,15 @@ pub(crate) fn with_known_changes(
     let within = |at: u32, start: u16, len: usize| {
         u32::from(start) <= at && at < u32::from(start) + len as u32
     };
+    // The upload fills its chain slots with where each hook went before:
+    // not the image's bytes as linked, nor the earlier version's.
+    let slots = image.chain_slot_bytes();
     for area in image.areas() {
         for (i, &byte) in area.bytes.iter().enumerate() {
             let at = u32::from(area.address) + i as u32;
+            if slots.contains(&(at as u16)) {
+                continue;
+            }
             let before = previous.iter().find_map(|earlier| {
                 let offset = at.checked_sub(u32::from(earlier.address))?;
                 earlier.bytes.get(offset as usize).copied()

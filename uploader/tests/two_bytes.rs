@@ -248,7 +248,18 @@ fn an_edit_that_balances_the_sums_is_written_where_the_earlier_version_is_known(
             previous,
             ..UploadOptions::default()
         };
-        upload(&mut client, &v2, &replace, &mut NoProgress).expect("v2 uploaded");
+        let report = upload(&mut client, &v2, &replace, &mut NoProgress).expect("v2 uploaded");
+        // The range the edit lies in (whole: the sums took it for held)
+        // and the table entry, not the chain slot's range (the upload
+        // fills the slot; the earlier version had it as linked).
+        assert!(
+            !report
+                .written
+                .iter()
+                .any(|&(start, len)| start <= 0x0401 && 0x0401 < usize::from(start) + len),
+            "{:?}",
+            report.written
+        );
         let wanted = &v2.areas()[0].bytes[300..304];
         assert_eq!(
             held(&mut client, at..at + 4) == wanted,
