@@ -6,6 +6,7 @@
 //! one range, and the upload undone.
 
 use std::io::{BufRead, BufReader};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
 use isa::objfmt::{HookKind, HookRecord, Hooks};
@@ -66,6 +67,16 @@ pub(crate) fn patrol_on_a_pty_robot(dir: &std::path::Path) -> (std::path::PathBu
 /// through, filler), with the byte at `changed` (if any) altered.
 fn extension_elf(len: usize, changed: Option<usize>) -> Vec<u8> {
     extension_at(0x0400, len, changed)
+}
+
+/// `scorpion ARGS LINE` in `dir`, which must exit 0: what it printed.
+fn run_ok(dir: &Path, line: &[&str], args: &[&str]) -> String {
+    let mut all = args.to_vec();
+    all.extend(line);
+    let output = scorpion(dir, &all);
+    let text = transcript(&output);
+    assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
+    text
 }
 
 /// [`extension_elf`] at `base` instead of $0400.
@@ -193,14 +204,7 @@ fn backup_a_hostile_change_restore_and_the_ram_compares() {
     std::fs::write(dir.path().join("ext.elf"), extension_elf(600, None)).expect("the image");
     let sim = Sim::start(dir.path(), &["--baud", "19200"]);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
-    let run = |args: &[&str]| {
-        let mut all = args.to_vec();
-        all.extend(line);
-        let output = scorpion(dir.path(), &all);
-        let text = transcript(&output);
-        assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
-        text
-    };
+    let run = |args: &[&str]| run_ok(dir.path(), &line, args);
     run(&["upload", "ext.elf", "--no-dry-run"]);
     run(&["backup", "-o", "before.bak"]);
     // Hostile: code and zero page overwritten, the hook pointed at them.
@@ -232,14 +236,7 @@ fn a_one_byte_change_goes_as_one_range_and_undo_puts_it_back() {
         .expect("the image");
     let sim = Sim::start(dir.path(), &["--baud", "19200"]);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
-    let run = |args: &[&str]| {
-        let mut all = args.to_vec();
-        all.extend(line);
-        let output = scorpion(dir.path(), &all);
-        let text = transcript(&output);
-        assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
-        text
-    };
+    let run = |args: &[&str]| run_ok(dir.path(), &line, args);
     run(&["upload", "ext.elf", "--no-dry-run"]);
     run(&["read", "$0400", "2048", "-o", "first.bin"]);
     let text = run(&["upload", "ext2.elf", "--no-dry-run", "--replace"]);
@@ -699,14 +696,7 @@ fn an_edit_that_balances_the_sums_is_written_by_the_next_upload() {
     std::fs::write(dir.path().join("v2.elf"), extension_of(0x0400, bytes)).expect("v2");
     let sim = Sim::start(dir.path(), &["--baud", "19200"]);
     let line = ["--port", sim.path.as_str(), "--baud", "19200"];
-    let run = |args: &[&str]| {
-        let mut all = args.to_vec();
-        all.extend(line);
-        let output = scorpion(dir.path(), &all);
-        let text = transcript(&output);
-        assert_eq!(output.status.code(), Some(0), "{args:?}: {text}");
-        text
-    };
+    let run = |args: &[&str]| run_ok(dir.path(), &line, args);
     run(&["upload", "v1.elf", "--no-dry-run"]);
     assert!(
         dir.path().join("scorpion-last-upload.undo.images").is_dir(),

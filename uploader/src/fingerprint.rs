@@ -17,12 +17,12 @@ use romlib::protocol::{Answer, Command, ReadSpan};
 use crate::client::{Client, spans};
 use crate::image::RomProfile;
 use crate::sums::robot_sum;
+use crate::transport::Transport;
+use crate::{Error, Result};
 
 /// A range of the ROM whose sums on the robot differ from the profile's:
 /// the range, the profile's sum, the robot's.
 pub type RomSum = ((u16, usize), u32, u32);
-use crate::transport::Transport;
-use crate::{Error, Result};
 
 /// The services of the ROM's jump table (docs/PROTOCOL.md section 4), at
 /// fixed addresses: an image calls them by address.

@@ -774,7 +774,6 @@ pub fn upload_keeping<T: Transport>(
                     first: found,
                     known,
                 } = summed;
-                let todo = delta::with_known_changes(todo, &known, &image, &previous);
                 let (whole, rest) = found.split_at(rom.len().min(found.len()));
                 fingerprint::check_whole(client, profile, &rom, whole)?;
                 let mut found = rest.iter().copied();
@@ -786,6 +785,7 @@ pub fn upload_keeping<T: Transport>(
                         fingerprint::check_jump_table(client, &profile)?;
                     }
                 }
+                let todo = delta::with_known_changes(todo, &known, &image, &previous);
                 kept_file = keep_summed(
                     client,
                     profile,
